@@ -1,0 +1,15 @@
+#pragma once
+// Each subcommand lives in its own cmd_<name>.cpp and registers itself here; main.cpp only
+// lists them. A subcommand's callback returns the process exit code through `exit_code`.
+#include <CLI/CLI.hpp>
+
+namespace lucent::app {
+
+// Exit codes shared by every subcommand.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;  // the work itself failed (GL, I/O, ...)
+inline constexpr int kExitUsage = 2;    // bad command line, config or input data
+
+void register_info(CLI::App& app, int& exit_code);
+
+}  // namespace lucent::app

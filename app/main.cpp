@@ -1,0 +1,49 @@
+// The lucent executable: parses the command line and hands over to one subcommand.
+#include <exception>
+#include <iostream>
+
+#include "commands.h"
+#include "lucent/version.h"
+
+int main(int argc, char** argv) {
+    using namespace lucent::app;
+    CLI::App app{"Lucent: stimuli, participant sessions and analysis for perceptual studies "
+                 "of translucent-looking objects",
+                 "lucent"};
+    app.set_version_flag("--version", std::string("lucent ") + lucent::version_string() +
+                                          " (" + lucent::build_hash() + ")");
+    app.require_subcommand(1);
+    app.fallthrough(false);
+
+    int exit_code = kExitOk;
+    register_info(app, exit_code);
+
+    // CLI11 would only say "A subcommand is required"; name the word it did not know.
+    if (argc > 1 && argv[1][0] != '-' && [&] { try { app.get_subcommand(argv[1]); return false; } catch (const CLI::OptionNotFound&) { return true; } }()) {
+        std::string valid;
+        for (const auto* sub : app.get_subcommands({}))
+            valid += (valid.empty() ? "" : ", ") + sub->get_name();
+        std::cerr << "lucent: unknown subcommand '" << argv[1] << "' (valid: " << valid
+                  << ")\n";
+        return kExitUsage;
+    }
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        // One line, then the usual hint; usage errors always exit 2.
+        std::cerr << "lucent: " << e.what() << "\n"
+                  << "Run 'lucent --help' (or 'lucent SUBCOMMAND --help') for usage.\n";
+        return kExitUsage;
+    } catch (const std::exception& e) {
+        std::cerr << "lucent: " << e.what() << "\n";
+        return kExitFailure;
+    }
+    return exit_code;
+}

@@ -1,0 +1,93 @@
+#include "gl/program.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+namespace lucent::embedded {
+std::optional<std::string_view> renderer_file(std::string_view relative_path);
+}
+
+namespace lucent::gl {
+namespace {
+
+std::string info_log(GLuint object, bool is_program) {
+    GLint length = 0;
+    if (is_program)
+        glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length);
+    else
+        glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<size_t>(length > 0 ? length : 1), '\0');
+    if (is_program)
+        glGetProgramInfoLog(object, length, nullptr, log.data());
+    else
+        glGetShaderInfoLog(object, length, nullptr, log.data());
+    while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
+    return log;
+}
+
+}  // namespace
+
+Program link_program(const std::vector<ShaderStage>& stages) {
+    Program program(glCreateProgram());
+    std::vector<GLuint> shaders;
+    std::string names;
+    for (const auto& stage : stages) {
+        GLuint shader = glCreateShader(stage.type);
+        const char* text = stage.source.c_str();
+        glShaderSource(shader, 1, &text, nullptr);
+        glCompileShader(shader);
+        GLint ok = GL_FALSE;
+        glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+        if (!ok) {
+            const std::string log = info_log(shader, false);
+            glDeleteShader(shader);
+            for (GLuint s : shaders) glDeleteShader(s);
+            throw ShaderError(stage.name + ": " + log);
+        }
+        glAttachShader(program.id(), shader);
+        shaders.push_back(shader);
+        names += (names.empty() ? "" : " + ") + stage.name;
+    }
+    glLinkProgram(program.id());
+    for (GLuint s : shaders) {
+        glDetachShader(program.id(), s);
+        glDeleteShader(s);
+    }
+    GLint ok = GL_FALSE;
+    glGetProgramiv(program.id(), GL_LINK_STATUS, &ok);
+    if (!ok) throw ShaderError(names + ": link failed: " + info_log(program.id(), true));
+    return program;
+}
+
+std::string shader_source(std::string_view relative_path) {
+    if (const char* dir = std::getenv("LUCENT_SHADER_DIR"); dir && *dir) {
+        std::ifstream file(std::filesystem::path(dir) / relative_path);
+        if (file) {
+            std::ostringstream text;
+            text << file.rdbuf();
+            return text.str();
+        }
+    }
+    if (auto text = lucent::embedded::renderer_file(relative_path)) return std::string(*text);
+    throw ShaderError("unknown shader '" + std::string(relative_path) + "'");
+}
+
+ShaderStage shader_stage(GLenum type, std::string_view relative_path,
+                         const std::vector<std::string>& defines) {
+    std::string source = shader_source(relative_path);
+    if (!defines.empty()) {
+        std::string block;
+        for (const auto& define : defines) block += "#define " + define + "\n";
+        // Insert after the #version line (which must stay first) and reset line numbers
+        // so compiler errors still point at the file's own lines.
+        const size_t eol = source.find('\n');
+        const size_t at = eol == std::string::npos ? source.size() : eol + 1;
+        source.insert(at, block + "#line 2\n");
+    }
+    return ShaderStage{type, std::string(relative_path), std::move(source)};
+}
+
+}  // namespace lucent::gl
