@@ -1,0 +1,28 @@
+#pragma once
+// The camera of the thesis: it looks at the bounding-sphere centre from a distance equal
+// to the bounding-sphere diameter, with near/far planes hugging the sphere.
+#include <glm/glm.hpp>
+
+#include "core/mesh.h"
+
+namespace lucent {
+
+struct Camera {
+    glm::vec3 eye{0.0f, 0.0f, 1.0f};
+    glm::vec3 target{0.0f};
+    glm::vec3 up{0.0f, 1.0f, 0.0f};
+    float fov_y_degrees = 45.0f;  // vertical field of view
+    float aspect = 1.0f;          // width / height
+    float near_plane = 0.1f;      // eye-space distances, > 0
+    float far_plane = 10.0f;
+
+    glm::mat4 view() const;        // right-handed, looking down -Z in eye space
+    glm::mat4 projection() const;  // OpenGL clip space (z_ndc in [-1, 1])
+};
+
+// Camera fitted to `sphere`: eye at centre + direction * diameter (direction normalised;
+// default +Z), near = diameter - radius, far = diameter + radius (clamped to stay > 0).
+Camera fit_camera(const BoundingSphere& sphere, float fov_y_degrees, float aspect,
+                  glm::vec3 view_direction = {0.0f, 0.0f, 1.0f});
+
+}  // namespace lucent

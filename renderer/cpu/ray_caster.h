@@ -1,0 +1,41 @@
+#pragma once
+// Embree ray casting over a Mesh, shared by the AO bake and the CPU reference renderers.
+#include <glm/glm.hpp>
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace lucent {
+
+struct RayHit {
+    float distance = 0.0f;  // along the (normalised) ray direction
+    unsigned triangle = 0;  // index into Mesh::triangles
+    glm::vec2 barycentric{0.0f};  // Embree's (u, v) for vertices 1 and 2
+    glm::vec3 geometric_normal{0.0f};  // unit, as wound
+};
+
+// Builds an Embree BVH once; all queries are const and thread-safe.
+class RayCaster {
+public:
+    explicit RayCaster(const Mesh& mesh);
+    ~RayCaster();
+    RayCaster(RayCaster&&) noexcept;
+    RayCaster& operator=(RayCaster&&) noexcept;
+
+    // Nearest hit with distance in (t_min, t_max), if any.
+    std::optional<RayHit> first_hit(glm::vec3 origin, glm::vec3 direction, float t_min = 0.0f,
+                                    float t_max = 1e30f) const;
+    // Up to `max_hits` successive hits along the ray, nearest first (depth layers).
+    std::vector<RayHit> hits(glm::vec3 origin, glm::vec3 direction, int max_hits) const;
+    // True when anything is hit with distance in (t_min, t_max).
+    bool occluded(glm::vec3 origin, glm::vec3 direction, float t_min, float t_max) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lucent
