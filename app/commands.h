@@ -11,5 +11,9 @@ inline constexpr int kExitFailure = 1;  // the work itself failed (GL, I/O, ...)
 inline constexpr int kExitUsage = 2;    // bad command line, config or input data
 
 void register_info(CLI::App& app, int& exit_code);
+void register_bench(CLI::App& app, int& exit_code);
+
+// `lucent bench <family>`: registered from bench_families.cpp, one function per family.
+void register_bench_families(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app
