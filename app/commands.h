@@ -15,5 +15,6 @@ void register_bench(CLI::App& app, int& exit_code);
 
 // `lucent bench <family>`: registered from bench_families.cpp, one function per family.
 void register_bench_families(CLI::App& bench, int& exit_code);
+void register_bench_ao(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app

@@ -5,7 +5,8 @@
 //   torus       major radius 1, tube radius 0.4, axis Y (seen side-on by default)
 //   torus_knot  (2,3) trefoil tube whose radius varies from 0.05 to 0.25 (thin and thick)
 //   hand        palm, four fingers, a thumb and a wrist smoothly merged (non-convex, thin
-//               protrusions; stand-in for the thesis's hand and Fertility models)
+//               protrusions; stand-in for the thesis's hand and Fertility models);
+//               polygonised, so budgets under ~1000 faces are met only roughly
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -318,19 +319,32 @@ Mesh polygonise(const std::function<float(glm::vec3)>& field, glm::vec3 lo, glm:
 
 Mesh make_hand(std::size_t budget) {
     const glm::vec3 lo(-1.25f, -1.5f, -0.35f), hi(0.75f, 1.6f, 0.4f);
-    // Faces scale as 1 / cell^2: start from a measured constant, then correct the cell
-    // size until the count is within 1% of the budget (a few passes at most).
-    float cell = 7.4f / std::sqrt(static_cast<float>(budget));
+    // Faces scale as 1 / cell^2: start from a measured constant and correct the cell
+    // size until the count is within 1% of the budget; the count is a noisy function of
+    // the cell size at small budgets, so then try a few sizes around the best one.
     Mesh best;
-    for (int pass = 0; pass < 8; ++pass) {
+    float best_cell = 0.0f;
+    auto error_of = [budget](const Mesh& m) {
+        return m.triangles.empty() ? 1e30 : std::abs(double(m.face_count()) / double(budget) - 1.0);
+    };
+    auto consider = [&](float cell) {
         Mesh mesh = polygonise(hand_distance, lo - 2.0f * cell, hi + 2.0f * cell, cell);
-        const double ratio = double(mesh.face_count()) / double(budget);
-        if (best.triangles.empty() || std::abs(ratio - 1.0) <
-                std::abs(double(best.face_count()) / double(budget) - 1.0))
-            best = std::move(mesh);
-        if (std::abs(ratio - 1.0) < 0.01) break;
-        cell *= static_cast<float>(std::sqrt(ratio));
+        const std::size_t faces = mesh.face_count();
+        if (best_cell == 0.0f || error_of(mesh) < error_of(best))
+            best = std::move(mesh), best_cell = cell;
+        return faces;
+    };
+    float cell = 7.4f / std::sqrt(static_cast<float>(budget));
+    for (int pass = 0; pass < 6 && (best_cell == 0.0f || error_of(best) > 0.01); ++pass) {
+        const std::size_t faces = consider(cell);
+        // Damped: at very coarse cells whole parts (the palm is 0.4 thick) drop out.
+        cell *= faces == 0 ? 0.5f
+                           : std::clamp(static_cast<float>(std::sqrt(double(faces) / budget)),
+                                        0.6f, 1.6f);
     }
+    for (int step = -8; step <= 8 && error_of(best) > 0.01; ++step)
+        consider(best_cell * (1.0f + 0.01f * static_cast<float>(step)));
+    if (best.triangles.empty()) throw MeshError("hand: no surface at this face budget");
     best.normals.resize(best.positions.size());
     for (std::size_t i = 0; i < best.positions.size(); ++i)
         best.normals[i] = glm::normalize(distance_gradient(hand_distance, best.positions[i], 1e-3f));
