@@ -1,6 +1,9 @@
 // The AO disk cache. One file per (mesh hash, rays, algorithm version):
-//   "LUCENTAO" | u32 file format | u32 algorithm version | u32 rays | u32 0
+//   "LUCENTAO" | u32 file format | u32 algorithm version | u32 rays | u32 normals hash
 //   | u64 count | 16 chars mesh hash | u64 FNV-1a of the values | count x f32
+// The mesh hash covers positions and triangles only; the normals (which orient the
+// hemispheres) are checked through their own hash, so a mesh with the same geometry
+// but other normals rebakes instead of reusing the file.
 // A file is trusted only if every header field matches, its size is exact, the
 // checksum matches and every value is in [0, 1]; otherwise the bake is redone.
 #include <unistd.h>
@@ -31,7 +34,7 @@ struct CacheHeader {
     std::uint32_t file_format;
     std::uint32_t algorithm_version;
     std::uint32_t rays;
-    std::uint32_t reserved;
+    std::uint32_t normals_hash;
     std::uint64_t count;
     char mesh_hash[16];
     std::uint64_t checksum;
@@ -39,10 +42,11 @@ struct CacheHeader {
 #pragma pack(pop)
 static_assert(sizeof(CacheHeader) == 56);
 
-std::uint64_t checksum(const std::vector<float>& values) {
+template <typename T>
+std::uint64_t checksum(const std::vector<T>& values) {  // FNV-1a over the bytes
     std::uint64_t hash = 0xcbf29ce484222325ull;
     const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-    for (std::size_t i = 0; i < values.size() * sizeof(float); ++i)
+    for (std::size_t i = 0; i < values.size() * sizeof(T); ++i)
         hash = (hash ^ bytes[i]) * 0x100000001b3ull;
     return hash;
 }
@@ -53,6 +57,8 @@ CacheHeader header_for(const Mesh& mesh, int rays, const std::vector<float>& val
     header.file_format = kFileFormat;
     header.algorithm_version = kAoAlgorithmVersion;
     header.rays = static_cast<std::uint32_t>(rays);
+    const std::uint64_t normals = checksum(mesh.normals);
+    header.normals_hash = static_cast<std::uint32_t>(normals ^ (normals >> 32));
     header.count = mesh.vertex_count();
     std::memset(header.mesh_hash, '0', sizeof header.mesh_hash);
     std::memcpy(header.mesh_hash, mesh.content_hash.data(),

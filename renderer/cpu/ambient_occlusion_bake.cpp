@@ -43,9 +43,10 @@ void tangent_frame(glm::vec3 n, glm::vec3& t, glm::vec3& b) {
     b = {c, sign + n.y * n.y * a, -n.y};
 }
 
-float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh, std::size_t vertex,
+float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh,
+                               const std::vector<glm::vec3>& normals, std::size_t vertex,
                                int rays, float offset, std::vector<glm::vec3>& directions) {
-    const glm::vec3 n = mesh.normals[vertex];
+    const glm::vec3 n = normals[vertex];
     glm::vec3 t, b;
     tangent_frame(n, t, b);
     const std::uint64_t h = mix(kSeed ^ mix(vertex));
@@ -83,6 +84,17 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh, const AoBakeOptions&
         return result;  // nothing to occlude
     }
     const RayCaster caster(mesh);
+    // Meshes from load_mesh() have unit normals; one assembled by hand may not.
+    std::vector<glm::vec3> repaired;
+    bool usable = mesh.normals.size() == total;
+    for (std::size_t i = 0; usable && i < total; ++i)
+        usable = std::abs(glm::length(mesh.normals[i]) - 1.0f) < 1e-3f;
+    if (!usable) {
+        Mesh copy = mesh;
+        finalize_mesh(copy);
+        repaired = std::move(copy.normals);
+    }
+    const std::vector<glm::vec3>& normals = usable ? mesh.normals : repaired;
     // Scale-aware offset: far above float noise at the mesh's size, far below its detail.
     const float offset = 1e-4f * std::max(mesh.bounding_sphere().radius, 1e-6f);
 
@@ -93,7 +105,8 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh, const AoBakeOptions&
         const std::size_t last = std::min(total, first + kChunk);
         std::vector<glm::vec3> directions;
         for (std::size_t v = first; v < last; ++v)
-            result[v] = vertex_ambient_occlusion(caster, mesh, v, options.rays, offset, directions);
+            result[v] = vertex_ambient_occlusion(caster, mesh, normals, v, options.rays, offset,
+                                                 directions);
         done.fetch_add(last - first);
         return true;
     };

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 namespace lucent {
@@ -54,6 +55,11 @@ std::optional<glm::vec3> unit(glm::vec3 origin, glm::vec3 direction) {
 }  // namespace
 
 RayCaster::RayCaster(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
+    for (const glm::uvec3& t : mesh.triangles)
+        if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() ||
+            t.z >= mesh.positions.size())
+            throw std::invalid_argument(mesh.name + ": a triangle refers to a vertex past the "
+                                        "last of " + std::to_string(mesh.positions.size()));
     impl_->positions = mesh.positions;
     impl_->triangles = mesh.triangles;
     impl_->epsilon = 1e-5f * std::max(mesh.bounding_sphere().radius, 1e-6f);

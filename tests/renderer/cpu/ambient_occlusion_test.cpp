@@ -54,6 +54,15 @@ TEST(AmbientOcclusion, ConvexSphereIsFullyOpenAtEveryVertex) {
     for (std::size_t i = 0; i < ao.size(); ++i) ASSERT_EQ(ao[i], 1.0f) << "vertex " << i;
 }
 
+TEST(AmbientOcclusion, MissingNormalsAreRebuiltFromTheFaces) {
+    // Angle-weighted normals of a convex polyhedron lie in each vertex's normal cone,
+    // so the sphere stays fully open with generated normals too.
+    Mesh sphere = load_mesh("sphere:1000");
+    sphere.normals.clear();
+    const std::vector<float> ao = bake_ambient_occlusion(sphere, {});
+    EXPECT_EQ(ao, std::vector<float>(sphere.vertex_count(), 1.0f));
+}
+
 TEST(AmbientOcclusion, VertexInsideAClosedBoxSeesNothing) {
     const std::vector<float> ao = bake_ambient_occlusion(box_with_floor_centre(1.0f, true), {});
     EXPECT_EQ(ao[0], 0.0f);
@@ -217,6 +226,20 @@ TEST_F(AoCacheTest, CorruptOrTruncatedFilesAreRebuiltNotTrusted) {
         file.seekp(16);  // after magic, file format and algorithm version
         file.put('\x20');
     });
+}
+
+TEST_F(AoCacheTest, SameGeometryWithOtherNormalsIsRebaked) {
+    const Mesh box = box_with_floor_centre(1.0f, false);
+    Mesh tilted = box;
+    tilted.normals[0] = glm::normalize(glm::vec3(0.0f, 0.9f, 0.3f));  // towards a wall
+    ASSERT_EQ(tilted.content_hash, box.content_hash);
+    bool baked = false;
+    const float open = load(box, baked)[0];
+    const float leaning = load(tilted, baked)[0];
+    EXPECT_TRUE(baked);
+    EXPECT_LT(leaning, open - 0.05f);
+    EXPECT_EQ(load(tilted, baked)[0], leaning);
+    EXPECT_FALSE(baked);
 }
 
 TEST_F(AoCacheTest, UnwritableCacheStillReturnsTheBake) {

@@ -88,6 +88,12 @@ TEST(RayCaster, FirstHitRespectsTheDistanceInterval) {
     EXPECT_FALSE(caster.occluded(origin, -down, 0.0f, 100.0f));
 }
 
+TEST(RayCaster, RejectsTrianglesPastTheLastVertex) {
+    Mesh broken = load_mesh("sphere:400");
+    broken.triangles.push_back({0, 1, static_cast<unsigned>(broken.vertex_count())});
+    EXPECT_THROW(RayCaster{broken}, std::invalid_argument);
+}
+
 TEST(RayCaster, UnusableRaysHitNothing) {
     const RayCaster caster(load_mesh("sphere:4000"));
     EXPECT_FALSE(caster.first_hit({0, 0, 3}, {0, 0, 0}).has_value());
