@@ -20,6 +20,7 @@
 #include <string>
 
 #include "core/ambient_occlusion.h"
+#include "core/progress.h"
 
 namespace lucent {
 
@@ -156,7 +157,17 @@ std::vector<float> load_or_bake_ambient_occlusion(const Mesh& mesh,
     const std::filesystem::path path = ambient_occlusion_cache_path(*source, options.rays);
     if (std::optional<std::vector<float>> cached = read_cache(path, *source, options.rays))
         return *cached;
-    std::vector<float> values = bake_ambient_occlusion(*source, options);
+    // Long bakes show progress: without a caller's callback, a bar on stderr (terminal
+    // only, after half a second).
+    std::vector<float> values;
+    if (options.progress) {
+        values = bake_ambient_occlusion(*source, options);
+    } else {
+        ProgressBar bar("AO bake " + mesh.name, mesh.vertex_count());
+        AoBakeOptions with_bar = options;
+        with_bar.progress = bar.callback();
+        values = bake_ambient_occlusion(*source, with_bar);
+    }
     if (std::string reason; !write_cache(path, *source, options.rays, values, reason))
         std::fprintf(stderr, "lucent: warning: AO cache %s not written: %s\n",
                      path.string().c_str(), reason.c_str());
