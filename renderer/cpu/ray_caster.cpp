@@ -45,6 +45,11 @@ RTCRayHit make_ray(glm::vec3 origin, glm::vec3 unit_direction, float t_min, floa
     return query;
 }
 
+// Embree's tnear is inclusive; the queries here exclude t_min itself.
+float exclusive_near(float t_min) {
+    return std::nextafter(std::max(t_min, 0.0f), std::numeric_limits<float>::infinity());
+}
+
 // Unit direction, or nullopt when the ray is unusable.
 std::optional<glm::vec3> unit(glm::vec3 origin, glm::vec3 direction) {
     const float length = glm::length(direction);
@@ -105,11 +110,9 @@ std::optional<RayHit> RayCaster::first_hit(glm::vec3 origin, glm::vec3 direction
     if (!dir || !(t_max > t_min)) return std::nullopt;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRayHit query = make_ray(origin, *dir, std::max(t_min, 0.0f), t_max);
+    RTCRayHit query = make_ray(origin, *dir, exclusive_near(t_min), t_max);
     rtcIntersect1(impl_->scene, &context, &query);
     if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-    // Embree's tnear is inclusive; the contract here is an open interval.
-    if (!(query.ray.tfar > t_min)) return std::nullopt;
     RayHit hit;
     hit.distance = query.ray.tfar;
     hit.triangle = query.hit.primID;
@@ -140,7 +143,7 @@ bool RayCaster::occluded(glm::vec3 origin, glm::vec3 direction, float t_min, flo
     if (!dir || !(t_max > t_min)) return false;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRay ray = make_ray(origin, *dir, std::max(t_min, 0.0f), t_max).ray;
+    RTCRay ray = make_ray(origin, *dir, exclusive_near(t_min), t_max).ray;
     rtcOccluded1(impl_->scene, &context, &ray);
     return ray.tfar == -std::numeric_limits<float>::infinity();
 }
@@ -154,7 +157,7 @@ std::size_t RayCaster::count_escaping(glm::vec3 origin, const std::vector<glm::v
     rtcInitIntersectContext(&context);
     std::size_t escaped = 0;
     for (const glm::vec3& direction : directions) {
-        RTCRay ray = make_ray(origin, direction, std::max(t_min, 0.0f),
+        RTCRay ray = make_ray(origin, direction, exclusive_near(t_min),
                               std::numeric_limits<float>::infinity()).ray;
         rtcOccluded1(impl_->scene, &context, &ray);
         if (ray.tfar != -std::numeric_limits<float>::infinity()) ++escaped;
