@@ -168,7 +168,6 @@ Mesh make_torus_knot(std::size_t budget) {
 
 // ---- hand: a signed distance field polygonised by marching tetrahedra ----
 
-
 float smooth_min(float a, float b, float k) {  // polynomial smooth minimum (blend width k)
     const float h = std::clamp(0.5f + 0.5f * (b - a) / k, 0.0f, 1.0f);
     return b + (a - b) * h - k * h * (1.0f - h);
