@@ -149,8 +149,9 @@ Mesh load_mesh(const std::string& spec) {
         throw MeshError(
             "(empty mesh spec): give a built-in name (sphere, torus, torus_knot, "
             "hand) or a mesh file path");
-    // A built-in name wins unless a file of that exact name exists.
-    if (is_builtin_mesh_spec(spec) && !std::filesystem::exists(spec))
+    // A built-in name wins unless a regular file of that exact name exists.
+    std::error_code error;
+    if (is_builtin_mesh_spec(spec) && !std::filesystem::is_regular_file(spec, error))
         return build_builtin_mesh(spec);
     return load_mesh_file(spec);
 }
