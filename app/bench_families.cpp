@@ -4,8 +4,7 @@
 namespace lucent::app {
 
 void register_bench_families(CLI::App& bench, int& exit_code) {
-    (void)bench;
-    (void)exit_code;
+    register_bench_stats(bench, exit_code);
 }
 
 }  // namespace lucent::app
