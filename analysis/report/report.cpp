@@ -254,7 +254,8 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses,
 
 }  // namespace
 
-void parse_formats(const std::string& list, ReportOptions& options) {
+void parse_formats(const std::string& list, ReportOptions& result) {
+    ReportOptions options = result;  // untouched on error
     options.markdown = options.csv = options.html = false;
     std::stringstream in(list);
     std::string item;
@@ -266,6 +267,7 @@ void parse_formats(const std::string& list, ReportOptions& options) {
     }
     if (!options.markdown && !options.csv && !options.html)
         throw InputError("--format: no format given (valid: md, csv, html)");
+    result = options;
 }
 
 std::string plot_file_name(const std::string& question, const std::string& factor) {

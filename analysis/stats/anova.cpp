@@ -23,10 +23,12 @@ AnovaResult one_way_anova(const OneWayData& data) {
     r.groups = static_cast<int>(groups.size());
     // Group means and within sums of squares (compensated two-pass per group), then the
     // grand mean weighted by n and the between sum of squares about it.
+    // Everything is centred on one observation so that means far from zero keep digits.
+    const double pivot = pivot_of(data);
     std::vector<MeanAndSquares> per_group;
     CompensatedSum weighted_means, within;
     for (const Group* group : groups) {
-        per_group.push_back(mean_and_squares(group->values));
+        per_group.push_back(mean_and_squares(group->values, pivot));
         r.observations += group->values.size();
         weighted_means.add(per_group.back().mean * static_cast<double>(group->values.size()));
         within.add(per_group.back().squares);
@@ -78,8 +80,9 @@ WelchResult welch_anova(const OneWayData& data) {
     // Weights w_i = n_i / s_i^2; the weighted grand mean; then Welch's F and its df.
     std::vector<double> weights, means, sizes;
     CompensatedSum total_weight, weighted_mean;
+    const double pivot = pivot_of(data);
     for (const Group* group : groups) {
-        const MeanAndSquares ms = mean_and_squares(group->values);
+        const MeanAndSquares ms = mean_and_squares(group->values, pivot);
         const double n = static_cast<double>(group->values.size());
         if (n < 2.0 || ms.squares <= 0.0) {
             r.note = "Welch's ANOVA needs two or more observations and a nonzero variance in "

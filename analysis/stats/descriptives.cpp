@@ -21,17 +21,23 @@ std::size_t total_observations(const OneWayData& data) {
     return n;
 }
 
-MeanAndSquares mean_and_squares(const std::vector<double>& values) {
+double pivot_of(const OneWayData& data) {
+    for (const Group& group : data.groups)
+        if (!group.values.empty()) return group.values.front();
+    return 0.0;
+}
+
+MeanAndSquares mean_and_squares(const std::vector<double>& values, double shift) {
     if (values.empty()) return {};
     CompensatedSum sum;
-    for (double x : values) sum.add(x);
+    for (double x : values) sum.add(x - shift);
     const double n = static_cast<double>(values.size());
     const double provisional = sum.value() / n;
     // Second pass about the provisional mean; its residual sum corrects the mean and the
     // squares (the "corrected two-pass algorithm" of Chan, Golub and LeVeque).
     CompensatedSum deviations, squares;
     for (double x : values) {
-        const double d = x - provisional;
+        const double d = (x - shift) - provisional;
         deviations.add(d);
         squares.add(d * d);
     }
@@ -44,8 +50,9 @@ Descriptives describe(const Group& group, double origin, double confidence) {
     d.level = group.level;
     d.n = group.values.size();
     if (d.n == 0) return d;
-    const MeanAndSquares ms = mean_and_squares(group.values);
-    d.mean = origin + ms.mean;
+    const double shift = group.values.front();
+    const MeanAndSquares ms = mean_and_squares(group.values, shift);
+    d.mean = origin + (shift + ms.mean);
     std::vector<double> sorted = group.values;
     const std::size_t half = d.n / 2;
     std::nth_element(sorted.begin(), sorted.begin() + half, sorted.end());

@@ -3,6 +3,7 @@
 #include "stats/studentized_range.h"
 
 #include <algorithm>
+#include <array>
 #include <boost/math/quadrature/gauss.hpp>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <boost/math/special_functions/erf.hpp>
@@ -185,6 +186,8 @@ void check_q(double q) {
 
 bool df_is_infinite(double df) { return df >= kDfTreatedAsInfinite; }
 
+double solve_quantile(double upper_p, int k, double df);
+
 }  // namespace
 
 double studentized_range_cdf(double q, int k, double df) {
@@ -218,6 +221,21 @@ double studentized_range_quantile_upper(double upper_p, int k, double df) {
     check_arguments(k, df);
     if (!(upper_p > 0.0 && upper_p < 1.0))
         throw std::domain_error("studentized range: p must lie strictly between 0 and 1");
+    // A quantile costs ~20 CDF evaluations, and Tukey HSD asks for the same few (alpha,
+    // .05, .01 at one k and df) again and again: remember the last ones per thread.
+    struct Remembered { double p, df, q; int k; };
+    thread_local std::array<Remembered, 8> remembered{};
+    thread_local std::size_t next_slot = 0;
+    for (const Remembered& r : remembered)
+        if (r.k == k && r.p == upper_p && r.df == df) return r.q;
+    const double q = solve_quantile(upper_p, k, df);
+    remembered[next_slot++ % remembered.size()] = {upper_p, df, q, k};
+    return q;
+}
+
+namespace {
+
+double solve_quantile(double upper_p, int k, double df) {
     // Solve on log(P(Q > q)) for small p (relative accuracy) and on the CDF otherwise.
     const bool small = upper_p < 0.5;
     auto residual = [&](double q) {
@@ -247,4 +265,5 @@ double studentized_range_quantile_upper(double upper_p, int k, double df) {
     return 0.5 * (a + b);
 }
 
+}  // namespace
 }  // namespace lucent::analysis

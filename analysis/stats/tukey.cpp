@@ -40,7 +40,8 @@ TukeyResult tukey_hsd(const OneWayData& data, const AnovaResult& anova,
     }
 
     std::vector<double> means;
-    for (const Group* g : groups) means.push_back(mean_and_squares(g->values).mean);
+    const double pivot = pivot_of(data);  // differences of means keep their digits
+    for (const Group* g : groups) means.push_back(mean_and_squares(g->values, pivot).mean);
     for (int a = 0; a < k; ++a) {
         for (int b = a + 1; b < k; ++b) {
             TukeyPair pair;
