@@ -108,7 +108,7 @@ double range_cdf_infinite_df(double q, int k) {
     const double low = std::max(-9.5, std::min(lowest, 0.5 * q - 9.5));
     const double high = std::min(9.5 + std::log(double(k)) / 9.5, 0.5 * q + 9.5);
     auto points = even_points(low, std::max(high, low + 1.0), 5.0);
-    return std::min(1.0, integrate_pieces(integrand, points, 1e-12));
+    return std::min(1.0, integrate_pieces(integrand, points, 1e-11));
 }
 
 // P(range of k standard normals > q) = k Int phi(z) [Phi(z)^m - (Phi(z) - Phi(z-q))^m] dz,
@@ -127,7 +127,7 @@ double range_upper_infinite_df(double q, int k) {
     const double low = std::max(-9.5, 0.5 * q - 9.5 - std::log(double(k)));
     const double high = 0.5 * q + 9.5 + std::log(double(k));
     auto points = even_points(low, high, 5.0);
-    return std::min(1.0, integrate_pieces(integrand, points, 1e-12));
+    return std::min(1.0, integrate_pieces(integrand, points, 1e-11));
 }
 
 // Density of S = sqrt(chi2_df / df): d/ds P(df/2, df s^2 / 2).
@@ -160,14 +160,19 @@ double mix_over_scale(double q, int k, double df, Inner inner, bool upper) {
     };
     add(mode);
     add(upper ? tail_peak : lower_peak);
-    // Typical ranges of k normals run from about 1 to 6: mark where q s crosses them.
-    if (q > 0.0)
-        for (double typical : {1.0, 4.0}) add(typical / q);
+    // U(q s) falls from 1 to 0 as q s crosses the typical range of k normals (about
+    // 2 Phi^-1(1 - 1/(2k))): mark that band, or a large q hides it between nodes.
+    if (q > 0.0) {
+        const double typical = 2.0 * std::sqrt(2.0) * boost::math::erfc_inv(1.0 / k);
+        for (double x : {0.25 * typical, 0.5 * typical, typical, typical + 1.5, typical + 3.0,
+                         typical + 5.0})
+            add(x / q);
+    }
     auto integrand = [&](double s) {
         const double density = scale_density(s, df);
         return density == 0.0 ? 0.0 : density * inner(q * s, k);
     };
-    return std::min(1.0, integrate_pieces(integrand, points, 1e-11));
+    return std::min(1.0, integrate_pieces(integrand, points, 1e-10));
 }
 
 void check_arguments(int k, double df) {
