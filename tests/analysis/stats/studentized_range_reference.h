@@ -98,7 +98,8 @@ inline RangeProbabilities reference_studentized_range(long double q, int k, long
     concave_support([&](long double t) { return log_density(t) - 0.25L * q * q * std::exp(2 * t); },
                     lo, hi, 40);
     concave_support([&](long double t) { return log_density(t) + (k - 1) * t; }, lo, hi, 40);
-    const long double sd = 1.0L / std::sqrt(2.0L * df);
+    // Narrowest peak: the tiny lower tail's, with curvature 2 (df + k - 1) in t.
+    const long double sd = 1.0L / std::sqrt(2.0L * (df + k - 1));
     const long double step = std::min(0.1L, sd / 3);
     auto both = [&](long double t) -> RangeProbabilities {
         const long double density = std::exp(log_density(t));
