@@ -2,6 +2,7 @@
 
 #include <array>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -89,10 +90,12 @@ std::string describe_scale(const RatingScale& scale) {
 }
 
 void check_scale(const LongTable& table, const RatingScale& scale, const std::string& source) {
-    if (scale.any) return;
     for (const RatingRow& row : table.rows) {
         if (!row.rating) continue;
         const double value = table.origin + *row.rating;
+        if (!std::isfinite(value))  // rows from a database reader arrive unparsed
+            throw InputError(location(source, row.source_line) + ": rating is not finite");
+        if (scale.any) continue;
         if (value < scale.min || value > scale.max)
             throw InputError(location(source, row.source_line) + ": rating " +
                              format_exact(value) + " is outside the scale " +

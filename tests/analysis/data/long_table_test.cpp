@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "data/decimal.h"
@@ -72,6 +73,21 @@ TEST(LongTable, BadInputIsReportedNotCrashed) {
     EXPECT_NE(error_of("").find("empty"), std::string::npos);
     EXPECT_THROW(parse_scale("7..1"), InputError);
     EXPECT_THROW(parse_scale("1-7"), InputError);
+}
+
+TEST(LongTable, TablesFromOtherReadersAreCheckedToo) {
+    // The study database reader fills LongTable directly; check_scale names its row.
+    LongTable t;
+    t.rows.push_back({"p1", "s1", "f", "1", "q", 3.0, 12});
+    t.rows.push_back({"p1", "s2", "f", "2", "q", 8.0, 13});
+    EXPECT_THROW(check_scale(t, RatingScale{}, "study.db"), InputError);
+    try {
+        check_scale(t, RatingScale{}, "study.db");
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("study.db:13"), std::string::npos);
+    }
+    t.rows[1].rating = std::nan("");
+    EXPECT_THROW(check_scale(t, RatingScale{true}, "study.db"), InputError);
 }
 
 TEST(Decimal, DifferencesAreExact) {
