@@ -3,10 +3,9 @@
 #include <iostream>
 
 #include "commands.h"
-#include "data/grouping.h"
+#include "analyze.h"
 #include "data/long_table.h"
 #include "report/report.h"
-#include "stats/one_way_analysis.h"
 
 namespace lucent::app {
 namespace {
@@ -26,18 +25,13 @@ int run_analyze(const AnalyzeArgs& args) {
         options.alpha = args.alpha;
         options.source = args.input;
         const LongTable table = read_long_csv(args.input, parse_scale(args.scale));
-        const auto pairs = split_by_question_and_factor(table, args.question, args.factor);
-        if (pairs.empty())
-            throw InputError(args.input + ": no ratings" +
-                             (args.question.empty() ? "" : " for question '" + args.question + "'") +
-                             (args.factor.empty() ? "" : " for factor '" + args.factor + "'"));
-        std::vector<OneWayAnalysis> analyses;
-        for (const FactorData& pair : pairs) {
-            std::cerr << "analyzing " << pair.question << " ~ " << pair.factor << " ("
-                      << pair.data.groups.size() << " levels)\n";
-            analyses.push_back(analyze_one_way(pair.question, pair.factor, pair.data, args.alpha));
-            analyses.back().missing_ratings = pair.missing_ratings;
-        }
+        AnalysisRequest request{args.alpha, args.question, args.factor,
+                                [](const std::string& question, const std::string& factor,
+                                   std::size_t levels) {
+                                    std::cerr << "analyzing " << question << " ~ " << factor
+                                              << " (" << levels << " levels)\n";
+                                }};
+        const std::vector<OneWayAnalysis> analyses = analyze_table(table, request);
         for (const auto& path : write_report(analyses, args.out_dir, options))
             std::cout << path.string() << "\n";
         return kExitOk;
