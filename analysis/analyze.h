@@ -11,15 +11,17 @@
 namespace lucent::analysis {
 
 struct AnalysisRequest {
-    double alpha = 0.10;       // the thesis's level; Tukey intervals at 1 - alpha
-    std::string question;      // only this question ("" = all)
-    std::string factor;        // only this factor ("" = all)
+    double alpha = 0.10;   // the thesis's level; Tukey intervals at 1 - alpha
+    std::string question;  // only this question ("" = all)
+    std::string factor;    // only this factor ("" = all)
     // Called before each pair is analyzed (progress on long runs); may be empty.
     std::function<void(const std::string& question, const std::string& factor,
-                       std::size_t levels)> on_pair;
+                       std::size_t levels)>
+        on_pair;
 };
 
 // Throws InputError when no rating matches the filters.
-std::vector<OneWayAnalysis> analyze_table(const LongTable& table, const AnalysisRequest& request);
+std::vector<OneWayAnalysis> analyze_table(const LongTable& table,
+                                          const AnalysisRequest& request);
 
 }  // namespace lucent::analysis

@@ -2,8 +2,8 @@
 // from a long CSV of ratings (participant,stimulus,factor,level,question,rating).
 #include <iostream>
 
-#include "commands.h"
 #include "analyze.h"
+#include "commands.h"
 #include "data/long_table.h"
 #include "report/report.h"
 
@@ -28,8 +28,8 @@ int run_analyze(const AnalyzeArgs& args) {
         AnalysisRequest request{args.alpha, args.question, args.factor,
                                 [](const std::string& question, const std::string& factor,
                                    std::size_t levels) {
-                                    std::cerr << "analyzing " << question << " ~ " << factor
-                                              << " (" << levels << " levels)\n";
+                                    std::cerr << "analyzing " << question << " ~ "
+                                              << factor << " (" << levels << " levels)\n";
                                 }};
         const std::vector<OneWayAnalysis> analyses = analyze_table(table, request);
         for (const auto& path : write_report(analyses, args.out_dir, options))
@@ -46,8 +46,9 @@ int run_analyze(const AnalyzeArgs& args) {
 void register_analyze(CLI::App& app, int& exit_code) {
     auto args = std::make_shared<AnalyzeArgs>();
     auto* cmd = app.add_subcommand(
-        "analyze", "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
-                   "with plots, from a long CSV of ratings");
+        "analyze",
+        "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
+        "with plots, from a long CSV of ratings");
     cmd->add_option("input", args->input,
                     "Long CSV: participant,stimulus,factor,level,question,rating")
         ->required();

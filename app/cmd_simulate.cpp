@@ -12,23 +12,27 @@ void register_simulate(CLI::App& app, int& exit_code) {
     auto spec = std::make_shared<analysis::SimulationSpec>();
     auto out = std::make_shared<std::string>();
     auto* cmd = app.add_subcommand(
-        "simulate", "Write a seeded synthetic study (long CSV of 7-point ratings from a latent "
-                    "normal model) for 'lucent analyze'");
+        "simulate",
+        "Write a seeded synthetic study (long CSV of 7-point ratings from a latent "
+        "normal model) for 'lucent analyze'");
     cmd->add_option("--out", *out, "CSV file to write")->required();
-    cmd->add_option("--participants", spec->participants, "Participants")->capture_default_str();
+    cmd->add_option("--participants", spec->participants, "Participants")
+        ->capture_default_str();
     cmd->add_option("--stimuli-per-level", spec->stimuli_per_level, "Stimuli per level")
         ->capture_default_str();
     cmd->add_option("--questions", spec->questions, "Question names")
         ->delimiter(',')
         ->capture_default_str();
     cmd->add_option("--factor", spec->factor, "Factor name")->capture_default_str();
-    cmd->add_option("--effects", spec->level_effects,
-                    "Latent effect per level in noise-SD units, e.g. 0,0.5,1 (one per level)")
+    cmd->add_option(
+           "--effects", spec->level_effects,
+           "Latent effect per level in noise-SD units, e.g. 0,0.5,1 (one per level)")
         ->delimiter(',')
         ->capture_default_str();
     cmd->add_option("--participant-sd", spec->participant_sd, "SD of participant offsets")
         ->capture_default_str();
-    cmd->add_option("--noise-sd", spec->noise_sd, "SD of per-rating noise")->capture_default_str();
+    cmd->add_option("--noise-sd", spec->noise_sd, "SD of per-rating noise")
+        ->capture_default_str();
     cmd->add_option("--seed", spec->seed, "Random seed")->capture_default_str();
     cmd->callback([spec, out, &exit_code] {
         try {

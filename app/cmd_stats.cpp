@@ -14,9 +14,11 @@ namespace {
 
 // "inf" (or "infinity") or a number >= 1.
 double parse_df(const std::string& text) {
-    if (text == "inf" || text == "infinity" || text == "Inf") return analysis::kInfiniteDf;
+    if (text == "inf" || text == "infinity" || text == "Inf")
+        return analysis::kInfiniteDf;
     const auto value = analysis::parse_finite_number(text);
-    if (!value) throw std::domain_error("--df: expected a number or 'inf', got '" + text + "'");
+    if (!value)
+        throw std::domain_error("--df: expected a number or 'inf', got '" + text + "'");
     return *value;
 }
 
@@ -35,7 +37,8 @@ int guarded(const char* name, const std::function<void()>& body) {
 }  // namespace
 
 void register_stats(CLI::App& app, int& exit_code) {
-    auto* stats = app.add_subcommand("stats", "Distribution functions used by the analysis");
+    auto* stats =
+        app.add_subcommand("stats", "Distribution functions used by the analysis");
     stats->require_subcommand(1);
 
     struct Args {
@@ -49,13 +52,15 @@ void register_stats(CLI::App& app, int& exit_code) {
         "ptukey", "Studentized range: P(Q > q) (a p-value), or P(Q <= q) with --lower");
     ptukey->add_option("--q", args->q, "Studentized range statistic (>= 0)")->required();
     ptukey->add_option("--k", args->k, "Number of groups (2..200)")->required();
-    ptukey->add_option("--df", args->df, "Error degrees of freedom (>= 1, or inf)")->required();
+    ptukey->add_option("--df", args->df, "Error degrees of freedom (>= 1, or inf)")
+        ->required();
     ptukey->add_flag("--lower", args->lower, "Print the CDF P(Q <= q) instead");
     ptukey->callback([args, &exit_code] {
         exit_code = guarded("ptukey", [&] {
             const double df = parse_df(args->df);
-            print_full(args->lower ? analysis::studentized_range_cdf(args->q, args->k, df)
-                                   : analysis::studentized_range_upper(args->q, args->k, df));
+            print_full(args->lower
+                           ? analysis::studentized_range_cdf(args->q, args->k, df)
+                           : analysis::studentized_range_upper(args->q, args->k, df));
         });
     });
 
@@ -63,7 +68,8 @@ void register_stats(CLI::App& app, int& exit_code) {
         "qtukey", "Studentized range: the q whose upper-tail probability P(Q > q) is p");
     qtukey->add_option("--p", args->p, "Upper-tail probability, 0 < p < 1")->required();
     qtukey->add_option("--k", args->k, "Number of groups (2..200)")->required();
-    qtukey->add_option("--df", args->df, "Error degrees of freedom (>= 1, or inf)")->required();
+    qtukey->add_option("--df", args->df, "Error degrees of freedom (>= 1, or inf)")
+        ->required();
     qtukey->callback([args, &exit_code] {
         exit_code = guarded("qtukey", [&] {
             print_full(analysis::studentized_range_quantile_upper(args->p, args->k,

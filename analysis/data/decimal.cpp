@@ -29,7 +29,8 @@ std::optional<double> parse_finite_number(std::string_view text) {
               c == 'E' || c == '-' || c == '+'))
             return std::nullopt;
     double value = 0.0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    const auto [end, error] =
+        std::from_chars(text.data(), text.data() + text.size(), value);
     if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
         return std::nullopt;
     return value;

@@ -16,7 +16,8 @@ std::vector<FactorData> split_by_question_and_factor(const LongTable& table,
     for (const RatingRow& row : table.rows) {
         if (!question_filter.empty() && row.question != question_filter) continue;
         if (!factor_filter.empty() && row.factor != factor_filter) continue;
-        auto [it, inserted] = pair_index.emplace(std::pair{row.question, row.factor}, pairs.size());
+        auto [it, inserted] =
+            pair_index.emplace(std::pair{row.question, row.factor}, pairs.size());
         if (inserted) {
             pairs.push_back({row.question, row.factor, {table.origin, {}}, 0});
             level_index.emplace_back();
@@ -32,13 +33,14 @@ std::vector<FactorData> split_by_question_and_factor(const LongTable& table,
     }
     for (FactorData& pair : pairs) {
         auto& groups = pair.data.groups;
-        const bool numeric = std::all_of(groups.begin(), groups.end(), [](const Group& g) {
-            return parse_finite_number(g.level).has_value();
-        });
+        const bool numeric = std::all_of(
+            groups.begin(), groups.end(),
+            [](const Group& g) { return parse_finite_number(g.level).has_value(); });
         if (numeric)
-            std::stable_sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) {
-                return *parse_finite_number(a.level) < *parse_finite_number(b.level);
-            });
+            std::stable_sort(
+                groups.begin(), groups.end(), [](const Group& a, const Group& b) {
+                    return *parse_finite_number(a.level) < *parse_finite_number(b.level);
+                });
     }
     return pairs;
 }

@@ -15,8 +15,8 @@ struct FactorData {
 // Pairs in order of first appearance; an empty filter keeps everything. Levels are in
 // numeric order when every level of the factor is a number, else in order of appearance.
 // A level whose rows all lack a rating becomes an empty group.
-std::vector<FactorData> split_by_question_and_factor(const LongTable& table,
-                                                     const std::string& question_filter = "",
-                                                     const std::string& factor_filter = "");
+std::vector<FactorData> split_by_question_and_factor(
+    const LongTable& table, const std::string& question_filter = "",
+    const std::string& factor_filter = "");
 
 }  // namespace lucent::analysis

@@ -26,8 +26,8 @@ std::string format_exact(double value) {
 }
 
 // Splits one CSV record (quotes may span lines: more lines are pulled from `in`).
-std::vector<std::string> split_record(std::string line, std::istream& in, std::size_t& line_no,
-                                      const std::string& source) {
+std::vector<std::string> split_record(std::string line, std::istream& in,
+                                      std::size_t& line_no, const std::string& source) {
     std::vector<std::string> fields(1);
     bool quoted = false;
     for (std::size_t i = 0;; ++i) {
@@ -35,7 +35,8 @@ std::vector<std::string> split_record(std::string line, std::istream& in, std::s
             if (!quoted) break;
             std::string more;
             if (!std::getline(in, more))
-                throw InputError(location(source, line_no) + ": unterminated quoted field");
+                throw InputError(location(source, line_no) +
+                                 ": unterminated quoted field");
             ++line_no;
             if (!more.empty() && more.back() == '\r') more.pop_back();
             line += "\n" + more;
@@ -79,8 +80,9 @@ RatingScale parse_scale(std::string_view text) {
         high = parse_finite_number(text.substr(dots + 2));
     }
     if (!low || !high || !(*low < *high))
-        throw InputError("--scale: expected MIN..MAX with MIN < MAX (e.g. 1..7) or 'any', got '" +
-                         std::string(text) + "'");
+        throw InputError(
+            "--scale: expected MIN..MAX with MIN < MAX (e.g. 1..7) or 'any', got '" +
+            std::string(text) + "'");
     return {false, *low, *high};
 }
 
@@ -89,12 +91,14 @@ std::string describe_scale(const RatingScale& scale) {
     return format_exact(scale.min) + ".." + format_exact(scale.max);
 }
 
-void check_scale(const LongTable& table, const RatingScale& scale, const std::string& source) {
+void check_scale(const LongTable& table, const RatingScale& scale,
+                 const std::string& source) {
     for (const RatingRow& row : table.rows) {
         if (!row.rating) continue;
         const double value = table.origin + *row.rating;
         if (!std::isfinite(value))  // rows from a database reader arrive unparsed
-            throw InputError(location(source, row.source_line) + ": rating is not finite");
+            throw InputError(location(source, row.source_line) +
+                             ": rating is not finite");
         if (scale.any) continue;
         if (value < scale.min || value > scale.max)
             throw InputError(location(source, row.source_line) + ": rating " +
@@ -104,7 +108,8 @@ void check_scale(const LongTable& table, const RatingScale& scale, const std::st
     }
 }
 
-LongTable read_long_csv(std::istream& in, const std::string& source, const RatingScale& scale) {
+LongTable read_long_csv(std::istream& in, const std::string& source,
+                        const RatingScale& scale) {
     LongTable table;
     std::string line;
     std::size_t line_no = 0;
@@ -123,11 +128,12 @@ LongTable read_long_csv(std::istream& in, const std::string& source, const Ratin
             header_fields = fields.size();
             for (std::size_t f = 0; f < fields.size(); ++f)
                 for (std::size_t c = 0; c < kColumns.size(); ++c)
-                    if (trimmed(fields[f]) == kColumns[c]) column[c] = static_cast<int>(f);
+                    if (trimmed(fields[f]) == kColumns[c])
+                        column[c] = static_cast<int>(f);
             for (std::size_t c = 0; c < kColumns.size(); ++c)
                 if (column[c] < 0)
-                    throw InputError(location(source, line_no) + ": header lacks column '" +
-                                     kColumns[c] +
+                    throw InputError(location(source, line_no) +
+                                     ": header lacks column '" + kColumns[c] +
                                      "' (expected participant,stimulus,factor,level,"
                                      "question,rating)");
             continue;
@@ -187,8 +193,9 @@ void write_long_csv(std::ostream& out, const LongTable& table) {
     };
     out << "participant,stimulus,factor,level,question,rating\n";
     for (const RatingRow& row : table.rows) {
-        out << quote(row.participant) << ',' << quote(row.stimulus) << ',' << quote(row.factor)
-            << ',' << quote(row.level) << ',' << quote(row.question) << ',';
+        out << quote(row.participant) << ',' << quote(row.stimulus) << ','
+            << quote(row.factor) << ',' << quote(row.level) << ',' << quote(row.question)
+            << ',';
         if (row.rating) out << format_exact(table.origin + *row.rating);
         out << '\n';
     }

@@ -41,11 +41,13 @@ RatingScale parse_scale(std::string_view text);
 std::string describe_scale(const RatingScale& scale);
 
 // Throws InputError naming `source:line` of the first rating outside the scale.
-void check_scale(const LongTable& table, const RatingScale& scale, const std::string& source);
+void check_scale(const LongTable& table, const RatingScale& scale,
+                 const std::string& source);
 
 // Reads the long CSV (header required, columns in any order, RFC 4180 quotes, CRLF or LF;
 // an empty rating is a missing value). Ratings are checked against the scale.
-LongTable read_long_csv(std::istream& in, const std::string& source, const RatingScale& scale);
+LongTable read_long_csv(std::istream& in, const std::string& source,
+                        const RatingScale& scale);
 LongTable read_long_csv(const std::filesystem::path& path, const RatingScale& scale);
 
 // Writes the same format (used by the simulator); ratings are printed exactly.

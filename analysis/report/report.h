@@ -11,7 +11,8 @@
 namespace lucent::analysis {
 
 struct ReportOptions {
-    double alpha = 0.10;  // significance level (the thesis used 0.10); Tukey CI at 1 - alpha
+    double alpha =
+        0.10;  // significance level (the thesis used 0.10); Tukey CI at 1 - alpha
     bool markdown = true, csv = true, html = true;
     std::string source;  // input description printed in the header
 };
@@ -20,9 +21,9 @@ struct ReportOptions {
 void parse_formats(const std::string& list, ReportOptions& options);
 
 // Writes into `directory` (created if needed); returns the files written.
-std::vector<std::filesystem::path> write_report(const std::vector<OneWayAnalysis>& analyses,
-                                                const std::filesystem::path& directory,
-                                                const ReportOptions& options);
+std::vector<std::filesystem::path> write_report(
+    const std::vector<OneWayAnalysis>& analyses, const std::filesystem::path& directory,
+    const ReportOptions& options);
 
 // File-name-safe slug for plot names: letters, digits, '-', '_'.
 std::string plot_file_name(const std::string& question, const std::string& factor);

@@ -12,11 +12,20 @@ std::string escape_xml(const std::string& s) {
     std::string out;
     for (char c : s) {
         switch (c) {
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '&': out += "&amp;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '&':
+                out += "&amp;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
@@ -54,35 +63,37 @@ std::string mean_ci_plot_svg(const std::string& title, const std::string& y_labe
     auto x_of = [&](std::size_t i) { return kLeft + plot_w * (i + 0.5) / n; };
 
     std::ostringstream svg;
-    svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kWidth << "\" height=\""
-        << kHeight << "\" viewBox=\"0 0 " << kWidth << ' ' << kHeight
+    svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kWidth
+        << "\" height=\"" << kHeight << "\" viewBox=\"0 0 " << kWidth << ' ' << kHeight
         << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
         << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-        << "<text x=\"" << kWidth / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">"
-        << escape_xml(title) << "</text>\n"
-        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop << "\" x2=\"" << kLeft << "\" y2=\""
-        << kTop + plot_h << "\" stroke=\"black\"/>\n"
-        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop + plot_h << "\" x2=\"" << kLeft + plot_w
-        << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/>\n";
+        << "<text x=\"" << kWidth / 2
+        << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" << escape_xml(title)
+        << "</text>\n"
+        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop << "\" x2=\"" << kLeft
+        << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/>\n"
+        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop + plot_h << "\" x2=\""
+        << kLeft + plot_w << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/>\n";
     // Five ticks on the y axis.
     for (int t = 0; t <= 4; ++t) {
         const double v = lo + (hi - lo) * t / 4.0;
-        svg << "<line x1=\"" << kLeft - 4 << "\" y1=\"" << num(y_of(v)) << "\" x2=\"" << kLeft
-            << "\" y2=\"" << num(y_of(v)) << "\" stroke=\"black\"/>"
+        svg << "<line x1=\"" << kLeft - 4 << "\" y1=\"" << num(y_of(v)) << "\" x2=\""
+            << kLeft << "\" y2=\"" << num(y_of(v)) << "\" stroke=\"black\"/>"
             << "<text x=\"" << kLeft - 6 << "\" y=\"" << num(y_of(v) + 4)
             << "\" text-anchor=\"end\">" << num(v) << "</text>\n";
     }
     svg << "<text x=\"14\" y=\"" << kTop + plot_h / 2 << "\" text-anchor=\"middle\" "
-        << "transform=\"rotate(-90 14 " << kTop + plot_h / 2 << ")\">" << escape_xml(y_label)
-        << "</text>\n";
+        << "transform=\"rotate(-90 14 " << kTop + plot_h / 2 << ")\">"
+        << escape_xml(y_label) << "</text>\n";
     for (std::size_t i = 0; i < levels.size(); ++i) {
         const Descriptives& d = levels[i];
         const double x = x_of(i);
         svg << "<text x=\"" << num(x) << "\" y=\"" << kTop + plot_h + 18
             << "\" text-anchor=\"middle\">" << escape_xml(d.level) << "</text>\n";
         if (d.ci_low && d.ci_high) {
-            svg << "<line x1=\"" << num(x) << "\" y1=\"" << num(y_of(*d.ci_low)) << "\" x2=\""
-                << num(x) << "\" y2=\"" << num(y_of(*d.ci_high)) << "\" stroke=\"#444\"/>";
+            svg << "<line x1=\"" << num(x) << "\" y1=\"" << num(y_of(*d.ci_low))
+                << "\" x2=\"" << num(x) << "\" y2=\"" << num(y_of(*d.ci_high))
+                << "\" stroke=\"#444\"/>";
             for (double end : {*d.ci_low, *d.ci_high})
                 svg << "<line x1=\"" << num(x - 6) << "\" y1=\"" << num(y_of(end))
                     << "\" x2=\"" << num(x + 6) << "\" y2=\"" << num(y_of(end))

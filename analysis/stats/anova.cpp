@@ -30,14 +30,16 @@ AnovaResult one_way_anova(const OneWayData& data) {
     for (const Group* group : groups) {
         per_group.push_back(mean_and_squares(group->values, pivot));
         r.observations += group->values.size();
-        weighted_means.add(per_group.back().mean * static_cast<double>(group->values.size()));
+        weighted_means.add(per_group.back().mean *
+                           static_cast<double>(group->values.size()));
         within.add(per_group.back().squares);
     }
     if (r.groups < 2) {
         r.note = r.groups == 0 ? "no observations" : "only one group has observations";
         return r;
     }
-    const double grand_mean = weighted_means.value() / static_cast<double>(r.observations);
+    const double grand_mean =
+        weighted_means.value() / static_cast<double>(r.observations);
     CompensatedSum between;
     for (std::size_t i = 0; i < groups.size(); ++i) {
         const double d = per_group[i].mean - grand_mean;
@@ -57,7 +59,8 @@ AnovaResult one_way_anova(const OneWayData& data) {
     r.ms_within = r.ss_within / r.df_within;
     if (*r.ms_within > 0.0) {
         r.f = *r.ms_between / *r.ms_within;
-        r.omega_sq = (r.ss_between - r.df_between * *r.ms_within) / (ss_total + *r.ms_within);
+        r.omega_sq =
+            (r.ss_between - r.df_between * *r.ms_within) / (ss_total + *r.ms_within);
     } else if (*r.ms_between > 0.0) {
         r.f = std::numeric_limits<double>::infinity();
         r.note = "zero within-group variance with different means: F is infinite";
@@ -85,8 +88,10 @@ WelchResult welch_anova(const OneWayData& data) {
         const MeanAndSquares ms = mean_and_squares(group->values, pivot);
         const double n = static_cast<double>(group->values.size());
         if (n < 2.0 || ms.squares <= 0.0) {
-            r.note = "Welch's ANOVA needs two or more observations and a nonzero variance in "
-                     "every group (level '" + group->level + "' has not)";
+            r.note =
+                "Welch's ANOVA needs two or more observations and a nonzero variance in "
+                "every group (level '" +
+                group->level + "' has not)";
             return r;
         }
         const double w = n / (ms.squares / (n - 1.0));

@@ -5,7 +5,7 @@
 namespace lucent::analysis {
 
 struct AnovaResult {
-    int groups = 0;                // groups with at least one observation
+    int groups = 0;  // groups with at least one observation
     std::size_t observations = 0;
     double df_between = 0, df_within = 0;
     double ss_between = 0, ss_within = 0;
@@ -13,7 +13,7 @@ struct AnovaResult {
     Statistic f;                      // +inf: zero within variance, different means
     Statistic p;                      // P(F' > F), Boost's complement; 0 when F is +inf
     Statistic eta_sq, omega_sq;
-    std::string note;                 // why something is undefined, or "" when all is
+    std::string note;  // why something is undefined, or "" when all is
 };
 
 AnovaResult one_way_anova(const OneWayData& data);

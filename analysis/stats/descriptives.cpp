@@ -42,7 +42,8 @@ MeanAndSquares mean_and_squares(const std::vector<double>& values, double shift)
         squares.add(d * d);
     }
     const double residual = deviations.value();
-    return {provisional + residual / n, std::max(0.0, squares.value() - residual * residual / n)};
+    return {provisional + residual / n,
+            std::max(0.0, squares.value() - residual * residual / n)};
 }
 
 Descriptives describe(const Group& group, double origin, double confidence) {
@@ -57,8 +58,9 @@ Descriptives describe(const Group& group, double origin, double confidence) {
     const std::size_t half = d.n / 2;
     std::nth_element(sorted.begin(), sorted.begin() + half, sorted.end());
     double median = sorted[half];
-    if (d.n % 2 == 0) median = 0.5 * (median + *std::max_element(sorted.begin(),
-                                                                  sorted.begin() + half));
+    if (d.n % 2 == 0)
+        median =
+            0.5 * (median + *std::max_element(sorted.begin(), sorted.begin() + half));
     d.median = origin + median;
     if (d.n < 2) return d;
     const double sd = std::sqrt(ms.squares / static_cast<double>(d.n - 1));
@@ -73,7 +75,8 @@ Descriptives describe(const Group& group, double origin, double confidence) {
 
 std::vector<Descriptives> describe_all(const OneWayData& data, double confidence) {
     std::vector<Descriptives> all;
-    for (const Group& group : data.groups) all.push_back(describe(group, data.origin, confidence));
+    for (const Group& group : data.groups)
+        all.push_back(describe(group, data.origin, confidence));
     return all;
 }
 

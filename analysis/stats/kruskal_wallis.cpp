@@ -43,8 +43,8 @@ KruskalWallisResult kruskal_wallis(const OneWayData& data) {
         const double rank_sum = rank_sums[g].value();
         weighted.add(rank_sum * rank_sum / static_cast<double>(groups[g]->values.size()));
     }
-    const double h = (12.0 / (n * (n + 1.0)) * weighted.value() - 3.0 * (n + 1.0)) /
-                     tie_correction;
+    const double h =
+        (12.0 / (n * (n + 1.0)) * weighted.value() - 3.0 * (n + 1.0)) / tie_correction;
     r.h = std::max(0.0, h);
     r.p = boost::math::cdf(boost::math::complement(boost::math::chi_squared(r.df), *r.h));
     return r;

@@ -1,8 +1,9 @@
 #pragma once
 // The input of every one-way test: named groups of observations. Values are stored
-// relative to `origin` (value = origin + stored): readers subtract a common origin exactly
-// in decimal before converting to double, so data such as 1e12 + 0.4 keep their digits
-// (NIST SmLs07-09). Every statistic except a mean or median is invariant to the origin.
+// relative to `origin` (value = origin + stored): readers subtract a common origin
+// exactly in decimal before converting to double, so data such as 1e12 + 0.4 keep their
+// digits (NIST SmLs07-09). Every statistic except a mean or median is invariant to the
+// origin.
 #include <cstddef>
 #include <optional>
 #include <string>

@@ -36,7 +36,8 @@ double normal_pdf(double x) { return kInvSqrt2Pi * std::exp(-0.5 * x * x); }
 double normal_mass(double a, double b) {
     if (b - a < 1.0)
         return boost::math::quadrature::gauss<double, 10>::integrate(normal_pdf, a, b);
-    return a + b >= 0.0 ? normal_upper(a) - normal_upper(b) : normal_cdf(b) - normal_cdf(a);
+    return a + b >= 0.0 ? normal_upper(a) - normal_upper(b)
+                        : normal_cdf(b) - normal_cdf(a);
 }
 
 // Integrates f over the pieces between sorted breakpoints with globally adaptive
@@ -93,7 +94,8 @@ std::vector<double> even_points(double a, double b, double step) {
 }
 
 // P(range of k standard normals <= q): condition on the maximum z; all others lie in
-// [z - q, z]. The difference of Phi values is taken on whichever side avoids cancellation.
+// [z - q, z]. The difference of Phi values is taken on whichever side avoids
+// cancellation.
 double range_cdf_infinite_df(double q, int k) {
     if (q <= 0.0) return 0.0;
     const int m = k - 1;
@@ -111,8 +113,9 @@ double range_cdf_infinite_df(double q, int k) {
     return std::min(1.0, integrate_pieces(integrand, points, 1e-11));
 }
 
-// P(range of k standard normals > q) = k Int phi(z) [Phi(z)^m - (Phi(z) - Phi(z-q))^m] dz,
-// with a^m - (a - c)^m = a^m * -expm1(m log1p(-c / a)) so tiny tails keep their digits.
+// P(range of k standard normals > q) = k Int phi(z) [Phi(z)^m - (Phi(z) - Phi(z-q))^m]
+// dz, with a^m - (a - c)^m = a^m * -expm1(m log1p(-c / a)) so tiny tails keep their
+// digits.
 double range_upper_infinite_df(double q, int k) {
     if (q <= 0.0) return 1.0;
     const int m = k - 1;
@@ -150,8 +153,10 @@ double mix_over_scale(double q, int k, double df, Inner inner, bool upper) {
     const double lower_peak = std::sqrt((df - 1.0 + m) / df);
     double low = mode - kHalfWidthSds * sd;
     double high = mode + kHalfWidthSds * sd;
-    if (upper) low = std::min(low, tail_peak - kHalfWidthSds * tail_sd);
-    else high = std::max(high, lower_peak + kHalfWidthSds * sd);
+    if (upper)
+        low = std::min(low, tail_peak - kHalfWidthSds * tail_sd);
+    else
+        high = std::max(high, lower_peak + kHalfWidthSds * sd);
     low = std::max(0.0, low);
 
     std::vector<double> points{low, high};
@@ -164,8 +169,8 @@ double mix_over_scale(double q, int k, double df, Inner inner, bool upper) {
     // 2 Phi^-1(1 - 1/(2k))): mark that band, or a large q hides it between nodes.
     if (q > 0.0) {
         const double typical = 2.0 * std::sqrt(2.0) * boost::math::erfc_inv(1.0 / k);
-        for (double x : {0.25 * typical, 0.5 * typical, typical, typical + 1.5, typical + 3.0,
-                         typical + 5.0})
+        for (double x : {0.25 * typical, 0.5 * typical, typical, typical + 1.5,
+                         typical + 3.0, typical + 5.0})
             add(x / q);
     }
     auto integrand = [&](double s) {
@@ -201,9 +206,9 @@ struct Tails {
     double lower, upper;  // P(Q <= q), P(Q > q)
 };
 
-// Integrates whichever tail is the smaller one directly (the other is 1 minus it, exact to
-// 1e-16 absolute). The df = infinity tail is cheap and guesses which one that is; a wrong
-// guess costs one more integral.
+// Integrates whichever tail is the smaller one directly (the other is 1 minus it, exact
+// to 1e-16 absolute). The df = infinity tail is cheap and guesses which one that is; a
+// wrong guess costs one more integral.
 Tails tails(double q, int k, double df) {
     const bool infinite = df_is_infinite(df);
     auto lower = [&] {
@@ -247,7 +252,10 @@ double studentized_range_quantile_upper(double upper_p, int k, double df) {
         throw std::domain_error("studentized range: p must lie strictly between 0 and 1");
     // A quantile costs ~20 CDF evaluations, and Tukey HSD asks for the same few (alpha,
     // .05, .01 at one k and df) again and again: remember the last ones per thread.
-    struct Remembered { double p, df, q; int k; };
+    struct Remembered {
+        double p, df, q;
+        int k;
+    };
     thread_local std::array<Remembered, 8> remembered{};
     thread_local std::size_t next_slot = 0;
     for (const Remembered& r : remembered)

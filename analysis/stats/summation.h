@@ -10,7 +10,8 @@ public:
     void add(double x) {
         const double t = sum_ + x;
         // The larger operand keeps its digits; recover what the smaller one lost.
-        compensation_ += std::fabs(sum_) >= std::fabs(x) ? (sum_ - t) + x : (x - t) + sum_;
+        compensation_ +=
+            std::fabs(sum_) >= std::fabs(x) ? (sum_ - t) + x : (x - t) + sum_;
         sum_ = t;
     }
     double value() const { return sum_ + compensation_; }

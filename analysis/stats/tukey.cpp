@@ -19,7 +19,8 @@ TukeyResult tukey_hsd(const OneWayData& data, const AnovaResult& anova,
         return r;
     }
     if (k > kMaxRangeGroups) {
-        r.note = "Tukey HSD supports at most 200 groups (" + std::to_string(k) + " given)";
+        r.note =
+            "Tukey HSD supports at most 200 groups (" + std::to_string(k) + " given)";
         return r;
     }
     if (!anova.ms_within) {
@@ -32,25 +33,29 @@ TukeyResult tukey_hsd(const OneWayData& data, const AnovaResult& anova,
 
     // HSD threshold per level as the thesis printed it, when every group has n obs.
     bool balanced = true;
-    for (const Group* g : groups) balanced &= g->values.size() == groups[0]->values.size();
+    for (const Group* g : groups)
+        balanced &= g->values.size() == groups[0]->values.size();
     if (balanced) {
-        const double unit = std::sqrt(msw / static_cast<double>(groups[0]->values.size()));
+        const double unit =
+            std::sqrt(msw / static_cast<double>(groups[0]->values.size()));
         r.hsd_05 = studentized_range_quantile_upper(0.05, k, df) * unit;
         r.hsd_01 = studentized_range_quantile_upper(0.01, k, df) * unit;
     }
 
     std::vector<double> means;
     const double pivot = pivot_of(data);  // differences of means keep their digits
-    for (const Group* g : groups) means.push_back(mean_and_squares(g->values, pivot).mean);
+    for (const Group* g : groups)
+        means.push_back(mean_and_squares(g->values, pivot).mean);
     for (int a = 0; a < k; ++a) {
         for (int b = a + 1; b < k; ++b) {
             TukeyPair pair;
             pair.level_a = groups[a]->level;
             pair.level_b = groups[b]->level;
             pair.diff = means[b] - means[a];
-            const double se = std::sqrt(0.5 * msw *
-                                        (1.0 / static_cast<double>(groups[a]->values.size()) +
-                                         1.0 / static_cast<double>(groups[b]->values.size())));
+            const double se =
+                std::sqrt(0.5 * msw *
+                          (1.0 / static_cast<double>(groups[a]->values.size()) +
+                           1.0 / static_cast<double>(groups[b]->values.size())));
             pair.se = se;
             pair.lower = pair.diff - *r.q_critical * se;
             pair.upper = pair.diff + *r.q_critical * se;

@@ -28,7 +28,8 @@ struct TukeyOptions {
     bool p_values = true;
 };
 
-// Pairs of groups with observations, in group order; `anova` must come from the same data.
+// Pairs of groups with observations, in group order; `anova` must come from the same
+// data.
 TukeyResult tukey_hsd(const OneWayData& data, const AnovaResult& anova,
                       const TukeyOptions& options = {});
 

@@ -24,7 +24,9 @@ TEST(AnalyzeTable, OnePairPerQuestionAndFactor) {
         "p1,c,backlight,0.8,translucent,4\np1,d,backlight,1.6,translucent,6\n");
     int calls = 0;
     AnalysisRequest request;
-    request.on_pair = [&](const std::string&, const std::string&, std::size_t) { ++calls; };
+    request.on_pair = [&](const std::string&, const std::string&, std::size_t) {
+        ++calls;
+    };
     const auto all = analyze_table(t, request);
     ASSERT_EQ(all.size(), 3u);
     EXPECT_EQ(calls, 3);

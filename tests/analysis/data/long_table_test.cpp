@@ -55,18 +55,21 @@ TEST(LongTable, RatingsOutsideTheScaleNameTheLine) {
     EXPECT_NE(message.find("1..7"), std::string::npos) << message;
     EXPECT_NO_THROW(read(csv, parse_scale("0..10")));
     EXPECT_NO_THROW(read(csv, parse_scale("any")));
-    EXPECT_NE(error_of(csv, parse_scale("1..5")).find("ratings.csv:2"), std::string::npos);
+    EXPECT_NE(error_of(csv, parse_scale("1..5")).find("ratings.csv:2"),
+              std::string::npos);
 }
 
 TEST(LongTable, BadInputIsReportedNotCrashed) {
     EXPECT_NE(error_of("participant,stimulus,factor,level,question\n").find("rating"),
               std::string::npos);
-    EXPECT_NE(error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,abc\n")
-                  .find("ratings.csv:2"),
-              std::string::npos);
-    EXPECT_NE(error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,nan\n")
-                  .find("not a finite number"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,abc\n")
+            .find("ratings.csv:2"),
+        std::string::npos);
+    EXPECT_NE(
+        error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,nan\n")
+            .find("not a finite number"),
+        std::string::npos);
     EXPECT_NE(error_of("participant,stimulus,factor,level,question,rating\np,s,f,1\n")
                   .find("expected 6 fields"),
               std::string::npos);

@@ -14,11 +14,13 @@ TEST(Simulation, SameSeedSameStudy) {
     spec.seed = 42;
     const LongTable a = simulate_study(spec), b = simulate_study(spec);
     ASSERT_EQ(a.rows.size(), 38u * 3);
-    for (std::size_t i = 0; i < a.rows.size(); ++i) ASSERT_EQ(*a.rows[i].rating, *b.rows[i].rating);
+    for (std::size_t i = 0; i < a.rows.size(); ++i)
+        ASSERT_EQ(*a.rows[i].rating, *b.rows[i].rating);
     spec.seed = 43;
     const LongTable c = simulate_study(spec);
     int differing = 0;
-    for (std::size_t i = 0; i < a.rows.size(); ++i) differing += *a.rows[i].rating != *c.rows[i].rating;
+    for (std::size_t i = 0; i < a.rows.size(); ++i)
+        differing += *a.rows[i].rating != *c.rows[i].rating;
     EXPECT_GT(differing, 10);
     for (const RatingRow& row : a.rows) ASSERT_TRUE(*row.rating >= 1 && *row.rating <= 7);
 }

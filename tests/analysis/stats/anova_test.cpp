@@ -123,8 +123,8 @@ TEST(Anova, MillionObservations) {
 TEST(Anova, LargeOffsetKeepsDigits) {
     // Shifting by 1e9 must not change SS (two-pass, compensated).
     const AnovaResult base = one_way_anova(groups({{1.5, 2.25, 3}, {4, 5.5, 6}}));
-    const AnovaResult shifted =
-        one_way_anova(groups({{1e9 + 1.5, 1e9 + 2.25, 1e9 + 3}, {1e9 + 4, 1e9 + 5.5, 1e9 + 6}}));
+    const AnovaResult shifted = one_way_anova(
+        groups({{1e9 + 1.5, 1e9 + 2.25, 1e9 + 3}, {1e9 + 4, 1e9 + 5.5, 1e9 + 6}}));
     EXPECT_NEAR(shifted.ss_within / base.ss_within, 1.0, 1e-12);
     EXPECT_NEAR(*shifted.f / *base.f, 1.0, 1e-12);
 }

@@ -59,7 +59,8 @@ TEST(KruskalWallis, LikertTiesMatchRankVarianceFormula) {
     for (int trial = 0; trial < 5; ++trial) {
         std::vector<std::vector<double>> values(4);
         for (int g = 0; g < 4; ++g)
-            for (int i = 0; i < 10 + 3 * g; ++i) values[g].push_back(rating(engine) + (g == 3));
+            for (int i = 0; i < 10 + 3 * g; ++i)
+                values[g].push_back(rating(engine) + (g == 3));
         const auto r = kruskal_wallis(groups(values));
         ASSERT_TRUE(r.h);
         EXPECT_NEAR(*r.h, h_by_rank_variance(values), 1e-10);
@@ -87,7 +88,8 @@ TEST(Welch, TwoGroupsEqualWelchTTestSquared) {
     const auto [mb, vb] = mean_var(b);
     const double ua = va / a.size(), ub = vb / b.size();
     const double t = (ma - mb) / std::sqrt(ua + ub);
-    const double df = (ua + ub) * (ua + ub) / (ua * ua / (a.size() - 1) + ub * ub / (b.size() - 1));
+    const double df =
+        (ua + ub) * (ua + ub) / (ua * ua / (a.size() - 1) + ub * ub / (b.size() - 1));
     const WelchResult r = welch_anova(groups({a, b}));
     ASSERT_TRUE(r.f && r.df2 && r.p);
     EXPECT_NEAR(*r.f, t * t, 1e-12 * t * t);
@@ -110,9 +112,10 @@ TEST(Welch, EqualVariancesBalancedIsNearClassicalF) {
 }
 
 TEST(Welch, UndefinedCases) {
-    EXPECT_FALSE(welch_anova(groups({{1, 2, 3}, {5}})).f.has_value());     // n = 1
-    EXPECT_FALSE(welch_anova(groups({{1, 2, 3}, {5, 5}})).f.has_value());  // zero variance
-    EXPECT_FALSE(welch_anova(groups({{1, 2, 3}})).f.has_value());          // one group
+    EXPECT_FALSE(welch_anova(groups({{1, 2, 3}, {5}})).f.has_value());  // n = 1
+    EXPECT_FALSE(
+        welch_anova(groups({{1, 2, 3}, {5, 5}})).f.has_value());   // zero variance
+    EXPECT_FALSE(welch_anova(groups({{1, 2, 3}})).f.has_value());  // one group
 }
 
 }  // namespace

@@ -41,11 +41,14 @@ NistDataset read_nist(const std::filesystem::path& path) {
         const auto t = tokens(line);
         if (t.empty()) continue;
         if (in_data) {
-            if (t.size() == 2) csv << ++row << ",," << "treatment," << t[0] << ",response," << t[1] << "\n";
+            if (t.size() == 2)
+                csv << ++row << ",,"
+                    << "treatment," << t[0] << ",response," << t[1] << "\n";
             continue;
         }
         const std::size_t n = t.size();
-        if (t[0] == "Data:" && d.residual_sd > 0) in_data = true;  // not the header's "Data: 1 Factor"
+        if (t[0] == "Data:" && d.residual_sd > 0)
+            in_data = true;  // not the header's "Data: 1 Factor"
         else if (t[0] == "Between" && n >= 5) {
             d.df_between = std::stod(t[n - 4]);
             d.ss_between = std::stod(t[n - 3]);
@@ -68,7 +71,8 @@ NistDataset read_nist(const std::filesystem::path& path) {
 // Log relative error, capped at 15 as NIST does.
 double lre(double value, double certified) {
     if (value == certified) return 15.0;
-    return std::min(15.0, -std::log10(std::fabs(value - certified) / std::fabs(certified)));
+    return std::min(15.0,
+                    -std::log10(std::fabs(value - certified) / std::fabs(certified)));
 }
 
 struct Case {
@@ -115,13 +119,14 @@ TEST_P(NistAnova, MatchesEveryCertifiedValue) {
     RecordProperty("worst_lre", std::to_string(worst));
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    StRD, NistAnova,
-    ::testing::Values(Case{"SiRstv", 9}, Case{"SmLs01", 9}, Case{"SmLs02", 9},
-                      Case{"SmLs03", 9}, Case{"AtmWtAg", 9}, Case{"SmLs04", 9},
-                      Case{"SmLs05", 9}, Case{"SmLs06", 9}, Case{"SmLs07", 7},
-                      Case{"SmLs08", 7}, Case{"SmLs09", 7}),
-    [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(StRD, NistAnova,
+                         ::testing::Values(Case{"SiRstv", 9}, Case{"SmLs01", 9},
+                                           Case{"SmLs02", 9}, Case{"SmLs03", 9},
+                                           Case{"AtmWtAg", 9}, Case{"SmLs04", 9},
+                                           Case{"SmLs05", 9}, Case{"SmLs06", 9},
+                                           Case{"SmLs07", 7}, Case{"SmLs08", 7},
+                                           Case{"SmLs09", 7}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace
 }  // namespace lucent::analysis

@@ -18,9 +18,12 @@ struct RangeProbabilities {
 
 namespace detail {
 
-inline long double phi_upper(long double x) { return 0.5L * std::erfc(x / std::sqrt(2.0L)); }
+inline long double phi_upper(long double x) {
+    return 0.5L * std::erfc(x / std::sqrt(2.0L));
+}
 inline long double phi_pdf(long double x) {
-    return std::exp(-0.5L * x * x) / std::sqrt(2.0L * 3.14159265358979323846264338327950288L);
+    return std::exp(-0.5L * x * x) /
+           std::sqrt(2.0L * 3.14159265358979323846264338327950288L);
 }
 
 // Trapezoid rule on [a, b] with at most `step` between nodes, for a pair of integrands
@@ -65,7 +68,10 @@ inline void concave_support(const std::function<long double(long double)>& log_d
     long double a = -80, b = 20;
     for (int i = 0; i < 200; ++i) {  // ternary search for the peak
         const long double m1 = a + (b - a) / 3, m2 = b - (b - a) / 3;
-        if (log_density(m1) < log_density(m2)) a = m1; else b = m2;
+        if (log_density(m1) < log_density(m2))
+            a = m1;
+        else
+            b = m2;
     }
     const long double peak = 0.5L * (a + b), top = log_density(peak);
     auto solve = [&](long double inside, long double outside) {
@@ -82,12 +88,13 @@ inline void concave_support(const std::function<long double(long double)>& log_d
 }  // namespace detail
 
 // P(Q <= q) and P(Q > q) for k groups and df degrees of freedom (infinity allowed).
-inline RangeProbabilities reference_studentized_range(long double q, int k, long double df) {
+inline RangeProbabilities reference_studentized_range(long double q, int k,
+                                                      long double df) {
     using namespace detail;
     if (std::isinf(df)) return range_infinite_df(q, k);
     // Log-density of t = log S: S^df exp(-df S^2 / 2) up to a constant.
-    const long double log_norm = std::log(2.0L) + 0.5L * df * std::log(0.5L * df) -
-                                 std::lgamma(0.5L * df);
+    const long double log_norm =
+        std::log(2.0L) + 0.5L * df * std::log(0.5L * df) - std::lgamma(0.5L * df);
     auto log_density = [&](long double t) {
         return log_norm + df * t - 0.5L * df * std::exp(2 * t);
     };
@@ -95,9 +102,11 @@ inline RangeProbabilities reference_studentized_range(long double q, int k, long
     // tiny lower tail's peak (W ~ (q S)^(k-1)).
     long double lo = 0, hi = 0;
     concave_support(log_density, lo, hi, 40);
-    concave_support([&](long double t) { return log_density(t) - 0.25L * q * q * std::exp(2 * t); },
-                    lo, hi, 40);
-    concave_support([&](long double t) { return log_density(t) + (k - 1) * t; }, lo, hi, 40);
+    concave_support(
+        [&](long double t) { return log_density(t) - 0.25L * q * q * std::exp(2 * t); },
+        lo, hi, 40);
+    concave_support([&](long double t) { return log_density(t) + (k - 1) * t; }, lo, hi,
+                    40);
     // Narrowest peak: the tiny lower tail's, with curvature 2 (df + k - 1) in t.
     const long double sd = 1.0L / std::sqrt(2.0L * (df + k - 1));
     const long double step = std::min(0.1L, sd / 3);

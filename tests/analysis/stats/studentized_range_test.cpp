@@ -41,10 +41,12 @@ TEST_P(RangeGrid, CdfAndUpperTailMatchIndependentQuadrature) {
     double worst_abs = 0.0;
     int index = 0;
     for (double q : kGridQ) {
-        // Default: three q per case, rotating with (k, df) so the whole q range is covered.
+        // Default: three q per case, rotating with (k, df) so the whole q range is
+        // covered.
         const int rotation = (k + static_cast<int>(std::isinf(df) ? 7 : df)) % 3;
         if (!full && (index++ % 3) != rotation && q != 100.0) continue;
-        const auto ref = test::reference_studentized_range(q, k, std::isinf(df) ? INFINITY : df);
+        const auto ref =
+            test::reference_studentized_range(q, k, std::isinf(df) ? INFINITY : df);
         const double cdf = studentized_range_cdf(q, k, df);
         const double upper = studentized_range_upper(q, k, df);
         const double abs_error = std::fabs(cdf - static_cast<double>(ref.lower));
@@ -61,7 +63,8 @@ TEST_P(RangeGrid, CdfAndUpperTailMatchIndependentQuadrature) {
             EXPECT_NEAR(cdf / static_cast<double>(ref.lower), 1.0, 1e-7);
         }
     }
-    std::printf("[ GRID     ] k=%d df=%g worst |cdf - reference| = %.2e\n", k, df, worst_abs);
+    std::printf("[ GRID     ] k=%d df=%g worst |cdf - reference| = %.2e\n", k, df,
+                worst_abs);
 }
 
 std::vector<GridCase> grid_cases() {
@@ -75,15 +78,17 @@ INSTANTIATE_TEST_SUITE_P(Grid, RangeGrid, ::testing::ValuesIn(grid_cases()),
                          [](const auto& info) {
                              const double df = info.param.df;
                              return "k" + std::to_string(info.param.k) + "_df" +
-                                    (std::isinf(df) ? std::string("inf")
-                                                    : std::to_string(static_cast<int>(df)));
+                                    (std::isinf(df)
+                                         ? std::string("inf")
+                                         : std::to_string(static_cast<int>(df)));
                          });
 
 TEST(StudentizedRange, TwoGroupsFollowStudentT) {
     for (double df : {2.0, 3.0, 7.5, 30.0, 1e4, kInf})
         for (double q : {0.01, 0.3, 1.0, 2.77, 5.0, 12.0}) {
             const double expected = upper_k2(q, df);
-            EXPECT_NEAR(studentized_range_upper(q, 2, df), expected, 1e-12 + 1e-10 * expected)
+            EXPECT_NEAR(studentized_range_upper(q, 2, df), expected,
+                        1e-12 + 1e-10 * expected)
                 << "df=" << df << " q=" << q;
             EXPECT_NEAR(studentized_range_cdf(q, 2, df), 1.0 - expected, 1e-12);
         }
@@ -123,7 +128,8 @@ TEST(StudentizedRange, QuantileInvertsTheUpperTail) {
         for (double df : {2.0, 40.0, kInf})
             for (double p : {0.9, 0.01, 1e-6}) {
                 const double q = studentized_range_quantile_upper(p, k, df);
-                EXPECT_NEAR(studentized_range_upper(q, k, df), p, 1e-9 * std::max(p, 1e-3))
+                EXPECT_NEAR(studentized_range_upper(q, k, df), p,
+                            1e-9 * std::max(p, 1e-3))
                     << "k=" << k << " df=" << df << " p=" << p;
             }
     // k = 2, df = 2 in closed form: P(Q > 1.5) = 0.4.
@@ -136,8 +142,10 @@ TEST(StudentizedRange, EdgesAndBadArguments) {
     EXPECT_EQ(studentized_range_upper(INFINITY, 5, 10.0), 0.0);
     EXPECT_GT(studentized_range_cdf(1e-3, 2, 2.0), 0.0);
     // Huge df behaves like infinity.
-    EXPECT_NEAR(studentized_range_cdf(3.5, 4, 1e13), studentized_range_cdf(3.5, 4, kInf), 1e-12);
-    EXPECT_NEAR(studentized_range_cdf(3.5, 4, 1e7), studentized_range_cdf(3.5, 4, kInf), 1e-6);
+    EXPECT_NEAR(studentized_range_cdf(3.5, 4, 1e13), studentized_range_cdf(3.5, 4, kInf),
+                1e-12);
+    EXPECT_NEAR(studentized_range_cdf(3.5, 4, 1e7), studentized_range_cdf(3.5, 4, kInf),
+                1e-6);
     // k up to 200.
     const double q200 = studentized_range_quantile_upper(0.05, 200, 1000.0);
     EXPECT_GT(q200, studentized_range_quantile_upper(0.05, 100, 1000.0));

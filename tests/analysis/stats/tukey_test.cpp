@@ -1,5 +1,5 @@
-// Tukey HSD: the k = 2 identity with the pooled t test, R's documented warpbreaks example,
-// the Tukey-Kramer standard error, and the interval/p-value agreement.
+// Tukey HSD: the k = 2 identity with the pooled t test, R's documented warpbreaks
+// example, the Tukey-Kramer standard error, and the interval/p-value agreement.
 #include "stats/tukey.h"
 
 #include <gtest/gtest.h>
@@ -38,8 +38,8 @@ TEST(Tukey, TwoGroupsMatchPooledTTest) {
     EXPECT_NEAR(p.diff, mb - ma, 1e-14);  // b - a, as R prints it
     EXPECT_NEAR(*p.se, se_t / std::sqrt(2.0), 1e-14);
     EXPECT_NEAR(*p.q, std::fabs(t) * std::sqrt(2.0), 1e-12);
-    EXPECT_NEAR(*p.p_adj, 2 * boost::math::cdf(boost::math::complement(dist, std::fabs(t))),
-                1e-10);
+    EXPECT_NEAR(*p.p_adj,
+                2 * boost::math::cdf(boost::math::complement(dist, std::fabs(t))), 1e-10);
     const double half = boost::math::quantile(dist, 0.975) * se_t;
     EXPECT_NEAR(*p.lower, (mb - ma) - half, 1e-8);
     EXPECT_NEAR(*p.upper, (mb - ma) + half, 1e-8);
@@ -51,7 +51,8 @@ TEST(Tukey, WarpbreaksByTensionAgainstHandMeansAndReferenceQuadrature) {
     const auto data = named(
         {{"L", {26, 30, 54, 25, 70, 52, 51, 26, 67, 27, 14, 29, 19, 29, 31, 41, 20, 44}},
          {"M", {18, 21, 29, 17, 12, 18, 35, 30, 36, 42, 26, 19, 16, 39, 28, 21, 39, 29}},
-         {"H", {36, 21, 24, 18, 10, 43, 28, 15, 26, 20, 21, 24, 17, 13, 15, 15, 16, 28}}});
+         {"H",
+          {36, 21, 24, 18, 10, 43, 28, 15, 26, 20, 21, 24, 17, 13, 15, 15, 16, 28}}});
     const AnovaResult anova = one_way_anova(data);
     const TukeyResult r = tukey_hsd(data, anova, {0.05, true});
     ASSERT_EQ(r.pairs.size(), 3u);
@@ -63,7 +64,8 @@ TEST(Tukey, WarpbreaksByTensionAgainstHandMeansAndReferenceQuadrature) {
         EXPECT_NEAR(p.diff, expected_diff[i], 1e-12);
         EXPECT_NEAR(*p.se, se, 1e-12);
         // p_adj against the independent extended-precision quadrature.
-        const auto ref = test::reference_studentized_range(std::fabs(p.diff) / se, 3, 51.0L);
+        const auto ref =
+            test::reference_studentized_range(std::fabs(p.diff) / se, 3, 51.0L);
         EXPECT_NEAR(*p.p_adj, static_cast<double>(ref.upper), 1e-10);
         const auto at_bound =
             test::reference_studentized_range((p.diff - *p.lower) / se, 3, 51.0L);
@@ -114,7 +116,8 @@ TEST(Tukey, DegenerateCases) {
     EXPECT_FALSE(tukey_hsd(singletons, one_way_anova(singletons)).note.empty());
     // More than 200 groups: refused with a note.
     OneWayData many;
-    for (int g = 0; g < 201; ++g) many.groups.push_back({std::to_string(g), {1.0 * g, g + 1.0}});
+    for (int g = 0; g < 201; ++g)
+        many.groups.push_back({std::to_string(g), {1.0 * g, g + 1.0}});
     const TukeyResult big = tukey_hsd(many, one_way_anova(many));
     EXPECT_TRUE(big.pairs.empty());
     EXPECT_NE(big.note.find("200"), std::string::npos);
@@ -123,10 +126,12 @@ TEST(Tukey, DegenerateCases) {
 TEST(Tukey, HundredFiftyGroupsIntervalsOnly) {
     OneWayData many;
     for (int g = 0; g < 150; ++g)
-        many.groups.push_back({std::to_string(g), {0.01 * g, 0.01 * g + 1, 0.01 * g + 2}});
+        many.groups.push_back(
+            {std::to_string(g), {0.01 * g, 0.01 * g + 1, 0.01 * g + 2}});
     const TukeyResult r = tukey_hsd(many, one_way_anova(many), {0.05, false});
     EXPECT_EQ(r.pairs.size(), 150u * 149 / 2);
-    for (const TukeyPair& p : r.pairs) ASSERT_TRUE(p.lower && *p.lower < 0 && *p.upper > 0);
+    for (const TukeyPair& p : r.pairs)
+        ASSERT_TRUE(p.lower && *p.lower < 0 && *p.upper > 0);
 }
 
 }  // namespace
