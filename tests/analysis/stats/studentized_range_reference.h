@@ -57,9 +57,10 @@ inline RangeProbabilities range_infinite_df(long double q, int k) {
                 density * std::pow(above_min, (long double)m) *
                     -std::expm1(m * std::log1p(-above_range / above_min))};
     };
-    // Step 0.05: the narrowest integrand (k = 100, tiny q) has a width near 0.1.
+    // The narrowest integrand (tiny q: phi(z)^k) has a width near 1/sqrt(k); the
+    // trapezoid error falls like exp(-2 pi^2 (width / step)^2).
     const long double a = -0.5L * q - 12.0L - std::log((long double)k);
-    return trapezoid(both, a, 12.0L, 0.05L);
+    return trapezoid(both, a, 12.0L, std::min(0.1L, 0.5L / std::sqrt((long double)k)));
 }
 
 // Finds [lo, hi] where a concave log-density L(t) lies within `drop` of its maximum.
@@ -109,7 +110,7 @@ inline RangeProbabilities reference_studentized_range(long double q, int k,
                     40);
     // Narrowest peak: the tiny lower tail's, with curvature 2 (df + k - 1) in t.
     const long double sd = 1.0L / std::sqrt(2.0L * (df + k - 1));
-    const long double step = std::min(0.1L, sd / 3);
+    const long double step = std::min(0.1L, sd / 2.5L);
     auto both = [&](long double t) -> RangeProbabilities {
         const long double density = std::exp(log_density(t));
         const RangeProbabilities inner = range_infinite_df(q * std::exp(t), k);
