@@ -5,6 +5,7 @@ namespace lucent::app {
 
 void register_bench_families(CLI::App& bench, int& exit_code) {
     register_bench_ao(bench, exit_code);
+    register_bench_stats(bench, exit_code);
 }
 
 }  // namespace lucent::app

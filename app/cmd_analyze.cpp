@@ -1,0 +1,68 @@
+// lucent analyze: one-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch reports with plots
+// from a long CSV of ratings (participant,stimulus,factor,level,question,rating).
+#include <iostream>
+
+#include "analyze.h"
+#include "commands.h"
+#include "data/long_table.h"
+#include "report/report.h"
+
+namespace lucent::app {
+namespace {
+
+struct AnalyzeArgs {
+    std::string input, out_dir, factor, question, formats = "md,csv,html", scale = "1..7";
+    double alpha = 0.10;
+};
+
+int run_analyze(const AnalyzeArgs& args) {
+    using namespace lucent::analysis;
+    try {
+        if (!(args.alpha > 0.0 && args.alpha < 1.0))
+            throw InputError("--alpha must lie strictly between 0 and 1");
+        ReportOptions options;
+        parse_formats(args.formats, options);
+        options.alpha = args.alpha;
+        options.source = args.input;
+        const LongTable table = read_long_csv(args.input, parse_scale(args.scale));
+        AnalysisRequest request{args.alpha, args.question, args.factor,
+                                [](const std::string& question, const std::string& factor,
+                                   std::size_t levels) {
+                                    std::cerr << "analyzing " << question << " ~ "
+                                              << factor << " (" << levels << " levels)\n";
+                                }};
+        const std::vector<OneWayAnalysis> analyses = analyze_table(table, request);
+        for (const auto& path : write_report(analyses, args.out_dir, options))
+            std::cout << path.string() << "\n";
+        return kExitOk;
+    } catch (const InputError& e) {
+        std::cerr << "lucent analyze: " << e.what() << "\n";
+        return kExitUsage;
+    }
+}
+
+}  // namespace
+
+void register_analyze(CLI::App& app, int& exit_code) {
+    auto args = std::make_shared<AnalyzeArgs>();
+    auto* cmd = app.add_subcommand(
+        "analyze",
+        "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
+        "with plots, from a long CSV of ratings");
+    cmd->add_option("input", args->input,
+                    "Long CSV: participant,stimulus,factor,level,question,rating")
+        ->required();
+    cmd->add_option("--out", args->out_dir, "Directory for the report")->required();
+    cmd->add_option("--alpha", args->alpha, "Significance level (Tukey CI at 1 - alpha)")
+        ->capture_default_str();
+    cmd->add_option("--factor", args->factor, "Analyze only this factor");
+    cmd->add_option("--question", args->question, "Analyze only this question");
+    cmd->add_option("--format", args->formats, "Comma-separated subset of md,csv,html")
+        ->capture_default_str();
+    cmd->add_option("--scale", args->scale,
+                    "Accepted ratings: MIN..MAX, or 'any' for any finite number")
+        ->capture_default_str();
+    cmd->callback([args, &exit_code] { exit_code = run_analyze(*args); });
+}
+
+}  // namespace lucent::app

@@ -1,0 +1,129 @@
+// The long CSV reader: CRLF, quotes, missing ratings, exact decimal origin, scale checks
+// and error messages that name the line.
+#include "data/long_table.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "data/decimal.h"
+#include "data/grouping.h"
+
+namespace lucent::analysis {
+namespace {
+
+LongTable read(const std::string& text, RatingScale scale = {}) {
+    std::istringstream in(text);
+    return read_long_csv(in, "ratings.csv", scale);
+}
+
+std::string error_of(const std::string& text, RatingScale scale = {}) {
+    try {
+        read(text, scale);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(LongTable, ReadsCrlfQuotesAndMissingRatings) {
+    const LongTable t = read(
+        "rating,question,level,factor,stimulus,participant\r\n"
+        "5,translucent,18,thickness,img1,p1\r\n"
+        "\"3\",\"looks, realistic\",18,thickness,img1,p1\r\n"
+        ",translucent,25,thickness,img2,p1\r\n");
+    ASSERT_EQ(t.rows.size(), 3u);
+    EXPECT_EQ(t.rows[1].question, "looks, realistic");
+    EXPECT_DOUBLE_EQ(t.origin + *t.rows[0].rating, 5.0);
+    EXPECT_DOUBLE_EQ(t.origin + *t.rows[1].rating, 3.0);
+    EXPECT_FALSE(t.rows[2].rating.has_value());
+    const auto pairs = split_by_question_and_factor(t, "translucent");
+    ASSERT_EQ(pairs.size(), 1u);
+    ASSERT_EQ(pairs[0].data.groups.size(), 2u);
+    EXPECT_TRUE(pairs[0].data.groups[1].values.empty());  // level 25: an empty group
+    EXPECT_EQ(pairs[0].missing_ratings, 1u);
+}
+
+TEST(LongTable, RatingsOutsideTheScaleNameTheLine) {
+    const std::string csv =
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,a,f,1,q,7\n"
+        "p1,b,f,2,q,9\n";
+    const std::string message = error_of(csv);
+    EXPECT_NE(message.find("ratings.csv:3"), std::string::npos) << message;
+    EXPECT_NE(message.find("1..7"), std::string::npos) << message;
+    EXPECT_NO_THROW(read(csv, parse_scale("0..10")));
+    EXPECT_NO_THROW(read(csv, parse_scale("any")));
+    EXPECT_NE(error_of(csv, parse_scale("1..5")).find("ratings.csv:2"),
+              std::string::npos);
+}
+
+TEST(LongTable, BadInputIsReportedNotCrashed) {
+    EXPECT_NE(error_of("participant,stimulus,factor,level,question\n").find("rating"),
+              std::string::npos);
+    EXPECT_NE(
+        error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,abc\n")
+            .find("ratings.csv:2"),
+        std::string::npos);
+    EXPECT_NE(
+        error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,nan\n")
+            .find("not a finite number"),
+        std::string::npos);
+    EXPECT_NE(error_of("participant,stimulus,factor,level,question,rating\np,s,f,1\n")
+                  .find("expected 6 fields"),
+              std::string::npos);
+    EXPECT_NE(error_of("").find("empty"), std::string::npos);
+    EXPECT_THROW(parse_scale("7..1"), InputError);
+    EXPECT_THROW(parse_scale("1-7"), InputError);
+}
+
+TEST(LongTable, TablesFromOtherReadersAreCheckedToo) {
+    // The study database reader fills LongTable directly; check_scale names its row.
+    LongTable t;
+    t.rows.push_back({"p1", "s1", "f", "1", "q", 3.0, 12});
+    t.rows.push_back({"p1", "s2", "f", "2", "q", 8.0, 13});
+    EXPECT_THROW(check_scale(t, RatingScale{}, "study.db"), InputError);
+    try {
+        check_scale(t, RatingScale{}, "study.db");
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("study.db:13"), std::string::npos);
+    }
+    t.rows[1].rating = std::nan("");
+    EXPECT_THROW(check_scale(t, RatingScale{true}, "study.db"), InputError);
+}
+
+TEST(Decimal, DifferencesAreExact) {
+    // 1e12 + 0.4 is not representable; its difference from 1e12 + 0.2 is, nearly: 0.2.
+    EXPECT_EQ(exact_difference("1000000000000.4", "1000000000000.2"), 0.2);
+    EXPECT_EQ(exact_difference("107.8681568", "107.8681465"), 0.0000103);
+    EXPECT_EQ(exact_difference("1.5e3", "1000"), 500.0);
+    EXPECT_FALSE(parse_finite_number("inf").has_value());
+    EXPECT_FALSE(parse_finite_number("1e400").has_value());
+    EXPECT_FALSE(parse_finite_number("").has_value());
+    EXPECT_EQ(*parse_finite_number(" 2.5 "), 2.5);
+}
+
+TEST(LongTable, OriginKeepsDigitsOfHugeValues) {
+    const LongTable t = read(
+        "participant,stimulus,factor,level,question,rating\n"
+        "1,,f,1,q,1000000000000.4\n"
+        "2,,f,1,q,1000000000000.3\n"
+        "3,,f,2,q,1000000000000.5\n",
+        RatingScale{true});
+    EXPECT_NEAR(*t.rows[1].rating - *t.rows[0].rating, -0.1, 1e-15);
+    EXPECT_NEAR(*t.rows[2].rating - *t.rows[0].rating, 0.1, 1e-15);
+}
+
+TEST(Grouping, NumericLevelsSortNumerically) {
+    const LongTable t = read(
+        "participant,stimulus,factor,level,question,rating\n"
+        "p,s,r,30,q,1\np,s,r,18,q,2\np,s,r,25,q,3\n");
+    const auto pairs = split_by_question_and_factor(t);
+    ASSERT_EQ(pairs[0].data.groups.size(), 3u);
+    EXPECT_EQ(pairs[0].data.groups[0].level, "18");
+    EXPECT_EQ(pairs[0].data.groups[2].level, "30");
+}
+
+}  // namespace
+}  // namespace lucent::analysis

@@ -1,0 +1,107 @@
+// Reports: exact CSV headers, 17-digit numbers that parse back, no NaN/Inf anywhere, the
+// SVG beside the HTML and embedded in it, hard cases spelled out.
+#include "report/report.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "data/long_table.h"
+#include "test_paths.h"
+
+namespace lucent::analysis {
+namespace {
+
+std::string slurp(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::string first_line(const std::string& text) {
+    return text.substr(0, text.find('\n'));
+}
+
+OneWayData groups(std::vector<std::vector<double>> values) {
+    OneWayData data;
+    for (std::size_t i = 0; i < values.size(); ++i)
+        data.groups.push_back({std::to_string(i + 1), std::move(values[i])});
+    return data;
+}
+
+TEST(Report, WritesEveryFormatWithExactHeaders) {
+    const auto dir = test::scratch_dir("report_formats");
+    std::vector<OneWayAnalysis> analyses{
+        analyze_one_way("translucent", "thickness",
+                        groups({{1, 2, 3, 2}, {4, 5, 6, 5}, {3, 4, 4}}), 0.10),
+        analyze_one_way("realistic", "thickness", groups({{4, 4}, {4, 4, 4}}),
+                        0.10),  // identical
+        analyze_one_way("varnished", "thickness", groups({{1, 1}, {3, 3}}),
+                        0.10),  // F = inf
+        analyze_one_way("single", "thickness", groups({{1, 2}, {}}),
+                        0.10)};  // one + empty
+    write_report(analyses, dir, ReportOptions{});
+    EXPECT_EQ(
+        first_line(slurp(dir / "anova.csv")),
+        "question,factor,ss_between,ss_within,df_between,df_within,ms_between,ms_within,"
+        "f,p,eta_sq,omega_sq");
+    EXPECT_EQ(first_line(slurp(dir / "tukey.csv")),
+              "question,factor,level_a,level_b,diff,se,q,p_adj,lower,upper");
+    EXPECT_EQ(first_line(slurp(dir / "kruskal.csv")), "question,factor,h,df,p");
+    EXPECT_EQ(first_line(slurp(dir / "welch.csv")), "question,factor,f,df1,df2,p");
+
+    const std::string anova = slurp(dir / "anova.csv");
+    // Full precision: F for the first pair printed with 17 significant digits
+    // round-trips.
+    std::istringstream rows(anova);
+    std::string header, first;
+    std::getline(rows, header);
+    std::getline(rows, first);
+    std::vector<std::string> cells;
+    for (std::stringstream s(first); std::getline(s, header, ',');)
+        cells.push_back(header);
+    ASSERT_EQ(cells.size(), 12u);
+    EXPECT_EQ(std::stod(cells[8]), *analyses[0].anova.f);
+    EXPECT_NE(anova.find("realistic,thickness,0,0,1,3,0,0,undefined,undefined"),
+              std::string::npos)
+        << anova;
+    EXPECT_NE(anova.find(",inf,< 1e-300,1,"), std::string::npos) << anova;
+
+    for (const char* name : {"anova.csv", "tukey.csv", "kruskal.csv", "welch.csv",
+                             "descriptives.csv", "report.md", "report.html"}) {
+        // No NaN in any spelling; "inf" only as a whole cell (spelled out on purpose).
+        const std::string text = slurp(dir / name);
+        EXPECT_FALSE(std::regex_search(text, std::regex("nan", std::regex::icase)))
+            << name;
+        EXPECT_FALSE(std::regex_search(text, std::regex("[0-9.]inf|infinity"))) << name;
+    }
+    const std::string md = slurp(dir / "report.md");
+    EXPECT_NE(md.find("| configuration | p | F |"), std::string::npos);
+    EXPECT_NE(md.find("translucent ~ thickness"), std::string::npos);
+    EXPECT_NE(md.find("undefined"), std::string::npos);
+    EXPECT_NE(md.find("no observations"), std::string::npos);
+    const std::string html = slurp(dir / "report.html");
+    EXPECT_NE(html.find("<svg"), std::string::npos);
+    const auto svg = dir / plot_file_name("translucent", "thickness");
+    ASSERT_TRUE(std::filesystem::exists(svg));
+    EXPECT_NE(slurp(svg).find("<circle"), std::string::npos);
+}
+
+TEST(Report, FormatSelectionAndErrors) {
+    ReportOptions options;
+    parse_formats("csv", options);
+    EXPECT_TRUE(options.csv);
+    EXPECT_FALSE(options.markdown || options.html);
+    EXPECT_THROW(parse_formats("md,pdf", options), InputError);
+    const auto dir = test::scratch_dir("report_csv_only");
+    write_report({analyze_one_way("q", "f", groups({{1, 2}, {3, 4}}), 0.05)}, dir,
+                 options);
+    EXPECT_TRUE(std::filesystem::exists(dir / "anova.csv"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "report.md"));
+}
+
+}  // namespace
+}  // namespace lucent::analysis

@@ -1,0 +1,59 @@
+# CLI tests of lucent analyze / stats / simulate / bench stats (included from
+# CMakeLists.txt). Expected numbers come from closed forms, not from lucent's output.
+set(LUCENT_APP_TEST_DIR ${CMAKE_CURRENT_SOURCE_DIR})
+function(lucent_expect_number name expect digits)
+  add_test(NAME ${name}
+           COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent> "-DARGS=${ARGN}"
+                   -DEXPECT=${expect} -DDIGITS=${digits}
+                   -P ${LUCENT_APP_TEST_DIR}/expect_number.cmake)
+endfunction()
+
+# k = 2, df = 2: P(Q > q) = 1 - q / sqrt(4 + q^2), so P(Q > 1.5) = 0.4 exactly.
+lucent_expect_number(app.stats_ptukey_k2_df2 0.4 13 stats;ptukey;--q;1.5;--k;2;--df;2)
+lucent_expect_number(app.stats_ptukey_lower 0.6 13 stats;ptukey;--q;1.5;--k;2;--df;2;--lower)
+lucent_expect_number(app.stats_qtukey_k2_df2 1.5 11 stats;qtukey;--p;0.4;--k;2;--df;2)
+# k = 2, df = inf: P(Q > q) = erfc(q / 2); erfc(1) and erfc(20) from tables.
+lucent_expect_number(app.stats_ptukey_k2_inf 0.157299207050285130658 13
+                     stats;ptukey;--q;2;--k;2;--df;inf)
+lucent_expect_number(app.stats_ptukey_far_tail 5.3958656116079e-176 12
+                     stats;ptukey;--q;40;--k;2;--df;inf)
+# Tukey's table: q(.05; k = 3, df = 10) = 3.877.
+lucent_expect_number(app.stats_qtukey_table 3.877 4 stats;qtukey;--p;0.05;--k;3;--df;10)
+
+add_test(NAME app.stats_bad_k_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=stats;ptukey;--q;3;--k;1;--df;10" -DEXPECT_CODE=2 -DEXPECT_STDERR=k
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.stats_bad_df_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=stats;qtukey;--p;0.05;--k;3;--df;lots" -DEXPECT_CODE=2
+                 -DEXPECT_STDERR=--df -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.analyze_rejects_out_of_scale
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/out_of_scale.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/out_of_scale"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=out_of_scale.csv:3: rating 9 is outside the scale 1..7"
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.analyze_bad_format_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/out_of_scale.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/bad_format;--format;pdf"
+                 -DEXPECT_CODE=2 -DEXPECT_STDERR=pdf -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.analyze_missing_input_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;/nonexistent/ratings.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/missing"
+                 -DEXPECT_CODE=2 -DEXPECT_STDERR=nonexistent -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.analyze_nist_sirstv_scale_any
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 -DNIST_FILE=${LUCENT_SHARED_DIR}/data/nist-strd-anova/SiRstv.dat
+                 -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/nist_sirstv
+                 -P ${LUCENT_APP_TEST_DIR}/analyze_nist.cmake)
+set_tests_properties(app.analyze_nist_sirstv_scale_any PROPERTIES SKIP_REGULAR_EXPRESSION "SKIP:")
+add_test(NAME app.analyze_simulated_study
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/pipeline
+                 -P ${LUCENT_APP_TEST_DIR}/analyze_pipeline.cmake)
+add_test(NAME app.simulate_bad_effects_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=simulate;--out;${CMAKE_CURRENT_BINARY_DIR}/x.csv;--participants;0"
+                 -DEXPECT_CODE=2 -DEXPECT_STDERR=participants -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.bench_stats_small COMMAND lucent bench stats --ratings 20000 --cdf-seconds 0.02)
+set_tests_properties(app.bench_stats_small PROPERTIES PASS_REGULAR_EXPRESSION "evals/s")
