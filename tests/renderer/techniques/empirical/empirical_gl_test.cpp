@@ -61,6 +61,23 @@ TEST_F(EmpiricalGl, AllocatesOnlyTheTexturesThePlanNames) {
     EXPECT_EQ(names({{"backlight", "0"}, {"ambient", "0"}}), (std::vector<std::string>{"colour", "shade_depth"}));
 }
 
+TEST_F(EmpiricalGl, TimesEachPlannedPass) {
+    gl::FrameExecutor executor;
+    const Scene scene = empirical_scene(builtin_mesh("sphere:2k"), {{"ao_rays", "16"}, {"blur_kernel", "1"}}, 32, 32);
+    const FramePlan plan = make_frame_plan(scene, find_technique("empirical"));
+    executor.execute(scene, plan, /*time_passes=*/true);
+    const auto& timings = executor.last_timings();
+    ASSERT_EQ(timings.passes.size(), plan.passes.size());
+    double sum = 0.0;
+    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+        EXPECT_EQ(timings.passes[i].pass, plan.passes[i].name);
+        EXPECT_GE(timings.passes[i].milliseconds, 0.0);
+        sum += timings.passes[i].milliseconds;
+    }
+    EXPECT_DOUBLE_EQ(timings.total_milliseconds, sum);
+    EXPECT_GT(sum, 0.0);
+}
+
 // GL vs the Embree reference on every built-in mesh: mean absolute error < 1/255 and
 // 99th percentile < 4/255 outside a 1-pixel silhouette band.
 TEST_F(EmpiricalGl, MatchesTheCpuReferenceOnTheBuiltInMeshes) {
