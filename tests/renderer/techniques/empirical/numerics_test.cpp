@@ -105,7 +105,9 @@ TEST_F(EmpiricalNumerics, ThicknessExponentZeroAndHuge) {
     EXPECT_GT(covered, 100);
     for (int y = 0; y < 48; ++y)
         for (int x = 0; x < 48; ++x)
-            if (cpu_zero.at(x, y).a > 0.0f) EXPECT_EQ(cpu_zero.at(x, y).r, 1.0f);
+            if (cpu_zero.at(x, y).a > 0.0f) {
+                EXPECT_EQ(cpu_zero.at(x, y).r, 1.0f);
+            }
 }
 
 // n = 0: (N.H)^0 = 1 wherever N.L > 0, so the specular term is ws * ks * Is = 1 there.
