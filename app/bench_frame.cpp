@@ -29,19 +29,32 @@ double median(std::vector<double> values) {
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// Median over `frames` frames of the summed GPU pass times (the CPU AO pass excluded).
+// Median over `frames` frames of the summed GPU pass times (the CPU AO pass excluded);
+// `breakdown` gets each GPU pass's median, "name ms" separated by commas.
 double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene, int frames, int warmup,
-                       bool& gpu_timer) {
+                       bool& gpu_timer, std::string& breakdown) {
     const FramePlan plan = make_frame_plan(scene, find_technique(scene.technique));
     std::vector<double> times;
+    std::vector<std::vector<double>> per_pass(plan.passes.size());
     for (int i = 0; i < warmup + frames; ++i) {
         executor.execute(scene, plan, /*time_passes=*/true);
         const auto& timings = executor.last_timings();
         gpu_timer = timings.gpu_timer;
         double ms = 0.0;
-        for (std::size_t p = 0; p < timings.passes.size(); ++p)
-            if (plan.passes[p].kind != PassKind::bake_ambient_occlusion) ms += timings.passes[p].milliseconds;
+        for (std::size_t p = 0; p < timings.passes.size(); ++p) {
+            if (plan.passes[p].kind == PassKind::bake_ambient_occlusion) continue;
+            ms += timings.passes[p].milliseconds;
+            if (i >= warmup) per_pass[p].push_back(timings.passes[p].milliseconds);
+        }
         if (i >= warmup) times.push_back(ms);
+    }
+    breakdown.clear();
+    char text[64];
+    for (std::size_t p = 0; p < plan.passes.size(); ++p) {
+        if (per_pass[p].empty()) continue;
+        std::snprintf(text, sizeof text, "%s%s %.2f", breakdown.empty() ? "" : ", ",
+                      plan.passes[p].name.c_str(), median(per_pass[p]));
+        breakdown += text;
     }
     return median(times);
 }
@@ -62,7 +75,7 @@ int run_frame_bench(const FrameBenchOptions& options) {
     }
     const gl::GlInfo info = context->info();
     gl::FrameExecutor executor;
-    std::ostringstream table;
+    std::ostringstream table, breakdowns;
     bool gpu_timer = false;
     char line[200];
     std::snprintf(line, sizeof line, "%10s %10s | %12s %8s | %12s %8s | %6s\n", "faces", "vertices",
@@ -82,8 +95,13 @@ int run_frame_bench(const FrameBenchOptions& options) {
             return kExitUsage;
         }
         std::cerr << "measuring " << request.mesh << " (" << full.mesh->face_count() << " faces)...\n";
-        const double full_ms = median_frame_ms(executor, full, options.frames, options.warmup, gpu_timer);
-        const double direct_ms = median_frame_ms(executor, direct, options.frames, options.warmup, gpu_timer);
+        std::string full_passes, direct_passes;
+        const double full_ms =
+            median_frame_ms(executor, full, options.frames, options.warmup, gpu_timer, full_passes);
+        const double direct_ms =
+            median_frame_ms(executor, direct, options.frames, options.warmup, gpu_timer, direct_passes);
+        breakdowns << "  " << full.mesh->face_count() << " faces: full: " << full_passes
+                   << " | direct: " << direct_passes << "\n";
         std::snprintf(line, sizeof line, "%10zu %10zu | %12.3f %8.1f | %12.3f %8.1f | %6.2f\n",
                       full.mesh->face_count(), full.mesh->vertex_count(), full_ms, 1000.0 / full_ms,
                       direct_ms, 1000.0 / direct_ms, full_ms / direct_ms);
@@ -99,7 +117,8 @@ int run_frame_bench(const FrameBenchOptions& options) {
               << "; AO bake precomputed, not in the frame\n"
               << "full = empirical shader (AO, peel, 5x5 smoothing, Eq. 3.6); direct = "
                  "ambient + diffuse + specular (backlight 0)\n\n"
-              << table.str() << "ratio = full / direct frame time\n";
+              << table.str() << "ratio = full / direct frame time\n\n"
+              << "median per pass (ms):\n" << breakdowns.str();
     return kExitOk;
 }
 
