@@ -29,35 +29,38 @@ double median(std::vector<double> values) {
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// Median over `frames` frames of the summed GPU pass times (the CPU AO pass excluded);
-// `breakdown` gets each GPU pass's median, "name ms" separated by commas.
-double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene, int frames, int warmup,
-                       bool& gpu_timer, std::string& breakdown) {
-    const FramePlan plan = make_frame_plan(scene, find_technique(scene.technique));
-    std::vector<double> times;
-    std::vector<std::vector<double>> per_pass(plan.passes.size());
-    for (int i = 0; i < warmup + frames; ++i) {
+// One frame's GPU time: the sum of its GPU passes (the CPU AO pass excluded).
+struct Sampler {
+    gl::FrameExecutor executor;
+    FramePlan plan;
+    std::vector<double> frame_ms;
+    std::vector<std::vector<double>> pass_ms;
+
+    void run(const Scene& scene, bool record) {
         executor.execute(scene, plan, /*time_passes=*/true);
         const auto& timings = executor.last_timings();
-        gpu_timer = timings.gpu_timer;
+        pass_ms.resize(plan.passes.size());
         double ms = 0.0;
         for (std::size_t p = 0; p < timings.passes.size(); ++p) {
             if (plan.passes[p].kind == PassKind::bake_ambient_occlusion) continue;
             ms += timings.passes[p].milliseconds;
-            if (i >= warmup) per_pass[p].push_back(timings.passes[p].milliseconds);
+            if (record) pass_ms[p].push_back(timings.passes[p].milliseconds);
         }
-        if (i >= warmup) times.push_back(ms);
+        if (record) frame_ms.push_back(ms);
     }
-    breakdown.clear();
-    char text[64];
-    for (std::size_t p = 0; p < plan.passes.size(); ++p) {
-        if (per_pass[p].empty()) continue;
-        std::snprintf(text, sizeof text, "%s%s %.2f", breakdown.empty() ? "" : ", ",
-                      plan.passes[p].name.c_str(), median(per_pass[p]));
-        breakdown += text;
+    // "name ms, name ms" with each GPU pass's median.
+    std::string breakdown() const {
+        std::string text;
+        char item[64];
+        for (std::size_t p = 0; p < plan.passes.size(); ++p) {
+            if (pass_ms[p].empty()) continue;
+            std::snprintf(item, sizeof item, "%s%s %.2f", text.empty() ? "" : ", ",
+                          plan.passes[p].name.c_str(), median(pass_ms[p]));
+            text += item;
+        }
+        return text;
     }
-    return median(times);
-}
+};
 
 int run_frame_bench(const FrameBenchOptions& options) {
     RenderRequest request;
@@ -74,7 +77,6 @@ int run_frame_bench(const FrameBenchOptions& options) {
         return kExitFailure;
     }
     const gl::GlInfo info = context->info();
-    gl::FrameExecutor executor;
     std::ostringstream table, breakdowns;
     bool gpu_timer = false;
     char line[200];
@@ -95,13 +97,20 @@ int run_frame_bench(const FrameBenchOptions& options) {
             return kExitUsage;
         }
         std::cerr << "measuring " << request.mesh << " (" << full.mesh->face_count() << " faces)...\n";
-        std::string full_passes, direct_passes;
-        const double full_ms =
-            median_frame_ms(executor, full, options.frames, options.warmup, gpu_timer, full_passes);
-        const double direct_ms =
-            median_frame_ms(executor, direct, options.frames, options.warmup, gpu_timer, direct_passes);
-        breakdowns << "  " << full.mesh->face_count() << " faces: full: " << full_passes
-                   << " | direct: " << direct_passes << "\n";
+        // Frames alternate between the two variants (one executor each, so neither
+        // reallocates), so both see the same load on a shared machine.
+        Sampler full_sampler, direct_sampler;
+        full_sampler.plan = make_frame_plan(full, find_technique(full.technique));
+        direct_sampler.plan = make_frame_plan(direct, find_technique(direct.technique));
+        for (int i = 0; i < options.warmup + options.frames; ++i) {
+            full_sampler.run(full, i >= options.warmup);
+            direct_sampler.run(direct, i >= options.warmup);
+        }
+        gpu_timer = full_sampler.executor.last_timings().gpu_timer;
+        const double full_ms = median(full_sampler.frame_ms);
+        const double direct_ms = median(direct_sampler.frame_ms);
+        breakdowns << "  " << full.mesh->face_count() << " faces: full: " << full_sampler.breakdown()
+                   << " | direct: " << direct_sampler.breakdown() << "\n";
         std::snprintf(line, sizeof line, "%10zu %10zu | %12.3f %8.1f | %12.3f %8.1f | %6.2f\n",
                       full.mesh->face_count(), full.mesh->vertex_count(), full_ms, 1000.0 / full_ms,
                       direct_ms, 1000.0 / direct_ms, full_ms / direct_ms);
