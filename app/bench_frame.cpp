@@ -64,7 +64,8 @@ struct Sampler {
 
 int run_frame_bench(const FrameBenchOptions& options) {
     RenderRequest request;
-    if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) != 2 ||
+    if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) !=
+            2 ||
         options.frames < 1) {
         std::cerr << "lucent bench frame: --size: '" << options.size << "' is not WxH\n";
         return kExitUsage;
@@ -80,8 +81,8 @@ int run_frame_bench(const FrameBenchOptions& options) {
     std::ostringstream table, breakdowns;
     bool gpu_timer = false;
     char line[200];
-    std::snprintf(line, sizeof line, "%10s %10s | %12s %8s | %12s %8s | %6s\n", "faces", "vertices",
-                  "full (ms)", "fps", "direct (ms)", "fps", "ratio");
+    std::snprintf(line, sizeof line, "%10s %10s | %12s %8s | %12s %8s | %6s\n", "faces",
+                  "vertices", "full (ms)", "fps", "direct (ms)", "fps", "ratio");
     table << line << std::string(80, '-') << "\n";
     for (const auto& faces : options.faces) {
         request.mesh = options.mesh + ":" + faces;
@@ -96,7 +97,8 @@ int run_frame_bench(const FrameBenchOptions& options) {
             std::cerr << "lucent bench frame: " << e.what() << "\n";
             return kExitUsage;
         }
-        std::cerr << "measuring " << request.mesh << " (" << full.mesh->face_count() << " faces)...\n";
+        std::cerr << "measuring " << request.mesh << " (" << full.mesh->face_count()
+                  << " faces)...\n";
         // Frames alternate between the two variants (one executor each, so neither
         // reallocates), so both see the same load on a shared machine.
         Sampler full_sampler, direct_sampler;
@@ -109,11 +111,13 @@ int run_frame_bench(const FrameBenchOptions& options) {
         gpu_timer = full_sampler.executor.last_timings().gpu_timer;
         const double full_ms = median(full_sampler.frame_ms);
         const double direct_ms = median(direct_sampler.frame_ms);
-        breakdowns << "  " << full.mesh->face_count() << " faces: full: " << full_sampler.breakdown()
+        breakdowns << "  " << full.mesh->face_count()
+                   << " faces: full: " << full_sampler.breakdown()
                    << " | direct: " << direct_sampler.breakdown() << "\n";
-        std::snprintf(line, sizeof line, "%10zu %10zu | %12.3f %8.1f | %12.3f %8.1f | %6.2f\n",
-                      full.mesh->face_count(), full.mesh->vertex_count(), full_ms, 1000.0 / full_ms,
-                      direct_ms, 1000.0 / direct_ms, full_ms / direct_ms);
+        std::snprintf(
+            line, sizeof line, "%10zu %10zu | %12.3f %8.1f | %12.3f %8.1f | %6.2f\n",
+            full.mesh->face_count(), full.mesh->vertex_count(), full_ms, 1000.0 / full_ms,
+            direct_ms, 1000.0 / direct_ms, full_ms / direct_ms);
         table << line;
     }
     std::cout << "lucent bench frame: " << options.mesh << " at " << request.width << "x"
@@ -127,7 +131,8 @@ int run_frame_bench(const FrameBenchOptions& options) {
               << "full = empirical shader (AO, peel, 5x5 smoothing, Eq. 3.6); direct = "
                  "ambient + diffuse + specular (backlight 0)\n\n"
               << table.str() << "ratio = full / direct frame time\n\n"
-              << "median per pass (ms):\n" << breakdowns.str();
+              << "median per pass (ms):\n"
+              << breakdowns.str();
     return kExitOk;
 }
 
@@ -135,9 +140,12 @@ int run_frame_bench(const FrameBenchOptions& options) {
 
 void register_bench_frame(CLI::App& bench, int& exit_code) {
     auto options = std::make_shared<FrameBenchOptions>();
-    auto* cmd = bench.add_subcommand("frame", "Median GPU frame time: full empirical shader vs direct light only");
-    cmd->add_option("--mesh", options->mesh, "built-in mesh family (face budgets from --faces)");
-    cmd->add_option("--faces", options->faces, "face budgets, e.g. 4k 30k 60k 120k 240k")->delimiter(',');
+    auto* cmd = bench.add_subcommand(
+        "frame", "Median GPU frame time: full empirical shader vs direct light only");
+    cmd->add_option("--mesh", options->mesh,
+                    "built-in mesh family (face budgets from --faces)");
+    cmd->add_option("--faces", options->faces, "face budgets, e.g. 4k 30k 60k 120k 240k")
+        ->delimiter(',');
     cmd->add_option("--size", options->size, "frame size WxH");
     cmd->add_option("--frames", options->frames, "timed frames per row (median)");
     cmd->add_option("--warmup", options->warmup, "untimed frames first");
