@@ -15,9 +15,12 @@ void register_bench(CLI::App& app, int& exit_code);
 void register_analyze(CLI::App& app, int& exit_code);
 void register_stats(CLI::App& app, int& exit_code);
 void register_simulate(CLI::App& app, int& exit_code);
+void register_render(CLI::App& app, int& exit_code);
 
 // `lucent bench <family>`: registered from bench_families.cpp, one function per family.
 void register_bench_families(CLI::App& bench, int& exit_code);
+void register_bench_frame(CLI::App& bench, int& exit_code);
+void register_bench_accuracy(CLI::App& bench, int& exit_code);
 void register_bench_ao(CLI::App& bench, int& exit_code);
 void register_bench_stats(CLI::App& bench, int& exit_code);
 
