@@ -287,5 +287,97 @@ TEST_F(SessionE2E, NoDisplayGivesOneLineSuggestingXvfb) {
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
 
+
+TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
+    // The built-in protocol, its live stimuli stood in for by pre-rendered files (the
+    // live renderer is wired separately): every planned (trial, question) gets a rating.
+    const Protocol thesis = builtin_protocol("thesis");
+    std::vector<std::string> ids;
+    for (const StimulusSpec& st : thesis.stimuli) ids.push_back(st.id);
+    write_images(dir_, ids, 64);
+    const std::string db = (dir_ / "thesis.db").string();
+    const Process p = start_lucent({"run", "--preset", "thesis", "--db", db, "--participant", "P4",
+                                    "--images", dir_.string(), "--autopilot", "3",
+                                    "--autopilot-speed", "25", "--windowed"}, dir_);
+    ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
+    Database d(db, SQLITE_OPEN_READONLY);
+    const int64_t trials = d.scalar_int("SELECT count(*) FROM trials");
+    EXPECT_EQ(trials, 2 + 15 + 2);  // practice + 9 empirical + 6 ward/contrast-reversed + catch
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 3);
+    EXPECT_EQ(d.scalar_int("SELECT count(DISTINCT question) FROM responses"), 3);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    // Participant 4, two blocks: Latin-square row 0 shows 'empirical' first.
+    Statement order = d.prepare("SELECT block_order FROM sessions");
+    ASSERT_TRUE(order.step());
+    EXPECT_EQ(order.text(0), "empirical,contrast_reversal");
+}
+
+// ---- The data commands, driven through the CLI (no display needed) ----------------
+class DataCommands : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = lucent::test::scratch_dir(std::string("cli_") +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        db_ = (dir_ / "study.db").string();
+        Store store(db_);
+        lucent::test::run_full_session(store, lucent::test::small_protocol(), "P1", 1);
+        lucent::test::run_full_session(store, lucent::test::small_protocol(), "P2", 2);
+    }
+    int run(const std::vector<std::string>& args, const std::string& stdin_text = "") {
+        const fs::path in = dir_ / "stdin.txt";
+        std::ofstream(in) << stdin_text;
+        const pid_t pid = fork();
+        if (pid == 0) {
+            const int fd = open(in.c_str(), O_RDONLY);
+            dup2(fd, 0);
+            const int err = open((dir_ / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            dup2(err, 2);
+            const int out = open((dir_ / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            dup2(out, 1);
+            std::vector<char*> argv{const_cast<char*>(LUCENT_EXECUTABLE)};
+            for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+            argv.push_back(nullptr);
+            execv(LUCENT_EXECUTABLE, argv.data());
+            _exit(127);
+        }
+        int status = 0;
+        waitpid(pid, &status, 0);
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    int64_t count(const std::string& sql) { return Database(db_, SQLITE_OPEN_READONLY).scalar_int(sql); }
+    fs::path dir_;
+    std::string db_;
+};
+
+TEST_F(DataCommands, WithdrawAsksAndOnlyYesDeletes) {
+    EXPECT_EQ(run({"participants", "withdraw", "P1", "--db", db_}, "no\n"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 2);
+    EXPECT_EQ(run({"participants", "withdraw", "P1", "--db", db_}, "yes\n"), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 1);
+    EXPECT_EQ(run({"participants", "withdraw", "P2", "--db", db_, "--yes"}), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
+    EXPECT_EQ(run({"participants", "withdraw", "P9", "--db", db_, "--yes"}), 2);
+    EXPECT_NE(read_file(dir_ / "stderr.txt").find("no participant 'P9'"), std::string::npos);
+}
+
+TEST_F(DataCommands, ExportWritesEachFormatAndMergeDeduplicates) {
+    for (const char* format : {"long", "wide", "analysis"}) {
+        const fs::path out = dir_ / (std::string(format) + ".csv");
+        ASSERT_EQ(run({"export", db_, "--format", format, "--out", out.string()}), 0) << format;
+        const std::string text = read_file(out);
+        const long lines = std::count(text.begin(), text.end(), '\n');
+        EXPECT_EQ(lines, std::string(format) == "long" ? 1 + 2 * 5 * 2
+                         : std::string(format) == "wide" ? 1 + 2 : 1 + 2 * 3 * 2) << format;
+        EXPECT_FALSE(fs::exists(out.string() + ".partial"));
+    }
+    EXPECT_EQ(run({"export", db_, "--format", "json", "--out", (dir_ / "x").string()}), 2);
+    const std::string copy = (dir_ / "copy.db").string();
+    fs::copy_file(db_, copy);
+    const std::string merged = (dir_ / "all.db").string();
+    ASSERT_EQ(run({"merge", db_, copy, "--out", merged}), 0);
+    EXPECT_EQ(Database(merged, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM sessions"), 2);
+    EXPECT_NE(read_file(dir_ / "stdout.txt").find("2 duplicates skipped"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace lucent::study
