@@ -24,7 +24,7 @@ TEST(ThesisPreset, HasTheNineStimuliOfTable43) {
                                 {25, 1.2, 0.2}, {25, 1.2, 0.0}, {25, 1.2, 0.5}};
     const char* varies[3] = {"thickness_exponent", "backlight", "diffuse_weight"};
     for (int i = 0; i < 9; ++i) {
-        const StimulusSpec* s = p.find_stimulus("emp" + std::to_string(i + 1));
+        const StimulusSpec* s = p.find_stimulus("empirical_row_" + std::to_string(i + 1));
         ASSERT_NE(s, nullptr) << i;
         EXPECT_EQ(s->technique, "empirical");
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("thickness_exponent")), table[i][0]);
@@ -39,13 +39,17 @@ TEST(ThesisPreset, ContrastReversedStimuliHaveWardCounterparts) {
     const Protocol p = builtin_protocol("thesis");
     int pairs = 0;
     for (const StimulusSpec& s : p.stimuli) {
-        if (s.technique != "contrast_reversed" || s.id.rfind("cr_", 0) != 0) continue;
+        if (s.technique != "contrast_reversed" || s.id.rfind("practice", 0) == 0) continue;
         for (const char* key : {"reversed_diffuse", "specular_reflectance", "roughness"})
             EXPECT_TRUE(s.parameters.count(key)) << s.id << " lacks " << key;
-        const StimulusSpec* ward = p.find_stimulus("ward_" + s.id.substr(3));
+        const StimulusSpec* ward = p.find_stimulus("ward_" + s.id.substr(18));
         ASSERT_NE(ward, nullptr) << s.id;
         EXPECT_EQ(ward->technique, "ward");
-        EXPECT_EQ(ward->parameters, s.parameters);
+        // The same material: ward's diffuse_reflectance is contrast_reversed's weight.
+        auto expected = s.parameters;
+        expected["diffuse_reflectance"] = expected.at("reversed_diffuse");
+        expected.erase("reversed_diffuse");
+        EXPECT_EQ(ward->parameters, expected);
         ++pairs;
     }
     EXPECT_GE(pairs, 3);
@@ -130,10 +134,10 @@ TEST(ProtocolErrors, ImpossibleRandomisationIsReportedWhenPlanning) {
 
 TEST(Protocol, LevelsAreCanonicalNumbers) {
     const Protocol p = builtin_protocol("thesis");
-    EXPECT_EQ(p.level_of(*p.find_stimulus("emp8"), "diffuse_weight"), "0");
-    EXPECT_EQ(p.level_of(*p.find_stimulus("emp9"), "diffuse_weight"), "0.5");
-    EXPECT_EQ(p.level_of(*p.find_stimulus("emp2"), "thickness_exponent"), "18");
-    EXPECT_EQ(p.level_of(*p.find_stimulus("cr_jade"), "technique"), "contrast_reversed");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_8"), "diffuse_weight"), "0");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_9"), "diffuse_weight"), "0.5");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_2"), "thickness_exponent"), "18");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("contrast_reversed_jade"), "technique"), "contrast_reversed");
 }
 
 }  // namespace
