@@ -15,7 +15,7 @@ std::vector<std::string> preset_names() { return {"thesis"}; }
 
 std::optional<std::string_view> preset_text(std::string_view name) {
     for (const auto& known : preset_names())
-        if (known == name) return embedded::stimuli_preset_file(std::string(name) + ".toml");
+        if (known == name) return embedded::stimuli_preset_file("presets/" + std::string(name) + ".toml");
     return std::nullopt;
 }
 
