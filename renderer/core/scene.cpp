@@ -1,5 +1,7 @@
 #include "core/scene.h"
 
+#include <algorithm>
+
 #include "core/technique.h"
 
 namespace lucent {
@@ -21,6 +23,12 @@ Scene make_scene(std::shared_ptr<const Mesh> mesh, const Technique& technique,
     scene.camera = fit_camera(scene.bounds, static_cast<float>(values.scalar("fov_y")),
                               static_cast<float>(width) / static_cast<float>(height),
                               view_direction);
+    // Widen near/far by a hair so the nearest and farthest points of the bounding sphere
+    // survive clipping and the depth test against the cleared depth (1.0); thickness uses
+    // eye-space distances, so this does not change it.
+    const float margin = 1e-3f * scene.bounds.radius;
+    scene.camera.near_plane = std::max(scene.camera.near_plane - margin, 0.5f * scene.camera.near_plane);
+    scene.camera.far_plane += margin;
     scene.values = std::move(values);
     return scene;
 }
