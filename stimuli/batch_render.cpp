@@ -47,7 +47,19 @@ std::vector<ManifestField> parameter_fields(const Stimulus& stimulus) {
     return fields;
 }
 
-// The identity part of a row (before statistics and hashes).
+// Every parameter name of the set's techniques, in knob order (scene knobs first), so
+// all rows list the parameters in the same columns.
+std::vector<std::string> parameter_columns(const StimulusSet& set) {
+    std::vector<std::string> columns;
+    for (const auto& s : set.stimuli)
+        for (const Knob& knob : knobs_for(find_technique(s.technique)))
+            if (std::find(columns.begin(), columns.end(), knob.name) == columns.end())
+                columns.push_back(knob.name);
+    return columns;
+}
+
+// The identity part of a row (before statistics and hashes); parameters the stimulus's
+// technique lacks are empty.
 ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mesh& mesh) {
     std::string files;
     for (const auto format : set.formats)
@@ -62,7 +74,12 @@ ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mes
                        {"width", std::to_string(set.width), true},
                        {"height", std::to_string(set.height), true}};
     const auto parameters = parameter_fields(s);
-    row.insert(row.end(), parameters.begin(), parameters.end());
+    for (const auto& column : parameter_columns(set)) {
+        ManifestField field{column, "", false};
+        for (const auto& p : parameters)
+            if (p.column == column) field = p;
+        row.push_back(field);
+    }
     return row;
 }
 

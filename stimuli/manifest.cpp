@@ -162,7 +162,8 @@ void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
         for (std::size_t f = 0; f < rows[r].size(); ++f) {
             const auto& field = rows[r][f];
             json << (f ? ", " : "") << "\"" << json_escape(field.column) << "\": ";
-            if (field.numeric) json << field.text;
+            if (field.text.empty()) json << "null";  // a parameter this technique lacks
+            else if (field.numeric) json << field.text;
             else json << "\"" << json_escape(field.text) << "\"";
         }
         json << "}";

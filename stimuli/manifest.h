@@ -29,7 +29,7 @@ private:
 // Hash of a file's bytes; throws std::runtime_error naming the file when unreadable.
 std::string hash_file(const std::filesystem::path& path);
 
-// One manifest cell; numbers are written bare in JSON, text quoted.
+// One manifest cell; numbers are written bare in JSON, text quoted, empty cells as null.
 struct ManifestField {
     std::string column;
     std::string text;

@@ -20,7 +20,7 @@ std::vector<Knob> make_knobs(Variant variant) {
             ? Knob{"diffuse_reflectance", "rho_d: Ward's diffuse reflectance (scalar)",
                    KnobKind::scalar, 0.0, 10.0, d.diffuse}
             : Knob{"reversed_diffuse",
-                   "w: weight of the reversed diffuse term Id*(1 - Kd*max(N.L,0)) (scalar)",
+                   "w: weight of the reversed diffuse term Id*chroma(Kd)*(1 - Y(Kd)*max(N.L,0)) (scalar)",
                    KnobKind::scalar, 0.0, 10.0, d.diffuse};
     return {albedo,
             ambient,
@@ -50,6 +50,15 @@ Params params(const Scene& scene, Variant variant) {
     p.roughness = v.scalar("roughness");
     p.ao_rays = v.integer("ao_rays");
     return p;
+}
+
+double albedo_luminance(glm::dvec3 albedo) {
+    return 0.2126 * albedo.r + 0.7152 * albedo.g + 0.0722 * albedo.b;
+}
+
+glm::dvec3 albedo_chroma(glm::dvec3 albedo) {
+    const double y = albedo_luminance(albedo);
+    return y > 1e-6 ? albedo / y : glm::dvec3(1.0);
 }
 
 bool has_ambient_term(const Params& p, const Light& light) {

@@ -30,7 +30,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
     Pass shade{"shade",
                variant == Variant::ward
                    ? "Eq. 14: ambient*AO + Ward diffuse + Ward specular"
-                   : "Eq. 15: ambient*AO + reversed diffuse Id*(1 - Kd*N.L) + Ward specular",
+                   : "Eq. 15: ambient*AO + reversed diffuse Id*chroma*(1 - Y(Kd)*N.L) + Ward specular",
                PassKind::draw_mesh,
                {"techniques/ward/shaders/mesh.vert", "techniques/ward/shaders/shade.frag", {}}};
     shade.uniforms = {{"u_model_view", view},
@@ -47,7 +47,11 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
     }
     if (diffuse_term) {
         shade.shader.defines.push_back("WITH_DIFFUSE");
-        if (variant == Variant::contrast_reversed) shade.shader.defines.push_back("REVERSED_DIFFUSE");
+        if (variant == Variant::contrast_reversed) {
+            shade.shader.defines.push_back("REVERSED_DIFFUSE");
+            shade.uniforms.push_back({"u_albedo_chroma", glm::vec3(albedo_chroma(p.albedo))});
+            shade.uniforms.push_back({"u_albedo_luminance", static_cast<float>(albedo_luminance(p.albedo))});
+        }
         shade.uniforms.push_back({"u_diffuse", static_cast<float>(p.diffuse)});
     }
     if (specular_term) {

@@ -22,9 +22,15 @@ glm::dvec3 shade(const Params& p, const Light& light, Variant variant, glm::dvec
     glm::dvec3 colour(0.0);
     // Ambient: ka * Ia * Kd * ao
     if (has_ambient_term(p, light)) colour += p.ambient * glm::dvec3(light.ambient) * kd * ao;
-    // Diffuse (Eq. 14) or reversed diffuse (Eq. 15 with Eq. 12, Li = Id), per channel
-    if (variant == Variant::ward) colour += p.diffuse * kd * id * lit;
-    else colour += p.diffuse * id * (glm::dvec3(1.0) - kd * lit);
+    // Diffuse (Eq. 14), or reversed diffuse (Eq. 15 with Eq. 12 on luminance, Li = Id):
+    // the backlit luminance 1 - Y(Kd) N.L, in the albedo's hue
+    if (variant == Variant::ward) {
+        colour += p.diffuse * kd * id * lit;
+    } else {
+        const double y = 0.2126 * kd.r + 0.7152 * kd.g + 0.0722 * kd.b;
+        const glm::dvec3 chroma = y > 1e-6 ? kd / y : glm::dvec3(1.0);
+        colour += p.diffuse * id * chroma * (1.0 - y * lit);
+    }
     // Specular: pi * f_s * Is * max(N.L, 0), Ward's lobe (Eq. 13)
     if (has_specular_term(p, light))
         colour += double(kPi) *

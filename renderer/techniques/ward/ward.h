@@ -35,14 +35,20 @@ const char* diffuse_knob_name(Variant variant);
 const std::vector<Knob>& knobs(Variant variant);
 Params params(const Scene& scene, Variant variant);
 
-// Radiance of one surface point (linear rgb). n, l, v: unit vectors in eye space
-// (l towards the light, v towards the eye); ao in [0, 1].
+// Radiance of one surface point (linear rgb). n, v: unit vectors in eye space (v towards
+// the eye; the light direction comes from `light`); ao in [0, 1].
 //   ambient  = ka * Ia * Kd * ao
 //   diffuse  = rho_d * Kd * Id * max(N.L, 0)                     (ward)
-//   reversed = w * Id * (1 - Kd * max(N.L, 0))   per channel      (contrast_reversed)
+//   reversed = w * Id * chroma * (1 - Y * max(N.L, 0))            (contrast_reversed)
+//              with Y = Rec. 709 luminance of Kd and chroma = Kd / Y (albedo_chroma())
 //   specular = pi * f_s(l, v) * Is * max(N.L, 0)                 (Ward's lobe, ward_brdf.h)
 glm::dvec3 shade(const Params& p, const Light& light, Variant variant, glm::dvec3 n,
                  glm::dvec3 v, double ao);
+
+// Contrast reversal acts on luminance and keeps the albedo's hue: Y(Kd) (Rec. 709) and
+// Kd / Y(Kd), which is white for an albedo darker than 1e-6 (no hue to keep).
+double albedo_luminance(glm::dvec3 albedo);
+glm::dvec3 albedo_chroma(glm::dvec3 albedo);
 
 // Which terms can change the image (the planner and the reference agree on these).
 bool has_ambient_term(const Params& p, const Light& light);

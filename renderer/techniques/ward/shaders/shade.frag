@@ -3,7 +3,8 @@
 // REVERSED_DIFFUSE the contrast-reversed form (Eq. 15), in linear floating point:
 //   ambient  = ka * Ia * Kd * ao
 //   diffuse  = rho_d * Kd * Id * max(N.L, 0)                  (Eq. 14)
-//   reversed = w * Id * (1 - Kd * max(N.L, 0)), per channel   (Eq. 15, Eq. 12 with Li = Id)
+//   reversed = w * Id * chroma(Kd) * (1 - Y(Kd) * max(N.L, 0))  (Eq. 15 with Eq. 12 on
+//              luminance, Li = Id; chroma = Kd / Y(Kd) keeps the albedo's hue)
 //   specular = pi * f_s(l, v) * Is * max(N.L, 0)              (Eq. 13 with Ward's alpha^2)
 // Terms that cannot change the image are compiled out by the planner. The guards match
 // renderer/techniques/ward/ward_brdf.cpp.
@@ -16,6 +17,10 @@ uniform vec3 u_light_ambient;
 #endif
 #ifdef WITH_DIFFUSE
 uniform float u_diffuse;  // rho_d, or the reversed-diffuse weight w
+#ifdef REVERSED_DIFFUSE
+uniform vec3 u_albedo_chroma;     // Kd / Y(Kd), white for a black albedo
+uniform float u_albedo_luminance;  // Y(Kd), Rec. 709
+#endif
 #endif
 #ifdef WITH_SPECULAR
 uniform float u_specular_reflectance;
@@ -67,8 +72,8 @@ void main() {
 #endif
 #ifdef WITH_DIFFUSE
 #ifdef REVERSED_DIFFUSE
-    // Reversed diffuse (Eq. 15): the backlit intensity Li - I_directlit (Eq. 12), Li = Id
-    colour += u_diffuse * u_light_diffuse * (vec3(1.0) - u_albedo * lit);
+    // Reversed diffuse (Eq. 15): backlit luminance Li - I_directlit (Eq. 12), Li = Id
+    colour += u_diffuse * u_light_diffuse * u_albedo_chroma * (1.0 - u_albedo_luminance * lit);
 #else
     // Diffuse (Eq. 14): rho_d * Kd * Id * max(N.L, 0)
     colour += u_diffuse * u_albedo * u_light_diffuse * lit;

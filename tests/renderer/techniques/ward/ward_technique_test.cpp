@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "core/technique.h"
 #include "gl_test_fixture.h"
@@ -79,22 +80,34 @@ TEST(WardShading, AnalyticPoints) {
     light.diffuse = glm::vec3(1.0f, 0.5f, 2.0f);
     light.direction = {0, 0, 1};
     const glm::dvec3 n(0, 0, 1), v(0, 0, 1);
-    // Facing the light: ward = rho_d*Kd*Id; reversed = w*Id*(1 - Kd), channel by channel.
+    // Facing the light: ward = rho_d*Kd*Id; reversed = w*Id*(Kd/Y)*(1 - Y), Y = Y(Kd).
+    const double y = 0.2126 * 0.2 + 0.7152 * 0.5 + 0.0722 * 0.8;
     const auto ward_lit = ward::shade(p, light, ward::Variant::ward, n, v, 1.0);
     const auto rev_lit = ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0);
     for (int c = 0; c < 3; ++c) {
         EXPECT_NEAR(ward_lit[c], 0.7 * p.albedo[c] * light.diffuse[c], 1e-6);
-        EXPECT_NEAR(rev_lit[c], 0.7 * light.diffuse[c] * (1.0 - p.albedo[c]), 1e-6);
+        EXPECT_NEAR(rev_lit[c], 0.7 * light.diffuse[c] * p.albedo[c] / y * (1.0 - y), 1e-6);
     }
-    // In the attached shadow (N.L <= 0) the reversed term is the whole light, w*Id.
+    // Luminance, not channels, is reversed: under white light the term keeps Kd's hue
+    // (channel ratios) and its luminance is w * (1 - Y N.L), Eq. 12 with Li = 1.
+    light.diffuse = glm::vec3(1.0f);
+    const auto tilted = ward::shade(p, light, ward::Variant::contrast_reversed,
+                                    glm::normalize(glm::dvec3(0, 0.6, 0.8)), v, 1.0);
+    EXPECT_NEAR(tilted.b / tilted.r, 0.8 / 0.2, 1e-9);
+    EXPECT_NEAR(0.2126 * tilted.r + 0.7152 * tilted.g + 0.0722 * tilted.b, 0.7 * (1.0 - y * 0.8), 1e-9);
+    // In the attached shadow (N.L <= 0) the reversed term is the whole light, w*Id*chroma.
     const glm::dvec3 away(0, 0, -1);
     const auto rev_dark = ward::shade(p, light, ward::Variant::contrast_reversed, away, v, 1.0);
-    EXPECT_NEAR(rev_dark.b, 0.7 * 2.0, 1e-6);
+    EXPECT_NEAR(rev_dark.b, 0.7 * 0.8 / y, 1e-6);
     EXPECT_EQ(ward::shade(p, light, ward::Variant::ward, away, v, 1.0), glm::dvec3(0.0));
-    // A white albedo facing the light reverses to exactly 0, never negative.
+    // A white albedo facing the light reverses to exactly 0, never negative; a black one
+    // has no hue to keep and reverses to the light's colour.
     p.albedo = glm::dvec3(1.0);
-    const auto white = ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0);
-    EXPECT_EQ(white, glm::dvec3(0.0));
+    EXPECT_EQ(ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0), glm::dvec3(0.0));
+    p.albedo = glm::dvec3(0.0);
+    const auto black = ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0);
+    EXPECT_NEAR(black.g, 0.7, 1e-12);
+    EXPECT_TRUE(std::isfinite(black.r));
     // Specular at normal incidence: pi * rho_s / (4 pi alpha^2) * Is.
     p.diffuse = 0.0;
     p.specular_reflectance = 0.1;
@@ -152,7 +165,20 @@ TEST_F(WardGlTest, GlMatchesCpuReferenceOnBuiltinMeshes) {
                 EXPECT_GT(c.compared, 3000u);
                 EXPECT_LT(c.mean, 1.0 / 255.0);
                 EXPECT_LT(c.p99, 4.0 / 255.0);
+                std::printf("%s %s roughness %s: mean %.2e p99 %.2e over %zu values\n", technique,
+                            mesh, roughness, c.mean, c.p99, c.compared);
             }
+}
+
+TEST_F(WardGlTest, ComparisonTellsTheTwoVariantsApart) {
+    // The same scene under the other variant's reference must fail the thresholds above.
+    gl::FrameExecutor executor;
+    const Scene ward_scene = scene_for("ward", {{"ao_rays", "16"}, {"diffuse_reflectance", "0.5"}});
+    const Scene reversed_scene =
+        scene_for("contrast_reversed", {{"ao_rays", "16"}, {"reversed_diffuse", "0.5"}});
+    const Comparison c = compare(render_image(executor, ward_scene),
+                                 find_technique("contrast_reversed").render_reference(reversed_scene));
+    EXPECT_GT(c.mean, 10.0 / 255.0);
 }
 
 TEST_F(WardGlTest, ContrastReversedKeepsABlackBackgroundAndFiniteValues) {
