@@ -123,7 +123,10 @@ KnobValue knob_value(const Knob& knob, const toml::node& node, const std::string
     try {
         return parse_knob_value(knob, text);
     } catch (const KnobError& e) {
-        errors.fail(node, key, e.what());
+        // The knob's message starts with its name, which `key` already gives.
+        std::string message = e.what();
+        if (message.rfind(knob.name + ": ", 0) == 0) message.erase(0, knob.name.size() + 2);
+        errors.fail(node, key, message);
     }
 }
 

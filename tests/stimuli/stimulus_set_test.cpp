@@ -120,7 +120,7 @@ TEST(StimulusSet, ErrorsNameFileLineAndKey) {
                   .find("set.toml:6:8: stimuli[0].rays: wrong type"), std::string::npos);
     // Out of range, including inside a vary list and in a material.
     EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nweight = 11\n")
-                  .find("set.toml:6:10: stimuli[0].weight: weight: '11' is out of range"),
+                  .find("set.toml:6:10: stimuli[0].weight: '11' is out of range"),
               std::string::npos);
     EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\n[stimuli.vary]\n"
                                  "weight = [1, -2]\n")
