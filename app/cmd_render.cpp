@@ -1,6 +1,8 @@
 // lucent render: one image of a mesh under a technique, with parameters from --set.
 // The work itself is lucent::build_scene + render_image + write_image (renderer/render.h),
 // the same path batch rendering and the explorer use.
+#include <unistd.h>
+
 #include <cstdio>
 #include <iostream>
 
@@ -45,11 +47,11 @@ void parse_size(const std::string& text, int& width, int& height) {
     }
 }
 
-// Prints a progress line for AO bakes that take a while (stderr, overwritten in place).
+// Prints a progress line for AO bakes on a terminal (stderr, overwritten in place).
 std::vector<float> bake_with_progress(const Mesh& mesh, int rays) {
     AoBakeOptions options;
     options.rays = rays;
-    options.progress = [&, last = -1](std::size_t done, std::size_t total) mutable {
+    if (isatty(STDERR_FILENO)) options.progress = [&, last = -1](std::size_t done, std::size_t total) mutable {
         const int percent = total ? static_cast<int>(100 * done / total) : 100;
         if (percent == last) return;
         last = percent;

@@ -16,5 +16,7 @@ void register_render(CLI::App& app, int& exit_code);
 
 // `lucent bench <family>`: registered from bench_families.cpp, one function per family.
 void register_bench_families(CLI::App& bench, int& exit_code);
+void register_bench_frame(CLI::App& bench, int& exit_code);
+void register_bench_accuracy(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app

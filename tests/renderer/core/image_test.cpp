@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/image.h"
+#include "core/image_compare.h"
 #include "test_paths.h"
 
 namespace lucent {
@@ -83,6 +84,32 @@ TEST(ImageIo, UnsupportedExtensionNamesTheFileAndWritesNothing) {
     }
     EXPECT_TRUE(std::filesystem::is_empty(dir));
     EXPECT_THROW(read_image(dir / "missing.exr"), ImageError);
+}
+
+}  // namespace
+}  // namespace lucent
+
+namespace lucent {
+namespace {
+
+TEST(ImageCompare, SkipsTheSilhouetteBandAndMeasuresTheRest) {
+    // 8x8: left half covered in both; b differs by 0.1 in red everywhere and has one
+    // extra covered column (a silhouette mismatch that must be skipped).
+    Image a(8, 8), b(8, 8);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            a.set(x, y, {0.5f, 0.5f, 0.5f, x < 4 ? 1.0f : 0.0f});
+            b.set(x, y, {0.6f, 0.5f, 0.5f, x < 5 ? 1.0f : 0.0f});
+        }
+    const ImageErrorStats all = compare_images(a, b, 0);
+    EXPECT_EQ(all.pixels, 64u);
+    EXPECT_NEAR(all.mean, 0.1 / 3.0, 1e-6);
+    EXPECT_NEAR(all.rmse, std::sqrt(0.01 / 3.0), 1e-6);
+    EXPECT_NEAR(all.p99, 0.1, 1e-6);
+    // Band 1: columns 3..5 touch a coverage change in a or b, or differ between them.
+    const ImageErrorStats banded = compare_images(a, b, 1);
+    EXPECT_EQ(banded.pixels, 8u * 5u);
+    EXPECT_THROW(compare_images(a, Image(4, 4)), std::invalid_argument);
 }
 
 }  // namespace

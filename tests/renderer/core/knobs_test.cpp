@@ -5,6 +5,11 @@
 #include "core/common_knobs.h"
 #include "core/knobs.h"
 #include "techniques/registry.h"
+#include "test_paths.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
 
 namespace lucent {
 namespace {
@@ -122,6 +127,34 @@ TEST(Registry, UnknownTechniqueListsTheValidNames) {
         EXPECT_EQ(message.rfind("technique: 'marble' is unknown (valid: ", 0), 0u) << message;
         EXPECT_NE(message.find("empirical"), std::string::npos) << message;
     }
+}
+
+}  // namespace
+}  // namespace lucent
+
+namespace lucent {
+namespace {
+
+// README.md's parameter table is the user's documentation: each knob has a row whose
+// default column parses to the knob's default.
+TEST(Knobs, ReadmeTableListsEveryKnobWithItsDefault) {
+    std::ifstream file(test::source_dir() / "README.md");
+    ASSERT_TRUE(file) << "README.md not found";
+    std::map<std::string, std::string> defaults;
+    for (std::string line; std::getline(file, line);) {
+        if (line.rfind("| `", 0) != 0) continue;
+        const auto name_end = line.find('`', 3);
+        const auto last_bar = line.rfind('|', line.size() - 2);
+        std::string cell = line.substr(last_bar + 1);
+        cell.erase(std::remove(cell.begin(), cell.end(), ' '), cell.end());
+        cell.erase(std::remove(cell.begin(), cell.end(), '|'), cell.end());
+        defaults[line.substr(3, name_end - 3)] = cell;
+    }
+    for (const Technique* technique : all_techniques())
+        for (const Knob& knob : knobs_for(*technique)) {
+            ASSERT_TRUE(defaults.count(knob.name)) << knob.name << " missing from README.md";
+            EXPECT_EQ(parse_knob_value(knob, defaults[knob.name]), knob.default_value) << knob.name;
+        }
 }
 
 }  // namespace
