@@ -12,6 +12,7 @@ inline constexpr int kExitUsage = 2;    // bad command line, config or input dat
 
 void register_info(CLI::App& app, int& exit_code);
 void register_bench(CLI::App& app, int& exit_code);
+void register_render(CLI::App& app, int& exit_code);
 void register_run(CLI::App& app, int& exit_code);
 void register_participants(CLI::App& app, int& exit_code);
 void register_export(CLI::App& app, int& exit_code);
@@ -19,5 +20,7 @@ void register_merge(CLI::App& app, int& exit_code);
 
 // `lucent bench <family>`: registered from bench_families.cpp, one function per family.
 void register_bench_families(CLI::App& bench, int& exit_code);
+void register_bench_frame(CLI::App& bench, int& exit_code);
+void register_bench_accuracy(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app

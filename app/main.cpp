@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     int exit_code = kExitOk;
     register_info(app, exit_code);
     register_bench(app, exit_code);
+    register_render(app, exit_code);
     register_run(app, exit_code);
     register_participants(app, exit_code);
     register_export(app, exit_code);

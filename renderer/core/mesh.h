@@ -33,6 +33,7 @@ struct Mesh {
 
     std::size_t face_count() const { return triangles.size(); }
     std::size_t vertex_count() const { return positions.size(); }
+    // Contains every position; the smaller of the AABB-centred and Ritter spheres.
     BoundingSphere bounding_sphere() const;
 };
 
@@ -43,5 +44,22 @@ Mesh load_mesh(const std::string& spec);
 
 // The built-in procedural mesh names, for help text and error messages.
 std::vector<std::string> builtin_mesh_names();
+
+// Face budget of a built-in mesh when the spec gives none.
+inline constexpr std::size_t kDefaultFaceBudget = 30000;
+
+// 64-bit FNV-1a over the position bits and triangle indices, as 16 hex digits.
+std::string compute_content_hash(const std::vector<glm::vec3>& positions,
+                                 const std::vector<glm::uvec3>& triangles);
+
+// Unit per-vertex normals: incident face normals weighted by the corner angle (so the
+// result does not depend on how a flat region is triangulated). A vertex whose weighted
+// sum vanishes gets the normal of its first incident face; an unreferenced one +Z.
+std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& positions,
+                                              const std::vector<glm::uvec3>& triangles);
+
+// Replaces non-finite or zero-length normals (computing smooth ones when `normals` is
+// empty or the wrong size), normalises the rest and sets content_hash.
+void finalize_mesh(Mesh& mesh);
 
 }  // namespace lucent

@@ -1,0 +1,164 @@
+// lucent render: one image of a mesh under a technique, with parameters from --set.
+// The work itself is lucent::build_scene + render_image + write_image (renderer/render.h),
+// the same path batch rendering and the explorer use.
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "commands.h"
+#include "core/ambient_occlusion.h"
+#include "core/technique.h"
+#include "gl/context.h"
+#include "batch_render.h"
+#include "render.h"
+#include "techniques/registry.h"
+
+namespace lucent::app {
+namespace {
+
+struct RenderOptions {
+    std::string mesh;
+    std::string technique = "empirical";
+    std::vector<std::string> settings;
+    std::string size = "512x512";
+    std::string out;
+    bool explain = false;
+    std::string plan = "pruned";
+    bool linear = false;
+    // Batch mode (stimuli/batch_render.h): a stimulus-set config or a built-in preset.
+    std::string config;
+    std::string preset;
+    int jobs = 1;
+    bool force = false;
+};
+
+// "WxH" -> (w, h); throws std::invalid_argument naming --size.
+void parse_size(const std::string& text, int& width, int& height) {
+    const auto x = text.find('x');
+    try {
+        std::size_t used_w = 0, used_h = 0;
+        if (x == std::string::npos) throw std::invalid_argument("");
+        width = std::stoi(text.substr(0, x), &used_w);
+        height = std::stoi(text.substr(x + 1), &used_h);
+        if (used_w != x || used_h != text.size() - x - 1) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+        throw std::invalid_argument("--size: '" + text + "' is not WxH (e.g. 512x512)");
+    }
+}
+
+// Prints a progress line for AO bakes on a terminal (stderr, overwritten in place).
+std::vector<float> bake_with_progress(const Mesh& mesh, int rays) {
+    AoBakeOptions options;
+    options.rays = rays;
+    if (isatty(STDERR_FILENO)) options.progress = [&, last = -1](std::size_t done, std::size_t total) mutable {
+        const int percent = total ? static_cast<int>(100 * done / total) : 100;
+        if (percent == last) return;
+        last = percent;
+        std::fprintf(stderr, "\rambient occlusion (%d rays/vertex, %zu vertices): %3d%%", rays,
+                     total, percent);
+        if (done == total) std::fprintf(stderr, "\n");
+    };
+    return load_or_bake_ambient_occlusion(mesh, options);
+}
+
+int run_render(const RenderOptions& options) {
+    RenderRequest request;
+    PlanMode mode = PlanMode::pruned;
+    Scene scene;
+    try {
+        parse_size(options.size, request.width, request.height);
+        request.mesh = options.mesh;
+        request.technique = options.technique;
+        for (const auto& s : options.settings) request.settings.push_back(parse_assignment(s));
+        if (options.plan == "full") mode = PlanMode::full;
+        else if (options.plan != "pruned")
+            throw std::invalid_argument("--plan: '" + options.plan + "' (accepted: pruned, full)");
+        if (options.out.empty() && !options.explain)
+            throw std::invalid_argument("--out: missing (give --out FILE, or --explain to print the plan)");
+        if (!options.out.empty() && !is_supported_image_path(options.out))
+            throw std::invalid_argument("--out: '" + options.out +
+                                        "' has an unsupported extension (accepted: .exr, .png, .tif)");
+        scene = build_scene(request);
+    } catch (const KnobError& e) {
+        std::cerr << "lucent render: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const MeshError& e) {
+        std::cerr << "lucent render: --mesh " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const std::invalid_argument& e) {
+        std::cerr << "lucent render: " << e.what() << "\n";
+        return kExitUsage;
+    }
+
+    const Technique& technique = find_technique(scene.technique);
+    if (options.explain) {
+        const FramePlan plan = make_frame_plan(scene, technique, mode);
+        std::cout << "plan for " << scene.mesh->name << " (" << scene.mesh->face_count()
+                  << " faces) with " << technique.name() << " at " << scene.width << "x"
+                  << scene.height << (mode == PlanMode::full ? ", full" : "") << ":\n"
+                  << plan.explain();
+        if (options.out.empty()) return kExitOk;
+    }
+    try {
+        auto context = gl::create_headless_context();
+        gl::FrameExecutor executor;
+        executor.set_ambient_occlusion_source(bake_with_progress);
+        const Image image = render_image(executor, scene, mode);
+        ImageWriteOptions write;
+        write.linear = options.linear;
+        write_image(options.out, image, write);
+    } catch (const std::exception& e) {
+        std::cerr << "lucent render: " << e.what() << "\n";
+        return kExitFailure;
+    }
+    std::cout << "wrote " << options.out << "\n";
+    return kExitOk;
+}
+
+}  // namespace
+
+void register_render(CLI::App& app, int& exit_code) {
+    auto options = std::make_shared<RenderOptions>();
+    auto* cmd = app.add_subcommand("render", "Render one image of a mesh (headless)");
+    std::string meshes;
+    for (const auto& name : builtin_mesh_names()) meshes += (meshes.empty() ? "" : ", ") + name;
+    std::string techniques, keys;
+    for (const Technique* t : all_techniques()) {
+        techniques += (techniques.empty() ? "" : ", ") + std::string(t->name());
+        for (const Knob& k : knobs_for(*t)) keys += (keys.empty() ? "" : ", ") + k.name;
+    }
+    cmd->add_option("--mesh", options->mesh,
+                    "built-in mesh (" + meshes + "; optional face budget, e.g. torus_knot:60k) or a mesh file");
+    cmd->add_option("config", options->config,
+                    "stimulus-set config (TOML): render every stimulus into --out DIR");
+    cmd->add_option("--preset", options->preset, "built-in stimulus set (thesis) into --out DIR");
+    cmd->add_option("--jobs", options->jobs, "stimulus sets: parallel workers (default 1)");
+    cmd->add_flag("--force", options->force, "stimulus sets: re-render unchanged stimuli too");
+    cmd->add_option("--technique", options->technique, "technique (" + techniques + ")");
+    cmd->add_option("--set", options->settings,
+                    "parameter key=value, repeatable; rgb as r,g,b or one grey value (keys: " + keys + ")");
+    cmd->add_option("--size", options->size, "image size WxH (default 512x512)");
+    cmd->add_option("--out", options->out, "output image: .exr (linear float), .png (8-bit), .tif (16-bit)");
+    cmd->add_flag("--explain", options->explain, "print the frame plan, one pass per line");
+    cmd->add_option("--plan", options->plan, "pruned (default) or full: run every pass, to check pruning");
+    cmd->add_flag("--linear", options->linear, "write .png/.tif without sRGB encoding");
+    cmd->callback([options, &exit_code] {
+        // One image (--mesh) or a stimulus set (CONFIG or --preset), never both.
+        const bool batch = !options->config.empty() || !options->preset.empty();
+        if (batch && (!options->mesh.empty() || (!options->config.empty() && !options->preset.empty()))) {
+            std::cerr << "lucent render: give one of --mesh, CONFIG or --preset\n";
+            exit_code = kExitUsage;
+        } else if (batch) {
+            exit_code = stimuli::run_render_set_command(options->config, options->preset,
+                                                        options->out, options->jobs, options->force);
+        } else if (options->mesh.empty()) {
+            std::cerr << "lucent render: --mesh is required (or a stimulus-set CONFIG or --preset)\n";
+            exit_code = kExitUsage;
+        } else {
+            exit_code = run_render(*options);
+        }
+    });
+}
+
+}  // namespace lucent::app

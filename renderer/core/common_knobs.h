@@ -1,0 +1,21 @@
+#pragma once
+// Knobs shared by every technique: the light, camera and background of a scene
+// (scene_knobs(), added by the registry to every technique), and material knobs that
+// several techniques reuse under the same canonical names.
+#include <vector>
+
+#include "core/knobs.h"
+
+namespace lucent {
+
+// light_ambient, light_diffuse, light_specular, light_direction, fov_y, background.
+const std::vector<Knob>& scene_knobs();
+
+// Material knobs a technique lists in its knobs() when it uses them.
+Knob albedo_knob();     // Kd
+Knob ambient_knob();    // ka
+Knob specular_knob();   // ks
+Knob shininess_knob();  // n
+Knob ao_rays_knob();    // rays per vertex of the ambient-occlusion bake
+
+}  // namespace lucent

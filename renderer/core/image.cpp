@@ -1,0 +1,126 @@
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <system_error>
+
+#include "core/image.h"
+
+namespace lucent {
+namespace {
+
+std::string lower_extension(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+[[noreturn]] void fail(const std::filesystem::path& path, const std::string& why) {
+    throw ImageError(path.string() + ": " + why);
+}
+
+// Rows stay top first; both OIIO and Image store them so.
+template <typename T>
+std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
+    std::vector<T> out(static_cast<std::size_t>(image.width) * image.height * 3);
+    for (std::size_t i = 0, n = out.size() / 3; i < n; ++i)
+        for (int c = 0; c < 3; ++c) {
+            const float v = std::clamp(image.rgba[i * 4 + c], 0.0f, 1.0f);
+            out[i * 3 + c] = static_cast<T>(std::lround((linear ? v : srgb_encode(v)) * scale));
+        }
+    return out;
+}
+
+}  // namespace
+
+float srgb_encode(float linear) {
+    const float v = std::clamp(linear, 0.0f, 1.0f);
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+std::size_t replace_non_finite(Image& image) {
+    std::size_t replaced = 0;
+    for (float& v : image.rgba) {
+        if (std::isfinite(v)) continue;
+        ++replaced;
+        v = std::isnan(v) ? 0.0f
+                          : std::copysign(std::numeric_limits<float>::max(), v);
+    }
+    return replaced;
+}
+
+bool is_supported_image_path(const std::filesystem::path& path) {
+    const std::string ext = lower_extension(path);
+    return ext == ".exr" || ext == ".png" || ext == ".tif" || ext == ".tiff";
+}
+
+void write_image(const std::filesystem::path& path, const Image& input,
+                 const ImageWriteOptions& options) {
+    const std::string ext = lower_extension(path);
+    if (!is_supported_image_path(path))
+        fail(path, "unsupported image format '" + ext + "' (use .exr, .png or .tif)");
+    if (input.width <= 0 || input.height <= 0 ||
+        input.rgba.size() != static_cast<std::size_t>(input.width) * input.height * 4)
+        fail(path, "image has no pixels");
+    Image image = input;
+    replace_non_finite(image);
+
+    // Write to a temporary sibling, then rename: readers never see a half-written file.
+    std::filesystem::path temporary = path;
+    temporary += ".partial" + ext;
+    auto out = OIIO::ImageOutput::create(temporary.string());
+    if (!out) fail(path, "OpenImageIO cannot write '" + ext + "': " + OIIO::geterror());
+    bool ok = false;
+    if (ext == ".exr") {
+        OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
+        spec.attribute("compression", "zip");
+        ok = out->open(temporary.string(), spec) &&
+             out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data());
+    } else if (ext == ".png") {
+        OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+        spec.attribute("oiio:ColorSpace", options.linear ? "linear" : "sRGB");
+        const auto pixels = encode_rgb<std::uint8_t>(image, options.linear, 255.0f);
+        ok = out->open(temporary.string(), spec) &&
+             out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
+    } else {
+        OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT16);
+        spec.attribute("oiio:ColorSpace", options.linear ? "linear" : "sRGB");
+        spec.attribute("compression", "zip");
+        const auto pixels = encode_rgb<std::uint16_t>(image, options.linear, 65535.0f);
+        ok = out->open(temporary.string(), spec) &&
+             out->write_image(OIIO::TypeDesc::UINT16, pixels.data());
+    }
+    const std::string error = ok ? "" : out->geterror();
+    ok = out->close() && ok;
+    if (!ok) {
+        std::error_code ignored;
+        std::filesystem::remove(temporary, ignored);
+        fail(path, "write failed: " + (error.empty() ? out->geterror() : error));
+    }
+    std::error_code rename_error;
+    std::filesystem::rename(temporary, path, rename_error);
+    if (rename_error) fail(path, "cannot rename temporary file: " + rename_error.message());
+}
+
+Image read_image(const std::filesystem::path& path) {
+    auto in = OIIO::ImageInput::open(path.string());
+    if (!in) fail(path, "cannot read: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    const int channels = spec.nchannels;
+    std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * channels);
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
+        fail(path, "cannot read pixels: " + in->geterror());
+    Image image(spec.width, spec.height);
+    for (std::size_t i = 0, n = static_cast<std::size_t>(spec.width) * spec.height; i < n; ++i)
+        for (int c = 0; c < 4; ++c)
+            image.rgba[i * 4 + c] = c < channels   ? pixels[i * channels + c]
+                                    : c == 3       ? 1.0f
+                                    : channels == 1 ? pixels[i * channels]
+                                                   : 0.0f;
+    return image;
+}
+
+}  // namespace lucent

@@ -1,0 +1,61 @@
+#pragma once
+// Linear float RGBA images, top row first (as image files store them). Alpha is coverage:
+// 1 where the object is, 0 on the background.
+#include <glm/glm.hpp>
+
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+namespace lucent {
+
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgba;  // width * height * 4
+
+    Image() = default;
+    Image(int w, int h) : width(w), height(h), rgba(static_cast<std::size_t>(w) * h * 4, 0.0f) {}
+    glm::vec4 at(int x, int y) const {
+        const float* p = &rgba[(static_cast<std::size_t>(y) * width + x) * 4];
+        return {p[0], p[1], p[2], p[3]};
+    }
+    void set(int x, int y, glm::vec4 value) {
+        float* p = &rgba[(static_cast<std::size_t>(y) * width + x) * 4];
+        p[0] = value.r;
+        p[1] = value.g;
+        p[2] = value.b;
+        p[3] = value.a;
+    }
+};
+
+// Replaces NaN with 0 and +-Inf with the largest finite float of that sign; returns how
+// many values it replaced. Every image passes through this before it is written.
+std::size_t replace_non_finite(Image& image);
+
+class ImageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct ImageWriteOptions {
+    // PNG / TIFF: store linear values instead of sRGB-encoding them.
+    bool linear = false;
+};
+
+// Writes by extension: ".exr" 32-bit float linear RGBA; ".png" 8-bit RGB,
+// sRGB-encoded unless options.linear; ".tif"/".tiff" 16-bit RGB, same encoding rule.
+// Non-finite values are replaced first (replace_non_finite) and 8/16-bit output clamps to
+// [0, 1]. The file is written to a temporary name and renamed, so it is never truncated.
+// Throws ImageError naming the file (unknown extension, I/O failure).
+void write_image(const std::filesystem::path& path, const Image& image,
+                 const ImageWriteOptions& options = {});
+// Reads any image OpenImageIO can; channels beyond 4 are dropped, missing alpha is 1.
+Image read_image(const std::filesystem::path& path);
+// True when write_image() accepts the extension of `path`.
+bool is_supported_image_path(const std::filesystem::path& path);
+
+// sRGB transfer function (IEC 61966-2-1) of one linear value clamped to [0, 1].
+float srgb_encode(float linear);
+
+}  // namespace lucent

@@ -1,0 +1,231 @@
+#include "core/knobs.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace lucent {
+namespace {
+
+std::string number_text(double value) {
+    std::ostringstream out;
+    out.precision(9);
+    out << value;
+    return out.str();
+}
+
+std::string_view trim(std::string_view text) {
+    while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+    while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
+    return text;
+}
+
+// Whole-string parse of a finite real number; nullopt-like failure through `ok`.
+bool parse_real(std::string_view text, double& value) {
+    text = trim(text);
+    if (text.empty()) return false;
+    if (text.front() == '+') text.remove_prefix(1);
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    return error == std::errc() && end == text.data() + text.size() && std::isfinite(value);
+}
+
+std::vector<std::string_view> split_commas(std::string_view text) {
+    std::vector<std::string_view> parts;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = text.find(',', start);
+        parts.push_back(text.substr(start, comma - start));
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    return parts;
+}
+
+[[noreturn]] void fail(const Knob& knob, const std::string& what) {
+    throw KnobError(knob.name + ": " + what + " (accepted: " + accepted_range(knob) + ")");
+}
+
+void check_range(const Knob& knob, double value, std::string_view text) {
+    if (!std::isfinite(value) || value < knob.min || value > knob.max)
+        fail(knob, "'" + std::string(text) + "' is out of range");
+}
+
+const char* kind_name(KnobKind kind) {
+    switch (kind) {
+        case KnobKind::scalar: return "a number";
+        case KnobKind::rgb: return "an rgb colour";
+        case KnobKind::integer: return "an integer";
+        case KnobKind::choice: return "a choice";
+        case KnobKind::vec3: return "a 3-vector";
+    }
+    return "?";
+}
+
+}  // namespace
+
+const KnobValue& KnobValues::get(std::string_view name) const {
+    const auto it = values_.find(name);
+    if (it == values_.end())
+        throw std::logic_error("knob '" + std::string(name) + "' has no value");
+    return it->second;
+}
+
+double KnobValues::scalar(std::string_view name) const {
+    const auto& value = get(name);
+    if (const double* v = std::get_if<double>(&value)) return *v;
+    if (const int* v = std::get_if<int>(&value)) return *v;
+    throw std::logic_error("knob '" + std::string(name) + "' is not a scalar");
+}
+
+glm::dvec3 KnobValues::vec3(std::string_view name) const {
+    const auto& value = get(name);
+    if (const auto* v = std::get_if<glm::dvec3>(&value)) return *v;
+    throw std::logic_error("knob '" + std::string(name) + "' is not an rgb/vec3");
+}
+
+int KnobValues::integer(std::string_view name) const {
+    const auto& value = get(name);
+    if (const int* v = std::get_if<int>(&value)) return *v;
+    throw std::logic_error("knob '" + std::string(name) + "' is not an integer");
+}
+
+const std::string& KnobValues::choice(std::string_view name) const {
+    const auto& value = get(name);
+    if (const auto* v = std::get_if<std::string>(&value)) return *v;
+    throw std::logic_error("knob '" + std::string(name) + "' is not a choice");
+}
+
+KnobAssignment parse_assignment(std::string_view key_equals_value) {
+    const std::size_t equals = key_equals_value.find('=');
+    if (equals == std::string_view::npos)
+        throw KnobError("'" + std::string(key_equals_value) + "': expected key=value");
+    const std::string_view key = trim(key_equals_value.substr(0, equals));
+    if (key.empty())
+        throw KnobError("'" + std::string(key_equals_value) + "': empty key in key=value");
+    return {std::string(key), std::string(trim(key_equals_value.substr(equals + 1)))};
+}
+
+std::string accepted_range(const Knob& knob) {
+    const std::string range = "[" + number_text(knob.min) + ", " + number_text(knob.max) + "]";
+    switch (knob.kind) {
+        case KnobKind::scalar: return "a number in " + range;
+        case KnobKind::integer: return "an integer in " + range;
+        case KnobKind::rgb: return "r,g,b (or one grey value) with each in " + range;
+        case KnobKind::vec3: return "x,y,z with each in " + range + ", not all zero";
+        case KnobKind::choice: {
+            std::string list;
+            for (const auto& c : knob.choices) list += (list.empty() ? "" : ", ") + c;
+            return "one of " + list;
+        }
+    }
+    return "";
+}
+
+KnobValue parse_knob_value(const Knob& knob, std::string_view text) {
+    text = trim(text);
+    switch (knob.kind) {
+        case KnobKind::scalar: {
+            double value = 0;
+            if (!parse_real(text, value)) fail(knob, "'" + std::string(text) + "' is not a number");
+            check_range(knob, value, text);
+            return value;
+        }
+        case KnobKind::integer: {
+            int value = 0;
+            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+            if (text.empty() || error != std::errc() || end != text.data() + text.size())
+                fail(knob, "'" + std::string(text) + "' is not an integer");
+            check_range(knob, value, text);
+            return value;
+        }
+        case KnobKind::rgb:
+        case KnobKind::vec3: {
+            const auto parts = split_commas(text);
+            const bool grey_allowed = knob.kind == KnobKind::rgb;
+            if (parts.size() != 3 && !(grey_allowed && parts.size() == 1))
+                fail(knob, "'" + std::string(text) + "' needs " +
+                               (grey_allowed ? "3 comma-separated numbers or 1"
+                                             : "3 comma-separated numbers"));
+            double c[3];
+            for (std::size_t i = 0; i < parts.size(); ++i) {
+                if (!parse_real(parts[i], c[i]))
+                    fail(knob, "'" + std::string(trim(parts[i])) + "' is not a number");
+                check_range(knob, c[i], text);
+            }
+            const glm::dvec3 value = parts.size() == 1 ? glm::dvec3(c[0]) : glm::dvec3(c[0], c[1], c[2]);
+            validate_knob_value(knob, value);
+            return value;
+        }
+        case KnobKind::choice:
+            for (const auto& c : knob.choices)
+                if (text == c) return c;
+            fail(knob, "'" + std::string(text) + "' is not a valid choice");
+    }
+    fail(knob, "unknown kind");
+}
+
+void validate_knob_value(const Knob& knob, const KnobValue& value) {
+    const auto wrong_type = [&] { fail(knob, std::string("expected ") + kind_name(knob.kind)); };
+    switch (knob.kind) {
+        case KnobKind::scalar: {
+            const double* v = std::get_if<double>(&value);
+            if (!v) wrong_type();
+            check_range(knob, *v, number_text(*v));
+            return;
+        }
+        case KnobKind::integer: {
+            const int* v = std::get_if<int>(&value);
+            if (!v) wrong_type();
+            check_range(knob, *v, std::to_string(*v));
+            return;
+        }
+        case KnobKind::rgb:
+        case KnobKind::vec3: {
+            const auto* v = std::get_if<glm::dvec3>(&value);
+            if (!v) wrong_type();
+            for (int i = 0; i < 3; ++i) check_range(knob, (*v)[i], format_knob_value(value));
+            if (knob.kind == KnobKind::vec3 && glm::dot(*v, *v) <= 0.0)
+                fail(knob, "'" + format_knob_value(value) + "' is the zero vector");
+            return;
+        }
+        case KnobKind::choice: {
+            const auto* v = std::get_if<std::string>(&value);
+            if (!v) wrong_type();
+            for (const auto& c : knob.choices)
+                if (*v == c) return;
+            fail(knob, "'" + *v + "' is not a valid choice");
+        }
+    }
+}
+
+std::string format_knob_value(const KnobValue& value) {
+    if (const double* v = std::get_if<double>(&value)) return number_text(*v);
+    if (const int* v = std::get_if<int>(&value)) return std::to_string(*v);
+    if (const auto* v = std::get_if<std::string>(&value)) return *v;
+    const auto& c = std::get<glm::dvec3>(value);
+    return number_text(c.x) + "," + number_text(c.y) + "," + number_text(c.z);
+}
+
+const Knob* find_knob(std::span<const Knob> knobs, std::string_view name) {
+    for (const auto& knob : knobs)
+        if (knob.name == name) return &knob;
+    return nullptr;
+}
+
+KnobValues resolve_knob_values(std::span<const Knob> knobs,
+                               std::span<const KnobAssignment> assignments) {
+    KnobValues values;
+    for (const auto& knob : knobs) values.set(knob.name, knob.default_value);
+    for (const auto& assignment : assignments) {
+        const Knob* knob = find_knob(knobs, assignment.key);
+        if (!knob) {
+            std::string valid;
+            for (const auto& k : knobs) valid += (valid.empty() ? "" : ", ") + k.name;
+            throw KnobError(assignment.key + ": unknown parameter (valid: " + valid + ")");
+        }
+        values.set(knob->name, parse_knob_value(*knob, assignment.text));
+    }
+    return values;
+}
+
+}  // namespace lucent

@@ -1,0 +1,149 @@
+// Mesh helpers shared by the built-in shapes and the file loader: bounding sphere,
+// content hash, smooth normals, and the spec dispatch of load_mesh().
+#include "core/mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "core/mesh_sources.h"
+
+namespace lucent {
+
+namespace {
+
+// Largest distance from `centre` to any position, computed in double precision and
+// nudged up one part in 1e6 so float rounding never leaves a vertex outside.
+float enclosing_radius(const std::vector<glm::vec3>& positions, glm::dvec3 centre) {
+    double max_squared = 0.0;
+    for (const glm::vec3& p : positions) {
+        const glm::dvec3 d = glm::dvec3(p) - centre;
+        max_squared = std::max(max_squared, glm::dot(d, d));
+    }
+    return static_cast<float>(std::sqrt(max_squared) * (1.0 + 1e-6));
+}
+
+// Ritter's approximate minimal sphere: start from two far-apart points, then grow.
+glm::dvec3 ritter_centre(const std::vector<glm::vec3>& positions) {
+    auto farthest_from = [&](glm::dvec3 from) {
+        glm::dvec3 best = positions.front();
+        double best_d = -1.0;
+        for (const glm::vec3& p : positions) {
+            const double d = glm::dot(glm::dvec3(p) - from, glm::dvec3(p) - from);
+            if (d > best_d) best_d = d, best = p;
+        }
+        return best;
+    };
+    const glm::dvec3 a = farthest_from(positions.front());
+    const glm::dvec3 b = farthest_from(a);
+    glm::dvec3 centre = 0.5 * (a + b);
+    double radius = 0.5 * glm::length(b - a);
+    for (const glm::vec3& p : positions) {
+        const double d = glm::length(glm::dvec3(p) - centre);
+        if (d > radius) {
+            const double grown = 0.5 * (radius + d);
+            centre += (d - grown) / d * (glm::dvec3(p) - centre);
+            radius = grown;
+        }
+    }
+    return centre;
+}
+
+}  // namespace
+
+BoundingSphere Mesh::bounding_sphere() const {
+    if (positions.empty()) return {};
+    glm::dvec3 lo(positions.front()), hi(positions.front());
+    for (const glm::vec3& p : positions) {
+        lo = glm::min(lo, glm::dvec3(p));
+        hi = glm::max(hi, glm::dvec3(p));
+    }
+    const glm::dvec3 box_centre = 0.5 * (lo + hi);
+    const glm::dvec3 ritter = ritter_centre(positions);
+    const float box_radius = enclosing_radius(positions, box_centre);
+    const float ritter_radius = enclosing_radius(positions, ritter);
+    if (box_radius <= ritter_radius) return {glm::vec3(box_centre), box_radius};
+    return {glm::vec3(ritter), ritter_radius};
+}
+
+std::string compute_content_hash(const std::vector<glm::vec3>& positions,
+                                 const std::vector<glm::uvec3>& triangles) {
+    std::uint64_t hash = 0xcbf29ce484222325ull;
+    auto mix = [&hash](std::uint32_t word) {
+        for (int byte = 0; byte < 4; ++byte) {
+            hash ^= (word >> (8 * byte)) & 0xffu;
+            hash *= 0x100000001b3ull;
+        }
+    };
+    // Counts first, so (positions, triangles) splits cannot collide by concatenation.
+    mix(static_cast<std::uint32_t>(positions.size()));
+    mix(static_cast<std::uint32_t>(triangles.size()));
+    for (const glm::vec3& p : positions)
+        for (int k = 0; k < 3; ++k) {
+            const float value = p[k] == 0.0f ? 0.0f : p[k];  // -0 and +0 hash alike
+            std::uint32_t bits = 0;
+            std::memcpy(&bits, &value, sizeof bits);
+            mix(bits);
+        }
+    for (const glm::uvec3& t : triangles)
+        for (int k = 0; k < 3; ++k) mix(t[k]);
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+    return text;
+}
+
+std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& positions,
+                                              const std::vector<glm::uvec3>& triangles) {
+    std::vector<glm::dvec3> sums(positions.size(), glm::dvec3(0.0));
+    std::vector<glm::dvec3> fallback(positions.size(), glm::dvec3(0.0));
+    for (const glm::uvec3& t : triangles) {
+        const glm::dvec3 p[3] = {positions[t.x], positions[t.y], positions[t.z]};
+        const glm::dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
+        const double face_length = glm::length(face);
+        if (!(face_length > 0.0)) continue;
+        const glm::dvec3 unit = face / face_length;
+        for (int corner = 0; corner < 3; ++corner) {
+            const glm::dvec3 e1 = p[(corner + 1) % 3] - p[corner];
+            const glm::dvec3 e2 = p[(corner + 2) % 3] - p[corner];
+            const double angle = std::atan2(glm::length(glm::cross(e1, e2)), glm::dot(e1, e2));
+            sums[t[corner]] += angle * unit;
+            if (fallback[t[corner]] == glm::dvec3(0.0)) fallback[t[corner]] = unit;
+        }
+    }
+    std::vector<glm::vec3> normals(positions.size());
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+        const double length = glm::length(sums[i]);
+        if (length > 1e-12) normals[i] = glm::vec3(sums[i] / length);
+        else if (fallback[i] != glm::dvec3(0.0)) normals[i] = glm::vec3(fallback[i]);
+        else normals[i] = glm::vec3(0.0f, 0.0f, 1.0f);
+    }
+    return normals;
+}
+
+void finalize_mesh(Mesh& mesh) {
+    if (mesh.normals.size() != mesh.positions.size())
+        mesh.normals = compute_smooth_normals(mesh.positions, mesh.triangles);
+    std::vector<glm::vec3> smooth;  // computed only if some normal needs replacing
+    for (std::size_t i = 0; i < mesh.normals.size(); ++i) {
+        glm::vec3& n = mesh.normals[i];
+        const float length = glm::length(n);
+        if (std::isfinite(length) && length > 1e-12f) {
+            n /= length;
+            continue;
+        }
+        if (smooth.empty()) smooth = compute_smooth_normals(mesh.positions, mesh.triangles);
+        n = smooth[i];
+    }
+    mesh.content_hash = compute_content_hash(mesh.positions, mesh.triangles);
+}
+
+Mesh load_mesh(const std::string& spec) {
+    // A built-in name wins unless a file of that exact name exists.
+    if (is_builtin_mesh_spec(spec) && !std::filesystem::exists(spec))
+        return build_builtin_mesh(spec);
+    return load_mesh_file(spec);
+}
+
+}  // namespace lucent

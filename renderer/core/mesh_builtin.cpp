@@ -1,0 +1,402 @@
+// Built-in procedural meshes, so every feature works without mesh files. Each takes a
+// face budget ("torus_knot:240k") and lands within a few percent of it.
+//   sphere      unit radius, poles on the Z axis (the default camera's central ray
+//               passes through both poles, so its thickness there is exactly 2)
+//   torus       major radius 1, tube radius 0.4, axis Y (seen side-on by default)
+//   torus_knot  (2,3) trefoil tube whose radius varies from 0.05 to 0.25 (thin and thick)
+//   hand        palm, four fingers, a thumb and a wrist smoothly merged (non-convex, thin
+//               protrusions; stand-in for the thesis's hand and Fertility models)
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <unordered_map>
+
+#include "core/mesh.h"
+#include "core/mesh_sources.h"
+
+namespace lucent {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr std::size_t kMinFaceBudget = 100;
+constexpr std::size_t kMaxFaceBudget = 20'000'000;
+
+double signed_volume(const Mesh& mesh) {
+    double six_volume = 0.0;
+    for (const glm::uvec3& t : mesh.triangles)
+        six_volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
+                               glm::cross(glm::dvec3(mesh.positions[t.y]),
+                                          glm::dvec3(mesh.positions[t.z])));
+    return six_volume / 6.0;
+}
+
+// Flips every triangle when the (consistently wound) mesh encloses negative volume.
+void orient_outward(Mesh& mesh) {
+    if (signed_volume(mesh) >= 0.0) return;
+    for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);
+}
+
+// Two triangles per cell of a (rows x columns) vertex grid that wraps around in both
+// directions; vertex (i, j) has index i * columns + j. Counter-clockwise seen from the
+// side that d(row) x d(column) points to.
+void add_wrapped_grid(Mesh& mesh, unsigned rows, unsigned columns) {
+    for (unsigned i = 0; i < rows; ++i)
+        for (unsigned j = 0; j < columns; ++j) {
+            const unsigned i1 = (i + 1) % rows, j1 = (j + 1) % columns;
+            const unsigned a = i * columns + j, b = i1 * columns + j;
+            const unsigned c = i1 * columns + j1, d = i * columns + j1;
+            mesh.triangles.push_back({a, b, c});
+            mesh.triangles.push_back({a, c, d});
+        }
+}
+
+// Picks (count_a, count_b) with 2 * a * b close to `faces` and a / b close to `ratio`;
+// a is rounded to a multiple of `a_multiple`, b to a multiple of `b_multiple`.
+std::pair<unsigned, unsigned> grid_for_budget(std::size_t faces, double ratio,
+                                              unsigned a_multiple, unsigned b_multiple) {
+    const double ideal_b = std::sqrt(static_cast<double>(faces) / (2.0 * ratio));
+    std::pair<unsigned, unsigned> best{0, 0};
+    double best_error = 1e300;
+    for (int db = -4; db <= 4; ++db) {
+        const long b = (std::lround(ideal_b / b_multiple) + db) * b_multiple;
+        if (b < 3) continue;
+        const long a = std::max<long>(
+            3, std::lround(static_cast<double>(faces) / (2.0 * b * a_multiple)) * a_multiple);
+        const double error = std::abs(2.0 * a * b - static_cast<double>(faces));
+        if (error < best_error) best_error = error, best = {unsigned(a), unsigned(b)};
+    }
+    return best;
+}
+
+Mesh make_sphere(std::size_t budget) {
+    // UV sphere: 2 * slices * (stacks - 1) faces, poles at z = +-1.
+    const auto [slices, rings] = grid_for_budget(budget, 2.0, 4, 1);  // rings = stacks - 1
+    const unsigned stacks = rings + 1;
+    Mesh mesh;
+    mesh.positions.push_back({0.0f, 0.0f, 1.0f});
+    for (unsigned i = 1; i < stacks; ++i) {
+        const double theta = kPi * i / stacks;
+        for (unsigned j = 0; j < slices; ++j) {
+            const double phi = 2.0 * kPi * j / slices;
+            mesh.positions.push_back(glm::vec3(glm::dvec3(
+                std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                std::cos(theta))));
+        }
+    }
+    mesh.positions.push_back({0.0f, 0.0f, -1.0f});
+    const unsigned south = static_cast<unsigned>(mesh.positions.size() - 1);
+    auto ring_vertex = [&](unsigned ring, unsigned j) { return 1 + ring * slices + j % slices; };
+    for (unsigned j = 0; j < slices; ++j) {
+        mesh.triangles.push_back({0, ring_vertex(0, j), ring_vertex(0, j + 1)});
+        mesh.triangles.push_back({south, ring_vertex(stacks - 2, j + 1),
+                                  ring_vertex(stacks - 2, j)});
+    }
+    for (unsigned ring = 0; ring + 1 < stacks - 1; ++ring)
+        for (unsigned j = 0; j < slices; ++j) {
+            const unsigned a = ring_vertex(ring, j), b = ring_vertex(ring + 1, j);
+            const unsigned c = ring_vertex(ring + 1, j + 1), d = ring_vertex(ring, j + 1);
+            mesh.triangles.push_back({a, b, c});
+            mesh.triangles.push_back({a, c, d});
+        }
+    mesh.normals = mesh.positions;  // unit sphere: the analytic normal is the position
+    return mesh;
+}
+
+Mesh make_torus(std::size_t budget) {
+    constexpr double major = 1.0, minor = 0.4;
+    // Multiples of 4 around the axis and of 2 around the tube put vertices exactly on
+    // the X and Z axes' crossings with the tube, so axis-aligned rays have exact hits.
+    const auto [around_axis, around_tube] = grid_for_budget(budget, major / minor, 4, 2);
+    Mesh mesh;
+    for (unsigned i = 0; i < around_axis; ++i) {
+        const double phi = 2.0 * kPi * i / around_axis;
+        const glm::dvec3 radial(std::cos(phi), 0.0, -std::sin(phi));
+        for (unsigned j = 0; j < around_tube; ++j) {
+            const double theta = 2.0 * kPi * j / around_tube;
+            const glm::dvec3 normal = std::cos(theta) * radial + glm::dvec3(0, std::sin(theta), 0);
+            mesh.positions.push_back(glm::vec3(major * radial + minor * normal));
+            mesh.normals.push_back(glm::vec3(normal));
+        }
+    }
+    add_wrapped_grid(mesh, around_axis, around_tube);
+    orient_outward(mesh);
+    return mesh;
+}
+
+Mesh make_torus_knot(std::size_t budget) {
+    // (2,3) torus knot on a torus of radii (1, 0.45): strands stay >= 0.89 apart and the
+    // curve's radius of curvature >= 0.73, so a tube of radius <= 0.25 never intersects
+    // itself. The radius swings between 0.05 and 0.25 three times along the knot.
+    constexpr double major = 1.0, minor = 0.45, p = 2.0, q = 3.0;
+    auto curve = [&](double t) {
+        const double r = major + minor * std::cos(q * t);
+        return glm::dvec3(r * std::cos(p * t), r * std::sin(p * t), minor * std::sin(q * t));
+    };
+    auto tangent = [&](double t) {
+        const double r = major + minor * std::cos(q * t);
+        const double dr = -q * minor * std::sin(q * t);
+        return glm::normalize(glm::dvec3(dr * std::cos(p * t) - p * r * std::sin(p * t),
+                                         dr * std::sin(p * t) + p * r * std::cos(p * t),
+                                         q * minor * std::cos(q * t)));
+    };
+    auto tube_radius = [](double t) { return 0.15 + 0.10 * std::sin(3.0 * t + 0.5); };
+    // Knot length ~13.9, mean tube circumference ~0.94: keep cells roughly square.
+    const auto [along, around] = grid_for_budget(budget, 14.0, 1, 1);
+    Mesh mesh;
+    for (unsigned i = 0; i < along; ++i) {
+        const double t = 2.0 * kPi * i / along;
+        const glm::dvec3 centre = curve(t), direction = tangent(t);
+        // Frame from the torus core circle: periodic, so the tube closes without twist.
+        const glm::dvec3 core = major * glm::dvec3(std::cos(p * t), std::sin(p * t), 0.0);
+        const glm::dvec3 out = centre - core;
+        const glm::dvec3 normal = glm::normalize(out - glm::dot(out, direction) * direction);
+        const glm::dvec3 binormal = glm::cross(direction, normal);
+        for (unsigned j = 0; j < around; ++j) {
+            const double theta = 2.0 * kPi * j / around;
+            mesh.positions.push_back(glm::vec3(
+                centre + tube_radius(t) * (std::cos(theta) * normal + std::sin(theta) * binormal)));
+        }
+    }
+    add_wrapped_grid(mesh, along, around);
+    orient_outward(mesh);
+    return mesh;
+}
+
+// ---- hand: a signed distance field polygonised by marching tetrahedra ----
+
+float smooth_min(float a, float b, float k) {  // polynomial smooth minimum (blend width k)
+    const float h = std::clamp(0.5f + 0.5f * (b - a) / k, 0.0f, 1.0f);
+    return b + (a - b) * h - k * h * (1.0f - h);
+}
+
+float capsule(glm::vec3 p, glm::vec3 a, glm::vec3 b, float radius) {
+    const glm::vec3 pa = p - a, ba = b - a;
+    const float h = std::clamp(glm::dot(pa, ba) / glm::dot(ba, ba), 0.0f, 1.0f);
+    return glm::length(pa - ba * h) - radius;
+}
+
+float ellipsoid(glm::vec3 p, glm::vec3 radii) {  // a bound, exact on the surface
+    const float k0 = glm::length(p / radii), k1 = glm::length(p / (radii * radii));
+    return k1 > 0.0f ? k0 * (k0 - 1.0f) / k1 : -std::min({radii.x, radii.y, radii.z});
+}
+
+// Negative inside. Palm faces +Z, fingers point to +Y, thumb to -X.
+float hand_distance(glm::vec3 p) {
+    float d = ellipsoid(p, {0.55f, 0.62f, 0.2f});
+    d = smooth_min(d, capsule(p, {0.0f, -0.45f, 0.0f}, {0.0f, -1.15f, 0.0f}, 0.26f), 0.15f);
+    struct Finger { glm::vec3 base, tip; float radius; };
+    const Finger fingers[] = {
+        {{-0.34f, 0.42f, 0.0f}, {-0.46f, 1.30f, 0.03f}, 0.085f},  // index
+        {{-0.11f, 0.50f, 0.0f}, {-0.13f, 1.45f, 0.04f}, 0.09f},   // middle
+        {{0.12f, 0.48f, 0.0f}, {0.20f, 1.36f, 0.03f}, 0.085f},    // ring
+        {{0.34f, 0.38f, 0.0f}, {0.52f, 1.08f, 0.02f}, 0.07f},     // little
+        {{-0.42f, -0.15f, 0.05f}, {-1.02f, 0.35f, 0.12f}, 0.095f},  // thumb
+    };
+    for (const Finger& f : fingers) d = smooth_min(d, capsule(p, f.base, f.tip, f.radius), 0.06f);
+    return d;
+}
+
+glm::vec3 distance_gradient(const std::function<float(glm::vec3)>& field, glm::vec3 p,
+                            float step) {
+    const glm::vec3 dx(step, 0, 0), dy(0, step, 0), dz(0, 0, step);
+    return {field(p + dx) - field(p - dx), field(p + dy) - field(p - dy),
+            field(p + dz) - field(p - dz)};
+}
+
+// Marching tetrahedra over a cubic grid of spacing `cell` covering [lo, hi]: each cube
+// is split into six tetrahedra around its main diagonal (a conforming split, so the
+// surface is closed), vertices on grid edges are shared, triangles face outward.
+// The grid is visited in blocks of 8^3 cells and a block whose centre is farther from
+// the surface than twice its half-diagonal is skipped (the field is a distance bound),
+// so the cost follows the surface area, not the bounding box volume.
+Mesh polygonise(const std::function<float(glm::vec3)>& field, glm::vec3 lo, glm::vec3 hi,
+                float cell) {
+    constexpr int kBlock = 8;
+    const glm::ivec3 cells = glm::ivec3(glm::ceil((hi - lo) / cell));
+    const glm::ivec3 dims = cells + 1;  // grid vertices
+    auto global_index = [&](glm::ivec3 g) {
+        return (static_cast<std::uint64_t>(g.z) * dims.y + g.y) * dims.x + g.x;
+    };
+    auto value_at = [&](glm::ivec3 g) {
+        // A value of exactly zero would put a vertex on a grid corner shared by several
+        // edges and create zero-area triangles: count it as outside.
+        const float v = field(lo + cell * glm::vec3(g));
+        return v == 0.0f ? 1e-7f * cell : v;
+    };
+    Mesh mesh;
+    std::unordered_map<std::uint64_t, unsigned> edge_vertex;
+    auto vertex_on_edge = [&](std::uint64_t a, glm::vec3 pa, float fa, std::uint64_t b,
+                              glm::vec3 pb, float fb) {
+        if (a > b) std::swap(a, b), std::swap(pa, pb), std::swap(fa, fb);
+        const auto [it, inserted] =
+            edge_vertex.try_emplace((a << 32) ^ b, static_cast<unsigned>(mesh.positions.size()));
+        if (inserted) mesh.positions.push_back(pa + (fa / (fa - fb)) * (pb - pa));
+        return it->second;
+    };
+    static constexpr int kTetrahedra[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                                              {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+    const float block_reach = 2.0f * 0.5f * std::sqrt(3.0f) * kBlock * cell;
+    std::vector<float> block_values;
+    for (int bz = 0; bz < cells.z; bz += kBlock)
+        for (int by = 0; by < cells.y; by += kBlock)
+            for (int bx = 0; bx < cells.x; bx += kBlock) {
+                const glm::ivec3 first(bx, by, bz);
+                const glm::ivec3 last = glm::min(first + kBlock, cells);  // vertex bounds
+                const glm::vec3 centre = lo + cell * 0.5f * glm::vec3(first + last);
+                if (std::abs(field(centre)) > block_reach) continue;
+                const glm::ivec3 size = last - first + 1;
+                block_values.resize(static_cast<std::size_t>(size.x) * size.y * size.z);
+                auto local = [&](glm::ivec3 g) {
+                    const glm::ivec3 l = g - first;
+                    return (static_cast<std::size_t>(l.z) * size.y + l.y) * size.x + l.x;
+                };
+                for (int z = first.z; z <= last.z; ++z)
+                    for (int y = first.y; y <= last.y; ++y)
+                        for (int x = first.x; x <= last.x; ++x)
+                            block_values[local({x, y, z})] = value_at({x, y, z});
+                for (int z = first.z; z < last.z; ++z)
+                    for (int y = first.y; y < last.y; ++y)
+                        for (int x = first.x; x < last.x; ++x) {
+                            std::uint64_t corner_index[8];
+                            glm::vec3 corner_position[8];
+                            float corner_value[8];
+                            bool any_inside = false, any_outside = false;
+                            for (int c = 0; c < 8; ++c) {
+                                const glm::ivec3 g(x + (c & 1), y + ((c >> 1) & 1),
+                                                   z + ((c >> 2) & 1));
+                                corner_index[c] = global_index(g);
+                                corner_position[c] = lo + cell * glm::vec3(g);
+                                corner_value[c] = block_values[local(g)];
+                                (corner_value[c] < 0.0f ? any_inside : any_outside) = true;
+                            }
+                            if (!any_inside || !any_outside) continue;
+                            for (const auto& tet : kTetrahedra) {
+                                int inside[4], outside[4], n_in = 0, n_out = 0;
+                                for (int k = 0; k < 4; ++k)
+                                    (corner_value[tet[k]] < 0.0f ? inside[n_in++]
+                                                                 : outside[n_out++]) = tet[k];
+                                if (n_in == 0 || n_out == 0) continue;
+                                auto on = [&](int a, int b) {
+                                    return vertex_on_edge(corner_index[a], corner_position[a],
+                                                          corner_value[a], corner_index[b],
+                                                          corner_position[b], corner_value[b]);
+                                };
+                                glm::vec3 in_centre(0.0f), out_centre(0.0f);
+                                for (int k = 0; k < n_in; ++k) in_centre += corner_position[inside[k]];
+                                for (int k = 0; k < n_out; ++k)
+                                    out_centre += corner_position[outside[k]];
+                                const glm::vec3 outward =
+                                    out_centre / float(n_out) - in_centre / float(n_in);
+                                auto emit = [&](unsigned a, unsigned b, unsigned c) {
+                                    const glm::vec3 n =
+                                        glm::cross(mesh.positions[b] - mesh.positions[a],
+                                                   mesh.positions[c] - mesh.positions[a]);
+                                    if (glm::dot(n, outward) < 0.0f) std::swap(b, c);
+                                    mesh.triangles.push_back({a, b, c});
+                                };
+                                if (n_in == 1 || n_out == 1) {
+                                    const int lone = n_in == 1 ? inside[0] : outside[0];
+                                    const int* others = n_in == 1 ? outside : inside;
+                                    emit(on(lone, others[0]), on(lone, others[1]),
+                                         on(lone, others[2]));
+                                } else {  // two in, two out: a quad around the tetrahedron
+                                    const unsigned q0 = on(inside[0], outside[0]);
+                                    const unsigned q1 = on(inside[1], outside[0]);
+                                    const unsigned q2 = on(inside[1], outside[1]);
+                                    const unsigned q3 = on(inside[0], outside[1]);
+                                    emit(q0, q1, q2);
+                                    emit(q0, q2, q3);
+                                }
+                            }
+                        }
+            }
+    return mesh;
+}
+
+Mesh make_hand(std::size_t budget) {
+    const glm::vec3 lo(-1.25f, -1.5f, -0.35f), hi(0.75f, 1.6f, 0.4f);
+    // Faces scale as 1 / cell^2: start from a measured constant, then correct the cell
+    // size until the count is within 1% of the budget (a few passes at most).
+    float cell = 7.4f / std::sqrt(static_cast<float>(budget));
+    Mesh best;
+    for (int pass = 0; pass < 8; ++pass) {
+        Mesh mesh = polygonise(hand_distance, lo - 2.0f * cell, hi + 2.0f * cell, cell);
+        const double ratio = double(mesh.face_count()) / double(budget);
+        if (best.triangles.empty() || std::abs(ratio - 1.0) <
+                std::abs(double(best.face_count()) / double(budget) - 1.0))
+            best = std::move(mesh);
+        if (std::abs(ratio - 1.0) < 0.01) break;
+        cell *= static_cast<float>(std::sqrt(ratio));
+    }
+    best.normals.resize(best.positions.size());
+    for (std::size_t i = 0; i < best.positions.size(); ++i)
+        best.normals[i] = glm::normalize(distance_gradient(hand_distance, best.positions[i], 1e-3f));
+    return best;
+}
+
+struct Builtin {
+    const char* name;
+    Mesh (*make)(std::size_t);
+};
+constexpr Builtin kBuiltins[] = {{"sphere", make_sphere},
+                                 {"torus", make_torus},
+                                 {"torus_knot", make_torus_knot},
+                                 {"hand", make_hand}};
+
+const Builtin* find_builtin(const std::string& name) {
+    for (const Builtin& b : kBuiltins)
+        if (name == b.name) return &b;
+    return nullptr;
+}
+
+std::size_t parse_face_budget(const std::string& spec, const std::string& text) {
+    const std::string usage = spec + ": face budget must be a whole number like 30000 or 240k, "
+                              "between 100 and 20m";
+    std::size_t value = 0;
+    const char* end = text.data() + text.size();
+    const auto [rest, error] = std::from_chars(text.data(), end, value);
+    if (error != std::errc{} || text.empty()) throw MeshError(usage);
+    std::size_t scale = 1;
+    const std::string suffix(rest, end);
+    if (suffix == "k" || suffix == "K") scale = 1000;
+    else if (suffix == "m" || suffix == "M") scale = 1'000'000;
+    else if (!suffix.empty()) throw MeshError(usage);
+    if (value > kMaxFaceBudget / scale) throw MeshError(usage);
+    value *= scale;
+    if (value < kMinFaceBudget || value > kMaxFaceBudget) throw MeshError(usage);
+    return value;
+}
+
+}  // namespace
+
+std::vector<std::string> builtin_mesh_names() {
+    std::vector<std::string> names;
+    for (const Builtin& b : kBuiltins) names.emplace_back(b.name);
+    return names;
+}
+
+bool is_builtin_mesh_spec(const std::string& spec) {
+    return find_builtin(spec.substr(0, spec.find(':'))) != nullptr;
+}
+
+Mesh build_builtin_mesh(const std::string& spec) {
+    const std::size_t colon = spec.find(':');
+    const Builtin* builtin = find_builtin(spec.substr(0, colon));
+    if (builtin == nullptr) {
+        std::string names;
+        for (const Builtin& b : kBuiltins) names += (names.empty() ? "" : ", ") + std::string(b.name);
+        throw MeshError(spec + ": not a built-in mesh (" + names + ")");
+    }
+    const std::size_t budget = colon == std::string::npos
+                                   ? kDefaultFaceBudget
+                                   : parse_face_budget(spec, spec.substr(colon + 1));
+    Mesh mesh = builtin->make(budget);
+    mesh.name = spec;
+    finalize_mesh(mesh);
+    return mesh;
+}
+
+}  // namespace lucent

@@ -1,0 +1,154 @@
+// Mesh files: read through Assimp (every mesh in the file flattened into one, node
+// transforms applied, polygons triangulated), except PLY triangle strips, which Assimp
+// 5.2 misreads and ply_strips.cpp reads. Then cleaned here, whatever the format:
+//   - vertices at the same position are welded (files with per-face normals, like STL
+//     or some OBJs, otherwise split every corner and leave no shared edges);
+//   - file normals are kept unless welding found them disagreeing (then smooth normals
+//     replace them all); missing, NaN or zero-length normals become smooth normals;
+//   - triangles touching a non-finite vertex or with zero area are dropped, and unused
+//     vertices removed. A file left with no triangle is an error.
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <unordered_map>
+
+#include "core/mesh.h"
+#include "core/mesh_sources.h"
+
+namespace lucent {
+
+namespace {
+
+bool finite(glm::vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Zero area relative to the longest edge squared (collinear or coincident corners).
+bool degenerate(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+    const double longest = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b),
+                                      glm::dot(a - c, a - c)});
+    return longest == 0.0 || !(glm::length(glm::cross(b - a, c - a)) > 1e-12 * longest);
+}
+
+RawMesh read_with_assimp(const std::string& path) {
+    Assimp::Importer importer;
+    // Points and lines carry no surface: drop them during import.
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    // No aiProcess_JoinIdenticalVertices: it compares with a tolerance that NaN passes,
+    // so it would weld a NaN vertex onto a valid one; clean() welds exactly instead.
+    const aiScene* scene = importer.ReadFile(
+        path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
+    if (scene == nullptr) throw MeshError(path + ": Assimp: " + importer.GetErrorString());
+    RawMesh raw;
+    bool all_have_normals = scene->mNumMeshes > 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+        all_have_normals = all_have_normals && scene->mMeshes[m]->HasNormals();
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+        const aiMesh* source = scene->mMeshes[m];
+        const auto base = static_cast<unsigned>(raw.positions.size());
+        for (unsigned v = 0; v < source->mNumVertices; ++v) {
+            const aiVector3D& p = source->mVertices[v];
+            raw.positions.emplace_back(p.x, p.y, p.z);
+            if (all_have_normals) {
+                const aiVector3D& n = source->mNormals[v];
+                raw.normals.emplace_back(n.x, n.y, n.z);
+            }
+        }
+        raw.faces_in_file += source->mNumFaces;
+        for (unsigned f = 0; f < source->mNumFaces; ++f) {
+            const aiFace& face = source->mFaces[f];
+            if (face.mNumIndices == 3)
+                raw.triangles.emplace_back(base + face.mIndices[0], base + face.mIndices[1],
+                                           base + face.mIndices[2]);
+        }
+    }
+    return raw;
+}
+
+struct PositionKey {
+    std::uint32_t bits[3];
+    bool operator==(const PositionKey& other) const {
+        return std::memcmp(bits, other.bits, sizeof bits) == 0;
+    }
+};
+struct PositionKeyHash {
+    std::size_t operator()(const PositionKey& k) const {
+        std::uint64_t h = 1469598103934665603ull;
+        for (std::uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
+        return static_cast<std::size_t>(h);
+    }
+};
+
+PositionKey key_of(glm::vec3 p) {
+    PositionKey key;
+    for (int k = 0; k < 3; ++k) {
+        const float v = p[k] == 0.0f ? 0.0f : p[k];  // weld -0 with +0
+        std::memcpy(&key.bits[k], &v, sizeof v);
+    }
+    return key;
+}
+
+// Welds equal positions, drops unusable triangles and unused vertices.
+Mesh clean(const std::string& path, RawMesh raw) {
+    std::unordered_map<PositionKey, unsigned, PositionKeyHash> welded;
+    std::vector<unsigned> representative(raw.positions.size());
+    bool normals_agree = !raw.normals.empty();
+    for (std::size_t i = 0; i < raw.positions.size(); ++i) {
+        const auto [it, inserted] =
+            welded.try_emplace(key_of(raw.positions[i]), static_cast<unsigned>(i));
+        representative[i] = it->second;
+        if (!inserted && normals_agree &&
+            glm::dot(raw.normals[i], raw.normals[it->second]) <
+                0.9999f * glm::length(raw.normals[i]) * glm::length(raw.normals[it->second]))
+            normals_agree = false;
+    }
+    Mesh mesh;
+    mesh.name = path;
+    std::vector<unsigned> remap(raw.positions.size(), ~0u);
+    for (glm::uvec3 t : raw.triangles) {
+        if (t.x >= raw.positions.size() || t.y >= raw.positions.size() ||
+            t.z >= raw.positions.size())
+            throw MeshError(path + ": a face refers to vertex " +
+                            std::to_string(std::max({t.x, t.y, t.z})) + " of only " +
+                            std::to_string(raw.positions.size()));
+        t = {representative[t.x], representative[t.y], representative[t.z]};
+        const glm::vec3 a = raw.positions[t.x], b = raw.positions[t.y], c = raw.positions[t.z];
+        if (!finite(a) || !finite(b) || !finite(c) || degenerate(a, b, c)) continue;
+        for (int k = 0; k < 3; ++k) {
+            unsigned& target = remap[t[k]];
+            if (target == ~0u) {
+                target = static_cast<unsigned>(mesh.positions.size());
+                mesh.positions.push_back(raw.positions[t[k]]);
+                if (normals_agree) mesh.normals.push_back(raw.normals[t[k]]);
+            }
+            t[k] = target;
+        }
+        mesh.triangles.push_back(t);
+    }
+    if (mesh.triangles.empty())
+        throw MeshError(path + ": no usable triangles (" + std::to_string(raw.faces_in_file) +
+                        " faces in the file, none with three finite, distinct corners)");
+    finalize_mesh(mesh);  // smooth normals when missing; zero or NaN normals replaced
+    return mesh;
+}
+
+}  // namespace
+
+Mesh load_mesh_file(const std::string& path) {
+    std::error_code error;
+    if (!std::filesystem::exists(path, error))
+        throw MeshError(path + ": no such file (and not a built-in mesh name)");
+    if (std::filesystem::is_directory(path, error))
+        throw MeshError(path + ": is a directory, not a mesh file");
+    if (std::optional<RawMesh> strips = read_ply_triangle_strips(path))
+        return clean(path, std::move(*strips));
+    return clean(path, read_with_assimp(path));
+}
+
+}  // namespace lucent

@@ -1,0 +1,29 @@
+#pragma once
+// Internal to lucent_renderer: the two sources load_mesh() dispatches to.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace lucent {
+
+// True when the text before any ':' is a built-in mesh name.
+bool is_builtin_mesh_spec(const std::string& spec);
+// "name" or "name:budget" (budget: digits with an optional k or m suffix). Throws MeshError.
+Mesh build_builtin_mesh(const std::string& spec);
+// Reads a file through Assimp and cleans it. Throws MeshError "PATH: reason".
+Mesh load_mesh_file(const std::string& path);
+
+// A file's contents before cleaning (indices may be out of range, faces degenerate).
+struct RawMesh {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals;  // empty, or one per position
+    std::vector<glm::uvec3> triangles;
+    std::size_t faces_in_file = 0;
+};
+// A PLY file with a 'tristrips' element (which Assimp 5.2 misreads), strips turned into
+// triangles; nullopt for any other file. Throws MeshError on a malformed one.
+std::optional<RawMesh> read_ply_triangle_strips(const std::string& path);
+
+}  // namespace lucent

@@ -1,0 +1,44 @@
+#pragma once
+// A scene: what one image shows. Mesh, fitted camera, key light, background, and the
+// technique with a value for each of its knobs (material and technique parameters).
+// GL-free; the frame plan and the CPU references are pure functions of a Scene.
+#include <glm/glm.hpp>
+
+#include <memory>
+#include <string>
+
+#include "core/camera.h"
+#include "core/knobs.h"
+#include "core/mesh.h"
+
+namespace lucent {
+
+class Technique;
+
+// One directional key light plus an ambient term (thesis Sec. 3.1.1).
+struct Light {
+    glm::vec3 ambient{0.6f};   // Ia, linear rgb
+    glm::vec3 diffuse{1.0f};   // Id
+    glm::vec3 specular{1.0f};  // Is
+    glm::vec3 direction{0.0f, 0.0f, 1.0f};  // unit, towards the light, eye space
+};
+
+struct Scene {
+    std::shared_ptr<const Mesh> mesh;
+    BoundingSphere bounds;  // of `mesh`; its diameter normalises thickness (Eq. 3.4)
+    Camera camera;
+    Light light;
+    glm::vec3 background{0.0f};  // linear rgb
+    std::string technique;       // registry name
+    KnobValues values;           // every knob of scene_knobs() + the technique's knobs
+    int width = 512;             // image size in pixels
+    int height = 512;
+};
+
+// Builds a scene whose light, background and camera (fitted as in the thesis with the
+// `fov_y` knob, looking along -`view_direction`) come from `values`.
+Scene make_scene(std::shared_ptr<const Mesh> mesh, const Technique& technique,
+                 KnobValues values, int width, int height,
+                 glm::vec3 view_direction = {0.0f, 0.0f, 1.0f});
+
+}  // namespace lucent

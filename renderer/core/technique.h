@@ -1,0 +1,44 @@
+#pragma once
+// The interface every translucency technique implements. Techniques are known at compile
+// time and listed once in renderer/techniques/registry.cpp; adding one is a folder under
+// renderer/techniques/ plus one registry line. GL-free: a technique describes passes
+// (shaders, reads, writes, uniforms) and renderer/gl executes them.
+#include <string_view>
+#include <vector>
+
+#include "core/frame_plan.h"
+#include "core/image.h"
+#include "core/knobs.h"
+#include "core/scene.h"
+
+namespace lucent {
+
+// A knob whose value trades accuracy for time, for `lucent bench accuracy`: the values
+// to sweep (cheapest first) and the value the CPU reference image is rendered with.
+struct QualitySweep {
+    std::string knob;
+    std::vector<KnobValue> values;
+    KnobValue reference;
+};
+
+class Technique {
+public:
+    virtual ~Technique() = default;
+    virtual std::string_view name() const = 0;         // registry name, e.g. "empirical"
+    virtual std::string_view description() const = 0;  // one line for help text
+    // The technique's own knobs, including shared material knobs it uses (albedo, ...).
+    // The scene knobs (light, camera, background) are added by the registry.
+    virtual const std::vector<Knob>& knobs() const = 0;
+    // Adds the passes `scene` calls for (all of them when plan.full()) and sets the output.
+    virtual void plan(const Scene& scene, PlanBuilder& plan) const = 0;
+    // The same image computed on the CPU (Embree ray casting), independent of the GL path.
+    virtual Image render_reference(const Scene& scene) const = 0;
+    // Quality knobs for the accuracy bench; empty when the technique has none.
+    virtual std::vector<QualitySweep> quality_sweeps() const { return {}; }
+};
+
+// The plan of `scene` under its technique: technique.plan() then compile().
+FramePlan make_frame_plan(const Scene& scene, const Technique& technique,
+                          PlanMode mode = PlanMode::pruned);
+
+}  // namespace lucent

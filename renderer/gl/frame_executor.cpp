@@ -1,0 +1,290 @@
+#include "gl/frame_executor.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "core/ambient_occlusion.h"
+#include "gl/program.h"
+#include "gl/readback.h"
+
+namespace lucent::gl {
+namespace {
+
+GLenum internal_format(ResourceFormat format) {
+    switch (format) {
+        case ResourceFormat::depth16: return GL_DEPTH_COMPONENT16;
+        case ResourceFormat::depth24: return GL_DEPTH_COMPONENT24;
+        case ResourceFormat::depth32f: return GL_DEPTH_COMPONENT32F;
+        case ResourceFormat::r32f: return GL_R32F;
+        case ResourceFormat::rgba32f: return GL_RGBA32F;
+        case ResourceFormat::vertex_float: break;
+    }
+    throw std::logic_error("not a texture format");
+}
+
+std::string program_key(const ShaderDesc& shader) {
+    std::string key = shader.vertex + "|" + shader.fragment;
+    for (const auto& d : shader.defines) key += "|" + d;
+    return key;
+}
+
+void set_uniform(GLuint program, const Uniform& uniform) {
+    const GLint location = glGetUniformLocation(program, uniform.name.c_str());
+    if (location < 0) return;  // unused by this variant: the compiler removed it
+    std::visit(
+        [&](const auto& v) {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, int>) glProgramUniform1i(program, location, v);
+            else if constexpr (std::is_same_v<T, float>) glProgramUniform1f(program, location, v);
+            else if constexpr (std::is_same_v<T, glm::vec3>) glProgramUniform3fv(program, location, 1, &v[0]);
+            else if constexpr (std::is_same_v<T, glm::vec4>) glProgramUniform4fv(program, location, 1, &v[0]);
+            else if constexpr (std::is_same_v<T, glm::mat3>) glProgramUniformMatrix3fv(program, location, 1, GL_FALSE, &v[0][0]);
+            else glProgramUniformMatrix4fv(program, location, 1, GL_FALSE, &v[0][0]);
+        },
+        uniform.value);
+}
+
+}  // namespace
+
+struct FrameExecutor::Impl {
+    struct Texture2d {
+        ResourceFormat format;
+        int width = 0, height = 0;
+        Texture texture;
+    };
+    // Mesh buffers, re-uploaded when the mesh changes (compared by content hash + size).
+    std::string mesh_key;
+    Buffer positions, normals, indices;
+    GLsizei index_count = 0;
+    VertexArray mesh_vao;
+    VertexArray empty_vao;  // full-screen passes draw without attributes
+    // AO streams by (mesh key, rays); the live one is attached at location 2.
+    std::map<std::string, Buffer> ao_streams;
+    std::map<std::string, Texture2d> textures;
+    std::map<std::string, Program> programs;
+    std::vector<Query> queries;
+    AmbientOcclusionSource ao_source = [](const Mesh& mesh, int rays) {
+        AoBakeOptions options;
+        options.rays = rays;
+        return load_or_bake_ambient_occlusion(mesh, options);
+    };
+
+    void upload_mesh(const Mesh& mesh) {
+        const std::string key = mesh.content_hash + "/" + std::to_string(mesh.vertex_count()) +
+                                "/" + std::to_string(mesh.face_count()) + "/" + mesh.name;
+        if (key == mesh_key) return;
+        if (mesh.normals.size() != mesh.positions.size())
+            throw std::runtime_error("mesh '" + mesh.name + "': normals and positions differ in count");
+        positions = make_buffer(mesh.positions.data(),
+                                static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::vec3)));
+        normals = make_buffer(mesh.normals.data(),
+                              static_cast<GLsizeiptr>(mesh.normals.size() * sizeof(glm::vec3)));
+        indices = make_buffer(mesh.triangles.data(),
+                              static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(glm::uvec3)));
+        index_count = static_cast<GLsizei>(mesh.triangles.size() * 3);
+        mesh_vao = make_vertex_array();
+        const GLuint vao = mesh_vao.id();
+        glVertexArrayVertexBuffer(vao, 0, positions.id(), 0, sizeof(glm::vec3));
+        glVertexArrayVertexBuffer(vao, 1, normals.id(), 0, sizeof(glm::vec3));
+        for (GLuint i = 0; i < 2; ++i) {
+            glEnableVertexArrayAttrib(vao, i);
+            glVertexArrayAttribFormat(vao, i, 3, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(vao, i, i);
+        }
+        glVertexArrayAttribFormat(vao, 2, 1, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(vao, 2, 2);
+        glVertexArrayElementBuffer(vao, indices.id());
+        mesh_key = key;
+        ao_streams.clear();
+    }
+
+    GLuint program(const ShaderDesc& shader) {
+        const std::string key = program_key(shader);
+        auto it = programs.find(key);
+        if (it == programs.end()) {
+            Program linked = link_program({shader_stage(GL_VERTEX_SHADER, shader.vertex, shader.defines),
+                                           shader_stage(GL_FRAGMENT_SHADER, shader.fragment, shader.defines)});
+            it = programs.emplace(key, std::move(linked)).first;
+        }
+        return it->second.id();
+    }
+
+    // Allocates the plan's textures (reusing same-format, same-size ones) and frees the
+    // ones it does not name.
+    void allocate(const FramePlan& plan) {
+        std::map<std::string, Texture2d> kept;
+        for (const auto& r : plan.resources) {
+            if (r.format == ResourceFormat::vertex_float) continue;
+            auto it = textures.find(r.name);
+            if (it != textures.end() && it->second.format == r.format &&
+                it->second.width == plan.width && it->second.height == plan.height) {
+                kept.emplace(r.name, std::move(it->second));
+            } else {
+                kept.emplace(r.name, Texture2d{r.format, plan.width, plan.height,
+                                               make_texture_2d(internal_format(r.format),
+                                                               plan.width, plan.height)});
+            }
+        }
+        textures = std::move(kept);
+    }
+
+    void bake(const Scene& scene, const Pass& pass) {
+        const std::string key = std::to_string(pass.ao_rays);
+        auto it = ao_streams.find(key);
+        if (it == ao_streams.end()) {
+            const std::vector<float> ao = ao_source(*scene.mesh, pass.ao_rays);
+            if (ao.size() != scene.mesh->vertex_count())
+                throw std::runtime_error("ambient occlusion: expected one value per vertex");
+            it = ao_streams.emplace(key, make_buffer(ao.data(), static_cast<GLsizeiptr>(ao.size() * sizeof(float))))
+                     .first;
+        }
+        glVertexArrayVertexBuffer(mesh_vao.id(), 2, it->second.id(), 0, sizeof(float));
+        glEnableVertexArrayAttrib(mesh_vao.id(), 2);
+    }
+
+    void draw(const Pass& pass, const FramePlan& plan) {
+        const GLuint prog = program(pass.shader);
+        // Attachments: the depth-format write becomes the depth attachment, the others
+        // colour attachments in order.
+        std::vector<const Texture*> colour;
+        const Texture* depth = nullptr;
+        for (const auto& w : pass.writes) {
+            const Texture2d& t = textures.at(w);
+            if (is_depth_format(t.format)) depth = &t.texture;
+            else colour.push_back(&t.texture);
+        }
+        Framebuffer fbo = colour.size() == 0   ? make_framebuffer({}, depth)
+                          : colour.size() == 1 ? make_framebuffer({colour[0]}, depth)
+                                               : make_framebuffer({colour[0], colour[1]}, depth);
+        for (std::size_t i = 0; i < colour.size(); ++i)
+            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, static_cast<GLint>(i), &pass.clear_colour[0]);
+        if (depth) {
+            const float one = 1.0f;
+            glClearNamedFramebufferfv(fbo.id(), GL_DEPTH, 0, &one);
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+        glViewport(0, 0, plan.width, plan.height);
+        glDisable(GL_BLEND);
+        glDisable(GL_CULL_FACE);  // both facings count as layers, as ray hits do
+        if (depth) {
+            glEnable(GL_DEPTH_TEST);
+            glDepthFunc(GL_LESS);
+            glDepthMask(GL_TRUE);
+        } else {
+            glDisable(GL_DEPTH_TEST);
+        }
+        glUseProgram(prog);
+        for (const auto& u : pass.uniforms) set_uniform(prog, u);
+        GLint unit = 0;
+        for (const auto& read : pass.reads) {
+            auto it = textures.find(read.resource);
+            if (it == textures.end()) continue;  // a vertex stream, bound by bake()
+            const std::string& sampler = read.sampler.empty() ? read.resource : read.sampler;
+            glBindTextureUnit(static_cast<GLuint>(unit), it->second.texture.id());
+            const GLint location = glGetUniformLocation(prog, sampler.c_str());
+            if (location >= 0) glProgramUniform1i(prog, location, unit);
+            ++unit;
+        }
+        if (pass.kind == PassKind::draw_mesh) {
+            glBindVertexArray(mesh_vao.id());
+            glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
+        } else {
+            glBindVertexArray(empty_vao.id());
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        }
+        glBindVertexArray(0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        for (GLint u = 0; u < unit; ++u) glBindTextureUnit(static_cast<GLuint>(u), 0);
+    }
+};
+
+FrameExecutor::FrameExecutor() : impl_(std::make_unique<Impl>()) {
+    impl_->empty_vao = make_vertex_array();
+}
+FrameExecutor::~FrameExecutor() = default;
+
+void FrameExecutor::set_ambient_occlusion_source(AmbientOcclusionSource source) {
+    impl_->ao_source = std::move(source);
+}
+
+void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time_passes) {
+    if (plan.width <= 0 || plan.height <= 0) throw std::runtime_error("frame plan has no pixels");
+    impl_->upload_mesh(*scene.mesh);
+    impl_->allocate(plan);
+    glDisableVertexArrayAttrib(impl_->mesh_vao.id(), 2);
+
+    GLint timer_bits = 0;
+    if (time_passes) glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &timer_bits);
+    const bool gpu_timer = timer_bits > 0;
+    timings_ = FrameTimings{};
+    timings_.gpu_timer = gpu_timer;
+    while (impl_->queries.size() < plan.passes.size())
+        impl_->queries.push_back(make_query(GL_TIME_ELAPSED));
+
+    std::vector<double> wall_ms;
+    std::size_t index = 0;
+    for_each_pass(plan, [&](const Pass& pass) {
+        const auto start = std::chrono::steady_clock::now();
+        const bool gpu = time_passes && gpu_timer && pass.kind != PassKind::bake_ambient_occlusion;
+        if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
+        if (pass.kind == PassKind::bake_ambient_occlusion) impl_->bake(scene, pass);
+        else impl_->draw(pass, plan);
+        if (gpu) glEndQuery(GL_TIME_ELAPSED);
+        if (time_passes && !gpu && pass.kind != PassKind::bake_ambient_occlusion) glFinish();
+        wall_ms.push_back(std::chrono::duration<double, std::milli>(
+                              std::chrono::steady_clock::now() - start).count());
+        ++index;
+    });
+    if (!time_passes) return;
+    for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+        double ms = wall_ms[i];
+        if (gpu_timer && plan.passes[i].kind != PassKind::bake_ambient_occlusion) {
+            GLuint64 ns = 0;
+            glGetQueryObjectui64v(impl_->queries[i].id(), GL_QUERY_RESULT, &ns);
+            ms = static_cast<double>(ns) * 1e-6;
+        }
+        timings_.passes.push_back({plan.passes[i].name, ms});
+        timings_.total_milliseconds += ms;
+    }
+}
+
+Image FrameExecutor::read_output(const FramePlan& plan) const {
+    const auto& texture = impl_->textures.at(plan.output);
+    const std::vector<float> pixels = read_texture_rgba32f(texture.texture, texture.width, texture.height);
+    Image image(texture.width, texture.height);
+    const std::size_t row = static_cast<std::size_t>(texture.width) * 4;
+    for (int y = 0; y < texture.height; ++y)  // GL rows are bottom first
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height - 1 - y) * row], row,
+                    &image.rgba[static_cast<std::size_t>(y) * row]);
+    return image;
+}
+
+std::vector<float> FrameExecutor::read_channel(const std::string& resource) const {
+    const auto& texture = impl_->textures.at(resource);
+    const GLenum format = is_depth_format(texture.format) ? GL_DEPTH_COMPONENT : GL_RED;
+    const std::vector<float> pixels = read_texture_r32f(texture.texture, format, texture.width, texture.height);
+    std::vector<float> flipped(pixels.size());
+    const std::size_t row = static_cast<std::size_t>(texture.width);
+    for (int y = 0; y < texture.height; ++y)
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height - 1 - y) * row], row,
+                    &flipped[static_cast<std::size_t>(y) * row]);
+    return flipped;
+}
+
+Image FrameExecutor::render(const Scene& scene, const FramePlan& plan) {
+    execute(scene, plan);
+    return read_output(plan);
+}
+
+std::vector<std::string> FrameExecutor::allocated_resources() const {
+    std::vector<std::string> names;
+    for (const auto& [name, texture] : impl_->textures) names.push_back(name);
+    if (glIsVertexArray(impl_->mesh_vao.id())) {
+        GLint enabled = 0;
+        glGetVertexArrayIndexediv(impl_->mesh_vao.id(), 2, GL_VERTEX_ATTRIB_ARRAY_ENABLED, &enabled);
+        if (enabled) names.push_back("vertex_ao");
+    }
+    return names;
+}
+
+}  // namespace lucent::gl

@@ -1,0 +1,67 @@
+#pragma once
+// Runs a FramePlan with OpenGL: allocates exactly the resources the plan names (frame-
+// sized textures, the AO vertex stream), compiles each pass's shader variant once, binds
+// reads to samplers and writes to a framebuffer, and draws. Optional per-pass GPU timer
+// queries feed `lucent bench frame` and the explorer's status bar. Needs a current GL 4.5
+// context; every GL object is owned by an RAII wrapper held here.
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/frame_plan.h"
+#include "core/image.h"
+#include "core/scene.h"
+#include "gl/objects.h"
+
+namespace lucent::gl {
+
+struct PassTiming {
+    std::string pass;
+    double milliseconds = 0.0;
+};
+
+struct FrameTimings {
+    std::vector<PassTiming> passes;
+    double total_milliseconds = 0.0;
+    // True: GL_TIME_ELAPSED queries; false: wall time around glFinish (no timer queries).
+    // The AO pass is CPU work and always wall time.
+    bool gpu_timer = false;
+};
+
+// Per-vertex AO for (mesh, rays). Defaults to load_or_bake_ambient_occlusion (disk cache).
+using AmbientOcclusionSource = std::function<std::vector<float>(const Mesh&, int rays)>;
+
+class FrameExecutor {
+public:
+    FrameExecutor();
+    ~FrameExecutor();
+    FrameExecutor(const FrameExecutor&) = delete;
+    FrameExecutor& operator=(const FrameExecutor&) = delete;
+
+    void set_ambient_occlusion_source(AmbientOcclusionSource source);
+
+    // Runs every pass of `plan` for `scene`. With `time_passes`, last_timings() holds
+    // per-pass times afterwards (this waits for the GPU). Throws ShaderError /
+    // std::runtime_error on GL failures.
+    void execute(const Scene& scene, const FramePlan& plan, bool time_passes = false);
+    // The plan's output after execute(), top row first.
+    Image read_output(const FramePlan& plan) const;
+    // A frame-sized single-channel resource (a depth layer, the smoothed layer), top row
+    // first: for tests and the explorer's buffer view.
+    std::vector<float> read_channel(const std::string& resource) const;
+    // execute() then read_output().
+    Image render(const Scene& scene, const FramePlan& plan);
+
+    const FrameTimings& last_timings() const { return timings_; }
+    // Names of the frame resources currently allocated (textures and vertex streams).
+    std::vector<std::string> allocated_resources() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    FrameTimings timings_;
+};
+
+}  // namespace lucent::gl

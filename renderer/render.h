@@ -1,0 +1,32 @@
+#pragma once
+// The single-image path shared by `lucent render`, batch rendering of stimulus sets and
+// the explorer's "Save image": request -> scene -> frame plan -> GL -> float image.
+#include <string>
+#include <vector>
+
+#include "core/frame_plan.h"
+#include "core/image.h"
+#include "core/knobs.h"
+#include "core/scene.h"
+#include "gl/frame_executor.h"
+
+namespace lucent {
+
+struct RenderRequest {
+    std::string mesh = "torus_knot";     // built-in name (optionally ":faces") or a file
+    std::string technique = "empirical";  // registry name
+    std::vector<KnobAssignment> settings;  // applied over the defaults, in order
+    int width = 512;
+    int height = 512;
+};
+
+// Validates the technique and settings first (KnobError: one line naming the key and the
+// accepted range), then loads the mesh (MeshError). Throws std::invalid_argument for a
+// non-positive size.
+Scene build_scene(const RenderRequest& request);
+
+// Plans `scene` under its technique and renders it with `executor` (current GL context).
+Image render_image(gl::FrameExecutor& executor, const Scene& scene,
+                   PlanMode mode = PlanMode::pruned);
+
+}  // namespace lucent

@@ -1,0 +1,86 @@
+#version 450 core
+// Shading with the thesis's lighting equation (Eq. 3.6), in linear floating point:
+//   colour = a*ka*Kd*Ia + wd*Kd*Id*max(N.L,0) + ws*ks*Is*max(N.H,0)^n   (only where N.L > 0)
+//          + wb*(1 - t)^r*(Kd + Kb)
+// Terms whose weight is zero are compiled out by the planner (WITH_AMBIENT_OCCLUSION,
+// WITH_BACKLIGHT), never branched on here.
+in vec3 v_normal_eye;
+#ifdef WITH_AMBIENT_OCCLUSION
+in float v_ambient_occlusion;
+uniform float u_ambient;
+uniform vec3 u_light_ambient;
+#endif
+#ifdef WITH_BACKLIGHT
+uniform sampler2D back_depth;  // window depth of the (smoothed) second layer; 1 = none
+uniform float u_near;
+uniform float u_far;
+uniform float u_diameter;
+uniform float u_backlight;
+uniform float u_thickness_exponent;
+uniform float u_diffuse_weight;
+#endif
+uniform vec3 u_albedo;
+uniform float u_diffuse_contribution;
+uniform float u_specular_contribution;
+uniform float u_specular;
+uniform float u_shininess;
+uniform vec3 u_light_diffuse;
+uniform vec3 u_light_specular;
+uniform vec3 u_light_direction;  // unit, towards the light, eye space
+layout(location = 0) out vec4 out_colour;
+
+// x^e with x^0 = 1 (also for x = 0) and negative bases treated as 0: GLSL's pow is
+// undefined there.
+float power(float x, float e) {
+    if (e == 0.0) return 1.0;
+    return x <= 0.0 ? 0.0 : pow(x, e);
+}
+
+#ifdef WITH_BACKLIGHT
+// Eq. 3.3: window depth -> positive eye-space distance.
+float eye_depth(float window_depth) {
+    float ndc = 2.0 * window_depth - 1.0;
+    return 2.0 * u_near * u_far / (u_far + u_near - ndc * (u_far - u_near));
+}
+
+// Thickness over the bounding-sphere diameter (Eq. 3.4), in [0, 1]. No second layer
+// (open mesh, clipped back) counts as the full diameter: t = 1.
+float thickness() {
+    float back = texelFetch(back_depth, ivec2(gl_FragCoord.xy), 0).r;
+    if (back >= 1.0 || !(u_diameter > 0.0)) return 1.0;
+    float t = (eye_depth(back) - eye_depth(gl_FragCoord.z)) / u_diameter;
+    return clamp(t, 0.0, 1.0);
+}
+#endif
+
+void main() {
+    // Unit normal; a zero-length one (degenerate input) faces the viewer.
+    float length2 = dot(v_normal_eye, v_normal_eye);
+    vec3 n = length2 > 1e-30 ? v_normal_eye * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
+    vec3 l = u_light_direction;
+    vec3 colour = vec3(0.0);
+
+#ifdef WITH_AMBIENT_OCCLUSION
+    // Ambient term (Eq. 3.7): a * ka * Kd * Ia
+    colour += v_ambient_occlusion * u_ambient * u_albedo * u_light_ambient;
+#endif
+
+    // Diffuse and specular terms (Eqs. 3.8-3.9), only where N.L > 0. The half vector uses
+    // a viewer at infinity (0,0,1), as OpenGL's fixed-function halfVector.
+    float n_dot_l = dot(n, l);
+    if (n_dot_l > 0.0) {
+        colour += u_diffuse_contribution * u_albedo * u_light_diffuse * n_dot_l;
+        vec3 h = l + vec3(0.0, 0.0, 1.0);
+        float h_length2 = dot(h, h);
+        float n_dot_h = h_length2 > 1e-30 ? max(dot(n, h * inversesqrt(h_length2)), 0.0) : 0.0;
+        colour += u_specular_contribution * u_specular * u_light_specular *
+                  power(n_dot_h, u_shininess);
+    }
+
+#ifdef WITH_BACKLIGHT
+    // Thickness term (Eq. 3.10): wb * (1 - t)^r * (Kd + Kb)
+    colour += u_backlight * power(1.0 - thickness(), u_thickness_exponent) *
+              (u_albedo + vec3(u_diffuse_weight));
+#endif
+    out_colour = vec4(colour, 1.0);
+}

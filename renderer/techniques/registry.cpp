@@ -1,0 +1,38 @@
+#include "techniques/registry.h"
+
+#include "core/common_knobs.h"
+
+namespace lucent {
+
+// Each technique folder defines one accessor; adding a technique adds one line to each
+// list below.
+const Technique& empirical_technique();
+const Technique& ward_technique();
+const Technique& contrast_reversed_technique();
+
+const std::vector<const Technique*>& all_techniques() {
+    static const std::vector<const Technique*> techniques = {
+        &empirical_technique(),
+        &ward_technique(),
+        &contrast_reversed_technique(),
+    };
+    return techniques;
+}
+
+const Technique& find_technique(std::string_view name) {
+    std::string valid;
+    for (const Technique* technique : all_techniques()) {
+        if (technique->name() == name) return *technique;
+        valid += (valid.empty() ? "" : ", ") + std::string(technique->name());
+    }
+    throw KnobError("technique: '" + std::string(name) + "' is unknown (valid: " + valid + ")");
+}
+
+std::vector<Knob> knobs_for(const Technique& technique) {
+    std::vector<Knob> knobs = scene_knobs();
+    const auto& own = technique.knobs();
+    knobs.insert(knobs.end(), own.begin(), own.end());
+    return knobs;
+}
+
+}  // namespace lucent

@@ -1,0 +1,18 @@
+#pragma once
+// The one list of techniques Lucent knows, and the knobs each one accepts.
+#include <string_view>
+#include <vector>
+
+#include "core/knobs.h"
+#include "core/technique.h"
+
+namespace lucent {
+
+// Every technique, in registry order.
+const std::vector<const Technique*>& all_techniques();
+// Throws KnobError "technique: 'x' is unknown (valid: empirical, ...)".
+const Technique& find_technique(std::string_view name);
+// scene_knobs() followed by the technique's own knobs: everything `--set` accepts.
+std::vector<Knob> knobs_for(const Technique& technique);
+
+}  // namespace lucent

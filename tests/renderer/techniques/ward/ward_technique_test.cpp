@@ -1,0 +1,205 @@
+// The ward and contrast_reversed techniques: GL-free planning, the shading equations at
+// analytic points, and GL against the CPU reference on built-in meshes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/technique.h"
+#include "gl_test_fixture.h"
+#include "render.h"
+#include "techniques/registry.h"
+#include "techniques/ward/ward.h"
+#include "techniques/ward/ward_brdf.h"
+
+namespace lucent {
+namespace {
+
+Scene scene_for(const std::string& technique, std::vector<KnobAssignment> settings,
+                const std::string& mesh = "sphere:2k", int size = 96) {
+    RenderRequest request;
+    request.mesh = mesh;
+    request.technique = technique;
+    request.settings = std::move(settings);
+    request.width = request.height = size;
+    return build_scene(request);
+}
+
+bool has_define(const Pass& pass, const std::string& define) {
+    return std::find(pass.shader.defines.begin(), pass.shader.defines.end(), define) !=
+           pass.shader.defines.end();
+}
+
+const Pass* find_pass(const FramePlan& plan, const std::string& name) {
+    for (const auto& pass : plan.passes)
+        if (pass.name == name) return &pass;
+    return nullptr;
+}
+
+TEST(WardPlan, BothTechniquesAreRegistered) {
+    EXPECT_EQ(find_technique("ward").name(), "ward");
+    EXPECT_EQ(find_technique("contrast_reversed").name(), "contrast_reversed");
+    EXPECT_NE(find_knob(find_technique("contrast_reversed").knobs(), "reversed_diffuse"), nullptr);
+    EXPECT_NE(find_knob(find_technique("ward").knobs(), "diffuse_reflectance"), nullptr);
+}
+
+TEST(WardPlan, ZeroAmbientCullsTheAoBake) {
+    for (const char* name : {"ward", "contrast_reversed"}) {
+        const Scene on = scene_for(name, {{"ambient", "0.2"}});
+        const Scene off = scene_for(name, {{"ambient", "0"}});
+        const Scene no_light = scene_for(name, {{"light_ambient", "0"}});
+        const auto& technique = find_technique(name);
+        EXPECT_NE(find_pass(make_frame_plan(on, technique), "ambient_occlusion"), nullptr) << name;
+        EXPECT_EQ(find_pass(make_frame_plan(off, technique), "ambient_occlusion"), nullptr) << name;
+        EXPECT_EQ(find_pass(make_frame_plan(no_light, technique), "ambient_occlusion"), nullptr) << name;
+        // Full mode keeps every pass, so pruning can be checked against it.
+        EXPECT_NE(find_pass(make_frame_plan(off, technique, PlanMode::full), "ambient_occlusion"), nullptr);
+    }
+}
+
+TEST(WardPlan, VariantDefinesFollowTheScene) {
+    const auto reversed = make_frame_plan(scene_for("contrast_reversed", {}),
+                                          find_technique("contrast_reversed"));
+    const auto ward_plan = make_frame_plan(scene_for("ward", {}), find_technique("ward"));
+    EXPECT_TRUE(has_define(*find_pass(reversed, "shade"), "REVERSED_DIFFUSE"));
+    EXPECT_FALSE(has_define(*find_pass(ward_plan, "shade"), "REVERSED_DIFFUSE"));
+    const auto matte = make_frame_plan(scene_for("ward", {{"specular_reflectance", "0"}}),
+                                       find_technique("ward"));
+    EXPECT_FALSE(has_define(*find_pass(matte, "shade"), "WITH_SPECULAR"));
+    EXPECT_TRUE(has_define(*find_pass(ward_plan, "shade"), "WITH_SPECULAR"));
+}
+
+TEST(WardShading, AnalyticPoints) {
+    ward::Params p;
+    p.albedo = {0.2, 0.5, 0.8};
+    p.ambient = 0.0;
+    p.diffuse = 0.7;
+    p.specular_reflectance = 0.0;
+    Light light;
+    light.diffuse = glm::vec3(1.0f, 0.5f, 2.0f);
+    light.direction = {0, 0, 1};
+    const glm::dvec3 n(0, 0, 1), v(0, 0, 1);
+    // Facing the light: ward = rho_d*Kd*Id; reversed = w*Id*(Kd/Y)*(1 - Y), Y = Y(Kd).
+    const double y = 0.2126 * 0.2 + 0.7152 * 0.5 + 0.0722 * 0.8;
+    const auto ward_lit = ward::shade(p, light, ward::Variant::ward, n, v, 1.0);
+    const auto rev_lit = ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(ward_lit[c], 0.7 * p.albedo[c] * light.diffuse[c], 1e-6);
+        EXPECT_NEAR(rev_lit[c], 0.7 * light.diffuse[c] * p.albedo[c] / y * (1.0 - y), 1e-6);
+    }
+    // Luminance, not channels, is reversed: under white light the term keeps Kd's hue
+    // (channel ratios) and its luminance is w * (1 - Y N.L), Eq. 12 with Li = 1.
+    light.diffuse = glm::vec3(1.0f);
+    const auto tilted = ward::shade(p, light, ward::Variant::contrast_reversed,
+                                    glm::normalize(glm::dvec3(0, 0.6, 0.8)), v, 1.0);
+    EXPECT_NEAR(tilted.b / tilted.r, 0.8 / 0.2, 1e-9);
+    EXPECT_NEAR(0.2126 * tilted.r + 0.7152 * tilted.g + 0.0722 * tilted.b, 0.7 * (1.0 - y * 0.8), 1e-9);
+    // In the attached shadow (N.L <= 0) the reversed term is the whole light, w*Id*chroma.
+    const glm::dvec3 away(0, 0, -1);
+    const auto rev_dark = ward::shade(p, light, ward::Variant::contrast_reversed, away, v, 1.0);
+    EXPECT_NEAR(rev_dark.b, 0.7 * 0.8 / y, 1e-6);
+    EXPECT_EQ(ward::shade(p, light, ward::Variant::ward, away, v, 1.0), glm::dvec3(0.0));
+    // A white albedo facing the light reverses to exactly 0, never negative; a black one
+    // has no hue to keep and reverses to the light's colour.
+    p.albedo = glm::dvec3(1.0);
+    EXPECT_EQ(ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0), glm::dvec3(0.0));
+    p.albedo = glm::dvec3(0.0);
+    const auto black = ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0);
+    EXPECT_NEAR(black.g, 0.7, 1e-12);
+    EXPECT_TRUE(std::isfinite(black.r));
+    // Specular at normal incidence: pi * rho_s / (4 pi alpha^2) * Is.
+    p.diffuse = 0.0;
+    p.specular_reflectance = 0.1;
+    p.roughness = 0.2;
+    const auto spec = ward::shade(p, light, ward::Variant::ward, n, v, 1.0);
+    EXPECT_NEAR(spec.r, 0.1 / (4.0 * 0.04), 1e-5);
+}
+
+// GL against the CPU reference: mean absolute error and 99th percentile outside a
+// 1-pixel band around silhouettes (rasterisation and ray casting may differ there).
+struct Comparison {
+    double mean = 0.0, p99 = 0.0;
+    std::size_t compared = 0;
+};
+
+Comparison compare(const Image& a, const Image& b) {
+    auto covered = [](const Image& image, int x, int y) { return image.at(x, y).a > 0.5f; };
+    std::vector<double> errors;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            bool band = false;
+            for (int j = -1; j <= 1 && !band; ++j)
+                for (int i = -1; i <= 1 && !band; ++i) {
+                    const int sx = std::clamp(x + i, 0, a.width - 1), sy = std::clamp(y + j, 0, a.height - 1);
+                    band = covered(a, sx, sy) != covered(a, x, y) || covered(b, sx, sy) != covered(a, x, y);
+                }
+            if (band) continue;
+            for (int c = 0; c < 3; ++c) errors.push_back(std::abs(a.at(x, y)[c] - b.at(x, y)[c]));
+        }
+    Comparison result;
+    result.compared = errors.size();
+    if (errors.empty()) return result;
+    for (double e : errors) result.mean += e;
+    result.mean /= double(errors.size());
+    std::sort(errors.begin(), errors.end());
+    result.p99 = errors[std::size_t(0.99 * double(errors.size() - 1))];
+    return result;
+}
+
+class WardGlTest : public test::HeadlessGlTest {};
+
+TEST_F(WardGlTest, GlMatchesCpuReferenceOnBuiltinMeshes) {
+    gl::FrameExecutor executor;
+    for (const char* technique : {"ward", "contrast_reversed"})
+        for (const char* mesh : {"sphere:2k", "torus_knot:4k"})
+            for (const char* roughness : {"0.08", "0.3"}) {
+                const Scene scene = scene_for(technique,
+                                              {{"ao_rays", "32"}, {"roughness", roughness},
+                                               {"specular_reflectance", "0.2"}},
+                                              mesh, 96);
+                const Image gl_image = render_image(executor, scene);
+                const Image cpu_image = find_technique(technique).render_reference(scene);
+                const Comparison c = compare(gl_image, cpu_image);
+                SCOPED_TRACE(std::string(technique) + " " + mesh + " roughness " + roughness);
+                EXPECT_GT(c.compared, 3000u);
+                EXPECT_LT(c.mean, 1.0 / 255.0);
+                EXPECT_LT(c.p99, 4.0 / 255.0);
+                std::printf("%s %s roughness %s: mean %.2e p99 %.2e over %zu values\n", technique,
+                            mesh, roughness, c.mean, c.p99, c.compared);
+            }
+}
+
+TEST_F(WardGlTest, ComparisonTellsTheTwoVariantsApart) {
+    // The same scene under the other variant's reference must fail the thresholds above.
+    gl::FrameExecutor executor;
+    const Scene ward_scene = scene_for("ward", {{"ao_rays", "16"}, {"diffuse_reflectance", "0.5"}});
+    const Scene reversed_scene =
+        scene_for("contrast_reversed", {{"ao_rays", "16"}, {"reversed_diffuse", "0.5"}});
+    const Comparison c = compare(render_image(executor, ward_scene),
+                                 find_technique("contrast_reversed").render_reference(reversed_scene));
+    EXPECT_GT(c.mean, 10.0 / 255.0);
+}
+
+TEST_F(WardGlTest, ContrastReversedKeepsABlackBackgroundAndFiniteValues) {
+    gl::FrameExecutor executor;
+    const Scene scene = scene_for("contrast_reversed",
+                                  {{"ao_rays", "16"}, {"roughness", "0"}, {"specular_reflectance", "1"}},
+                                  "torus:2k", 64);
+    const Image image = render_image(executor, scene);
+    std::size_t background = 0;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+            const glm::vec4 p = image.at(x, y);
+            for (int c = 0; c < 4; ++c) ASSERT_TRUE(std::isfinite(p[c]));
+            for (int c = 0; c < 3; ++c) ASSERT_GE(p[c], 0.0f);
+            if (p.a == 0.0f) {
+                ++background;
+                EXPECT_EQ(glm::vec3(p), glm::vec3(0.0f));
+            }
+        }
+    EXPECT_GT(background, 100u);
+}
+
+}  // namespace
+}  // namespace lucent
