@@ -3,6 +3,7 @@
 
 #include "commands.h"
 #include "protocol.h"
+#include "session/live_stimuli.h"
 #include "session/runner.h"
 #include "session/stimulus_source.h"
 #include "sqlite.h"
@@ -30,7 +31,7 @@ int run_command(RunArgs& args) {
                                          : study::builtin_protocol(args.preset);
         if (args.seed >= 0) o.seed = static_cast<uint64_t>(args.seed);
         study::plan_trials(o.protocol, 0, 0);  // impossible randomisation fails here, early
-        study::PrerenderedStimuli stimuli(args.images_dir);
+        study::LiveOrPrerenderedStimuli stimuli(args.images_dir);
         switch (study::run_session(o, stimuli, std::cerr)) {
         case study::RunResult::Completed:
         case study::RunResult::SavedAndQuit:
@@ -69,7 +70,8 @@ void register_run(CLI::App& app, int& exit_code) {
     cmd->add_option("--monitor", args->options.monitor, "Monitor index for full screen")->check(CLI::NonNegativeNumber);
     cmd->add_flag("--resume", args->options.resume, "Continue the participant's unfinished session");
     cmd->add_option("--images", args->images_dir,
-                    "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr");
+                    "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr (e.g. from "
+                    "'lucent render --preset thesis --out DIR'); others render live");
     cmd->add_option("--seed", args->seed, "Session seed (default: random; stored either way)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--autopilot", args->options.autopilot,

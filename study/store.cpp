@@ -308,7 +308,7 @@ std::optional<SessionRow> Store::unfinished_session(const std::string& participa
     Statement s = db_.prepare(
         "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
         "FROM sessions s JOIN participants p ON p.id = s.participant_id "
-        "WHERE p.code = ? AND s.status != 'completed' ORDER BY s.id DESC LIMIT 1");
+        "WHERE p.code = ? AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT 1");
     s.bind(1, participant_code);
     if (!s.step()) return std::nullopt;
     SessionRow row;

@@ -96,7 +96,7 @@ public:
     // Writes the session and its full planned trial order in one transaction.
     SessionRow create_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
                               uint64_t seed, const SessionEnvironment& env);
-    // The participant's newest session that is not completed, if any.
+    // The participant's newest running or paused session (not completed, not declined).
     std::optional<SessionRow> unfinished_session(const std::string& participant_code);
     bool has_completed_session(const std::string& participant_code);
     std::vector<TrialRow> trials(int64_t session_id);

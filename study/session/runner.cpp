@@ -76,6 +76,7 @@ private:
     RunResult prepare_store();
     void open_window();
     void start_or_resume_session();
+    void prepare_stimuli();
     void enter(Screen s);
     void begin_trial_or_next();
     void handle_key(const KeyEvent& e);
@@ -83,6 +84,7 @@ private:
     void draw_rating_panel(const ScreenLayout& layout, int w);
     void draw_pause(int w, int h);
     void finish_trial();
+    void resume();
     ScreenView view() const;
     int main_trials_done() const;
 
@@ -114,7 +116,8 @@ private:
     RunResult result_ = RunResult::Completed;
     bool quit_ = false;
     int64_t screen_start_ns_ = 0;
-    std::optional<StimulusTexture> texture_;
+    std::map<std::string, StimulusTexture> textures_;  // by stimulus id; before window_ dies
+    const StimulusTexture* texture_ = nullptr;
     bool onset_pending_ = false;
     std::optional<RatingInput> input_;
     int64_t onset_ns_ = 0;
@@ -209,16 +212,40 @@ void Session::enter(Screen s) {
     screen_ = s;
     ++serial_;
     screen_start_ns_ = now_ns();
-    if (s == Screen::Blank) {
-        // Load the next picture during the blank interval, off the measured trial.
-        texture_ = stimuli_.render(*p_.find_stimulus(trials_[current_].stimulus),
-                                   p_.stimulus_width, p_.stimulus_height);
-    }
     if (s == Screen::Trial) {
+        texture_ = &textures_.at(trials_[current_].stimulus);
         onset_pending_ = true;
         input_.reset();
         stimulus_swaps_.clear();
     }
+}
+
+// Renders (or loads) every picture still to be shown before the first trial, so no
+// trial waits for the renderer; a progress line shows on screen and on stderr.
+void Session::prepare_stimuli() {
+    std::vector<std::string> ids;
+    for (size_t i = current_; i < trials_.size(); ++i)
+        if (std::find(ids.begin(), ids.end(), trials_[i].stimulus) == ids.end())
+            ids.push_back(trials_[i].stimulus);
+    for (size_t k = 0; k < ids.size(); ++k) {
+        window_->begin_frame();
+        int w = 0, h = 0;
+        window_->framebuffer_size(w, h);
+        glViewport(0, 0, w, h);
+        glClearColor(p_.background[0], p_.background[1], p_.background[2], 1.f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        const std::string line = "Preparing pictures: " + std::to_string(k) + " of " +
+                                 std::to_string(ids.size());
+        centred_text_window("preparing", line, w, h);
+        ImGui::End();
+        window_->render_imgui();
+        window_->swap();
+        log_ << "\rlucent run: preparing stimuli " << k + 1 << "/" << ids.size() << std::flush;
+        textures_.emplace(ids[k], stimuli_.render(*p_.find_stimulus(ids[k]), p_.stimulus_width,
+                                                  p_.stimulus_height));
+    }
+    if (!ids.empty()) log_ << "\n";
+    keys_.events.clear();  // keys pressed while preparing belong to no screen
 }
 
 // After consent/instructions/breaks: the next unanswered trial, through its break
@@ -264,6 +291,18 @@ void Session::finish_trial() {
     }
 }
 
+// Leaves the pause screen. A trial interrupted by the pause starts again from a new
+// onset with no answers, so its response times never include the pause.
+void Session::resume() {
+    paused_ = false;
+    ++serial_;
+    if (screen_ == Screen::Trial) {
+        input_.reset();
+        onset_pending_ = true;
+        stimulus_swaps_.clear();
+    }
+}
+
 void Session::handle_key(const KeyEvent& e) {
     if (e.key == GLFW_KEY_ESCAPE && screen_ != Screen::Done) {
         paused_ = true;
@@ -271,10 +310,7 @@ void Session::handle_key(const KeyEvent& e) {
         return;
     }
     if (paused_) {
-        if (e.key == GLFW_KEY_ENTER || e.key == GLFW_KEY_KP_ENTER || e.key == GLFW_KEY_R) {
-            paused_ = false;
-            ++serial_;
-        } else if (e.key == GLFW_KEY_Q) {
+        if (e.key == GLFW_KEY_ENTER || e.key == GLFW_KEY_KP_ENTER || e.key == GLFW_KEY_R) resume(); else if (e.key == GLFW_KEY_Q) {
             result_ = RunResult::SavedAndQuit;
             quit_ = true;
         }
@@ -386,7 +422,7 @@ void Session::draw_rating_panel(const ScreenLayout& layout, int w) {
 void Session::draw_pause(int w, int h) {
     centred_text_window("pause", "Paused. Your answers so far are saved.\n\n"
                                  "Enter or R: resume      Q: save and quit", w, h);
-    if (ImGui::Button("Resume")) { paused_ = false; ++serial_; }
+    if (ImGui::Button("Resume")) resume();
     ImGui::SameLine();
     if (ImGui::Button("Save and quit")) { result_ = RunResult::SavedAndQuit; quit_ = true; }
     ImGui::End();
@@ -464,6 +500,14 @@ RunResult Session::run() {
         return RunResult::Failure;
     }
     start_or_resume_session();
+    try {
+        prepare_stimuli();
+    } catch (const std::exception& e) {
+        log_ << "\nlucent run: " << e.what() << "\n";
+        store_->set_status(session_.id, "paused", false);
+        return RunResult::Failure;
+    }
+    enter(screen_);  // restart the first screen's clock after preparing
 
     int64_t last_swap = now_ns();
     while (!quit_) {

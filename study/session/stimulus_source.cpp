@@ -2,6 +2,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "core/image.h"
+
 #include <cmath>
 #include <filesystem>
 
@@ -9,11 +11,8 @@ namespace lucent::study {
 
 namespace {
 uint8_t encode_srgb(float linear) {
-    if (!(linear > 0.f)) return 0;  // also maps NaN to 0: no NaN reaches the screen
-    if (linear >= 1.f) return 255;
-    const float s = linear <= 0.0031308f ? 12.92f * linear
-                                         : 1.055f * std::pow(linear, 1.f / 2.4f) - 0.055f;
-    return static_cast<uint8_t>(std::lround(s * 255.f));
+    if (!std::isfinite(linear)) return 0;  // no NaN reaches the screen
+    return static_cast<uint8_t>(std::lround(lucent::srgb_encode(linear) * 255.f));
 }
 }  // namespace
 

@@ -312,6 +312,54 @@ TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
     EXPECT_EQ(order.text(0), "empirical,contrast_reversal");
 }
 
+TEST_F(SessionE2E, LiveStimuliAreRenderedLikeLucentRender) {
+    // No --images: the runner renders each stimulus with the renderer. The first rating
+    // screen (practice stimulus 'p': ward on a sphere) must show exactly the picture
+    // `lucent render` makes from the same technique and parameters.
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("break_every = 2"), 15, "inter_trial_ms = 100\nstimulus_size = [96, 96]");
+    const fs::path protocol = dir_ / "live.toml";
+    std::ofstream(protocol) << text;
+    const fs::path shot = dir_ / "live_screen.png", reference = dir_ / "reference.png";
+    const std::string db = (dir_ / "live.db").string();
+    const Process run = start_lucent({"run", protocol.string(), "--db", db, "--participant", "P1",
+                                      "--autopilot", "5", "--autopilot-speed", "12",
+                                      "--screenshot", shot.string()}, dir_);
+    ASSERT_EQ(wait_exit(run), 0) << read_file(run.stderr_path);
+    const Process render = start_lucent({"render", "--mesh", "sphere", "--technique", "ward",
+                                         "--set", "roughness=0.2", "--size", "96x96",
+                                         "--out", reference.string()}, dir_);
+    ASSERT_EQ(wait_exit(render), 0) << read_file(render.stderr_path);
+    const CpuImage screen = load_image_rgba8(shot.string());
+    const CpuImage ref = load_image_rgba8(reference.string());
+    const int x0 = (screen.width - 96) / 2, y0 = (screen.height - 96) / 2;
+    int max_difference = 0, object_pixels = 0;
+    for (int y = 0; y < 96; ++y)
+        for (int x = 0; x < 96; ++x) {
+            const uint8_t* a = &screen.rgba[(size_t(y0 + y) * screen.width + x0 + x) * 4];
+            const uint8_t* b = &ref.rgba[(size_t(y) * 96 + x) * 4];
+            object_pixels += b[0] + b[1] + b[2] > 0;
+            for (int c = 0; c < 3; ++c) max_difference = std::max(max_difference, std::abs(a[c] - b[c]));
+        }
+    EXPECT_GT(object_pixels, 96 * 96 / 4) << "the reference shows no object";
+    EXPECT_LE(max_difference, 1) << "live stimulus differs from lucent render's image";
+    EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM responses"), 10);
+}
+
+TEST_F(SessionE2E, BadLiveParametersAreRefusedBeforeAnyWindow) {
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("roughness = 0.2"), 15, "roughness = 0.2, sparkle = 3");
+    const fs::path protocol = dir_ / "bad.toml";
+    std::ofstream(protocol) << text;
+    const Process p = start_lucent({"run", protocol.string(), "--db", (dir_ / "b.db").string(),
+                                    "--participant", "P1"}, dir_);
+    EXPECT_EQ(wait_exit(p), 2);
+    const std::string err = read_file(p.stderr_path);
+    EXPECT_NE(err.find("stimulus 'p'"), std::string::npos) << err;
+    EXPECT_NE(err.find("sparkle"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
 // ---- The data commands, driven through the CLI (no display needed) ----------------
 class DataCommands : public ::testing::Test {
 protected:
