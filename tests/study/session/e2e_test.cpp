@@ -427,5 +427,16 @@ TEST_F(DataCommands, ExportWritesEachFormatAndMergeDeduplicates) {
     EXPECT_NE(read_file(dir_ / "stdout.txt").find("2 duplicates skipped"), std::string::npos);
 }
 
+TEST_F(DataCommands, AnalyzeReadsTheStudyDatabaseDirectly) {
+    // Two participants x 3 levels of thickness_exponent x 2 questions (see study_fixtures).
+    const fs::path out = dir_ / "report";
+    ASSERT_EQ(run({"analyze", db_, "--out", out.string(), "--format", "csv"}), 0)
+        << read_file(dir_ / "stderr.txt");
+    const std::string anova = read_file(out / "anova.csv");
+    EXPECT_NE(anova.find("translucent,thickness_exponent,"), std::string::npos) << anova;
+    EXPECT_NE(anova.find("realistic,thickness_exponent,"), std::string::npos) << anova;
+    EXPECT_EQ(std::count(anova.begin(), anova.end(), '\n'), 3);  // header + 2 questions
+}
+
 }  // namespace
 }  // namespace lucent::study

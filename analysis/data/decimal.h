@@ -1,0 +1,18 @@
+#pragma once
+// Exact decimal arithmetic on number texts, so that an origin can be subtracted before a
+// value is rounded to double (1000000000000.4 parsed as a double is already off by 2e-5).
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace lucent::analysis {
+
+// The finite number the whole text spells (decimal or exponent notation, surrounding
+// blanks allowed), or nullopt when it is not one.
+std::optional<double> parse_finite_number(std::string_view text);
+
+// (value - origin) computed exactly in 100-digit decimal, then rounded once to double.
+// Both texts must be valid numbers (parse_finite_number).
+double exact_difference(std::string_view value, std::string_view origin);
+
+}  // namespace lucent::analysis

@@ -1,0 +1,46 @@
+#include "data/grouping.h"
+
+#include <algorithm>
+#include <map>
+
+#include "data/decimal.h"
+
+namespace lucent::analysis {
+
+std::vector<FactorData> split_by_question_and_factor(const LongTable& table,
+                                                     const std::string& question_filter,
+                                                     const std::string& factor_filter) {
+    std::vector<FactorData> pairs;
+    std::map<std::pair<std::string, std::string>, std::size_t> pair_index;
+    std::vector<std::map<std::string, std::size_t>> level_index;
+    for (const RatingRow& row : table.rows) {
+        if (!question_filter.empty() && row.question != question_filter) continue;
+        if (!factor_filter.empty() && row.factor != factor_filter) continue;
+        auto [it, inserted] = pair_index.emplace(std::pair{row.question, row.factor}, pairs.size());
+        if (inserted) {
+            pairs.push_back({row.question, row.factor, {table.origin, {}}, 0});
+            level_index.emplace_back();
+        }
+        FactorData& pair = pairs[it->second];
+        auto [level, new_level] =
+            level_index[it->second].emplace(row.level, pair.data.groups.size());
+        if (new_level) pair.data.groups.push_back({row.level, {}});
+        if (row.rating)
+            pair.data.groups[level->second].values.push_back(*row.rating);
+        else
+            ++pair.missing_ratings;
+    }
+    for (FactorData& pair : pairs) {
+        auto& groups = pair.data.groups;
+        const bool numeric = std::all_of(groups.begin(), groups.end(), [](const Group& g) {
+            return parse_finite_number(g.level).has_value();
+        });
+        if (numeric)
+            std::stable_sort(groups.begin(), groups.end(), [](const Group& a, const Group& b) {
+                return *parse_finite_number(a.level) < *parse_finite_number(b.level);
+            });
+    }
+    return pairs;
+}
+
+}  // namespace lucent::analysis

@@ -1,0 +1,307 @@
+#include "report/report.h"
+
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+#include "data/long_table.h"
+#include "report/format.h"
+#include "report/svg_plot.h"
+
+namespace lucent::analysis {
+namespace {
+
+// A tiny document model rendered to both Markdown and HTML, so the two never disagree.
+struct Table {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+};
+struct Block {
+    enum Kind { kHeading, kParagraph, kTable, kPlot } kind;
+    std::string text;  // heading/paragraph text, or plot file name
+    Table table;
+    std::string svg;
+    int level = 2;
+};
+
+std::string csv_field(const std::string& s) {
+    if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+}
+
+std::string html_escape(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '<') out += "&lt;";
+        else if (c == '>') out += "&gt;";
+        else if (c == '&') out += "&amp;";
+        else out += c;
+    }
+    return out;
+}
+
+std::string md_cell(const std::string& s) {
+    std::string out;
+    for (char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out;
+}
+
+std::string significance(const Statistic& p) {
+    if (!p) return "undefined";
+    if (*p < 0.01) return "p < .01";
+    if (*p < 0.05) return "p < .05";
+    return "n.s.";
+}
+
+std::string configuration(const OneWayAnalysis& a) { return a.question + " ~ " + a.factor; }
+
+std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
+                                  const ReportOptions& options) {
+    std::vector<Block> doc;
+    doc.push_back({Block::kHeading, "Lucent analysis report", {}, {}, 1});
+    doc.push_back({Block::kParagraph,
+                   "Input: " + options.source + ". One-way ANOVA per (question, factor); " +
+                       "alpha = " + format_short(options.alpha) +
+                       ", Tukey HSD intervals at " + format_short(1.0 - options.alpha) +
+                       " confidence, descriptive intervals at 95%."});
+    // Summary in the layout of the thesis's Table 4.4.
+    Table summary{{"configuration", "p", "F", "significant at alpha"}, {}};
+    for (const OneWayAnalysis& a : analyses)
+        summary.rows.push_back({configuration(a), format_p_short(a.anova.p),
+                                format_short(a.anova.f),
+                                a.anova.p ? (*a.anova.p < options.alpha ? "yes" : "no")
+                                          : "undefined"});
+    doc.push_back({Block::kHeading, "Summary", {}, {}, 2});
+    doc.push_back({Block::kTable, "", summary});
+
+    for (const OneWayAnalysis& a : analyses) {
+        doc.push_back({Block::kHeading, configuration(a), {}, {}, 2});
+        Block plot{Block::kPlot, plot_file_name(a.question, a.factor), {}, {}};
+        plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives);
+        doc.push_back(plot);
+
+        Table desc{{"level", "n", "mean", "SD", "SE", "median", "95% CI"}, {}};
+        for (const Descriptives& d : a.descriptives)
+            desc.rows.push_back({d.level, std::to_string(d.n), format_short(d.mean),
+                                 format_short(d.sd), format_short(d.se), format_short(d.median),
+                                 d.ci_low ? "[" + format_short(d.ci_low) + ", " +
+                                                format_short(d.ci_high) + "]"
+                                          : "undefined"});
+        doc.push_back({Block::kHeading, "Descriptives", {}, {}, 3});
+        doc.push_back({Block::kTable, "", desc});
+
+        const AnovaResult& an = a.anova;
+        Table anova{{"source", "SS", "df", "MS", "F", "p"}, {}};
+        anova.rows.push_back({"between", format_short(an.ss_between),
+                              format_short(an.df_between), format_short(an.ms_between),
+                              format_short(an.f), format_p_short(an.p)});
+        anova.rows.push_back({"within", format_short(an.ss_within), format_short(an.df_within),
+                              format_short(an.ms_within), "", ""});
+        anova.rows.push_back({"total", format_short(an.ss_between + an.ss_within),
+                              format_short(an.df_between + an.df_within), "", "", ""});
+        doc.push_back({Block::kHeading, "One-way ANOVA", {}, {}, 3});
+        doc.push_back({Block::kTable, "", anova});
+        doc.push_back({Block::kParagraph, "eta squared = " + format_short(an.eta_sq) +
+                                              ", omega squared = " + format_short(an.omega_sq) +
+                                              (an.note.empty() ? "" : ". Note: " + an.note)});
+
+        const TukeyResult& tk = a.tukey;
+        doc.push_back({Block::kHeading, "Tukey HSD", {}, {}, 3});
+        if (tk.pairs.empty()) {
+            doc.push_back({Block::kParagraph, "Not computed: " + tk.note});
+        } else {
+            Table tukey{{"level a", "level b", "diff (b - a)", "se", "q", "p adj", "lower",
+                         "upper", "significance"},
+                        {}};
+            for (const TukeyPair& p : tk.pairs)
+                tukey.rows.push_back({p.level_a, p.level_b, format_short(p.diff),
+                                      format_short(p.se), format_short(p.q),
+                                      format_p_short(p.p_adj), format_short(p.lower),
+                                      format_short(p.upper), significance(p.p_adj)});
+            doc.push_back({Block::kTable, "", tukey});
+            std::string hsd = "q critical (alpha " + format_short(tk.alpha) +
+                              ") = " + format_short(tk.q_critical);
+            if (tk.hsd_05)
+                hsd += "; HSD[.05] = " + format_short(tk.hsd_05) +
+                       ", HSD[.01] = " + format_short(tk.hsd_01);
+            else
+                hsd += "; groups are unbalanced (Tukey-Kramer), so no single HSD";
+            doc.push_back({Block::kParagraph, hsd});
+        }
+        doc.push_back({Block::kHeading, "Rank and heteroscedastic tests", {}, {}, 3});
+        doc.push_back({Block::kParagraph,
+                       "Kruskal-Wallis (tie-corrected): H = " + format_short(a.kruskal.h) +
+                           ", df = " + format_short(a.kruskal.df) +
+                           ", p = " + format_p_short(a.kruskal.p) +
+                           (a.kruskal.note.empty() ? "" : " (" + a.kruskal.note + ")")});
+        doc.push_back({Block::kParagraph,
+                       "Welch's ANOVA: F = " + format_short(a.welch.f) +
+                           ", df1 = " + format_short(a.welch.df1) +
+                           ", df2 = " + format_short(a.welch.df2) +
+                           ", p = " + format_p_short(a.welch.p) +
+                           (a.welch.note.empty() ? "" : " (" + a.welch.note + ")")});
+        std::string notes;
+        for (const std::string& level : a.empty_levels)
+            notes += "Level '" + level + "' has no observations and is left out of the tests. ";
+        if (a.missing_ratings > 0)
+            notes += std::to_string(a.missing_ratings) + " missing ratings were skipped.";
+        if (!notes.empty()) doc.push_back({Block::kParagraph, notes});
+    }
+    return doc;
+}
+
+void render_markdown(const std::vector<Block>& doc, std::ostream& out) {
+    for (const Block& b : doc) {
+        switch (b.kind) {
+            case Block::kHeading: out << std::string(b.level, '#') << ' ' << b.text << "\n\n"; break;
+            case Block::kParagraph: out << b.text << "\n\n"; break;
+            case Block::kPlot: out << "![" << b.text << "](" << b.text << ")\n\n"; break;
+            case Block::kTable:
+                out << '|';
+                for (const auto& h : b.table.header) out << ' ' << md_cell(h) << " |";
+                out << "\n|";
+                for (std::size_t i = 0; i < b.table.header.size(); ++i) out << "---|";
+                out << '\n';
+                for (const auto& row : b.table.rows) {
+                    out << '|';
+                    for (const auto& cell : row) out << ' ' << md_cell(cell) << " |";
+                    out << '\n';
+                }
+                out << '\n';
+        }
+    }
+}
+
+void render_html(const std::vector<Block>& doc, std::ostream& out) {
+    out << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Lucent analysis "
+           "report</title>\n<style>body{font-family:sans-serif;max-width:60em;margin:auto}"
+           "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 8px;"
+           "text-align:right}</style></head><body>\n";
+    for (const Block& b : doc) {
+        switch (b.kind) {
+            case Block::kHeading:
+                out << "<h" << b.level << '>' << html_escape(b.text) << "</h" << b.level << ">\n";
+                break;
+            case Block::kParagraph: out << "<p>" << html_escape(b.text) << "</p>\n"; break;
+            case Block::kPlot:
+                out << "<figure>" << b.svg << "<figcaption>saved as " << html_escape(b.text)
+                    << "</figcaption></figure>\n";
+                break;
+            case Block::kTable:
+                out << "<table><tr>";
+                for (const auto& h : b.table.header) out << "<th>" << html_escape(h) << "</th>";
+                out << "</tr>\n";
+                for (const auto& row : b.table.rows) {
+                    out << "<tr>";
+                    for (const auto& cell : row) out << "<td>" << html_escape(cell) << "</td>";
+                    out << "</tr>\n";
+                }
+                out << "</table>\n";
+        }
+    }
+    out << "</body></html>\n";
+}
+
+std::ofstream open_output(const std::filesystem::path& path) {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) throw InputError(path.string() + ": cannot open for writing");
+    return out;
+}
+
+void write_csv_tables(const std::vector<OneWayAnalysis>& analyses,
+                      const std::filesystem::path& dir,
+                      std::vector<std::filesystem::path>& written) {
+    auto open = [&](const char* name, const char* header) {
+        written.push_back(dir / name);
+        auto out = open_output(written.back());
+        out << header << '\n';
+        return out;
+    };
+    auto anova = open("anova.csv",
+                      "question,factor,ss_between,ss_within,df_between,df_within,ms_between,"
+                      "ms_within,f,p,eta_sq,omega_sq");
+    auto tukey = open("tukey.csv", "question,factor,level_a,level_b,diff,se,q,p_adj,lower,upper");
+    auto kruskal = open("kruskal.csv", "question,factor,h,df,p");
+    auto welch = open("welch.csv", "question,factor,f,df1,df2,p");
+    auto desc = open("descriptives.csv",
+                     "question,factor,level,n,mean,sd,se,median,ci_low,ci_high");
+    for (const OneWayAnalysis& a : analyses) {
+        const std::string key = csv_field(a.question) + ',' + csv_field(a.factor) + ',';
+        const AnovaResult& r = a.anova;
+        anova << key << format_full(r.ss_between) << ',' << format_full(r.ss_within) << ','
+              << format_full(r.df_between) << ',' << format_full(r.df_within) << ','
+              << format_full(r.ms_between) << ',' << format_full(r.ms_within) << ','
+              << format_full(r.f) << ',' << format_p_full(r.p) << ',' << format_full(r.eta_sq)
+              << ',' << format_full(r.omega_sq) << '\n';
+        for (const TukeyPair& p : a.tukey.pairs)
+            tukey << key << csv_field(p.level_a) << ',' << csv_field(p.level_b) << ','
+                  << format_full(p.diff) << ',' << format_full(p.se) << ',' << format_full(p.q)
+                  << ',' << format_p_full(p.p_adj) << ',' << format_full(p.lower) << ','
+                  << format_full(p.upper) << '\n';
+        kruskal << key << format_full(a.kruskal.h) << ',' << format_full(a.kruskal.df) << ','
+                << format_p_full(a.kruskal.p) << '\n';
+        welch << key << format_full(a.welch.f) << ',' << format_full(a.welch.df1) << ','
+              << format_full(a.welch.df2) << ',' << format_p_full(a.welch.p) << '\n';
+        for (const Descriptives& d : a.descriptives)
+            desc << key << csv_field(d.level) << ',' << d.n << ',' << format_full(d.mean) << ','
+                 << format_full(d.sd) << ',' << format_full(d.se) << ','
+                 << format_full(d.median) << ',' << format_full(d.ci_low) << ','
+                 << format_full(d.ci_high) << '\n';
+    }
+}
+
+}  // namespace
+
+void parse_formats(const std::string& list, ReportOptions& options) {
+    options.markdown = options.csv = options.html = false;
+    std::stringstream in(list);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        if (item == "md") options.markdown = true;
+        else if (item == "csv") options.csv = true;
+        else if (item == "html") options.html = true;
+        else throw InputError("--format: unknown format '" + item + "' (valid: md, csv, html)");
+    }
+    if (!options.markdown && !options.csv && !options.html)
+        throw InputError("--format: no format given (valid: md, csv, html)");
+}
+
+std::string plot_file_name(const std::string& question, const std::string& factor) {
+    std::string name = "plot_";
+    for (char c : question + "__" + factor)
+        name += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '-';
+    return name + ".svg";
+}
+
+std::vector<std::filesystem::path> write_report(const std::vector<OneWayAnalysis>& analyses,
+                                                const std::filesystem::path& directory,
+                                                const ReportOptions& options) {
+    std::error_code error;
+    std::filesystem::create_directories(directory, error);
+    if (error) throw InputError(directory.string() + ": cannot create directory: " + error.message());
+    std::vector<std::filesystem::path> written;
+    const std::vector<Block> doc = build_document(analyses, options);
+    if (options.markdown || options.html) {
+        for (const Block& b : doc)
+            if (b.kind == Block::kPlot) {
+                written.push_back(directory / b.text);
+                open_output(written.back()) << b.svg;
+            }
+    }
+    if (options.markdown) {
+        written.push_back(directory / "report.md");
+        auto out = open_output(written.back());
+        render_markdown(doc, out);
+    }
+    if (options.html) {
+        written.push_back(directory / "report.html");
+        auto out = open_output(written.back());
+        render_html(doc, out);
+    }
+    if (options.csv) write_csv_tables(analyses, directory, written);
+    return written;
+}
+
+}  // namespace lucent::analysis

@@ -1,0 +1,26 @@
+#pragma once
+// Per-group descriptive statistics: n, mean, SD, SE, median and the t-based confidence
+// interval of the mean.
+#include "stats/one_way_data.h"
+
+namespace lucent::analysis {
+
+struct Descriptives {
+    std::string level;
+    std::size_t n = 0;
+    Statistic mean, sd, se, median;  // sd, se need n >= 2; mean, median need n >= 1
+    Statistic ci_low, ci_high;       // mean -/+ t(1 - (1-confidence)/2, n-1) * se
+};
+
+// Mean and sum of squared deviations of values (relative to their origin), by compensated
+// two-pass summation.
+struct MeanAndSquares {
+    double mean = 0.0;  // relative to the origin of the values
+    double squares = 0.0;
+};
+MeanAndSquares mean_and_squares(const std::vector<double>& values);
+
+Descriptives describe(const Group& group, double origin, double confidence = 0.95);
+std::vector<Descriptives> describe_all(const OneWayData& data, double confidence = 0.95);
+
+}  // namespace lucent::analysis

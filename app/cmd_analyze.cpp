@@ -1,0 +1,74 @@
+// lucent analyze: one-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch reports with plots
+// from a long CSV of ratings (participant,stimulus,factor,level,question,rating).
+#include <iostream>
+
+#include "commands.h"
+#include "data/grouping.h"
+#include "data/long_table.h"
+#include "report/report.h"
+#include "stats/one_way_analysis.h"
+#include "study_input.h"
+
+namespace lucent::app {
+namespace {
+
+struct AnalyzeArgs {
+    std::string input, out_dir, factor, question, formats = "md,csv,html", scale = "1..7";
+    double alpha = 0.10;
+};
+
+int run_analyze(const AnalyzeArgs& args) {
+    using namespace lucent::analysis;
+    try {
+        if (!(args.alpha > 0.0 && args.alpha < 1.0))
+            throw InputError("--alpha must lie strictly between 0 and 1");
+        ReportOptions options;
+        parse_formats(args.formats, options);
+        options.alpha = args.alpha;
+        options.source = args.input;
+        const LongTable table = read_ratings(args.input, parse_scale(args.scale));
+        const auto pairs = split_by_question_and_factor(table, args.question, args.factor);
+        if (pairs.empty())
+            throw InputError(args.input + ": no ratings" +
+                             (args.question.empty() ? "" : " for question '" + args.question + "'") +
+                             (args.factor.empty() ? "" : " for factor '" + args.factor + "'"));
+        std::vector<OneWayAnalysis> analyses;
+        for (const FactorData& pair : pairs) {
+            std::cerr << "analyzing " << pair.question << " ~ " << pair.factor << " ("
+                      << pair.data.groups.size() << " levels)\n";
+            analyses.push_back(analyze_one_way(pair.question, pair.factor, pair.data, args.alpha));
+            analyses.back().missing_ratings = pair.missing_ratings;
+        }
+        for (const auto& path : write_report(analyses, args.out_dir, options))
+            std::cout << path.string() << "\n";
+        return kExitOk;
+    } catch (const InputError& e) {
+        std::cerr << "lucent analyze: " << e.what() << "\n";
+        return kExitUsage;
+    }
+}
+
+}  // namespace
+
+void register_analyze(CLI::App& app, int& exit_code) {
+    auto args = std::make_shared<AnalyzeArgs>();
+    auto* cmd = app.add_subcommand(
+        "analyze", "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
+                   "with plots, from a long CSV of ratings");
+    cmd->add_option("input", args->input,
+                    "Study database, or long CSV: participant,stimulus,factor,level,question,rating")
+        ->required();
+    cmd->add_option("--out", args->out_dir, "Directory for the report")->required();
+    cmd->add_option("--alpha", args->alpha, "Significance level (Tukey CI at 1 - alpha)")
+        ->capture_default_str();
+    cmd->add_option("--factor", args->factor, "Analyze only this factor");
+    cmd->add_option("--question", args->question, "Analyze only this question");
+    cmd->add_option("--format", args->formats, "Comma-separated subset of md,csv,html")
+        ->capture_default_str();
+    cmd->add_option("--scale", args->scale,
+                    "Accepted ratings: MIN..MAX, or 'any' for any finite number")
+        ->capture_default_str();
+    cmd->callback([args, &exit_code] { exit_code = run_analyze(*args); });
+}
+
+}  // namespace lucent::app
