@@ -18,5 +18,6 @@ void register_render(CLI::App& app, int& exit_code);
 void register_bench_families(CLI::App& bench, int& exit_code);
 void register_bench_frame(CLI::App& bench, int& exit_code);
 void register_bench_accuracy(CLI::App& bench, int& exit_code);
+void register_bench_render(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app
