@@ -19,5 +19,6 @@ void register_bench_families(CLI::App& bench, int& exit_code);
 void register_bench_frame(CLI::App& bench, int& exit_code);
 void register_bench_accuracy(CLI::App& bench, int& exit_code);
 void register_bench_render(CLI::App& bench, int& exit_code);
+void register_bench_ao(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app
