@@ -32,8 +32,7 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::filesystem::path file_of(const StimulusSet& set, const Stimulus& s, ImageFormat format) {
-    (void)set;
+std::filesystem::path file_of(const Stimulus& s, ImageFormat format) {
     return s.id + "." + std::string(extension(format));
 }
 
@@ -64,9 +63,9 @@ std::vector<std::string> parameter_columns(const StimulusSet& set) {
 ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mesh& mesh) {
     std::string files;
     for (const auto format : set.formats)
-        files += (files.empty() ? "" : ";") + file_of(set, s, format).string();
+        files += (files.empty() ? "" : ";") + file_of(s, format).string();
     ManifestRow row = {{"id", s.id, false},
-                       {"file", file_of(set, s, set.formats.front()).string(), false},
+                       {"file", file_of(s, set.formats.front()).string(), false},
                        {"files", files, false},
                        {"technique", s.technique, false},
                        {"mesh", s.mesh_spec, false},
@@ -86,7 +85,7 @@ ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mes
 
 std::string files_hash(const std::filesystem::path& dir, const StimulusSet& set, const Stimulus& s) {
     Hasher hasher;
-    for (const auto format : set.formats) hasher.add_field(hash_file(dir / file_of(set, s, format)));
+    for (const auto format : set.formats) hasher.add_field(hash_file(dir / file_of(s, format)));
     return hasher.hex();
 }
 
@@ -102,7 +101,7 @@ bool reusable(const std::map<std::string, std::string>* previous, const std::str
     if (field("input_hash") != inputs) return false;
     for (const auto format : set.formats) {
         std::error_code error;
-        if (!std::filesystem::is_regular_file(dir / file_of(set, s, format), error)) return false;
+        if (!std::filesystem::is_regular_file(dir / file_of(s, format), error)) return false;
     }
     try {
         return files_hash(dir, set, s) == field("content_hash");
@@ -257,7 +256,7 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
 
                 start = Clock::now();
                 for (const auto format : set.formats)
-                    write_image(dir / file_of(set, s, format), image);
+                    write_image(dir / file_of(s, format), image);
                 timings.encode_seconds += seconds_since(start);
 
                 start = Clock::now();
