@@ -1,5 +1,9 @@
 // Batch rendering: load meshes, decide what changed, render on N workers (one GL context
 // each), write images + manifest, show progress.
+// [SECTION] manifest rows: identity, parameter columns, file hashes, reuse decision
+// [SECTION] BatchProgress: stimuli done, time per stimulus, time left
+// [SECTION] render_stimulus_set(): meshes, reuse, AO pre-bake, workers, manifest
+// [SECTION] run_render_set_command(): the CLI's batch path and its exit codes
 #include "batch_render.h"
 
 #include <algorithm>

@@ -1,4 +1,9 @@
 // Stimulus-set loader: TOML -> validated, expanded list of stimuli.
+// [SECTION] ErrorReporter: "file:line:column: key: reason" from toml++ source regions
+// [SECTION] knob_value(): one TOML value -> a validated KnobValue (type, then range)
+// [SECTION] Loader: top-level keys, meshes, shared parameter tables, each [[stimuli]]
+//           entry with its [stimuli.vary] expansion and ids
+// [SECTION] public entry points
 // Parameter precedence (later wins): technique defaults, [defaults], [camera], the
 // stimulus's light, its material, its own keys, its [stimuli.vary] values.
 #include "stimulus_set.h"
