@@ -1,13 +1,9 @@
 // lucent render: one image of a mesh under a technique, with parameters from --set.
 // The work itself is lucent::build_scene + render_image + write_image (renderer/render.h),
 // the same path batch rendering and the explorer use.
-#include <unistd.h>
-
-#include <cstdio>
 #include <iostream>
 
 #include "commands.h"
-#include "core/ambient_occlusion.h"
 #include "core/technique.h"
 #include "gl/context.h"
 #include "batch_render.h"
@@ -45,21 +41,6 @@ void parse_size(const std::string& text, int& width, int& height) {
     } catch (const std::exception&) {
         throw std::invalid_argument("--size: '" + text + "' is not WxH (e.g. 512x512)");
     }
-}
-
-// Prints a progress line for AO bakes on a terminal (stderr, overwritten in place).
-std::vector<float> bake_with_progress(const Mesh& mesh, int rays) {
-    AoBakeOptions options;
-    options.rays = rays;
-    if (isatty(STDERR_FILENO)) options.progress = [&, last = -1](std::size_t done, std::size_t total) mutable {
-        const int percent = total ? static_cast<int>(100 * done / total) : 100;
-        if (percent == last) return;
-        last = percent;
-        std::fprintf(stderr, "\rambient occlusion (%d rays/vertex, %zu vertices): %3d%%", rays,
-                     total, percent);
-        if (done == total) std::fprintf(stderr, "\n");
-    };
-    return load_or_bake_ambient_occlusion(mesh, options);
 }
 
 int run_render(const RenderOptions& options) {
@@ -103,7 +84,6 @@ int run_render(const RenderOptions& options) {
     try {
         auto context = gl::create_headless_context();
         gl::FrameExecutor executor;
-        executor.set_ambient_occlusion_source(bake_with_progress);
         const Image image = render_image(executor, scene, mode);
         ImageWriteOptions write;
         write.linear = options.linear;
@@ -120,7 +100,7 @@ int run_render(const RenderOptions& options) {
 
 void register_render(CLI::App& app, int& exit_code) {
     auto options = std::make_shared<RenderOptions>();
-    auto* cmd = app.add_subcommand("render", "Render one image of a mesh (headless)");
+    auto* cmd = app.add_subcommand("render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
     std::string meshes;
     for (const auto& name : builtin_mesh_names()) meshes += (meshes.empty() ? "" : ", ") + name;
     std::string techniques, keys;

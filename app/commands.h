@@ -26,5 +26,7 @@ void register_bench_families(CLI::App& bench, int& exit_code);
 void register_bench_frame(CLI::App& bench, int& exit_code);
 void register_bench_accuracy(CLI::App& bench, int& exit_code);
 void register_bench_stats(CLI::App& bench, int& exit_code);
+void register_bench_render(CLI::App& bench, int& exit_code);
+void register_bench_ao(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app

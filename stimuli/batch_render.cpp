@@ -1,5 +1,9 @@
 // Batch rendering: load meshes, decide what changed, render on N workers (one GL context
 // each), write images + manifest, show progress.
+// [SECTION] manifest rows: identity, parameter columns, file hashes, reuse decision
+// [SECTION] BatchProgress: stimuli done, time per stimulus, time left
+// [SECTION] render_stimulus_set(): meshes, reuse, AO pre-bake, workers, manifest
+// [SECTION] run_render_set_command(): the CLI's batch path and its exit codes
 #include "batch_render.h"
 
 #include <algorithm>
@@ -11,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <unistd.h>
 
@@ -31,8 +36,7 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::filesystem::path file_of(const StimulusSet& set, const Stimulus& s, ImageFormat format) {
-    (void)set;
+std::filesystem::path file_of(const Stimulus& s, ImageFormat format) {
     return s.id + "." + std::string(extension(format));
 }
 
@@ -63,9 +67,9 @@ std::vector<std::string> parameter_columns(const StimulusSet& set) {
 ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mesh& mesh) {
     std::string files;
     for (const auto format : set.formats)
-        files += (files.empty() ? "" : ";") + file_of(set, s, format).string();
+        files += (files.empty() ? "" : ";") + file_of(s, format).string();
     ManifestRow row = {{"id", s.id, false},
-                       {"file", file_of(set, s, set.formats.front()).string(), false},
+                       {"file", file_of(s, set.formats.front()).string(), false},
                        {"files", files, false},
                        {"technique", s.technique, false},
                        {"mesh", s.mesh_spec, false},
@@ -85,7 +89,7 @@ ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mes
 
 std::string files_hash(const std::filesystem::path& dir, const StimulusSet& set, const Stimulus& s) {
     Hasher hasher;
-    for (const auto format : set.formats) hasher.add_field(hash_file(dir / file_of(set, s, format)));
+    for (const auto format : set.formats) hasher.add_field(hash_file(dir / file_of(s, format)));
     return hasher.hex();
 }
 
@@ -101,7 +105,7 @@ bool reusable(const std::map<std::string, std::string>* previous, const std::str
     if (field("input_hash") != inputs) return false;
     for (const auto format : set.formats) {
         std::error_code error;
-        if (!std::filesystem::is_regular_file(dir / file_of(set, s, format), error)) return false;
+        if (!std::filesystem::is_regular_file(dir / file_of(s, format), error)) return false;
     }
     try {
         return files_hash(dir, set, s) == field("content_hash");
@@ -191,6 +195,29 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
         }
     }
 
+    // Bake (or load) the AO each pending plan reads once, here, so parallel workers never
+    // bake the same mesh twice and the bake's own progress bar is not interleaved.
+    double prebake_seconds = 0.0;
+    {
+        std::set<std::pair<std::string, int>> bakes;
+        for (const std::size_t i : pending) {
+            const Stimulus& s = set.stimuli[i];
+            const Technique& technique = find_technique(s.technique);
+            const Scene scene = make_scene(meshes.at(s.mesh_spec), technique, s.parameters,
+                                           set.width, set.height);
+            for (const Pass& pass : make_frame_plan(scene, technique).passes)
+                if (pass.kind == PassKind::bake_ambient_occlusion)
+                    bakes.emplace(s.mesh_spec, pass.ao_rays);
+        }
+        const auto start = Clock::now();
+        for (const auto& [spec, rays] : bakes) {
+            AoBakeOptions ao;
+            ao.rays = rays;
+            (void)load_or_bake_ambient_occlusion(*meshes.at(spec), ao);
+        }
+        prebake_seconds = seconds_since(start);
+    }
+
     // Render the pending stimuli on `jobs` workers, each with its own GL context.
     std::mutex mutex;
     std::condition_variable finished_signal;
@@ -233,7 +260,7 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
 
                 start = Clock::now();
                 for (const auto format : set.formats)
-                    write_image(dir / file_of(set, s, format), image);
+                    write_image(dir / file_of(s, format), image);
                 timings.encode_seconds += seconds_since(start);
 
                 start = Clock::now();
@@ -296,6 +323,7 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     }
     write_manifest(dir, set.name, rows);
     result.rows = std::move(rows);
+    result.timings.ao_seconds = prebake_seconds;
     for (const auto& t : worker_timings) {
         result.timings.ao_seconds += t.ao_seconds;
         result.timings.gl_seconds += t.gl_seconds;

@@ -1,4 +1,9 @@
 // Stimulus-set loader: TOML -> validated, expanded list of stimuli.
+// [SECTION] ErrorReporter: "file:line:column: key: reason" from toml++ source regions
+// [SECTION] knob_value(): one TOML value -> a validated KnobValue (type, then range)
+// [SECTION] Loader: top-level keys, meshes, shared parameter tables, each [[stimuli]]
+//           entry with its [stimuli.vary] expansion and ids
+// [SECTION] public entry points
 // Parameter precedence (later wins): technique defaults, [defaults], [camera], the
 // stimulus's light, its material, its own keys, its [stimuli.vary] values.
 #include "stimulus_set.h"
@@ -151,6 +156,7 @@ public:
         set.source = source;
         check_keys(root, {"name", "resolution", "formats", "meshes", "camera", "lights",
                           "materials", "defaults", "stimuli"}, "", errors_);
+        set.name = std::filesystem::path(source).stem().string();  // unless named
         if (const auto* node = root.get("name")) set.name = as_string(*node, "name", errors_);
         if (const auto* node = root.get("resolution")) read_resolution(*node, set);
         if (const auto* node = root.get("formats")) read_formats(*node, set);
@@ -394,7 +400,7 @@ private:
                 stimulus.parameters.set(axis->first, axis->second[pick]);
             }
             stimulus.id = expanded_id(id, stimulus.parameters, index, count);
-            check_id(stimulus.id, *id_node, prefix + "id", set);
+            check_id(stimulus.id, *id_node, prefix + "id");
             set.stimuli.push_back(std::move(stimulus));
         }
     }
@@ -425,8 +431,7 @@ private:
         return out;
     }
 
-    void check_id(const std::string& id, const toml::node& node, const std::string& key,
-                  const StimulusSet& set) {
+    void check_id(const std::string& id, const toml::node& node, const std::string& key) {
         const bool safe = !id.empty() && id.front() != '.' &&
                           std::all_of(id.begin(), id.end(), [](char c) {
                               return std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
@@ -436,7 +441,6 @@ private:
             errors_.fail(node, key, "'" + id + "' is not a valid id (letters, digits, _ - . only)");
         if (!ids_.insert(id).second)
             errors_.fail(node, key, "duplicate id '" + id + "'");
-        (void)set;
     }
 
     const SetCatalog& catalog_;

@@ -40,7 +40,8 @@ std::filesystem::path ambient_occlusion_cache_path(const Mesh& mesh, int rays);
 // Reads the cached bake for (mesh hash, rays, algorithm version) if present and intact;
 // otherwise bakes and writes it (atomically: temporary file + rename). A truncated or
 // corrupt cache file is detected (size + checksum) and rebuilt, never trusted. A cache
-// that cannot be written costs a warning on stderr, not the result.
+// that cannot be written costs a warning on stderr, not the result. Without a progress
+// callback, a bake running over half a second draws a ProgressBar on a terminal.
 std::vector<float> load_or_bake_ambient_occlusion(const Mesh& mesh,
                                                   const AoBakeOptions& options);
 

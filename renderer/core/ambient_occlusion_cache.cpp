@@ -1,6 +1,9 @@
 // The AO disk cache. One file per (mesh hash, rays, algorithm version):
-//   "LUCENTAO" | u32 file format | u32 algorithm version | u32 rays | u32 0
+//   "LUCENTAO" | u32 file format | u32 algorithm version | u32 rays | u32 normals hash
 //   | u64 count | 16 chars mesh hash | u64 FNV-1a of the values | count x f32
+// The mesh hash covers positions and triangles only; the normals (which orient the
+// hemispheres) are checked through their own hash, so a mesh with the same geometry
+// but other normals rebakes instead of reusing the file.
 // A file is trusted only if every header field matches, its size is exact, the
 // checksum matches and every value is in [0, 1]; otherwise the bake is redone.
 #include <unistd.h>
@@ -17,6 +20,7 @@
 #include <string>
 
 #include "core/ambient_occlusion.h"
+#include "core/progress.h"
 
 namespace lucent {
 
@@ -31,7 +35,7 @@ struct CacheHeader {
     std::uint32_t file_format;
     std::uint32_t algorithm_version;
     std::uint32_t rays;
-    std::uint32_t reserved;
+    std::uint32_t normals_hash;
     std::uint64_t count;
     char mesh_hash[16];
     std::uint64_t checksum;
@@ -39,10 +43,11 @@ struct CacheHeader {
 #pragma pack(pop)
 static_assert(sizeof(CacheHeader) == 56);
 
-std::uint64_t checksum(const std::vector<float>& values) {
+template <typename T>
+std::uint64_t checksum(const std::vector<T>& values) {  // FNV-1a over the bytes
     std::uint64_t hash = 0xcbf29ce484222325ull;
     const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-    for (std::size_t i = 0; i < values.size() * sizeof(float); ++i)
+    for (std::size_t i = 0; i < values.size() * sizeof(T); ++i)
         hash = (hash ^ bytes[i]) * 0x100000001b3ull;
     return hash;
 }
@@ -53,6 +58,8 @@ CacheHeader header_for(const Mesh& mesh, int rays, const std::vector<float>& val
     header.file_format = kFileFormat;
     header.algorithm_version = kAoAlgorithmVersion;
     header.rays = static_cast<std::uint32_t>(rays);
+    const std::uint64_t normals = checksum(mesh.normals);
+    header.normals_hash = static_cast<std::uint32_t>(normals ^ (normals >> 32));
     header.count = mesh.vertex_count();
     std::memset(header.mesh_hash, '0', sizeof header.mesh_hash);
     std::memcpy(header.mesh_hash, mesh.content_hash.data(),
@@ -150,7 +157,17 @@ std::vector<float> load_or_bake_ambient_occlusion(const Mesh& mesh,
     const std::filesystem::path path = ambient_occlusion_cache_path(*source, options.rays);
     if (std::optional<std::vector<float>> cached = read_cache(path, *source, options.rays))
         return *cached;
-    std::vector<float> values = bake_ambient_occlusion(*source, options);
+    // Long bakes show progress: without a caller's callback, a bar on stderr (terminal
+    // only, after half a second).
+    std::vector<float> values;
+    if (options.progress) {
+        values = bake_ambient_occlusion(*source, options);
+    } else {
+        ProgressBar bar("AO bake " + mesh.name, mesh.vertex_count());
+        AoBakeOptions with_bar = options;
+        with_bar.progress = bar.callback();
+        values = bake_ambient_occlusion(*source, with_bar);
+    }
     if (std::string reason; !write_cache(path, *source, options.rays, values, reason))
         std::fprintf(stderr, "lucent: warning: AO cache %s not written: %s\n",
                      path.string().c_str(), reason.c_str());

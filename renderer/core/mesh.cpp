@@ -140,6 +140,9 @@ void finalize_mesh(Mesh& mesh) {
 }
 
 Mesh load_mesh(const std::string& spec) {
+    if (spec.empty())
+        throw MeshError("(empty mesh spec): give a built-in name (sphere, torus, torus_knot, "
+                        "hand) or a mesh file path");
     // A built-in name wins unless a file of that exact name exists.
     if (is_builtin_mesh_spec(spec) && !std::filesystem::exists(spec))
         return build_builtin_mesh(spec);

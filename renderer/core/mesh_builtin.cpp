@@ -5,16 +5,17 @@
 //   torus       major radius 1, tube radius 0.4, axis Y (seen side-on by default)
 //   torus_knot  (2,3) trefoil tube whose radius varies from 0.05 to 0.25 (thin and thick)
 //   hand        palm, four fingers, a thumb and a wrist smoothly merged (non-convex, thin
-//               protrusions; stand-in for the thesis's hand and Fertility models)
+//               protrusions; stand-in for the thesis's hand and Fertility models);
+//               polygonised, so budgets under ~1000 faces are met only roughly
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <functional>
 #include <numbers>
-#include <unordered_map>
 
 #include "core/mesh.h"
 #include "core/mesh_sources.h"
+#include "core/polygonise.h"
 
 namespace lucent {
 
@@ -167,6 +168,7 @@ Mesh make_torus_knot(std::size_t budget) {
 
 // ---- hand: a signed distance field polygonised by marching tetrahedra ----
 
+
 float smooth_min(float a, float b, float k) {  // polynomial smooth minimum (blend width k)
     const float h = std::clamp(0.5f + 0.5f * (b - a) / k, 0.0f, 1.0f);
     return b + (a - b) * h - k * h * (1.0f - h);
@@ -206,131 +208,34 @@ glm::vec3 distance_gradient(const std::function<float(glm::vec3)>& field, glm::v
             field(p + dz) - field(p - dz)};
 }
 
-// Marching tetrahedra over a cubic grid of spacing `cell` covering [lo, hi]: each cube
-// is split into six tetrahedra around its main diagonal (a conforming split, so the
-// surface is closed), vertices on grid edges are shared, triangles face outward.
-// The grid is visited in blocks of 8^3 cells and a block whose centre is farther from
-// the surface than twice its half-diagonal is skipped (the field is a distance bound),
-// so the cost follows the surface area, not the bounding box volume.
-Mesh polygonise(const std::function<float(glm::vec3)>& field, glm::vec3 lo, glm::vec3 hi,
-                float cell) {
-    constexpr int kBlock = 8;
-    const glm::ivec3 cells = glm::ivec3(glm::ceil((hi - lo) / cell));
-    const glm::ivec3 dims = cells + 1;  // grid vertices
-    auto global_index = [&](glm::ivec3 g) {
-        return (static_cast<std::uint64_t>(g.z) * dims.y + g.y) * dims.x + g.x;
-    };
-    auto value_at = [&](glm::ivec3 g) {
-        // A value of exactly zero would put a vertex on a grid corner shared by several
-        // edges and create zero-area triangles: count it as outside.
-        const float v = field(lo + cell * glm::vec3(g));
-        return v == 0.0f ? 1e-7f * cell : v;
-    };
-    Mesh mesh;
-    std::unordered_map<std::uint64_t, unsigned> edge_vertex;
-    auto vertex_on_edge = [&](std::uint64_t a, glm::vec3 pa, float fa, std::uint64_t b,
-                              glm::vec3 pb, float fb) {
-        if (a > b) std::swap(a, b), std::swap(pa, pb), std::swap(fa, fb);
-        const auto [it, inserted] =
-            edge_vertex.try_emplace((a << 32) ^ b, static_cast<unsigned>(mesh.positions.size()));
-        if (inserted) mesh.positions.push_back(pa + (fa / (fa - fb)) * (pb - pa));
-        return it->second;
-    };
-    static constexpr int kTetrahedra[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
-                                              {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-    const float block_reach = 2.0f * 0.5f * std::sqrt(3.0f) * kBlock * cell;
-    std::vector<float> block_values;
-    for (int bz = 0; bz < cells.z; bz += kBlock)
-        for (int by = 0; by < cells.y; by += kBlock)
-            for (int bx = 0; bx < cells.x; bx += kBlock) {
-                const glm::ivec3 first(bx, by, bz);
-                const glm::ivec3 last = glm::min(first + kBlock, cells);  // vertex bounds
-                const glm::vec3 centre = lo + cell * 0.5f * glm::vec3(first + last);
-                if (std::abs(field(centre)) > block_reach) continue;
-                const glm::ivec3 size = last - first + 1;
-                block_values.resize(static_cast<std::size_t>(size.x) * size.y * size.z);
-                auto local = [&](glm::ivec3 g) {
-                    const glm::ivec3 l = g - first;
-                    return (static_cast<std::size_t>(l.z) * size.y + l.y) * size.x + l.x;
-                };
-                for (int z = first.z; z <= last.z; ++z)
-                    for (int y = first.y; y <= last.y; ++y)
-                        for (int x = first.x; x <= last.x; ++x)
-                            block_values[local({x, y, z})] = value_at({x, y, z});
-                for (int z = first.z; z < last.z; ++z)
-                    for (int y = first.y; y < last.y; ++y)
-                        for (int x = first.x; x < last.x; ++x) {
-                            std::uint64_t corner_index[8];
-                            glm::vec3 corner_position[8];
-                            float corner_value[8];
-                            bool any_inside = false, any_outside = false;
-                            for (int c = 0; c < 8; ++c) {
-                                const glm::ivec3 g(x + (c & 1), y + ((c >> 1) & 1),
-                                                   z + ((c >> 2) & 1));
-                                corner_index[c] = global_index(g);
-                                corner_position[c] = lo + cell * glm::vec3(g);
-                                corner_value[c] = block_values[local(g)];
-                                (corner_value[c] < 0.0f ? any_inside : any_outside) = true;
-                            }
-                            if (!any_inside || !any_outside) continue;
-                            for (const auto& tet : kTetrahedra) {
-                                int inside[4], outside[4], n_in = 0, n_out = 0;
-                                for (int k = 0; k < 4; ++k)
-                                    (corner_value[tet[k]] < 0.0f ? inside[n_in++]
-                                                                 : outside[n_out++]) = tet[k];
-                                if (n_in == 0 || n_out == 0) continue;
-                                auto on = [&](int a, int b) {
-                                    return vertex_on_edge(corner_index[a], corner_position[a],
-                                                          corner_value[a], corner_index[b],
-                                                          corner_position[b], corner_value[b]);
-                                };
-                                glm::vec3 in_centre(0.0f), out_centre(0.0f);
-                                for (int k = 0; k < n_in; ++k) in_centre += corner_position[inside[k]];
-                                for (int k = 0; k < n_out; ++k)
-                                    out_centre += corner_position[outside[k]];
-                                const glm::vec3 outward =
-                                    out_centre / float(n_out) - in_centre / float(n_in);
-                                auto emit = [&](unsigned a, unsigned b, unsigned c) {
-                                    const glm::vec3 n =
-                                        glm::cross(mesh.positions[b] - mesh.positions[a],
-                                                   mesh.positions[c] - mesh.positions[a]);
-                                    if (glm::dot(n, outward) < 0.0f) std::swap(b, c);
-                                    mesh.triangles.push_back({a, b, c});
-                                };
-                                if (n_in == 1 || n_out == 1) {
-                                    const int lone = n_in == 1 ? inside[0] : outside[0];
-                                    const int* others = n_in == 1 ? outside : inside;
-                                    emit(on(lone, others[0]), on(lone, others[1]),
-                                         on(lone, others[2]));
-                                } else {  // two in, two out: a quad around the tetrahedron
-                                    const unsigned q0 = on(inside[0], outside[0]);
-                                    const unsigned q1 = on(inside[1], outside[0]);
-                                    const unsigned q2 = on(inside[1], outside[1]);
-                                    const unsigned q3 = on(inside[0], outside[1]);
-                                    emit(q0, q1, q2);
-                                    emit(q0, q2, q3);
-                                }
-                            }
-                        }
-            }
-    return mesh;
-}
-
 Mesh make_hand(std::size_t budget) {
     const glm::vec3 lo(-1.25f, -1.5f, -0.35f), hi(0.75f, 1.6f, 0.4f);
-    // Faces scale as 1 / cell^2: start from a measured constant, then correct the cell
-    // size until the count is within 1% of the budget (a few passes at most).
-    float cell = 7.4f / std::sqrt(static_cast<float>(budget));
+    // Faces scale as 1 / cell^2: start from a measured constant and correct the cell
+    // size until the count is within 1% of the budget; the count is a noisy function of
+    // the cell size at small budgets, so then try a few sizes around the best one.
     Mesh best;
-    for (int pass = 0; pass < 8; ++pass) {
+    float best_cell = 0.0f;
+    auto error_of = [budget](const Mesh& m) {
+        return m.triangles.empty() ? 1e30 : std::abs(double(m.face_count()) / double(budget) - 1.0);
+    };
+    auto consider = [&](float cell) {
         Mesh mesh = polygonise(hand_distance, lo - 2.0f * cell, hi + 2.0f * cell, cell);
-        const double ratio = double(mesh.face_count()) / double(budget);
-        if (best.triangles.empty() || std::abs(ratio - 1.0) <
-                std::abs(double(best.face_count()) / double(budget) - 1.0))
-            best = std::move(mesh);
-        if (std::abs(ratio - 1.0) < 0.01) break;
-        cell *= static_cast<float>(std::sqrt(ratio));
+        const std::size_t faces = mesh.face_count();
+        if (best_cell == 0.0f || error_of(mesh) < error_of(best))
+            best = std::move(mesh), best_cell = cell;
+        return faces;
+    };
+    float cell = 7.4f / std::sqrt(static_cast<float>(budget));
+    for (int pass = 0; pass < 6 && (best_cell == 0.0f || error_of(best) > 0.01); ++pass) {
+        const std::size_t faces = consider(cell);
+        // Damped: at very coarse cells whole parts (the palm is 0.4 thick) drop out.
+        cell *= faces == 0 ? 0.5f
+                           : std::clamp(static_cast<float>(std::sqrt(double(faces) / budget)),
+                                        0.6f, 1.6f);
     }
+    for (int step = -8; step <= 8 && error_of(best) > 0.01; ++step)
+        consider(best_cell * (1.0f + 0.01f * static_cast<float>(step)));
+    if (best.triangles.empty()) throw MeshError("hand: no surface at this face budget");
     best.normals.resize(best.positions.size());
     for (std::size_t i = 0; i < best.positions.size(); ++i)
         best.normals[i] = glm::normalize(distance_gradient(hand_distance, best.positions[i], 1e-3f));

@@ -43,17 +43,16 @@ void tangent_frame(glm::vec3 n, glm::vec3& t, glm::vec3& b) {
     b = {c, sign + n.y * n.y * a, -n.y};
 }
 
-float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh, std::size_t vertex,
-                               int rays, float offset) {
-    const glm::vec3 n = mesh.normals[vertex];
+float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh,
+                               const std::vector<glm::vec3>& normals, std::size_t vertex,
+                               int rays, float offset, std::vector<glm::vec3>& directions) {
+    const glm::vec3 n = normals[vertex];
     glm::vec3 t, b;
     tangent_frame(n, t, b);
-    // Start just above the surface so the vertex's own triangles are not hit.
-    const glm::vec3 origin = mesh.positions[vertex] + offset * n;
     const std::uint64_t h = mix(kSeed ^ mix(vertex));
     const double shift_u = unit_interval(h), shift_v = unit_interval(mix(h));
     constexpr double kGolden = 0.6180339887498949;  // 1 / golden ratio
-    int escaped = 0;
+    directions.resize(static_cast<std::size_t>(rays));
     for (int i = 0; i < rays; ++i) {
         double u = (i + 0.5) / rays + shift_u;
         u -= std::floor(u);
@@ -63,13 +62,13 @@ float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh, std::s
         const double cos_theta = 1.0 - u;
         const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
         const double phi = 2.0 * std::numbers::pi * v;
-        const glm::vec3 direction =
-            float(sin_theta * std::cos(phi)) * t + float(sin_theta * std::sin(phi)) * b +
-            float(cos_theta) * n;
-        if (!caster.occluded(origin, direction, 0.0f, std::numeric_limits<float>::infinity()))
-            ++escaped;
+        directions[i] = glm::normalize(float(sin_theta * std::cos(phi)) * t +
+                                       float(sin_theta * std::sin(phi)) * b +
+                                       float(cos_theta) * n);
     }
-    return float(escaped) / float(rays);
+    // Start just above the surface so the vertex's own triangles are not hit.
+    const glm::vec3 origin = mesh.positions[vertex] + offset * n;
+    return float(caster.count_escaping(origin, directions)) / float(rays);
 }
 
 }  // namespace
@@ -85,6 +84,17 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh, const AoBakeOptions&
         return result;  // nothing to occlude
     }
     const RayCaster caster(mesh);
+    // Meshes from load_mesh() have unit normals; one assembled by hand may not.
+    std::vector<glm::vec3> repaired;
+    bool usable = mesh.normals.size() == total;
+    for (std::size_t i = 0; usable && i < total; ++i)
+        usable = std::abs(glm::length(mesh.normals[i]) - 1.0f) < 1e-3f;
+    if (!usable) {
+        Mesh copy = mesh;
+        finalize_mesh(copy);
+        repaired = std::move(copy.normals);
+    }
+    const std::vector<glm::vec3>& normals = usable ? mesh.normals : repaired;
     // Scale-aware offset: far above float noise at the mesh's size, far below its detail.
     const float offset = 1e-4f * std::max(mesh.bounding_sphere().radius, 1e-6f);
 
@@ -93,8 +103,10 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh, const AoBakeOptions&
         const std::size_t first = next_chunk.fetch_add(1) * kChunk;
         if (first >= total) return false;
         const std::size_t last = std::min(total, first + kChunk);
+        std::vector<glm::vec3> directions;
         for (std::size_t v = first; v < last; ++v)
-            result[v] = vertex_ambient_occlusion(caster, mesh, v, options.rays, offset);
+            result[v] = vertex_ambient_occlusion(caster, mesh, normals, v, options.rays, offset,
+                                                 directions);
         done.fetch_add(last - first);
         return true;
     };

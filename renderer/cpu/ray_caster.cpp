@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 namespace lucent {
@@ -54,6 +55,11 @@ std::optional<glm::vec3> unit(glm::vec3 origin, glm::vec3 direction) {
 }  // namespace
 
 RayCaster::RayCaster(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
+    for (const glm::uvec3& t : mesh.triangles)
+        if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() ||
+            t.z >= mesh.positions.size())
+            throw std::invalid_argument(mesh.name + ": a triangle refers to a vertex past the "
+                                        "last of " + std::to_string(mesh.positions.size()));
     impl_->positions = mesh.positions;
     impl_->triangles = mesh.triangles;
     impl_->epsilon = 1e-5f * std::max(mesh.bounding_sphere().radius, 1e-6f);
@@ -137,6 +143,23 @@ bool RayCaster::occluded(glm::vec3 origin, glm::vec3 direction, float t_min, flo
     RTCRay ray = make_ray(origin, *dir, std::max(t_min, 0.0f), t_max).ray;
     rtcOccluded1(impl_->scene, &context, &ray);
     return ray.tfar == -std::numeric_limits<float>::infinity();
+}
+
+std::size_t RayCaster::count_escaping(glm::vec3 origin, const std::vector<glm::vec3>& directions,
+                                      float t_min) const {
+    if (!finite(origin)) return directions.size();  // an unusable ray hits nothing
+    // One ray at a time: measured faster here than rtcOccluded16 packets, since AO rays
+    // fan out over a hemisphere and share little traversal.
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    std::size_t escaped = 0;
+    for (const glm::vec3& direction : directions) {
+        RTCRay ray = make_ray(origin, direction, std::max(t_min, 0.0f),
+                              std::numeric_limits<float>::infinity()).ray;
+        rtcOccluded1(impl_->scene, &context, &ray);
+        if (ray.tfar != -std::numeric_limits<float>::infinity()) ++escaped;
+    }
+    return escaped;
 }
 
 }  // namespace lucent

@@ -38,6 +38,11 @@ public:
     // True when anything is hit with distance in (t_min, t_max).
     bool occluded(glm::vec3 origin, glm::vec3 direction, float t_min, float t_max) const;
 
+    // How many rays from one origin along `directions` (unit) hit nothing with distance
+    // in (t_min, inf): the AO estimator's count.
+    std::size_t count_escaping(glm::vec3 origin, const std::vector<glm::vec3>& directions,
+                               float t_min = 0.0f) const;
+
     // 1e-5 of the mesh's bounding-sphere radius: the gap between successive layers.
     float layer_epsilon() const;
 

@@ -271,6 +271,21 @@ std::vector<float> FrameExecutor::read_channel(const std::string& resource) cons
     return flipped;
 }
 
+void FrameExecutor::present(const FramePlan& plan, int x, int y, int width, int height) {
+    const auto& texture = impl_->textures.at(plan.output);
+    const GLuint prog = impl_->program({"gl/shaders/fullscreen.vert", "gl/shaders/present.frag", {}});
+    glViewport(x, y, width, height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(prog);
+    glBindTextureUnit(0, texture.texture.id());
+    glProgramUniform1i(prog, glGetUniformLocation(prog, "image"), 0);
+    glBindVertexArray(impl_->empty_vao.id());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glBindTextureUnit(0, 0);
+}
+
 Image FrameExecutor::render(const Scene& scene, const FramePlan& plan) {
     execute(scene, plan);
     return read_output(plan);

@@ -46,3 +46,8 @@ add_test(NAME app.render_mesh_and_config_exits_2
                  "-DARGS=render;x.toml;--mesh;sphere;--out;${LUCENT_STIMULI_CLI_DIR}/both"
                  -DEXPECT_CODE=2 "-DEXPECT_STDERR=one of --mesh, CONFIG or --preset"
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+
+# lucent bench render runs end to end (small images; the figures come from a full run).
+add_test(NAME app.bench_render_smoke COMMAND lucent bench render --size 64x64)
+set_tests_properties(app.bench_render_smoke PROPERTIES
+    PASS_REGULAR_EXPRESSION "15 stimuli at 64x64.*empty +[0-9.]+ .*filled +[0-9.]+ .*throughput")

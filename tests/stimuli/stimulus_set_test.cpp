@@ -58,6 +58,7 @@ TEST(StimulusSet, MinimalSetTakesDefaults) {
     EXPECT_EQ(s.parameters.scalar("weight"), 1.0);
     EXPECT_EQ(s.parameters.integer("rays"), 320);
     EXPECT_EQ(set.width, 512);
+    EXPECT_EQ(set.name, "set");  // unnamed sets take the file's stem
     EXPECT_EQ(set.formats, std::vector<ImageFormat>{ImageFormat::png});
 }
 

@@ -19,8 +19,8 @@ enum class Variant {
 };
 
 struct Params {
-    glm::dvec3 albedo{0.45, 0.65, 0.5};  // Kd, linear rgb in [0, 1]
-    double ambient = 0.15;               // ka, [0, 10]
+    glm::dvec3 albedo{0.8, 0.55, 0.35};  // Kd, linear rgb in [0, 1] (shared default)
+    double ambient = 0.3;                // ka, [0, 10] (shared default)
     // ward: rho_d, the diffuse reflectance; contrast_reversed: the reversed-diffuse
     // weight. [0, 10] (Ward's energy bound is rho_d + rho_s <= 1).
     double diffuse = 0.5;

@@ -163,6 +163,7 @@ TEST(BuiltinMesh, HandIsNonConvexWithThinFingers) {
 
 TEST(BuiltinMesh, FaceBudgetSuffixesAndErrors) {
     EXPECT_NEAR(double(load_mesh("torus_knot:240k").face_count()), 240000.0, 0.03 * 240000);
+    EXPECT_THROW(load_mesh(""), MeshError);
     for (const char* bad : {"sphere:abc", "sphere:10", "sphere:", "torus:30kk", "hand:-5"}) {
         try {
             load_mesh(bad);

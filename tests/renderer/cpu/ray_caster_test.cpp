@@ -88,6 +88,12 @@ TEST(RayCaster, FirstHitRespectsTheDistanceInterval) {
     EXPECT_FALSE(caster.occluded(origin, -down, 0.0f, 100.0f));
 }
 
+TEST(RayCaster, RejectsTrianglesPastTheLastVertex) {
+    Mesh broken = load_mesh("sphere:400");
+    broken.triangles.push_back({0, 1, static_cast<unsigned>(broken.vertex_count())});
+    EXPECT_THROW(RayCaster{broken}, std::invalid_argument);
+}
+
 TEST(RayCaster, UnusableRaysHitNothing) {
     const RayCaster caster(load_mesh("sphere:4000"));
     EXPECT_FALSE(caster.first_hit({0, 0, 3}, {0, 0, 0}).has_value());
@@ -114,6 +120,29 @@ TEST(RayCaster, ConcurrentQueriesAgreeWithSerialOnes) {
         });
     for (std::thread& thread : threads) thread.join();
     EXPECT_EQ(serial, parallel);
+}
+
+}  // namespace
+}  // namespace lucent
+
+namespace lucent {
+namespace {
+
+TEST(RayCaster, CountEscapingCountsRaysThatMissEverything) {
+    const RayCaster caster(load_mesh("sphere:4000"));
+    // From (0, 0, 3) the unit sphere fills a cone of half-angle asin(1/3) around -Z.
+    std::vector<glm::vec3> directions;
+    int expected_escaping = 0;
+    for (int i = 0; i < 200; ++i) {
+        const float angle = 3.14159265f * (i + 0.5f) / 200.0f;  // from -Z towards +Z
+        directions.push_back({std::sin(angle), 0.0f, -std::cos(angle)});
+        if (angle > std::asin(1.0f / 3.0f) + 0.01f) ++expected_escaping;
+        else if (angle < std::asin(1.0f / 3.0f) - 0.01f) {}
+        else directions.pop_back();  // too close to the silhouette to call
+    }
+    EXPECT_EQ(caster.count_escaping({0.0f, 0.0f, 3.0f}, directions),
+              static_cast<std::size_t>(expected_escaping));
+    EXPECT_EQ(caster.count_escaping({0.0f, 0.0f, NAN}, directions), directions.size());
 }
 
 }  // namespace
