@@ -517,8 +517,12 @@ RunResult Session::run() {
             break;
         }
         const int64_t now = now_ns();
-        if (autopilot_)
-            for (const std::string& key : autopilot_->due(now, view())) x_keyboard_->tap(key);
+        if (autopilot_) {
+            const std::vector<std::string> keys = autopilot_->due(now, view());
+            // Take the focus back first: another window on the same X server may hold it.
+            if (!keys.empty()) x_keyboard_->focus_window();
+            for (const std::string& key : keys) x_keyboard_->tap(key);
+        }
         while (!keys_.events.empty() && !quit_) {
             const KeyEvent e = keys_.events.front();
             keys_.events.pop_front();
