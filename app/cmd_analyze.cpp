@@ -6,6 +6,8 @@
 #include "commands.h"
 #include "data/long_table.h"
 #include "report/report.h"
+#include "stats/one_way_analysis.h"
+#include "study_input.h"
 
 namespace lucent::app {
 namespace {
@@ -24,7 +26,7 @@ int run_analyze(const AnalyzeArgs& args) {
         parse_formats(args.formats, options);
         options.alpha = args.alpha;
         options.source = args.input;
-        const LongTable table = read_long_csv(args.input, parse_scale(args.scale));
+        const LongTable table = read_ratings(args.input, parse_scale(args.scale));
         AnalysisRequest request{args.alpha, args.question, args.factor,
                                 [](const std::string& question, const std::string& factor,
                                    std::size_t levels) {
@@ -50,7 +52,7 @@ void register_analyze(CLI::App& app, int& exit_code) {
         "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
         "with plots, from a long CSV of ratings");
     cmd->add_option("input", args->input,
-                    "Long CSV: participant,stimulus,factor,level,question,rating")
+                    "Study database, or long CSV: participant,stimulus,factor,level,question,rating")
         ->required();
     cmd->add_option("--out", args->out_dir, "Directory for the report")->required();
     cmd->add_option("--alpha", args->alpha, "Significance level (Tukey CI at 1 - alpha)")

@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "core/technique.h"
 #include "gl/context.h"
+#include "batch_render.h"
 #include "render.h"
 #include "techniques/registry.h"
 
@@ -21,6 +22,11 @@ struct RenderOptions {
     bool explain = false;
     std::string plan = "pruned";
     bool linear = false;
+    // Batch mode (stimuli/batch_render.h): a stimulus-set config or a built-in preset.
+    std::string config;
+    std::string preset;
+    int jobs = 1;
+    bool force = false;
 };
 
 // "WxH" -> (w, h); throws std::invalid_argument naming --size.
@@ -99,7 +105,7 @@ int run_render(const RenderOptions& options) {
 
 void register_render(CLI::App& app, int& exit_code) {
     auto options = std::make_shared<RenderOptions>();
-    auto* cmd = app.add_subcommand("render", "Render one image of a mesh (headless)");
+    auto* cmd = app.add_subcommand("render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
     std::string meshes;
     for (const auto& name : builtin_mesh_names())
         meshes += (meshes.empty() ? "" : ", ") + name;
@@ -109,9 +115,12 @@ void register_render(CLI::App& app, int& exit_code) {
         for (const Knob& k : knobs_for(*t)) keys += (keys.empty() ? "" : ", ") + k.name;
     }
     cmd->add_option("--mesh", options->mesh,
-                    "built-in mesh (" + meshes +
-                        "; optional face budget, e.g. torus_knot:60k) or a mesh file")
-        ->required();
+                    "built-in mesh (" + meshes + "; optional face budget, e.g. torus_knot:60k) or a mesh file");
+    cmd->add_option("config", options->config,
+                    "stimulus-set config (TOML): render every stimulus into --out DIR");
+    cmd->add_option("--preset", options->preset, "built-in stimulus set (thesis) into --out DIR");
+    cmd->add_option("--jobs", options->jobs, "stimulus sets: parallel workers (default 1)");
+    cmd->add_flag("--force", options->force, "stimulus sets: re-render unchanged stimuli too");
     cmd->add_option("--technique", options->technique, "technique (" + techniques + ")");
     cmd->add_option(
         "--set", options->settings,
@@ -125,7 +134,22 @@ void register_render(CLI::App& app, int& exit_code) {
     cmd->add_option("--plan", options->plan,
                     "pruned (default) or full: run every pass, to check pruning");
     cmd->add_flag("--linear", options->linear, "write .png/.tif without sRGB encoding");
-    cmd->callback([options, &exit_code] { exit_code = run_render(*options); });
+    cmd->callback([options, &exit_code] {
+        // One image (--mesh) or a stimulus set (CONFIG or --preset), never both.
+        const bool batch = !options->config.empty() || !options->preset.empty();
+        if (batch && (!options->mesh.empty() || (!options->config.empty() && !options->preset.empty()))) {
+            std::cerr << "lucent render: give one of --mesh, CONFIG or --preset\n";
+            exit_code = kExitUsage;
+        } else if (batch) {
+            exit_code = stimuli::run_render_set_command(options->config, options->preset,
+                                                        options->out, options->jobs, options->force);
+        } else if (options->mesh.empty()) {
+            std::cerr << "lucent render: --mesh is required (or a stimulus-set CONFIG or --preset)\n";
+            exit_code = kExitUsage;
+        } else {
+            exit_code = run_render(*options);
+        }
+    });
 }
 
 }  // namespace lucent::app

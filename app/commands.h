@@ -16,6 +16,10 @@ void register_analyze(CLI::App& app, int& exit_code);
 void register_stats(CLI::App& app, int& exit_code);
 void register_simulate(CLI::App& app, int& exit_code);
 void register_render(CLI::App& app, int& exit_code);
+void register_run(CLI::App& app, int& exit_code);
+void register_participants(CLI::App& app, int& exit_code);
+void register_export(CLI::App& app, int& exit_code);
+void register_merge(CLI::App& app, int& exit_code);
 
 // `lucent bench <family>`: registered from bench_families.cpp, one function per family.
 void register_bench_families(CLI::App& bench, int& exit_code);
@@ -23,5 +27,6 @@ void register_bench_frame(CLI::App& bench, int& exit_code);
 void register_bench_accuracy(CLI::App& bench, int& exit_code);
 void register_bench_ao(CLI::App& bench, int& exit_code);
 void register_bench_stats(CLI::App& bench, int& exit_code);
+void register_bench_render(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app

@@ -17,11 +17,15 @@ int main(int argc, char** argv) {
 
     int exit_code = kExitOk;
     register_info(app, exit_code);
-    register_bench(app, exit_code);
+    register_render(app, exit_code);
+    register_run(app, exit_code);
+    register_participants(app, exit_code);
+    register_export(app, exit_code);
+    register_merge(app, exit_code);
     register_analyze(app, exit_code);
     register_stats(app, exit_code);
     register_simulate(app, exit_code);
-    register_render(app, exit_code);
+    register_bench(app, exit_code);
 
     // CLI11 would only say "A subcommand is required"; name the word it did not know.
     if (argc > 1 && argv[1][0] != '-' && [&] { try { app.get_subcommand(argv[1]); return false; } catch (const CLI::OptionNotFound&) { return true; } }()) {

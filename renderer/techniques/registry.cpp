@@ -7,10 +7,14 @@ namespace lucent {
 // Each technique folder defines one accessor; adding a technique adds one line to each
 // list below.
 const Technique& empirical_technique();
+const Technique& ward_technique();
+const Technique& contrast_reversed_technique();
 
 const std::vector<const Technique*>& all_techniques() {
     static const std::vector<const Technique*> techniques = {
         &empirical_technique(),
+        &ward_technique(),
+        &contrast_reversed_technique(),
     };
     return techniques;
 }

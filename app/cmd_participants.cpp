@@ -1,0 +1,91 @@
+// lucent participants: list the participants of a study database, or withdraw one.
+#include <iostream>
+
+#include "commands.h"
+#include "sqlite.h"
+#include "store.h"
+
+namespace lucent::app {
+namespace {
+
+int list_participants(const std::string& db_path) {
+    study::check_database_file(db_path);
+    study::Database db(db_path, SQLITE_OPEN_READONLY);
+    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'participants'") == 0) {
+        std::cout << "no participants\n";
+        return kExitOk;
+    }
+    study::Statement s = db.prepare(
+        "SELECT p.code, p.number, count(DISTINCT se.id), "
+        "(SELECT count(*) FROM responses r JOIN sessions x ON x.id = r.session_id "
+        " WHERE x.participant_id = p.id), group_concat(DISTINCT se.status) "
+        "FROM participants p LEFT JOIN sessions se ON se.participant_id = p.id "
+        "GROUP BY p.id ORDER BY p.code");
+    std::cout << "participant  number  sessions  ratings  status\n";
+    while (s.step())
+        std::cout << s.text(0) << "  " << s.integer(1) << "  " << s.integer(2) << "  "
+                  << s.integer(3) << "  " << s.text(4) << "\n";
+    return kExitOk;
+}
+
+int withdraw(const std::string& db_path, const std::string& code, bool yes) {
+    study::Store store(db_path);
+    study::Statement s = store.db().prepare(
+        "SELECT count(DISTINCT se.id), count(r.id) FROM participants p "
+        "LEFT JOIN sessions se ON se.participant_id = p.id "
+        "LEFT JOIN responses r ON r.session_id = se.id WHERE p.code = ?");
+    s.bind(1, code);
+    s.step();
+    if (store.db().scalar_int("SELECT count(*) FROM participants") == 0 || s.integer(0) == 0) {
+        study::Statement exists = store.db().prepare("SELECT count(*) FROM participants WHERE code = ?");
+        exists.bind(1, code);
+        exists.step();
+        if (exists.integer(0) == 0) {
+            std::cerr << "lucent participants withdraw: no participant '" << code << "' in "
+                      << db_path << "\n";
+            return kExitUsage;
+        }
+    }
+    if (!yes) {
+        std::cout << "Delete all data of participant '" << code << "' (" << s.integer(0)
+                  << " sessions, " << s.integer(1) << " ratings) from " << db_path
+                  << "? This cannot be undone. Type 'yes' to confirm: " << std::flush;
+        std::string answer;
+        std::getline(std::cin, answer);
+        if (answer != "yes") {
+            std::cerr << "lucent participants withdraw: not confirmed; nothing deleted\n";
+            return kExitFailure;
+        }
+    }
+    store.withdraw_participant(code);
+    std::cout << "withdrew participant '" << code << "': their sessions and ratings are deleted\n";
+    return kExitOk;
+}
+
+}  // namespace
+
+void register_participants(CLI::App& app, int& exit_code) {
+    auto* cmd = app.add_subcommand("participants", "List or withdraw the participants of a study database");
+    cmd->require_subcommand(1);
+    auto db = std::make_shared<std::string>();
+    auto code = std::make_shared<std::string>();
+    auto yes = std::make_shared<bool>(false);
+    auto* list = cmd->add_subcommand("list", "List participants with their sessions and ratings");
+    list->add_option("--db", *db, "Study database")->required()->check(CLI::ExistingFile);
+    auto* wd = cmd->add_subcommand("withdraw", "Delete a participant and all their data (asks first)");
+    wd->add_option("id", *code, "Participant code")->required();
+    wd->add_option("--db", *db, "Study database")->required()->check(CLI::ExistingFile);
+    wd->add_flag("--yes", *yes, "Do not ask for confirmation (scripts)");
+    auto guarded = [&exit_code](auto fn) {
+        try {
+            exit_code = fn();
+        } catch (const study::StoreError& e) {
+            std::cerr << "lucent participants: " << e.what() << "\n";
+            exit_code = kExitUsage;
+        }
+    };
+    list->callback([=] { guarded([&] { return list_participants(*db); }); });
+    wd->callback([=] { guarded([&] { return withdraw(*db, *code, *yes); }); });
+}
+
+}  // namespace lucent::app

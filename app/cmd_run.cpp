@@ -1,0 +1,87 @@
+// lucent run: a participant session from a protocol file or the built-in preset.
+#include <iostream>
+
+#include "commands.h"
+#include "protocol.h"
+#include "session/live_stimuli.h"
+#include "session/runner.h"
+#include "session/stimulus_source.h"
+#include "sqlite.h"
+#include "trial_plan.h"
+
+namespace lucent::app {
+namespace {
+
+struct RunArgs {
+    std::string protocol_file;
+    std::string preset;
+    std::string images_dir;
+    int64_t seed = -1;
+    study::RunOptions options;
+};
+
+int run_command(RunArgs& args) {
+    study::RunOptions& o = args.options;
+    if (args.protocol_file.empty() == args.preset.empty()) {
+        std::cerr << "lucent run: give a PROTOCOL.toml or --preset NAME (exactly one)\n";
+        return kExitUsage;
+    }
+    try {
+        o.protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
+                                         : study::builtin_protocol(args.preset);
+        if (args.seed >= 0) o.seed = static_cast<uint64_t>(args.seed);
+        study::plan_trials(o.protocol, 0, 0);  // impossible randomisation fails here, early
+        study::LiveOrPrerenderedStimuli stimuli(args.images_dir);
+        switch (study::run_session(o, stimuli, std::cerr)) {
+        case study::RunResult::Completed:
+        case study::RunResult::SavedAndQuit:
+        case study::RunResult::Declined: return kExitOk;
+        case study::RunResult::UsageError: return kExitUsage;
+        case study::RunResult::Failure: return kExitFailure;
+        }
+    } catch (const study::ProtocolError& e) {
+        std::cerr << "lucent run: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const study::PlanError& e) {
+        std::cerr << "lucent run: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const study::StoreError& e) {
+        std::cerr << "lucent run: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const std::exception& e) {
+        std::cerr << "lucent run: " << e.what() << "\n";
+        return kExitFailure;
+    }
+    return kExitFailure;
+}
+
+}  // namespace
+
+void register_run(CLI::App& app, int& exit_code) {
+    auto args = std::make_shared<RunArgs>();
+    auto* cmd = app.add_subcommand(
+        "run", "Run a participant session full-screen (ratings stored in an SQLite database)");
+    cmd->add_option("protocol", args->protocol_file, "Study protocol file (TOML)");
+    cmd->add_option("--preset", args->preset, "Built-in protocol instead of a file")
+        ->check(CLI::IsMember(study::builtin_protocol_names()));
+    cmd->add_option("--db", args->options.db_path, "Study database (created when absent)")->required();
+    cmd->add_option("--participant", args->options.participant, "Participant code, e.g. P07")->required();
+    cmd->add_flag("--windowed", args->options.windowed, "A 1280x1024 window instead of full screen");
+    cmd->add_option("--monitor", args->options.monitor, "Monitor index for full screen")->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--resume", args->options.resume, "Continue the participant's unfinished session");
+    cmd->add_option("--images", args->images_dir,
+                    "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr (e.g. from "
+                    "'lucent render --preset thesis --out DIR'); others render live");
+    cmd->add_option("--seed", args->seed, "Session seed (default: random; stored either way)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--autopilot", args->options.autopilot,
+                    "Simulated participant: a SEED, or a FILE of 'DELAY_MS KEY' lines");
+    cmd->add_option("--autopilot-speed", args->options.autopilot_speed,
+                    "Divide the autopilot's human-like delays by this factor")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--screenshot", args->options.screenshot_path,
+                    "Save the first rating screen as a PNG (for tests)");
+    cmd->callback([args, &exit_code] { exit_code = run_command(*args); });
+}
+
+}  // namespace lucent::app

@@ -1,0 +1,38 @@
+#include "study_input.h"
+
+#include <fstream>
+#include <iostream>
+
+#include "export.h"
+#include "sqlite.h"
+
+namespace lucent::app {
+
+bool is_sqlite_file(const std::string& path) {
+    char magic[16] = {};
+    std::ifstream in(path, std::ios::binary);
+    in.read(magic, sizeof magic);
+    return in.gcount() == 16 && std::string(magic, 16) == std::string("SQLite format 3\0", 16);
+}
+
+analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale) {
+    if (!is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
+    study::LongTable rows;
+    try {
+        rows = study::analysis_long_table(path);
+    } catch (const study::StoreError& e) {
+        throw analysis::InputError(e.what());
+    }
+    for (const std::string& p : rows.excluded_participants)
+        std::cerr << "lucent analyze: excluded participant " << p << "\n";
+    analysis::LongTable table;
+    for (size_t i = 0; i < rows.rows.size(); ++i) {
+        const study::LongRow& r = rows.rows[i];
+        table.rows.push_back({r.participant, r.stimulus, r.factor, r.level, r.question,
+                              static_cast<double>(r.rating), i + 1});
+    }
+    analysis::check_scale(table, scale, path);
+    return table;
+}
+
+}  // namespace lucent::app

@@ -1,0 +1,372 @@
+// Batch rendering: load meshes, decide what changed, render on N workers (one GL context
+// each), write images + manifest, show progress.
+// [SECTION] manifest rows: identity, parameter columns, file hashes, reuse decision
+// [SECTION] BatchProgress: stimuli done, time per stimulus, time left
+// [SECTION] render_stimulus_set(): meshes, reuse, AO pre-bake, workers, manifest
+// [SECTION] run_render_set_command(): the CLI's batch path and its exit codes
+#include "batch_render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <unistd.h>
+
+#include "core/ambient_occlusion.h"
+#include "core/mesh.h"
+#include "core/technique.h"
+#include "gl/context.h"
+#include "lucent/version.h"
+#include "render.h"
+#include "techniques/registry.h"
+
+namespace lucent::stimuli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr int kHistogramBins = 16;  // manifest columns hist_00 .. hist_15
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::filesystem::path file_of(const Stimulus& s, ImageFormat format) {
+    return s.id + "." + std::string(extension(format));
+}
+
+// The parameter columns in knob order (scene knobs first), values as text.
+std::vector<ManifestField> parameter_fields(const Stimulus& stimulus) {
+    std::vector<ManifestField> fields;
+    for (const Knob& knob : knobs_for(find_technique(stimulus.technique))) {
+        const auto& value = stimulus.parameters.get(knob.name);
+        const bool numeric = std::holds_alternative<double>(value) || std::holds_alternative<int>(value);
+        fields.push_back({knob.name, format_knob_value(value), numeric});
+    }
+    return fields;
+}
+
+// Every parameter name of the set's techniques, in knob order (scene knobs first), so
+// all rows list the parameters in the same columns.
+std::vector<std::string> parameter_columns(const StimulusSet& set) {
+    std::vector<std::string> columns;
+    for (const auto& s : set.stimuli)
+        for (const Knob& knob : knobs_for(find_technique(s.technique)))
+            if (std::find(columns.begin(), columns.end(), knob.name) == columns.end())
+                columns.push_back(knob.name);
+    return columns;
+}
+
+// The identity part of a row (before statistics and hashes); parameters the stimulus's
+// technique lacks are empty.
+ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mesh& mesh) {
+    std::string files;
+    for (const auto format : set.formats)
+        files += (files.empty() ? "" : ";") + file_of(s, format).string();
+    ManifestRow row = {{"id", s.id, false},
+                       {"file", file_of(s, set.formats.front()).string(), false},
+                       {"files", files, false},
+                       {"technique", s.technique, false},
+                       {"mesh", s.mesh_spec, false},
+                       {"mesh_faces", std::to_string(mesh.face_count()), true},
+                       {"mesh_hash", mesh.content_hash, false},
+                       {"width", std::to_string(set.width), true},
+                       {"height", std::to_string(set.height), true}};
+    const auto parameters = parameter_fields(s);
+    for (const auto& column : parameter_columns(set)) {
+        ManifestField field{column, "", false};
+        for (const auto& p : parameters)
+            if (p.column == column) field = p;
+        row.push_back(field);
+    }
+    return row;
+}
+
+std::string files_hash(const std::filesystem::path& dir, const StimulusSet& set, const Stimulus& s) {
+    Hasher hasher;
+    for (const auto format : set.formats) hasher.add_field(hash_file(dir / file_of(s, format)));
+    return hasher.hex();
+}
+
+// True when the previous run's files for `s` are present, unchanged and made from the
+// same inputs.
+bool reusable(const std::map<std::string, std::string>* previous, const std::string& inputs,
+              const std::filesystem::path& dir, const StimulusSet& set, const Stimulus& s) {
+    if (!previous) return false;
+    const auto field = [&](const char* column) {
+        const auto it = previous->find(column);
+        return it == previous->end() ? std::string() : it->second;
+    };
+    if (field("input_hash") != inputs) return false;
+    for (const auto format : set.formats) {
+        std::error_code error;
+        if (!std::filesystem::is_regular_file(dir / file_of(s, format), error)) return false;
+    }
+    try {
+        return files_hash(dir, set, s) == field("content_hash");
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+// A one-line progress display: stimuli done, time per stimulus, time left. Redrawn in
+// place on a terminal; one line per stimulus otherwise (logs).
+class BatchProgress {
+public:
+    BatchProgress(std::size_t total, bool enabled)
+        : total_(total), enabled_(enabled && total > 0), tty_(isatty(STDERR_FILENO)),
+          start_(Clock::now()) {}
+    void done(std::size_t finished, const std::string& id) {
+        if (!enabled_) return;
+        const double elapsed = seconds_since(start_);
+        const double per = elapsed / double(std::max<std::size_t>(finished, 1));
+        const double left = per * double(total_ - finished);
+        const int width = 24, filled = int(double(width) * double(finished) / double(total_));
+        std::string bar(std::size_t(filled), '#');
+        bar.resize(std::size_t(width), '.');
+        std::fprintf(stderr, "%s[%s] %zu/%zu stimuli  %.2f s/stimulus  %.1f s left  %s%s",
+                     tty_ ? "\r" : "", bar.c_str(), finished, total_, per, left, id.c_str(),
+                     tty_ ? "\033[K" : "\n");
+        if (tty_ && finished == total_) std::fprintf(stderr, "\n");
+        std::fflush(stderr);
+    }
+
+private:
+    std::size_t total_;
+    bool enabled_, tty_;
+    Clock::time_point start_;
+};
+
+}  // namespace
+
+std::string input_hash(const StimulusSet& set, const Stimulus& stimulus,
+                       const std::string& mesh_hash) {
+    Hasher hasher;
+    hasher.add_field(version_string()).add_field(build_hash());
+    hasher.add_field(stimulus.technique).add_field(mesh_hash);
+    hasher.add_field(std::to_string(set.width)).add_field(std::to_string(set.height));
+    for (const auto format : set.formats) hasher.add_field(extension(format));
+    for (const auto& [name, value] : stimulus.parameters.all())
+        hasher.add_field(name).add_field(format_knob_value(value));
+    return hasher.hex();
+}
+
+BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& options) {
+    const auto wall_start = Clock::now();
+    const auto& dir = options.out_dir;
+    BatchResult result;
+
+    // Meshes, once per spec (MeshError propagates before anything is written).
+    std::map<std::string, std::shared_ptr<const Mesh>> meshes;
+    for (const auto& s : set.stimuli)
+        if (!meshes.count(s.mesh_spec))
+            meshes[s.mesh_spec] = std::make_shared<const Mesh>(load_mesh(s.mesh_spec));
+
+    std::filesystem::create_directories(dir);
+    const auto previous = read_manifest_csv(dir);
+
+    // Decide what to render; reused rows keep the previous run's statistics verbatim.
+    const std::size_t count = set.stimuli.size();
+    std::vector<ManifestRow> rows(count);
+    std::vector<std::string> inputs(count);
+    std::vector<std::size_t> pending;
+    for (std::size_t i = 0; i < count; ++i) {
+        const auto& s = set.stimuli[i];
+        const Mesh& mesh = *meshes.at(s.mesh_spec);
+        inputs[i] = input_hash(set, s, mesh.content_hash);
+        const auto it = previous.find(s.id);
+        const auto* old = it == previous.end() ? nullptr : &it->second;
+        if (!options.force && reusable(old, inputs[i], dir, set, s)) {
+            rows[i] = identity_fields(set, s, mesh);
+            ImageStatistics columns;
+            columns.luminance_histogram.resize(kHistogramBins);
+            for (const auto& field : statistics_fields(columns)) {
+                const auto found = old->find(field.column);
+                rows[i].push_back({field.column, found == old->end() ? "0" : found->second, true});
+            }
+            ++result.reused;
+        } else {
+            pending.push_back(i);
+        }
+    }
+
+    // Bake (or load) the AO each pending plan reads once, here, so parallel workers never
+    // bake the same mesh twice and the bake's own progress bar is not interleaved.
+    double prebake_seconds = 0.0;
+    {
+        std::set<std::pair<std::string, int>> bakes;
+        for (const std::size_t i : pending) {
+            const Stimulus& s = set.stimuli[i];
+            const Technique& technique = find_technique(s.technique);
+            const Scene scene = make_scene(meshes.at(s.mesh_spec), technique, s.parameters,
+                                           set.width, set.height);
+            for (const Pass& pass : make_frame_plan(scene, technique).passes)
+                if (pass.kind == PassKind::bake_ambient_occlusion)
+                    bakes.emplace(s.mesh_spec, pass.ao_rays);
+        }
+        const auto start = Clock::now();
+        for (const auto& [spec, rays] : bakes) {
+            AoBakeOptions ao;
+            ao.rays = rays;
+            (void)load_or_bake_ambient_occlusion(*meshes.at(spec), ao);
+        }
+        prebake_seconds = seconds_since(start);
+    }
+
+    // Render the pending stimuli on `jobs` workers, each with its own GL context.
+    std::mutex mutex;
+    std::condition_variable finished_signal;
+    std::size_t finished = 0;
+    std::atomic<std::size_t> next{0};
+    std::string failure;
+    std::vector<std::string> finished_ids;
+    const int jobs = std::clamp(options.jobs, 1, int(std::max<std::size_t>(pending.size(), 1)));
+    std::vector<BatchTimings> worker_timings(static_cast<std::size_t>(jobs));
+
+    auto worker = [&](int index) {
+        BatchTimings& timings = worker_timings[std::size_t(index)];
+        try {
+            auto context = gl::create_headless_context();
+            gl::FrameExecutor executor;
+            executor.set_ambient_occlusion_source([&timings](const Mesh& mesh, int rays) {
+                const auto start = Clock::now();
+                AoBakeOptions ao;
+                ao.rays = rays;
+                auto values = load_or_bake_ambient_occlusion(mesh, ao);
+                timings.ao_seconds += seconds_since(start);
+                return values;
+            });
+            for (std::size_t k; (k = next++) < pending.size();) {
+                {
+                    std::lock_guard lock(mutex);
+                    if (!failure.empty()) return;
+                }
+                const std::size_t i = pending[k];
+                const Stimulus& s = set.stimuli[i];
+                const auto mesh = meshes.at(s.mesh_spec);
+                const Technique& technique = find_technique(s.technique);
+
+                // The single-image path of `lucent render --mesh`.
+                auto start = Clock::now();
+                const double ao_before = timings.ao_seconds;
+                const Scene scene = make_scene(mesh, technique, s.parameters, set.width, set.height);
+                const Image image = render_image(executor, scene);
+                timings.gl_seconds += seconds_since(start) - (timings.ao_seconds - ao_before);
+
+                start = Clock::now();
+                for (const auto format : set.formats)
+                    write_image(dir / file_of(s, format), image);
+                timings.encode_seconds += seconds_since(start);
+
+                start = Clock::now();
+                ManifestRow row = identity_fields(set, s, *mesh);
+                const auto stats = compute_image_statistics(
+                    FloatImageView{image.width, image.height, 4, image.rgba}, kHistogramBins);
+                const auto stat_fields = statistics_fields(stats);
+                row.insert(row.end(), stat_fields.begin(), stat_fields.end());
+                const std::string content = files_hash(dir, set, s);
+                timings.statistics_seconds += seconds_since(start);
+
+                std::lock_guard lock(mutex);
+                rows[i] = std::move(row);
+                rows[i].push_back({"content_hash", content, false});
+                finished_ids.push_back(s.id);
+                ++finished;
+                finished_signal.notify_one();
+            }
+        } catch (const std::exception& e) {
+            std::lock_guard lock(mutex);
+            if (failure.empty()) failure = e.what();
+            finished_signal.notify_one();
+        }
+    };
+    std::vector<std::thread> workers;
+    for (int w = 0; w < jobs && !pending.empty(); ++w) workers.emplace_back(worker, w);
+
+    BatchProgress progress(pending.size(), options.progress);
+    {
+        std::unique_lock lock(mutex);
+        std::size_t shown = 0;
+        while (shown < pending.size() && failure.empty()) {
+            finished_signal.wait(lock, [&] { return finished > shown || !failure.empty(); });
+            while (shown < finished) {
+                const std::string id = finished_ids[shown++];
+                lock.unlock();
+                progress.done(shown, id);
+                lock.lock();
+            }
+        }
+    }
+    for (auto& thread : workers) thread.join();
+    if (!failure.empty()) throw std::runtime_error(failure);
+    result.rendered = pending.size();
+
+    // Hashes and software columns last, so every row ends the same way.
+    for (std::size_t i = 0; i < count; ++i) {
+        std::string content;
+        auto& row = rows[i];
+        if (!row.empty() && row.back().column == "content_hash") {
+            content = row.back().text;
+            row.pop_back();
+        } else {
+            content = files_hash(dir, set, set.stimuli[i]);
+        }
+        row.push_back({"software_version", version_string(), false});
+        row.push_back({"build_hash", build_hash(), false});
+        row.push_back({"input_hash", inputs[i], false});
+        row.push_back({"content_hash", content, false});
+    }
+    write_manifest(dir, set.name, rows);
+    result.rows = std::move(rows);
+    result.timings.ao_seconds = prebake_seconds;
+    for (const auto& t : worker_timings) {
+        result.timings.ao_seconds += t.ao_seconds;
+        result.timings.gl_seconds += t.gl_seconds;
+        result.timings.encode_seconds += t.encode_seconds;
+        result.timings.statistics_seconds += t.statistics_seconds;
+    }
+    result.timings.wall_seconds = seconds_since(wall_start);
+    return result;
+}
+
+int run_render_set_command(const std::string& config_path, const std::string& preset,
+                           const std::string& out_dir, int jobs, bool force) {
+    StimulusSet set;
+    try {
+        if (out_dir.empty()) throw StimulusSetError("--out: missing (give --out DIR)");
+        if (jobs < 1 || jobs > 64)
+            throw StimulusSetError("--jobs: " + std::to_string(jobs) + " is out of range (accepted: 1..64)");
+        const auto catalog = default_catalog();
+        set = preset.empty() ? load_stimulus_set(config_path, catalog) : load_preset(preset, catalog);
+        std::error_code error;
+        if (std::filesystem::exists(out_dir, error) && !std::filesystem::is_directory(out_dir, error))
+            throw StimulusSetError("--out: '" + out_dir + "' exists and is not a directory");
+    } catch (const StimulusSetError& e) {
+        std::cerr << "lucent render: " << e.what() << "\n";
+        return 2;
+    }
+    try {
+        BatchOptions options;
+        options.out_dir = out_dir;
+        options.jobs = jobs;
+        options.force = force;
+        const BatchResult result = render_stimulus_set(set, options);
+        std::cout << "rendered " << result.rendered << ", unchanged " << result.reused << " of "
+                  << set.stimuli.size() << " stimuli into " << out_dir
+                  << " (manifest.csv, manifest.json) in " << result.timings.wall_seconds << " s\n";
+    } catch (const MeshError& e) {
+        std::cerr << "lucent render: " << set.source << ": mesh " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "lucent render: " << e.what() << "\n";
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace lucent::stimuli

@@ -1,0 +1,56 @@
+#pragma once
+// Batch rendering of a stimulus set: every stimulus through the same single-image path
+// as `lucent render --mesh` (make_scene + render_image + write_image), image statistics,
+// and manifest.csv / manifest.json. A second run re-renders only stimuli whose inputs
+// (input hash) or files changed; `force` re-renders all.
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "manifest.h"
+#include "stimulus_set.h"
+
+namespace lucent::stimuli {
+
+struct BatchOptions {
+    std::filesystem::path out_dir;
+    int jobs = 1;           // worker threads, each with its own headless GL context
+    bool force = false;     // re-render every stimulus
+    bool progress = true;   // progress line on stderr
+};
+
+// Where the time went (seconds, summed over workers).
+struct BatchTimings {
+    double ao_seconds = 0.0;          // AO bakes and cache loads
+    double gl_seconds = 0.0;          // plan + GL passes + read-back, AO excluded
+    double encode_seconds = 0.0;      // image encoding and writing (all formats)
+    double statistics_seconds = 0.0;  // image statistics and content hashes
+    double wall_seconds = 0.0;        // the whole batch, start to manifest
+};
+
+struct BatchResult {
+    std::size_t rendered = 0;
+    std::size_t reused = 0;  // inputs and files unchanged since the last run
+    BatchTimings timings;
+    std::vector<ManifestRow> rows;  // in set order, as written to the manifest
+};
+
+// The hash of everything that determines a stimulus's files: software version and build,
+// technique, mesh content hash, every parameter value, resolution and formats.
+std::string input_hash(const StimulusSet& set, const Stimulus& stimulus,
+                       const std::string& mesh_hash);
+
+// Renders `set` into options.out_dir (created if needed). Throws std::runtime_error on
+// GL or I/O failure (files already finished stay valid: each is written to a temporary
+// name and renamed).
+BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& options);
+
+// `lucent render CONFIG.toml --out DIR` / `--preset NAME`: loads, renders and reports;
+// returns the exit code (2 for config or usage errors, with nothing written; 1 for
+// rendering failures). Exactly one of config_path and preset is non-empty.
+int run_render_set_command(const std::string& config_path, const std::string& preset,
+                           const std::string& out_dir, int jobs, bool force);
+
+}  // namespace lucent::stimuli

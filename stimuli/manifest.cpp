@@ -1,0 +1,194 @@
+#include "manifest.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "lucent/version.h"
+
+namespace lucent::stimuli {
+namespace {
+
+std::string number(double value) {
+    if (!std::isfinite(value)) value = 0.0;  // never let NaN/Inf into a table
+    char text[32];
+    std::snprintf(text, sizeof text, "%.9g", value);
+    return text;
+}
+
+std::string json_escape(std::string_view text) {
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+            case '"': out += "\\\""; break;
+            case '\\': out += "\\\\"; break;
+            case '\n': out += "\\n"; break;
+            case '\r': out += "\\r"; break;
+            case '\t': out += "\\t"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20) {
+                    char code[8];
+                    std::snprintf(code, sizeof code, "\\u%04x", c);
+                    out += code;
+                } else {
+                    out += c;
+                }
+        }
+    }
+    return out;
+}
+
+void write_atomically(const std::filesystem::path& path, const std::string& text) {
+    const auto temporary = path.parent_path() / ("." + path.filename().string() + ".partial");
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out << text;
+        out.flush();
+        if (!out) throw std::runtime_error(temporary.string() + ": cannot write");
+    }
+    std::filesystem::rename(temporary, path);
+}
+
+}  // namespace
+
+Hasher& Hasher::add(std::string_view bytes) {
+    for (unsigned char byte : bytes) {
+        state_ ^= byte;
+        state_ *= 0x100000001b3ull;
+    }
+    return *this;
+}
+
+Hasher& Hasher::add_field(std::string_view text) {
+    add(std::to_string(text.size()) + ":");
+    return add(text);
+}
+
+std::string Hasher::hex() const {
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(state_));
+    return text;
+}
+
+std::string hash_file(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path.string() + ": cannot read");
+    Hasher hasher;
+    char buffer[1 << 16];
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
+        hasher.add(std::string_view(buffer, std::size_t(in.gcount())));
+    return hasher.hex();
+}
+
+std::vector<ManifestField> statistics_fields(const ImageStatistics& stats) {
+    std::vector<ManifestField> fields = {
+        {"object_pixels", std::to_string(stats.object_pixels), true},
+        {"mean_luminance", number(stats.mean_luminance), true},
+        {"sd_luminance", number(stats.sd_luminance), true},
+        {"rms_contrast", number(stats.rms_contrast), true},
+        {"skewness", number(stats.skewness), true},
+        {"saturation_intensity_correlation", number(stats.saturation_intensity_correlation), true},
+    };
+    for (std::size_t bin = 0; bin < stats.luminance_histogram.size(); ++bin) {
+        char column[32];
+        std::snprintf(column, sizeof column, "hist_%02zu", bin);
+        fields.push_back({column, std::to_string(stats.luminance_histogram[bin]), true});
+    }
+    return fields;
+}
+
+std::string csv_escape(std::string_view text) {
+    if (text.find_first_of(",\"\n\r") == std::string_view::npos) return std::string(text);
+    std::string out = "\"";
+    for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+}
+
+std::vector<std::string> csv_split(std::string_view line) {
+    std::vector<std::string> fields(1);
+    bool quoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (quoted) {
+            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+                fields.back() += '"';
+                ++i;
+            } else if (c == '"') {
+                quoted = false;
+            } else {
+                fields.back() += c;
+            }
+        } else if (c == '"') {
+            quoted = true;
+        } else if (c == ',') {
+            fields.emplace_back();
+        } else if (c != '\r') {
+            fields.back() += c;
+        }
+    }
+    return fields;
+}
+
+void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
+                    std::span<const ManifestRow> rows) {
+    // The header: every column in first-seen order.
+    std::vector<std::string> columns;
+    for (const auto& row : rows)
+        for (const auto& field : row)
+            if (std::find(columns.begin(), columns.end(), field.column) == columns.end())
+                columns.push_back(field.column);
+
+    std::ostringstream csv;
+    for (std::size_t c = 0; c < columns.size(); ++c) csv << (c ? "," : "") << csv_escape(columns[c]);
+    csv << "\n";
+    for (const auto& row : rows) {
+        for (std::size_t c = 0; c < columns.size(); ++c) {
+            if (c) csv << ",";
+            for (const auto& field : row)
+                if (field.column == columns[c]) csv << csv_escape(field.text);
+        }
+        csv << "\n";
+    }
+
+    std::ostringstream json;
+    json << "{\n  \"set\": \"" << json_escape(set_name) << "\",\n  \"software_version\": \""
+         << json_escape(version_string()) << "\",\n  \"build_hash\": \""
+         << json_escape(build_hash()) << "\",\n  \"stimuli\": [";
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+        json << (r ? ",\n" : "\n") << "    {";
+        for (std::size_t f = 0; f < rows[r].size(); ++f) {
+            const auto& field = rows[r][f];
+            json << (f ? ", " : "") << "\"" << json_escape(field.column) << "\": ";
+            if (field.text.empty()) json << "null";  // a parameter this technique lacks
+            else if (field.numeric) json << field.text;
+            else json << "\"" << json_escape(field.text) << "\"";
+        }
+        json << "}";
+    }
+    json << "\n  ]\n}\n";
+
+    write_atomically(dir / "manifest.csv", csv.str());
+    write_atomically(dir / "manifest.json", json.str());
+}
+
+std::map<std::string, std::map<std::string, std::string>> read_manifest_csv(
+    const std::filesystem::path& dir) {
+    std::map<std::string, std::map<std::string, std::string>> rows;
+    std::ifstream in(dir / "manifest.csv");
+    std::string line;
+    if (!in || !std::getline(in, line)) return rows;
+    const auto header = csv_split(line);
+    while (std::getline(in, line)) {
+        const auto cells = csv_split(line);
+        if (cells.size() != header.size()) continue;  // a damaged row: render it again
+        std::map<std::string, std::string> row;
+        for (std::size_t c = 0; c < header.size(); ++c) row[header[c]] = cells[c];
+        if (row.count("id")) rows[row["id"]] = std::move(row);
+    }
+    return rows;
+}
+
+}  // namespace lucent::stimuli

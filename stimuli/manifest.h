@@ -1,0 +1,59 @@
+#pragma once
+// Manifests of a rendered stimulus set: manifest.csv and manifest.json, one row per
+// stimulus (id, file, technique, every parameter value, mesh hash, image statistics,
+// software version, input and content hashes). The CSV is also read back so a second
+// run can skip stimuli whose inputs did not change.
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "image_statistics.h"
+
+namespace lucent::stimuli {
+
+// 64-bit FNV-1a, as 16 hex digits: detects changed inputs and files (not cryptographic).
+class Hasher {
+public:
+    Hasher& add(std::string_view bytes);
+    Hasher& add_field(std::string_view text);  // length-prefixed, so fields never run together
+    std::uint64_t value() const { return state_; }
+    std::string hex() const;
+
+private:
+    std::uint64_t state_ = 0xcbf29ce484222325ull;
+};
+// Hash of a file's bytes; throws std::runtime_error naming the file when unreadable.
+std::string hash_file(const std::filesystem::path& path);
+
+// One manifest cell; numbers are written bare in JSON, text quoted, empty cells as null.
+struct ManifestField {
+    std::string column;
+    std::string text;
+    bool numeric = false;
+};
+using ManifestRow = std::vector<ManifestField>;
+
+// The statistics as manifest fields: object_pixels, mean_luminance, sd_luminance,
+// rms_contrast, skewness, saturation_intensity_correlation, hist_00 ... hist_NN.
+std::vector<ManifestField> statistics_fields(const ImageStatistics& stats);
+
+// Writes DIR/manifest.csv and DIR/manifest.json (each via a temporary file + rename).
+// Rows may have different columns (techniques differ): the CSV header is the union in
+// first-seen order and a missing cell is empty.
+void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
+                    std::span<const ManifestRow> rows);
+
+// Reads DIR/manifest.csv as id -> (column -> text); an absent or unreadable manifest
+// gives an empty map (everything is then rendered again).
+std::map<std::string, std::map<std::string, std::string>> read_manifest_csv(
+    const std::filesystem::path& dir);
+
+// CSV quoting (RFC 4180) and its inverse for one line of fields.
+std::string csv_escape(std::string_view text);
+std::vector<std::string> csv_split(std::string_view line);
+
+}  // namespace lucent::stimuli

@@ -1,0 +1,487 @@
+// Stimulus-set loader: TOML -> validated, expanded list of stimuli.
+// [SECTION] ErrorReporter: "file:line:column: key: reason" from toml++ source regions
+// [SECTION] knob_value(): one TOML value -> a validated KnobValue (type, then range)
+// [SECTION] Loader: top-level keys, meshes, shared parameter tables, each [[stimuli]]
+//           entry with its [stimuli.vary] expansion and ids
+// [SECTION] public entry points
+// Parameter precedence (later wins): technique defaults, [defaults], [camera], the
+// stimulus's light, its material, its own keys, its [stimuli.vary] values.
+#include "stimulus_set.h"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace lucent::stimuli {
+namespace {
+
+constexpr int kMaxSide = 8192;
+constexpr std::size_t kMaxStimuli = 100000;
+
+std::string join(const std::vector<std::string>& items) {
+    std::string out;
+    for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
+    return out;
+}
+
+// Builds "file:line:column: key: message" errors from toml++ source regions.
+class ErrorReporter {
+public:
+    explicit ErrorReporter(std::string source) : source_(std::move(source)) {}
+    [[noreturn]] void fail(const toml::source_region& where, const std::string& key,
+                           const std::string& message) const {
+        std::ostringstream out;
+        out << source_ << ":" << where.begin.line << ":" << where.begin.column << ": ";
+        if (!key.empty()) out << key << ": ";
+        out << message;
+        throw StimulusSetError(out.str());
+    }
+    [[noreturn]] void fail(const toml::node& node, const std::string& key,
+                           const std::string& message) const {
+        fail(node.source(), key, message);
+    }
+
+private:
+    std::string source_;
+};
+
+// Rejects keys of `table` that are not in `allowed`.
+void check_keys(const toml::table& table, std::initializer_list<std::string_view> allowed,
+                const std::string& prefix, const ErrorReporter& errors) {
+    for (auto&& [key, node] : table) {
+        (void)node;
+        if (std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end()) {
+            std::vector<std::string> names(allowed.begin(), allowed.end());
+            errors.fail(key.source(), prefix + std::string(key.str()),
+                        "unknown key (valid: " + join(names) + ")");
+        }
+    }
+}
+
+const toml::table& as_table(const toml::node& node, const std::string& key,
+                            const ErrorReporter& errors) {
+    if (const auto* table = node.as_table()) return *table;
+    errors.fail(node, key, "expected a table");
+}
+
+std::string as_string(const toml::node& node, const std::string& key,
+                      const ErrorReporter& errors) {
+    if (const auto* text = node.as_string()) return text->get();
+    errors.fail(node, key, "expected a string");
+}
+
+std::string number_text(const toml::node& node) {
+    if (node.is_integer()) return std::to_string(node.as_integer()->get());
+    std::ostringstream out;
+    out.precision(17);
+    out << node.as_floating_point()->get();
+    return out.str();
+}
+
+// One TOML value for `knob` as a validated KnobValue. Numbers for scalars, integers for
+// integers, a number / [r, g, b] / "r,g,b" for rgb, [x, y, z] / "x,y,z" for vectors,
+// a string (or an integer) for choices.
+KnobValue knob_value(const Knob& knob, const toml::node& node, const std::string& key,
+                     const ErrorReporter& errors) {
+    std::string text;
+    auto wrong_type = [&](const char* expected) {
+        errors.fail(node, key, std::string("wrong type: expected ") + expected + " (accepted: " +
+                                   accepted_range(knob) + ")");
+    };
+    switch (knob.kind) {
+        case KnobKind::scalar:
+            if (!node.is_number()) wrong_type("a number");
+            text = number_text(node);
+            break;
+        case KnobKind::integer:
+            if (!node.is_integer()) wrong_type("an integer");
+            text = number_text(node);
+            break;
+        case KnobKind::rgb:
+        case KnobKind::vec3:
+            if (const auto* array = node.as_array()) {
+                if (array->size() != 3) wrong_type("3 numbers");
+                for (const auto& element : *array) {
+                    if (!element.is_number()) wrong_type("3 numbers");
+                    text += (text.empty() ? "" : ",") + number_text(element);
+                }
+            } else if (node.is_string()) {
+                text = node.as_string()->get();
+            } else if (node.is_number() && knob.kind == KnobKind::rgb) {
+                text = number_text(node);
+            } else {
+                wrong_type(knob.kind == KnobKind::rgb ? "a number, [r, g, b] or \"r,g,b\""
+                                                      : "[x, y, z] or \"x,y,z\"");
+            }
+            break;
+        case KnobKind::choice:
+            if (node.is_string()) text = node.as_string()->get();
+            else if (node.is_integer()) text = number_text(node);
+            else wrong_type("a string");
+            break;
+    }
+    try {
+        return parse_knob_value(knob, text);
+    } catch (const KnobError& e) {
+        // The knob's message starts with its name, which `key` already gives.
+        std::string message = e.what();
+        if (message.rfind(knob.name + ": ", 0) == 0) message.erase(0, knob.name.size() + 2);
+        errors.fail(node, key, message);
+    }
+}
+
+// A parameter assignment kept with its source node until a technique is known.
+struct Assignment {
+    std::string key;
+    const toml::node* node;
+};
+using Assignments = std::vector<Assignment>;
+
+class Loader {
+public:
+    Loader(const SetCatalog& catalog, const std::string& source, std::filesystem::path base)
+        : catalog_(catalog), errors_(source), base_dir_(std::move(base)) {
+        for (const auto& name : catalog_.technique_names)
+            if (auto knobs = catalog_.knobs_of(name))
+                for (const auto& knob : *knobs) any_knob_.emplace(knob.name, knob);
+    }
+
+    StimulusSet load(const toml::table& root, const std::string& source) {
+        StimulusSet set;
+        set.source = source;
+        check_keys(root, {"name", "resolution", "formats", "meshes", "camera", "lights",
+                          "materials", "defaults", "stimuli"}, "", errors_);
+        set.name = std::filesystem::path(source).stem().string();  // unless named
+        if (const auto* node = root.get("name")) set.name = as_string(*node, "name", errors_);
+        if (const auto* node = root.get("resolution")) read_resolution(*node, set);
+        if (const auto* node = root.get("formats")) read_formats(*node, set);
+        read_meshes(root);
+        if (const auto* node = root.get("defaults"))
+            defaults_ = read_parameters(as_table(*node, "defaults", errors_), "defaults.", {});
+        if (const auto* node = root.get("camera")) {
+            const auto& camera = as_table(*node, "camera", errors_);
+            check_keys(camera, {"fov_y"}, "camera.", errors_);
+            camera_ = read_parameters(camera, "camera.", {});
+        }
+        read_named_tables(root, "lights", lights_,
+                          {"light_ambient", "light_diffuse", "light_specular", "light_direction"});
+        read_named_tables(root, "materials", materials_, {});
+        const auto* stimuli = root.get("stimuli");
+        if (!stimuli) errors_.fail(root.source(), "stimuli", "missing: the set lists no stimuli");
+        const auto* array = stimuli->as_array();
+        if (!array || !array->is_array_of_tables())
+            errors_.fail(*stimuli, "stimuli", "expected [[stimuli]] tables");
+        if (array->empty()) errors_.fail(*stimuli, "stimuli", "the set lists no stimuli");
+        for (std::size_t i = 0; i < array->size(); ++i)
+            read_stimulus(*(*array)[i].as_table(), "stimuli[" + std::to_string(i) + "].", set);
+        return set;
+    }
+
+private:
+    void read_resolution(const toml::node& node, StimulusSet& set) {
+        const auto* array = node.as_array();
+        if (!array || array->size() != 2 || !(*array)[0].is_integer() || !(*array)[1].is_integer())
+            errors_.fail(node, "resolution", "wrong type: expected [width, height] integers");
+        const auto w = (*array)[0].as_integer()->get(), h = (*array)[1].as_integer()->get();
+        if (w < 1 || h < 1 || w > kMaxSide || h > kMaxSide)
+            errors_.fail(node, "resolution", "out of range: each side in [1, " +
+                                                 std::to_string(kMaxSide) + "]");
+        set.width = int(w);
+        set.height = int(h);
+    }
+
+    void read_formats(const toml::node& node, StimulusSet& set) {
+        const auto* array = node.as_array();
+        if (!array || array->empty())
+            errors_.fail(node, "formats", "wrong type: expected a list such as [\"png\", \"exr\"]");
+        set.formats.clear();
+        for (const auto& element : *array) {
+            const std::string name = as_string(element, "formats", errors_);
+            ImageFormat format = ImageFormat::png;
+            if (name == "exr") format = ImageFormat::exr;
+            else if (name == "tif") format = ImageFormat::tif;
+            else if (name != "png")
+                errors_.fail(element, "formats", "'" + name + "' is not a format (valid: png, exr, tif)");
+            if (std::find(set.formats.begin(), set.formats.end(), format) != set.formats.end())
+                errors_.fail(element, "formats", "'" + name + "' is listed twice");
+            set.formats.push_back(format);
+        }
+    }
+
+    void read_meshes(const toml::table& root) {
+        const auto* node = root.get("meshes");
+        if (!node) errors_.fail(root.source(), "meshes", "missing: name at least one mesh");
+        for (auto&& [key, value] : as_table(*node, "meshes", errors_)) {
+            const std::string name(key.str()), full = "meshes." + name;
+            const std::string spec = as_string(value, full, errors_);
+            const std::string builtin = spec.substr(0, spec.find(':'));
+            const auto& names = catalog_.builtin_meshes;
+            if (std::find(names.begin(), names.end(), builtin) != names.end()) {
+                meshes_[name] = spec;
+                continue;
+            }
+            std::filesystem::path path(spec);
+            if (path.is_relative()) path = base_dir_ / path;
+            std::error_code error;
+            if (!std::filesystem::is_regular_file(path, error))
+                errors_.fail(value, full, "missing mesh: '" + spec +
+                                              "' is neither a built-in mesh (" + join(names) +
+                                              ") nor a file");
+            meshes_[name] = std::filesystem::absolute(path).lexically_normal().string();
+        }
+        if (meshes_.empty()) errors_.fail(*node, "meshes", "name at least one mesh");
+    }
+
+    // A table of parameters; each key must be a knob of some technique (or of `only`).
+    Assignments read_parameters(const toml::table& table, const std::string& prefix,
+                                std::initializer_list<std::string_view> only) {
+        Assignments out;
+        for (auto&& [key, value] : table) {
+            const std::string name(key.str());
+            const auto it = any_knob_.find(name);
+            const bool allowed = only.size() == 0 ||
+                                 std::find(only.begin(), only.end(), name) != only.end();
+            if (it == any_knob_.end() || !allowed)
+                errors_.fail(key.source(), prefix + name, "unknown key (not a parameter of any technique)");
+            knob_value(it->second, value, prefix + name, errors_);  // type and range now
+            out.push_back({name, &value});
+        }
+        return out;
+    }
+
+    void read_named_tables(const toml::table& root, const char* section,
+                           std::map<std::string, Assignments>& into,
+                           std::initializer_list<std::string_view> only) {
+        const auto* node = root.get(section);
+        if (!node) return;
+        for (auto&& [key, value] : as_table(*node, section, errors_)) {
+            const std::string prefix = std::string(section) + "." + std::string(key.str()) + ".";
+            into[std::string(key.str())] =
+                read_parameters(as_table(value, prefix, errors_), prefix, only);
+        }
+    }
+
+    // Looks up a named light or material; one defined and none named means that one.
+    const Assignments* lookup(const toml::table& stimulus, const char* key,
+                              const std::map<std::string, Assignments>& table,
+                              const std::string& prefix) {
+        const auto* node = stimulus.get(key);
+        if (!node) return nullptr;
+        const std::string name = as_string(*node, prefix + key, errors_);
+        const auto it = table.find(name);
+        if (it == table.end()) {
+            std::vector<std::string> names;
+            for (const auto& entry : table) names.push_back(entry.first);
+            errors_.fail(*node, prefix + key, "unknown name '" + name + "' (defined: " +
+                                                  (names.empty() ? "none" : join(names)) + ")");
+        }
+        return &it->second;
+    }
+
+    void read_stimulus(const toml::table& table, const std::string& prefix, StimulusSet& set) {
+        const int line = int(table.source().begin.line);
+        // Identity: id, technique, mesh.
+        const auto* id_node = table.get("id");
+        if (!id_node) errors_.fail(table.source(), prefix + "id", "missing");
+        const std::string id = as_string(*id_node, prefix + "id", errors_);
+        const auto* technique_node = table.get("technique");
+        if (!technique_node) errors_.fail(table.source(), prefix + "technique", "missing");
+        const std::string technique = as_string(*technique_node, prefix + "technique", errors_);
+        const auto knobs = catalog_.knobs_of(technique);
+        if (!knobs)
+            errors_.fail(*technique_node, prefix + "technique",
+                         "unknown technique '" + technique + "' (valid: " +
+                             join(catalog_.technique_names) + ")");
+        std::string mesh_name;
+        if (const auto* node = table.get("mesh")) {
+            mesh_name = as_string(*node, prefix + "mesh", errors_);
+            if (!meshes_.count(mesh_name)) {
+                std::vector<std::string> names;
+                for (const auto& entry : meshes_) names.push_back(entry.first);
+                errors_.fail(*node, prefix + "mesh", "missing mesh '" + mesh_name +
+                                                         "' (defined in [meshes]: " + join(names) + ")");
+            }
+        } else if (meshes_.size() == 1) {
+            mesh_name = meshes_.begin()->first;
+        } else {
+            errors_.fail(table.source(), prefix + "mesh", "missing: several meshes are defined");
+        }
+
+        // Own parameters (every other key must be a knob of this technique).
+        Assignments own;
+        for (auto&& [key, value] : table) {
+            const std::string name(key.str());
+            if (name == "id" || name == "technique" || name == "mesh" || name == "light" ||
+                name == "material" || name == "vary" || name == "expand")
+                continue;
+            const Knob* knob = find_knob(*knobs, name);
+            if (!knob)
+                errors_.fail(key.source(), prefix + name,
+                             "unknown key (not a parameter of technique '" + technique + "')");
+            knob_value(*knob, value, prefix + name, errors_);
+            own.push_back({name, &value});
+        }
+        const auto* light = lookup(table, "light", lights_, prefix);
+        const auto* material = lookup(table, "material", materials_, prefix);
+
+        // Base values in precedence order; keys a technique lacks are skipped here.
+        KnobValues base;
+        for (const auto& knob : *knobs) base.set(knob.name, knob.default_value);
+        auto apply = [&](const Assignments& assignments) {
+            for (const auto& a : assignments)
+                if (const Knob* knob = find_knob(*knobs, a.key))
+                    base.set(a.key, knob_value(*knob, *a.node, a.key, errors_));
+        };
+        apply(defaults_);
+        apply(camera_);
+        if (light) apply(*light);
+        if (material) apply(*material);
+        apply(own);
+
+        // Expansion: [stimuli.vary] lists, as a grid (every combination) or zipped.
+        std::vector<std::pair<std::string, std::vector<KnobValue>>> axes;
+        if (const auto* vary_node = table.get("vary")) {
+            // toml++ keeps keys sorted; restore the order they are written in, so the first
+            // listed parameter varies slowest.
+            std::vector<std::pair<const toml::key*, const toml::node*>> entries;
+            for (auto&& [key, value] : as_table(*vary_node, prefix + "vary", errors_))
+                entries.emplace_back(&key, &value);
+            std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+                const auto& pa = a.first->source().begin;
+                const auto& pb = b.first->source().begin;
+                return pa.line != pb.line ? pa.line < pb.line : pa.column < pb.column;
+            });
+            for (const auto& [key_ptr, value_ptr] : entries) {
+                const toml::key& key = *key_ptr;
+                const toml::node& value = *value_ptr;
+                const std::string name(key.str()), full = prefix + "vary." + name;
+                const Knob* knob = find_knob(*knobs, name);
+                if (!knob)
+                    errors_.fail(key.source(), full,
+                                 "unknown key (not a parameter of technique '" + technique + "')");
+                const auto* list = value.as_array();
+                if (!list || list->empty())
+                    errors_.fail(value, full, "wrong type: expected a non-empty list of values");
+                std::vector<KnobValue> values;
+                for (const auto& element : *list) values.push_back(knob_value(*knob, element, full, errors_));
+                axes.emplace_back(name, std::move(values));
+            }
+        }
+        std::string expand = "grid";
+        if (const auto* node = table.get("expand")) {
+            expand = as_string(*node, prefix + "expand", errors_);
+            if (expand != "grid" && expand != "zip")
+                errors_.fail(*node, prefix + "expand", "'" + expand + "' is out of range (valid: grid, zip)");
+        }
+        std::size_t count = 1;
+        for (const auto& axis : axes) {
+            if (expand == "zip" && axis.second.size() != axes.front().second.size())
+                errors_.fail(*table.get("vary"), prefix + "vary",
+                             "zip needs lists of equal length ('" + axis.first + "' has " +
+                                 std::to_string(axis.second.size()) + ", '" + axes.front().first +
+                                 "' has " + std::to_string(axes.front().second.size()) + ")");
+            count = expand == "zip" ? axis.second.size() : count * axis.second.size();
+            if (count > kMaxStimuli)
+                errors_.fail(*table.get("vary"), prefix + "vary", "expands to too many stimuli");
+        }
+
+        for (std::size_t index = 0; index < count; ++index) {
+            Stimulus stimulus{id, technique, mesh_name, meshes_.at(mesh_name), base, line};
+            std::size_t rest = index;
+            for (auto axis = axes.rbegin(); axis != axes.rend(); ++axis) {
+                const std::size_t n = axis->second.size();
+                const std::size_t pick = expand == "zip" ? index : rest % n;
+                rest /= n;
+                stimulus.parameters.set(axis->first, axis->second[pick]);
+            }
+            stimulus.id = expanded_id(id, stimulus.parameters, index, count);
+            check_id(stimulus.id, *id_node, prefix + "id");
+            set.stimuli.push_back(std::move(stimulus));
+        }
+    }
+
+    // "{key}" placeholders take the value's text; without any, expanded ids get "_N".
+    static std::string expanded_id(const std::string& pattern, const KnobValues& values,
+                                   std::size_t index, std::size_t count) {
+        std::string out;
+        bool substituted = false;
+        for (std::size_t i = 0; i < pattern.size(); ++i) {
+            const std::size_t close = pattern.find('}', i);
+            if (pattern[i] == '{' && close != std::string::npos) {
+                const std::string key = pattern.substr(i + 1, close - i - 1);
+                if (values.contains(key)) {
+                    out += format_knob_value(values.get(key));
+                    i = close;
+                    substituted = true;
+                    continue;
+                }
+            }
+            out += pattern[i];
+        }
+        if (count > 1 && !substituted) {
+            const int width = int(std::to_string(count).size());
+            std::string number = std::to_string(index + 1);
+            out += "_" + std::string(std::size_t(width) - number.size(), '0') + number;
+        }
+        return out;
+    }
+
+    void check_id(const std::string& id, const toml::node& node, const std::string& key) {
+        const bool safe = !id.empty() && id.front() != '.' &&
+                          std::all_of(id.begin(), id.end(), [](char c) {
+                              return std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
+                                     c == '-' || c == '.';
+                          });
+        if (!safe)
+            errors_.fail(node, key, "'" + id + "' is not a valid id (letters, digits, _ - . only)");
+        if (!ids_.insert(id).second)
+            errors_.fail(node, key, "duplicate id '" + id + "'");
+    }
+
+    const SetCatalog& catalog_;
+    ErrorReporter errors_;
+    std::filesystem::path base_dir_;
+    std::map<std::string, Knob> any_knob_;
+    std::map<std::string, std::string> meshes_;
+    Assignments defaults_, camera_;
+    std::map<std::string, Assignments> lights_, materials_;
+    std::set<std::string> ids_;
+};
+
+}  // namespace
+
+std::string_view extension(ImageFormat format) {
+    switch (format) {
+        case ImageFormat::png: return "png";
+        case ImageFormat::exr: return "exr";
+        case ImageFormat::tif: return "tif";
+    }
+    return "png";
+}
+
+StimulusSet parse_stimulus_set(std::string_view toml_text, const std::string& source_name,
+                               const std::filesystem::path& base_dir,
+                               const SetCatalog& catalog) {
+    toml::table root;
+    try {
+        root = toml::parse(toml_text, source_name);
+    } catch (const toml::parse_error& e) {
+        ErrorReporter(source_name).fail(e.source(), "", std::string(e.description()));
+    }
+    return Loader(catalog, source_name, base_dir).load(root, source_name);
+}
+
+StimulusSet load_stimulus_set(const std::filesystem::path& file, const SetCatalog& catalog) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw StimulusSetError(file.string() + ": cannot read the config file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_stimulus_set(text.str(), file.string(), file.parent_path(), catalog);
+}
+
+}  // namespace lucent::stimuli

@@ -1,0 +1,219 @@
+// CSV export and the analysis long table.
+#include "export.h"
+
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "sqlite.h"
+#include "store.h"
+
+namespace lucent::study {
+namespace {
+
+Database open_read_only(const std::string& path) {
+    check_database_file(path);
+    Database db(path, SQLITE_OPEN_READONLY);
+    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'responses'") == 0)
+        throw StoreError(path + ": holds no study yet (run a session first)");
+    return db;
+}
+
+// Parameters of every stimulus: stimulus key -> (name -> value).
+std::map<std::string, std::map<std::string, std::string>> stimulus_parameters(Database& db) {
+    std::map<std::string, std::map<std::string, std::string>> out;
+    Statement s = db.prepare(
+        "SELECT st.stimulus_key, p.name, p.value FROM stimulus_parameters p "
+        "JOIN stimuli st ON st.id = p.stimulus_id");
+    while (s.step()) out[s.text(0)][s.text(1)] = s.text(2);
+    return out;
+}
+
+// Participants whose catch-trial failures exceed the protocol's allowance.
+std::map<std::string, int> catch_failures(Database& db) {
+    std::map<std::string, int> failed;
+    Statement s = db.prepare(
+        "SELECT p.code, count(DISTINCT t.id) FROM responses r "
+        "JOIN trials t ON t.id = r.trial_id JOIN sessions s ON s.id = r.session_id "
+        "JOIN participants p ON p.id = s.participant_id "
+        "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > coalesce(t.tolerance, 0) "
+        "GROUP BY p.code");
+    while (s.step()) failed[s.text(0)] = static_cast<int>(s.integer(1));
+    return failed;
+}
+
+int max_failed_catch(Database& db) {
+    Statement s = db.prepare("SELECT protocol_text, name FROM studies LIMIT 1");
+    if (!s.step()) return 0;
+    try {
+        return parse_protocol(s.text(0), db.path() + " (stored protocol)").max_failed_catch;
+    } catch (const ProtocolError&) {
+        return 0;
+    }
+}
+
+std::string format_number(double v) {
+    std::ostringstream out;
+    out.precision(10);
+    out << v;
+    return out.str();
+}
+
+}  // namespace
+
+std::string csv_cell(const std::string& value) {
+    if (value.find_first_of(",\"\r\n") == std::string::npos) return value;
+    std::string out = "\"";
+    for (char c : value) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+}
+
+int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out) {
+    Database db = open_read_only(db_path);
+    const auto params = stimulus_parameters(db);
+    std::set<std::string> names;
+    for (const auto& [stimulus, values] : params)
+        for (const auto& [name, value] : values) names.insert(name);
+    const auto failed = catch_failures(db);
+    int rows = 0;
+
+    if (format == ExportFormat::Long) {
+        out << "participant,session,trial_position,block,stimulus,technique,mesh";
+        for (const std::string& n : names) out << "," << csv_cell(n);
+        out << ",question,rating,rt_ms,changes,practice,catch,expected_rating,catch_passed\n";
+        Statement s = db.prepare(
+            "SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, st.technique, "
+            "st.mesh, r.question, r.rating, r.rt_ms, r.changes, t.practice, t.catch, "
+            "t.expected_rating, coalesce(t.tolerance, 0) FROM responses r "
+            "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
+            "JOIN participants p ON p.id = se.participant_id "
+            "JOIN stimuli st ON st.id = t.stimulus_id "
+            "ORDER BY p.code, se.id, t.position, r.id");
+        while (s.step()) {
+            for (int c = 0; c < 7; ++c) out << (c ? "," : "") << csv_cell(s.text(c));
+            const auto it = params.find(s.text(4));
+            for (const std::string& n : names) {
+                std::string v;
+                if (it != params.end() && it->second.count(n)) v = it->second.at(n);
+                out << "," << csv_cell(v);
+            }
+            const bool is_catch = s.integer(12) != 0;
+            std::string passed;
+            if (is_catch)
+                passed = std::abs(s.integer(8) - s.integer(13)) <= s.integer(14) ? "1" : "0";
+            out << "," << csv_cell(s.text(7)) << "," << s.integer(8) << ","
+                << format_number(s.real(9)) << "," << s.integer(10) << "," << s.integer(11)
+                << "," << s.integer(12) << "," << (is_catch ? s.text(13) : "") << ","
+                << passed << "\n";
+            ++rows;
+        }
+        return rows;
+    }
+
+    // Wide: one row per participant, one column per (stimulus, question) of the rated
+    // (non-practice, non-catch) trials; repeated ratings are averaged.
+    std::vector<std::string> columns;
+    std::set<std::string> seen;
+    std::map<std::string, std::map<std::string, std::pair<double, int>>> cells;
+    std::map<std::string, int> sessions;
+    {
+        Statement s = db.prepare(
+            "SELECT p.code, st.stimulus_key, r.question, r.rating FROM responses r "
+            "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
+            "JOIN participants p ON p.id = se.participant_id "
+            "JOIN stimuli st ON st.id = t.stimulus_id "
+            "WHERE t.practice = 0 AND t.catch = 0 ORDER BY st.id, r.id");
+        while (s.step()) {
+            const std::string column = s.text(1) + "." + s.text(2);
+            if (seen.insert(column).second) columns.push_back(column);
+            auto& cell = cells[s.text(0)][column];
+            cell.first += static_cast<double>(s.integer(3));
+            cell.second += 1;
+        }
+        Statement c = db.prepare(
+            "SELECT p.code, count(s.id) FROM participants p "
+            "LEFT JOIN sessions s ON s.participant_id = p.id GROUP BY p.code ORDER BY p.code");
+        while (c.step()) sessions[c.text(0)] = static_cast<int>(c.integer(1));
+    }
+    out << "participant,sessions,catch_failed";
+    for (const std::string& c : columns) out << "," << csv_cell(c);
+    out << "\n";
+    for (const auto& [participant, n_sessions] : sessions) {
+        const auto f = failed.find(participant);
+        out << csv_cell(participant) << "," << n_sessions << ","
+            << (f == failed.end() ? 0 : f->second);
+        const auto& row = cells[participant];
+        for (const std::string& c : columns) {
+            const auto it = row.find(c);
+            out << ",";
+            if (it != row.end()) out << format_number(it->second.first / it->second.second);
+        }
+        out << "\n";
+        ++rows;
+    }
+    return rows;
+}
+
+LongTable analysis_long_table(const std::string& db_path, const LongTableOptions& options) {
+    Database db = open_read_only(db_path);
+    const auto params = stimulus_parameters(db);
+    std::map<std::string, std::pair<std::string, std::vector<std::string>>> stimuli;  // technique, varies
+    {
+        Statement s = db.prepare("SELECT stimulus_key, technique, varies FROM stimuli");
+        while (s.step()) {
+            std::vector<std::string> varies;
+            std::istringstream words(s.text(2));
+            for (std::string w; words >> w;) varies.push_back(w);
+            stimuli[s.text(0)] = {s.text(1), varies};
+        }
+    }
+    LongTable table;
+    std::set<std::string> excluded;
+    if (options.exclude_failed_catch) {
+        const int allowed = max_failed_catch(db);
+        for (const auto& [participant, n] : catch_failures(db))
+            if (n > allowed) {
+                excluded.insert(participant);
+                table.excluded_participants.push_back(participant + " (" + std::to_string(n) +
+                                                      " catch trials failed)");
+            }
+    }
+    Statement s = db.prepare(
+        "SELECT p.code, st.stimulus_key, r.question, r.rating FROM responses r "
+        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
+        "JOIN participants p ON p.id = se.participant_id "
+        "JOIN stimuli st ON st.id = t.stimulus_id "
+        "WHERE t.practice = 0 AND t.catch = 0 ORDER BY p.code, se.id, t.position, r.id");
+    while (s.step()) {
+        const std::string participant = s.text(0);
+        if (excluded.count(participant)) continue;
+        const std::string stimulus = s.text(1);
+        const auto& [technique, varies] = stimuli[stimulus];
+        const auto pit = params.find(stimulus);
+        std::vector<std::pair<std::string, std::string>> factors;
+        if (varies.empty()) {
+            if (pit != params.end())
+                for (const auto& [name, value] : pit->second) factors.emplace_back(name, value);
+        } else {
+            for (const std::string& f : varies) {
+                if (f == "technique") factors.emplace_back(f, technique);
+                else if (pit != params.end() && pit->second.count(f))
+                    factors.emplace_back(f, pit->second.at(f));
+            }
+        }
+        for (const auto& [factor, level] : factors)
+            table.rows.push_back({participant, stimulus, factor, level, s.text(2),
+                                  static_cast<int>(s.integer(3))});
+    }
+    return table;
+}
+
+void write_long_table_csv(const LongTable& table, std::ostream& out) {
+    out << "participant,stimulus,factor,level,question,rating\n";
+    for (const LongRow& r : table.rows)
+        out << csv_cell(r.participant) << "," << csv_cell(r.stimulus) << ","
+            << csv_cell(r.factor) << "," << csv_cell(r.level) << "," << csv_cell(r.question)
+            << "," << r.rating << "\n";
+}
+
+}  // namespace lucent::study

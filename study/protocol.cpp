@@ -1,0 +1,389 @@
+// Protocol parsing: TOML -> Protocol, with every error naming file, line and key.
+#include "protocol.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "embedded_study_files.h"
+#include "sha256.h"
+
+namespace lucent::study {
+namespace {
+
+// Reads one TOML table, remembering which keys were used so unknown ones are reported.
+class TableReader {
+public:
+    TableReader(const toml::table& table, std::string path, const std::string& source)
+        : table_(table), path_(std::move(path)), source_(source) {}
+
+    [[noreturn]] void fail(const toml::node* node, const std::string& key,
+                           const std::string& reason) const {
+        const toml::source_region& where = node ? node->source() : table_.source();
+        std::ostringstream out;
+        out << source_ << ":" << where.begin.line << ":" << where.begin.column << ": key '"
+            << full(key) << "': " << reason;
+        throw ProtocolError(out.str());
+    }
+    std::string full(const std::string& key) const {
+        return path_.empty() ? key : path_ + "." + key;
+    }
+    const toml::node* get(const std::string& key) {
+        used_.insert(key);
+        return table_.get(key);
+    }
+    std::string string(const std::string& key, std::string fallback, bool required = false) {
+        const toml::node* node = get(key);
+        if (!node) {
+            if (required) fail(nullptr, key, "is required");
+            return fallback;
+        }
+        if (!node->is_string()) fail(node, key, "must be a string");
+        return std::string(*node->value<std::string>());
+    }
+    double number(const std::string& key, double fallback, double lo, double hi) {
+        const toml::node* node = get(key);
+        if (!node) return fallback;
+        std::optional<double> value = node->value<double>();
+        if (!value || !(node->is_integer() || node->is_floating_point()))
+            fail(node, key, "must be a number");
+        if (!std::isfinite(*value) || *value < lo || *value > hi) {
+            std::ostringstream range;
+            range << "must lie in [" << lo << ", " << hi << "], got " << *value;
+            fail(node, key, range.str());
+        }
+        return *value;
+    }
+    int integer(const std::string& key, int fallback, int lo, int hi) {
+        const toml::node* node = get(key);
+        if (node && !node->is_integer()) fail(node, key, "must be an integer");
+        return static_cast<int>(number(key, fallback, lo, hi));
+    }
+    bool boolean(const std::string& key, bool fallback) {
+        const toml::node* node = get(key);
+        if (!node) return fallback;
+        if (!node->is_boolean()) fail(node, key, "must be true or false");
+        return *node->value<bool>();
+    }
+    std::vector<std::string> strings(const std::string& key) {
+        std::vector<std::string> out;
+        const toml::node* node = get(key);
+        if (!node) return out;
+        const toml::array* array = node->as_array();
+        if (!array) fail(node, key, "must be an array of strings");
+        for (const toml::node& item : *array) {
+            if (!item.is_string()) fail(&item, key, "must be an array of strings");
+            out.emplace_back(*item.value<std::string>());
+        }
+        return out;
+    }
+    const toml::array* array(const std::string& key) {
+        const toml::node* node = get(key);
+        if (!node) return nullptr;
+        if (!node->is_array()) fail(node, key, "must be an array");
+        return node->as_array();
+    }
+    const toml::table* table(const std::string& key) {
+        const toml::node* node = get(key);
+        if (!node) return nullptr;
+        if (!node->is_table()) fail(node, key, "must be a table");
+        return node->as_table();
+    }
+    // Call after reading: any key not asked for is a typo or an unsupported option.
+    void reject_unknown() const {
+        for (const auto& [key, node] : table_) {
+            if (!used_.count(std::string(key.str())))
+                fail(&node, std::string(key.str()), "unknown key");
+        }
+    }
+    const toml::table& raw() const { return table_; }
+    const std::string& path() const { return path_; }
+
+private:
+    const toml::table& table_;
+    std::string path_;
+    const std::string& source_;
+    std::set<std::string> used_;
+};
+
+// Canonical text of a parameter value: numbers as written by the shortest round trip,
+// arrays (rgb) as "r,g,b", so equal values compare equal as factor levels.
+std::string parameter_text(const toml::node& node, TableReader& reader,
+                           const std::string& key) {
+    auto number_text = [](double v) {
+        std::ostringstream out;
+        out.precision(12);
+        out << v;
+        return out.str();
+    };
+    if (node.is_integer() || node.is_floating_point()) {
+        double v = *node.value<double>();
+        if (!std::isfinite(v)) reader.fail(&node, key, "must be finite");
+        return number_text(v);
+    }
+    if (node.is_string()) return std::string(*node.value<std::string>());
+    if (node.is_boolean()) return *node.value<bool>() ? "true" : "false";
+    if (const toml::array* array = node.as_array()) {
+        std::string out;
+        for (const toml::node& item : *array) {
+            if (!(item.is_integer() || item.is_floating_point()))
+                reader.fail(&item, key, "array values must be numbers (r,g,b)");
+            out += (out.empty() ? "" : ",") + number_text(*item.value<double>());
+        }
+        return out;
+    }
+    reader.fail(&node, key, "must be a number, string, boolean or array of numbers");
+}
+
+const toml::table& as_table(const toml::node& node, TableReader& parent,
+                            const std::string& key) {
+    if (!node.is_table()) parent.fail(&node, key, "entries must be tables");
+    return *node.as_table();
+}
+
+void read_study(Protocol& p, TableReader& root) {
+    const toml::table* study = root.table("study");
+    if (!study) root.fail(nullptr, "study", "is required ([study] with name)");
+    TableReader r(*study, "study", p.source);
+    p.name = r.string("name", "", true);
+    p.title = r.string("title", p.name);
+    if (const toml::array* bg = r.array("background")) {
+        if (bg->size() != 3) r.fail(bg, "background", "must have 3 values (r, g, b)");
+        for (int i = 0; i < 3; ++i) {
+            std::optional<double> v = (*bg)[i].value<double>();
+            if (!v || *v < 0 || *v > 1)
+                r.fail(&(*bg)[i], "background", "values must be numbers in [0, 1]");
+            p.background[i] = static_cast<float>(*v);
+        }
+    }
+    if (const toml::array* size = r.array("stimulus_size")) {
+        std::optional<int64_t> w = size->size() == 2 ? (*size)[0].value<int64_t>() : std::nullopt;
+        std::optional<int64_t> h = size->size() == 2 ? (*size)[1].value<int64_t>() : std::nullopt;
+        if (!w || !h || *w < 1 || *h < 1 || *w > 16384 || *h > 16384)
+            r.fail(size, "stimulus_size", "must be [width, height] in pixels, 1..16384");
+        p.stimulus_width = static_cast<int>(*w);
+        p.stimulus_height = static_cast<int>(*h);
+    }
+    p.break_every = r.integer("break_every", 0, 0, 100000);
+    p.inter_trial_ms = r.integer("inter_trial_ms", 500, 0, 60000);
+    p.max_failed_catch = r.integer("max_failed_catch", 0, 0, 100000);
+    r.reject_unknown();
+}
+
+void read_screens(Protocol& p, TableReader& root) {
+    const toml::table* screens = root.table("screens");
+    if (!screens) return;
+    TableReader r(*screens, "screens", p.source);
+    p.screens.consent = r.string("consent", "");
+    p.screens.instructions = r.string("instructions", "");
+    p.screens.practice_done = r.string("practice_done", p.screens.practice_done);
+    p.screens.break_text = r.string("break", p.screens.break_text);
+    p.screens.debrief = r.string("debrief", "");
+    r.reject_unknown();
+}
+
+void read_questions(Protocol& p, TableReader& root) {
+    const toml::array* questions = root.array("questions");
+    if (!questions || questions->empty())
+        root.fail(questions, "questions", "at least one [[questions]] entry is required");
+    for (const toml::node& node : *questions) {
+        TableReader r(as_table(node, root, "questions"), "questions", p.source);
+        Question q;
+        q.id = r.string("id", "", true);
+        q.text = r.string("text", "", true);
+        q.labels = r.strings("labels");
+        const toml::node* labels = r.raw().get("labels");
+        if (q.labels.empty()) {
+            // Default: 7 points with the thesis's end labels.
+            q.labels = {"completely disagree", "", "", "", "", "", "completely agree"};
+        } else if (q.labels.size() < 2 || q.labels.size() > 7) {
+            r.fail(labels, "labels", "needs one label per scale point, 2 to 7 points");
+        }
+        for (const Question& other : p.questions)
+            if (other.id == q.id) r.fail(r.raw().get("id"), "id", "duplicate question id '" + q.id + "'");
+        r.reject_unknown();
+        p.questions.push_back(std::move(q));
+    }
+}
+
+void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
+    const toml::array* stimuli = root.array("stimuli");
+    if (!stimuli || stimuli->empty())
+        root.fail(stimuli, "stimuli", "at least one [[stimuli]] entry is required");
+    for (const toml::node& node : *stimuli) {
+        TableReader r(as_table(node, root, "stimuli"), "stimuli", p.source);
+        StimulusSpec s;
+        s.id = r.string("id", "", true);
+        s.technique = r.string("technique", "");
+        s.mesh = r.string("mesh", "");
+        s.image = r.string("image", "");
+        if (s.technique.empty() == s.image.empty())
+            r.fail(nullptr, "technique", "stimulus '" + s.id +
+                   "' needs exactly one of technique (live) or image (pre-rendered)");
+        static const std::set<std::string> techniques = {"empirical", "ward",
+                                                         "contrast_reversed"};
+        if (!s.technique.empty() && !techniques.count(s.technique))
+            r.fail(r.raw().get("technique"), "technique",
+                   "unknown technique '" + s.technique +
+                       "' (valid: empirical, ward, contrast_reversed)");
+        if (!s.image.empty() && !base_dir.empty() && std::filesystem::path(s.image).is_relative())
+            s.image = (std::filesystem::path(base_dir) / s.image).string();
+        if (const toml::table* params = r.table("params")) {
+            TableReader pr(*params, "stimuli.params", p.source);
+            for (const auto& [key, value] : *params)
+                s.parameters[std::string(key.str())] =
+                    parameter_text(value, pr, std::string(key.str()));
+        }
+        s.varies = r.strings("varies");
+        for (const std::string& factor : s.varies)
+            if (factor != "technique" && !s.parameters.count(factor))
+                r.fail(r.raw().get("varies"), "varies",
+                       "'" + factor + "' is not a parameter of stimulus '" + s.id + "'");
+        if (p.find_stimulus(s.id))
+            r.fail(r.raw().get("id"), "id", "duplicate stimulus id '" + s.id + "'");
+        r.reject_unknown();
+        p.stimuli.push_back(std::move(s));
+    }
+}
+
+void check_stimulus_ref(const Protocol& p, TableReader& r, const std::string& key,
+                        const std::string& id) {
+    if (!p.find_stimulus(id))
+        r.fail(r.raw().get(key), key, "no stimulus with id '" + id + "'");
+}
+
+void read_trials(Protocol& p, TableReader& root) {
+    if (const toml::table* practice = root.table("practice")) {
+        TableReader r(*practice, "practice", p.source);
+        p.practice = r.strings("stimuli");
+        for (const std::string& id : p.practice) check_stimulus_ref(p, r, "stimuli", id);
+        r.reject_unknown();
+    }
+    const toml::array* blocks = root.array("blocks");
+    if (!blocks || blocks->empty())
+        root.fail(blocks, "blocks", "at least one [[blocks]] entry is required");
+    for (const toml::node& node : *blocks) {
+        TableReader r(as_table(node, root, "blocks"), "blocks", p.source);
+        Block b;
+        b.id = r.string("id", "", true);
+        b.stimuli = r.strings("stimuli");
+        if (b.stimuli.empty()) r.fail(nullptr, "stimuli", "block '" + b.id + "' has no stimuli");
+        for (const std::string& id : b.stimuli) check_stimulus_ref(p, r, "stimuli", id);
+        b.repeats = r.integer("repeats", 1, 1, 1000);
+        for (const Block& other : p.blocks)
+            if (other.id == b.id) r.fail(r.raw().get("id"), "id", "duplicate block id '" + b.id + "'");
+        r.reject_unknown();
+        p.blocks.push_back(std::move(b));
+    }
+    if (const toml::array* catches = root.array("catch_trials")) {
+        for (const toml::node& node : *catches) {
+            TableReader r(as_table(node, root, "catch_trials"), "catch_trials", p.source);
+            CatchTrial c;
+            c.id = r.string("id", "", true);
+            c.stimulus = r.string("stimulus", "", true);
+            check_stimulus_ref(p, r, "stimulus", c.stimulus);
+            c.block = r.string("block", p.blocks.front().id);
+            if (std::none_of(p.blocks.begin(), p.blocks.end(),
+                             [&](const Block& b) { return b.id == c.block; }))
+                r.fail(r.raw().get("block"), "block", "no block with id '" + c.block + "'");
+            c.prompt = r.string("prompt", "", true);
+            int max_points = 7;
+            for (const Question& q : p.questions) max_points = std::min(max_points, q.points());
+            c.expected = r.integer("expected", 7, 1, max_points);
+            c.tolerance = r.integer("tolerance", 0, 0, 6);
+            r.reject_unknown();
+            p.catch_trials.push_back(std::move(c));
+        }
+    }
+}
+
+void read_randomisation(Protocol& p, TableReader& root) {
+    const toml::table* table = root.table("randomisation");
+    if (!table) return;
+    TableReader r(*table, "randomisation", p.source);
+    Randomisation& rz = p.randomisation;
+    rz.shuffle = r.boolean("shuffle", true);
+    rz.factor = r.string("factor", "stimulus");
+    rz.max_repeat = r.integer("max_repeat", 0, 0, 100000);
+    rz.min_distance = r.integer("min_distance", 0, 0, 100000);
+    rz.counterbalance_blocks = r.boolean("counterbalance_blocks", true);
+    if (rz.factor != "stimulus" && rz.factor != "technique") {
+        bool known = std::any_of(p.stimuli.begin(), p.stimuli.end(), [&](const StimulusSpec& s) {
+            return s.parameters.count(rz.factor) > 0;
+        });
+        if (!known)
+            r.fail(r.raw().get("factor"), "factor",
+                   "'" + rz.factor + "' is not 'stimulus', 'technique' or a stimulus parameter");
+    }
+    r.reject_unknown();
+}
+
+}  // namespace
+
+const StimulusSpec* Protocol::find_stimulus(std::string_view id) const {
+    for (const StimulusSpec& s : stimuli)
+        if (s.id == id) return &s;
+    return nullptr;
+}
+
+std::string Protocol::level_of(const StimulusSpec& stimulus, std::string_view factor) const {
+    if (factor == "stimulus") return stimulus.id;
+    if (factor == "technique") return stimulus.technique.empty() ? "image" : stimulus.technique;
+    auto it = stimulus.parameters.find(std::string(factor));
+    return it == stimulus.parameters.end() ? std::string() : it->second;
+}
+
+Protocol parse_protocol(std::string_view text, const std::string& source,
+                        const std::string& base_dir) {
+    toml::table root_table;
+    try {
+        root_table = toml::parse(text, source);
+    } catch (const toml::parse_error& e) {
+        std::ostringstream out;
+        out << source << ":" << e.source().begin.line << ":" << e.source().begin.column
+            << ": " << e.description();
+        throw ProtocolError(out.str());
+    }
+    Protocol p;
+    p.source = source;
+    p.text = std::string(text);
+    TableReader root(root_table, "", p.source);
+    read_study(p, root);
+    read_screens(p, root);
+    read_questions(p, root);
+    read_stimuli(p, root, base_dir);
+    read_trials(p, root);
+    read_randomisation(p, root);
+    root.reject_unknown();
+    return p;
+}
+
+Protocol load_protocol_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ProtocolError(path + ": cannot open protocol file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_protocol(text.str(), path,
+                          std::filesystem::absolute(path).parent_path().string());
+}
+
+std::vector<std::string> builtin_protocol_names() { return {"thesis"}; }
+
+Protocol builtin_protocol(std::string_view name) {
+    std::optional<std::string_view> text =
+        embedded::study_file("presets/" + std::string(name) + ".toml");
+    if (!text) {
+        std::string valid;
+        for (const std::string& n : builtin_protocol_names()) valid += (valid.empty() ? "" : ", ") + n;
+        throw ProtocolError("unknown preset '" + std::string(name) + "' (valid: " + valid + ")");
+    }
+    return parse_protocol(*text, "preset:" + std::string(name));
+}
+
+std::string protocol_hash(std::string_view text) { return sha256_hex(text); }
+
+}  // namespace lucent::study

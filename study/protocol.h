@@ -1,0 +1,112 @@
+#pragma once
+// A study protocol: what participants see and rate, in what order, and how trials are
+// randomised. Parsed from TOML (parse_protocol) or the built-in `thesis` preset. GL-free.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lucent::study {
+
+// Bad protocol text. what() is one line: "FILE:LINE:COL: key 'a.b': reason".
+class ProtocolError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// One stimulus: either rendered live (technique + parameters) or a pre-rendered image.
+struct StimulusSpec {
+    std::string id;         // unique within the protocol, e.g. "emp1"
+    std::string technique;  // "empirical", "ward", "contrast_reversed"; "" for images
+    std::string mesh;       // built-in mesh name or path (live stimuli)
+    std::string image;      // image path (pre-rendered stimuli), relative to the protocol
+    // Technique parameters in canonical names (issue 3 / 5), values as written ("25",
+    // "1.2", "0.8,0.6,0.5"), ordered by name. They become analysis factors.
+    std::map<std::string, std::string> parameters;
+    // Which parameters this stimulus was designed to vary (its factor series); empty
+    // means every parameter is a factor. "technique" may be listed too.
+    std::vector<std::string> varies;
+    bool live() const { return image.empty(); }
+};
+
+struct Question {
+    std::string id;    // short key stored in responses.question, e.g. "translucent"
+    std::string text;  // the statement shown, e.g. "The object looks translucent."
+    std::vector<std::string> labels;  // one per scale point (ends may be the only text)
+    int points() const { return static_cast<int>(labels.size()); }
+};
+
+// A catch trial: a stimulus shown with a prompt that fixes the right answer.
+struct CatchTrial {
+    std::string id;
+    std::string stimulus;  // stimulus id
+    std::string block;     // block it is shuffled into
+    std::string prompt;    // shown above the scale, e.g. "Attention check: choose 7"
+    int expected = 7;      // the expected rating on every question
+    int tolerance = 0;     // |rating - expected| <= tolerance passes
+};
+
+struct Block {
+    std::string id;
+    std::vector<std::string> stimuli;  // stimulus ids, each shown `repeats` times
+    int repeats = 1;
+};
+
+// Randomisation within blocks, and block order across participants.
+struct Randomisation {
+    bool shuffle = true;
+    std::string factor = "stimulus";  // "stimulus", "technique" or a parameter name
+    int max_repeat = 0;    // at most this many consecutive trials share a level (0: off)
+    int min_distance = 0;  // trials sharing a level are at least this far apart (0: off)
+    bool counterbalance_blocks = true;  // Latin square of block order by participant
+};
+
+struct Screens {
+    std::string consent;
+    std::string instructions;
+    std::string practice_done = "The practice trials are over. The study starts now.";
+    std::string break_text = "Take a short break. Press Enter when you are ready.";
+    std::string debrief;
+};
+
+struct Protocol {
+    std::string name;
+    std::string title;
+    std::string source;       // file name or "preset:thesis", for messages
+    std::string text;         // the TOML text itself (stored with its hash)
+    float background[3] = {0.f, 0.f, 0.f};  // linear 0..1, behind every stimulus
+    int stimulus_width = 512;  // live stimuli are rendered at this size
+    int stimulus_height = 512;
+    int break_every = 0;        // break screen after every N main trials (0: never)
+    int inter_trial_ms = 500;   // blank screen between trials
+    int max_failed_catch = 0;   // participants failing more catch trials are excluded
+    Screens screens;
+    std::vector<StimulusSpec> stimuli;
+    std::vector<Question> questions;
+    std::vector<std::string> practice;  // stimulus ids of the practice trials, in order
+    std::vector<Block> blocks;
+    std::vector<CatchTrial> catch_trials;
+    Randomisation randomisation;
+
+    const StimulusSpec* find_stimulus(std::string_view id) const;
+    // Level of `factor` for a stimulus ("stimulus", "technique" or a parameter); empty
+    // when the stimulus has no such parameter.
+    std::string level_of(const StimulusSpec& stimulus, std::string_view factor) const;
+};
+
+// Parses and validates a protocol. `source` names the file in error messages; image
+// paths are resolved relative to `base_dir` when given. Unknown keys are errors.
+Protocol parse_protocol(std::string_view text, const std::string& source,
+                        const std::string& base_dir = "");
+Protocol load_protocol_file(const std::string& path);
+// Built-in protocols by name ("thesis"); throws ProtocolError listing valid names.
+Protocol builtin_protocol(std::string_view name);
+std::vector<std::string> builtin_protocol_names();
+
+// Hex SHA-256 of the protocol text: studies with different hashes are never merged.
+std::string protocol_hash(std::string_view text);
+
+}  // namespace lucent::study

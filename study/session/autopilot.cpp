@@ -1,0 +1,109 @@
+#include "session/autopilot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace lucent::study {
+namespace {
+
+const std::set<std::string> kKeys = {"1", "2", "3", "4", "5", "6", "7", "8", "9", "Enter",
+                                     "Escape", "Left", "Right", "Up", "Down", "Q", "R"};
+
+}  // namespace
+
+Autopilot Autopilot::from_seed(uint64_t seed, double speed) {
+    Autopilot a;
+    a.rng_.seed(seed);
+    a.speed_ = speed > 0 ? speed : 1.0;
+    return a;
+}
+
+Autopilot Autopilot::from_file(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error(path + ": cannot open autopilot script");
+    Autopilot a;
+    a.scripted_ = true;
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) {
+        line = line.substr(0, line.find('#'));
+        std::istringstream words(line);
+        double delay;
+        std::string key;
+        if (!(words >> delay)) continue;  // blank or comment
+        if (!(words >> key) || !kKeys.count(key) || delay < 0 || !std::isfinite(delay))
+            throw std::runtime_error(path + ":" + std::to_string(n) +
+                                     ": expected 'DELAY_MS KEY' with KEY one of 1-9, Enter, "
+                                     "Escape, Left, Right, Up, Down, Q, R");
+        a.script_.emplace_back(delay, key);
+    }
+    return a;
+}
+
+Autopilot Autopilot::from_argument(const std::string& argument, double speed) {
+    if (!argument.empty() && std::all_of(argument.begin(), argument.end(), ::isdigit))
+        return from_seed(std::stoull(argument), speed);
+    return from_file(argument);
+}
+
+double Autopilot::delay_ms(double median_ms) {
+    // Response times are roughly log-normal; sigma 0.35 gives a realistic spread.
+    std::lognormal_distribution<double> d(std::log(median_ms), 0.35);
+    return d(rng_) / speed_;
+}
+
+void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
+    queue_.clear();
+    double t = 0;
+    auto press = [&](double after_ms, const std::string& key) {
+        t += after_ms;
+        queue_.push_back({now_ns + static_cast<int64_t>(t * 1e6), key});
+    };
+    switch (view.kind) {
+    case ScreenView::Kind::Blank: break;
+    case ScreenView::Kind::Text: press(delay_ms(1500), "Enter"); break;
+    case ScreenView::Kind::Pause: press(delay_ms(800), "Enter"); break;
+    case ScreenView::Kind::Rating: {
+        std::uniform_int_distribution<int> point(1, std::max(1, view.points));
+        std::bernoulli_distribution change_mind(0.15);
+        for (int q = 0; q < view.questions; ++q) {
+            const int rating = view.is_catch ? view.expected : point(rng_);
+            if (change_mind(rng_) && !view.is_catch) {  // first pick, then a correction
+                press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating % view.points + 1));
+                press(delay_ms(350), std::to_string(rating));
+            } else {
+                press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating));
+            }
+            press(delay_ms(250), "Enter");  // next statement; after the last: confirm
+        }
+        break;
+    }
+    }
+}
+
+std::vector<std::string> Autopilot::due(int64_t now_ns, const ScreenView& view) {
+    std::vector<std::string> keys;
+    if (scripted_) {
+        if (script_start_ < 0) {
+            script_start_ = now_ns;
+            double t = 0;
+            for (const auto& [delay, key] : script_) {
+                t += delay;
+                queue_.push_back({now_ns + static_cast<int64_t>(t * 1e6), key});
+            }
+        }
+    } else if (view.serial != planned_serial_) {
+        planned_serial_ = view.serial;
+        plan_screen(now_ns, view);
+    }
+    while (!queue_.empty() && queue_.front().at_ns <= now_ns) {
+        keys.push_back(queue_.front().key);
+        queue_.erase(queue_.begin());
+    }
+    return keys;
+}
+
+}  // namespace lucent::study

@@ -1,0 +1,56 @@
+#pragma once
+// A simulated participant for end-to-end tests and demos. It decides *which* key to
+// press and *when* (seeded, human-like delays); the runner sends each key as a real X
+// key event through XTest (x_keyboard.h), so it reaches GLFW exactly as a keyboard's.
+// GL-free and X-free, so its timing model is unit-tested.
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace lucent::study {
+
+// What is on screen, as far as a participant can tell.
+struct ScreenView {
+    enum class Kind { Text, Rating, Blank, Pause };
+    Kind kind = Kind::Blank;
+    int serial = 0;         // increases whenever a new screen appears
+    int questions = 0;      // rating screens
+    int points = 7;
+    bool is_catch = false;  // catch trials: the prompt asks for `expected`
+    int expected = 0;
+};
+
+struct ScheduledKey {
+    int64_t at_ns = 0;
+    std::string key;  // "1".."9", "Enter", "Escape", "Left", "Right", "Up", "Down", "Q", "R"
+};
+
+class Autopilot {
+public:
+    // Seeded participant; `speed` divides every delay (1 = human-like, 20 = fast tests).
+    static Autopilot from_seed(uint64_t seed, double speed = 1.0);
+    // A script: one "DELAY_MS KEY" per line (# comments), played in order from the
+    // first call, whatever is on screen. Throws std::runtime_error naming file:line.
+    static Autopilot from_file(const std::string& path);
+    // The argument of --autopilot: digits are a seed, anything else a script file.
+    static Autopilot from_argument(const std::string& argument, double speed);
+
+    // Keys due at `now_ns` for the screen shown; call once per frame.
+    std::vector<std::string> due(int64_t now_ns, const ScreenView& view);
+    bool scripted() const { return scripted_; }
+
+private:
+    void plan_screen(int64_t now_ns, const ScreenView& view);
+    double delay_ms(double median_ms);  // log-normal around a median, divided by speed
+
+    bool scripted_ = false;
+    std::mt19937_64 rng_;
+    double speed_ = 1.0;
+    int planned_serial_ = -1;
+    int64_t script_start_ = -1;
+    std::vector<std::pair<double, std::string>> script_;  // (delay ms, key)
+    std::vector<ScheduledKey> queue_;
+};
+
+}  // namespace lucent::study

@@ -1,0 +1,32 @@
+#pragma once
+// The session runner: consent, instructions, practice, rated trials with breaks,
+// debrief, in a full-screen window; every trial's ratings committed before the next.
+#include <cstdint>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "protocol.h"
+#include "session/stimulus_source.h"
+
+namespace lucent::study {
+
+struct RunOptions {
+    Protocol protocol;
+    std::string db_path;
+    std::string participant;
+    bool windowed = false;       // a 1280x1024 window instead of full screen
+    int monitor = 0;
+    bool resume = false;         // continue the participant's unfinished session
+    std::optional<uint64_t> seed;  // session seed (default: random, stored)
+    std::string autopilot;       // "" (a person), a seed, or a script file
+    double autopilot_speed = 1.0;
+    std::string screenshot_path;   // save the first rating screen as PNG (tests)
+};
+
+// Outcome of run_session, mapped to exit codes by the caller.
+enum class RunResult { Completed, SavedAndQuit, Declined, UsageError, Failure };
+
+RunResult run_session(const RunOptions& options, StimulusRenderer& stimuli, std::ostream& log);
+
+}  // namespace lucent::study

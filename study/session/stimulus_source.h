@@ -1,0 +1,65 @@
+#pragma once
+// Where stimulus pictures come from. The runner asks a StimulusRenderer for a texture
+// per stimulus; PrerenderedStimuli loads image files (shown pixel for pixel), and a live
+// renderer (techniques from renderer/) plugs in behind the same interface.
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "gl/objects.h"
+#include "protocol.h"
+
+namespace lucent::study {
+
+// An image file that cannot be used; what() names the file and the reason.
+class StimulusError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// 8-bit RGBA, sRGB-encoded, top row first.
+struct CpuImage {
+    int width = 0;
+    int height = 0;
+    std::vector<uint8_t> rgba;
+};
+
+// Loads PNG/TIFF/JPEG as 8-bit; EXR (linear float) is sRGB-encoded on the way.
+CpuImage load_image_rgba8(const std::string& path);
+void save_image_rgba8(const std::string& path, const CpuImage& image);
+
+struct StimulusTexture {
+    gl::Texture texture;  // RGBA8, nearest filtering, row 0 = top of the picture
+    int width = 0;
+    int height = 0;
+};
+
+class StimulusRenderer {
+public:
+    virtual ~StimulusRenderer() = default;
+    // Renders (or loads) the stimulus at the protocol's size into a texture; a GL
+    // context is current. Throws StimulusError naming the stimulus on failure.
+    virtual StimulusTexture render(const StimulusSpec& spec, int width, int height) = 0;
+    // Checks, before any window opens, that every stimulus can be provided.
+    virtual void check(const Protocol& protocol) const = 0;
+};
+
+// Image stimuli from their `image` path; live stimuli from `images_dir/<id>.png|.tif|.exr`
+// (e.g. the output of `lucent render --preset thesis --out DIR`). Live stimuli without
+// such a file are an error naming what to do: the live renderer is not wired in yet.
+class PrerenderedStimuli : public StimulusRenderer {
+public:
+    explicit PrerenderedStimuli(std::string images_dir) : images_dir_(std::move(images_dir)) {}
+    StimulusTexture render(const StimulusSpec& spec, int width, int height) override;
+    void check(const Protocol& protocol) const override;
+    std::string path_for(const StimulusSpec& spec) const;  // "" when none exists
+
+private:
+    std::string images_dir_;
+};
+
+StimulusTexture upload_texture(const CpuImage& image);
+
+}  // namespace lucent::study

@@ -1,0 +1,53 @@
+#include "session/x_keyboard.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <X11/Xlib.h>
+#include <X11/extensions/XTest.h>
+#include <X11/keysym.h>
+
+#include <map>
+#include <stdexcept>
+
+// GLFW's X11 native access, declared here because glfw3native.h also pulls in Xrandr
+// headers (libxrandr-dev) that nothing else needs.
+extern "C" Display* glfwGetX11Display(void);
+extern "C" Window glfwGetX11Window(GLFWwindow* window);
+
+namespace lucent::study {
+
+XKeyboard::XKeyboard(GLFWwindow* window) : window_(window), display_(glfwGetX11Display()) {
+    if (!display_)
+        throw std::runtime_error("autopilot needs an X11 display (XTest); none is in use");
+    int event_base, error_base, major, minor;
+    if (!XTestQueryExtension(static_cast<Display*>(display_), &event_base, &error_base, &major,
+                             &minor))
+        throw std::runtime_error("autopilot: the X server has no XTest extension");
+}
+
+void XKeyboard::focus_window() {
+    Display* dpy = static_cast<Display*>(display_);
+    int x = 0, y = 0, w = 0, h = 0;
+    glfwGetWindowPos(window_, &x, &y);
+    glfwGetWindowSize(window_, &w, &h);
+    XTestFakeMotionEvent(dpy, -1, x + w / 2, y + h / 2, CurrentTime);
+    XSetInputFocus(dpy, glfwGetX11Window(window_), RevertToParent, CurrentTime);
+    XFlush(dpy);
+}
+
+void XKeyboard::tap(const std::string& key, int hold_ms) {
+    static const std::map<std::string, KeySym> kSyms = {
+        {"1", XK_1}, {"2", XK_2}, {"3", XK_3}, {"4", XK_4}, {"5", XK_5}, {"6", XK_6},
+        {"7", XK_7}, {"8", XK_8}, {"9", XK_9}, {"Enter", XK_Return}, {"Escape", XK_Escape},
+        {"Left", XK_Left}, {"Right", XK_Right}, {"Up", XK_Up}, {"Down", XK_Down},
+        {"Q", XK_q}, {"R", XK_r}};
+    const auto it = kSyms.find(key);
+    if (it == kSyms.end()) throw std::runtime_error("autopilot: unknown key '" + key + "'");
+    Display* dpy = static_cast<Display*>(display_);
+    const KeyCode code = XKeysymToKeycode(dpy, it->second);
+    XTestFakeKeyEvent(dpy, code, True, CurrentTime);
+    XTestFakeKeyEvent(dpy, code, False, static_cast<unsigned long>(hold_ms));
+    XFlush(dpy);
+}
+
+}  // namespace lucent::study

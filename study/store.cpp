@@ -1,0 +1,467 @@
+// The study database: schema and migrations, the read-only safety check, sessions,
+// trials and responses.
+#include "store.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace lucent::study {
+namespace {
+
+// Migration i (1-based) brings user_version from i-1 to i. Never edit a released step:
+// add a new one.
+const char* const kMigrations[] = {
+    // 1: the core tables.
+    R"sql(
+CREATE TABLE studies (
+    id INTEGER PRIMARY KEY,
+    name TEXT NOT NULL,
+    protocol_text TEXT NOT NULL,
+    protocol_hash TEXT NOT NULL UNIQUE,
+    created_utc TEXT NOT NULL);
+CREATE TABLE stimuli (
+    id INTEGER PRIMARY KEY,
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    stimulus_key TEXT NOT NULL,
+    technique TEXT NOT NULL,
+    mesh TEXT NOT NULL,
+    image TEXT NOT NULL,
+    varies TEXT NOT NULL,
+    UNIQUE (study_id, stimulus_key));
+CREATE TABLE stimulus_parameters (
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id) ON DELETE CASCADE,
+    name TEXT NOT NULL,
+    value TEXT NOT NULL,
+    PRIMARY KEY (stimulus_id, name));
+CREATE TABLE participants (
+    id INTEGER PRIMARY KEY,
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    code TEXT NOT NULL UNIQUE,
+    number INTEGER NOT NULL,
+    created_utc TEXT NOT NULL);
+CREATE TABLE sessions (
+    id INTEGER PRIMARY KEY,
+    uuid TEXT NOT NULL UNIQUE,
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    participant_id INTEGER NOT NULL REFERENCES participants(id) ON DELETE CASCADE,
+    machine_id TEXT NOT NULL,
+    seed TEXT NOT NULL,
+    cell INTEGER NOT NULL,
+    block_order TEXT NOT NULL,
+    status TEXT NOT NULL CHECK (status IN ('running', 'paused', 'completed', 'aborted')),
+    started_utc TEXT NOT NULL,
+    ended_utc TEXT,
+    consent_utc TEXT,
+    software_version TEXT NOT NULL,
+    build_hash TEXT NOT NULL,
+    gl_vendor TEXT,
+    gl_renderer TEXT,
+    display_mode TEXT,
+    display_refresh_hz REAL,
+    measured_refresh_hz REAL);
+CREATE TABLE trials (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+    position INTEGER NOT NULL,
+    block TEXT NOT NULL,
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id),
+    practice INTEGER NOT NULL CHECK (practice IN (0, 1)),
+    catch INTEGER NOT NULL CHECK (catch IN (0, 1)),
+    catch_id TEXT,
+    prompt TEXT,
+    expected_rating INTEGER,
+    tolerance INTEGER,
+    break_before INTEGER NOT NULL CHECK (break_before IN (0, 1)),
+    onset_ns INTEGER,
+    confirm_ns INTEGER,
+    answered_utc TEXT,
+    UNIQUE (session_id, position));
+CREATE TABLE responses (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+    trial_id INTEGER NOT NULL REFERENCES trials(id) ON DELETE CASCADE,
+    question TEXT NOT NULL,
+    rating INTEGER NOT NULL CHECK (rating BETWEEN 1 AND 7),
+    rt_ms REAL NOT NULL CHECK (rt_ms >= 0),
+    changes INTEGER NOT NULL CHECK (changes >= 0),
+    first_choice_ns INTEGER NOT NULL,
+    final_choice_ns INTEGER NOT NULL,
+    UNIQUE (trial_id, question));
+CREATE INDEX responses_by_session ON responses(session_id);
+CREATE INDEX trials_by_session ON trials(session_id);
+)sql",
+    // 2: frame timing (why a refresh is unknown; dropped frames per trial).
+    R"sql(
+ALTER TABLE sessions ADD COLUMN refresh_note TEXT;
+ALTER TABLE trials ADD COLUMN dropped_frames INTEGER;
+)sql",
+};
+static_assert(std::size(kMigrations) == kSchemaVersion);
+
+std::string hex32(uint32_t v) {
+    char out[16];
+    std::snprintf(out, sizeof out, "0x%08x", v);
+    return out;
+}
+
+int participant_number_from_code(const std::string& code) {
+    size_t end = code.size(), begin = end;
+    while (begin > 0 && std::isdigit(static_cast<unsigned char>(code[begin - 1]))) --begin;
+    if (begin == end || end - begin > 9) return -1;
+    return std::stoi(code.substr(begin));
+}
+
+}  // namespace
+
+void check_database_file(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return;  // created on open
+    if (fs::is_directory(path, ec)) throw StoreError(path + ": is a directory, not a database");
+    const auto size = fs::file_size(path, ec);
+    const bool has_wal = fs::exists(path + "-wal", ec);
+    if (size > 0) {
+        char magic[16] = {};
+        std::ifstream in(path, std::ios::binary);
+        in.read(magic, sizeof magic);
+        if (in.gcount() < 16 || std::string(magic, 16) != std::string("SQLite format 3\0", 16))
+            throw StoreError(path + ": not a Lucent study database (not an SQLite file); "
+                             "left unchanged");
+    } else if (!has_wal) {
+        return;  // an empty file: initialised on open
+    }
+    // Without a -wal file the main file is the whole database: open it immutable, so
+    // not even the -wal/-shm side files of a WAL-mode database get created.
+    const std::string uri = file_uri(path, has_wal ? "mode=ro" : "mode=ro&immutable=1");
+    sqlite3* raw = nullptr;
+    int rc = sqlite3_open_v2(uri.c_str(), &raw, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
+    struct Closer { sqlite3* db; ~Closer() { sqlite3_close_v2(db); } } closer{raw};
+    if (rc != SQLITE_OK)
+        throw StoreError(path + ": cannot open read-only: " + sqlite3_errstr(rc));
+    auto query_int = [&](const char* sql, int64_t& out) -> std::string {
+        sqlite3_stmt* stmt = nullptr;
+        int r = sqlite3_prepare_v2(raw, sql, -1, &stmt, nullptr);
+        if (r == SQLITE_OK) {
+            r = sqlite3_step(stmt);
+            if (r == SQLITE_ROW) { out = sqlite3_column_int64(stmt, 0); r = SQLITE_OK; }
+        }
+        std::string why = r == SQLITE_OK ? "" : sqlite3_errmsg(raw);
+        sqlite3_finalize(stmt);
+        return why;
+    };
+    int64_t app_id = 0, version = 0, tables = 0;
+    std::string why = query_int("PRAGMA application_id", app_id);
+    if (why.empty()) why = query_int("PRAGMA user_version", version);
+    if (why.empty()) why = query_int("SELECT count(*) FROM sqlite_schema", tables);
+    if (!why.empty())
+        throw StoreError(path + ": database is corrupt (" + why + "); left unchanged");
+    if (app_id == 0 && version == 0 && tables == 0) return;  // an empty SQLite file
+    if (app_id != kApplicationId)
+        throw StoreError(path + ": not a Lucent study database (application_id " +
+                         hex32(static_cast<uint32_t>(app_id)) + ", " + std::to_string(tables) +
+                         " schema entries); left unchanged");
+    if (version > kSchemaVersion)
+        throw StoreError(path + ": written by a newer Lucent (schema " + std::to_string(version) +
+                         ", this build knows " + std::to_string(kSchemaVersion) +
+                         "); left unchanged");
+    sqlite3_stmt* stmt = nullptr;
+    std::string check = "ok";
+    if (sqlite3_prepare_v2(raw, "PRAGMA quick_check(1)", -1, &stmt, nullptr) != SQLITE_OK ||
+        sqlite3_step(stmt) != SQLITE_ROW) {
+        check = sqlite3_errmsg(raw);
+    } else {
+        check = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0));
+    }
+    for (char& c : check)
+        if (c == '\n' || c == '\r') c = ' ';  // errors stay on one line
+    sqlite3_finalize(stmt);
+    if (check != "ok")
+        throw StoreError(path + ": database is corrupt (quick_check: " + check +
+                         "); left unchanged");
+}
+
+void migrate(Database& db, int target) {
+    const int current = static_cast<int>(db.scalar_int("PRAGMA user_version"));
+    if (current >= target) return;
+    Transaction tx(db);
+    if (current == 0) db.exec("PRAGMA application_id = " + std::to_string(kApplicationId));
+    for (int v = current + 1; v <= target; ++v) db.exec(kMigrations[v - 1]);
+    db.exec("PRAGMA user_version = " + std::to_string(target));
+    tx.commit();
+}
+
+Store::Store(const std::string& path, const std::string& vfs)
+    : db_((check_database_file(path), path), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_URI, vfs) {
+    db_.exec("PRAGMA journal_mode = WAL");
+    db_.exec("PRAGMA synchronous = FULL");
+    db_.exec("PRAGMA foreign_keys = ON");
+    migrate(db_);
+}
+
+int64_t Store::ensure_study(const Protocol& protocol) {
+    const std::string hash = protocol_hash(protocol.text);
+    {
+        Statement s = db_.prepare("SELECT id, protocol_hash, name FROM studies");
+        while (s.step()) {
+            if (s.text(1) == hash) return s.integer(0);
+            throw StoreError(db_.path() + ": holds study '" + s.text(2) + "' (protocol " +
+                             s.text(1).substr(0, 12) + "), not this protocol (" +
+                             hash.substr(0, 12) + "); use a new database per protocol");
+        }
+    }
+    Transaction tx(db_);
+    db_.prepare("INSERT INTO studies (name, protocol_text, protocol_hash, created_utc) "
+                "VALUES (?, ?, ?, ?)")
+        .bind(1, protocol.name).bind(2, protocol.text).bind(3, hash).bind(4, utc_now_iso8601())
+        .run();
+    const int64_t study_id = db_.last_insert_id();
+    Statement stim = db_.prepare(
+        "INSERT INTO stimuli (study_id, stimulus_key, technique, mesh, image, varies) "
+        "VALUES (?, ?, ?, ?, ?, ?)");
+    Statement param = db_.prepare(
+        "INSERT INTO stimulus_parameters (stimulus_id, name, value) VALUES (?, ?, ?)");
+    for (const StimulusSpec& s : protocol.stimuli) {
+        std::string varies;
+        for (const std::string& v : s.varies) varies += (varies.empty() ? "" : " ") + v;
+        stim.reset();
+        stim.bind(1, study_id).bind(2, s.id).bind(3, s.technique).bind(4, s.mesh)
+            .bind(5, s.image).bind(6, varies).run();
+        const int64_t stimulus_id = db_.last_insert_id();
+        for (const auto& [name, value] : s.parameters) {
+            param.reset();
+            param.bind(1, stimulus_id).bind(2, name).bind(3, value).run();
+        }
+    }
+    tx.commit();
+    return study_id;
+}
+
+int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int* number) {
+    Statement find = db_.prepare("SELECT id, number FROM participants WHERE code = ?");
+    find.bind(1, code);
+    if (find.step()) {
+        if (number) *number = static_cast<int>(find.integer(1));
+        return find.integer(0);
+    }
+    int n = participant_number_from_code(code);
+    if (n < 0) n = static_cast<int>(db_.scalar_int("SELECT count(*) FROM participants")) + 1;
+    db_.prepare("INSERT INTO participants (study_id, code, number, created_utc) "
+                "VALUES (?, ?, ?, ?)")
+        .bind(1, study_id).bind(2, code).bind(3, n).bind(4, utc_now_iso8601()).run();
+    if (number) *number = n;
+    return db_.last_insert_id();
+}
+
+SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
+                                 const TrialPlan& plan, uint64_t seed,
+                                 const SessionEnvironment& env) {
+    SessionRow row;
+    row.uuid = new_uuid_v4();
+    row.participant_id = participant_id;
+    row.seed = seed;
+    row.cell = plan.cell;
+    row.status = "running";
+    std::string order;
+    for (const std::string& b : plan.block_order) order += (order.empty() ? "" : ",") + b;
+
+    Transaction tx(db_);
+    db_.prepare(
+           "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, cell, "
+           "block_order, status, started_utc, software_version, build_hash, gl_vendor, "
+           "gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, refresh_note) "
+           "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+        .bind(1, row.uuid).bind(2, study_id).bind(3, participant_id).bind(4, env.machine_id)
+        .bind(5, std::to_string(seed)).bind(6, plan.cell).bind(7, order)
+        .bind(8, utc_now_iso8601()).bind(9, env.software_version).bind(10, env.build_hash)
+        .bind(11, env.gl_vendor).bind(12, env.gl_renderer).bind(13, env.display_mode)
+        .bind(14, env.display_refresh_hz).bind(15, env.measured_refresh_hz)
+        .bind(16, env.refresh_note)
+        .run();
+    row.id = db_.last_insert_id();
+    Statement insert = db_.prepare(
+        "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, "
+        "catch_id, prompt, expected_rating, tolerance, break_before) VALUES "
+        "(?, ?, ?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), "
+        "?, ?, ?, ?, ?, ?, ?)");
+    for (const PlannedTrial& t : plan.trials) {
+        insert.reset();
+        insert.bind(1, row.id).bind(2, t.position).bind(3, t.block).bind(4, study_id)
+            .bind(5, t.stimulus).bind(6, t.practice ? 1 : 0).bind(7, t.is_catch ? 1 : 0);
+        if (t.is_catch) {
+            insert.bind(8, t.catch_id).bind(9, t.prompt).bind(10, t.expected)
+                .bind(11, t.tolerance);
+        }
+        insert.bind(12, t.break_before ? 1 : 0).run();
+    }
+    tx.commit();
+    return row;
+}
+
+std::optional<SessionRow> Store::unfinished_session(const std::string& participant_code) {
+    Statement s = db_.prepare(
+        "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
+        "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+        "WHERE p.code = ? AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT 1");
+    s.bind(1, participant_code);
+    if (!s.step()) return std::nullopt;
+    SessionRow row;
+    row.id = s.integer(0);
+    row.uuid = s.text(1);
+    row.participant_id = s.integer(2);
+    row.participant = s.text(3);
+    row.seed = std::stoull(s.text(4));
+    row.cell = static_cast<int>(s.integer(5));
+    row.status = s.text(6);
+    return row;
+}
+
+bool Store::has_completed_session(const std::string& participant_code) {
+    Statement s = db_.prepare(
+        "SELECT count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
+        "WHERE p.code = ? AND s.status = 'completed'");
+    s.bind(1, participant_code);
+    return s.step() && s.integer(0) > 0;
+}
+
+std::vector<TrialRow> Store::trials(int64_t session_id) {
+    Statement s = db_.prepare(
+        "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
+        "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
+        "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id) "
+        "FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
+        "WHERE t.session_id = ? ORDER BY t.position");
+    s.bind(1, session_id);
+    std::vector<TrialRow> out;
+    while (s.step()) {
+        TrialRow t;
+        t.id = s.integer(0);
+        t.position = static_cast<int>(s.integer(1));
+        t.block = s.text(2);
+        t.stimulus = s.text(3);
+        t.practice = s.integer(4) != 0;
+        t.is_catch = s.integer(5) != 0;
+        t.prompt = s.text(6);
+        t.expected = static_cast<int>(s.integer(7));
+        t.break_before = s.integer(8) != 0;
+        t.answered = s.integer(9) != 0;
+        out.push_back(std::move(t));
+    }
+    return out;
+}
+
+void Store::update_environment(int64_t session_id, const SessionEnvironment& env) {
+    db_.prepare("UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
+                "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
+                "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
+        .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
+        .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
+        .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
+        .bind(9, env.refresh_note).bind(10, session_id)
+        .run();
+}
+
+void Store::set_consent(int64_t session_id) {
+    db_.prepare("UPDATE sessions SET consent_utc = ? WHERE id = ?")
+        .bind(1, utc_now_iso8601()).bind(2, session_id).run();
+}
+
+bool Store::has_consent(int64_t session_id) {
+    Statement s = db_.prepare("SELECT consent_utc IS NOT NULL FROM sessions WHERE id = ?");
+    s.bind(1, session_id);
+    return s.step() && s.integer(0) != 0;
+}
+
+void Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) {
+    Transaction tx(db_);
+    {
+        Statement check = db_.prepare(
+            "SELECT (SELECT count(*) FROM trials WHERE id = ? AND session_id = ?), "
+            "(SELECT count(*) FROM responses WHERE trial_id = ?)");
+        check.bind(1, trial_id).bind(2, session_id).bind(3, trial_id);
+        check.step();
+        if (check.integer(0) != 1)
+            throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) +
+                             " is not part of session " + std::to_string(session_id));
+        if (check.integer(1) != 0)
+            throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) +
+                             " already has ratings; refusing to record it twice");
+    }
+    Statement insert = db_.prepare(
+        "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
+        "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
+    for (const Response& r : outcome.responses) {
+        insert.reset();
+        insert.bind(1, session_id).bind(2, trial_id).bind(3, r.question).bind(4, r.rating)
+            .bind(5, r.rt_ms).bind(6, r.changes).bind(7, r.first_choice_ns)
+            .bind(8, r.final_choice_ns).run();
+    }
+    db_.prepare("UPDATE trials SET onset_ns = ?, confirm_ns = ?, dropped_frames = ?, "
+                "answered_utc = ? WHERE id = ?")
+        .bind(1, outcome.onset_ns).bind(2, outcome.confirm_ns).bind(3, outcome.dropped_frames)
+        .bind(4, utc_now_iso8601()).bind(5, trial_id).run();
+    tx.commit();
+}
+
+void Store::set_status(int64_t session_id, const std::string& status, bool ended) {
+    if (ended) {
+        db_.prepare("UPDATE sessions SET status = ?, ended_utc = ? WHERE id = ?")
+            .bind(1, status).bind(2, utc_now_iso8601()).bind(3, session_id).run();
+    } else {
+        db_.prepare("UPDATE sessions SET status = ?, ended_utc = NULL WHERE id = ?")
+            .bind(1, status).bind(2, session_id).run();
+    }
+}
+
+bool Store::withdraw_participant(const std::string& code) {
+    Transaction tx(db_);
+    db_.prepare("DELETE FROM participants WHERE code = ?").bind(1, code).run();
+    const bool deleted = sqlite3_changes(db_.handle()) > 0;
+    tx.commit();
+    return deleted;
+}
+
+std::string utc_now_iso8601() {
+    const auto now = std::chrono::system_clock::now();
+    const std::time_t t = std::chrono::system_clock::to_time_t(now);
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                        now.time_since_epoch()).count() % 1000;
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    char out[64];
+    std::snprintf(out, sizeof out, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
+                  tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
+                  static_cast<int>(ms));
+    return out;
+}
+
+std::string new_uuid_v4() {
+    std::random_device device;
+    std::mt19937_64 rng((uint64_t(device()) << 32) ^ device() ^
+                        uint64_t(std::chrono::steady_clock::now().time_since_epoch().count()));
+    uint64_t hi = rng(), lo = rng();
+    hi = (hi & ~0xF000ull) | 0x4000ull;                     // version 4
+    lo = (lo & ~(0xC000ull << 48)) | (0x8000ull << 48);     // variant 10xx
+    char out[40];
+    std::snprintf(out, sizeof out, "%08x-%04x-%04x-%04x-%012llx", uint32_t(hi >> 32),
+                  uint32_t(hi >> 16) & 0xFFFF, uint32_t(hi) & 0xFFFF, uint32_t(lo >> 48),
+                  static_cast<unsigned long long>(lo & 0xFFFFFFFFFFFFull));
+    return out;
+}
+
+std::string machine_id() {
+    std::ifstream in("/etc/machine-id");
+    std::string id;
+    if (in >> id && !id.empty()) return id;
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    return std::string("host:") + host;
+}
+
+}  // namespace lucent::study

@@ -1,0 +1,85 @@
+// Manifest pieces: hashing, CSV quoting, and writing then reading a manifest back.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "manifest.h"
+#include "test_paths.h"
+
+namespace lucent::stimuli {
+namespace {
+
+TEST(Manifest, HasherIsFnv1a64) {
+    // Published FNV-1a 64-bit test vectors.
+    EXPECT_EQ(Hasher().hex(), "cbf29ce484222325");
+    EXPECT_EQ(Hasher().add("a").hex(), "af63dc4c8601ec8c");
+    EXPECT_EQ(Hasher().add("foobar").hex(), "85944171f73967e8");
+    // Length-prefixed fields never run together.
+    EXPECT_NE(Hasher().add_field("ab").add_field("c").hex(), Hasher().add_field("a").add_field("bc").hex());
+}
+
+TEST(Manifest, HashFileMatchesHashOfBytes) {
+    const auto dir = test::scratch_dir("manifest_hash");
+    std::ofstream(dir / "f.bin", std::ios::binary) << "foobar";
+    EXPECT_EQ(hash_file(dir / "f.bin"), "85944171f73967e8");
+    EXPECT_THROW(hash_file(dir / "absent"), std::runtime_error);
+}
+
+TEST(Manifest, CsvQuotingRoundTrips) {
+    for (std::string text : {"plain", "0.8,0.5,0.3", "say \"hi\"", "", "a,\"b\",c"}) {
+        const auto fields = csv_split(csv_escape(text) + "," + csv_escape("next"));
+        ASSERT_EQ(fields.size(), 2u) << text;
+        EXPECT_EQ(fields[0], text);
+        EXPECT_EQ(fields[1], "next");
+    }
+    EXPECT_EQ(csv_escape("0.8,0.5,0.3"), "\"0.8,0.5,0.3\"");
+}
+
+TEST(Manifest, WritesUnionOfColumnsAndReadsBack) {
+    const auto dir = test::scratch_dir("manifest_roundtrip");
+    const std::vector<ManifestRow> rows = {
+        {{"id", "a", false}, {"albedo", "0.8,0.5,0.3", false}, {"rms_contrast", "0.25", true}},
+        {{"id", "b", false}, {"roughness", "0.1", true}, {"rms_contrast", "0.5", true}},
+    };
+    write_manifest(dir, "demo", rows);
+    std::ifstream csv(dir / "manifest.csv");
+    std::string header;
+    std::getline(csv, header);
+    EXPECT_EQ(header, "id,albedo,rms_contrast,roughness");
+    const auto back = read_manifest_csv(dir);
+    ASSERT_EQ(back.size(), 2u);
+    EXPECT_EQ(back.at("a").at("albedo"), "0.8,0.5,0.3");
+    EXPECT_EQ(back.at("a").at("roughness"), "");
+    EXPECT_EQ(back.at("b").at("rms_contrast"), "0.5");
+    std::ifstream json_in(dir / "manifest.json");
+    std::stringstream json;
+    json << json_in.rdbuf();
+    EXPECT_NE(json.str().find("\"set\": \"demo\""), std::string::npos);
+    EXPECT_NE(json.str().find("{\"id\": \"a\", \"albedo\": \"0.8,0.5,0.3\", \"rms_contrast\": 0.25}"),
+              std::string::npos)
+        << json.str();
+    // No temporary files are left behind.
+    int files = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) (void)entry, ++files;
+    EXPECT_EQ(files, 2);
+    // An absent manifest reads as empty (everything is rendered again).
+    EXPECT_TRUE(read_manifest_csv(test::scratch_dir("manifest_absent")).empty());
+}
+
+TEST(Manifest, StatisticsFieldsNeverHoldNaN) {
+    ImageStatistics stats;
+    stats.rms_contrast = std::nan("");
+    stats.skewness = std::numeric_limits<double>::infinity();
+    stats.luminance_histogram.assign(16, 0);
+    for (const auto& field : statistics_fields(stats)) {
+        EXPECT_EQ(field.text.find("nan"), std::string::npos) << field.column;
+        EXPECT_EQ(field.text.find("inf"), std::string::npos) << field.column;
+    }
+    EXPECT_EQ(statistics_fields(stats).size(), 6u + 16u);
+}
+
+}  // namespace
+}  // namespace lucent::stimuli

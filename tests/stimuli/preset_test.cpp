@@ -1,0 +1,97 @@
+// The built-in `thesis` set: Table 4.3 of the thesis and the ward / contrast_reversed pairs.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "stimulus_set.h"
+#include "test_paths.h"
+
+namespace lucent::stimuli {
+namespace {
+
+const Stimulus& find(const StimulusSet& set, const std::string& id) {
+    for (const auto& s : set.stimuli)
+        if (s.id == id) return s;
+    throw std::runtime_error("no stimulus " + id);
+}
+
+TEST(ThesisPreset, EmbeddedTextIsTheCommittedExampleFile) {
+    std::ifstream in(test::source_dir() / "stimuli/presets/thesis.toml", std::ios::binary);
+    std::ostringstream file;
+    file << in.rdbuf();
+    ASSERT_TRUE(preset_text("thesis").has_value());
+    EXPECT_EQ(std::string(*preset_text("thesis")), file.str());
+    EXPECT_FALSE(preset_text("nope").has_value());
+    EXPECT_THROW(load_preset("nope", default_catalog()), StimulusSetError);
+}
+
+TEST(ThesisPreset, NineEmpiricalRendersOfTable43) {
+    const auto set = load_preset("thesis", default_catalog());
+    EXPECT_EQ(set.width, 512);
+    EXPECT_EQ(set.height, 512);
+    // Table 4.3 (seeds.md, section A): r / wb / Kb per row.
+    const double table[9][3] = {{25, 1.2, 0.2}, {18, 1.2, 0.2}, {30, 1.2, 0.2},
+                                {25, 1.2, 0.2}, {25, 0.8, 0.2}, {25, 1.6, 0.2},
+                                {25, 1.2, 0.2}, {25, 1.2, 0.0}, {25, 1.2, 0.5}};
+    for (int row = 0; row < 9; ++row) {
+        const auto& s = find(set, "empirical_row_" + std::to_string(row + 1));
+        EXPECT_EQ(s.technique, "empirical");
+        EXPECT_EQ(s.mesh_spec.substr(0, s.mesh_spec.find(':')), "torus_knot");  // built-in
+        EXPECT_DOUBLE_EQ(s.parameters.scalar("thickness_exponent"), table[row][0]) << row;
+        EXPECT_DOUBLE_EQ(s.parameters.scalar("backlight"), table[row][1]) << row;
+        EXPECT_DOUBLE_EQ(s.parameters.scalar("diffuse_weight"), table[row][2]) << row;
+    }
+}
+
+TEST(ThesisPreset, WardAndContrastReversedPairsShareEveryParameter) {
+    const auto set = load_preset("thesis", default_catalog());
+    for (const char* material : {"jade", "wax", "jade_strong"}) {
+        const auto& ward = find(set, std::string("ward_") + material);
+        const auto& reversed = find(set, std::string("contrast_reversed_") + material);
+        EXPECT_EQ(ward.technique, "ward");
+        EXPECT_EQ(reversed.technique, "contrast_reversed");
+        EXPECT_EQ(ward.mesh_spec, reversed.mesh_spec);
+        EXPECT_EQ(ward.parameters.scalar("diffuse_reflectance"),
+                  reversed.parameters.scalar("reversed_diffuse"));
+        for (const auto& [name, value] : ward.parameters.all()) {
+            if (name == "diffuse_reflectance") continue;
+            ASSERT_TRUE(reversed.parameters.contains(name)) << name;
+            EXPECT_EQ(format_knob_value(value), format_knob_value(reversed.parameters.get(name)))
+                << material << " " << name;
+        }
+    }
+    // Jade and wax differ only in roughness (Domon et al. Figs. 3a / 4b) ...
+    const auto& jade = find(set, "ward_jade");
+    const auto& wax = find(set, "ward_wax");
+    for (const auto& [name, value] : jade.parameters.all())
+        if (name != "roughness")
+            EXPECT_EQ(format_knob_value(value), format_knob_value(wax.parameters.get(name))) << name;
+    EXPECT_LT(jade.parameters.scalar("roughness"), wax.parameters.scalar("roughness"));
+    // ... and the strong pair has a higher reversed-diffuse weight (Fig. 4a).
+    EXPECT_GT(find(set, "contrast_reversed_jade_strong").parameters.scalar("reversed_diffuse"),
+              find(set, "contrast_reversed_jade").parameters.scalar("reversed_diffuse"));
+}
+
+TEST(ThesisPreset, RealCatalogRejectsUnknownTechniqueAndKeys) {
+    const auto catalog = default_catalog();
+    const std::string head = "[meshes]\nm = \"sphere\"\n[[stimuli]]\nid = \"a\"\n";
+    try {
+        parse_stimulus_set(head + "technique = \"phong\"\n", "x.toml", ".", catalog);
+        FAIL() << "no error";
+    } catch (const StimulusSetError& e) {
+        EXPECT_NE(std::string(e.what()).find("x.toml:5:13: stimuli[0].technique: unknown technique "
+                                             "'phong' (valid: empirical, ward, contrast_reversed)"),
+                  std::string::npos)
+            << e.what();
+    }
+    // reversed_diffuse belongs to contrast_reversed, not ward.
+    EXPECT_THROW(parse_stimulus_set(head + "technique = \"ward\"\nreversed_diffuse = 0.5\n", "x.toml",
+                                    ".", catalog),
+                 StimulusSetError);
+    EXPECT_NO_THROW(parse_stimulus_set(
+        head + "technique = \"contrast_reversed\"\nreversed_diffuse = 0.5\n", "x.toml", ".", catalog));
+}
+
+}  // namespace
+}  // namespace lucent::stimuli

@@ -1,0 +1,144 @@
+// Protocol parsing: the thesis preset's content, and errors naming file, line and key.
+#include "protocol.h"
+
+#include <gtest/gtest.h>
+
+#include "sha256.h"
+#include "study_fixtures.h"
+
+namespace lucent::study {
+namespace {
+
+TEST(Sha256, MatchesFipsVectors) {
+    EXPECT_EQ(sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+    EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    EXPECT_EQ(sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+              "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+}
+
+TEST(ThesisPreset, HasTheNineStimuliOfTable43) {
+    const Protocol p = builtin_protocol("thesis");
+    // Table 4.3 of the thesis: r, wb, Kb per image.
+    const double table[9][3] = {{25, 1.2, 0.2}, {18, 1.2, 0.2}, {30, 1.2, 0.2},
+                                {25, 1.2, 0.2}, {25, 0.8, 0.2}, {25, 1.6, 0.2},
+                                {25, 1.2, 0.2}, {25, 1.2, 0.0}, {25, 1.2, 0.5}};
+    const char* varies[3] = {"thickness_exponent", "backlight", "diffuse_weight"};
+    for (int i = 0; i < 9; ++i) {
+        const StimulusSpec* s = p.find_stimulus("empirical_row_" + std::to_string(i + 1));
+        ASSERT_NE(s, nullptr) << i;
+        EXPECT_EQ(s->technique, "empirical");
+        EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("thickness_exponent")), table[i][0]);
+        EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("backlight")), table[i][1]);
+        EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("diffuse_weight")), table[i][2]);
+        ASSERT_EQ(s->varies.size(), 1u);
+        EXPECT_EQ(s->varies[0], varies[i / 3]);
+    }
+}
+
+TEST(ThesisPreset, ContrastReversedStimuliHaveWardCounterparts) {
+    const Protocol p = builtin_protocol("thesis");
+    int pairs = 0;
+    for (const StimulusSpec& s : p.stimuli) {
+        if (s.technique != "contrast_reversed" || s.id.rfind("practice", 0) == 0) continue;
+        for (const char* key : {"reversed_diffuse", "specular_reflectance", "roughness"})
+            EXPECT_TRUE(s.parameters.count(key)) << s.id << " lacks " << key;
+        const StimulusSpec* ward = p.find_stimulus("ward_" + s.id.substr(18));
+        ASSERT_NE(ward, nullptr) << s.id;
+        EXPECT_EQ(ward->technique, "ward");
+        // The same material: ward's diffuse_reflectance is contrast_reversed's weight.
+        auto expected = s.parameters;
+        expected["diffuse_reflectance"] = expected.at("reversed_diffuse");
+        expected.erase("reversed_diffuse");
+        EXPECT_EQ(ward->parameters, expected);
+        ++pairs;
+    }
+    EXPECT_GE(pairs, 3);
+}
+
+TEST(ThesisPreset, AsksTheThreeStatementsOnSevenPoints) {
+    const Protocol p = builtin_protocol("thesis");
+    ASSERT_EQ(p.questions.size(), 3u);
+    EXPECT_EQ(p.questions[0].id, "translucent");
+    EXPECT_EQ(p.questions[1].id, "realistic");
+    EXPECT_EQ(p.questions[2].id, "varnished");
+    for (const Question& q : p.questions) {
+        EXPECT_EQ(q.points(), 7);
+        EXPECT_EQ(q.labels.front(), "completely disagree");
+        EXPECT_EQ(q.labels.back(), "completely agree");
+    }
+    EXPECT_FALSE(p.practice.empty());
+    EXPECT_FALSE(p.catch_trials.empty());
+    EXPECT_GT(p.break_every, 0);
+    EXPECT_FALSE(p.screens.consent.empty());
+    EXPECT_FALSE(p.screens.debrief.empty());
+}
+
+TEST(BuiltinProtocol, UnknownNameListsValidOnes) {
+    try {
+        builtin_protocol("nope");
+        FAIL();
+    } catch (const ProtocolError& e) {
+        EXPECT_NE(std::string(e.what()).find("thesis"), std::string::npos);
+    }
+}
+
+std::string error_of(const std::string& text) {
+    try {
+        parse_protocol(text, "bad.toml");
+    } catch (const ProtocolError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(ProtocolErrors, UnknownKeyNamesFileLineAndKey) {
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("break_every = 2"), 15, "break_every = 2\ncolour = 3");
+    const std::string e = error_of(text);
+    // kSmallProtocol starts with a newline: [study] is line 2, colour line 5.
+    EXPECT_NE(e.find("bad.toml:5:"), std::string::npos) << e;
+    EXPECT_NE(e.find("study.colour"), std::string::npos) << e;
+    EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
+}
+
+TEST(ProtocolErrors, EachKindIsOneLineNamingTheKey) {
+    struct Case { std::string from, to, expect; };
+    const Case cases[] = {
+        {"break_every = 2", "break_every = \"two\"", "study.break_every"},
+        {"break_every = 2", "break_every = -1", "must lie in"},
+        {"stimuli = [\"a\", \"b\", \"c\"]", "stimuli = [\"a\", \"zz\"]", "no stimulus with id 'zz'"},
+        {"technique = \"ward\"", "technique = \"raytraced\"", "unknown technique"},
+        {"expected = 7", "expected = 9", "catch_trials.expected"},
+        {"varies = [\"thickness_exponent\"]\n\n[[stimuli]]\nid = \"b\"",
+         "varies = [\"roughness\"]\n\n[[stimuli]]\nid = \"b\"", "stimuli.varies"},
+        {"name = \"small\"", "name = \"small", "bad.toml:3:"},  // parse error position
+    };
+    for (const Case& c : cases) {
+        std::string text = lucent::test::kSmallProtocol;
+        const size_t at = text.find(c.from);
+        ASSERT_NE(at, std::string::npos) << c.from;
+        text.replace(at, c.from.size(), c.to);
+        const std::string e = error_of(text);
+        EXPECT_NE(e.find(c.expect), std::string::npos) << "got: " << e;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+        EXPECT_EQ(e.rfind("bad.toml:", 0), 0u) << e;
+    }
+}
+
+TEST(ProtocolErrors, ImpossibleRandomisationIsReportedWhenPlanning) {
+    std::string text = lucent::test::kSmallProtocol;
+    text += "\n[randomisation]\nfactor = \"backlight\"\nmax_repeat = 1\n";
+    const Protocol p = parse_protocol(text, "bad.toml");
+    EXPECT_THROW(plan_trials(p, 1, 1), PlanError);
+}
+
+TEST(Protocol, LevelsAreCanonicalNumbers) {
+    const Protocol p = builtin_protocol("thesis");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_8"), "diffuse_weight"), "0");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_9"), "diffuse_weight"), "0.5");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_2"), "thickness_exponent"), "18");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("contrast_reversed_jade"), "technique"), "contrast_reversed");
+}
+
+}  // namespace
+}  // namespace lucent::study

@@ -1,0 +1,74 @@
+// The simulated participant's decisions and timing (the X side is tested end to end).
+#include "session/autopilot.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include "test_paths.h"
+
+namespace lucent::study {
+namespace {
+
+// Runs the autopilot over a rating screen until it confirms; returns keys and times.
+std::vector<std::pair<int64_t, std::string>> drive(Autopilot& a, ScreenView v) {
+    std::vector<std::pair<int64_t, std::string>> out;
+    int enters = 0;
+    for (int64_t t = 0; t < 60'000'000'000LL && enters < v.questions; t += 1'000'000) {
+        for (const std::string& k : a.due(t, v)) {
+            out.emplace_back(t, k);
+            enters += k == "Enter";
+        }
+    }
+    return out;
+}
+
+TEST(Autopilot, AnswersEveryStatementWithHumanLikeDelays) {
+    Autopilot a = Autopilot::from_seed(5, 1.0);
+    ScreenView v{ScreenView::Kind::Rating, 1, 3, 7, false, 0};
+    const auto keys = drive(a, v);
+    ASSERT_FALSE(keys.empty());
+    EXPECT_EQ(std::count_if(keys.begin(), keys.end(), [](auto& k) { return k.second == "Enter"; }), 3);
+    EXPECT_EQ(keys.back().second, "Enter");
+    // A person needs hundreds of milliseconds per statement, not microseconds.
+    EXPECT_GT(keys.front().first, 300'000'000);
+    EXPECT_LT(keys.back().first, 20'000'000'000LL);
+    for (const auto& [t, k] : keys) {
+        if (k != "Enter") {
+            EXPECT_TRUE(k >= "1" && k <= "7") << k;
+        }
+    }
+}
+
+TEST(Autopilot, CatchTrialsGetTheExpectedAnswerAndSpeedScalesDelays) {
+    Autopilot slow = Autopilot::from_seed(9, 1.0), fast = Autopilot::from_seed(9, 10.0);
+    ScreenView v{ScreenView::Kind::Rating, 1, 2, 7, true, 7};
+    const auto s = drive(slow, v), f = drive(fast, v);
+    for (const auto& [t, k] : s) EXPECT_TRUE(k == "7" || k == "Enter");
+    ASSERT_EQ(s.size(), f.size());
+    EXPECT_NEAR(static_cast<double>(f.back().first), s.back().first / 10.0, 2e6);
+}
+
+TEST(Autopilot, ScriptsPlayInOrderAndBadLinesNameTheLine) {
+    const auto dir = lucent::test::scratch_dir("autopilot_script");
+    const std::string good = (dir / "good.txt").string(), bad = (dir / "bad.txt").string();
+    std::ofstream(good) << "# consent\n100 Enter\n50 3\n\n10 Escape\n";
+    std::ofstream(bad) << "100 Enter\n20 Space\n";
+    Autopilot a = Autopilot::from_argument(good, 1.0);
+    EXPECT_TRUE(a.scripted());
+    ScreenView v;
+    EXPECT_TRUE(a.due(0, v).empty());
+    EXPECT_EQ(a.due(100'000'000, v), std::vector<std::string>{"Enter"});
+    EXPECT_EQ(a.due(200'000'000, v), (std::vector<std::string>{"3", "Escape"}));
+    try {
+        Autopilot::from_file(bad);
+        FAIL();
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.txt:2:"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(Autopilot::from_argument("42", 1.0).scripted());
+}
+
+}  // namespace
+}  // namespace lucent::study

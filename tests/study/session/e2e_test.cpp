@@ -1,0 +1,442 @@
+// End to end: `lucent run` in a real X window (Xvfb in tests), the autopilot pressing
+// keys through XTest, the database checked afterwards. Sessions are short (a small
+// protocol, fast autopilot) so they stay quick on llvmpipe.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <thread>
+
+#include "../study_fixtures.h"
+#include "session/stimulus_source.h"
+#include "sha256.h"
+#include "sqlite.h"
+#include "test_paths.h"
+
+namespace lucent::study {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Process {
+    pid_t pid = -1;
+    fs::path stderr_path;
+};
+
+// Starts the lucent binary; stderr goes to a file; optionally without DISPLAY.
+Process start_lucent(const std::vector<std::string>& args, const fs::path& dir,
+                     bool without_display = false) {
+    static int counter = 0;
+    Process p;
+    p.stderr_path = dir / ("stderr" + std::to_string(counter++) + ".txt");
+    p.pid = fork();
+    if (p.pid == 0) {
+        const int fd = open(p.stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(fd, 2);
+        const int devnull = open("/dev/null", O_WRONLY);
+        dup2(devnull, 1);
+        if (without_display) unsetenv("DISPLAY");
+        std::vector<char*> argv;
+        argv.push_back(const_cast<char*>(LUCENT_EXECUTABLE));
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(LUCENT_EXECUTABLE, argv.data());
+        _exit(127);
+    }
+    return p;
+}
+
+int wait_exit(const Process& p) {
+    int status = 0;
+    waitpid(p.pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string read_file(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Distinct test pictures, one per stimulus id, named as --images expects.
+void write_images(const fs::path& dir, const std::vector<std::string>& ids, int size) {
+    for (size_t i = 0; i < ids.size(); ++i) {
+        CpuImage img{size, size, std::vector<uint8_t>(size_t(size) * size * 4)};
+        for (int y = 0; y < size; ++y)
+            for (int x = 0; x < size; ++x) {
+                uint8_t* px = &img.rgba[(size_t(y) * size + x) * 4];
+                px[0] = uint8_t(40 + x * 200 / size);
+                px[1] = uint8_t(30 + y * 200 / size);
+                px[2] = uint8_t(50 + 60 * i);
+                px[3] = 255;
+            }
+        save_image_rgba8((dir / (ids[i] + ".png")).string(), img);
+    }
+}
+
+class SessionE2E : public ::testing::Test {
+protected:
+    void SetUp() override {
+        if (!std::getenv("DISPLAY")) GTEST_SKIP() << "no X display (scripts/test runs ctest under xvfb-run)";
+        dir_ = lucent::test::scratch_dir(std::string("e2e_") +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        write_images(dir_, {"a", "b", "c", "p"}, 128);
+    }
+    // The small protocol with a short blank between trials; `repeats` per main stimulus.
+    std::string write_protocol(int repeats) {
+        std::string text = lucent::test::kSmallProtocol;
+        text.replace(text.find("break_every = 2"), 15, "break_every = 4\ninter_trial_ms = 100");
+        text += "\n[screens]\nconsent = \"Do you agree?\"\ninstructions = \"Rate each picture.\"\n";
+        text.replace(text.find("id = \"main\""), 11, "id = \"main\"\nrepeats = " + std::to_string(repeats));
+        const fs::path path = dir_ / "small.toml";
+        std::ofstream(path) << text;
+        return path.string();
+    }
+    std::vector<std::string> run_args(const std::string& protocol, const std::string& db,
+                                      const std::string& autopilot) {
+        return {"run", protocol, "--db", db, "--participant", "P1", "--images", dir_.string(),
+                "--autopilot", autopilot, "--autopilot-speed", "12", "--seed", "77"};
+    }
+    fs::path dir_;
+};
+
+TEST_F(SessionE2E, FullSessionStoresEveryRatingWithSensibleResponseTimes) {
+    const std::string db = (dir_ / "study.db").string();
+    const fs::path shot = dir_ / "rating_screen.png";
+    auto args = run_args(write_protocol(1), db, "7");
+    args.insert(args.end(), {"--screenshot", shot.string()});
+    const Process p = start_lucent(args, dir_);
+    ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
+
+    Database d(db, SQLITE_OPEN_READONLY);
+    const int64_t trials = d.scalar_int("SELECT count(*) FROM trials");
+    EXPECT_EQ(trials, 5);  // 1 practice + 3 rated + 1 catch
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 2);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
+                           "AND ended_utc IS NOT NULL AND consent_utc IS NOT NULL"), 1);
+    // Autopilot delays at speed 12 are ~60-150 ms: RTs must be positive and bounded.
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses WHERE rt_ms < 10 OR rt_ms > 5000"), 0);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE onset_ns IS NULL OR "
+                           "confirm_ns <= onset_ns"), 0);
+    // The catch trial was answered as asked.
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
+                           "WHERE t.catch = 1 AND r.rating != t.expected_rating"), 0);
+    // Under Xvfb the video mode says 0 Hz: the refresh is recorded as unknown, with why.
+    Statement s = d.prepare("SELECT display_refresh_hz, measured_refresh_hz, refresh_note, "
+                            "gl_renderer, software_version FROM sessions");
+    ASSERT_TRUE(s.step());
+    if (s.is_null(0)) {
+        EXPECT_TRUE(s.is_null(1));
+        EXPECT_NE(s.text(2).find("unknown"), std::string::npos);
+    }
+    EXPECT_FALSE(s.text(3).empty());
+    EXPECT_FALSE(s.text(4).empty());
+    Statement rt = d.prepare("SELECT rt_ms FROM responses ORDER BY rt_ms");
+    std::vector<double> rts;
+    while (rt.step()) rts.push_back(rt.real(0));
+    RecordProperty("median_rt_ms", std::to_string(rts[rts.size() / 2]));
+    std::printf("autopilot session: median RT %.1f ms over %zu ratings; refresh note: %s\n",
+                rts[rts.size() / 2], rts.size(), s.text(2).c_str());
+
+    // Screenshot of the first rating screen (the practice stimulus 'p'): the picture sits
+    // centred, pixel for pixel, on the black background.
+    ASSERT_TRUE(fs::exists(shot));
+    const CpuImage screen = load_image_rgba8(shot.string());
+    const CpuImage stimulus = load_image_rgba8((dir_ / "p.png").string());
+    const int x0 = (screen.width - 128) / 2, y0 = (screen.height - 128) / 2;
+    auto px = [&](const CpuImage& im, int x, int y) { return &im.rgba[(size_t(y) * im.width + x) * 4]; };
+    int mismatched = 0;
+    for (int y = 0; y < 128; ++y)
+        for (int x = 0; x < 128; ++x)
+            for (int c = 0; c < 3; ++c)
+                mismatched += px(screen, x0 + x, y0 + y)[c] != px(stimulus, x, y)[c];
+    EXPECT_EQ(mismatched, 0) << "stimulus not shown pixel for pixel at (" << x0 << "," << y0 << ")";
+    for (int i = -1; i <= 128; ++i)  // a one-pixel ring around it is background
+        for (auto [x, y] : {std::pair{x0 + i, y0 - 1}, {x0 + i, y0 + 128}, {x0 - 1, y0 + i}, {x0 + 128, y0 + i}})
+            EXPECT_EQ(px(screen, x, y)[0] + px(screen, x, y)[1] + px(screen, x, y)[2], 0) << x << "," << y;
+    // The scale: rows below the picture crossing exactly 7 separate point buttons
+    // (button colour 0.25, 0.25, 0.3), in two separate bands for the two statements.
+    // Digits split rows through their buttons, so rows with 7 runs are grouped into
+    // bands separated by gaps of more than 20 rows.
+    std::vector<int> scale_rows;
+    for (int y = y0 + 128; y < screen.height; ++y) {
+        int runs = 0;
+        bool in_run = false;
+        for (int x = 0; x < screen.width; ++x) {
+            const uint8_t* c = px(screen, x, y);
+            const bool button = std::abs(c[0] - 64) <= 2 && std::abs(c[1] - 64) <= 2 && std::abs(c[2] - 77) <= 2;
+            runs += button && !in_run;
+            in_run = button;
+        }
+        if (runs == 7) scale_rows.push_back(y);
+    }
+    int bands = scale_rows.empty() ? 0 : 1;
+    for (size_t i = 1; i < scale_rows.size(); ++i) bands += scale_rows[i] - scale_rows[i - 1] > 20;
+    EXPECT_EQ(bands, 2) << "expected one 7-point scale per statement";
+}
+
+TEST_F(SessionE2E, KilledAtARandomTrialAndResumedKeepsExactlyOneRatingEach) {
+    const std::string db = (dir_ / "study.db").string();
+    const std::string protocol = write_protocol(3);  // 1 practice + 9 rated + 1 catch
+    std::mt19937 gen(static_cast<unsigned>(std::random_device{}()));
+    const int kill_after = 2 + static_cast<int>(gen() % 6);  // trials answered before the kill
+    const Process first = start_lucent(run_args(protocol, db, "11"), dir_);
+    int64_t answered = 0;
+    std::vector<std::pair<int, std::string>> order_before;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (!fs::exists(db)) continue;
+        try {
+            Database d(db, SQLITE_OPEN_READONLY);
+            answered = d.scalar_int("SELECT count(DISTINCT trial_id) FROM responses");
+            if (answered >= kill_after) break;
+        } catch (const StoreError&) {
+        }
+    }
+    kill(first.pid, SIGKILL);
+    EXPECT_EQ(wait_exit(first), 128 + SIGKILL);
+    ASSERT_GE(answered, kill_after) << read_file(first.stderr_path);
+    {
+        Database d(db, SQLITE_OPEN_READONLY);
+        Statement s = d.prepare("SELECT t.position, st.stimulus_key FROM trials t JOIN stimuli st "
+                                "ON st.id = t.stimulus_id ORDER BY t.position");
+        while (s.step()) order_before.emplace_back(int(s.integer(0)), s.text(1));
+    }
+    // Without --resume the runner refuses (exit 2) rather than starting over.
+    const Process refused = start_lucent(run_args(protocol, db, "12"), dir_);
+    EXPECT_EQ(wait_exit(refused), 2);
+    auto resume_args = run_args(protocol, db, "12");
+    resume_args.push_back("--resume");
+    const Process second = start_lucent(resume_args, dir_);
+    ASSERT_EQ(wait_exit(second), 0) << read_file(second.stderr_path);
+
+    Database d(db, SQLITE_OPEN_READONLY);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions"), 1);
+    const int64_t trials = d.scalar_int("SELECT count(*) FROM trials");
+    EXPECT_EQ(trials, 11);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 2);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM (SELECT trial_id, question FROM responses "
+                           "GROUP BY 1, 2 HAVING count(*) != 1)"), 0);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    std::vector<std::pair<int, std::string>> order_after;
+    Statement s = d.prepare("SELECT t.position, st.stimulus_key FROM trials t JOIN stimuli st "
+                            "ON st.id = t.stimulus_id ORDER BY t.position");
+    while (s.step()) order_after.emplace_back(int(s.integer(0)), s.text(1));
+    EXPECT_EQ(order_after, order_before);
+    RecordProperty("killed_after_trials", std::to_string(answered));
+    std::printf("kill-and-resume: killed with %lld of %lld trials answered; after resume %lld "
+                "ratings = %lld trials x 2 questions, no duplicates\n",
+                static_cast<long long>(answered), static_cast<long long>(trials),
+                static_cast<long long>(d.scalar_int("SELECT count(*) FROM responses")),
+                static_cast<long long>(trials));
+}
+
+TEST_F(SessionE2E, EscapeThenQuitSavesAndAScriptedAutopilotDrivesIt) {
+    const std::string db = (dir_ / "study.db").string();
+    const fs::path script = dir_ / "pause.txt";
+    // consent, instructions, wait for the first rating screen, rate, pause, quit.
+    std::ofstream(script) << "300 Enter\n300 Enter\n800 4\n100 Enter\n100 5\n100 Enter\n"
+                             "900 Escape\n300 Q\n";
+    const Process p = start_lucent(run_args(write_protocol(1), db, script.string()), dir_);
+    ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
+    Database d(db, SQLITE_OPEN_READONLY);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'paused'"), 1);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), 2);
+    EXPECT_EQ(d.scalar_int("SELECT rating FROM responses WHERE question = 'translucent'"), 4);
+    EXPECT_EQ(d.scalar_int("SELECT rating FROM responses WHERE question = 'realistic'"), 5);
+}
+
+TEST_F(SessionE2E, ForeignOrCorruptDatabaseIsRefusedAndLeftUnchanged) {
+    const fs::path db = dir_ / "foreign.db";
+    {
+        Database other(db.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+        other.exec("CREATE TABLE inventory (item TEXT); INSERT INTO inventory VALUES ('x')");
+    }
+    const fs::path junk = dir_ / "junk.db";
+    std::ofstream(junk, std::ios::binary) << std::string(5000, '\x42');
+    for (const fs::path& path : {db, junk}) {
+        const std::string before = sha256_hex(read_file(path));
+        const Process p = start_lucent(run_args(write_protocol(1), path.string(), "1"), dir_);
+        EXPECT_EQ(wait_exit(p), 2);
+        const std::string err = read_file(p.stderr_path);
+        EXPECT_NE(err.find("not a Lucent study database"), std::string::npos) << err;
+        EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+        EXPECT_EQ(sha256_hex(read_file(path)), before);
+        EXPECT_FALSE(fs::exists(path.string() + "-wal"));
+        const Process e = start_lucent({"export", path.string(), "--out", (dir_ / "x.csv").string()}, dir_);
+        EXPECT_EQ(wait_exit(e), 2);
+        EXPECT_EQ(sha256_hex(read_file(path)), before);
+    }
+}
+
+TEST_F(SessionE2E, NoDisplayGivesOneLineSuggestingXvfb) {
+    const std::string db = (dir_ / "study.db").string();
+    const Process p = start_lucent(run_args(write_protocol(1), db, "1"), dir_, /*without_display=*/true);
+    EXPECT_EQ(wait_exit(p), 1);
+    const std::string err = read_file(p.stderr_path);
+    EXPECT_NE(err.find("xvfb-run"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
+
+TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
+    // The built-in protocol, its live stimuli stood in for by pre-rendered files (the
+    // live renderer is wired separately): every planned (trial, question) gets a rating.
+    const Protocol thesis = builtin_protocol("thesis");
+    std::vector<std::string> ids;
+    for (const StimulusSpec& st : thesis.stimuli) ids.push_back(st.id);
+    write_images(dir_, ids, 64);
+    const std::string db = (dir_ / "thesis.db").string();
+    const Process p = start_lucent({"run", "--preset", "thesis", "--db", db, "--participant", "P4",
+                                    "--images", dir_.string(), "--autopilot", "3",
+                                    "--autopilot-speed", "25", "--windowed"}, dir_);
+    ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
+    Database d(db, SQLITE_OPEN_READONLY);
+    const int64_t trials = d.scalar_int("SELECT count(*) FROM trials");
+    EXPECT_EQ(trials, 2 + 15 + 2);  // practice + 9 empirical + 6 ward/contrast-reversed + catch
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 3);
+    EXPECT_EQ(d.scalar_int("SELECT count(DISTINCT question) FROM responses"), 3);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    // Participant 4, two blocks: Latin-square row 0 shows 'empirical' first.
+    Statement order = d.prepare("SELECT block_order FROM sessions");
+    ASSERT_TRUE(order.step());
+    EXPECT_EQ(order.text(0), "empirical,contrast_reversal");
+}
+
+TEST_F(SessionE2E, LiveStimuliAreRenderedLikeLucentRender) {
+    // No --images: the runner renders each stimulus with the renderer. The first rating
+    // screen (practice stimulus 'p': ward on a sphere) must show exactly the picture
+    // `lucent render` makes from the same technique and parameters.
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("break_every = 2"), 15, "inter_trial_ms = 100\nstimulus_size = [96, 96]");
+    const fs::path protocol = dir_ / "live.toml";
+    std::ofstream(protocol) << text;
+    const fs::path shot = dir_ / "live_screen.png", reference = dir_ / "reference.png";
+    const std::string db = (dir_ / "live.db").string();
+    const Process run = start_lucent({"run", protocol.string(), "--db", db, "--participant", "P1",
+                                      "--autopilot", "5", "--autopilot-speed", "12",
+                                      "--screenshot", shot.string()}, dir_);
+    ASSERT_EQ(wait_exit(run), 0) << read_file(run.stderr_path);
+    const Process render = start_lucent({"render", "--mesh", "sphere", "--technique", "ward",
+                                         "--set", "roughness=0.2", "--size", "96x96",
+                                         "--out", reference.string()}, dir_);
+    ASSERT_EQ(wait_exit(render), 0) << read_file(render.stderr_path);
+    const CpuImage screen = load_image_rgba8(shot.string());
+    const CpuImage ref = load_image_rgba8(reference.string());
+    const int x0 = (screen.width - 96) / 2, y0 = (screen.height - 96) / 2;
+    int max_difference = 0, object_pixels = 0;
+    for (int y = 0; y < 96; ++y)
+        for (int x = 0; x < 96; ++x) {
+            const uint8_t* a = &screen.rgba[(size_t(y0 + y) * screen.width + x0 + x) * 4];
+            const uint8_t* b = &ref.rgba[(size_t(y) * 96 + x) * 4];
+            object_pixels += b[0] + b[1] + b[2] > 0;
+            for (int c = 0; c < 3; ++c) max_difference = std::max(max_difference, std::abs(a[c] - b[c]));
+        }
+    EXPECT_GT(object_pixels, 96 * 96 / 4) << "the reference shows no object";
+    EXPECT_LE(max_difference, 1) << "live stimulus differs from lucent render's image";
+    EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM responses"), 10);
+}
+
+TEST_F(SessionE2E, BadLiveParametersAreRefusedBeforeAnyWindow) {
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("roughness = 0.2"), 15, "roughness = 0.2, sparkle = 3");
+    const fs::path protocol = dir_ / "bad.toml";
+    std::ofstream(protocol) << text;
+    const Process p = start_lucent({"run", protocol.string(), "--db", (dir_ / "b.db").string(),
+                                    "--participant", "P1"}, dir_);
+    EXPECT_EQ(wait_exit(p), 2);
+    const std::string err = read_file(p.stderr_path);
+    EXPECT_NE(err.find("stimulus 'p'"), std::string::npos) << err;
+    EXPECT_NE(err.find("sparkle"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
+// ---- The data commands, driven through the CLI (no display needed) ----------------
+class DataCommands : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = lucent::test::scratch_dir(std::string("cli_") +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        db_ = (dir_ / "study.db").string();
+        Store store(db_);
+        lucent::test::run_full_session(store, lucent::test::small_protocol(), "P1", 1);
+        lucent::test::run_full_session(store, lucent::test::small_protocol(), "P2", 2);
+    }
+    int run(const std::vector<std::string>& args, const std::string& stdin_text = "") {
+        const fs::path in = dir_ / "stdin.txt";
+        std::ofstream(in) << stdin_text;
+        const pid_t pid = fork();
+        if (pid == 0) {
+            const int fd = open(in.c_str(), O_RDONLY);
+            dup2(fd, 0);
+            const int err = open((dir_ / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            dup2(err, 2);
+            const int out = open((dir_ / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            dup2(out, 1);
+            std::vector<char*> argv{const_cast<char*>(LUCENT_EXECUTABLE)};
+            for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+            argv.push_back(nullptr);
+            execv(LUCENT_EXECUTABLE, argv.data());
+            _exit(127);
+        }
+        int status = 0;
+        waitpid(pid, &status, 0);
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    int64_t count(const std::string& sql) { return Database(db_, SQLITE_OPEN_READONLY).scalar_int(sql); }
+    fs::path dir_;
+    std::string db_;
+};
+
+TEST_F(DataCommands, WithdrawAsksAndOnlyYesDeletes) {
+    EXPECT_EQ(run({"participants", "withdraw", "P1", "--db", db_}, "no\n"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 2);
+    EXPECT_EQ(run({"participants", "withdraw", "P1", "--db", db_}, "yes\n"), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 1);
+    EXPECT_EQ(run({"participants", "withdraw", "P2", "--db", db_, "--yes"}), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
+    EXPECT_EQ(run({"participants", "withdraw", "P9", "--db", db_, "--yes"}), 2);
+    EXPECT_NE(read_file(dir_ / "stderr.txt").find("no participant 'P9'"), std::string::npos);
+}
+
+TEST_F(DataCommands, ExportWritesEachFormatAndMergeDeduplicates) {
+    for (const char* format : {"long", "wide", "analysis"}) {
+        const fs::path out = dir_ / (std::string(format) + ".csv");
+        ASSERT_EQ(run({"export", db_, "--format", format, "--out", out.string()}), 0) << format;
+        const std::string text = read_file(out);
+        const long lines = std::count(text.begin(), text.end(), '\n');
+        EXPECT_EQ(lines, std::string(format) == "long" ? 1 + 2 * 5 * 2
+                         : std::string(format) == "wide" ? 1 + 2 : 1 + 2 * 3 * 2) << format;
+        EXPECT_FALSE(fs::exists(out.string() + ".partial"));
+    }
+    EXPECT_EQ(run({"export", db_, "--format", "json", "--out", (dir_ / "x").string()}), 2);
+    const std::string copy = (dir_ / "copy.db").string();
+    fs::copy_file(db_, copy);
+    const std::string merged = (dir_ / "all.db").string();
+    ASSERT_EQ(run({"merge", db_, copy, "--out", merged}), 0);
+    EXPECT_EQ(Database(merged, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM sessions"), 2);
+    EXPECT_NE(read_file(dir_ / "stdout.txt").find("2 duplicates skipped"), std::string::npos);
+}
+
+TEST_F(DataCommands, AnalyzeReadsTheStudyDatabaseDirectly) {
+    // Two participants x 3 levels of thickness_exponent x 2 questions (see study_fixtures).
+    const fs::path out = dir_ / "report";
+    ASSERT_EQ(run({"analyze", db_, "--out", out.string(), "--format", "csv"}), 0)
+        << read_file(dir_ / "stderr.txt");
+    const std::string anova = read_file(out / "anova.csv");
+    EXPECT_NE(anova.find("translucent,thickness_exponent,"), std::string::npos) << anova;
+    EXPECT_NE(anova.find("realistic,thickness_exponent,"), std::string::npos) << anova;
+    EXPECT_EQ(std::count(anova.begin(), anova.end(), '\n'), 3);  // header + 2 questions
+}
+
+}  // namespace
+}  // namespace lucent::study

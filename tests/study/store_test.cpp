@@ -1,0 +1,151 @@
+// The study store: pragmas, schema version and migration, planned order written before
+// trial 1, one transaction per trial, resume and withdrawal.
+#include "store.h"
+
+#include <gtest/gtest.h>
+
+#include "study_fixtures.h"
+#include "test_paths.h"
+
+namespace lucent::study {
+namespace {
+
+using lucent::test::kSmallProtocol;
+using lucent::test::small_protocol;
+
+TEST(Store, OpensWithWalFullSyncAndForeignKeys) {
+    const auto dir = lucent::test::scratch_dir("store_pragmas");
+    Store store((dir / "s.db").string());
+    Database& db = store.db();
+    Statement mode = db.prepare("PRAGMA journal_mode");
+    ASSERT_TRUE(mode.step());
+    EXPECT_EQ(mode.text(0), "wal");
+    EXPECT_EQ(db.scalar_int("PRAGMA synchronous"), 2);  // FULL
+    EXPECT_EQ(db.scalar_int("PRAGMA foreign_keys"), 1);
+    EXPECT_EQ(db.scalar_int("PRAGMA application_id"), kApplicationId);
+    EXPECT_EQ(db.scalar_int("PRAGMA user_version"), kSchemaVersion);
+}
+
+TEST(Store, WritesTheWholePlanBeforeTheFirstTrial) {
+    const auto dir = lucent::test::scratch_dir("store_plan");
+    Store store((dir / "s.db").string());
+    const Protocol p = small_protocol();
+    const int64_t study = store.ensure_study(p);
+    int number = -1;
+    const int64_t pid = store.ensure_participant(study, "P7", &number);
+    EXPECT_EQ(number, 7);
+    const TrialPlan plan = plan_trials(p, 42, number);
+    const SessionRow s = store.create_session(study, pid, plan, 42, {});
+    const std::vector<TrialRow> trials = store.trials(s.id);
+    ASSERT_EQ(trials.size(), plan.trials.size());
+    for (size_t i = 0; i < trials.size(); ++i) {
+        EXPECT_EQ(trials[i].stimulus, plan.trials[i].stimulus);
+        EXPECT_EQ(trials[i].practice, plan.trials[i].practice);
+        EXPECT_EQ(trials[i].is_catch, plan.trials[i].is_catch);
+        EXPECT_FALSE(trials[i].answered);
+    }
+    EXPECT_EQ(s.uuid.size(), 36u);
+    EXPECT_EQ(s.uuid[14], '4');
+    // Stimulus parameters are stored as rows, ready to serve as factors.
+    EXPECT_EQ(store.db().scalar_int(
+                  "SELECT count(*) FROM stimulus_parameters p JOIN stimuli s ON s.id = "
+                  "p.stimulus_id WHERE s.stimulus_key = 'b' AND p.name = 'thickness_exponent' "
+                  "AND p.value = '25'"),
+              1);
+}
+
+TEST(Store, RecordsEachTrialOnceAndRefusesDuplicates) {
+    const auto dir = lucent::test::scratch_dir("store_record");
+    Store store((dir / "s.db").string());
+    const Protocol p = small_protocol();
+    const int64_t study = store.ensure_study(p);
+    const int64_t pid = store.ensure_participant(study, "anna", nullptr);
+    const SessionRow s = store.create_session(study, pid, plan_trials(p, 1, 1), 1, {});
+    const std::vector<TrialRow> trials = store.trials(s.id);
+    store.record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
+    EXPECT_THROW(store.record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0])),
+                 StoreError);
+    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM responses"), 2);
+    // A rating outside 1..7 violates the CHECK constraint and leaves nothing behind.
+    TrialOutcome bad = lucent::test::outcome_for(p, trials[1]);
+    bad.responses[1].rating = 8;
+    EXPECT_THROW(store.record_trial(s.id, trials[1].id, bad), StoreError);
+    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM responses"), 2);
+    EXPECT_TRUE(store.trials(s.id)[0].answered);
+    EXPECT_FALSE(store.trials(s.id)[1].answered);
+}
+
+TEST(Store, ResumeFindsTheUnfinishedSessionWithItsOrder) {
+    const auto dir = lucent::test::scratch_dir("store_resume");
+    const std::string path = (dir / "s.db").string();
+    const Protocol p = small_protocol();
+    std::vector<std::string> order;
+    {
+        Store store(path);
+        const int64_t study = store.ensure_study(p);
+        const int64_t pid = store.ensure_participant(study, "P2", nullptr);
+        const SessionRow s = store.create_session(study, pid, plan_trials(p, 9, 2), 9, {});
+        const auto trials = store.trials(s.id);
+        for (const auto& t : trials) order.push_back(t.stimulus);
+        store.record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
+        store.record_trial(s.id, trials[1].id, lucent::test::outcome_for(p, trials[1]));
+    }
+    Store store(path);
+    const auto s = store.unfinished_session("P2");
+    ASSERT_TRUE(s.has_value());
+    EXPECT_EQ(s->seed, 9u);
+    const auto trials = store.trials(s->id);
+    std::vector<std::string> again;
+    for (const auto& t : trials) again.push_back(t.stimulus);
+    EXPECT_EQ(again, order);
+    EXPECT_TRUE(trials[1].answered);
+    EXPECT_FALSE(trials[2].answered);
+    EXPECT_FALSE(store.unfinished_session("nobody").has_value());
+}
+
+TEST(Store, RefusesASecondProtocolInOneDatabase) {
+    const auto dir = lucent::test::scratch_dir("store_two_protocols");
+    Store store((dir / "s.db").string());
+    store.ensure_study(small_protocol());
+    EXPECT_THROW(store.ensure_study(builtin_protocol("thesis")), StoreError);
+    EXPECT_EQ(store.ensure_study(small_protocol()), store.ensure_study(small_protocol()));
+}
+
+TEST(Store, WithdrawDeletesEverythingOfThatParticipantOnly) {
+    const auto dir = lucent::test::scratch_dir("store_withdraw");
+    Store store((dir / "s.db").string());
+    const Protocol p = small_protocol();
+    lucent::test::run_full_session(store, p, "P1", 1);
+    lucent::test::run_full_session(store, p, "P2", 2);
+    const int64_t per_session = store.db().scalar_int("SELECT count(*) FROM responses") / 2;
+    EXPECT_TRUE(store.withdraw_participant("P1"));
+    EXPECT_FALSE(store.withdraw_participant("P1"));
+    Database& db = store.db();
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM participants WHERE code = 'P1'"), 0);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM sessions"), 1);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM responses"), per_session);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM trials t LEFT JOIN sessions s ON "
+                            "s.id = t.session_id WHERE s.id IS NULL"),
+              0);
+}
+
+TEST(Store, MigratesAVersion1DatabaseKeepingItsRows) {
+    const auto dir = lucent::test::scratch_dir("store_migrate");
+    const std::string path = (dir / "old.db").string();
+    {
+        Database db(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+        migrate(db, 1);
+        db.exec("INSERT INTO studies (name, protocol_text, protocol_hash, created_utc) "
+                "VALUES ('old', 'x', 'h', 'now')");
+        ASSERT_EQ(db.scalar_int("PRAGMA user_version"), 1);
+    }
+    Store store(path);
+    EXPECT_EQ(store.db().scalar_int("PRAGMA user_version"), kSchemaVersion);
+    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM studies WHERE name = 'old'"), 1);
+    EXPECT_EQ(store.db().scalar_int(
+                  "SELECT count(*) FROM pragma_table_info('sessions') WHERE name = 'refresh_note'"),
+              1);
+}
+
+}  // namespace
+}  // namespace lucent::study

@@ -1,0 +1,105 @@
+#pragma once
+// A small protocol and helpers that fill a study database the way the runner does.
+#include <string>
+
+#include "protocol.h"
+#include "store.h"
+#include "trial_plan.h"
+
+namespace lucent::test {
+
+// 3 rated stimuli varying thickness_exponent, 1 practice, 1 catch (expected 7), 2 questions.
+inline const char* kSmallProtocol = R"toml(
+[study]
+name = "small"
+break_every = 2
+
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+
+[[questions]]
+id = "realistic"
+text = "The object looks realistic."
+
+[[stimuli]]
+id = "a"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 18, backlight = 1.2 }
+varies = ["thickness_exponent"]
+
+[[stimuli]]
+id = "b"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 25, backlight = 1.2 }
+varies = ["thickness_exponent"]
+
+[[stimuli]]
+id = "c"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 30, backlight = 1.2 }
+varies = ["thickness_exponent"]
+
+[[stimuli]]
+id = "p"
+technique = "ward"
+mesh = "sphere"
+params = { roughness = 0.2 }
+
+[practice]
+stimuli = ["p"]
+
+[[blocks]]
+id = "main"
+stimuli = ["a", "b", "c"]
+
+[[catch_trials]]
+id = "attention"
+stimulus = "a"
+block = "main"
+prompt = "Choose 7"
+expected = 7
+)toml";
+
+inline study::Protocol small_protocol() { return study::parse_protocol(kSmallProtocol, "small.toml"); }
+
+// Deterministic rating for (trial position, question index): lets tests recompute
+// expected exports independently of the database.
+inline int rating_for(int position, int question) { return 1 + (position * 3 + question * 2) % 7; }
+
+inline study::TrialOutcome outcome_for(const study::Protocol& p, const study::TrialRow& t,
+                                       int catch_rating = 7) {
+    study::TrialOutcome o;
+    o.onset_ns = 1000000LL * (t.position + 1);
+    o.confirm_ns = o.onset_ns + 900000000LL;
+    for (int q = 0; q < static_cast<int>(p.questions.size()); ++q) {
+        study::Response r;
+        r.question = p.questions[q].id;
+        r.rating = t.is_catch ? catch_rating : rating_for(t.position, q);
+        r.rt_ms = 500.0 + 100 * q;
+        r.changes = q;
+        r.first_choice_ns = o.onset_ns + 100;
+        r.final_choice_ns = o.onset_ns + 200;
+        o.responses.push_back(r);
+    }
+    return o;
+}
+
+// Starts a session for `code` and answers every trial; returns the session id.
+inline int64_t run_full_session(study::Store& store, const study::Protocol& p,
+                                const std::string& code, uint64_t seed, int catch_rating = 7) {
+    const int64_t study_id = store.ensure_study(p);
+    int number = 0;
+    const int64_t pid = store.ensure_participant(study_id, code, &number);
+    study::SessionRow s = store.create_session(study_id, pid, study::plan_trials(p, seed, number),
+                                              seed, {});
+    for (const study::TrialRow& t : store.trials(s.id))
+        store.record_trial(s.id, t.id, outcome_for(p, t, catch_rating));
+    store.set_status(s.id, "completed", true);
+    return s.id;
+}
+
+}  // namespace lucent::test
