@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "batch_render.h"
 #include "core/image.h"
@@ -24,7 +26,7 @@ std::string read_bytes(const std::filesystem::path& path) {
 
 // A small set: two ward roughness values (a vary list) and one contrast_reversed.
 std::string small_config(const std::string& reversed_weight = "0.6") {
-    return "name = \"small\"\nresolution = [48, 40]\nformats = [\"exr\", \"png\"]\n"
+    return "name = \"small\"\nresolution = [48, 40]\nformats = [\"exr\", \"png\", \"tif\"]\n"
            "[meshes]\nball = \"sphere:1k\"\n"
            "[defaults]\nao_rays = 8\n"
            "[[stimuli]]\nid = \"w_{roughness}\"\ntechnique = \"ward\"\n"
@@ -59,7 +61,7 @@ TEST(BatchRender, WritesImagesAndACompleteManifest) {
         ASSERT_TRUE(rows.count(id)) << id;
         const auto& row = rows.at(id);
         EXPECT_EQ(row.at("file"), std::string(id) + ".exr");
-        EXPECT_EQ(row.at("files"), std::string(id) + ".exr;" + id + ".png");
+        EXPECT_EQ(row.at("files"), std::string(id) + ".exr;" + id + ".png;" + id + ".tif");
         EXPECT_EQ(row.at("mesh_hash"), mesh.content_hash);
         EXPECT_EQ(row.at("software_version"), version_string());
         EXPECT_EQ(row.at("ao_rays"), "8");
@@ -68,6 +70,7 @@ TEST(BatchRender, WritesImagesAndACompleteManifest) {
         Hasher files;
         files.add_field(hash_file(dir / (std::string(id) + ".exr")));
         files.add_field(hash_file(dir / (std::string(id) + ".png")));
+        files.add_field(hash_file(dir / (std::string(id) + ".tif")));
         EXPECT_EQ(row.at("content_hash"), files.hex());
         // Statistics agree with the EXR read back (float, lossless).
         const Image image = read_image(dir / (std::string(id) + ".exr"));
@@ -86,14 +89,15 @@ TEST(BatchRender, WritesImagesAndACompleteManifest) {
     // Nothing but the images and the manifest: no temporary files left.
     std::size_t files = 0;
     for (const auto& entry : std::filesystem::directory_iterator(dir)) (void)entry, ++files;
-    EXPECT_EQ(files, 3u * 2u + 2u);
+    EXPECT_EQ(files, 3u * 3u + 2u);
 }
 
 TEST(BatchRender, SecondRunReusesForceRerendersByteIdentically) {
     const auto dir = test::scratch_dir("batch_rerun");
     const auto set = small_set();
     render(set, dir);
-    const std::string exr = read_bytes(dir / "w_0.3.exr"), png = read_bytes(dir / "cr.png");
+    const std::string exr = read_bytes(dir / "w_0.3.exr"), png = read_bytes(dir / "cr.png"),
+                      tif = read_bytes(dir / "w_0.1.tif");
     const std::string manifest = read_bytes(dir / "manifest.csv");
 
     const auto again = render(set, dir);
@@ -101,10 +105,13 @@ TEST(BatchRender, SecondRunReusesForceRerendersByteIdentically) {
     EXPECT_EQ(again.reused, 3u);
     EXPECT_EQ(read_bytes(dir / "manifest.csv"), manifest);
 
+    // A later second: encoders that stamp the time would change the bytes.
+    std::this_thread::sleep_for(std::chrono::milliseconds(1100));
     const auto forced = render(set, dir, /*force=*/true, /*jobs=*/2);
     EXPECT_EQ(forced.rendered, 3u);
     EXPECT_EQ(read_bytes(dir / "w_0.3.exr"), exr);  // same inputs, same bytes
     EXPECT_EQ(read_bytes(dir / "cr.png"), png);
+    EXPECT_EQ(read_bytes(dir / "w_0.1.tif"), tif);
     EXPECT_EQ(read_bytes(dir / "manifest.csv"), manifest);
 }
 
