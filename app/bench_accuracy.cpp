@@ -28,7 +28,7 @@ struct AccuracyBenchOptions {
     std::string mesh = "torus_knot:30k";
     std::string size = "256x256";
     std::vector<std::string> settings;
-    int frames = 10;
+    int frames = 30;
     std::string svg = "bench-accuracy.svg";
 };
 
@@ -40,17 +40,20 @@ struct Row {
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+        .count();
 }
 
-double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene, const FramePlan& plan, int frames) {
+double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene,
+                       const FramePlan& plan, int frames) {
     std::vector<double> times;
     for (int i = 0; i < frames + 1; ++i) {  // the first frame warms caches
         executor.execute(scene, plan, true);
         double ms = 0.0;
         const auto& passes = executor.last_timings().passes;
         for (std::size_t p = 0; p < passes.size(); ++p)
-            if (plan.passes[p].kind != PassKind::bake_ambient_occlusion) ms += passes[p].milliseconds;
+            if (plan.passes[p].kind != PassKind::bake_ambient_occlusion)
+                ms += passes[p].milliseconds;
         if (i > 0) times.push_back(ms);
     }
     std::sort(times.begin(), times.end());
@@ -65,45 +68,65 @@ std::string escape(const std::string& text) {
 
 // One panel per knob: RMSE (y) against the cost that varies along the sweep (x): the
 // precomputation when it varies, otherwise the GPU frame time.
-void write_svg(const std::string& path, const std::vector<Row>& rows, const std::string& title) {
+void write_svg(const std::string& path, const std::vector<Row>& rows,
+               const std::string& title) {
     std::vector<std::string> knobs;
     for (const auto& r : rows)
-        if (std::find(knobs.begin(), knobs.end(), r.knob) == knobs.end()) knobs.push_back(r.knob);
+        if (std::find(knobs.begin(), knobs.end(), r.knob) == knobs.end())
+            knobs.push_back(r.knob);
     const int panel_w = 320, panel_h = 260, margin = 50;
     std::ofstream svg(path);
     svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << panel_w * knobs.size()
         << "' height='" << panel_h + 40 << "' font-family='sans-serif' font-size='11'>\n"
-        << "<rect width='100%' height='100%' fill='white'/>\n<text x='10' y='16' font-size='13'>"
+        << "<rect width='100%' height='100%' fill='white'/>\n<text x='10' y='16' "
+           "font-size='13'>"
         << escape(title) << "</text>\n";
     for (std::size_t k = 0; k < knobs.size(); ++k) {
         std::vector<const Row*> series;
         for (const auto& r : rows)
             if (r.knob == knobs[k]) series.push_back(&r);
         double min_pre = 1e300, max_pre = 0;
-        for (const Row* r : series) min_pre = std::min(min_pre, r->precompute_s), max_pre = std::max(max_pre, r->precompute_s);
+        for (const Row* r : series)
+            min_pre = std::min(min_pre, r->precompute_s),
+            max_pre = std::max(max_pre, r->precompute_s);
         const bool by_precompute = max_pre > 1.5 * std::max(min_pre, 1e-9);
-        const auto x_of = [&](const Row* r) { return by_precompute ? r->precompute_s : r->frame_ms; };
+        const auto x_of = [&](const Row* r) {
+            return by_precompute ? r->precompute_s : r->frame_ms;
+        };
         double max_x = 0, max_y = 0;
-        for (const Row* r : series) max_x = std::max(max_x, x_of(r)), max_y = std::max(max_y, r->error.rmse);
+        for (const Row* r : series)
+            max_x = std::max(max_x, x_of(r)), max_y = std::max(max_y, r->error.rmse);
         max_x = max_x > 0 ? max_x * 1.15 : 1;
         max_y = max_y > 0 ? max_y * 1.15 : 1;
         const int ox = static_cast<int>(k) * panel_w + margin, oy = 30 + panel_h - margin;
         const int w = panel_w - margin - 20, h = panel_h - margin - 20;
         const auto px = [&](double x) { return ox + x / max_x * w; };
         const auto py = [&](double y) { return oy - y / max_y * h; };
-        svg << "<text x='" << ox << "' y='" << oy - h - 6 << "' font-weight='bold'>" << escape(knobs[k]) << "</text>\n"
-            << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox + w << "' y2='" << oy << "' stroke='black'/>\n"
-            << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox << "' y2='" << oy - h << "' stroke='black'/>\n"
-            << "<text x='" << ox + w / 2 << "' y='" << oy + 30 << "' text-anchor='middle'>"
-            << (by_precompute ? "AO bake time (s)" : "GPU frame time (ms)") << ", max " << max_x / 1.15 << "</text>\n"
-            << "<text x='" << ox - 8 << "' y='" << oy - h / 2 << "' text-anchor='middle' transform='rotate(-90 "
-            << ox - 36 << " " << oy - h / 2 << ")'>RMSE vs CPU reference (max " << max_y / 1.15 << ")</text>\n";
+        svg << "<text x='" << ox << "' y='" << oy - h - 6 << "' font-weight='bold'>"
+            << escape(knobs[k]) << "</text>\n"
+            << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox + w << "' y2='"
+            << oy << "' stroke='black'/>\n"
+            << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox << "' y2='"
+            << oy - h << "' stroke='black'/>\n"
+            << "<text x='" << ox + w / 2 << "' y='" << oy + 30
+            << "' text-anchor='middle'>"
+            << (by_precompute ? "AO bake time (s)" : "GPU frame time (ms)") << ", max "
+            << max_x / 1.15 << "</text>\n"
+            << "<text x='" << ox - 8 << "' y='" << oy - h / 2
+            << "' text-anchor='middle' transform='rotate(-90 " << ox - 36 << " "
+            << oy - h / 2 << ")'>RMSE vs CPU reference (max " << max_y / 1.15
+            << ")</text>\n";
         std::string points;
-        for (const Row* r : series) points += std::to_string(px(x_of(r))) + "," + std::to_string(py(r->error.rmse)) + " ";
-        svg << "<polyline fill='none' stroke='steelblue' stroke-width='1.5' points='" << points << "'/>\n";
         for (const Row* r : series)
-            svg << "<circle cx='" << px(x_of(r)) << "' cy='" << py(r->error.rmse) << "' r='3' fill='steelblue'/>"
-                << "<text x='" << px(x_of(r)) + 5 << "' y='" << py(r->error.rmse) - 5 << "'>" << escape(r->value) << "</text>\n";
+            points += std::to_string(px(x_of(r))) + "," +
+                      std::to_string(py(r->error.rmse)) + " ";
+        svg << "<polyline fill='none' stroke='steelblue' stroke-width='1.5' points='"
+            << points << "'/>\n";
+        for (const Row* r : series)
+            svg << "<circle cx='" << px(x_of(r)) << "' cy='" << py(r->error.rmse)
+                << "' r='3' fill='steelblue'/>"
+                << "<text x='" << px(x_of(r)) + 5 << "' y='" << py(r->error.rmse) - 5
+                << "'>" << escape(r->value) << "</text>\n";
     }
     svg << "</svg>\n";
     if (!svg) throw std::runtime_error(path + ": cannot write the SVG plot");
@@ -116,14 +139,19 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
     std::vector<QualitySweep> sweeps;
     Scene reference_scene;
     try {
-        if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) != 2)
+        if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) !=
+            2)
             throw std::invalid_argument("--size: '" + options.size + "' is not WxH");
-        if (options.frames < 1) throw std::invalid_argument("--frames: must be at least 1");
+        if (options.frames < 1)
+            throw std::invalid_argument("--frames: must be at least 1");
         sweeps = find_technique(options.technique).quality_sweeps();
         if (sweeps.empty())
-            throw std::invalid_argument("--technique: '" + options.technique + "' declares no quality knobs");
-        for (const auto& s : options.settings) request.settings.push_back(parse_assignment(s));
-        for (const auto& sweep : sweeps) request.settings.push_back({sweep.knob, format_knob_value(sweep.reference)});
+            throw std::invalid_argument("--technique: '" + options.technique +
+                                        "' declares no quality knobs");
+        for (const auto& s : options.settings)
+            request.settings.push_back(parse_assignment(s));
+        for (const auto& sweep : sweeps)
+            request.settings.push_back({sweep.knob, format_knob_value(sweep.reference)});
         reference_scene = build_scene(request);
     } catch (const std::exception& e) {
         std::cerr << "lucent bench accuracy: " << e.what() << "\n";
@@ -139,7 +167,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
     }
     // AO bakes timed uncached, once per ray count; the GL path then uses those values.
     std::map<int, std::pair<std::vector<float>, double>> bakes;
-    const auto bake = [&](const Mesh& mesh, int rays) -> const std::pair<std::vector<float>, double>& {
+    const auto bake = [&](const Mesh& mesh,
+                          int rays) -> const std::pair<std::vector<float>, double>& {
         auto it = bakes.find(rays);
         if (it == bakes.end()) {
             std::cerr << "baking AO with " << rays << " rays per vertex...\n";
@@ -147,12 +176,16 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
             bake_options.rays = rays;
             const auto start = std::chrono::steady_clock::now();
             auto values = bake_ambient_occlusion(mesh, bake_options);
-            it = bakes.emplace(rays, std::make_pair(std::move(values), seconds_since(start))).first;
+            it = bakes
+                     .emplace(rays,
+                              std::make_pair(std::move(values), seconds_since(start)))
+                     .first;
         }
         return it->second;
     };
     gl::FrameExecutor executor;
-    executor.set_ambient_occlusion_source([&](const Mesh& mesh, int rays) { return bake(mesh, rays).first; });
+    executor.set_ambient_occlusion_source(
+        [&](const Mesh& mesh, int rays) { return bake(mesh, rays).first; });
 
     std::cerr << "CPU reference...\n";
     const auto reference_start = std::chrono::steady_clock::now();
@@ -166,7 +199,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
                 RenderRequest row_request = request;
                 row_request.settings.push_back({sweep.knob, format_knob_value(value)});
                 Scene scene = reference_scene;
-                scene.values = resolve_knob_values(knobs_for(technique), row_request.settings);
+                scene.values =
+                    resolve_knob_values(knobs_for(technique), row_request.settings);
                 const FramePlan plan = make_frame_plan(scene, technique);
                 Row row{sweep.knob, format_knob_value(value)};
                 row.frame_ms = median_frame_ms(executor, scene, plan, options.frames);
@@ -179,28 +213,37 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
                 rows.push_back(row);
             }
         write_svg(options.svg, rows,
-                  "lucent bench accuracy: " + options.technique + " on " + options.mesh + " at " + options.size);
+                  "lucent bench accuracy: " + options.technique + " on " + options.mesh +
+                      " at " + options.size);
     } catch (const std::exception& e) {
         std::cerr << "lucent bench accuracy: " << e.what() << "\n";
         return kExitFailure;
     }
 
     const gl::GlInfo info = context->info();
-    std::cout << "lucent bench accuracy: " << options.technique << " on " << reference_scene.mesh->name << " ("
-              << reference_scene.mesh->face_count() << " faces) at " << request.width << "x" << request.height
-              << "\nGL: " << info.renderer << "; frame time = median of " << options.frames
-              << " frames, " << (executor.last_timings().gpu_timer ? "GL timer queries" : "glFinish wall time")
-              << "; CPU reference (Embree) took " << reference_s << " s\n"
+    std::cout << "lucent bench accuracy: " << options.technique << " on "
+              << reference_scene.mesh->name << " (" << reference_scene.mesh->face_count()
+              << " faces) at " << request.width << "x" << request.height
+              << "\nGL: " << info.renderer << "; frame time = median of "
+              << options.frames << " frames, "
+              << (executor.last_timings().gpu_timer ? "GL timer queries"
+                                                    : "glFinish wall time")
+              << "; CPU reference (Embree, AO from the cache when present) took "
+              << reference_s << " s\n"
               << "reference values:";
-    for (const auto& sweep : sweeps) std::cout << " " << sweep.knob << "=" << format_knob_value(sweep.reference);
-    std::cout << "; error = GL image vs CPU reference outside a 1-pixel silhouette band, linear rgb\n\n";
+    for (const auto& sweep : sweeps)
+        std::cout << " " << sweep.knob << "=" << format_knob_value(sweep.reference);
+    std::cout << "; error = GL image vs CPU reference outside a 1-pixel silhouette band, "
+                 "linear rgb\n\n";
     char line[200];
-    std::snprintf(line, sizeof line, "%-16s %6s | %10s %10s %10s | %9s %9s\n", "knob", "value", "RMSE",
-                  "p99", "mean", "frame ms", "bake s");
-    std::cout << line << std::string(82, '-') << "\n";
+    std::snprintf(line, sizeof line, "%-16s %6s | %10s %10s %10s %10s | %9s %9s\n",
+                  "knob", "value", "RMSE", "p99", "mean", "max", "frame ms", "bake s");
+    std::cout << line << std::string(93, '-') << "\n";
     for (const auto& r : rows) {
-        std::snprintf(line, sizeof line, "%-16s %6s | %10.2e %10.2e %10.2e | %9.3f %9.3f\n", r.knob.c_str(),
-                      r.value.c_str(), r.error.rmse, r.error.p99, r.error.mean, r.frame_ms, r.precompute_s);
+        std::snprintf(line, sizeof line,
+                      "%-16s %6s | %10.2e %10.2e %10.2e %10.2e | %9.3f %9.3f\n",
+                      r.knob.c_str(), r.value.c_str(), r.error.rmse, r.error.p99,
+                      r.error.mean, r.error.max, r.frame_ms, r.precompute_s);
         std::cout << line;
     }
     std::cout << "\nplot: " << options.svg << "\n";
@@ -211,11 +254,15 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
 
 void register_bench_accuracy(CLI::App& bench, int& exit_code) {
     auto options = std::make_shared<AccuracyBenchOptions>();
-    auto* cmd = bench.add_subcommand("accuracy", "Error vs time of each quality knob against the CPU reference");
-    cmd->add_option("--technique", options->technique, "technique whose quality knobs to sweep");
-    cmd->add_option("--mesh", options->mesh, "mesh (built-in name with face budget, or file)");
+    auto* cmd = bench.add_subcommand(
+        "accuracy", "Error vs time of each quality knob against the CPU reference");
+    cmd->add_option("--technique", options->technique,
+                    "technique whose quality knobs to sweep");
+    cmd->add_option("--mesh", options->mesh,
+                    "mesh (built-in name with face budget, or file)");
     cmd->add_option("--size", options->size, "image size WxH");
-    cmd->add_option("--set", options->settings, "other parameters, key=value (repeatable)");
+    cmd->add_option("--set", options->settings,
+                    "other parameters, key=value (repeatable)");
     cmd->add_option("--frames", options->frames, "timed frames per row (median)");
     cmd->add_option("--svg", options->svg, "where to write the error-vs-time plot");
     cmd->callback([options, &exit_code] { exit_code = run_accuracy_bench(*options); });

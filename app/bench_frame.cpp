@@ -29,26 +29,43 @@ double median(std::vector<double> values) {
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// Median over `frames` frames of the summed GPU pass times (the CPU AO pass excluded).
-double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene, int frames, int warmup,
-                       bool& gpu_timer) {
-    const FramePlan plan = make_frame_plan(scene, find_technique(scene.technique));
-    std::vector<double> times;
-    for (int i = 0; i < warmup + frames; ++i) {
+// One frame's GPU time: the sum of its GPU passes (the CPU AO pass excluded).
+struct Sampler {
+    gl::FrameExecutor executor;
+    FramePlan plan;
+    std::vector<double> frame_ms;
+    std::vector<std::vector<double>> pass_ms;
+
+    void run(const Scene& scene, bool record) {
         executor.execute(scene, plan, /*time_passes=*/true);
         const auto& timings = executor.last_timings();
-        gpu_timer = timings.gpu_timer;
+        pass_ms.resize(plan.passes.size());
         double ms = 0.0;
-        for (std::size_t p = 0; p < timings.passes.size(); ++p)
-            if (plan.passes[p].kind != PassKind::bake_ambient_occlusion) ms += timings.passes[p].milliseconds;
-        if (i >= warmup) times.push_back(ms);
+        for (std::size_t p = 0; p < timings.passes.size(); ++p) {
+            if (plan.passes[p].kind == PassKind::bake_ambient_occlusion) continue;
+            ms += timings.passes[p].milliseconds;
+            if (record) pass_ms[p].push_back(timings.passes[p].milliseconds);
+        }
+        if (record) frame_ms.push_back(ms);
     }
-    return median(times);
-}
+    // "name ms, name ms" with each GPU pass's median.
+    std::string breakdown() const {
+        std::string text;
+        char item[64];
+        for (std::size_t p = 0; p < plan.passes.size(); ++p) {
+            if (pass_ms[p].empty()) continue;
+            std::snprintf(item, sizeof item, "%s%s %.2f", text.empty() ? "" : ", ",
+                          plan.passes[p].name.c_str(), median(pass_ms[p]));
+            text += item;
+        }
+        return text;
+    }
+};
 
 int run_frame_bench(const FrameBenchOptions& options) {
     RenderRequest request;
-    if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) != 2 ||
+    if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) !=
+            2 ||
         options.frames < 1) {
         std::cerr << "lucent bench frame: --size: '" << options.size << "' is not WxH\n";
         return kExitUsage;
@@ -61,12 +78,11 @@ int run_frame_bench(const FrameBenchOptions& options) {
         return kExitFailure;
     }
     const gl::GlInfo info = context->info();
-    gl::FrameExecutor executor;
-    std::ostringstream table;
+    std::ostringstream table, breakdowns;
     bool gpu_timer = false;
     char line[200];
-    std::snprintf(line, sizeof line, "%10s %10s | %12s %8s | %12s %8s | %6s\n", "faces", "vertices",
-                  "full (ms)", "fps", "direct (ms)", "fps", "ratio");
+    std::snprintf(line, sizeof line, "%10s %10s | %12s %8s | %12s %8s | %6s\n", "faces",
+                  "vertices", "full (ms)", "fps", "direct (ms)", "fps", "ratio");
     table << line << std::string(80, '-') << "\n";
     for (const auto& faces : options.faces) {
         request.mesh = options.mesh + ":" + faces;
@@ -81,12 +97,27 @@ int run_frame_bench(const FrameBenchOptions& options) {
             std::cerr << "lucent bench frame: " << e.what() << "\n";
             return kExitUsage;
         }
-        std::cerr << "measuring " << request.mesh << " (" << full.mesh->face_count() << " faces)...\n";
-        const double full_ms = median_frame_ms(executor, full, options.frames, options.warmup, gpu_timer);
-        const double direct_ms = median_frame_ms(executor, direct, options.frames, options.warmup, gpu_timer);
-        std::snprintf(line, sizeof line, "%10zu %10zu | %12.3f %8.1f | %12.3f %8.1f | %6.2f\n",
-                      full.mesh->face_count(), full.mesh->vertex_count(), full_ms, 1000.0 / full_ms,
-                      direct_ms, 1000.0 / direct_ms, full_ms / direct_ms);
+        std::cerr << "measuring " << request.mesh << " (" << full.mesh->face_count()
+                  << " faces)...\n";
+        // Frames alternate between the two variants (one executor each, so neither
+        // reallocates), so both see the same load on a shared machine.
+        Sampler full_sampler, direct_sampler;
+        full_sampler.plan = make_frame_plan(full, find_technique(full.technique));
+        direct_sampler.plan = make_frame_plan(direct, find_technique(direct.technique));
+        for (int i = 0; i < options.warmup + options.frames; ++i) {
+            full_sampler.run(full, i >= options.warmup);
+            direct_sampler.run(direct, i >= options.warmup);
+        }
+        gpu_timer = full_sampler.executor.last_timings().gpu_timer;
+        const double full_ms = median(full_sampler.frame_ms);
+        const double direct_ms = median(direct_sampler.frame_ms);
+        breakdowns << "  " << full.mesh->face_count()
+                   << " faces: full: " << full_sampler.breakdown()
+                   << " | direct: " << direct_sampler.breakdown() << "\n";
+        std::snprintf(
+            line, sizeof line, "%10zu %10zu | %12.3f %8.1f | %12.3f %8.1f | %6.2f\n",
+            full.mesh->face_count(), full.mesh->vertex_count(), full_ms, 1000.0 / full_ms,
+            direct_ms, 1000.0 / direct_ms, full_ms / direct_ms);
         table << line;
     }
     std::cout << "lucent bench frame: " << options.mesh << " at " << request.width << "x"
@@ -99,7 +130,9 @@ int run_frame_bench(const FrameBenchOptions& options) {
               << "; AO bake precomputed, not in the frame\n"
               << "full = empirical shader (AO, peel, 5x5 smoothing, Eq. 3.6); direct = "
                  "ambient + diffuse + specular (backlight 0)\n\n"
-              << table.str() << "ratio = full / direct frame time\n";
+              << table.str() << "ratio = full / direct frame time\n\n"
+              << "median per pass (ms):\n"
+              << breakdowns.str();
     return kExitOk;
 }
 
@@ -107,9 +140,12 @@ int run_frame_bench(const FrameBenchOptions& options) {
 
 void register_bench_frame(CLI::App& bench, int& exit_code) {
     auto options = std::make_shared<FrameBenchOptions>();
-    auto* cmd = bench.add_subcommand("frame", "Median GPU frame time: full empirical shader vs direct light only");
-    cmd->add_option("--mesh", options->mesh, "built-in mesh family (face budgets from --faces)");
-    cmd->add_option("--faces", options->faces, "face budgets, e.g. 4k 30k 60k 120k 240k")->delimiter(',');
+    auto* cmd = bench.add_subcommand(
+        "frame", "Median GPU frame time: full empirical shader vs direct light only");
+    cmd->add_option("--mesh", options->mesh,
+                    "built-in mesh family (face budgets from --faces)");
+    cmd->add_option("--faces", options->faces, "face budgets, e.g. 4k 30k 60k 120k 240k")
+        ->delimiter(',');
     cmd->add_option("--size", options->size, "frame size WxH");
     cmd->add_option("--frames", options->frames, "timed frames per row (median)");
     cmd->add_option("--warmup", options->warmup, "untimed frames first");

@@ -1,6 +1,6 @@
 // lucent render: one image of a mesh under a technique, with parameters from --set.
-// The work itself is lucent::build_scene + render_image + write_image (renderer/render.h),
-// the same path batch rendering and the explorer use.
+// The work itself is lucent::build_scene + render_image + write_image
+// (renderer/render.h), the same path batch rendering and the explorer use.
 #include <iostream>
 
 #include "commands.h"
@@ -51,15 +51,20 @@ int run_render(const RenderOptions& options) {
         parse_size(options.size, request.width, request.height);
         request.mesh = options.mesh;
         request.technique = options.technique;
-        for (const auto& s : options.settings) request.settings.push_back(parse_assignment(s));
-        if (options.plan == "full") mode = PlanMode::full;
+        for (const auto& s : options.settings)
+            request.settings.push_back(parse_assignment(s));
+        if (options.plan == "full")
+            mode = PlanMode::full;
         else if (options.plan != "pruned")
-            throw std::invalid_argument("--plan: '" + options.plan + "' (accepted: pruned, full)");
+            throw std::invalid_argument("--plan: '" + options.plan +
+                                        "' (accepted: pruned, full)");
         if (options.out.empty() && !options.explain)
-            throw std::invalid_argument("--out: missing (give --out FILE, or --explain to print the plan)");
+            throw std::invalid_argument(
+                "--out: missing (give --out FILE, or --explain to print the plan)");
         if (!options.out.empty() && !is_supported_image_path(options.out))
-            throw std::invalid_argument("--out: '" + options.out +
-                                        "' has an unsupported extension (accepted: .exr, .png, .tif)");
+            throw std::invalid_argument(
+                "--out: '" + options.out +
+                "' has an unsupported extension (accepted: .exr, .png, .tif)");
         scene = build_scene(request);
     } catch (const KnobError& e) {
         std::cerr << "lucent render: " << e.what() << "\n";
@@ -102,31 +107,39 @@ void register_render(CLI::App& app, int& exit_code) {
     auto options = std::make_shared<RenderOptions>();
     auto* cmd = app.add_subcommand("render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
     std::string meshes;
-    for (const auto& name : builtin_mesh_names()) meshes += (meshes.empty() ? "" : ", ") + name;
+    for (const auto& name : builtin_mesh_names())
+        meshes += (meshes.empty() ? "" : ", ") + name;
     std::string techniques, keys;
     for (const Technique* t : all_techniques()) {
         techniques += (techniques.empty() ? "" : ", ") + std::string(t->name());
         for (const Knob& k : knobs_for(*t)) keys += (keys.empty() ? "" : ", ") + k.name;
     }
     cmd->add_option("--mesh", options->mesh,
-                    "built-in mesh (" + meshes + "; optional face budget, e.g. torus_knot:60k) or a mesh file");
+                    "built-in mesh (" + meshes +
+                        "; optional face budget, e.g. torus_knot:60k) or a mesh file");
     cmd->add_option("config", options->config,
                     "stimulus-set config (TOML): render every stimulus into --out DIR");
     cmd->add_option("--preset", options->preset, "built-in stimulus set (thesis) into --out DIR");
     cmd->add_option("--jobs", options->jobs, "stimulus sets: parallel workers (default 1)");
     cmd->add_flag("--force", options->force, "stimulus sets: re-render unchanged stimuli too");
     cmd->add_option("--technique", options->technique, "technique (" + techniques + ")");
-    cmd->add_option("--set", options->settings,
-                    "parameter key=value, repeatable; rgb as r,g,b or one grey value (keys: " + keys + ")");
+    cmd->add_option(
+        "--set", options->settings,
+        "parameter key=value, repeatable; rgb as r,g,b or one grey value (keys: " + keys +
+            ")");
     cmd->add_option("--size", options->size, "image size WxH (default 512x512)");
-    cmd->add_option("--out", options->out, "output image: .exr (linear float), .png (8-bit), .tif (16-bit)");
-    cmd->add_flag("--explain", options->explain, "print the frame plan, one pass per line");
-    cmd->add_option("--plan", options->plan, "pruned (default) or full: run every pass, to check pruning");
+    cmd->add_option("--out", options->out,
+                    "output image: .exr (linear float), .png (8-bit), .tif (16-bit)");
+    cmd->add_flag("--explain", options->explain,
+                  "print the frame plan, one pass per line");
+    cmd->add_option("--plan", options->plan,
+                    "pruned (default) or full: run every pass, to check pruning");
     cmd->add_flag("--linear", options->linear, "write .png/.tif without sRGB encoding");
     cmd->callback([options, &exit_code] {
         // One image (--mesh) or a stimulus set (CONFIG or --preset), never both.
         const bool batch = !options->config.empty() || !options->preset.empty();
-        if (batch && (!options->mesh.empty() || (!options->config.empty() && !options->preset.empty()))) {
+        const bool both = !options->config.empty() && !options->preset.empty();
+        if (batch && (!options->mesh.empty() || both)) {
             std::cerr << "lucent render: give one of --mesh, CONFIG or --preset\n";
             exit_code = kExitUsage;
         } else if (batch) {

@@ -8,15 +8,18 @@
 namespace lucent {
 
 Scene build_scene(const RenderRequest& request) {
-    if (request.width <= 0 || request.height <= 0 || request.width > 16384 || request.height > 16384)
-        throw std::invalid_argument("size: " + std::to_string(request.width) + "x" +
-                                    std::to_string(request.height) +
-                                    " is out of range (accepted: WxH with each in [1, 16384])");
+    if (request.width <= 0 || request.height <= 0 || request.width > 16384 ||
+        request.height > 16384)
+        throw std::invalid_argument(
+            "size: " + std::to_string(request.width) + "x" +
+            std::to_string(request.height) +
+            " is out of range (accepted: WxH with each in [1, 16384])");
     const Technique& technique = find_technique(request.technique);
     const std::vector<Knob> knobs = knobs_for(technique);
     KnobValues values = resolve_knob_values(knobs, request.settings);
     auto mesh = std::make_shared<const Mesh>(load_mesh(request.mesh));
-    return make_scene(std::move(mesh), technique, std::move(values), request.width, request.height);
+    return make_scene(std::move(mesh), technique, std::move(values), request.width,
+                      request.height);
 }
 
 Image render_image(gl::FrameExecutor& executor, const Scene& scene, PlanMode mode) {

@@ -13,7 +13,7 @@
 namespace lucent {
 
 struct RenderRequest {
-    std::string mesh = "torus_knot";     // built-in name (optionally ":faces") or a file
+    std::string mesh = "torus_knot";      // built-in name (optionally ":faces") or a file
     std::string technique = "empirical";  // registry name
     std::vector<KnobAssignment> settings;  // applied over the defaults, in order
     int width = 512;

@@ -23,7 +23,8 @@ struct AoBakeOptions {
     // Worker threads including the caller; 0 = one per hardware thread. Results do not
     // depend on it.
     unsigned threads = 0;
-    // Called now and then with (vertices done, total) from the calling thread; may be empty.
+    // Called now and then with (vertices done, total) from the calling thread; may be
+    // empty.
     std::function<void(std::size_t, std::size_t)> progress;
 };
 

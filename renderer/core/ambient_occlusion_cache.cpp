@@ -68,8 +68,8 @@ CacheHeader header_for(const Mesh& mesh, int rays, const std::vector<float>& val
     return header;
 }
 
-std::optional<std::vector<float>> read_cache(const std::filesystem::path& path, const Mesh& mesh,
-                                             int rays) {
+std::optional<std::vector<float>> read_cache(const std::filesystem::path& path,
+                                             const Mesh& mesh, int rays) {
     std::ifstream file(path, std::ios::binary);
     if (!file) return std::nullopt;
     CacheHeader stored{};
@@ -101,8 +101,9 @@ bool write_cache(const std::filesystem::path& path, const Mesh& mesh, int rays,
         return false;
     }
     std::random_device entropy;
-    const auto temporary = std::filesystem::path(
-        path.string() + ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(entropy()));
+    const auto temporary =
+        std::filesystem::path(path.string() + ".tmp-" + std::to_string(getpid()) + "-" +
+                              std::to_string(entropy()));
     {
         std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
         const CacheHeader header = header_for(mesh, rays, values);
@@ -141,8 +142,8 @@ std::filesystem::path ambient_occlusion_cache_path(const Mesh& mesh, int rays) {
                                  ? compute_content_hash(mesh.positions, mesh.triangles)
                                  : mesh.content_hash;
     return cache_directory() / "ao" /
-           (hash + "-r" + std::to_string(rays) + "-a" + std::to_string(kAoAlgorithmVersion) +
-            ".ao");
+           (hash + "-r" + std::to_string(rays) + "-a" +
+            std::to_string(kAoAlgorithmVersion) + ".ao");
 }
 
 std::vector<float> load_or_bake_ambient_occlusion(const Mesh& mesh,
@@ -154,8 +155,10 @@ std::vector<float> load_or_bake_ambient_occlusion(const Mesh& mesh,
         keyed.content_hash = compute_content_hash(mesh.positions, mesh.triangles);
         source = &keyed;
     }
-    const std::filesystem::path path = ambient_occlusion_cache_path(*source, options.rays);
-    if (std::optional<std::vector<float>> cached = read_cache(path, *source, options.rays))
+    const std::filesystem::path path =
+        ambient_occlusion_cache_path(*source, options.rays);
+    if (std::optional<std::vector<float>> cached =
+            read_cache(path, *source, options.rays))
         return *cached;
     // Long bakes show progress: without a caller's callback, a bar on stderr (terminal
     // only, after half a second).

@@ -1,10 +1,9 @@
 // The thesis's camera (Eq. 3.4): distance to the bounding-sphere centre = its diameter.
 #include "core/camera.h"
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
 
 namespace lucent {
 
@@ -27,8 +26,9 @@ Camera fit_camera(const BoundingSphere& sphere, float fov_y_degrees, float aspec
     const float radius = std::max(sphere.radius, 1e-6f);
     const float distance = 2.0f * radius;
     const float length = glm::length(view_direction);
-    const glm::vec3 direction =
-        length > 0.0f && std::isfinite(length) ? view_direction / length : glm::vec3(0, 0, 1);
+    const glm::vec3 direction = length > 0.0f && std::isfinite(length)
+                                    ? view_direction / length
+                                    : glm::vec3(0, 0, 1);
     Camera camera;
     camera.target = sphere.centre;
     camera.eye = sphere.centre + direction * distance;

@@ -13,12 +13,18 @@ bool is_depth_format(ResourceFormat format) {
 
 const char* format_name(ResourceFormat format) {
     switch (format) {
-        case ResourceFormat::depth16: return "depth16";
-        case ResourceFormat::depth24: return "depth24";
-        case ResourceFormat::depth32f: return "depth32f";
-        case ResourceFormat::r32f: return "r32f";
-        case ResourceFormat::rgba32f: return "rgba32f";
-        case ResourceFormat::vertex_float: return "vertex float";
+        case ResourceFormat::depth16:
+            return "depth16";
+        case ResourceFormat::depth24:
+            return "depth24";
+        case ResourceFormat::depth32f:
+            return "depth32f";
+        case ResourceFormat::r32f:
+            return "r32f";
+        case ResourceFormat::rgba32f:
+            return "rgba32f";
+        case ResourceFormat::vertex_float:
+            return "vertex float";
     }
     return "?";
 }
@@ -33,7 +39,8 @@ std::string FramePlan::explain() const {
     std::string text;
     for (const auto& pass : passes) {
         std::string reads, writes;
-        for (const auto& r : pass.reads) reads += (reads.empty() ? "" : ", ") + r.resource;
+        for (const auto& r : pass.reads)
+            reads += (reads.empty() ? "" : ", ") + r.resource;
         for (const auto& w : pass.writes) {
             const ResourceDesc* desc = resource(w);
             writes += (writes.empty() ? "" : ", ") + w + " (" +
@@ -42,7 +49,8 @@ std::string FramePlan::explain() const {
         text += pass.name + ": " + (reads.empty() ? "-" : reads) + " -> " + writes;
         if (!pass.shader.defines.empty()) {
             std::string defines;
-            for (const auto& d : pass.shader.defines) defines += (defines.empty() ? "" : " ") + d;
+            for (const auto& d : pass.shader.defines)
+                defines += (defines.empty() ? "" : " ") + d;
             text += "  {" + defines + "}";
         }
         text += "  [" + pass.purpose + "]\n";
@@ -56,13 +64,15 @@ PlanBuilder::PlanBuilder(PlanMode mode, int width, int height)
 
 void PlanBuilder::create(std::string name, ResourceFormat format) {
     for (const auto& r : resources_)
-        if (r.name == name) throw std::logic_error("frame plan: resource '" + name + "' created twice");
+        if (r.name == name)
+            throw std::logic_error("frame plan: resource '" + name + "' created twice");
     resources_.push_back({std::move(name), format});
 }
 
 void PlanBuilder::add(Pass pass) {
     for (const auto& p : passes_)
-        if (p.name == pass.name) throw std::logic_error("frame plan: pass '" + pass.name + "' added twice");
+        if (p.name == pass.name)
+            throw std::logic_error("frame plan: pass '" + pass.name + "' added twice");
     passes_.push_back(std::move(pass));
 }
 
@@ -73,7 +83,8 @@ FramePlan PlanBuilder::compile() const {
         return std::any_of(resources_.begin(), resources_.end(),
                            [&](const ResourceDesc& r) { return r.name == name; });
     };
-    // Validate the declared data flow: reads follow writes, writes name created resources.
+    // Validate the declared data flow: reads follow writes, writes name created
+    // resources.
     std::set<std::string> written;
     for (const auto& pass : passes_) {
         for (const auto& read : pass.reads)
@@ -82,7 +93,8 @@ FramePlan PlanBuilder::compile() const {
                                        read.resource + "' before any pass writes it");
         for (const auto& w : pass.writes) {
             if (!created(w))
-                throw std::logic_error("frame plan: pass '" + pass.name + "' writes undeclared '" + w + "'");
+                throw std::logic_error("frame plan: pass '" + pass.name +
+                                       "' writes undeclared '" + w + "'");
             written.insert(w);
         }
     }
@@ -95,8 +107,9 @@ FramePlan PlanBuilder::compile() const {
     std::vector<bool> keep(passes_.size(), false);
     for (std::size_t i = passes_.size(); i-- > 0;) {
         const Pass& pass = passes_[i];
-        const bool used = std::any_of(pass.writes.begin(), pass.writes.end(),
-                                      [&](const std::string& w) { return needed.count(w) > 0; });
+        const bool used =
+            std::any_of(pass.writes.begin(), pass.writes.end(),
+                        [&](const std::string& w) { return needed.count(w) > 0; });
         keep[i] = used || full();
         if (keep[i])
             for (const auto& read : pass.reads) needed.insert(read.resource);

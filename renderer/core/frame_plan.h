@@ -3,9 +3,8 @@
 // resources it reads and writes. A technique adds the passes a scene calls for; compile()
 // then culls every pass whose outputs nobody reads, so an effect that is off costs no
 // pass and no texture. Pure data, no GL: renderer/gl/frame_executor runs it.
-#include <glm/glm.hpp>
-
 #include <functional>
+#include <glm/glm.hpp>
 #include <string>
 #include <variant>
 #include <vector>
@@ -30,12 +29,14 @@ struct ResourceDesc {
 };
 
 enum class PassKind {
-    bake_ambient_occlusion,  // CPU: per-vertex AO (cached bake) uploaded as a vertex stream
+    bake_ambient_occlusion,  // CPU: per-vertex AO (cached bake) uploaded as a vertex
+                             // stream
     draw_mesh,               // rasterise the mesh: attributes 0 position, 1 normal, 2 AO
     fullscreen,              // one full-screen triangle (gl/shaders/fullscreen.vert)
 };
 
-// Paths relative to renderer/; `defines` select the compiled variant ("NAME" or "NAME 5").
+// Paths relative to renderer/; `defines` select the compiled variant ("NAME" or "NAME
+// 5").
 struct ShaderDesc {
     std::string vertex;
     std::string fragment;

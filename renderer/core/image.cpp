@@ -1,3 +1,5 @@
+#include "core/image.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -5,8 +7,6 @@
 #include <cstdint>
 #include <limits>
 #include <system_error>
-
-#include "core/image.h"
 
 namespace lucent {
 namespace {
@@ -29,7 +29,8 @@ std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
     for (std::size_t i = 0, n = out.size() / 3; i < n; ++i)
         for (int c = 0; c < 3; ++c) {
             const float v = std::clamp(image.rgba[i * 4 + c], 0.0f, 1.0f);
-            out[i * 3 + c] = static_cast<T>(std::lround((linear ? v : srgb_encode(v)) * scale));
+            out[i * 3 + c] =
+                static_cast<T>(std::lround((linear ? v : srgb_encode(v)) * scale));
         }
     return out;
 }
@@ -46,8 +47,7 @@ std::size_t replace_non_finite(Image& image) {
     for (float& v : image.rgba) {
         if (std::isfinite(v)) continue;
         ++replaced;
-        v = std::isnan(v) ? 0.0f
-                          : std::copysign(std::numeric_limits<float>::max(), v);
+        v = std::isnan(v) ? 0.0f : std::copysign(std::numeric_limits<float>::max(), v);
     }
     return replaced;
 }
@@ -104,7 +104,8 @@ void write_image(const std::filesystem::path& path, const Image& input,
     }
     std::error_code rename_error;
     std::filesystem::rename(temporary, path, rename_error);
-    if (rename_error) fail(path, "cannot rename temporary file: " + rename_error.message());
+    if (rename_error)
+        fail(path, "cannot rename temporary file: " + rename_error.message());
 }
 
 Image read_image(const std::filesystem::path& path) {
@@ -112,16 +113,18 @@ Image read_image(const std::filesystem::path& path) {
     if (!in) fail(path, "cannot read: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
     const int channels = spec.nchannels;
-    std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * channels);
+    std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height *
+                              channels);
     if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
         fail(path, "cannot read pixels: " + in->geterror());
     Image image(spec.width, spec.height);
-    for (std::size_t i = 0, n = static_cast<std::size_t>(spec.width) * spec.height; i < n; ++i)
+    for (std::size_t i = 0, n = static_cast<std::size_t>(spec.width) * spec.height; i < n;
+         ++i)
         for (int c = 0; c < 4; ++c)
-            image.rgba[i * 4 + c] = c < channels   ? pixels[i * channels + c]
-                                    : c == 3       ? 1.0f
+            image.rgba[i * 4 + c] = c < channels    ? pixels[i * channels + c]
+                                    : c == 3        ? 1.0f
                                     : channels == 1 ? pixels[i * channels]
-                                                   : 0.0f;
+                                                    : 0.0f;
     return image;
 }
 

@@ -1,9 +1,8 @@
 #pragma once
 // Linear float RGBA images, top row first (as image files store them). Alpha is coverage:
 // 1 where the object is, 0 on the background.
-#include <glm/glm.hpp>
-
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <stdexcept>
 #include <vector>
 
@@ -15,7 +14,8 @@ struct Image {
     std::vector<float> rgba;  // width * height * 4
 
     Image() = default;
-    Image(int w, int h) : width(w), height(h), rgba(static_cast<std::size_t>(w) * h * 4, 0.0f) {}
+    Image(int w, int h)
+        : width(w), height(h), rgba(static_cast<std::size_t>(w) * h * 4, 0.0f) {}
     glm::vec4 at(int x, int y) const {
         const float* p = &rgba[(static_cast<std::size_t>(y) * width + x) * 4];
         return {p[0], p[1], p[2], p[3]};

@@ -9,13 +9,17 @@ namespace lucent {
 ImageErrorStats compare_images(const Image& a, const Image& b, int band) {
     if (a.width != b.width || a.height != b.height)
         throw std::invalid_argument("compare_images: sizes differ");
-    const auto covered = [](const Image& image, int x, int y) { return image.at(x, y).a > 0.5f; };
+    const auto covered = [](const Image& image, int x, int y) {
+        return image.at(x, y).a > 0.5f;
+    };
     const auto near_silhouette = [&](int x, int y) {
         if (covered(a, x, y) != covered(b, x, y)) return true;
         for (int j = -band; j <= band; ++j)
             for (int i = -band; i <= band; ++i) {
-                const int sx = std::clamp(x + i, 0, a.width - 1), sy = std::clamp(y + j, 0, a.height - 1);
-                if (covered(a, sx, sy) != covered(a, x, y) || covered(b, sx, sy) != covered(b, x, y))
+                const int sx = std::clamp(x + i, 0, a.width - 1),
+                          sy = std::clamp(y + j, 0, a.height - 1);
+                if (covered(a, sx, sy) != covered(a, x, y) ||
+                    covered(b, sx, sy) != covered(b, x, y))
                     return true;
             }
         return false;
@@ -43,7 +47,8 @@ ImageErrorStats compare_images(const Image& a, const Image& b, int band) {
     stats.mean = sum / n;
     stats.rmse = std::sqrt(sum_squares / n);
     std::sort(worst.begin(), worst.end());
-    stats.p99 = worst[std::min(worst.size() - 1, static_cast<std::size_t>(0.99 * worst.size()))];
+    stats.p99 =
+        worst[std::min(worst.size() - 1, static_cast<std::size_t>(0.99 * worst.size()))];
     stats.max = worst.back();
     return stats;
 }

@@ -15,8 +15,10 @@ std::string number_text(double value) {
 }
 
 std::string_view trim(std::string_view text) {
-    while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
-    while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
+    while (!text.empty() && (text.front() == ' ' || text.front() == '\t'))
+        text.remove_prefix(1);
+    while (!text.empty() && (text.back() == ' ' || text.back() == '\t'))
+        text.remove_suffix(1);
     return text;
 }
 
@@ -25,8 +27,10 @@ bool parse_real(std::string_view text, double& value) {
     text = trim(text);
     if (text.empty()) return false;
     if (text.front() == '+') text.remove_prefix(1);
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    return error == std::errc() && end == text.data() + text.size() && std::isfinite(value);
+    const auto [end, error] =
+        std::from_chars(text.data(), text.data() + text.size(), value);
+    return error == std::errc() && end == text.data() + text.size() &&
+           std::isfinite(value);
 }
 
 std::vector<std::string_view> split_commas(std::string_view text) {
@@ -42,7 +46,8 @@ std::vector<std::string_view> split_commas(std::string_view text) {
 }
 
 [[noreturn]] void fail(const Knob& knob, const std::string& what) {
-    throw KnobError(knob.name + ": " + what + " (accepted: " + accepted_range(knob) + ")");
+    throw KnobError(knob.name + ": " + what + " (accepted: " + accepted_range(knob) +
+                    ")");
 }
 
 void check_range(const Knob& knob, double value, std::string_view text) {
@@ -52,11 +57,16 @@ void check_range(const Knob& knob, double value, std::string_view text) {
 
 const char* kind_name(KnobKind kind) {
     switch (kind) {
-        case KnobKind::scalar: return "a number";
-        case KnobKind::rgb: return "an rgb colour";
-        case KnobKind::integer: return "an integer";
-        case KnobKind::choice: return "a choice";
-        case KnobKind::vec3: return "a 3-vector";
+        case KnobKind::scalar:
+            return "a number";
+        case KnobKind::rgb:
+            return "an rgb colour";
+        case KnobKind::integer:
+            return "an integer";
+        case KnobKind::choice:
+            return "a choice";
+        case KnobKind::vec3:
+            return "a 3-vector";
     }
     return "?";
 }
@@ -101,17 +111,23 @@ KnobAssignment parse_assignment(std::string_view key_equals_value) {
         throw KnobError("'" + std::string(key_equals_value) + "': expected key=value");
     const std::string_view key = trim(key_equals_value.substr(0, equals));
     if (key.empty())
-        throw KnobError("'" + std::string(key_equals_value) + "': empty key in key=value");
+        throw KnobError("'" + std::string(key_equals_value) +
+                        "': empty key in key=value");
     return {std::string(key), std::string(trim(key_equals_value.substr(equals + 1)))};
 }
 
 std::string accepted_range(const Knob& knob) {
-    const std::string range = "[" + number_text(knob.min) + ", " + number_text(knob.max) + "]";
+    const std::string range =
+        "[" + number_text(knob.min) + ", " + number_text(knob.max) + "]";
     switch (knob.kind) {
-        case KnobKind::scalar: return "a number in " + range;
-        case KnobKind::integer: return "an integer in " + range;
-        case KnobKind::rgb: return "r,g,b (or one grey value) with each in " + range;
-        case KnobKind::vec3: return "x,y,z with each in " + range + ", not all zero";
+        case KnobKind::scalar:
+            return "a number in " + range;
+        case KnobKind::integer:
+            return "an integer in " + range;
+        case KnobKind::rgb:
+            return "r,g,b (or one grey value) with each in " + range;
+        case KnobKind::vec3:
+            return "x,y,z with each in " + range + ", not all zero";
         case KnobKind::choice: {
             std::string list;
             for (const auto& c : knob.choices) list += (list.empty() ? "" : ", ") + c;
@@ -126,13 +142,15 @@ KnobValue parse_knob_value(const Knob& knob, std::string_view text) {
     switch (knob.kind) {
         case KnobKind::scalar: {
             double value = 0;
-            if (!parse_real(text, value)) fail(knob, "'" + std::string(text) + "' is not a number");
+            if (!parse_real(text, value))
+                fail(knob, "'" + std::string(text) + "' is not a number");
             check_range(knob, value, text);
             return value;
         }
         case KnobKind::integer: {
             int value = 0;
-            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+            const auto [end, error] =
+                std::from_chars(text.data(), text.data() + text.size(), value);
             if (text.empty() || error != std::errc() || end != text.data() + text.size())
                 fail(knob, "'" + std::string(text) + "' is not an integer");
             check_range(knob, value, text);
@@ -152,7 +170,8 @@ KnobValue parse_knob_value(const Knob& knob, std::string_view text) {
                     fail(knob, "'" + std::string(trim(parts[i])) + "' is not a number");
                 check_range(knob, c[i], text);
             }
-            const glm::dvec3 value = parts.size() == 1 ? glm::dvec3(c[0]) : glm::dvec3(c[0], c[1], c[2]);
+            const glm::dvec3 value =
+                parts.size() == 1 ? glm::dvec3(c[0]) : glm::dvec3(c[0], c[1], c[2]);
             validate_knob_value(knob, value);
             return value;
         }
@@ -165,7 +184,9 @@ KnobValue parse_knob_value(const Knob& knob, std::string_view text) {
 }
 
 void validate_knob_value(const Knob& knob, const KnobValue& value) {
-    const auto wrong_type = [&] { fail(knob, std::string("expected ") + kind_name(knob.kind)); };
+    const auto wrong_type = [&] {
+        fail(knob, std::string("expected ") + kind_name(knob.kind));
+    };
     switch (knob.kind) {
         case KnobKind::scalar: {
             const double* v = std::get_if<double>(&value);
@@ -183,7 +204,8 @@ void validate_knob_value(const Knob& knob, const KnobValue& value) {
         case KnobKind::vec3: {
             const auto* v = std::get_if<glm::dvec3>(&value);
             if (!v) wrong_type();
-            for (int i = 0; i < 3; ++i) check_range(knob, (*v)[i], format_knob_value(value));
+            for (int i = 0; i < 3; ++i)
+                check_range(knob, (*v)[i], format_knob_value(value));
             if (knob.kind == KnobKind::vec3 && glm::dot(*v, *v) <= 0.0)
                 fail(knob, "'" + format_knob_value(value) + "' is the zero vector");
             return;
@@ -221,7 +243,8 @@ KnobValues resolve_knob_values(std::span<const Knob> knobs,
         if (!knob) {
             std::string valid;
             for (const auto& k : knobs) valid += (valid.empty() ? "" : ", ") + k.name;
-            throw KnobError(assignment.key + ": unknown parameter (valid: " + valid + ")");
+            throw KnobError(assignment.key + ": unknown parameter (valid: " + valid +
+                            ")");
         }
         values.set(knob->name, parse_knob_value(*knob, assignment.text));
     }

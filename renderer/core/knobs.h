@@ -3,7 +3,6 @@
 // default). The CLI's `--set key=value`, TOML configs, the explorer's sliders, manifests
 // and `lucent bench accuracy` all read these descriptions; nothing else lists parameters.
 #include <glm/glm.hpp>
-
 #include <map>
 #include <span>
 #include <stdexcept>
@@ -29,7 +28,8 @@ enum class KnobKind {
     vec3,     // "x,y,z"; each component in [min, max]; never the zero vector
 };
 
-// double for scalar, glm::dvec3 for rgb and vec3, int for integer, std::string for choice.
+// double for scalar, glm::dvec3 for rgb and vec3, int for integer, std::string for
+// choice.
 using KnobValue = std::variant<double, glm::dvec3, int, std::string>;
 
 struct Knob {
@@ -46,8 +46,12 @@ struct Knob {
 // (the planner asked for a knob its technique never declared).
 class KnobValues {
 public:
-    void set(const std::string& name, KnobValue value) { values_[name] = std::move(value); }
-    bool contains(std::string_view name) const { return values_.find(name) != values_.end(); }
+    void set(const std::string& name, KnobValue value) {
+        values_[name] = std::move(value);
+    }
+    bool contains(std::string_view name) const {
+        return values_.find(name) != values_.end();
+    }
     const KnobValue& get(std::string_view name) const;
     double scalar(std::string_view name) const;
     glm::dvec3 vec3(std::string_view name) const;  // rgb or vec3 knobs
@@ -73,7 +77,8 @@ KnobValue parse_knob_value(const Knob& knob, std::string_view text);
 void validate_knob_value(const Knob& knob, const KnobValue& value);
 // The value written back as text that parse_knob_value() accepts ("0.8,0.5,0.3").
 std::string format_knob_value(const KnobValue& value);
-// "a number in [0, 10]", "r,g,b (or one grey value) with each in [0, 1]", "one of 1, 3, 5".
+// "a number in [0, 10]", "r,g,b (or one grey value) with each in [0, 1]", "one of 1, 3,
+// 5".
 std::string accepted_range(const Knob& knob);
 
 const Knob* find_knob(std::span<const Knob> knobs, std::string_view name);

@@ -107,7 +107,8 @@ std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& posi
         for (int corner = 0; corner < 3; ++corner) {
             const glm::dvec3 e1 = p[(corner + 1) % 3] - p[corner];
             const glm::dvec3 e2 = p[(corner + 2) % 3] - p[corner];
-            const double angle = std::atan2(glm::length(glm::cross(e1, e2)), glm::dot(e1, e2));
+            const double angle =
+                std::atan2(glm::length(glm::cross(e1, e2)), glm::dot(e1, e2));
             sums[t[corner]] += angle * unit;
             if (fallback[t[corner]] == glm::dvec3(0.0)) fallback[t[corner]] = unit;
         }
@@ -115,9 +116,12 @@ std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& posi
     std::vector<glm::vec3> normals(positions.size());
     for (std::size_t i = 0; i < positions.size(); ++i) {
         const double length = glm::length(sums[i]);
-        if (length > 1e-12) normals[i] = glm::vec3(sums[i] / length);
-        else if (fallback[i] != glm::dvec3(0.0)) normals[i] = glm::vec3(fallback[i]);
-        else normals[i] = glm::vec3(0.0f, 0.0f, 1.0f);
+        if (length > 1e-12)
+            normals[i] = glm::vec3(sums[i] / length);
+        else if (fallback[i] != glm::dvec3(0.0))
+            normals[i] = glm::vec3(fallback[i]);
+        else
+            normals[i] = glm::vec3(0.0f, 0.0f, 1.0f);
     }
     return normals;
 }
@@ -133,7 +137,8 @@ void finalize_mesh(Mesh& mesh) {
             n /= length;
             continue;
         }
-        if (smooth.empty()) smooth = compute_smooth_normals(mesh.positions, mesh.triangles);
+        if (smooth.empty())
+            smooth = compute_smooth_normals(mesh.positions, mesh.triangles);
         n = smooth[i];
     }
     mesh.content_hash = compute_content_hash(mesh.positions, mesh.triangles);
@@ -141,10 +146,12 @@ void finalize_mesh(Mesh& mesh) {
 
 Mesh load_mesh(const std::string& spec) {
     if (spec.empty())
-        throw MeshError("(empty mesh spec): give a built-in name (sphere, torus, torus_knot, "
-                        "hand) or a mesh file path");
-    // A built-in name wins unless a file of that exact name exists.
-    if (is_builtin_mesh_spec(spec) && !std::filesystem::exists(spec))
+        throw MeshError(
+            "(empty mesh spec): give a built-in name (sphere, torus, torus_knot, "
+            "hand) or a mesh file path");
+    // A built-in name wins unless a regular file of that exact name exists.
+    std::error_code error;
+    if (is_builtin_mesh_spec(spec) && !std::filesystem::is_regular_file(spec, error))
         return build_builtin_mesh(spec);
     return load_mesh_file(spec);
 }

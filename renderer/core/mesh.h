@@ -2,9 +2,8 @@
 // Triangle meshes: built-in procedural shapes (so nothing needs files) and files loaded
 // through Assimp, cleaned (degenerate triangles dropped, smooth normals generated when
 // missing) and identified by a content hash.
-#include <glm/glm.hpp>
-
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -25,7 +24,7 @@ struct BoundingSphere {
 };
 
 struct Mesh {
-    std::string name;                   // the spec it came from: "torus_knot:240k" or a path
+    std::string name;  // the spec it came from: "torus_knot:240k" or a path
     std::vector<glm::vec3> positions;   // object space
     std::vector<glm::vec3> normals;     // unit length, one per position
     std::vector<glm::uvec3> triangles;  // indices into positions; no degenerate ones

@@ -28,9 +28,9 @@ constexpr std::size_t kMaxFaceBudget = 20'000'000;
 double signed_volume(const Mesh& mesh) {
     double six_volume = 0.0;
     for (const glm::uvec3& t : mesh.triangles)
-        six_volume += glm::dot(glm::dvec3(mesh.positions[t.x]),
-                               glm::cross(glm::dvec3(mesh.positions[t.y]),
-                                          glm::dvec3(mesh.positions[t.z])));
+        six_volume += glm::dot(
+            glm::dvec3(mesh.positions[t.x]),
+            glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z])));
     return six_volume / 6.0;
 }
 
@@ -65,7 +65,8 @@ std::pair<unsigned, unsigned> grid_for_budget(std::size_t faces, double ratio,
         const long b = (std::lround(ideal_b / b_multiple) + db) * b_multiple;
         if (b < 3) continue;
         const long a = std::max<long>(
-            3, std::lround(static_cast<double>(faces) / (2.0 * b * a_multiple)) * a_multiple);
+            3, std::lround(static_cast<double>(faces) / (2.0 * b * a_multiple)) *
+                   a_multiple);
         const double error = std::abs(2.0 * a * b - static_cast<double>(faces));
         if (error < best_error) best_error = error, best = {unsigned(a), unsigned(b)};
     }
@@ -74,7 +75,8 @@ std::pair<unsigned, unsigned> grid_for_budget(std::size_t faces, double ratio,
 
 Mesh make_sphere(std::size_t budget) {
     // UV sphere: 2 * slices * (stacks - 1) faces, poles at z = +-1.
-    const auto [slices, rings] = grid_for_budget(budget, 2.0, 4, 1);  // rings = stacks - 1
+    const auto [slices, rings] =
+        grid_for_budget(budget, 2.0, 4, 1);  // rings = stacks - 1
     const unsigned stacks = rings + 1;
     Mesh mesh;
     mesh.positions.push_back({0.0f, 0.0f, 1.0f});
@@ -82,18 +84,20 @@ Mesh make_sphere(std::size_t budget) {
         const double theta = kPi * i / stacks;
         for (unsigned j = 0; j < slices; ++j) {
             const double phi = 2.0 * kPi * j / slices;
-            mesh.positions.push_back(glm::vec3(glm::dvec3(
-                std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                std::cos(theta))));
+            mesh.positions.push_back(
+                glm::vec3(glm::dvec3(std::sin(theta) * std::cos(phi),
+                                     std::sin(theta) * std::sin(phi), std::cos(theta))));
         }
     }
     mesh.positions.push_back({0.0f, 0.0f, -1.0f});
     const unsigned south = static_cast<unsigned>(mesh.positions.size() - 1);
-    auto ring_vertex = [&](unsigned ring, unsigned j) { return 1 + ring * slices + j % slices; };
+    auto ring_vertex = [&](unsigned ring, unsigned j) {
+        return 1 + ring * slices + j % slices;
+    };
     for (unsigned j = 0; j < slices; ++j) {
         mesh.triangles.push_back({0, ring_vertex(0, j), ring_vertex(0, j + 1)});
-        mesh.triangles.push_back({south, ring_vertex(stacks - 2, j + 1),
-                                  ring_vertex(stacks - 2, j)});
+        mesh.triangles.push_back(
+            {south, ring_vertex(stacks - 2, j + 1), ring_vertex(stacks - 2, j)});
     }
     for (unsigned ring = 0; ring + 1 < stacks - 1; ++ring)
         for (unsigned j = 0; j < slices; ++j) {
@@ -117,7 +121,8 @@ Mesh make_torus(std::size_t budget) {
         const glm::dvec3 radial(std::cos(phi), 0.0, -std::sin(phi));
         for (unsigned j = 0; j < around_tube; ++j) {
             const double theta = 2.0 * kPi * j / around_tube;
-            const glm::dvec3 normal = std::cos(theta) * radial + glm::dvec3(0, std::sin(theta), 0);
+            const glm::dvec3 normal =
+                std::cos(theta) * radial + glm::dvec3(0, std::sin(theta), 0);
             mesh.positions.push_back(glm::vec3(major * radial + minor * normal));
             mesh.normals.push_back(glm::vec3(normal));
         }
@@ -134,7 +139,8 @@ Mesh make_torus_knot(std::size_t budget) {
     constexpr double major = 1.0, minor = 0.45, p = 2.0, q = 3.0;
     auto curve = [&](double t) {
         const double r = major + minor * std::cos(q * t);
-        return glm::dvec3(r * std::cos(p * t), r * std::sin(p * t), minor * std::sin(q * t));
+        return glm::dvec3(r * std::cos(p * t), r * std::sin(p * t),
+                          minor * std::sin(q * t));
     };
     auto tangent = [&](double t) {
         const double r = major + minor * std::cos(q * t);
@@ -153,12 +159,14 @@ Mesh make_torus_knot(std::size_t budget) {
         // Frame from the torus core circle: periodic, so the tube closes without twist.
         const glm::dvec3 core = major * glm::dvec3(std::cos(p * t), std::sin(p * t), 0.0);
         const glm::dvec3 out = centre - core;
-        const glm::dvec3 normal = glm::normalize(out - glm::dot(out, direction) * direction);
+        const glm::dvec3 normal =
+            glm::normalize(out - glm::dot(out, direction) * direction);
         const glm::dvec3 binormal = glm::cross(direction, normal);
         for (unsigned j = 0; j < around; ++j) {
             const double theta = 2.0 * kPi * j / around;
-            mesh.positions.push_back(glm::vec3(
-                centre + tube_radius(t) * (std::cos(theta) * normal + std::sin(theta) * binormal)));
+            mesh.positions.push_back(
+                glm::vec3(centre + tube_radius(t) * (std::cos(theta) * normal +
+                                                     std::sin(theta) * binormal)));
         }
     }
     add_wrapped_grid(mesh, along, around);
@@ -168,8 +176,8 @@ Mesh make_torus_knot(std::size_t budget) {
 
 // ---- hand: a signed distance field polygonised by marching tetrahedra ----
 
-
-float smooth_min(float a, float b, float k) {  // polynomial smooth minimum (blend width k)
+float smooth_min(float a, float b,
+                 float k) {  // polynomial smooth minimum (blend width k)
     const float h = std::clamp(0.5f + 0.5f * (b - a) / k, 0.0f, 1.0f);
     return b + (a - b) * h - k * h * (1.0f - h);
 }
@@ -188,16 +196,21 @@ float ellipsoid(glm::vec3 p, glm::vec3 radii) {  // a bound, exact on the surfac
 // Negative inside. Palm faces +Z, fingers point to +Y, thumb to -X.
 float hand_distance(glm::vec3 p) {
     float d = ellipsoid(p, {0.55f, 0.62f, 0.2f});
-    d = smooth_min(d, capsule(p, {0.0f, -0.45f, 0.0f}, {0.0f, -1.15f, 0.0f}, 0.26f), 0.15f);
-    struct Finger { glm::vec3 base, tip; float radius; };
+    d = smooth_min(d, capsule(p, {0.0f, -0.45f, 0.0f}, {0.0f, -1.15f, 0.0f}, 0.26f),
+                   0.15f);
+    struct Finger {
+        glm::vec3 base, tip;
+        float radius;
+    };
     const Finger fingers[] = {
-        {{-0.34f, 0.42f, 0.0f}, {-0.46f, 1.30f, 0.03f}, 0.085f},  // index
-        {{-0.11f, 0.50f, 0.0f}, {-0.13f, 1.45f, 0.04f}, 0.09f},   // middle
-        {{0.12f, 0.48f, 0.0f}, {0.20f, 1.36f, 0.03f}, 0.085f},    // ring
-        {{0.34f, 0.38f, 0.0f}, {0.52f, 1.08f, 0.02f}, 0.07f},     // little
+        {{-0.34f, 0.42f, 0.0f}, {-0.46f, 1.30f, 0.03f}, 0.085f},    // index
+        {{-0.11f, 0.50f, 0.0f}, {-0.13f, 1.45f, 0.04f}, 0.09f},     // middle
+        {{0.12f, 0.48f, 0.0f}, {0.20f, 1.36f, 0.03f}, 0.085f},      // ring
+        {{0.34f, 0.38f, 0.0f}, {0.52f, 1.08f, 0.02f}, 0.07f},       // little
         {{-0.42f, -0.15f, 0.05f}, {-1.02f, 0.35f, 0.12f}, 0.095f},  // thumb
     };
-    for (const Finger& f : fingers) d = smooth_min(d, capsule(p, f.base, f.tip, f.radius), 0.06f);
+    for (const Finger& f : fingers)
+        d = smooth_min(d, capsule(p, f.base, f.tip, f.radius), 0.06f);
     return d;
 }
 
@@ -216,7 +229,9 @@ Mesh make_hand(std::size_t budget) {
     Mesh best;
     float best_cell = 0.0f;
     auto error_of = [budget](const Mesh& m) {
-        return m.triangles.empty() ? 1e30 : std::abs(double(m.face_count()) / double(budget) - 1.0);
+        return m.triangles.empty()
+                   ? 1e30
+                   : std::abs(double(m.face_count()) / double(budget) - 1.0);
     };
     auto consider = [&](float cell) {
         Mesh mesh = polygonise(hand_distance, lo - 2.0f * cell, hi + 2.0f * cell, cell);
@@ -229,16 +244,18 @@ Mesh make_hand(std::size_t budget) {
     for (int pass = 0; pass < 6 && (best_cell == 0.0f || error_of(best) > 0.01); ++pass) {
         const std::size_t faces = consider(cell);
         // Damped: at very coarse cells whole parts (the palm is 0.4 thick) drop out.
-        cell *= faces == 0 ? 0.5f
-                           : std::clamp(static_cast<float>(std::sqrt(double(faces) / budget)),
-                                        0.6f, 1.6f);
+        cell *= faces == 0
+                    ? 0.5f
+                    : std::clamp(static_cast<float>(std::sqrt(double(faces) / budget)),
+                                 0.6f, 1.6f);
     }
     for (int step = -8; step <= 8 && error_of(best) > 0.01; ++step)
         consider(best_cell * (1.0f + 0.01f * static_cast<float>(step)));
     if (best.triangles.empty()) throw MeshError("hand: no surface at this face budget");
     best.normals.resize(best.positions.size());
     for (std::size_t i = 0; i < best.positions.size(); ++i)
-        best.normals[i] = glm::normalize(distance_gradient(hand_distance, best.positions[i], 1e-3f));
+        best.normals[i] =
+            glm::normalize(distance_gradient(hand_distance, best.positions[i], 1e-3f));
     return best;
 }
 
@@ -258,7 +275,8 @@ const Builtin* find_builtin(const std::string& name) {
 }
 
 std::size_t parse_face_budget(const std::string& spec, const std::string& text) {
-    const std::string usage = spec + ": face budget must be a whole number like 30000 or 240k, "
+    const std::string usage = spec +
+                              ": face budget must be a whole number like 30000 or 240k, "
                               "between 100 and 20m";
     std::size_t value = 0;
     const char* end = text.data() + text.size();
@@ -266,9 +284,12 @@ std::size_t parse_face_budget(const std::string& spec, const std::string& text) 
     if (error != std::errc{} || text.empty()) throw MeshError(usage);
     std::size_t scale = 1;
     const std::string suffix(rest, end);
-    if (suffix == "k" || suffix == "K") scale = 1000;
-    else if (suffix == "m" || suffix == "M") scale = 1'000'000;
-    else if (!suffix.empty()) throw MeshError(usage);
+    if (suffix == "k" || suffix == "K")
+        scale = 1000;
+    else if (suffix == "m" || suffix == "M")
+        scale = 1'000'000;
+    else if (!suffix.empty())
+        throw MeshError(usage);
     if (value > kMaxFaceBudget / scale) throw MeshError(usage);
     value *= scale;
     if (value < kMinFaceBudget || value > kMaxFaceBudget) throw MeshError(usage);
@@ -292,7 +313,8 @@ Mesh build_builtin_mesh(const std::string& spec) {
     const Builtin* builtin = find_builtin(spec.substr(0, colon));
     if (builtin == nullptr) {
         std::string names;
-        for (const Builtin& b : kBuiltins) names += (names.empty() ? "" : ", ") + std::string(b.name);
+        for (const Builtin& b : kBuiltins)
+            names += (names.empty() ? "" : ", ") + std::string(b.name);
         throw MeshError(spec + ": not a built-in mesh (" + names + ")");
     }
     const std::size_t budget = colon == std::string::npos

@@ -7,10 +7,10 @@
 //     replace them all); missing, NaN or zero-length normals become smooth normals;
 //   - triangles touching a non-finite vertex or with zero area are dropped, and unused
 //     vertices removed. A file left with no triangle is an error.
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -30,8 +30,8 @@ bool finite(glm::vec3 v) {
 
 // Zero area relative to the longest edge squared (collinear or coincident corners).
 bool degenerate(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
-    const double longest = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b),
-                                      glm::dot(a - c, a - c)});
+    const double longest = std::max(
+        {glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
     return longest == 0.0 || !(glm::length(glm::cross(b - a, c - a)) > 1e-12 * longest);
 }
 
@@ -42,9 +42,11 @@ RawMesh read_with_assimp(const std::string& path) {
                                 aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     // No aiProcess_JoinIdenticalVertices: it compares with a tolerance that NaN passes,
     // so it would weld a NaN vertex onto a valid one; clean() welds exactly instead.
-    const aiScene* scene = importer.ReadFile(
-        path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
-    if (scene == nullptr) throw MeshError(path + ": Assimp: " + importer.GetErrorString());
+    const aiScene* scene =
+        importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                                    aiProcess_SortByPType);
+    if (scene == nullptr)
+        throw MeshError(path + ": Assimp: " + importer.GetErrorString());
     RawMesh raw;
     bool all_have_normals = scene->mNumMeshes > 0;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m)
@@ -64,7 +66,8 @@ RawMesh read_with_assimp(const std::string& path) {
         for (unsigned f = 0; f < source->mNumFaces; ++f) {
             const aiFace& face = source->mFaces[f];
             if (face.mNumIndices == 3)
-                raw.triangles.emplace_back(base + face.mIndices[0], base + face.mIndices[1],
+                raw.triangles.emplace_back(base + face.mIndices[0],
+                                           base + face.mIndices[1],
                                            base + face.mIndices[2]);
         }
     }
@@ -105,7 +108,8 @@ Mesh clean(const std::string& path, RawMesh raw) {
         representative[i] = it->second;
         if (!inserted && normals_agree &&
             glm::dot(raw.normals[i], raw.normals[it->second]) <
-                0.9999f * glm::length(raw.normals[i]) * glm::length(raw.normals[it->second]))
+                0.9999f * glm::length(raw.normals[i]) *
+                    glm::length(raw.normals[it->second]))
             normals_agree = false;
     }
     Mesh mesh;
@@ -118,7 +122,8 @@ Mesh clean(const std::string& path, RawMesh raw) {
                             std::to_string(std::max({t.x, t.y, t.z})) + " of only " +
                             std::to_string(raw.positions.size()));
         t = {representative[t.x], representative[t.y], representative[t.z]};
-        const glm::vec3 a = raw.positions[t.x], b = raw.positions[t.y], c = raw.positions[t.z];
+        const glm::vec3 a = raw.positions[t.x], b = raw.positions[t.y],
+                        c = raw.positions[t.z];
         if (!finite(a) || !finite(b) || !finite(c) || degenerate(a, b, c)) continue;
         for (int k = 0; k < 3; ++k) {
             unsigned& target = remap[t[k]];
@@ -132,7 +137,8 @@ Mesh clean(const std::string& path, RawMesh raw) {
         mesh.triangles.push_back(t);
     }
     if (mesh.triangles.empty())
-        throw MeshError(path + ": no usable triangles (" + std::to_string(raw.faces_in_file) +
+        throw MeshError(path + ": no usable triangles (" +
+                        std::to_string(raw.faces_in_file) +
                         " faces in the file, none with three finite, distinct corners)");
     finalize_mesh(mesh);  // smooth normals when missing; zero or NaN normals replaced
     return mesh;

@@ -28,7 +28,8 @@ struct Element {
 
 int type_size(const std::string& type) {
     if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16")
+        return 2;
     if (type == "int" || type == "uint" || type == "int32" || type == "uint32" ||
         type == "float" || type == "float32")
         return 4;
@@ -45,7 +46,8 @@ public:
     double read(const std::string& type) {
         if (!binary_) {
             double value = 0.0;
-            if (!(text_ >> value)) throw MeshError(path_ + ": PLY body ends early or is not numeric");
+            if (!(text_ >> value))
+                throw MeshError(path_ + ": PLY body ends early or is not numeric");
             return value;
         }
         const int size = type_size(type);
@@ -53,7 +55,10 @@ public:
             throw MeshError(path_ + ": PLY body is truncated");
         const char* p = body_.data() + offset_;
         offset_ += size;
-        auto as = [p](auto value) { std::memcpy(&value, p, sizeof value); return double(value); };
+        auto as = [p](auto value) {
+            std::memcpy(&value, p, sizeof value);
+            return double(value);
+        };
         if (type == "char" || type == "int8") return as(std::int8_t{});
         if (type == "uchar" || type == "uint8") return as(std::uint8_t{});
         if (type == "short" || type == "int16") return as(std::int16_t{});
@@ -77,7 +82,8 @@ private:
 std::optional<RawMesh> read_ply_triangle_strips(const std::string& path) {
     std::ifstream file(path, std::ios::binary);
     std::string line;
-    if (!std::getline(file, line) || (line != "ply" && line != "ply\r")) return std::nullopt;
+    if (!std::getline(file, line) || (line != "ply" && line != "ply\r"))
+        return std::nullopt;
 
     // Header.
     std::string format;
@@ -88,7 +94,8 @@ std::optional<RawMesh> read_ply_triangle_strips(const std::string& path) {
         std::string keyword;
         words >> keyword;
         if (keyword == "end_header") break;
-        if (keyword == "format") words >> format;
+        if (keyword == "format")
+            words >> format;
         else if (keyword == "element") {
             Element element;
             words >> element.name >> element.count;
@@ -109,10 +116,13 @@ std::optional<RawMesh> read_ply_triangle_strips(const std::string& path) {
     for (const Element& e : elements) has_strips = has_strips || e.name == "tristrips";
     if (!has_strips) return std::nullopt;
     if (format != "ascii" && format != "binary_little_endian")
-        throw MeshError(path + ": PLY triangle strips are read only from ascii or "
-                        "binary_little_endian files, not " + format);
+        throw MeshError(path +
+                        ": PLY triangle strips are read only from ascii or "
+                        "binary_little_endian files, not " +
+                        format);
 
-    std::string body((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    std::string body((std::istreambuf_iterator<char>(file)),
+                     std::istreambuf_iterator<char>());
     BodyReader reader(path, std::move(body), format != "ascii");
     RawMesh raw;
     for (const Element& element : elements) {
@@ -122,34 +132,49 @@ std::optional<RawMesh> read_ply_triangle_strips(const std::string& path) {
                 if (property.count_type.empty()) {
                     const double value = reader.read(property.type);
                     const std::string& n = property.name;
-                    if (n == "x") position.x = float(value);
-                    else if (n == "y") position.y = float(value);
-                    else if (n == "z") position.z = float(value);
-                    else if (n == "nx") normal.x = float(value);
-                    else if (n == "ny") normal.y = float(value);
-                    else if (n == "nz") normal.z = float(value);
+                    if (n == "x")
+                        position.x = float(value);
+                    else if (n == "y")
+                        position.y = float(value);
+                    else if (n == "z")
+                        position.z = float(value);
+                    else if (n == "nx")
+                        normal.x = float(value);
+                    else if (n == "ny")
+                        normal.y = float(value);
+                    else if (n == "nz")
+                        normal.z = float(value);
                     continue;
                 }
                 const double count = reader.read(property.count_type);
-                if (count < 0 || count > 1e9) throw MeshError(path + ": PLY list length is invalid");
+                if (count < 0 || count > 1e9)
+                    throw MeshError(path + ": PLY list length is invalid");
                 std::vector<long long> indices(static_cast<std::size_t>(count));
-                for (long long& index : indices) index = static_cast<long long>(reader.read(property.type));
+                for (long long& index : indices)
+                    index = static_cast<long long>(reader.read(property.type));
                 if (element.name == "tristrips") {
                     // Each strip alternates its winding; -1 starts a new strip.
                     std::size_t strip_start = 0;
                     for (std::size_t k = 0; k < indices.size(); ++k) {
-                        if (indices[k] < 0) { strip_start = k + 1; continue; }
+                        if (indices[k] < 0) {
+                            strip_start = k + 1;
+                            continue;
+                        }
                         if (k < strip_start + 2) continue;
-                        const long long a = indices[k - 2], b = indices[k - 1], c = indices[k];
+                        const long long a = indices[k - 2], b = indices[k - 1],
+                                        c = indices[k];
                         ++raw.faces_in_file;
                         if (a == b || b == c || a == c) continue;  // strip joints
-                        if ((k - strip_start) % 2 == 0) raw.triangles.emplace_back(a, b, c);
-                        else raw.triangles.emplace_back(b, a, c);
+                        if ((k - strip_start) % 2 == 0)
+                            raw.triangles.emplace_back(a, b, c);
+                        else
+                            raw.triangles.emplace_back(b, a, c);
                     }
                 } else if (element.name == "face") {
                     ++raw.faces_in_file;
                     for (std::size_t k = 2; k < indices.size(); ++k)  // fan
-                        raw.triangles.emplace_back(indices[0], indices[k - 1], indices[k]);
+                        raw.triangles.emplace_back(indices[0], indices[k - 1],
+                                                   indices[k]);
                 }
             }
             if (element.name == "vertex") {
@@ -161,7 +186,8 @@ std::optional<RawMesh> read_ply_triangle_strips(const std::string& path) {
     bool has_normals = false;
     for (const Element& e : elements)
         if (e.name == "vertex")
-            for (const Property& p : e.properties) has_normals = has_normals || p.name == "nx";
+            for (const Property& p : e.properties)
+                has_normals = has_normals || p.name == "nx";
     if (!has_normals) raw.normals.clear();
     return raw;
 }

@@ -32,8 +32,8 @@ Mesh polygonise(const std::function<float(glm::vec3)>& field, glm::vec3 lo, glm:
     auto vertex_on_edge = [&](std::uint64_t a, glm::vec3 pa, float fa, std::uint64_t b,
                               glm::vec3 pb, float fb) {
         if (a > b) std::swap(a, b), std::swap(pa, pb), std::swap(fa, fb);
-        const auto [it, inserted] =
-            edge_vertex.try_emplace((a << 32) ^ b, static_cast<unsigned>(mesh.positions.size()));
+        const auto [it, inserted] = edge_vertex.try_emplace(
+            (a << 32) ^ b, static_cast<unsigned>(mesh.positions.size()));
         if (inserted) mesh.positions.push_back(pa + (fa / (fa - fb)) * (pb - pa));
         return it->second;
     };
@@ -71,35 +71,43 @@ Mesh polygonise(const std::function<float(glm::vec3)>& field, glm::vec3 lo, glm:
                                 corner_index[c] = global_index(g);
                                 corner_position[c] = lo + cell * glm::vec3(g);
                                 corner_value[c] = block_values[local(g)];
-                                (corner_value[c] < 0.0f ? any_inside : any_outside) = true;
+                                (corner_value[c] < 0.0f ? any_inside : any_outside) =
+                                    true;
                             }
                             if (!any_inside || !any_outside) continue;
                             for (const auto& tet : kTetrahedra) {
                                 int inside[4], outside[4], n_in = 0, n_out = 0;
                                 for (int k = 0; k < 4; ++k)
                                     (corner_value[tet[k]] < 0.0f ? inside[n_in++]
-                                                                 : outside[n_out++]) = tet[k];
+                                                                 : outside[n_out++]) =
+                                        tet[k];
                                 if (n_in == 0 || n_out == 0) continue;
                                 auto on = [&](int a, int b) {
-                                    return vertex_on_edge(corner_index[a], corner_position[a],
-                                                          corner_value[a], corner_index[b],
-                                                          corner_position[b], corner_value[b]);
+                                    return vertex_on_edge(
+                                        corner_index[a], corner_position[a],
+                                        corner_value[a], corner_index[b],
+                                        corner_position[b], corner_value[b]);
                                 };
                                 glm::vec3 in_centre(0.0f), out_centre(0.0f);
-                                for (int k = 0; k < n_in; ++k) in_centre += corner_position[inside[k]];
+                                for (int k = 0; k < n_in; ++k)
+                                    in_centre += corner_position[inside[k]];
                                 for (int k = 0; k < n_out; ++k)
                                     out_centre += corner_position[outside[k]];
                                 const glm::vec3 outward =
                                     out_centre / float(n_out) - in_centre / float(n_in);
                                 // Orientation is decided on the edge midpoints, which are
-                                // exact and never degenerate: moving each vertex along its
-                                // edge keeps the triangle's side, while the interpolated
-                                // vertices can form slivers whose own normal is noise.
+                                // exact and never degenerate: moving each vertex along
+                                // its edge keeps the triangle's side, while the
+                                // interpolated vertices can form slivers whose own normal
+                                // is noise.
                                 auto mid = [&](int a, int b) {
-                                    return 0.5f * (corner_position[a] + corner_position[b]);
+                                    return 0.5f *
+                                           (corner_position[a] + corner_position[b]);
                                 };
-                                auto faces_out = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c) {
-                                    return glm::dot(glm::cross(b - a, c - a), outward) > 0.0f;
+                                auto faces_out = [&](glm::vec3 a, glm::vec3 b,
+                                                     glm::vec3 c) {
+                                    return glm::dot(glm::cross(b - a, c - a), outward) >
+                                           0.0f;
                                 };
                                 if (n_in == 1 || n_out == 1) {
                                     const int lone = n_in == 1 ? inside[0] : outside[0];
@@ -107,17 +115,20 @@ Mesh polygonise(const std::function<float(glm::vec3)>& field, glm::vec3 lo, glm:
                                     const unsigned a = on(lone, others[0]);
                                     const unsigned b = on(lone, others[1]);
                                     const unsigned c = on(lone, others[2]);
-                                    if (faces_out(mid(lone, others[0]), mid(lone, others[1]),
+                                    if (faces_out(mid(lone, others[0]),
+                                                  mid(lone, others[1]),
                                                   mid(lone, others[2])))
                                         mesh.triangles.push_back({a, b, c});
                                     else
                                         mesh.triangles.push_back({a, c, b});
-                                } else {  // two in, two out: a quad around the tetrahedron
+                                } else {  // two in, two out: a quad around the
+                                          // tetrahedron
                                     const unsigned q0 = on(inside[0], outside[0]);
                                     const unsigned q1 = on(inside[1], outside[0]);
                                     const unsigned q2 = on(inside[1], outside[1]);
                                     const unsigned q3 = on(inside[0], outside[1]);
-                                    if (faces_out(mid(inside[0], outside[0]), mid(inside[1], outside[0]),
+                                    if (faces_out(mid(inside[0], outside[0]),
+                                                  mid(inside[1], outside[0]),
                                                   mid(inside[1], outside[1]))) {
                                         mesh.triangles.push_back({q0, q1, q2});
                                         mesh.triangles.push_back({q0, q2, q3});

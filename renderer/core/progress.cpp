@@ -31,7 +31,9 @@ void ProgressBar::finish() {
     if (finished_) return;
     finished_ = true;
     if (!shown_) return;
-    draw(total_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
+    draw(
+        total_,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
     std::fputc('\n', stderr);
     std::fflush(stderr);
 }
@@ -42,7 +44,8 @@ std::function<void(std::size_t, std::size_t)> ProgressBar::callback() {
 
 void ProgressBar::draw(std::size_t done, double elapsed) {
     constexpr int kWidth = 30;
-    const double fraction = total_ == 0 ? 1.0 : std::min(1.0, double(done) / double(total_));
+    const double fraction =
+        total_ == 0 ? 1.0 : std::min(1.0, double(done) / double(total_));
     const int filled = static_cast<int>(fraction * kWidth);
     std::string bar(filled, '#');
     bar.append(kWidth - filled, '.');

@@ -27,7 +27,8 @@ Scene make_scene(std::shared_ptr<const Mesh> mesh, const Technique& technique,
     // survive clipping and the depth test against the cleared depth (1.0); thickness uses
     // eye-space distances, so this does not change it.
     const float margin = 1e-3f * scene.bounds.radius;
-    scene.camera.near_plane = std::max(scene.camera.near_plane - margin, 0.5f * scene.camera.near_plane);
+    scene.camera.near_plane =
+        std::max(scene.camera.near_plane - margin, 0.5f * scene.camera.near_plane);
     scene.camera.far_plane += margin;
     scene.values = std::move(values);
     return scene;

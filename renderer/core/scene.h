@@ -3,7 +3,6 @@
 // technique with a value for each of its knobs (material and technique parameters).
 // GL-free; the frame plan and the CPU references are pure functions of a Scene.
 #include <glm/glm.hpp>
-
 #include <memory>
 #include <string>
 
@@ -17,9 +16,9 @@ class Technique;
 
 // One directional key light plus an ambient term (thesis Sec. 3.1.1).
 struct Light {
-    glm::vec3 ambient{0.6f};   // Ia, linear rgb
-    glm::vec3 diffuse{1.0f};   // Id
-    glm::vec3 specular{1.0f};  // Is
+    glm::vec3 ambient{0.6f};                // Ia, linear rgb
+    glm::vec3 diffuse{1.0f};                // Id
+    glm::vec3 specular{1.0f};               // Is
     glm::vec3 direction{0.0f, 0.0f, 1.0f};  // unit, towards the light, eye space
 };
 

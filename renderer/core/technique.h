@@ -29,9 +29,11 @@ public:
     // The technique's own knobs, including shared material knobs it uses (albedo, ...).
     // The scene knobs (light, camera, background) are added by the registry.
     virtual const std::vector<Knob>& knobs() const = 0;
-    // Adds the passes `scene` calls for (all of them when plan.full()) and sets the output.
+    // Adds the passes `scene` calls for (all of them when plan.full()) and sets the
+    // output.
     virtual void plan(const Scene& scene, PlanBuilder& plan) const = 0;
-    // The same image computed on the CPU (Embree ray casting), independent of the GL path.
+    // The same image computed on the CPU (Embree ray casting), independent of the GL
+    // path.
     virtual Image render_reference(const Scene& scene) const = 0;
     // Quality knobs for the accuracy bench; empty when the technique has none.
     virtual std::vector<QualitySweep> quality_sweeps() const { return {}; }

@@ -21,8 +21,9 @@ namespace lucent {
 
 namespace {
 
-constexpr std::uint64_t kSeed = 0x6c75'6365'6e74'414full;  // fixed: bakes are reproducible
-constexpr std::size_t kChunk = 64;                          // vertices per work item
+constexpr std::uint64_t kSeed =
+    0x6c75'6365'6e74'414full;       // fixed: bakes are reproducible
+constexpr std::size_t kChunk = 64;  // vertices per work item
 
 // SplitMix64 finaliser: a well-mixed 64-bit hash of the vertex index.
 std::uint64_t mix(std::uint64_t x) {
@@ -45,7 +46,8 @@ void tangent_frame(glm::vec3 n, glm::vec3& t, glm::vec3& b) {
 
 float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh,
                                const std::vector<glm::vec3>& normals, std::size_t vertex,
-                               int rays, float offset, std::vector<glm::vec3>& directions) {
+                               int rays, float offset,
+                               std::vector<glm::vec3>& directions) {
     const glm::vec3 n = normals[vertex];
     glm::vec3 t, b;
     tangent_frame(n, t, b);
@@ -62,9 +64,9 @@ float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh,
         const double cos_theta = 1.0 - u;
         const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
         const double phi = 2.0 * std::numbers::pi * v;
-        directions[i] = glm::normalize(float(sin_theta * std::cos(phi)) * t +
-                                       float(sin_theta * std::sin(phi)) * b +
-                                       float(cos_theta) * n);
+        directions[i] =
+            glm::normalize(float(sin_theta * std::cos(phi)) * t +
+                           float(sin_theta * std::sin(phi)) * b + float(cos_theta) * n);
     }
     // Start just above the surface so the vertex's own triangles are not hit.
     const glm::vec3 origin = mesh.positions[vertex] + offset * n;
@@ -73,7 +75,8 @@ float vertex_ambient_occlusion(const RayCaster& caster, const Mesh& mesh,
 
 }  // namespace
 
-std::vector<float> bake_ambient_occlusion(const Mesh& mesh, const AoBakeOptions& options) {
+std::vector<float> bake_ambient_occlusion(const Mesh& mesh,
+                                          const AoBakeOptions& options) {
     if (options.rays < 1)
         throw std::invalid_argument("ao_rays: must be at least 1 (got " +
                                     std::to_string(options.rays) + ")");
@@ -105,17 +108,22 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh, const AoBakeOptions&
         const std::size_t last = std::min(total, first + kChunk);
         std::vector<glm::vec3> directions;
         for (std::size_t v = first; v < last; ++v)
-            result[v] = vertex_ambient_occlusion(caster, mesh, normals, v, options.rays, offset,
-                                                 directions);
+            result[v] = vertex_ambient_occlusion(caster, mesh, normals, v, options.rays,
+                                                 offset, directions);
         done.fetch_add(last - first);
         return true;
     };
-    unsigned threads = options.threads != 0 ? options.threads
-                                            : std::max(1u, std::thread::hardware_concurrency());
-    threads = static_cast<unsigned>(std::min<std::size_t>(threads, (total + kChunk - 1) / kChunk));
+    unsigned threads = options.threads != 0
+                           ? options.threads
+                           : std::max(1u, std::thread::hardware_concurrency());
+    threads = static_cast<unsigned>(
+        std::min<std::size_t>(threads, (total + kChunk - 1) / kChunk));
     std::vector<std::thread> workers;
     for (unsigned i = 1; i < threads; ++i)
-        workers.emplace_back([&] { while (work()) {} });
+        workers.emplace_back([&] {
+            while (work()) {
+            }
+        });
     // The calling thread works too, reporting progress between its chunks.
     while (work())
         if (options.progress) options.progress(done.load(), total);

@@ -13,7 +13,7 @@ namespace lucent {
 struct RayCaster::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    std::vector<glm::vec3> positions;    // copies: hit normals are computed from them
+    std::vector<glm::vec3> positions;  // copies: hit normals are computed from them
     std::vector<glm::uvec3> triangles;
     float epsilon = 0.0f;
 
@@ -45,10 +45,16 @@ RTCRayHit make_ray(glm::vec3 origin, glm::vec3 unit_direction, float t_min, floa
     return query;
 }
 
+// Embree's tnear is inclusive; the queries here exclude t_min itself.
+float exclusive_near(float t_min) {
+    return std::nextafter(std::max(t_min, 0.0f), std::numeric_limits<float>::infinity());
+}
+
 // Unit direction, or nullopt when the ray is unusable.
 std::optional<glm::vec3> unit(glm::vec3 origin, glm::vec3 direction) {
     const float length = glm::length(direction);
-    if (!finite(origin) || !(length > 0.0f) || !std::isfinite(length)) return std::nullopt;
+    if (!finite(origin) || !(length > 0.0f) || !std::isfinite(length))
+        return std::nullopt;
     return direction / length;
 }
 
@@ -58,8 +64,10 @@ RayCaster::RayCaster(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
     for (const glm::uvec3& t : mesh.triangles)
         if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() ||
             t.z >= mesh.positions.size())
-            throw std::invalid_argument(mesh.name + ": a triangle refers to a vertex past the "
-                                        "last of " + std::to_string(mesh.positions.size()));
+            throw std::invalid_argument(mesh.name +
+                                        ": a triangle refers to a vertex past the "
+                                        "last of " +
+                                        std::to_string(mesh.positions.size()));
     impl_->positions = mesh.positions;
     impl_->triangles = mesh.triangles;
     impl_->epsilon = 1e-5f * std::max(mesh.bounding_sphere().radius, 1e-6f);
@@ -78,9 +86,9 @@ RayCaster::RayCaster(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
             mesh.positions.size()));
         for (std::size_t i = 0; i < mesh.positions.size(); ++i)
             for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.positions[i][k];
-        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-            mesh.triangles.size()));
+        auto* indices = static_cast<unsigned*>(
+            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(unsigned), mesh.triangles.size()));
         for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
             for (int k = 0; k < 3; ++k) indices[3 * i + k] = mesh.triangles[i][k];
         rtcCommitGeometry(geometry);
@@ -99,29 +107,28 @@ RayCaster& RayCaster::operator=(RayCaster&&) noexcept = default;
 
 float RayCaster::layer_epsilon() const { return impl_->epsilon; }
 
-std::optional<RayHit> RayCaster::first_hit(glm::vec3 origin, glm::vec3 direction, float t_min,
-                                           float t_max) const {
+std::optional<RayHit> RayCaster::first_hit(glm::vec3 origin, glm::vec3 direction,
+                                           float t_min, float t_max) const {
     const std::optional<glm::vec3> dir = unit(origin, direction);
     if (!dir || !(t_max > t_min)) return std::nullopt;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRayHit query = make_ray(origin, *dir, std::max(t_min, 0.0f), t_max);
+    RTCRayHit query = make_ray(origin, *dir, exclusive_near(t_min), t_max);
     rtcIntersect1(impl_->scene, &context, &query);
     if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-    // Embree's tnear is inclusive; the contract here is an open interval.
-    if (!(query.ray.tfar > t_min)) return std::nullopt;
     RayHit hit;
     hit.distance = query.ray.tfar;
     hit.triangle = query.hit.primID;
     hit.barycentric = {query.hit.u, query.hit.v};
     const glm::uvec3 t = impl_->triangles[hit.triangle];
     const glm::vec3& p0 = impl_->positions[t.x];
-    hit.geometric_normal =
-        glm::normalize(glm::cross(impl_->positions[t.y] - p0, impl_->positions[t.z] - p0));
+    hit.geometric_normal = glm::normalize(
+        glm::cross(impl_->positions[t.y] - p0, impl_->positions[t.z] - p0));
     return hit;
 }
 
-std::vector<RayHit> RayCaster::hits(glm::vec3 origin, glm::vec3 direction, int max_hits) const {
+std::vector<RayHit> RayCaster::hits(glm::vec3 origin, glm::vec3 direction,
+                                    int max_hits) const {
     std::vector<RayHit> layers;
     float t_min = 0.0f;
     while (static_cast<int>(layers.size()) < max_hits) {
@@ -129,23 +136,25 @@ std::vector<RayHit> RayCaster::hits(glm::vec3 origin, glm::vec3 direction, int m
         if (!hit) break;
         layers.push_back(*hit);
         // Relative term too: far from the origin a float step can exceed the epsilon.
-        t_min = hit->distance + impl_->epsilon + 4.0f * std::numeric_limits<float>::epsilon() *
-                                                     hit->distance;
+        t_min = hit->distance + impl_->epsilon +
+                4.0f * std::numeric_limits<float>::epsilon() * hit->distance;
     }
     return layers;
 }
 
-bool RayCaster::occluded(glm::vec3 origin, glm::vec3 direction, float t_min, float t_max) const {
+bool RayCaster::occluded(glm::vec3 origin, glm::vec3 direction, float t_min,
+                         float t_max) const {
     const std::optional<glm::vec3> dir = unit(origin, direction);
     if (!dir || !(t_max > t_min)) return false;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRay ray = make_ray(origin, *dir, std::max(t_min, 0.0f), t_max).ray;
+    RTCRay ray = make_ray(origin, *dir, exclusive_near(t_min), t_max).ray;
     rtcOccluded1(impl_->scene, &context, &ray);
     return ray.tfar == -std::numeric_limits<float>::infinity();
 }
 
-std::size_t RayCaster::count_escaping(glm::vec3 origin, const std::vector<glm::vec3>& directions,
+std::size_t RayCaster::count_escaping(glm::vec3 origin,
+                                      const std::vector<glm::vec3>& directions,
                                       float t_min) const {
     if (!finite(origin)) return directions.size();  // an unusable ray hits nothing
     // One ray at a time: measured faster here than rtcOccluded16 packets, since AO rays
@@ -154,8 +163,9 @@ std::size_t RayCaster::count_escaping(glm::vec3 origin, const std::vector<glm::v
     rtcInitIntersectContext(&context);
     std::size_t escaped = 0;
     for (const glm::vec3& direction : directions) {
-        RTCRay ray = make_ray(origin, direction, std::max(t_min, 0.0f),
-                              std::numeric_limits<float>::infinity()).ray;
+        RTCRay ray = make_ray(origin, direction, exclusive_near(t_min),
+                              std::numeric_limits<float>::infinity())
+                         .ray;
         rtcOccluded1(impl_->scene, &context, &ray);
         if (ray.tfar != -std::numeric_limits<float>::infinity()) ++escaped;
     }

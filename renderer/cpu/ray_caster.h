@@ -1,7 +1,6 @@
 #pragma once
 // Embree ray casting over a Mesh, shared by the AO bake and the CPU reference renderers.
 #include <glm/glm.hpp>
-
 #include <memory>
 #include <optional>
 #include <vector>
@@ -11,9 +10,9 @@
 namespace lucent {
 
 struct RayHit {
-    float distance = 0.0f;  // along the (normalised) ray direction
-    unsigned triangle = 0;  // index into Mesh::triangles
-    glm::vec2 barycentric{0.0f};  // Embree's (u, v) for vertices 1 and 2
+    float distance = 0.0f;             // along the (normalised) ray direction
+    unsigned triangle = 0;             // index into Mesh::triangles
+    glm::vec2 barycentric{0.0f};       // Embree's (u, v) for vertices 1 and 2
     glm::vec3 geometric_normal{0.0f};  // unit, as wound (counter-clockwise = front)
 };
 
@@ -28,8 +27,8 @@ public:
     RayCaster& operator=(RayCaster&&) noexcept;
 
     // Nearest hit with distance in (t_min, t_max), if any.
-    std::optional<RayHit> first_hit(glm::vec3 origin, glm::vec3 direction, float t_min = 0.0f,
-                                    float t_max = 1e30f) const;
+    std::optional<RayHit> first_hit(glm::vec3 origin, glm::vec3 direction,
+                                    float t_min = 0.0f, float t_max = 1e30f) const;
     // Up to `max_hits` successive surface crossings along the ray, nearest first (depth
     // layers). Each next search starts layer_epsilon() beyond the previous hit, so one
     // surface is never reported twice (e.g. a ray through an edge shared by two

@@ -12,12 +12,18 @@ namespace {
 
 GLenum internal_format(ResourceFormat format) {
     switch (format) {
-        case ResourceFormat::depth16: return GL_DEPTH_COMPONENT16;
-        case ResourceFormat::depth24: return GL_DEPTH_COMPONENT24;
-        case ResourceFormat::depth32f: return GL_DEPTH_COMPONENT32F;
-        case ResourceFormat::r32f: return GL_R32F;
-        case ResourceFormat::rgba32f: return GL_RGBA32F;
-        case ResourceFormat::vertex_float: break;
+        case ResourceFormat::depth16:
+            return GL_DEPTH_COMPONENT16;
+        case ResourceFormat::depth24:
+            return GL_DEPTH_COMPONENT24;
+        case ResourceFormat::depth32f:
+            return GL_DEPTH_COMPONENT32F;
+        case ResourceFormat::r32f:
+            return GL_R32F;
+        case ResourceFormat::rgba32f:
+            return GL_RGBA32F;
+        case ResourceFormat::vertex_float:
+            break;
     }
     throw std::logic_error("not a texture format");
 }
@@ -34,12 +40,18 @@ void set_uniform(GLuint program, const Uniform& uniform) {
     std::visit(
         [&](const auto& v) {
             using T = std::decay_t<decltype(v)>;
-            if constexpr (std::is_same_v<T, int>) glProgramUniform1i(program, location, v);
-            else if constexpr (std::is_same_v<T, float>) glProgramUniform1f(program, location, v);
-            else if constexpr (std::is_same_v<T, glm::vec3>) glProgramUniform3fv(program, location, 1, &v[0]);
-            else if constexpr (std::is_same_v<T, glm::vec4>) glProgramUniform4fv(program, location, 1, &v[0]);
-            else if constexpr (std::is_same_v<T, glm::mat3>) glProgramUniformMatrix3fv(program, location, 1, GL_FALSE, &v[0][0]);
-            else glProgramUniformMatrix4fv(program, location, 1, GL_FALSE, &v[0][0]);
+            if constexpr (std::is_same_v<T, int>)
+                glProgramUniform1i(program, location, v);
+            else if constexpr (std::is_same_v<T, float>)
+                glProgramUniform1f(program, location, v);
+            else if constexpr (std::is_same_v<T, glm::vec3>)
+                glProgramUniform3fv(program, location, 1, &v[0]);
+            else if constexpr (std::is_same_v<T, glm::vec4>)
+                glProgramUniform4fv(program, location, 1, &v[0]);
+            else if constexpr (std::is_same_v<T, glm::mat3>)
+                glProgramUniformMatrix3fv(program, location, 1, GL_FALSE, &v[0][0]);
+            else
+                glProgramUniformMatrix4fv(program, location, 1, GL_FALSE, &v[0][0]);
         },
         uniform.value);
 }
@@ -70,17 +82,22 @@ struct FrameExecutor::Impl {
     };
 
     void upload_mesh(const Mesh& mesh) {
-        const std::string key = mesh.content_hash + "/" + std::to_string(mesh.vertex_count()) +
-                                "/" + std::to_string(mesh.face_count()) + "/" + mesh.name;
+        const std::string key = mesh.content_hash + "/" +
+                                std::to_string(mesh.vertex_count()) + "/" +
+                                std::to_string(mesh.face_count()) + "/" + mesh.name;
         if (key == mesh_key) return;
         if (mesh.normals.size() != mesh.positions.size())
-            throw std::runtime_error("mesh '" + mesh.name + "': normals and positions differ in count");
-        positions = make_buffer(mesh.positions.data(),
-                                static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::vec3)));
-        normals = make_buffer(mesh.normals.data(),
-                              static_cast<GLsizeiptr>(mesh.normals.size() * sizeof(glm::vec3)));
-        indices = make_buffer(mesh.triangles.data(),
-                              static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(glm::uvec3)));
+            throw std::runtime_error("mesh '" + mesh.name +
+                                     "': normals and positions differ in count");
+        positions = make_buffer(
+            mesh.positions.data(),
+            static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::vec3)));
+        normals =
+            make_buffer(mesh.normals.data(),
+                        static_cast<GLsizeiptr>(mesh.normals.size() * sizeof(glm::vec3)));
+        indices = make_buffer(
+            mesh.triangles.data(),
+            static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(glm::uvec3)));
         index_count = static_cast<GLsizei>(mesh.triangles.size() * 3);
         mesh_vao = make_vertex_array();
         const GLuint vao = mesh_vao.id();
@@ -102,8 +119,9 @@ struct FrameExecutor::Impl {
         const std::string key = program_key(shader);
         auto it = programs.find(key);
         if (it == programs.end()) {
-            Program linked = link_program({shader_stage(GL_VERTEX_SHADER, shader.vertex, shader.defines),
-                                           shader_stage(GL_FRAGMENT_SHADER, shader.fragment, shader.defines)});
+            Program linked = link_program(
+                {shader_stage(GL_VERTEX_SHADER, shader.vertex, shader.defines),
+                 shader_stage(GL_FRAGMENT_SHADER, shader.fragment, shader.defines)});
             it = programs.emplace(key, std::move(linked)).first;
         }
         return it->second.id();
@@ -134,8 +152,11 @@ struct FrameExecutor::Impl {
         if (it == ao_streams.end()) {
             const std::vector<float> ao = ao_source(*scene.mesh, pass.ao_rays);
             if (ao.size() != scene.mesh->vertex_count())
-                throw std::runtime_error("ambient occlusion: expected one value per vertex");
-            it = ao_streams.emplace(key, make_buffer(ao.data(), static_cast<GLsizeiptr>(ao.size() * sizeof(float))))
+                throw std::runtime_error(
+                    "ambient occlusion: expected one value per vertex");
+            it = ao_streams
+                     .emplace(key, make_buffer(ao.data(), static_cast<GLsizeiptr>(
+                                                              ao.size() * sizeof(float))))
                      .first;
         }
         glVertexArrayVertexBuffer(mesh_vao.id(), 2, it->second.id(), 0, sizeof(float));
@@ -150,14 +171,18 @@ struct FrameExecutor::Impl {
         const Texture* depth = nullptr;
         for (const auto& w : pass.writes) {
             const Texture2d& t = textures.at(w);
-            if (is_depth_format(t.format)) depth = &t.texture;
-            else colour.push_back(&t.texture);
+            if (is_depth_format(t.format))
+                depth = &t.texture;
+            else
+                colour.push_back(&t.texture);
         }
-        Framebuffer fbo = colour.size() == 0   ? make_framebuffer({}, depth)
-                          : colour.size() == 1 ? make_framebuffer({colour[0]}, depth)
-                                               : make_framebuffer({colour[0], colour[1]}, depth);
+        Framebuffer fbo = colour.size() == 0 ? make_framebuffer({}, depth)
+                          : colour.size() == 1
+                              ? make_framebuffer({colour[0]}, depth)
+                              : make_framebuffer({colour[0], colour[1]}, depth);
         for (std::size_t i = 0; i < colour.size(); ++i)
-            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, static_cast<GLint>(i), &pass.clear_colour[0]);
+            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, static_cast<GLint>(i),
+                                      &pass.clear_colour[0]);
         if (depth) {
             const float one = 1.0f;
             glClearNamedFramebufferfv(fbo.id(), GL_DEPTH, 0, &one);
@@ -179,7 +204,8 @@ struct FrameExecutor::Impl {
         for (const auto& read : pass.reads) {
             auto it = textures.find(read.resource);
             if (it == textures.end()) continue;  // a vertex stream, bound by bake()
-            const std::string& sampler = read.sampler.empty() ? read.resource : read.sampler;
+            const std::string& sampler =
+                read.sampler.empty() ? read.resource : read.sampler;
             glBindTextureUnit(static_cast<GLuint>(unit), it->second.texture.id());
             const GLint location = glGetUniformLocation(prog, sampler.c_str());
             if (location >= 0) glProgramUniform1i(prog, location, unit);
@@ -208,7 +234,8 @@ void FrameExecutor::set_ambient_occlusion_source(AmbientOcclusionSource source) 
 }
 
 void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time_passes) {
-    if (plan.width <= 0 || plan.height <= 0) throw std::runtime_error("frame plan has no pixels");
+    if (plan.width <= 0 || plan.height <= 0)
+        throw std::runtime_error("frame plan has no pixels");
     impl_->upload_mesh(*scene.mesh);
     impl_->allocate(plan);
     glDisableVertexArrayAttrib(impl_->mesh_vao.id(), 2);
@@ -225,14 +252,19 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
     std::size_t index = 0;
     for_each_pass(plan, [&](const Pass& pass) {
         const auto start = std::chrono::steady_clock::now();
-        const bool gpu = time_passes && gpu_timer && pass.kind != PassKind::bake_ambient_occlusion;
+        const bool gpu =
+            time_passes && gpu_timer && pass.kind != PassKind::bake_ambient_occlusion;
         if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
-        if (pass.kind == PassKind::bake_ambient_occlusion) impl_->bake(scene, pass);
-        else impl_->draw(pass, plan);
+        if (pass.kind == PassKind::bake_ambient_occlusion)
+            impl_->bake(scene, pass);
+        else
+            impl_->draw(pass, plan);
         if (gpu) glEndQuery(GL_TIME_ELAPSED);
-        if (time_passes && !gpu && pass.kind != PassKind::bake_ambient_occlusion) glFinish();
+        if (time_passes && !gpu && pass.kind != PassKind::bake_ambient_occlusion)
+            glFinish();
         wall_ms.push_back(std::chrono::duration<double, std::milli>(
-                              std::chrono::steady_clock::now() - start).count());
+                              std::chrono::steady_clock::now() - start)
+                              .count());
         ++index;
     });
     if (!time_passes) return;
@@ -250,7 +282,8 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
 
 Image FrameExecutor::read_output(const FramePlan& plan) const {
     const auto& texture = impl_->textures.at(plan.output);
-    const std::vector<float> pixels = read_texture_rgba32f(texture.texture, texture.width, texture.height);
+    const std::vector<float> pixels =
+        read_texture_rgba32f(texture.texture, texture.width, texture.height);
     Image image(texture.width, texture.height);
     const std::size_t row = static_cast<std::size_t>(texture.width) * 4;
     for (int y = 0; y < texture.height; ++y)  // GL rows are bottom first
@@ -262,7 +295,8 @@ Image FrameExecutor::read_output(const FramePlan& plan) const {
 std::vector<float> FrameExecutor::read_channel(const std::string& resource) const {
     const auto& texture = impl_->textures.at(resource);
     const GLenum format = is_depth_format(texture.format) ? GL_DEPTH_COMPONENT : GL_RED;
-    const std::vector<float> pixels = read_texture_r32f(texture.texture, format, texture.width, texture.height);
+    const std::vector<float> pixels =
+        read_texture_r32f(texture.texture, format, texture.width, texture.height);
     std::vector<float> flipped(pixels.size());
     const std::size_t row = static_cast<std::size_t>(texture.width);
     for (int y = 0; y < texture.height; ++y)
@@ -273,7 +307,8 @@ std::vector<float> FrameExecutor::read_channel(const std::string& resource) cons
 
 void FrameExecutor::present(const FramePlan& plan, int x, int y, int width, int height) {
     const auto& texture = impl_->textures.at(plan.output);
-    const GLuint prog = impl_->program({"gl/shaders/fullscreen.vert", "gl/shaders/present.frag", {}});
+    const GLuint prog =
+        impl_->program({"gl/shaders/fullscreen.vert", "gl/shaders/present.frag", {}});
     glViewport(x, y, width, height);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -296,7 +331,8 @@ std::vector<std::string> FrameExecutor::allocated_resources() const {
     for (const auto& [name, texture] : impl_->textures) names.push_back(name);
     if (glIsVertexArray(impl_->mesh_vao.id())) {
         GLint enabled = 0;
-        glGetVertexArrayIndexediv(impl_->mesh_vao.id(), 2, GL_VERTEX_ATTRIB_ARRAY_ENABLED, &enabled);
+        glGetVertexArrayIndexediv(impl_->mesh_vao.id(), 2, GL_VERTEX_ATTRIB_ARRAY_ENABLED,
+                                  &enabled);
         if (enabled) names.push_back("vertex_ao");
     }
     return names;

@@ -30,7 +30,8 @@ struct FrameTimings {
     bool gpu_timer = false;
 };
 
-// Per-vertex AO for (mesh, rays). Defaults to load_or_bake_ambient_occlusion (disk cache).
+// Per-vertex AO for (mesh, rays). Defaults to load_or_bake_ambient_occlusion (disk
+// cache).
 using AmbientOcclusionSource = std::function<std::vector<float>(const Mesh&, int rays)>;
 
 class FrameExecutor {

@@ -25,7 +25,8 @@ const Technique& find_technique(std::string_view name) {
         if (technique->name() == name) return *technique;
         valid += (valid.empty() ? "" : ", ") + std::string(technique->name());
     }
-    throw KnobError("technique: '" + std::string(name) + "' is unknown (valid: " + valid + ")");
+    throw KnobError("technique: '" + std::string(name) + "' is unknown (valid: " + valid +
+                    ")");
 }
 
 std::vector<Knob> knobs_for(const Technique& technique) {

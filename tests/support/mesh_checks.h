@@ -14,9 +14,9 @@ namespace lucent::test {
 inline double signed_volume(const Mesh& mesh) {
     double sum = 0.0;
     for (const glm::uvec3& t : mesh.triangles)
-        sum += glm::dot(glm::dvec3(mesh.positions[t.x]),
-                        glm::cross(glm::dvec3(mesh.positions[t.y]),
-                                   glm::dvec3(mesh.positions[t.z])));
+        sum += glm::dot(
+            glm::dvec3(mesh.positions[t.x]),
+            glm::cross(glm::dvec3(mesh.positions[t.y]), glm::dvec3(mesh.positions[t.z])));
     return sum / 6.0;
 }
 
@@ -28,11 +28,12 @@ inline ::testing::AssertionResult closed_and_consistently_wound(const Mesh& mesh
         for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
     for (const auto& [edge, count] : directed) {
         if (count != 1)
-            return ::testing::AssertionFailure() << "edge " << edge.first << "->" << edge.second
-                                                 << " used " << count << " times";
-        if (directed.find({edge.second, edge.first}) == directed.end())
             return ::testing::AssertionFailure()
-                   << "edge " << edge.first << "->" << edge.second << " has no twin (open)";
+                   << "edge " << edge.first << "->" << edge.second << " used " << count
+                   << " times";
+        if (directed.find({edge.second, edge.first}) == directed.end())
+            return ::testing::AssertionFailure() << "edge " << edge.first << "->"
+                                                 << edge.second << " has no twin (open)";
     }
     return ::testing::AssertionSuccess();
 }

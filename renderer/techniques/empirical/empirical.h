@@ -15,9 +15,13 @@ namespace lucent::empirical {
 inline constexpr double kSmoothingFalloff = 0.1;
 // Integer kernel weights of the thesis's 5x5 kernel (1,4,7,16,26,41; the /26 cancels in
 // the normalisation) and a binomial 3x3; row-major, symmetric.
-inline constexpr std::array<double, 25> kKernel5 = {1,  4,  7,  4,  1,  4,  16, 26, 16,
-                                                    4,  7,  26, 41, 26, 7,  4,  16, 26,
-                                                    16, 4,  1,  4,  7,  4,  1};
+// clang-format off
+inline constexpr std::array<double, 25> kKernel5 = {1,  4,  7,  4, 1,
+                                                    4, 16, 26, 16, 4,
+                                                    7, 26, 41, 26, 7,
+                                                    4, 16, 26, 16, 4,
+                                                    1,  4,  7,  4, 1};
+// clang-format on
 inline constexpr std::array<double, 9> kKernel3 = {1, 2, 1, 2, 4, 2, 1, 2, 1};
 
 // Peeling epsilon (App. B) in window depth: the thesis's 1e-6, raised to one depth

@@ -2,8 +2,8 @@
 //   ambient_occlusion  per-vertex AO bake            -> vertex_ao        (ka*Ia != 0)
 //   front_depth        nearest surface depth         -> front_depth      (wb != 0)
 //   second_layer       depth peeling (App. B)        -> second_depth     (wb != 0)
-//   smooth_back_layer  depth-aware 5x5 / 3x3 blur    -> smoothed_depth   (wb != 0, kernel > 1)
-//   shade              Eq. 3.6                       -> colour
+//   smooth_back_layer  depth-aware 5x5 / 3x3 blur    -> smoothed_depth   (wb != 0, kernel
+//   > 1) shade              Eq. 3.6                       -> colour
 // Terms that cannot change the image select a shader variant without them, and the
 // passes that only fed them are culled by PlanBuilder::compile().
 #include <glm/gtc/matrix_inverse.hpp>
@@ -65,7 +65,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     plan.add(ao);
 
     // Step 1 (Sec. 3.1): depth of the nearest surface; only the peel reads it.
-    Pass front{"front_depth", "depth of the first layer", PassKind::draw_mesh,
+    Pass front{"front_depth",
+               "depth of the first layer",
+               PassKind::draw_mesh,
                {mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}}};
     front.writes = {"front_depth"};
     front.uniforms = camera;
@@ -74,12 +76,14 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     std::string back_layer;
     if (backlight_term) {
         // Step 2 (App. B): the second layer by depth peeling.
-        Pass peel{"second_layer", "depth peeling: nearest depth behind front + epsilon",
+        Pass peel{"second_layer",
+                  "depth peeling: nearest depth behind front + epsilon",
                   PassKind::draw_mesh,
                   {mesh_vert, "techniques/empirical/shaders/peel.frag", {}}};
         peel.reads = {{"front_depth", ""}};
         peel.writes = {"second_depth"};
-        peel.uniforms = with(camera, {{"u_epsilon", static_cast<float>(peel_epsilon(p.depth_precision))}});
+        peel.uniforms = with(
+            camera, {{"u_epsilon", static_cast<float>(peel_epsilon(p.depth_precision))}});
         plan.add(peel);
         back_layer = "second_depth";
 
@@ -88,7 +92,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
             // with blur_kernel = 1 this runs a 1x1 kernel, an exact copy.
             const int size = p.blur_kernel;
             Pass smooth{"smooth_back_layer",
-                        "depth-aware " + std::to_string(size) + "x" + std::to_string(size) +
+                        "depth-aware " + std::to_string(size) + "x" +
+                            std::to_string(size) +
                             " smoothing of the second layer (Eq. C.1)",
                         PassKind::fullscreen,
                         {"gl/shaders/fullscreen.vert",
@@ -103,7 +108,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     }
 
     // Step 4 (Eq. 3.6): shading, one variant per set of live terms.
-    Pass shade{"shade", "Eq. 3.6: ambient*AO + diffuse + specular + backlight(thickness)",
+    Pass shade{"shade",
+               "Eq. 3.6: ambient*AO + diffuse + specular + backlight(thickness)",
                PassKind::draw_mesh,
                {mesh_vert, "techniques/empirical/shaders/shade.frag", {}}};
     std::vector<Uniform> u = {

@@ -2,10 +2,9 @@
 // one ray through each pixel centre; its first and second hits are the exact two depth
 // layers (no depth buffer, no peeling epsilon beyond the thesis's). Then the same
 // smoothing (Eq. C.1) and lighting (Eq. 3.6) run in double precision.
-#include <glm/gtc/matrix_inverse.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/matrix_inverse.hpp>
 #include <thread>
 
 #include "core/ambient_occlusion.h"
@@ -18,10 +17,11 @@ namespace {
 constexpr double kNoLayer = 1.0;  // window depth of "no surface" (cleared depth)
 
 struct Layers {
-    std::vector<double> front;       // window depth, kNoLayer where the ray misses
-    std::vector<double> second;      // window depth of the second layer, or kNoLayer
-    std::vector<glm::dvec3> normal;  // interpolated vertex normal at the front hit (eye space)
-    std::vector<double> ao;          // interpolated AO at the front hit
+    std::vector<double> front;   // window depth, kNoLayer where the ray misses
+    std::vector<double> second;  // window depth of the second layer, or kNoLayer
+    std::vector<glm::dvec3>
+        normal;              // interpolated vertex normal at the front hit (eye space)
+    std::vector<double> ao;  // interpolated AO at the front hit
 };
 
 // x^e with x^0 = 1 and non-positive bases giving 0 (as the shader's power()).
@@ -70,8 +70,10 @@ Layers cast_layers(const Scene& scene, const std::vector<float>& vertex_ao) {
         for (int x = 0; x < w; ++x) {
             // Ray through the pixel centre, from the eye (un-projected far point).
             const glm::dvec2 ndc((x + 0.5) / w * 2.0 - 1.0, (gl_y + 0.5) / h * 2.0 - 1.0);
-            const glm::dvec4 far_point = inverse_view_projection * glm::dvec4(ndc, 1.0, 1.0);
-            const glm::dvec3 direction = glm::normalize(glm::dvec3(far_point) / far_point.w - eye);
+            const glm::dvec4 far_point =
+                inverse_view_projection * glm::dvec4(ndc, 1.0, 1.0);
+            const glm::dvec3 direction =
+                glm::normalize(glm::dvec3(far_point) / far_point.w - eye);
             const double cos_forward = glm::dot(direction, forward);
             const auto hits = caster.hits(glm::vec3(eye), glm::vec3(direction), 8);
             const std::size_t i = static_cast<std::size_t>(row) * w + x;
@@ -80,19 +82,20 @@ Layers cast_layers(const Scene& scene, const std::vector<float>& vertex_ao) {
                 const double z = hit.distance * cos_forward;
                 if (z < n || z > f) continue;  // clipped by the near/far planes
                 const double d = window_depth(z);
-                if (d >= 1.0) continue;        // fails the depth test against the clear
+                if (d >= 1.0) continue;  // fails the depth test against the clear
                 if (!have_front) {
                     have_front = true;
                     layers.front[i] = d;
                     const glm::uvec3 tri = mesh.triangles[hit.triangle];
                     const double u = hit.barycentric.x, v = hit.barycentric.y;
-                    const glm::dvec3 object_normal = (1.0 - u - v) * glm::dvec3(mesh.normals[tri.x]) +
-                                                     u * glm::dvec3(mesh.normals[tri.y]) +
-                                                     v * glm::dvec3(mesh.normals[tri.z]);
+                    const glm::dvec3 object_normal =
+                        (1.0 - u - v) * glm::dvec3(mesh.normals[tri.x]) +
+                        u * glm::dvec3(mesh.normals[tri.y]) +
+                        v * glm::dvec3(mesh.normals[tri.z]);
                     layers.normal[i] = normal_matrix * object_normal;
                     if (!vertex_ao.empty())
-                        layers.ao[i] = (1.0 - u - v) * vertex_ao[tri.x] + u * vertex_ao[tri.y] +
-                                       v * vertex_ao[tri.z];
+                        layers.ao[i] = (1.0 - u - v) * vertex_ao[tri.x] +
+                                       u * vertex_ao[tri.y] + v * vertex_ao[tri.z];
                 } else if (d > layers.front[i] + epsilon) {
                     layers.second[i] = d;  // App. B: nearest depth behind front + epsilon
                     break;
@@ -119,11 +122,14 @@ std::vector<double> smooth(const std::vector<double>& depth, int w, int h, int s
             double sum = 0.0, total = 0.0;
             for (int j = -radius; j <= radius; ++j)
                 for (int i = -radius; i <= radius; ++i) {
-                    const int sx = std::clamp(x + i, 0, w - 1), sy = std::clamp(y + j, 0, h - 1);
+                    const int sx = std::clamp(x + i, 0, w - 1),
+                              sy = std::clamp(y + j, 0, h - 1);
                     const double d = depth[static_cast<std::size_t>(sy) * w + sx];
                     if (d >= kNoLayer) continue;
-                    const double weight = kernel[(j + radius) * size + (i + radius)] *
-                                          (1.0 - std::clamp(std::abs(d - d0) / kSmoothingFalloff, 0.0, 1.0));
+                    const double weight =
+                        kernel[(j + radius) * size + (i + radius)] *
+                        (1.0 -
+                         std::clamp(std::abs(d - d0) / kSmoothingFalloff, 0.0, 1.0));
                     sum += weight * d;
                     total += weight;
                 }
@@ -156,7 +162,8 @@ Image render_reference(const Scene& scene) {
         const double ndc = 2.0 * window_depth - 1.0;
         return 2.0 * n * f / (f + n - ndc * (f - n));
     };
-    const glm::dvec3 kd = p.albedo, ia = light.ambient, id = light.diffuse, is = light.specular;
+    const glm::dvec3 kd = p.albedo, ia = light.ambient, id = light.diffuse,
+                     is = light.specular;
     const glm::dvec3 l = light.direction;
     const glm::dvec3 half_sum = l + glm::dvec3(0.0, 0.0, 1.0);  // viewer at infinity
 
@@ -169,8 +176,9 @@ Image render_reference(const Scene& scene) {
                 continue;
             }
             const double length2 = glm::dot(layers.normal[i], layers.normal[i]);
-            const glm::dvec3 normal = length2 > 1e-30 ? layers.normal[i] / std::sqrt(length2)
-                                                      : glm::dvec3(0.0, 0.0, 1.0);
+            const glm::dvec3 normal = length2 > 1e-30
+                                          ? layers.normal[i] / std::sqrt(length2)
+                                          : glm::dvec3(0.0, 0.0, 1.0);
             glm::dvec3 colour(0.0);
             // Ambient term (Eq. 3.7)
             if (ambient_term) colour += layers.ao[i] * p.ambient * kd * ia;
@@ -180,14 +188,20 @@ Image render_reference(const Scene& scene) {
                 colour += p.diffuse_contribution * kd * id * n_dot_l;
                 const double half_length2 = glm::dot(half_sum, half_sum);
                 const double n_dot_h =
-                    half_length2 > 1e-30 ? std::max(glm::dot(normal, half_sum / std::sqrt(half_length2)), 0.0) : 0.0;
-                colour += p.specular_contribution * p.specular * is * power(n_dot_h, p.shininess);
+                    half_length2 > 1e-30
+                        ? std::max(glm::dot(normal, half_sum / std::sqrt(half_length2)),
+                                   0.0)
+                        : 0.0;
+                colour += p.specular_contribution * p.specular * is *
+                          power(n_dot_h, p.shininess);
             }
             // Thickness term (Eq. 3.10); no second layer counts as the full diameter.
             if (p.backlight != 0.0) {
                 double t = 1.0;
                 if (back[i] < kNoLayer && diameter > 0.0)
-                    t = std::clamp((eye_depth(back[i]) - eye_depth(layers.front[i])) / diameter, 0.0, 1.0);
+                    t = std::clamp(
+                        (eye_depth(back[i]) - eye_depth(layers.front[i])) / diameter, 0.0,
+                        1.0);
                 colour += p.backlight * power(1.0 - t, p.thickness_exponent) *
                           (kd + glm::dvec3(p.diffuse_weight));
             }

@@ -1,5 +1,6 @@
 // Registers the empirical technique: its knobs, passes and CPU reference.
 #include "core/technique.h"
+
 #include "techniques/empirical/empirical.h"
 
 namespace lucent {
@@ -9,7 +10,8 @@ class EmpiricalTechnique final : public Technique {
 public:
     std::string_view name() const override { return "empirical"; }
     std::string_view description() const override {
-        return "screen-space thickness from two depth layers, backlight through thin parts, "
+        return "screen-space thickness from two depth layers, backlight through thin "
+               "parts, "
                "AO and Blinn-Phong (Eq. 3.6)";
     }
     const std::vector<Knob>& knobs() const override { return empirical::knobs(); }
@@ -20,11 +22,14 @@ public:
         return empirical::render_reference(scene);
     }
     std::vector<QualitySweep> quality_sweeps() const override {
-        // Reference values: the thesis's 5x5 smoothing, exact layers (the CPU has no depth
-        // buffer) and an AO bake converged well beyond the thesis's 320 rays.
+        // Reference values: the thesis's 5x5 smoothing, exact layers (the CPU has no
+        // depth buffer) and an AO bake converged well beyond the thesis's 320 rays.
         return {
-            {"blur_kernel", {std::string("1"), std::string("3"), std::string("5")}, std::string("5")},
-            {"depth_precision", {std::string("16"), std::string("24"), std::string("32f")},
+            {"blur_kernel",
+             {std::string("1"), std::string("3"), std::string("5")},
+             std::string("5")},
+            {"depth_precision",
+             {std::string("16"), std::string("24"), std::string("32f")},
              std::string("32f")},
             {"ao_rays", {16, 40, 80, 160, 320}, 1024},
         };

@@ -1,11 +1,11 @@
 // fit_camera against the thesis's rule (Eq. 3.4): eye one diameter from the centre,
 // near/far planes touching the bounding sphere; projection's depth mapping checked on
 // points placed at the planes.
+#include "core/camera.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "core/camera.h"
 
 namespace lucent {
 namespace {
@@ -53,7 +53,8 @@ TEST(Camera, ViewLooksDownMinusZAndProjectionUsesTheFieldOfView) {
 }
 
 TEST(Camera, ViewFromStraightAboveIsStillAValidMatrix) {
-    const Camera camera = fit_camera({{0.0f, 0.0f, 0.0f}, 1.0f}, 45.0f, 1.0f, {0.0f, 1.0f, 0.0f});
+    const Camera camera =
+        fit_camera({{0.0f, 0.0f, 0.0f}, 1.0f}, 45.0f, 1.0f, {0.0f, 1.0f, 0.0f});
     const glm::mat4 view = camera.view();
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) ASSERT_TRUE(std::isfinite(view[c][r]));
@@ -61,7 +62,8 @@ TEST(Camera, ViewFromStraightAboveIsStillAValidMatrix) {
 }
 
 TEST(Camera, DegenerateSphereAndDirectionStillGiveAValidFrustum) {
-    const Camera camera = fit_camera({{0.0f, 0.0f, 0.0f}, 0.0f}, 45.0f, 1.0f, {0.0f, 0.0f, 0.0f});
+    const Camera camera =
+        fit_camera({{0.0f, 0.0f, 0.0f}, 0.0f}, 45.0f, 1.0f, {0.0f, 0.0f, 0.0f});
     EXPECT_GT(camera.near_plane, 0.0f);
     EXPECT_GT(camera.far_plane, camera.near_plane);
     EXPECT_GT(camera.eye.z, 0.0f);  // falls back to +Z

@@ -1,10 +1,11 @@
 // The frame planner with no GL: which passes exist for each scene, that culled passes
 // are never visited, and that the plan is a pure function of (scene, knobs).
+#include "core/frame_plan.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
-#include "core/frame_plan.h"
 #include "core/technique.h"
 #include "techniques/registry.h"
 
@@ -37,7 +38,8 @@ bool has_define(const Pass& pass, const std::string& define) {
 
 class EmpiricalPlan : public ::testing::Test {
 protected:
-    FramePlan plan(std::vector<KnobAssignment> settings, PlanMode mode = PlanMode::pruned) {
+    FramePlan plan(std::vector<KnobAssignment> settings,
+                   PlanMode mode = PlanMode::pruned) {
         static const auto mesh = std::make_shared<const Mesh>(load_mesh("sphere:200"));
         const Technique& technique = find_technique("empirical");
         const auto knobs = knobs_for(technique);
@@ -49,8 +51,9 @@ protected:
 
 TEST_F(EmpiricalPlan, DefaultSceneRunsEveryPass) {
     const FramePlan p = plan({});
-    EXPECT_EQ(pass_names(p), (std::vector<std::string>{"ambient_occlusion", "front_depth",
-                                                        "second_layer", "smooth_back_layer", "shade"}));
+    EXPECT_EQ(pass_names(p),
+              (std::vector<std::string>{"ambient_occlusion", "front_depth",
+                                        "second_layer", "smooth_back_layer", "shade"}));
     EXPECT_TRUE(p.culled.empty());
     EXPECT_EQ(p.width, 64);
     EXPECT_EQ(p.height, 48);
@@ -67,15 +70,17 @@ TEST_F(EmpiricalPlan, ZeroBacklightDropsPeelingSmoothingAndTheirTextures) {
     EXPECT_EQ(pass_names(p), (std::vector<std::string>{"ambient_occlusion", "shade"}));
     // front_depth was added but nothing reads it any more: the compiler culled it.
     EXPECT_EQ(p.culled, (std::vector<std::string>{"front_depth"}));
-    EXPECT_EQ(resource_names(p), (std::vector<std::string>{"colour", "shade_depth", "vertex_ao"}));
+    EXPECT_EQ(resource_names(p),
+              (std::vector<std::string>{"colour", "shade_depth", "vertex_ao"}));
     EXPECT_FALSE(has_define(pass_named(p, "shade"), "WITH_BACKLIGHT"));
 }
 
 TEST_F(EmpiricalPlan, ZeroAmbientOrZeroAmbientLightSkipsTheAoBake) {
-    for (const auto& setting : {KnobAssignment{"ambient", "0"}, KnobAssignment{"light_ambient", "0"}}) {
+    for (const auto& setting :
+         {KnobAssignment{"ambient", "0"}, KnobAssignment{"light_ambient", "0"}}) {
         const FramePlan p = plan({setting});
         EXPECT_EQ(pass_names(p), (std::vector<std::string>{"front_depth", "second_layer",
-                                                            "smooth_back_layer", "shade"}))
+                                                           "smooth_back_layer", "shade"}))
             << setting.key;
         EXPECT_EQ(p.culled, (std::vector<std::string>{"ambient_occlusion"}));
         EXPECT_EQ(p.resource("vertex_ao"), nullptr);
@@ -88,13 +93,14 @@ TEST_F(EmpiricalPlan, ZeroAmbientOrZeroAmbientLightSkipsTheAoBake) {
 TEST_F(EmpiricalPlan, KernelOneDropsSmoothingAndShadesFromTheRawSecondLayer) {
     const FramePlan p = plan({{"blur_kernel", "1"}});
     EXPECT_EQ(pass_names(p), (std::vector<std::string>{"ambient_occlusion", "front_depth",
-                                                        "second_layer", "shade"}));
+                                                       "second_layer", "shade"}));
     EXPECT_EQ(p.resource("smoothed_depth"), nullptr);
     const auto& reads = pass_named(p, "shade").reads;
     EXPECT_TRUE(std::any_of(reads.begin(), reads.end(), [](const Read& r) {
         return r.resource == "second_depth" && r.sampler == "back_depth";
     }));
-    EXPECT_TRUE(has_define(pass_named(plan({{"blur_kernel", "3"}}), "smooth_back_layer"), "KERNEL_SIZE 3"));
+    EXPECT_TRUE(has_define(pass_named(plan({{"blur_kernel", "3"}}), "smooth_back_layer"),
+                           "KERNEL_SIZE 3"));
 }
 
 TEST_F(EmpiricalPlan, EverythingOffLeavesOnlyShading) {
@@ -104,9 +110,11 @@ TEST_F(EmpiricalPlan, EverythingOffLeavesOnlyShading) {
 }
 
 TEST_F(EmpiricalPlan, FullModeForcesEveryPassAndEveryTerm) {
-    const FramePlan p = plan({{"backlight", "0"}, {"ambient", "0"}, {"blur_kernel", "1"}}, PlanMode::full);
-    EXPECT_EQ(pass_names(p), (std::vector<std::string>{"ambient_occlusion", "front_depth",
-                                                        "second_layer", "smooth_back_layer", "shade"}));
+    const FramePlan p = plan({{"backlight", "0"}, {"ambient", "0"}, {"blur_kernel", "1"}},
+                             PlanMode::full);
+    EXPECT_EQ(pass_names(p),
+              (std::vector<std::string>{"ambient_occlusion", "front_depth",
+                                        "second_layer", "smooth_back_layer", "shade"}));
     EXPECT_TRUE(p.culled.empty());
     EXPECT_TRUE(has_define(pass_named(p, "smooth_back_layer"), "KERNEL_SIZE 1"));
     EXPECT_TRUE(has_define(pass_named(p, "shade"), "WITH_AMBIENT_OCCLUSION"));
@@ -114,11 +122,15 @@ TEST_F(EmpiricalPlan, FullModeForcesEveryPassAndEveryTerm) {
 }
 
 TEST_F(EmpiricalPlan, DepthPrecisionPicksTheLayerFormatAndPlansArePure) {
-    EXPECT_EQ(plan({{"depth_precision", "16"}}).resource("second_depth")->format, ResourceFormat::depth16);
-    EXPECT_EQ(plan({{"depth_precision", "24"}}).resource("front_depth")->format, ResourceFormat::depth24);
+    EXPECT_EQ(plan({{"depth_precision", "16"}}).resource("second_depth")->format,
+              ResourceFormat::depth16);
+    EXPECT_EQ(plan({{"depth_precision", "24"}}).resource("front_depth")->format,
+              ResourceFormat::depth24);
     EXPECT_EQ(plan({{"shininess", "3"}}).explain(), plan({{"shininess", "3"}}).explain());
     const std::string text = plan({{"backlight", "0"}}).explain();
-    EXPECT_NE(text.find("shade: vertex_ao -> colour (rgba32f), shade_depth (depth32f)"), std::string::npos) << text;
+    EXPECT_NE(text.find("shade: vertex_ao -> colour (rgba32f), shade_depth (depth32f)"),
+              std::string::npos)
+        << text;
     EXPECT_NE(text.find("culled: front_depth"), std::string::npos) << text;
 }
 

@@ -1,10 +1,11 @@
 // Image output: formats, encodings, atomic writes, and no NaN/Inf ever written.
+#include "core/image.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "core/image.h"
 #include "core/image_compare.h"
 #include "test_paths.h"
 
@@ -21,7 +22,8 @@ Image gradient() {
 TEST(ImageIo, ExrRoundTripsLinearFloatsExactly) {
     const auto dir = test::scratch_dir("image_exr");
     Image image = gradient();
-    image.set(1, 1, {2.5f, -0.25f, 1e-8f, 0.0f});  // HDR, negative and tiny values survive
+    image.set(1, 1,
+              {2.5f, -0.25f, 1e-8f, 0.0f});  // HDR, negative and tiny values survive
     write_image(dir / "a.exr", image);
     const Image back = read_image(dir / "a.exr");
     ASSERT_EQ(back.width, 4);
@@ -80,7 +82,8 @@ TEST(ImageIo, UnsupportedExtensionNamesTheFileAndWritesNothing) {
         write_image(dir / "a.jpg", gradient());
         FAIL();
     } catch (const ImageError& e) {
-        EXPECT_NE(std::string(e.what()).find("a.jpg: unsupported image format '.jpg'"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("a.jpg: unsupported image format '.jpg'"),
+                  std::string::npos);
     }
     EXPECT_TRUE(std::filesystem::is_empty(dir));
     EXPECT_THROW(read_image(dir / "missing.exr"), ImageError);

@@ -26,8 +26,10 @@ class BuiltinMeshTest : public ::testing::TestWithParam<BuiltinCase> {};
 
 TEST_P(BuiltinMeshTest, HitsFaceBudgetWithinThreePercent) {
     for (const std::size_t budget : {4000u, 30000u}) {
-        const Mesh mesh = load_mesh(std::string(GetParam().name) + ":" + std::to_string(budget));
-        EXPECT_NEAR(double(mesh.face_count()), double(budget), 0.03 * budget) << mesh.name;
+        const Mesh mesh =
+            load_mesh(std::string(GetParam().name) + ":" + std::to_string(budget));
+        EXPECT_NEAR(double(mesh.face_count()), double(budget), 0.03 * budget)
+            << mesh.name;
     }
     const Mesh by_default = load_mesh(GetParam().name);
     EXPECT_NEAR(double(by_default.face_count()), double(kDefaultFaceBudget),
@@ -38,8 +40,7 @@ TEST_P(BuiltinMeshTest, IsClosedOrientableWithTheRightGenus) {
     const Mesh mesh = load_mesh(std::string(GetParam().name) + ":8000");
     EXPECT_TRUE(closed_and_consistently_wound(mesh));
     // Closed triangle mesh: E = 3F/2, so V - E + F = 2 - 2g gives V = F/2 + 2 - 2g.
-    const long expected_vertices =
-        long(mesh.face_count()) / 2 + 2 - 2 * GetParam().genus;
+    const long expected_vertices = long(mesh.face_count()) / 2 + 2 - 2 * GetParam().genus;
     EXPECT_EQ(long(mesh.vertex_count()), expected_vertices);
 }
 
@@ -59,7 +60,8 @@ TEST_P(BuiltinMeshTest, WindsOutwardWithUnitNormalsAndNoDegenerateFaces) {
         for (int k = 0; k < 3; ++k)
             if (glm::dot(face, mesh.normals[t[k]]) <= 0.0f) ++disagreeing;
     }
-    EXPECT_LE(disagreeing, mesh.face_count() / 500) << "corners whose normal faces inward";
+    EXPECT_LE(disagreeing, mesh.face_count() / 500)
+        << "corners whose normal faces inward";
 }
 
 TEST_P(BuiltinMeshTest, BoundingSphereContainsEveryVertexAndIsTight) {
@@ -78,7 +80,8 @@ TEST_P(BuiltinMeshTest, BoundingSphereContainsEveryVertexAndIsTight) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Builtins, BuiltinMeshTest,
-                         ::testing::Values(BuiltinCase{"sphere", 0}, BuiltinCase{"torus", 1},
+                         ::testing::Values(BuiltinCase{"sphere", 0},
+                                           BuiltinCase{"torus", 1},
                                            BuiltinCase{"torus_knot", 1},
                                            BuiltinCase{"hand", 0}),
                          [](const auto& info) { return std::string(info.param.name); });
@@ -110,7 +113,8 @@ TEST(BuiltinMesh, TorusKnotHasThinAndThickParts) {
     const Mesh mesh = load_mesh("torus_knot:8000");
     auto curve = [](double t) {
         const double r = 1.0 + 0.45 * std::cos(3 * t);
-        return glm::dvec3(r * std::cos(2 * t), r * std::sin(2 * t), 0.45 * std::sin(3 * t));
+        return glm::dvec3(r * std::cos(2 * t), r * std::sin(2 * t),
+                          0.45 * std::sin(3 * t));
     };
     std::vector<glm::dvec3> samples;
     for (int i = 0; i < 4000; ++i) samples.push_back(curve(2 * kPi * i / 4000));
@@ -139,7 +143,8 @@ TEST(BuiltinMesh, HandIsNonConvexWithThinFingers) {
         // Point-in-mesh by ray parity along +Z (the hand is closed).
         int crossings = 0;
         for (const glm::uvec3& t : mesh.triangles) {
-            const glm::vec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+            const glm::vec3 a = mesh.positions[t.x], b = mesh.positions[t.y],
+                            c = mesh.positions[t.z];
             const auto edge = [&](glm::vec3 p0, glm::vec3 p1) {
                 return (p1.x - p0.x) * (q.y - p0.y) - (p1.y - p0.y) * (q.x - p0.x);
             };
@@ -162,9 +167,11 @@ TEST(BuiltinMesh, HandIsNonConvexWithThinFingers) {
 }
 
 TEST(BuiltinMesh, FaceBudgetSuffixesAndErrors) {
-    EXPECT_NEAR(double(load_mesh("torus_knot:240k").face_count()), 240000.0, 0.03 * 240000);
+    EXPECT_NEAR(double(load_mesh("torus_knot:240k").face_count()), 240000.0,
+                0.03 * 240000);
     EXPECT_THROW(load_mesh(""), MeshError);
-    for (const char* bad : {"sphere:abc", "sphere:10", "sphere:", "torus:30kk", "hand:-5"}) {
+    for (const char* bad :
+         {"sphere:abc", "sphere:10", "sphere:", "torus:30kk", "hand:-5"}) {
         try {
             load_mesh(bad);
             ADD_FAILURE() << bad << " should be rejected";

@@ -78,10 +78,11 @@ TEST(MeshIo, ObjIsTriangulatedDegenerateFacesDroppedAndNormalsGenerated) {
 
 // 1e39 overflows a float to infinity.
 TEST(MeshIo, TrianglesTouchingNonFiniteVerticesAreDropped) {
-    const Mesh mesh = load_mesh(write_file("nan", "nan.obj",
-                                           "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan nan nan\n"
-                                           "v 0 0 1\nv 1e39 0 0\nf 1 2 3\nf 1 4 2\nf 1 2 5\n"
-                                           "f 6 2 3\n"));
+    const Mesh mesh =
+        load_mesh(write_file("nan", "nan.obj",
+                             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan nan nan\n"
+                             "v 0 0 1\nv 1e39 0 0\nf 1 2 3\nf 1 4 2\nf 1 2 5\n"
+                             "f 6 2 3\n"));
     EXPECT_EQ(mesh.face_count(), 2u);
     EXPECT_EQ(mesh.vertex_count(), 4u);
     for (const glm::vec3& p : mesh.positions) EXPECT_TRUE(std::isfinite(glm::length(p)));
@@ -118,7 +119,8 @@ end_header
     EXPECT_GT(signed_volume(mesh), 0.0);
     // By symmetry every vertex normal (given or generated) points away from the centre.
     for (std::size_t i = 0; i < 4; ++i)
-        EXPECT_NEAR(glm::dot(mesh.normals[i], glm::normalize(mesh.positions[i])), 1.0f, 1e-5f)
+        EXPECT_NEAR(glm::dot(mesh.normals[i], glm::normalize(mesh.positions[i])), 1.0f,
+                    1e-5f)
             << i;
 }
 
@@ -127,12 +129,13 @@ TEST(MeshIo, StlFacetNormalsAreWeldedIntoSmoothOnes) {
     const glm::vec3 v[4] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
     const int faces[4][3] = {{0, 2, 3}, {0, 3, 1}, {0, 1, 2}, {1, 3, 2}};
     for (const auto& f : faces) {
-        const glm::vec3 n = glm::normalize(glm::cross(v[f[1]] - v[f[0]], v[f[2]] - v[f[0]]));
+        const glm::vec3 n =
+            glm::normalize(glm::cross(v[f[1]] - v[f[0]], v[f[2]] - v[f[0]]));
         stl += "facet normal " + std::to_string(n.x) + " " + std::to_string(n.y) + " " +
                std::to_string(n.z) + "\nouter loop\n";
         for (int k : f)
-            stl += "vertex " + std::to_string(v[k].x) + " " + std::to_string(v[k].y) + " " +
-                   std::to_string(v[k].z) + "\n";
+            stl += "vertex " + std::to_string(v[k].x) + " " + std::to_string(v[k].y) +
+                   " " + std::to_string(v[k].z) + "\n";
         stl += "endloop\nendfacet\n";
     }
     stl += "endsolid tetra\n";
@@ -142,7 +145,8 @@ TEST(MeshIo, StlFacetNormalsAreWeldedIntoSmoothOnes) {
     EXPECT_TRUE(closed_and_consistently_wound(mesh));
     EXPECT_NEAR(signed_volume(mesh), 8.0 / 3.0, 1e-5);  // a third of the 2x2x2 cube
     for (std::size_t i = 0; i < 4; ++i)
-        EXPECT_NEAR(glm::dot(mesh.normals[i], glm::normalize(mesh.positions[i])), 1.0f, 1e-5f);
+        EXPECT_NEAR(glm::dot(mesh.normals[i], glm::normalize(mesh.positions[i])), 1.0f,
+                    1e-5f);
 }
 
 TEST(MeshIo, OffQuadsAreTriangulated) {
@@ -253,9 +257,9 @@ TEST(MeshIo, BadFilesGiveOneLineNamingTheFile) {
     for (const char* name : {"garbage.obj", "garbage.ply", "garbage.stl", "garbage.xyz"})
         expect_one_line_error(write_file("garbage", name, garbage), "");
     expect_one_line_error(write_file("empty", "points.obj", "v 0 0 0\nv 1 1 1\n"), "");
-    expect_one_line_error(write_file("degenerate", "flat.obj",
-                                     "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
-                          "no usable triangles");
+    expect_one_line_error(
+        write_file("degenerate", "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
+        "no usable triangles");
     expect_one_line_error(write_file("range", "range.ply", R"(ply
 format ascii 1.0
 element vertex 3

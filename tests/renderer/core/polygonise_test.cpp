@@ -1,11 +1,12 @@
 // Marching tetrahedra on fields with known zero sets: closed, outward, right genus, and
 // enclosing the analytic volume.
+#include "core/polygonise.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "core/polygonise.h"
 #include "mesh_checks.h"
 
 namespace lucent {
@@ -35,8 +36,10 @@ TEST(Polygonise, TorusFieldGivesGenusOne) {
 
 TEST(Polygonise, FaceCountScalesWithTheInverseSquareOfTheCell) {
     const auto sphere = [](glm::vec3 p) { return glm::length(p) - 1.0f; };
-    const double coarse = double(polygonise(sphere, glm::vec3(-1.2f), glm::vec3(1.2f), 0.08f).face_count());
-    const double fine = double(polygonise(sphere, glm::vec3(-1.2f), glm::vec3(1.2f), 0.04f).face_count());
+    const double coarse =
+        double(polygonise(sphere, glm::vec3(-1.2f), glm::vec3(1.2f), 0.08f).face_count());
+    const double fine =
+        double(polygonise(sphere, glm::vec3(-1.2f), glm::vec3(1.2f), 0.04f).face_count());
     EXPECT_NEAR(fine / coarse, 4.0, 0.4);
 }
 

@@ -1,8 +1,8 @@
 // ProgressBar output as a terminal would see it (forced), and its silence otherwise.
+#include "core/progress.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
-
-#include "core/progress.h"
 
 namespace lucent {
 namespace {

@@ -2,6 +2,8 @@
 // (AO exactly 1), a vertex inside a closed box none of it (exactly 0), and the centre
 // of an open box's floor sees the opening's solid angle over 2 pi (uniform hemisphere).
 // Plus determinism across thread counts and the cache's round trip and corruption.
+#include "core/ambient_occlusion.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 #include <numbers>
 #include <thread>
 
-#include "core/ambient_occlusion.h"
 #include "test_paths.h"
 
 namespace lucent {
@@ -23,9 +24,9 @@ namespace {
 Mesh box_with_floor_centre(float height, bool closed) {
     Mesh mesh;
     mesh.name = "test box";
-    mesh.positions = {{0, 0, 0},       {-1, -1, 0},      {1, -1, 0},       {1, 1, 0},
-                      {-1, 1, 0},      {-1, -1, height}, {1, -1, height},  {1, 1, height},
-                      {-1, 1, height}};
+    mesh.positions = {{0, 0, 0},       {-1, -1, 0},    {1, -1, 0},
+                      {1, 1, 0},       {-1, 1, 0},     {-1, -1, height},
+                      {1, -1, height}, {1, 1, height}, {-1, 1, height}};
     // Wound so the box's inside is the front (we look from the centre vertex).
     mesh.triangles = {{0, 2, 1}, {0, 3, 2}, {0, 4, 3}, {0, 1, 4}};
     for (unsigned i = 0; i < 4; ++i) {
@@ -64,7 +65,8 @@ TEST(AmbientOcclusion, MissingNormalsAreRebuiltFromTheFaces) {
 }
 
 TEST(AmbientOcclusion, VertexInsideAClosedBoxSeesNothing) {
-    const std::vector<float> ao = bake_ambient_occlusion(box_with_floor_centre(1.0f, true), {});
+    const std::vector<float> ao =
+        bake_ambient_occlusion(box_with_floor_centre(1.0f, true), {});
     EXPECT_EQ(ao[0], 0.0f);
 }
 
@@ -139,15 +141,17 @@ TEST(AmbientOcclusion, ProgressIsReportedFromTheCallingThreadAndEndsAtTotal) {
 TEST(AmbientOcclusion, RejectsFewerThanOneRay) {
     AoBakeOptions options;
     options.rays = 0;
-    EXPECT_THROW(bake_ambient_occlusion(load_mesh("sphere:400"), options), std::invalid_argument);
+    EXPECT_THROW(bake_ambient_occlusion(load_mesh("sphere:400"), options),
+                 std::invalid_argument);
 }
 
 // Points the cache at a fresh directory for one test.
 class AoCacheTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = test::scratch_dir(std::string("ao_cache/") +
-                                 ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = test::scratch_dir(
+            std::string("ao_cache/") +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
         setenv("LUCENT_CACHE_DIR", dir_.c_str(), 1);
         options_.rays = 16;
         options_.progress = [this](std::size_t, std::size_t) { baked_ = true; };
@@ -215,11 +219,13 @@ TEST_F(AoCacheTest, CorruptOrTruncatedFilesAreRebuiltNotTrusted) {
         file.seekp(static_cast<std::streamoff>(good_size - 5));
         file.put('\x7f');
     });
-    damage_and_reload("truncated", [&] { std::filesystem::resize_file(path, good_size / 2); });
+    damage_and_reload("truncated",
+                      [&] { std::filesystem::resize_file(path, good_size / 2); });
     damage_and_reload("header only", [&] { std::filesystem::resize_file(path, 40); });
     damage_and_reload("empty", [&] { std::filesystem::resize_file(path, 0); });
     damage_and_reload("garbage", [&] {
-        std::ofstream(path, std::ios::binary | std::ios::trunc) << std::string(good_size, 'x');
+        std::ofstream(path, std::ios::binary | std::ios::trunc)
+            << std::string(good_size, 'x');
     });
     damage_and_reload("wrong rays in header", [&] {
         std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);

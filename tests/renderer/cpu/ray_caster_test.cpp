@@ -1,13 +1,14 @@
 // RayCaster against analytic distances: the built-in sphere has vertices on its poles
 // and the torus vertices where the axis-aligned rays below cross it, so those hits are
 // exact; rays through edges and vertices must give an even number of layers.
+#include "cpu/ray_caster.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <thread>
 
 #include "core/mesh.h"
-#include "cpu/ray_caster.h"
 
 namespace lucent {
 namespace {
@@ -16,7 +17,8 @@ TEST(RayCaster, RayThroughSphereCentreHitsAtDMinusRAndDPlusR) {
     const Mesh sphere = load_mesh("sphere:4000");
     const RayCaster caster(sphere);
     const float d = 3.0f;
-    const std::vector<RayHit> layers = caster.hits({0.0f, 0.0f, d}, {0.0f, 0.0f, -2.0f}, 8);
+    const std::vector<RayHit> layers =
+        caster.hits({0.0f, 0.0f, d}, {0.0f, 0.0f, -2.0f}, 8);
     ASSERT_EQ(layers.size(), 2u);
     EXPECT_NEAR(layers[0].distance, d - 1.0f, 1e-5f);
     EXPECT_NEAR(layers[1].distance, d + 1.0f, 1e-5f);
@@ -29,12 +31,13 @@ TEST(RayCaster, ObliqueRaysThroughTheCentreMatchTheSphereToMeshAccuracy) {
     const Mesh sphere = load_mesh("sphere:30000");
     const RayCaster caster(sphere);
     for (int i = 0; i < 50; ++i) {
-        const glm::vec3 dir = glm::normalize(glm::vec3(std::sin(i * 1.3f), std::cos(i * 0.7f),
-                                                       std::sin(i * 2.9f + 0.3f)));
+        const glm::vec3 dir = glm::normalize(
+            glm::vec3(std::sin(i * 1.3f), std::cos(i * 0.7f), std::sin(i * 2.9f + 0.3f)));
         const glm::vec3 origin = -2.5f * dir;
         const std::vector<RayHit> layers = caster.hits(origin, dir, 4);
         ASSERT_EQ(layers.size(), 2u);
-        // Inscribed polyhedron: hits lie inside the sphere, by at most ~1e-3 at 30K faces.
+        // Inscribed polyhedron: hits lie inside the sphere, by at most ~1e-3 at 30K
+        // faces.
         EXPECT_GE(layers[0].distance, 1.5f - 1e-5f);
         EXPECT_NEAR(layers[0].distance, 1.5f, 1e-3f);
         EXPECT_LE(layers[1].distance, 3.5f + 1e-5f);
@@ -45,7 +48,8 @@ TEST(RayCaster, ObliqueRaysThroughTheCentreMatchTheSphereToMeshAccuracy) {
 TEST(RayCaster, SideOnTorusGivesFourLayersAtAnalyticDistances) {
     const Mesh torus = load_mesh("torus:30000");  // radii 1 and 0.4, axis Y
     const RayCaster caster(torus);
-    const std::vector<RayHit> layers = caster.hits({0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 8);
+    const std::vector<RayHit> layers =
+        caster.hits({0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 8);
     ASSERT_EQ(layers.size(), 4u);
     const float expected[] = {3.0f - 1.4f, 3.0f - 0.6f, 3.0f + 0.6f, 3.0f + 1.4f};
     for (int i = 0; i < 4; ++i) EXPECT_NEAR(layers[i].distance, expected[i], 1e-5f) << i;
@@ -56,15 +60,16 @@ TEST(RayCaster, EveryRayOfAGridCrossesClosedMeshesAnEvenNumberOfTimes) {
     // Many of these rays pass exactly through shared edges and vertices (the grid is
     // aligned with the meshes' symmetry planes): a duplicate or missed hit shows up as
     // an odd count.
-    for (const char* spec : {"sphere:4000", "torus:4000", "torus_knot:8000", "hand:8000"}) {
+    for (const char* spec :
+         {"sphere:4000", "torus:4000", "torus_knot:8000", "hand:8000"}) {
         const Mesh mesh = load_mesh(spec);
         const RayCaster caster(mesh);
         const BoundingSphere bound = mesh.bounding_sphere();
         int odd = 0, hit_rays = 0;
         for (int y = -32; y <= 32; ++y)
             for (int x = -32; x <= 32; ++x) {
-                const glm::vec3 origin = bound.centre + bound.radius *
-                    glm::vec3(x / 32.0f, y / 32.0f, 2.0f);
+                const glm::vec3 origin =
+                    bound.centre + bound.radius * glm::vec3(x / 32.0f, y / 32.0f, 2.0f);
                 const auto layers = caster.hits(origin, {0.0f, 0.0f, -1.0f}, 64);
                 if (layers.size() % 2 != 0) ++odd;
                 if (!layers.empty()) ++hit_rays;
@@ -110,7 +115,8 @@ TEST(RayCaster, ConcurrentQueriesAgreeWithSerialOnes) {
     };
     constexpr int kRays = 4000;
     std::vector<std::size_t> serial(kRays);
-    for (int i = 0; i < kRays; ++i) serial[i] = caster.hits(ray(i).first, ray(i).second, 16).size();
+    for (int i = 0; i < kRays; ++i)
+        serial[i] = caster.hits(ray(i).first, ray(i).second, 16).size();
     std::vector<std::size_t> parallel(kRays);
     std::vector<std::thread> threads;
     for (int t = 0; t < 4; ++t)
@@ -136,9 +142,11 @@ TEST(RayCaster, CountEscapingCountsRaysThatMissEverything) {
     for (int i = 0; i < 200; ++i) {
         const float angle = 3.14159265f * (i + 0.5f) / 200.0f;  // from -Z towards +Z
         directions.push_back({std::sin(angle), 0.0f, -std::cos(angle)});
-        if (angle > std::asin(1.0f / 3.0f) + 0.01f) ++expected_escaping;
-        else if (angle < std::asin(1.0f / 3.0f) - 0.01f) {}
-        else directions.pop_back();  // too close to the silhouette to call
+        if (angle > std::asin(1.0f / 3.0f) + 0.01f)
+            ++expected_escaping;
+        else if (angle < std::asin(1.0f / 3.0f) - 0.01f) {
+        } else
+            directions.pop_back();  // too close to the silhouette to call
     }
     EXPECT_EQ(caster.count_escaping({0.0f, 0.0f, 3.0f}, directions),
               static_cast<std::size_t>(expected_escaping));

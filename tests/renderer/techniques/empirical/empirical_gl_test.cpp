@@ -26,22 +26,30 @@ class EmpiricalGl : public test::HeadlessGlTest {};
 TEST_F(EmpiricalGl, PrunedRenderEqualsFullRenderForEachPrunableTerm) {
     const auto dir = test::scratch_dir("empirical_pruning");
     gl::FrameExecutor executor;
-    const std::vector<std::vector<KnobAssignment>> cases = {
-        {{"backlight", "0"}}, {{"ambient", "0"}}, {{"light_ambient", "0"}}, {{"blur_kernel", "1"}}};
+    const std::vector<std::vector<KnobAssignment>> cases = {{{"backlight", "0"}},
+                                                            {{"ambient", "0"}},
+                                                            {{"light_ambient", "0"}},
+                                                            {{"blur_kernel", "1"}}};
     int index = 0;
     for (auto settings : cases) {
         settings.push_back({"ao_rays", "32"});
-        const Scene scene = empirical_scene(builtin_mesh("torus_knot:6k"), settings, 96, 80);
-        const FramePlan pruned = make_frame_plan(scene, find_technique("empirical"), PlanMode::pruned);
-        const FramePlan full = make_frame_plan(scene, find_technique("empirical"), PlanMode::full);
-        ASSERT_LT(pruned.passes.size(), full.passes.size()) << settings[0].key << " pruned nothing";
+        const Scene scene =
+            empirical_scene(builtin_mesh("torus_knot:6k"), settings, 96, 80);
+        const FramePlan pruned =
+            make_frame_plan(scene, find_technique("empirical"), PlanMode::pruned);
+        const FramePlan full =
+            make_frame_plan(scene, find_technique("empirical"), PlanMode::full);
+        ASSERT_LT(pruned.passes.size(), full.passes.size())
+            << settings[0].key << " pruned nothing";
         const auto a = dir / ("pruned" + std::to_string(index) + ".exr");
         const auto b = dir / ("full" + std::to_string(index) + ".exr");
         write_image(a, render_image(executor, scene, PlanMode::pruned));
         write_image(b, render_image(executor, scene, PlanMode::full));
         const Image pruned_image = read_image(a), full_image = read_image(b);
-        EXPECT_LT(test::max_abs_difference(pruned_image, full_image), 1e-6) << settings[0].key;
-        EXPECT_GT(*std::max_element(full_image.rgba.begin(), full_image.rgba.end()), 0.05f);
+        EXPECT_LT(test::max_abs_difference(pruned_image, full_image), 1e-6)
+            << settings[0].key;
+        EXPECT_GT(*std::max_element(full_image.rgba.begin(), full_image.rgba.end()),
+                  0.05f);
         ++index;
     }
 }
@@ -56,15 +64,19 @@ TEST_F(EmpiricalGl, AllocatesOnlyTheTexturesThePlanNames) {
         std::sort(allocated.begin(), allocated.end());
         return allocated;
     };
-    EXPECT_EQ(names({}), (std::vector<std::string>{"colour", "front_depth", "second_depth",
-                                                   "shade_depth", "smoothed_depth", "vertex_ao"}));
-    EXPECT_EQ(names({{"backlight", "0"}}), (std::vector<std::string>{"colour", "shade_depth", "vertex_ao"}));
-    EXPECT_EQ(names({{"backlight", "0"}, {"ambient", "0"}}), (std::vector<std::string>{"colour", "shade_depth"}));
+    EXPECT_EQ(names({}),
+              (std::vector<std::string>{"colour", "front_depth", "second_depth",
+                                        "shade_depth", "smoothed_depth", "vertex_ao"}));
+    EXPECT_EQ(names({{"backlight", "0"}}),
+              (std::vector<std::string>{"colour", "shade_depth", "vertex_ao"}));
+    EXPECT_EQ(names({{"backlight", "0"}, {"ambient", "0"}}),
+              (std::vector<std::string>{"colour", "shade_depth"}));
 }
 
 TEST_F(EmpiricalGl, TimesEachPlannedPass) {
     gl::FrameExecutor executor;
-    const Scene scene = empirical_scene(builtin_mesh("sphere:2k"), {{"ao_rays", "16"}, {"blur_kernel", "1"}}, 32, 32);
+    const Scene scene = empirical_scene(
+        builtin_mesh("sphere:2k"), {{"ao_rays", "16"}, {"blur_kernel", "1"}}, 32, 32);
     const FramePlan plan = make_frame_plan(scene, find_technique("empirical"));
     executor.execute(scene, plan, /*time_passes=*/true);
     const auto& timings = executor.last_timings();
@@ -82,7 +94,8 @@ TEST_F(EmpiricalGl, TimesEachPlannedPass) {
 // present() shows exactly what a PNG stores: the output clamped and sRGB-encoded.
 TEST_F(EmpiricalGl, PresentShowsTheSrgbEncodedOutput) {
     gl::FrameExecutor executor;
-    const Scene scene = empirical_scene(builtin_mesh("torus:2k"), {{"ao_rays", "16"}, {"backlight", "3"}}, 40, 30);
+    const Scene scene = empirical_scene(builtin_mesh("torus:2k"),
+                                        {{"ao_rays", "16"}, {"backlight", "3"}}, 40, 30);
     const FramePlan plan = make_frame_plan(scene, find_technique("empirical"));
     executor.execute(scene, plan);
     const Image linear = executor.read_output(plan);
@@ -109,16 +122,19 @@ TEST_F(EmpiricalGl, MatchesTheCpuReferenceOnTheBuiltInMeshes) {
     gl::FrameExecutor executor;
     for (const std::string spec : {"sphere:4k", "torus:4k", "torus_knot:8k", "hand:8k"}) {
         for (const std::string kernel : {"5", "3"}) {
-            const Scene scene = empirical_scene(builtin_mesh(spec),
-                                                {{"ao_rays", "32"}, {"blur_kernel", kernel}}, 128, 112);
+            const Scene scene =
+                empirical_scene(builtin_mesh(spec),
+                                {{"ao_rays", "32"}, {"blur_kernel", kernel}}, 128, 112);
             const Image gl_image = render_image(executor, scene);
             const Image cpu_image = find_technique("empirical").render_reference(scene);
             const ImageErrorStats d = compare_images(gl_image, cpu_image, 1);
-            std::cout << spec << " kernel " << kernel << ": mean " << d.mean * 255 << "/255, p99 "
-                      << d.p99 * 255 << "/255, max " << d.max * 255 << "/255 over " << d.pixels << " pixels\n";
+            std::cout << spec << " kernel " << kernel << ": mean " << d.mean * 255
+                      << "/255, p99 " << d.p99 * 255 << "/255, max " << d.max * 255
+                      << "/255 over " << d.pixels << " pixels\n";
             EXPECT_GT(d.pixels, 2000u) << spec;
             EXPECT_LT(d.mean, 1.0 / 255.0) << spec << " kernel " << kernel;
-            EXPECT_LT(d.p99, 4.0 / 255.0) << spec << " kernel " << kernel << " (max " << d.max << ")";
+            EXPECT_LT(d.p99, 4.0 / 255.0)
+                << spec << " kernel " << kernel << " (max " << d.max << ")";
         }
     }
 }
@@ -129,7 +145,8 @@ TEST_F(EmpiricalGl, MatchesTheCpuReferenceOnTheBuiltInMeshes) {
 TEST_F(EmpiricalGl, SphereThicknessMatchesTheAnalyticChord) {
     gl::FrameExecutor executor;
     const int size = 65;  // odd: the central pixel's ray passes through the centre
-    const Scene scene = empirical_scene(builtin_mesh("sphere:40k"), test::thickness_only(), size, size);
+    const Scene scene =
+        empirical_scene(builtin_mesh("sphere:40k"), test::thickness_only(), size, size);
     const Image gl_image = render_image(executor, scene);
     const Image cpu_image = find_technique("empirical").render_reference(scene);
     const glm::dvec3 eye = scene.camera.eye;
@@ -139,11 +156,14 @@ TEST_F(EmpiricalGl, SphereThicknessMatchesTheAnalyticChord) {
     for (int y = 4; y < size; y += 6)
         for (int x = 4; x < size; x += 6) {
             // Eye-space ray through the pixel centre; camera looks down -z from (0,0,2).
-            const glm::dvec3 d = glm::normalize(glm::dvec3(((x + 0.5) / size * 2 - 1) * tan_half,
-                                                           (1 - (y + 0.5) / size * 2) * tan_half, -1.0));
-            const double b = glm::dot(eye, glm::dvec3(d.x, d.y, d.z));  // eye along +z, d in world
+            const glm::dvec3 d =
+                glm::normalize(glm::dvec3(((x + 0.5) / size * 2 - 1) * tan_half,
+                                          (1 - (y + 0.5) / size * 2) * tan_half, -1.0));
+            const double b =
+                glm::dot(eye, glm::dvec3(d.x, d.y, d.z));  // eye along +z, d in world
             const double disc = b * b - (glm::dot(eye, eye) - 1.0);
-            if (disc < 0.05) continue;  // misses or grazes the sphere: skip the silhouette
+            if (disc < 0.05)
+                continue;  // misses or grazes the sphere: skip the silhouette
             const double s0 = -b - std::sqrt(disc), s1 = -b + std::sqrt(disc);
             const double t = (s1 - s0) * -d.z / 2.0;
             EXPECT_NEAR(1.0 - gl_image.at(x, y).r, t, 0.01) << x << "," << y;
@@ -160,14 +180,19 @@ TEST_F(EmpiricalGl, SphereThicknessMatchesTheAnalyticChord) {
 TEST_F(EmpiricalGl, SideOnTorusUsesTheSecondLayerNotTheLast) {
     gl::FrameExecutor executor;
     const int size = 101;
-    const Scene scene = empirical_scene(builtin_mesh("torus:40k"), test::thickness_only(), size, size);
+    const Scene scene =
+        empirical_scene(builtin_mesh("torus:40k"), test::thickness_only(), size, size);
     ASSERT_NEAR(scene.bounds.diameter(), 2.8, 1e-3);
     const double expected = 1.0 - 0.8 / 2.8;
     EXPECT_NEAR(render_image(executor, scene).at(size / 2, size / 2).r, expected, 0.01);
-    EXPECT_NEAR(find_technique("empirical").render_reference(scene).at(size / 2, size / 2).r, expected, 0.01);
+    EXPECT_NEAR(
+        find_technique("empirical").render_reference(scene).at(size / 2, size / 2).r,
+        expected, 0.01);
     // The raw layers agree: the second-layer depth is that of eye distance 2.2, not 4.2.
     const double n = scene.camera.near_plane, f = scene.camera.far_plane;
-    const auto window = [&](double z) { return 0.5 * ((f + n) / (f - n) - 2 * f * n / ((f - n) * z)) + 0.5; };
+    const auto window = [&](double z) {
+        return 0.5 * ((f + n) / (f - n) - 2 * f * n / ((f - n) * z)) + 0.5;
+    };
     const auto second = executor.read_channel("second_depth");
     EXPECT_NEAR(second[(size / 2) * size + size / 2], window(2.2), 2e-3);
 }

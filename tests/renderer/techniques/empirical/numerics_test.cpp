@@ -23,7 +23,8 @@ std::shared_ptr<const Mesh> open_square(glm::vec3 normal = {0, 0, 1}) {
     mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
     mesh.normals.assign(4, normal);
     mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
-    mesh.content_hash = "open_square/" + std::to_string(normal.x) + std::to_string(normal.z);
+    mesh.content_hash =
+        "open_square/" + std::to_string(normal.x) + std::to_string(normal.z);
     return std::make_shared<const Mesh>(std::move(mesh));
 }
 
@@ -45,7 +46,10 @@ protected:
 TEST_F(EmpiricalNumerics, OpenMeshWithoutSecondLayerHasThicknessOne) {
     for (const char* r : {"1", "0"}) {
         for (const char* kernel : {"1", "5"}) {
-            const Scene scene = empirical_scene(open_square(), thickness_only({{"thickness_exponent", r}, {"blur_kernel", kernel}}), 32, 32);
+            const Scene scene = empirical_scene(
+                open_square(),
+                thickness_only({{"thickness_exponent", r}, {"blur_kernel", kernel}}), 32,
+                32);
             const auto [gl_image, cpu_image] = both(scene);
             const float expected = std::string(r) == "0" ? 1.0f : 0.0f;
             EXPECT_EQ(gl_image.at(16, 16).a, 1.0f);
@@ -58,7 +62,8 @@ TEST_F(EmpiricalNumerics, OpenMeshWithoutSecondLayerHasThicknessOne) {
 // Geometry cut by the far plane: the clipped back has no second layer (t = 1 there), the
 // rest keeps its thickness; nothing becomes NaN at window depth 1.
 TEST_F(EmpiricalNumerics, PixelsAtTheFarPlaneStayFinite) {
-    Scene scene = empirical_scene(test::builtin_mesh("sphere:4k"), thickness_only(), 33, 33);
+    Scene scene =
+        empirical_scene(test::builtin_mesh("sphere:4k"), thickness_only(), 33, 33);
     scene.camera.far_plane = 2.5f;  // the sphere spans eye depths [1, 3]
     const auto [gl_image, cpu_image] = both(scene);
     // Central ray: front at 1, back at 3 > far: no second layer, t = 1, colour 0.
@@ -77,11 +82,14 @@ TEST_F(EmpiricalNumerics, PixelsAtTheFarPlaneStayFinite) {
 // Documented: a zero-length normal faces the viewer, N = (0,0,1) in eye space. With only
 // the diffuse term (wd = Kd = Id = 1) and the light along +z the colour is N.L = 1.
 TEST_F(EmpiricalNumerics, ZeroLengthNormalsFaceTheViewer) {
-    const Scene scene = empirical_scene(
-        open_square({0, 0, 0}),
-        {{"albedo", "1"}, {"ambient", "0"}, {"backlight", "0"}, {"specular_contribution", "0"},
-         {"diffuse_contribution", "1"}, {"light_direction", "0,0,1"}},
-        32, 32);
+    const Scene scene = empirical_scene(open_square({0, 0, 0}),
+                                        {{"albedo", "1"},
+                                         {"ambient", "0"},
+                                         {"backlight", "0"},
+                                         {"specular_contribution", "0"},
+                                         {"diffuse_contribution", "1"},
+                                         {"light_direction", "0,0,1"}},
+                                        32, 32);
     const auto [gl_image, cpu_image] = both(scene);
     EXPECT_FLOAT_EQ(gl_image.at(16, 16).r, 1.0f);
     EXPECT_FLOAT_EQ(cpu_image.at(16, 16).r, 1.0f);
@@ -91,8 +99,10 @@ TEST_F(EmpiricalNumerics, ZeroLengthNormalsFaceTheViewer) {
 // covered pixel. A huge r leaves only the thinnest rims, in [0, 1] and finite.
 TEST_F(EmpiricalNumerics, ThicknessExponentZeroAndHuge) {
     const auto mesh = test::builtin_mesh("torus_knot:4k");
-    const auto [gl_zero, cpu_zero] = both(empirical_scene(mesh, thickness_only({{"thickness_exponent", "0"}}), 48, 48));
-    const auto [gl_huge, cpu_huge] = both(empirical_scene(mesh, thickness_only({{"thickness_exponent", "10000"}}), 48, 48));
+    const auto [gl_zero, cpu_zero] = both(
+        empirical_scene(mesh, thickness_only({{"thickness_exponent", "0"}}), 48, 48));
+    const auto [gl_huge, cpu_huge] = both(
+        empirical_scene(mesh, thickness_only({{"thickness_exponent", "10000"}}), 48, 48));
     int covered = 0;
     for (int y = 0; y < 48; ++y)
         for (int x = 0; x < 48; ++x) {
@@ -105,16 +115,22 @@ TEST_F(EmpiricalNumerics, ThicknessExponentZeroAndHuge) {
     EXPECT_GT(covered, 100);
     for (int y = 0; y < 48; ++y)
         for (int x = 0; x < 48; ++x)
-            if (cpu_zero.at(x, y).a > 0.0f) EXPECT_EQ(cpu_zero.at(x, y).r, 1.0f);
+            if (cpu_zero.at(x, y).a > 0.0f) {
+                EXPECT_EQ(cpu_zero.at(x, y).r, 1.0f);
+            }
 }
 
 // n = 0: (N.H)^0 = 1 wherever N.L > 0, so the specular term is ws * ks * Is = 1 there.
 TEST_F(EmpiricalNumerics, ShininessZeroGivesAConstantLobe) {
-    const Scene scene = empirical_scene(
-        test::builtin_mesh("sphere:4k"),
-        {{"ambient", "0"}, {"backlight", "0"}, {"diffuse_contribution", "0"},
-         {"specular_contribution", "1"}, {"specular", "1"}, {"shininess", "0"}, {"light_direction", "0,0,1"}},
-        33, 33);
+    const Scene scene = empirical_scene(test::builtin_mesh("sphere:4k"),
+                                        {{"ambient", "0"},
+                                         {"backlight", "0"},
+                                         {"diffuse_contribution", "0"},
+                                         {"specular_contribution", "1"},
+                                         {"specular", "1"},
+                                         {"shininess", "0"},
+                                         {"light_direction", "0,0,1"}},
+                                        33, 33);
     const auto [gl_image, cpu_image] = both(scene);
     EXPECT_FLOAT_EQ(gl_image.at(16, 16).r, 1.0f);
     EXPECT_FLOAT_EQ(cpu_image.at(16, 16).r, 1.0f);
@@ -149,8 +165,9 @@ TEST_F(EmpiricalNumerics, ZeroAreaTrianglesChangeNothing) {
 // A key light exactly opposite the viewer makes L + V = 0 (no half vector): the specular
 // term is then 0, not NaN.
 TEST_F(EmpiricalNumerics, LightBehindTheObjectHasNoHalfVector) {
-    const auto [gl_image, cpu_image] = both(empirical_scene(
-        test::builtin_mesh("torus:2k"), {{"ambient", "0"}, {"light_direction", "0,0,-1"}}, 40, 40));
+    const auto [gl_image, cpu_image] =
+        both(empirical_scene(test::builtin_mesh("torus:2k"),
+                             {{"ambient", "0"}, {"light_direction", "0,0,-1"}}, 40, 40));
     EXPECT_NEAR(test::max_abs_difference(gl_image, cpu_image), 0.0, 0.05);
 }
 
