@@ -105,7 +105,8 @@ int run_render(const RenderOptions& options) {
 
 void register_render(CLI::App& app, int& exit_code) {
     auto options = std::make_shared<RenderOptions>();
-    auto* cmd = app.add_subcommand("render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
+    auto* cmd = app.add_subcommand(
+        "render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
     std::string meshes;
     for (const auto& name : builtin_mesh_names())
         meshes += (meshes.empty() ? "" : ", ") + name;
