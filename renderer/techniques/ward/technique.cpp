@@ -22,6 +22,10 @@ public:
     Image render_reference(const Scene& scene) const override {
         return ward::render_reference(scene, ward::Variant::ward);
     }
+    std::vector<QualitySweep> quality_sweeps() const override {
+        // The only approximation the GL path adds: the AO bake's ray count.
+        return {{"ao_rays", {16, 40, 80, 160, 320}, 1024}};
+    }
 };
 
 }  // namespace
