@@ -105,7 +105,8 @@ int run_render(const RenderOptions& options) {
 
 void register_render(CLI::App& app, int& exit_code) {
     auto options = std::make_shared<RenderOptions>();
-    auto* cmd = app.add_subcommand("render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
+    auto* cmd = app.add_subcommand(
+        "render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
     std::string meshes;
     for (const auto& name : builtin_mesh_names())
         meshes += (meshes.empty() ? "" : ", ") + name;
@@ -115,7 +116,8 @@ void register_render(CLI::App& app, int& exit_code) {
         for (const Knob& k : knobs_for(*t)) keys += (keys.empty() ? "" : ", ") + k.name;
     }
     cmd->add_option("--mesh", options->mesh,
-                    "built-in mesh (" + meshes + "; optional face budget, e.g. torus_knot:60k) or a mesh file");
+                    "built-in mesh (" + meshes +
+                        "; optional face budget, e.g. torus_knot:60k) or a mesh file");
     cmd->add_option("config", options->config,
                     "stimulus-set config (TOML): render every stimulus into --out DIR");
     cmd->add_option("--preset", options->preset, "built-in stimulus set (thesis) into --out DIR");
@@ -137,7 +139,8 @@ void register_render(CLI::App& app, int& exit_code) {
     cmd->callback([options, &exit_code] {
         // One image (--mesh) or a stimulus set (CONFIG or --preset), never both.
         const bool batch = !options->config.empty() || !options->preset.empty();
-        if (batch && (!options->mesh.empty() || (!options->config.empty() && !options->preset.empty()))) {
+        const bool both = !options->config.empty() && !options->preset.empty();
+        if (batch && (!options->mesh.empty() || both)) {
             std::cerr << "lucent render: give one of --mesh, CONFIG or --preset\n";
             exit_code = kExitUsage;
         } else if (batch) {

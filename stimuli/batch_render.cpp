@@ -6,6 +6,8 @@
 // [SECTION] run_render_set_command(): the CLI's batch path and its exit codes
 #include "batch_render.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -17,7 +19,6 @@
 #include <mutex>
 #include <set>
 #include <thread>
-#include <unistd.h>
 
 #include "core/ambient_occlusion.h"
 #include "core/mesh.h"
@@ -45,7 +46,8 @@ std::vector<ManifestField> parameter_fields(const Stimulus& stimulus) {
     std::vector<ManifestField> fields;
     for (const Knob& knob : knobs_for(find_technique(stimulus.technique))) {
         const auto& value = stimulus.parameters.get(knob.name);
-        const bool numeric = std::holds_alternative<double>(value) || std::holds_alternative<int>(value);
+        const bool numeric =
+            std::holds_alternative<double>(value) || std::holds_alternative<int>(value);
         fields.push_back({knob.name, format_knob_value(value), numeric});
     }
     return fields;
@@ -87,16 +89,19 @@ ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mes
     return row;
 }
 
-std::string files_hash(const std::filesystem::path& dir, const StimulusSet& set, const Stimulus& s) {
+std::string files_hash(const std::filesystem::path& dir, const StimulusSet& set,
+                       const Stimulus& s) {
     Hasher hasher;
-    for (const auto format : set.formats) hasher.add_field(hash_file(dir / file_of(s, format)));
+    for (const auto format : set.formats)
+        hasher.add_field(hash_file(dir / file_of(s, format)));
     return hasher.hex();
 }
 
 // True when the previous run's files for `s` are present, unchanged and made from the
 // same inputs.
-bool reusable(const std::map<std::string, std::string>* previous, const std::string& inputs,
-              const std::filesystem::path& dir, const StimulusSet& set, const Stimulus& s) {
+bool reusable(const std::map<std::string, std::string>* previous,
+              const std::string& inputs, const std::filesystem::path& dir,
+              const StimulusSet& set, const Stimulus& s) {
     if (!previous) return false;
     const auto field = [&](const char* column) {
         const auto it = previous->find(column);
@@ -105,7 +110,8 @@ bool reusable(const std::map<std::string, std::string>* previous, const std::str
     if (field("input_hash") != inputs) return false;
     for (const auto format : set.formats) {
         std::error_code error;
-        if (!std::filesystem::is_regular_file(dir / file_of(s, format), error)) return false;
+        if (!std::filesystem::is_regular_file(dir / file_of(s, format), error))
+            return false;
     }
     try {
         return files_hash(dir, set, s) == field("content_hash");
@@ -119,19 +125,22 @@ bool reusable(const std::map<std::string, std::string>* previous, const std::str
 class BatchProgress {
 public:
     BatchProgress(std::size_t total, bool enabled)
-        : total_(total), enabled_(enabled && total > 0), tty_(isatty(STDERR_FILENO)),
+        : total_(total),
+          enabled_(enabled && total > 0),
+          tty_(isatty(STDERR_FILENO)),
           start_(Clock::now()) {}
     void done(std::size_t finished, const std::string& id) {
         if (!enabled_) return;
         const double elapsed = seconds_since(start_);
         const double per = elapsed / double(std::max<std::size_t>(finished, 1));
         const double left = per * double(total_ - finished);
-        const int width = 24, filled = int(double(width) * double(finished) / double(total_));
+        const int width = 24,
+                  filled = int(double(width) * double(finished) / double(total_));
         std::string bar(std::size_t(filled), '#');
         bar.resize(std::size_t(width), '.');
         std::fprintf(stderr, "%s[%s] %zu/%zu stimuli  %.2f s/stimulus  %.1f s left  %s%s",
-                     tty_ ? "\r" : "", bar.c_str(), finished, total_, per, left, id.c_str(),
-                     tty_ ? "\033[K" : "\n");
+                     tty_ ? "\r" : "", bar.c_str(), finished, total_, per, left,
+                     id.c_str(), tty_ ? "\033[K" : "\n");
         if (tty_ && finished == total_) std::fprintf(stderr, "\n");
         std::fflush(stderr);
     }
@@ -187,7 +196,8 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
             columns.luminance_histogram.resize(kHistogramBins);
             for (const auto& field : statistics_fields(columns)) {
                 const auto found = old->find(field.column);
-                rows[i].push_back({field.column, found == old->end() ? "0" : found->second, true});
+                rows[i].push_back(
+                    {field.column, found == old->end() ? "0" : found->second, true});
             }
             ++result.reused;
         } else {
@@ -203,8 +213,8 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
         for (const std::size_t i : pending) {
             const Stimulus& s = set.stimuli[i];
             const Technique& technique = find_technique(s.technique);
-            const Scene scene = make_scene(meshes.at(s.mesh_spec), technique, s.parameters,
-                                           set.width, set.height);
+            const Scene scene = make_scene(meshes.at(s.mesh_spec), technique,
+                                           s.parameters, set.width, set.height);
             for (const Pass& pass : make_frame_plan(scene, technique).passes)
                 if (pass.kind == PassKind::bake_ambient_occlusion)
                     bakes.emplace(s.mesh_spec, pass.ao_rays);
@@ -225,7 +235,8 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     std::atomic<std::size_t> next{0};
     std::string failure;
     std::vector<std::string> finished_ids;
-    const int jobs = std::clamp(options.jobs, 1, int(std::max<std::size_t>(pending.size(), 1)));
+    const int jobs =
+        std::clamp(options.jobs, 1, int(std::max<std::size_t>(pending.size(), 1)));
     std::vector<BatchTimings> worker_timings(static_cast<std::size_t>(jobs));
 
     auto worker = [&](int index) {
@@ -254,9 +265,11 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
                 // The single-image path of `lucent render --mesh`.
                 auto start = Clock::now();
                 const double ao_before = timings.ao_seconds;
-                const Scene scene = make_scene(mesh, technique, s.parameters, set.width, set.height);
+                const Scene scene =
+                    make_scene(mesh, technique, s.parameters, set.width, set.height);
                 const Image image = render_image(executor, scene);
-                timings.gl_seconds += seconds_since(start) - (timings.ao_seconds - ao_before);
+                timings.gl_seconds +=
+                    seconds_since(start) - (timings.ao_seconds - ao_before);
 
                 start = Clock::now();
                 for (const auto format : set.formats)
@@ -266,7 +279,8 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
                 start = Clock::now();
                 ManifestRow row = identity_fields(set, s, *mesh);
                 const auto stats = compute_image_statistics(
-                    FloatImageView{image.width, image.height, 4, image.rgba}, kHistogramBins);
+                    FloatImageView{image.width, image.height, 4, image.rgba},
+                    kHistogramBins);
                 const auto stat_fields = statistics_fields(stats);
                 row.insert(row.end(), stat_fields.begin(), stat_fields.end());
                 const std::string content = files_hash(dir, set, s);
@@ -293,7 +307,8 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
         std::unique_lock lock(mutex);
         std::size_t shown = 0;
         while (shown < pending.size() && failure.empty()) {
-            finished_signal.wait(lock, [&] { return finished > shown || !failure.empty(); });
+            finished_signal.wait(lock,
+                                 [&] { return finished > shown || !failure.empty(); });
             while (shown < finished) {
                 const std::string id = finished_ids[shown++];
                 lock.unlock();
@@ -340,12 +355,16 @@ int run_render_set_command(const std::string& config_path, const std::string& pr
     try {
         if (out_dir.empty()) throw StimulusSetError("--out: missing (give --out DIR)");
         if (jobs < 1 || jobs > 64)
-            throw StimulusSetError("--jobs: " + std::to_string(jobs) + " is out of range (accepted: 1..64)");
+            throw StimulusSetError("--jobs: " + std::to_string(jobs) +
+                                   " is out of range (accepted: 1..64)");
         const auto catalog = default_catalog();
-        set = preset.empty() ? load_stimulus_set(config_path, catalog) : load_preset(preset, catalog);
+        set = preset.empty() ? load_stimulus_set(config_path, catalog)
+                             : load_preset(preset, catalog);
         std::error_code error;
-        if (std::filesystem::exists(out_dir, error) && !std::filesystem::is_directory(out_dir, error))
-            throw StimulusSetError("--out: '" + out_dir + "' exists and is not a directory");
+        if (std::filesystem::exists(out_dir, error) &&
+            !std::filesystem::is_directory(out_dir, error))
+            throw StimulusSetError("--out: '" + out_dir +
+                                   "' exists and is not a directory");
     } catch (const StimulusSetError& e) {
         std::cerr << "lucent render: " << e.what() << "\n";
         return 2;
@@ -356,9 +375,10 @@ int run_render_set_command(const std::string& config_path, const std::string& pr
         options.jobs = jobs;
         options.force = force;
         const BatchResult result = render_stimulus_set(set, options);
-        std::cout << "rendered " << result.rendered << ", unchanged " << result.reused << " of "
-                  << set.stimuli.size() << " stimuli into " << out_dir
-                  << " (manifest.csv, manifest.json) in " << result.timings.wall_seconds << " s\n";
+        std::cout << "rendered " << result.rendered << ", unchanged " << result.reused
+                  << " of " << set.stimuli.size() << " stimuli into " << out_dir
+                  << " (manifest.csv, manifest.json) in " << result.timings.wall_seconds
+                  << " s\n";
     } catch (const MeshError& e) {
         std::cerr << "lucent render: " << set.source << ": mesh " << e.what() << "\n";
         return 2;

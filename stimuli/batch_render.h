@@ -16,9 +16,9 @@ namespace lucent::stimuli {
 
 struct BatchOptions {
     std::filesystem::path out_dir;
-    int jobs = 1;           // worker threads, each with its own headless GL context
-    bool force = false;     // re-render every stimulus
-    bool progress = true;   // progress line on stderr
+    int jobs = 1;          // worker threads, each with its own headless GL context
+    bool force = false;    // re-render every stimulus
+    bool progress = true;  // progress line on stderr
 };
 
 // Where the time went (seconds, summed over workers).

@@ -40,22 +40,27 @@ double luminance_rec709(double r, double g, double b) {
 ImageStatistics compute_image_statistics(const FloatImageView& image,
                                          std::span<const std::uint8_t> mask,
                                          int histogram_bins) {
-    if (image.width < 0 || image.height < 0 || (image.channels != 3 && image.channels != 4))
+    if (image.width < 0 || image.height < 0 ||
+        (image.channels != 3 && image.channels != 4))
         throw std::invalid_argument("image statistics: need a 3- or 4-channel image");
     const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
     if (image.values.size() != pixels * std::size_t(image.channels))
-        throw std::invalid_argument("image statistics: " + std::to_string(image.values.size()) +
-                                    " values for a " + std::to_string(image.width) + "x" +
-                                    std::to_string(image.height) + " image");
+        throw std::invalid_argument(
+            "image statistics: " + std::to_string(image.values.size()) +
+            " values for a " + std::to_string(image.width) + "x" +
+            std::to_string(image.height) + " image");
     if (mask.size() != pixels)
         throw std::invalid_argument("image statistics: mask size differs from the image");
     histogram_bins = std::max(histogram_bins, 1);
 
     ImageStatistics stats;
     stats.luminance_histogram.assign(std::size_t(histogram_bins), 0);
-    auto rgb = [&](std::size_t i, int c) { return double(image.values[i * image.channels + c]); };
+    auto rgb = [&](std::size_t i, int c) {
+        return double(image.values[i * image.channels + c]);
+    };
     auto finite_pixel = [&](std::size_t i) {
-        return std::isfinite(rgb(i, 0)) && std::isfinite(rgb(i, 1)) && std::isfinite(rgb(i, 2));
+        return std::isfinite(rgb(i, 0)) && std::isfinite(rgb(i, 1)) &&
+               std::isfinite(rgb(i, 2));
     };
 
     // Pass 1: counts, means and the histogram (non-finite pixels are not object pixels).
@@ -69,7 +74,8 @@ ImageStatistics compute_image_statistics(const FloatImageView& image,
         sum_s += si.saturation;
         sum_i += si.intensity;
         const double scaled = std::clamp(y, 0.0, 1.0) * histogram_bins;
-        const auto bin = std::min<std::size_t>(std::size_t(scaled), std::size_t(histogram_bins - 1));
+        const auto bin =
+            std::min<std::size_t>(std::size_t(scaled), std::size_t(histogram_bins - 1));
         ++stats.luminance_histogram[bin];
     }
     if (stats.object_pixels == 0) return stats;
@@ -93,7 +99,8 @@ ImageStatistics compute_image_statistics(const FloatImageView& image,
     m3 /= n;
     stats.mean_luminance = mean_y;
     stats.sd_luminance = std::sqrt(m2);
-    // A relative tolerance keeps rounding noise of a constant image from reading as spread.
+    // A relative tolerance keeps rounding noise of a constant image from reading as
+    // spread.
     const double noise_floor = 1e-12 * std::max(1.0, mean_y * mean_y);
     if (m2 <= noise_floor) stats.sd_luminance = 0.0;
     stats.rms_contrast = mean_y > 0.0 ? stats.sd_luminance / mean_y : 0.0;
@@ -102,7 +109,8 @@ ImageStatistics compute_image_statistics(const FloatImageView& image,
     return stats;
 }
 
-ImageStatistics compute_image_statistics(const FloatImageView& image, int histogram_bins) {
+ImageStatistics compute_image_statistics(const FloatImageView& image,
+                                         int histogram_bins) {
     const std::size_t pixels =
         std::size_t(std::max(image.width, 0)) * std::size_t(std::max(image.height, 0));
     std::vector<std::uint8_t> mask(pixels, 1);

@@ -13,11 +13,11 @@ namespace lucent::stimuli {
 double luminance_rec709(double r, double g, double b);
 
 struct ImageStatistics {
-    std::size_t object_pixels = 0;        // pixels counted (mask set)
-    double mean_luminance = 0.0;          // mean of Rec. 709 luminance, linear
-    double sd_luminance = 0.0;            // population SD (divides by N)
-    double rms_contrast = 0.0;            // sd / mean; 0 when mean <= 0 or no pixels
-    double skewness = 0.0;                // m3 / m2^1.5; 0 when sd == 0
+    std::size_t object_pixels = 0;  // pixels counted (mask set)
+    double mean_luminance = 0.0;    // mean of Rec. 709 luminance, linear
+    double sd_luminance = 0.0;      // population SD (divides by N)
+    double rms_contrast = 0.0;      // sd / mean; 0 when mean <= 0 or no pixels
+    double skewness = 0.0;          // m3 / m2^1.5; 0 when sd == 0
     double saturation_intensity_correlation = 0.0;  // Pearson r; 0 when a variance is 0
     // Luminance histogram: bins of equal width over [0, 1]; values >= 1 fall into the
     // last bin, values < 0 into the first.

@@ -23,11 +23,21 @@ std::string json_escape(std::string_view text) {
     std::string out;
     for (char c : text) {
         switch (c) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\r': out += "\\r"; break;
-            case '\t': out += "\\t"; break;
+            case '"':
+                out += "\\\"";
+                break;
+            case '\\':
+                out += "\\\\";
+                break;
+            case '\n':
+                out += "\\n";
+                break;
+            case '\r':
+                out += "\\r";
+                break;
+            case '\t':
+                out += "\\t";
+                break;
             default:
                 if (static_cast<unsigned char>(c) < 0x20) {
                     char code[8];
@@ -42,7 +52,8 @@ std::string json_escape(std::string_view text) {
 }
 
 void write_atomically(const std::filesystem::path& path, const std::string& text) {
-    const auto temporary = path.parent_path() / ("." + path.filename().string() + ".partial");
+    const auto temporary =
+        path.parent_path() / ("." + path.filename().string() + ".partial");
     {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
         out << text;
@@ -90,7 +101,8 @@ std::vector<ManifestField> statistics_fields(const ImageStatistics& stats) {
         {"sd_luminance", number(stats.sd_luminance), true},
         {"rms_contrast", number(stats.rms_contrast), true},
         {"skewness", number(stats.skewness), true},
-        {"saturation_intensity_correlation", number(stats.saturation_intensity_correlation), true},
+        {"saturation_intensity_correlation",
+         number(stats.saturation_intensity_correlation), true},
     };
     for (std::size_t bin = 0; bin < stats.luminance_histogram.size(); ++bin) {
         char column[32];
@@ -142,7 +154,8 @@ void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
                 columns.push_back(field.column);
 
     std::ostringstream csv;
-    for (std::size_t c = 0; c < columns.size(); ++c) csv << (c ? "," : "") << csv_escape(columns[c]);
+    for (std::size_t c = 0; c < columns.size(); ++c)
+        csv << (c ? "," : "") << csv_escape(columns[c]);
     csv << "\n";
     for (const auto& row : rows) {
         for (std::size_t c = 0; c < columns.size(); ++c) {
@@ -154,17 +167,21 @@ void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
     }
 
     std::ostringstream json;
-    json << "{\n  \"set\": \"" << json_escape(set_name) << "\",\n  \"software_version\": \""
-         << json_escape(version_string()) << "\",\n  \"build_hash\": \""
-         << json_escape(build_hash()) << "\",\n  \"stimuli\": [";
+    json << "{\n  \"set\": \"" << json_escape(set_name)
+         << "\",\n  \"software_version\": \"" << json_escape(version_string())
+         << "\",\n  \"build_hash\": \"" << json_escape(build_hash())
+         << "\",\n  \"stimuli\": [";
     for (std::size_t r = 0; r < rows.size(); ++r) {
         json << (r ? ",\n" : "\n") << "    {";
         for (std::size_t f = 0; f < rows[r].size(); ++f) {
             const auto& field = rows[r][f];
             json << (f ? ", " : "") << "\"" << json_escape(field.column) << "\": ";
-            if (field.text.empty()) json << "null";  // a parameter this technique lacks
-            else if (field.numeric) json << field.text;
-            else json << "\"" << json_escape(field.text) << "\"";
+            if (field.text.empty())
+                json << "null";  // a parameter this technique lacks
+            else if (field.numeric)
+                json << field.text;
+            else
+                json << "\"" << json_escape(field.text) << "\"";
         }
         json << "}";
     }

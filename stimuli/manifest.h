@@ -19,7 +19,8 @@ namespace lucent::stimuli {
 class Hasher {
 public:
     Hasher& add(std::string_view bytes);
-    Hasher& add_field(std::string_view text);  // length-prefixed, so fields never run together
+    Hasher& add_field(
+        std::string_view text);  // length-prefixed, so fields never run together
     std::uint64_t value() const { return state_; }
     std::string hex() const;
 

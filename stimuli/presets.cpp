@@ -15,7 +15,9 @@ std::vector<std::string> preset_names() { return {"thesis"}; }
 
 std::optional<std::string_view> preset_text(std::string_view name) {
     for (const auto& known : preset_names())
-        if (known == name) return embedded::stimuli_preset_file("presets/" + std::string(name) + ".toml");
+        if (known == name)
+            return embedded::stimuli_preset_file("presets/" + std::string(name) +
+                                                 ".toml");
     return std::nullopt;
 }
 
@@ -23,9 +25,10 @@ StimulusSet load_preset(std::string_view name, const SetCatalog& catalog) {
     const auto text = preset_text(name);
     if (!text) {
         std::string valid;
-        for (const auto& known : preset_names()) valid += (valid.empty() ? "" : ", ") + known;
-        throw StimulusSetError("--preset: unknown preset '" + std::string(name) + "' (valid: " +
-                               valid + ")");
+        for (const auto& known : preset_names())
+            valid += (valid.empty() ? "" : ", ") + known;
+        throw StimulusSetError("--preset: unknown preset '" + std::string(name) +
+                               "' (valid: " + valid + ")");
     }
     // Presets name built-in meshes only, so the base directory is never used.
     auto set = parse_stimulus_set(*text, "preset:" + std::string(name), ".", catalog);

@@ -90,8 +90,9 @@ KnobValue knob_value(const Knob& knob, const toml::node& node, const std::string
                      const ErrorReporter& errors) {
     std::string text;
     auto wrong_type = [&](const char* expected) {
-        errors.fail(node, key, std::string("wrong type: expected ") + expected + " (accepted: " +
-                                   accepted_range(knob) + ")");
+        errors.fail(node, key,
+                    std::string("wrong type: expected ") + expected +
+                        " (accepted: " + accepted_range(knob) + ")");
     };
     switch (knob.kind) {
         case KnobKind::scalar:
@@ -120,9 +121,12 @@ KnobValue knob_value(const Knob& knob, const toml::node& node, const std::string
             }
             break;
         case KnobKind::choice:
-            if (node.is_string()) text = node.as_string()->get();
-            else if (node.is_integer()) text = number_text(node);
-            else wrong_type("a string");
+            if (node.is_string())
+                text = node.as_string()->get();
+            else if (node.is_integer())
+                text = number_text(node);
+            else
+                wrong_type("a string");
             break;
     }
     try {
@@ -130,7 +134,8 @@ KnobValue knob_value(const Knob& knob, const toml::node& node, const std::string
     } catch (const KnobError& e) {
         // The knob's message starts with its name, which `key` already gives.
         std::string message = e.what();
-        if (message.rfind(knob.name + ": ", 0) == 0) message.erase(0, knob.name.size() + 2);
+        if (message.rfind(knob.name + ": ", 0) == 0)
+            message.erase(0, knob.name.size() + 2);
         errors.fail(node, key, message);
     }
 }
@@ -144,7 +149,8 @@ using Assignments = std::vector<Assignment>;
 
 class Loader {
 public:
-    Loader(const SetCatalog& catalog, const std::string& source, std::filesystem::path base)
+    Loader(const SetCatalog& catalog, const std::string& source,
+           std::filesystem::path base)
         : catalog_(catalog), errors_(source), base_dir_(std::move(base)) {
         for (const auto& name : catalog_.technique_names)
             if (auto knobs = catalog_.knobs_of(name))
@@ -154,43 +160,54 @@ public:
     StimulusSet load(const toml::table& root, const std::string& source) {
         StimulusSet set;
         set.source = source;
-        check_keys(root, {"name", "resolution", "formats", "meshes", "camera", "lights",
-                          "materials", "defaults", "stimuli"}, "", errors_);
+        check_keys(root,
+                   {"name", "resolution", "formats", "meshes", "camera", "lights",
+                    "materials", "defaults", "stimuli"},
+                   "", errors_);
         set.name = std::filesystem::path(source).stem().string();  // unless named
-        if (const auto* node = root.get("name")) set.name = as_string(*node, "name", errors_);
+        if (const auto* node = root.get("name"))
+            set.name = as_string(*node, "name", errors_);
         if (const auto* node = root.get("resolution")) read_resolution(*node, set);
         if (const auto* node = root.get("formats")) read_formats(*node, set);
         read_meshes(root);
         if (const auto* node = root.get("defaults"))
-            defaults_ = read_parameters(as_table(*node, "defaults", errors_), "defaults.", {});
+            defaults_ =
+                read_parameters(as_table(*node, "defaults", errors_), "defaults.", {});
         if (const auto* node = root.get("camera")) {
             const auto& camera = as_table(*node, "camera", errors_);
             check_keys(camera, {"fov_y"}, "camera.", errors_);
             camera_ = read_parameters(camera, "camera.", {});
         }
-        read_named_tables(root, "lights", lights_,
-                          {"light_ambient", "light_diffuse", "light_specular", "light_direction"});
+        read_named_tables(
+            root, "lights", lights_,
+            {"light_ambient", "light_diffuse", "light_specular", "light_direction"});
         read_named_tables(root, "materials", materials_, {});
         const auto* stimuli = root.get("stimuli");
-        if (!stimuli) errors_.fail(root.source(), "stimuli", "missing: the set lists no stimuli");
+        if (!stimuli)
+            errors_.fail(root.source(), "stimuli", "missing: the set lists no stimuli");
         const auto* array = stimuli->as_array();
         if (!array || !array->is_array_of_tables())
             errors_.fail(*stimuli, "stimuli", "expected [[stimuli]] tables");
         if (array->empty()) errors_.fail(*stimuli, "stimuli", "the set lists no stimuli");
         for (std::size_t i = 0; i < array->size(); ++i)
-            read_stimulus(*(*array)[i].as_table(), "stimuli[" + std::to_string(i) + "].", set);
+            read_stimulus(*(*array)[i].as_table(), "stimuli[" + std::to_string(i) + "].",
+                          set);
         return set;
     }
 
 private:
     void read_resolution(const toml::node& node, StimulusSet& set) {
         const auto* array = node.as_array();
-        if (!array || array->size() != 2 || !(*array)[0].is_integer() || !(*array)[1].is_integer())
-            errors_.fail(node, "resolution", "wrong type: expected [width, height] integers");
-        const auto w = (*array)[0].as_integer()->get(), h = (*array)[1].as_integer()->get();
+        if (!array || array->size() != 2 || !(*array)[0].is_integer() ||
+            !(*array)[1].is_integer())
+            errors_.fail(node, "resolution",
+                         "wrong type: expected [width, height] integers");
+        const auto w = (*array)[0].as_integer()->get(),
+                   h = (*array)[1].as_integer()->get();
         if (w < 1 || h < 1 || w > kMaxSide || h > kMaxSide)
-            errors_.fail(node, "resolution", "out of range: each side in [1, " +
-                                                 std::to_string(kMaxSide) + "]");
+            errors_.fail(
+                node, "resolution",
+                "out of range: each side in [1, " + std::to_string(kMaxSide) + "]");
         set.width = int(w);
         set.height = int(h);
     }
@@ -198,16 +215,21 @@ private:
     void read_formats(const toml::node& node, StimulusSet& set) {
         const auto* array = node.as_array();
         if (!array || array->empty())
-            errors_.fail(node, "formats", "wrong type: expected a list such as [\"png\", \"exr\"]");
+            errors_.fail(node, "formats",
+                         "wrong type: expected a list such as [\"png\", \"exr\"]");
         set.formats.clear();
         for (const auto& element : *array) {
             const std::string name = as_string(element, "formats", errors_);
             ImageFormat format = ImageFormat::png;
-            if (name == "exr") format = ImageFormat::exr;
-            else if (name == "tif") format = ImageFormat::tif;
+            if (name == "exr")
+                format = ImageFormat::exr;
+            else if (name == "tif")
+                format = ImageFormat::tif;
             else if (name != "png")
-                errors_.fail(element, "formats", "'" + name + "' is not a format (valid: png, exr, tif)");
-            if (std::find(set.formats.begin(), set.formats.end(), format) != set.formats.end())
+                errors_.fail(element, "formats",
+                             "'" + name + "' is not a format (valid: png, exr, tif)");
+            if (std::find(set.formats.begin(), set.formats.end(), format) !=
+                set.formats.end())
                 errors_.fail(element, "formats", "'" + name + "' is listed twice");
             set.formats.push_back(format);
         }
@@ -215,7 +237,8 @@ private:
 
     void read_meshes(const toml::table& root) {
         const auto* node = root.get("meshes");
-        if (!node) errors_.fail(root.source(), "meshes", "missing: name at least one mesh");
+        if (!node)
+            errors_.fail(root.source(), "meshes", "missing: name at least one mesh");
         for (auto&& [key, value] : as_table(*node, "meshes", errors_)) {
             const std::string name(key.str()), full = "meshes." + name;
             const std::string spec = as_string(value, full, errors_);
@@ -229,9 +252,9 @@ private:
             if (path.is_relative()) path = base_dir_ / path;
             std::error_code error;
             if (!std::filesystem::is_regular_file(path, error))
-                errors_.fail(value, full, "missing mesh: '" + spec +
-                                              "' is neither a built-in mesh (" + join(names) +
-                                              ") nor a file");
+                errors_.fail(value, full,
+                             "missing mesh: '" + spec + "' is neither a built-in mesh (" +
+                                 join(names) + ") nor a file");
             meshes_[name] = std::filesystem::absolute(path).lexically_normal().string();
         }
         if (meshes_.empty()) errors_.fail(*node, "meshes", "name at least one mesh");
@@ -247,7 +270,8 @@ private:
             const bool allowed = only.size() == 0 ||
                                  std::find(only.begin(), only.end(), name) != only.end();
             if (it == any_knob_.end() || !allowed)
-                errors_.fail(key.source(), prefix + name, "unknown key (not a parameter of any technique)");
+                errors_.fail(key.source(), prefix + name,
+                             "unknown key (not a parameter of any technique)");
             knob_value(it->second, value, prefix + name, errors_);  // type and range now
             out.push_back({name, &value});
         }
@@ -260,7 +284,8 @@ private:
         const auto* node = root.get(section);
         if (!node) return;
         for (auto&& [key, value] : as_table(*node, section, errors_)) {
-            const std::string prefix = std::string(section) + "." + std::string(key.str()) + ".";
+            const std::string prefix =
+                std::string(section) + "." + std::string(key.str()) + ".";
             into[std::string(key.str())] =
                 read_parameters(as_table(value, prefix, errors_), prefix, only);
         }
@@ -277,52 +302,60 @@ private:
         if (it == table.end()) {
             std::vector<std::string> names;
             for (const auto& entry : table) names.push_back(entry.first);
-            errors_.fail(*node, prefix + key, "unknown name '" + name + "' (defined: " +
-                                                  (names.empty() ? "none" : join(names)) + ")");
+            errors_.fail(*node, prefix + key,
+                         "unknown name '" + name + "' (defined: " +
+                             (names.empty() ? "none" : join(names)) + ")");
         }
         return &it->second;
     }
 
-    void read_stimulus(const toml::table& table, const std::string& prefix, StimulusSet& set) {
+    void read_stimulus(const toml::table& table, const std::string& prefix,
+                       StimulusSet& set) {
         const int line = int(table.source().begin.line);
         // Identity: id, technique, mesh.
         const auto* id_node = table.get("id");
         if (!id_node) errors_.fail(table.source(), prefix + "id", "missing");
         const std::string id = as_string(*id_node, prefix + "id", errors_);
         const auto* technique_node = table.get("technique");
-        if (!technique_node) errors_.fail(table.source(), prefix + "technique", "missing");
-        const std::string technique = as_string(*technique_node, prefix + "technique", errors_);
+        if (!technique_node)
+            errors_.fail(table.source(), prefix + "technique", "missing");
+        const std::string technique =
+            as_string(*technique_node, prefix + "technique", errors_);
         const auto knobs = catalog_.knobs_of(technique);
         if (!knobs)
             errors_.fail(*technique_node, prefix + "technique",
-                         "unknown technique '" + technique + "' (valid: " +
-                             join(catalog_.technique_names) + ")");
+                         "unknown technique '" + technique +
+                             "' (valid: " + join(catalog_.technique_names) + ")");
         std::string mesh_name;
         if (const auto* node = table.get("mesh")) {
             mesh_name = as_string(*node, prefix + "mesh", errors_);
             if (!meshes_.count(mesh_name)) {
                 std::vector<std::string> names;
                 for (const auto& entry : meshes_) names.push_back(entry.first);
-                errors_.fail(*node, prefix + "mesh", "missing mesh '" + mesh_name +
-                                                         "' (defined in [meshes]: " + join(names) + ")");
+                errors_.fail(*node, prefix + "mesh",
+                             "missing mesh '" + mesh_name +
+                                 "' (defined in [meshes]: " + join(names) + ")");
             }
         } else if (meshes_.size() == 1) {
             mesh_name = meshes_.begin()->first;
         } else {
-            errors_.fail(table.source(), prefix + "mesh", "missing: several meshes are defined");
+            errors_.fail(table.source(), prefix + "mesh",
+                         "missing: several meshes are defined");
         }
 
         // Own parameters (every other key must be a knob of this technique).
         Assignments own;
         for (auto&& [key, value] : table) {
             const std::string name(key.str());
-            if (name == "id" || name == "technique" || name == "mesh" || name == "light" ||
-                name == "material" || name == "vary" || name == "expand")
+            if (name == "id" || name == "technique" || name == "mesh" ||
+                name == "light" || name == "material" || name == "vary" ||
+                name == "expand")
                 continue;
             const Knob* knob = find_knob(*knobs, name);
             if (!knob)
-                errors_.fail(key.source(), prefix + name,
-                             "unknown key (not a parameter of technique '" + technique + "')");
+                errors_.fail(
+                    key.source(), prefix + name,
+                    "unknown key (not a parameter of technique '" + technique + "')");
             knob_value(*knob, value, prefix + name, errors_);
             own.push_back({name, &value});
         }
@@ -346,8 +379,8 @@ private:
         // Expansion: [stimuli.vary] lists, as a grid (every combination) or zipped.
         std::vector<std::pair<std::string, std::vector<KnobValue>>> axes;
         if (const auto* vary_node = table.get("vary")) {
-            // toml++ keeps keys sorted; restore the order they are written in, so the first
-            // listed parameter varies slowest.
+            // toml++ keeps keys sorted; restore the order they are written in, so the
+            // first listed parameter varies slowest.
             std::vector<std::pair<const toml::key*, const toml::node*>> entries;
             for (auto&& [key, value] : as_table(*vary_node, prefix + "vary", errors_))
                 entries.emplace_back(&key, &value);
@@ -362,13 +395,16 @@ private:
                 const std::string name(key.str()), full = prefix + "vary." + name;
                 const Knob* knob = find_knob(*knobs, name);
                 if (!knob)
-                    errors_.fail(key.source(), full,
-                                 "unknown key (not a parameter of technique '" + technique + "')");
+                    errors_.fail(
+                        key.source(), full,
+                        "unknown key (not a parameter of technique '" + technique + "')");
                 const auto* list = value.as_array();
                 if (!list || list->empty())
-                    errors_.fail(value, full, "wrong type: expected a non-empty list of values");
+                    errors_.fail(value, full,
+                                 "wrong type: expected a non-empty list of values");
                 std::vector<KnobValue> values;
-                for (const auto& element : *list) values.push_back(knob_value(*knob, element, full, errors_));
+                for (const auto& element : *list)
+                    values.push_back(knob_value(*knob, element, full, errors_));
                 axes.emplace_back(name, std::move(values));
             }
         }
@@ -376,22 +412,26 @@ private:
         if (const auto* node = table.get("expand")) {
             expand = as_string(*node, prefix + "expand", errors_);
             if (expand != "grid" && expand != "zip")
-                errors_.fail(*node, prefix + "expand", "'" + expand + "' is out of range (valid: grid, zip)");
+                errors_.fail(*node, prefix + "expand",
+                             "'" + expand + "' is out of range (valid: grid, zip)");
         }
         std::size_t count = 1;
         for (const auto& axis : axes) {
             if (expand == "zip" && axis.second.size() != axes.front().second.size())
                 errors_.fail(*table.get("vary"), prefix + "vary",
-                             "zip needs lists of equal length ('" + axis.first + "' has " +
-                                 std::to_string(axis.second.size()) + ", '" + axes.front().first +
-                                 "' has " + std::to_string(axes.front().second.size()) + ")");
+                             "zip needs lists of equal length ('" + axis.first +
+                                 "' has " + std::to_string(axis.second.size()) + ", '" +
+                                 axes.front().first + "' has " +
+                                 std::to_string(axes.front().second.size()) + ")");
             count = expand == "zip" ? axis.second.size() : count * axis.second.size();
             if (count > kMaxStimuli)
-                errors_.fail(*table.get("vary"), prefix + "vary", "expands to too many stimuli");
+                errors_.fail(*table.get("vary"), prefix + "vary",
+                             "expands to too many stimuli");
         }
 
         for (std::size_t index = 0; index < count; ++index) {
-            Stimulus stimulus{id, technique, mesh_name, meshes_.at(mesh_name), base, line};
+            Stimulus stimulus{id,   technique, mesh_name, meshes_.at(mesh_name),
+                              base, line};
             std::size_t rest = index;
             for (auto axis = axes.rbegin(); axis != axes.rend(); ++axis) {
                 const std::size_t n = axis->second.size();
@@ -434,13 +474,13 @@ private:
     void check_id(const std::string& id, const toml::node& node, const std::string& key) {
         const bool safe = !id.empty() && id.front() != '.' &&
                           std::all_of(id.begin(), id.end(), [](char c) {
-                              return std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
-                                     c == '-' || c == '.';
+                              return std::isalnum(static_cast<unsigned char>(c)) ||
+                                     c == '_' || c == '-' || c == '.';
                           });
         if (!safe)
-            errors_.fail(node, key, "'" + id + "' is not a valid id (letters, digits, _ - . only)");
-        if (!ids_.insert(id).second)
-            errors_.fail(node, key, "duplicate id '" + id + "'");
+            errors_.fail(node, key,
+                         "'" + id + "' is not a valid id (letters, digits, _ - . only)");
+        if (!ids_.insert(id).second) errors_.fail(node, key, "duplicate id '" + id + "'");
     }
 
     const SetCatalog& catalog_;
@@ -457,9 +497,12 @@ private:
 
 std::string_view extension(ImageFormat format) {
     switch (format) {
-        case ImageFormat::png: return "png";
-        case ImageFormat::exr: return "exr";
-        case ImageFormat::tif: return "tif";
+        case ImageFormat::png:
+            return "png";
+        case ImageFormat::exr:
+            return "exr";
+        case ImageFormat::tif:
+            return "tif";
     }
     return "png";
 }
@@ -476,7 +519,8 @@ StimulusSet parse_stimulus_set(std::string_view toml_text, const std::string& so
     return Loader(catalog, source_name, base_dir).load(root, source_name);
 }
 
-StimulusSet load_stimulus_set(const std::filesystem::path& file, const SetCatalog& catalog) {
+StimulusSet load_stimulus_set(const std::filesystem::path& file,
+                              const SetCatalog& catalog) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw StimulusSetError(file.string() + ": cannot read the config file");
     std::ostringstream text;

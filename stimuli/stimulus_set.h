@@ -25,12 +25,12 @@ enum class ImageFormat { png, exr, tif };
 std::string_view extension(ImageFormat format);  // "png", "exr", "tif"
 
 struct Stimulus {
-    std::string id;           // unique in the set; also the image file's stem
-    std::string technique;    // a registered technique name
-    std::string mesh_name;    // the key in [meshes]
-    std::string mesh_spec;    // built-in spec ("torus_knot:60k") or absolute file path
-    KnobValues parameters;    // every knob of the technique, defaults filled in
-    int source_line = 0;      // line of the [[stimuli]] entry it expanded from
+    std::string id;         // unique in the set; also the image file's stem
+    std::string technique;  // a registered technique name
+    std::string mesh_name;  // the key in [meshes]
+    std::string mesh_spec;  // built-in spec ("torus_knot:60k") or absolute file path
+    KnobValues parameters;  // every knob of the technique, defaults filled in
+    int source_line = 0;    // line of the [[stimuli]] entry it expanded from
 };
 
 struct StimulusSet {
@@ -53,12 +53,14 @@ struct SetCatalog {
 SetCatalog default_catalog();
 
 // Parses `toml_text`; `source_name` is used in messages and `base_dir` resolves relative
-// mesh paths. Throws StimulusSetError; reads no file other than checking mesh paths exist.
+// mesh paths. Throws StimulusSetError; reads no file other than checking mesh paths
+// exist.
 StimulusSet parse_stimulus_set(std::string_view toml_text, const std::string& source_name,
                                const std::filesystem::path& base_dir,
                                const SetCatalog& catalog);
 // Reads and parses a config file (errors name it).
-StimulusSet load_stimulus_set(const std::filesystem::path& file, const SetCatalog& catalog);
+StimulusSet load_stimulus_set(const std::filesystem::path& file,
+                              const SetCatalog& catalog);
 
 // Built-in sets embedded in the binary ("thesis"); text is the TOML file as committed.
 std::vector<std::string> preset_names();

@@ -77,6 +77,7 @@ void write_image(const std::filesystem::path& path, const Image& input,
     if (ext == ".exr") {
         OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
         spec.attribute("compression", "zip");
+        spec.attribute("DateTime", "");  // OIIO stamps the time otherwise: same image, other bytes
         ok = out->open(temporary.string(), spec) &&
              out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data());
     } else if (ext == ".png") {
@@ -89,6 +90,7 @@ void write_image(const std::filesystem::path& path, const Image& input,
         OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT16);
         spec.attribute("oiio:ColorSpace", options.linear ? "linear" : "sRGB");
         spec.attribute("compression", "zip");
+        spec.attribute("DateTime", "");  // as for EXR: no timestamp in the file
         const auto pixels = encode_rgb<std::uint16_t>(image, options.linear, 65535.0f);
         ok = out->open(temporary.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT16, pixels.data());

@@ -1,12 +1,15 @@
 // Batch rendering: images + complete manifest, byte-identical re-runs, re-rendering only
 // what changed, atomic files, and config errors that write nothing.
+#include "batch_render.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
-#include "batch_render.h"
 #include "core/image.h"
 #include "core/mesh.h"
 #include "lucent/version.h"
@@ -24,21 +27,24 @@ std::string read_bytes(const std::filesystem::path& path) {
 
 // A small set: two ward roughness values (a vary list) and one contrast_reversed.
 std::string small_config(const std::string& reversed_weight = "0.6") {
-    return "name = \"small\"\nresolution = [48, 40]\nformats = [\"exr\", \"png\"]\n"
+    return "name = \"small\"\nresolution = [48, 40]\nformats = [\"exr\", \"png\", "
+           "\"tif\"]\n"
            "[meshes]\nball = \"sphere:1k\"\n"
            "[defaults]\nao_rays = 8\n"
            "[[stimuli]]\nid = \"w_{roughness}\"\ntechnique = \"ward\"\n"
            "[stimuli.vary]\nroughness = [0.1, 0.3]\n"
-           "[[stimuli]]\nid = \"cr\"\ntechnique = \"contrast_reversed\"\nreversed_diffuse = " +
+           "[[stimuli]]\nid = \"cr\"\ntechnique = "
+           "\"contrast_reversed\"\nreversed_diffuse = " +
            reversed_weight + "\n";
 }
 
 StimulusSet small_set(const std::string& reversed_weight = "0.6") {
-    return parse_stimulus_set(small_config(reversed_weight), "small.toml", ".", default_catalog());
+    return parse_stimulus_set(small_config(reversed_weight), "small.toml", ".",
+                              default_catalog());
 }
 
-BatchResult render(const StimulusSet& set, const std::filesystem::path& dir, bool force = false,
-                   int jobs = 1) {
+BatchResult render(const StimulusSet& set, const std::filesystem::path& dir,
+                   bool force = false, int jobs = 1) {
     BatchOptions options;
     options.out_dir = dir;
     options.force = force;
@@ -59,7 +65,8 @@ TEST(BatchRender, WritesImagesAndACompleteManifest) {
         ASSERT_TRUE(rows.count(id)) << id;
         const auto& row = rows.at(id);
         EXPECT_EQ(row.at("file"), std::string(id) + ".exr");
-        EXPECT_EQ(row.at("files"), std::string(id) + ".exr;" + id + ".png");
+        EXPECT_EQ(row.at("files"),
+                  std::string(id) + ".exr;" + id + ".png;" + id + ".tif");
         EXPECT_EQ(row.at("mesh_hash"), mesh.content_hash);
         EXPECT_EQ(row.at("software_version"), version_string());
         EXPECT_EQ(row.at("ao_rays"), "8");
@@ -68,12 +75,14 @@ TEST(BatchRender, WritesImagesAndACompleteManifest) {
         Hasher files;
         files.add_field(hash_file(dir / (std::string(id) + ".exr")));
         files.add_field(hash_file(dir / (std::string(id) + ".png")));
+        files.add_field(hash_file(dir / (std::string(id) + ".tif")));
         EXPECT_EQ(row.at("content_hash"), files.hex());
         // Statistics agree with the EXR read back (float, lossless).
         const Image image = read_image(dir / (std::string(id) + ".exr"));
         EXPECT_EQ(image.width, 48);
         EXPECT_EQ(image.height, 40);
-        const auto stats = compute_image_statistics(FloatImageView{48, 40, 4, image.rgba});
+        const auto stats =
+            compute_image_statistics(FloatImageView{48, 40, 4, image.rgba});
         EXPECT_EQ(row.at("object_pixels"), std::to_string(stats.object_pixels));
         EXPECT_NEAR(std::stod(row.at("rms_contrast")), stats.rms_contrast, 1e-6);
         EXPECT_NEAR(std::stod(row.at("mean_luminance")), stats.mean_luminance, 1e-6);
@@ -82,18 +91,22 @@ TEST(BatchRender, WritesImagesAndACompleteManifest) {
     EXPECT_EQ(rows.at("w_0.1").at("roughness"), "0.1");
     EXPECT_EQ(rows.at("w_0.3").at("roughness"), "0.3");
     EXPECT_EQ(rows.at("cr").at("reversed_diffuse"), "0.6");
-    EXPECT_EQ(rows.at("cr").at("diffuse_reflectance"), "");  // not a contrast_reversed knob
+    EXPECT_EQ(rows.at("cr").at("diffuse_reflectance"),
+              "");  // not a contrast_reversed knob
     // Nothing but the images and the manifest: no temporary files left.
     std::size_t files = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) (void)entry, ++files;
-    EXPECT_EQ(files, 3u * 2u + 2u);
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        (void)entry, ++files;
+    EXPECT_EQ(files, 3u * 3u + 2u);
 }
 
 TEST(BatchRender, SecondRunReusesForceRerendersByteIdentically) {
     const auto dir = test::scratch_dir("batch_rerun");
     const auto set = small_set();
     render(set, dir);
-    const std::string exr = read_bytes(dir / "w_0.3.exr"), png = read_bytes(dir / "cr.png");
+    const std::string exr = read_bytes(dir / "w_0.3.exr"),
+                      png = read_bytes(dir / "cr.png"),
+                      tif = read_bytes(dir / "w_0.1.tif");
     const std::string manifest = read_bytes(dir / "manifest.csv");
 
     const auto again = render(set, dir);
@@ -101,10 +114,13 @@ TEST(BatchRender, SecondRunReusesForceRerendersByteIdentically) {
     EXPECT_EQ(again.reused, 3u);
     EXPECT_EQ(read_bytes(dir / "manifest.csv"), manifest);
 
+    // A later second: encoders that stamp the time would change the bytes.
+    std::this_thread::sleep_for(std::chrono::milliseconds(1100));
     const auto forced = render(set, dir, /*force=*/true, /*jobs=*/2);
     EXPECT_EQ(forced.rendered, 3u);
     EXPECT_EQ(read_bytes(dir / "w_0.3.exr"), exr);  // same inputs, same bytes
     EXPECT_EQ(read_bytes(dir / "cr.png"), png);
+    EXPECT_EQ(read_bytes(dir / "w_0.1.tif"), tif);
     EXPECT_EQ(read_bytes(dir / "manifest.csv"), manifest);
 }
 
@@ -129,19 +145,24 @@ TEST(BatchRender, RerendersOnlyChangedOrDamagedStimuli) {
 
 TEST(BatchRender, ConfigErrorsExitTwoAndWriteNothing) {
     const auto dir = test::scratch_dir("batch_errors");
-    std::ofstream(dir / "bad.toml") << small_config() << "roughness = 2\n";  // in cr, out of range
-    std::ofstream(dir / "bad_mesh.toml") << "[meshes]\nm = \"absent.obj\"\n"
-                                            "[[stimuli]]\nid = \"a\"\ntechnique = \"ward\"\n";
+    std::ofstream(dir / "bad.toml")
+        << small_config() << "roughness = 2\n";  // in cr, out of range
+    std::ofstream(dir / "bad_mesh.toml")
+        << "[meshes]\nm = \"absent.obj\"\n"
+           "[[stimuli]]\nid = \"a\"\ntechnique = \"ward\"\n";
     std::ofstream(dir / "broken_mesh.obj") << "this is not an obj file\n";
-    std::ofstream(dir / "broken_mesh.toml") << "[meshes]\nm = \"broken_mesh.obj\"\n"
-                                               "[[stimuli]]\nid = \"a\"\ntechnique = \"ward\"\n";
-    for (const char* config : {"bad.toml", "bad_mesh.toml", "broken_mesh.toml", "absent.toml"}) {
+    std::ofstream(dir / "broken_mesh.toml")
+        << "[meshes]\nm = \"broken_mesh.obj\"\n"
+           "[[stimuli]]\nid = \"a\"\ntechnique = \"ward\"\n";
+    for (const char* config :
+         {"bad.toml", "bad_mesh.toml", "broken_mesh.toml", "absent.toml"}) {
         const auto out = dir / (std::string("out_") + config);
         testing::internal::CaptureStderr();
-        const int code = run_render_set_command((dir / config).string(), "", out.string(), 1, false);
+        const int code =
+            run_render_set_command((dir / config).string(), "", out.string(), 1, false);
         const std::string err = testing::internal::GetCapturedStderr();
         EXPECT_EQ(code, 2) << config << ": " << err;
-        EXPECT_NE(err.find(config), std::string::npos) << err;  // names the file
+        EXPECT_NE(err.find(config), std::string::npos) << err;          // names the file
         EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;  // one line
         EXPECT_FALSE(std::filesystem::exists(out)) << config;
     }

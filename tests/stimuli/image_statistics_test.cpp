@@ -1,10 +1,10 @@
 // Image statistics against hand-computable images and degenerate ones.
+#include "image_statistics.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
-
-#include "image_statistics.h"
 
 namespace lucent::stimuli {
 namespace {
@@ -32,7 +32,8 @@ TEST(ImageStatistics, LuminanceIsRec709OfLinearValues) {
 TEST(ImageStatistics, TwoValuedHalfAndHalf) {
     // Half the object at 0.2, half at 0.6: mean 0.4, SD 0.2, contrast 0.5, skew 0.
     TestImage image(4, 2);
-    for (int p = 0; p < 8; ++p) image.set(p, p % 2 ? 0.6f : 0.2f, p % 2 ? 0.6f : 0.2f, p % 2 ? 0.6f : 0.2f);
+    for (int p = 0; p < 8; ++p)
+        image.set(p, p % 2 ? 0.6f : 0.2f, p % 2 ? 0.6f : 0.2f, p % 2 ? 0.6f : 0.2f);
     const auto s = compute_image_statistics(image.view(), 10);
     EXPECT_EQ(s.object_pixels, 8u);
     EXPECT_NEAR(s.mean_luminance, 0.4, 1e-6);
@@ -85,12 +86,14 @@ TEST(ImageStatistics, SaturationIntensityCorrelationSign) {
     image.set(1, 0.6f, 0.0f, 0.0f);
     image.set(2, 0.9f, 0.9f, 0.9f);  // I = 0.9, S = 0
     image.set(3, 0.9f, 0.9f, 0.9f);
-    EXPECT_NEAR(compute_image_statistics(image.view()).saturation_intensity_correlation, -1.0, 1e-9);
+    EXPECT_NEAR(compute_image_statistics(image.view()).saturation_intensity_correlation,
+                -1.0, 1e-9);
     image.set(0, 0.3f, 0.3f, 0.3f);  // now the dim pixels are grey, the bright ones red
     image.set(1, 0.3f, 0.3f, 0.3f);
     image.set(2, 2.7f, 0.0f, 0.0f);
     image.set(3, 2.7f, 0.0f, 0.0f);
-    EXPECT_NEAR(compute_image_statistics(image.view()).saturation_intensity_correlation, 1.0, 1e-9);
+    EXPECT_NEAR(compute_image_statistics(image.view()).saturation_intensity_correlation,
+                1.0, 1e-9);
 }
 
 TEST(ImageStatistics, EmptyMaskGivesZerosNotNaN) {

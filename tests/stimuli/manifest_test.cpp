@@ -1,4 +1,6 @@
 // Manifest pieces: hashing, CSV quoting, and writing then reading a manifest back.
+#include "manifest.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,7 +8,6 @@
 #include <limits>
 #include <sstream>
 
-#include "manifest.h"
 #include "test_paths.h"
 
 namespace lucent::stimuli {
@@ -18,7 +19,8 @@ TEST(Manifest, HasherIsFnv1a64) {
     EXPECT_EQ(Hasher().add("a").hex(), "af63dc4c8601ec8c");
     EXPECT_EQ(Hasher().add("foobar").hex(), "85944171f73967e8");
     // Length-prefixed fields never run together.
-    EXPECT_NE(Hasher().add_field("ab").add_field("c").hex(), Hasher().add_field("a").add_field("bc").hex());
+    EXPECT_NE(Hasher().add_field("ab").add_field("c").hex(),
+              Hasher().add_field("a").add_field("bc").hex());
 }
 
 TEST(Manifest, HashFileMatchesHashOfBytes) {
@@ -41,7 +43,9 @@ TEST(Manifest, CsvQuotingRoundTrips) {
 TEST(Manifest, WritesUnionOfColumnsAndReadsBack) {
     const auto dir = test::scratch_dir("manifest_roundtrip");
     const std::vector<ManifestRow> rows = {
-        {{"id", "a", false}, {"albedo", "0.8,0.5,0.3", false}, {"rms_contrast", "0.25", true}},
+        {{"id", "a", false},
+         {"albedo", "0.8,0.5,0.3", false},
+         {"rms_contrast", "0.25", true}},
         {{"id", "b", false}, {"roughness", "0.1", true}, {"rms_contrast", "0.5", true}},
     };
     write_manifest(dir, "demo", rows);
@@ -58,12 +62,14 @@ TEST(Manifest, WritesUnionOfColumnsAndReadsBack) {
     std::stringstream json;
     json << json_in.rdbuf();
     EXPECT_NE(json.str().find("\"set\": \"demo\""), std::string::npos);
-    EXPECT_NE(json.str().find("{\"id\": \"a\", \"albedo\": \"0.8,0.5,0.3\", \"rms_contrast\": 0.25}"),
+    EXPECT_NE(json.str().find(
+                  "{\"id\": \"a\", \"albedo\": \"0.8,0.5,0.3\", \"rms_contrast\": 0.25}"),
               std::string::npos)
         << json.str();
     // No temporary files are left behind.
     int files = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) (void)entry, ++files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        (void)entry, ++files;
     EXPECT_EQ(files, 2);
     // An absent manifest reads as empty (everything is rendered again).
     EXPECT_TRUE(read_manifest_csv(test::scratch_dir("manifest_absent")).empty());

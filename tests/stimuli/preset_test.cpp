@@ -1,4 +1,5 @@
-// The built-in `thesis` set: Table 4.3 of the thesis and the ward / contrast_reversed pairs.
+// The built-in `thesis` set: Table 4.3 of the thesis and the ward / contrast_reversed
+// pairs.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -17,7 +18,8 @@ const Stimulus& find(const StimulusSet& set, const std::string& id) {
 }
 
 TEST(ThesisPreset, EmbeddedTextIsTheCommittedExampleFile) {
-    std::ifstream in(test::source_dir() / "stimuli/presets/thesis.toml", std::ios::binary);
+    std::ifstream in(test::source_dir() / "stimuli/presets/thesis.toml",
+                     std::ios::binary);
     std::ostringstream file;
     file << in.rdbuf();
     ASSERT_TRUE(preset_text("thesis").has_value());
@@ -37,7 +39,8 @@ TEST(ThesisPreset, NineEmpiricalRendersOfTable43) {
     for (int row = 0; row < 9; ++row) {
         const auto& s = find(set, "empirical_row_" + std::to_string(row + 1));
         EXPECT_EQ(s.technique, "empirical");
-        EXPECT_EQ(s.mesh_spec.substr(0, s.mesh_spec.find(':')), "torus_knot");  // built-in
+        EXPECT_EQ(s.mesh_spec.substr(0, s.mesh_spec.find(':')),
+                  "torus_knot");  // built-in
         EXPECT_DOUBLE_EQ(s.parameters.scalar("thickness_exponent"), table[row][0]) << row;
         EXPECT_DOUBLE_EQ(s.parameters.scalar("backlight"), table[row][1]) << row;
         EXPECT_DOUBLE_EQ(s.parameters.scalar("diffuse_weight"), table[row][2]) << row;
@@ -57,7 +60,8 @@ TEST(ThesisPreset, WardAndContrastReversedPairsShareEveryParameter) {
         for (const auto& [name, value] : ward.parameters.all()) {
             if (name == "diffuse_reflectance") continue;
             ASSERT_TRUE(reversed.parameters.contains(name)) << name;
-            EXPECT_EQ(format_knob_value(value), format_knob_value(reversed.parameters.get(name)))
+            EXPECT_EQ(format_knob_value(value),
+                      format_knob_value(reversed.parameters.get(name)))
                 << material << " " << name;
         }
     }
@@ -66,11 +70,14 @@ TEST(ThesisPreset, WardAndContrastReversedPairsShareEveryParameter) {
     const auto& wax = find(set, "ward_wax");
     for (const auto& [name, value] : jade.parameters.all())
         if (name != "roughness")
-            EXPECT_EQ(format_knob_value(value), format_knob_value(wax.parameters.get(name))) << name;
+            EXPECT_EQ(format_knob_value(value),
+                      format_knob_value(wax.parameters.get(name)))
+                << name;
     EXPECT_LT(jade.parameters.scalar("roughness"), wax.parameters.scalar("roughness"));
     // ... and the strong pair has a higher reversed-diffuse weight (Fig. 4a).
-    EXPECT_GT(find(set, "contrast_reversed_jade_strong").parameters.scalar("reversed_diffuse"),
-              find(set, "contrast_reversed_jade").parameters.scalar("reversed_diffuse"));
+    EXPECT_GT(
+        find(set, "contrast_reversed_jade_strong").parameters.scalar("reversed_diffuse"),
+        find(set, "contrast_reversed_jade").parameters.scalar("reversed_diffuse"));
 }
 
 TEST(ThesisPreset, RealCatalogRejectsUnknownTechniqueAndKeys) {
@@ -80,17 +87,20 @@ TEST(ThesisPreset, RealCatalogRejectsUnknownTechniqueAndKeys) {
         parse_stimulus_set(head + "technique = \"phong\"\n", "x.toml", ".", catalog);
         FAIL() << "no error";
     } catch (const StimulusSetError& e) {
-        EXPECT_NE(std::string(e.what()).find("x.toml:5:13: stimuli[0].technique: unknown technique "
-                                             "'phong' (valid: empirical, ward, contrast_reversed)"),
+        EXPECT_NE(std::string(e.what()).find(
+                      "x.toml:5:13: stimuli[0].technique: unknown technique "
+                      "'phong' (valid: empirical, ward, contrast_reversed)"),
                   std::string::npos)
             << e.what();
     }
     // reversed_diffuse belongs to contrast_reversed, not ward.
-    EXPECT_THROW(parse_stimulus_set(head + "technique = \"ward\"\nreversed_diffuse = 0.5\n", "x.toml",
-                                    ".", catalog),
-                 StimulusSetError);
+    EXPECT_THROW(
+        parse_stimulus_set(head + "technique = \"ward\"\nreversed_diffuse = 0.5\n",
+                           "x.toml", ".", catalog),
+        StimulusSetError);
     EXPECT_NO_THROW(parse_stimulus_set(
-        head + "technique = \"contrast_reversed\"\nreversed_diffuse = 0.5\n", "x.toml", ".", catalog));
+        head + "technique = \"contrast_reversed\"\nreversed_diffuse = 0.5\n", "x.toml",
+        ".", catalog));
 }
 
 }  // namespace

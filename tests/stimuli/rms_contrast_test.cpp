@@ -12,14 +12,16 @@ namespace {
 class RmsContrastTest : public test::HeadlessGlTest {};
 
 ImageStatistics statistics_of(gl::FrameExecutor& executor, const std::string& mesh,
-                              const std::string& technique, std::vector<KnobAssignment> settings) {
+                              const std::string& technique,
+                              std::vector<KnobAssignment> settings) {
     RenderRequest request;
     request.mesh = mesh;
     request.technique = technique;
     request.settings = std::move(settings);
     request.width = request.height = 128;
     const Image image = render_image(executor, build_scene(request));
-    return compute_image_statistics(FloatImageView{image.width, image.height, 4, image.rgba});
+    return compute_image_statistics(
+        FloatImageView{image.width, image.height, 4, image.rgba});
 }
 
 TEST_F(RmsContrastTest, ContrastReversedIsLowerThanWardOnBuiltinMeshes) {
@@ -48,9 +50,10 @@ TEST_F(RmsContrastTest, ContrastReversedIsLowerThanWardOnBuiltinMeshes) {
                 ward.push_back({"diffuse_reflectance", m.weight});
                 reversed.push_back({"reversed_diffuse", m.weight});
                 const auto w = statistics_of(executor, mesh, "ward", ward);
-                const auto r = statistics_of(executor, mesh, "contrast_reversed", reversed);
-                SCOPED_TRACE(std::string(mesh) + " light " + light + " albedo " + m.albedo +
-                             " w " + m.weight + " alpha " + m.roughness);
+                const auto r =
+                    statistics_of(executor, mesh, "contrast_reversed", reversed);
+                SCOPED_TRACE(std::string(mesh) + " light " + light + " albedo " +
+                             m.albedo + " w " + m.weight + " alpha " + m.roughness);
                 EXPECT_EQ(w.object_pixels, r.object_pixels);  // same silhouette
                 EXPECT_GT(w.object_pixels, 1000u);
                 EXPECT_LT(r.rms_contrast, w.rms_contrast);

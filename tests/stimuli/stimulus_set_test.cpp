@@ -1,9 +1,10 @@
 // The stimulus-set TOML loader: expansion, precedence, and errors naming file, line, key.
+#include "stimulus_set.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
 
-#include "stimulus_set.h"
 #include "test_paths.h"
 
 namespace lucent::stimuli {
@@ -24,7 +25,8 @@ SetCatalog fake_catalog() {
     SetCatalog catalog;
     catalog.technique_names = {"alpha", "beta"};
     catalog.builtin_meshes = {"sphere", "torus"};
-    catalog.knobs_of = [alpha, beta](std::string_view name) -> std::optional<std::vector<Knob>> {
+    catalog.knobs_of = [alpha,
+                        beta](std::string_view name) -> std::optional<std::vector<Knob>> {
         if (name == "alpha") return alpha;
         if (name == "beta") return beta;
         return std::nullopt;
@@ -69,17 +71,18 @@ TEST(StimulusSet, PrecedenceDefaultsCameraLightMaterialOwn) {
         "[camera]\nfov_y = 30\n"
         "[lights.side]\nlight_direction = [1, 0, 0]\nlight_diffuse = \"0.5,0.4,0.3\"\n"
         "[materials.red]\nalbedo = [0.9, 0.1, 0.1]\nroughness = 0.7\nweight = 3\n"
-        "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nlight = \"side\"\nmaterial = \"red\"\nweight = 4\n"
+        "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nlight = \"side\"\nmaterial = "
+        "\"red\"\nweight = 4\n"
         "[[stimuli]]\nid = \"b\"\ntechnique = \"beta\"\nmaterial = \"red\"\n");
     EXPECT_EQ(set.width, 64);
     EXPECT_EQ(set.height, 32);
     ASSERT_EQ(set.formats.size(), 2u);
     const auto& a = set.stimuli[0].parameters;
-    EXPECT_EQ(a.scalar("fov_y"), 30.0);                               // camera over defaults
-    EXPECT_EQ(a.vec3("light_direction"), glm::dvec3(1, 0, 0));        // light
-    EXPECT_EQ(a.vec3("light_diffuse"), glm::dvec3(0.5, 0.4, 0.3));    // rgb as text
-    EXPECT_EQ(a.vec3("albedo"), glm::dvec3(0.9, 0.1, 0.1));           // material
-    EXPECT_EQ(a.scalar("weight"), 4.0);                               // own over material
+    EXPECT_EQ(a.scalar("fov_y"), 30.0);                         // camera over defaults
+    EXPECT_EQ(a.vec3("light_direction"), glm::dvec3(1, 0, 0));  // light
+    EXPECT_EQ(a.vec3("light_diffuse"), glm::dvec3(0.5, 0.4, 0.3));  // rgb as text
+    EXPECT_EQ(a.vec3("albedo"), glm::dvec3(0.9, 0.1, 0.1));         // material
+    EXPECT_EQ(a.scalar("weight"), 4.0);                             // own over material
     const auto& b = set.stimuli[1].parameters;
     EXPECT_EQ(b.scalar("roughness"), 0.7);  // beta takes the material's roughness ...
     EXPECT_FALSE(b.contains("weight"));     // ... and ignores keys it lacks
@@ -87,18 +90,20 @@ TEST(StimulusSet, PrecedenceDefaultsCameraLightMaterialOwn) {
 }
 
 TEST(StimulusSet, GridAndZipExpansion) {
-    const auto grid = parse(kHeader +
-                            "[[stimuli]]\nid = \"g_{weight}_{rays}\"\ntechnique = \"alpha\"\n"
-                            "[stimuli.vary]\nweight = [1, 2, 3]\nrays = [16, 32]\n");
+    const auto grid =
+        parse(kHeader +
+              "[[stimuli]]\nid = \"g_{weight}_{rays}\"\ntechnique = \"alpha\"\n"
+              "[stimuli.vary]\nweight = [1, 2, 3]\nrays = [16, 32]\n");
     ASSERT_EQ(grid.stimuli.size(), 6u);
     EXPECT_EQ(grid.stimuli[0].id, "g_1_16");
     EXPECT_EQ(grid.stimuli[5].id, "g_3_32");
     EXPECT_EQ(grid.stimuli[3].parameters.scalar("weight"), 2.0);
     EXPECT_EQ(grid.stimuli[3].parameters.integer("rays"), 32);
 
-    const auto zip = parse(kHeader +
-                           "[[stimuli]]\nid = \"z\"\ntechnique = \"alpha\"\nexpand = \"zip\"\n"
-                           "[stimuli.vary]\nweight = [1, 2, 3]\nrays = [16, 32, 64]\n");
+    const auto zip =
+        parse(kHeader +
+              "[[stimuli]]\nid = \"z\"\ntechnique = \"alpha\"\nexpand = \"zip\"\n"
+              "[stimuli.vary]\nweight = [1, 2, 3]\nrays = [16, 32, 64]\n");
     ASSERT_EQ(zip.stimuli.size(), 3u);
     EXPECT_EQ(zip.stimuli[0].id, "z_1");  // no placeholder: numbered
     EXPECT_EQ(zip.stimuli[2].id, "z_3");
@@ -108,40 +113,55 @@ TEST(StimulusSet, GridAndZipExpansion) {
 
 TEST(StimulusSet, ErrorsNameFileLineAndKey) {
     // Unknown key at the top level and inside a stimulus.
-    EXPECT_EQ(error_of("colour = 1\n" + kHeader),
-              "set.toml:1:1: colour: unknown key (valid: name, resolution, formats, meshes, "
-              "camera, lights, materials, defaults, stimuli)");
-    EXPECT_EQ(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nroughness = 0.1\n"),
-              "set.toml:6:1: stimuli[0].roughness: unknown key (not a parameter of technique 'alpha')");
+    EXPECT_EQ(
+        error_of("colour = 1\n" + kHeader),
+        "set.toml:1:1: colour: unknown key (valid: name, resolution, formats, meshes, "
+        "camera, lights, materials, defaults, stimuli)");
+    EXPECT_EQ(
+        error_of(kHeader +
+                 "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nroughness = 0.1\n"),
+        "set.toml:6:1: stimuli[0].roughness: unknown key (not a parameter of technique "
+        "'alpha')");
     // Wrong type.
-    EXPECT_EQ(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nweight = \"x\"\n"),
-              "set.toml:6:10: stimuli[0].weight: wrong type: expected a number (accepted: a "
-              "number in [0, 10])");
-    EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nrays = 1.5\n")
-                  .find("set.toml:6:8: stimuli[0].rays: wrong type"), std::string::npos);
+    EXPECT_EQ(
+        error_of(kHeader +
+                 "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nweight = \"x\"\n"),
+        "set.toml:6:10: stimuli[0].weight: wrong type: expected a number (accepted: a "
+        "number in [0, 10])");
+    EXPECT_NE(
+        error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nrays = 1.5\n")
+            .find("set.toml:6:8: stimuli[0].rays: wrong type"),
+        std::string::npos);
     // Out of range, including inside a vary list and in a material.
-    EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nweight = 11\n")
+    EXPECT_NE(error_of(kHeader +
+                       "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nweight = 11\n")
                   .find("set.toml:6:10: stimuli[0].weight: '11' is out of range"),
               std::string::npos);
-    EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\n[stimuli.vary]\n"
-                                 "weight = [1, -2]\n")
+    EXPECT_NE(error_of(kHeader +
+                       "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\n[stimuli.vary]\n"
+                       "weight = [1, -2]\n")
                   .find("set.toml:7:14: stimuli[0].vary.weight"),
               std::string::npos);
-    EXPECT_NE(error_of(kHeader + "[materials.m]\nalbedo = [2, 0, 0]\n").find("set.toml:4:10: "
-                                                                             "materials.m.albedo"),
+    EXPECT_NE(error_of(kHeader + "[materials.m]\nalbedo = [2, 0, 0]\n")
+                  .find("set.toml:4:10: "
+                        "materials.m.albedo"),
               std::string::npos);
-    EXPECT_NE(error_of("resolution = [0, 10]\n" + kHeader).find("set.toml:1:14: resolution: out of range"),
+    EXPECT_NE(error_of("resolution = [0, 10]\n" + kHeader)
+                  .find("set.toml:1:14: resolution: out of range"),
               std::string::npos);
     // Missing mesh: an unknown mesh name and a file that does not exist.
-    EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nmesh = \"cube\"\n")
-                  .find("set.toml:6:8: stimuli[0].mesh: missing mesh 'cube'"),
-              std::string::npos);
-    EXPECT_NE(error_of("[meshes]\nbunny = \"no/such/bunny.obj\"\n").find(
-                  "set.toml:2:9: meshes.bunny: missing mesh: 'no/such/bunny.obj'"),
+    EXPECT_NE(
+        error_of(kHeader +
+                 "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\nmesh = \"cube\"\n")
+            .find("set.toml:6:8: stimuli[0].mesh: missing mesh 'cube'"),
+        std::string::npos);
+    EXPECT_NE(error_of("[meshes]\nbunny = \"no/such/bunny.obj\"\n")
+                  .find("set.toml:2:9: meshes.bunny: missing mesh: 'no/such/bunny.obj'"),
               std::string::npos);
     // Unknown technique.
     EXPECT_EQ(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"phong\"\n"),
-              "set.toml:5:13: stimuli[0].technique: unknown technique 'phong' (valid: alpha, beta)");
+              "set.toml:5:13: stimuli[0].technique: unknown technique 'phong' (valid: "
+              "alpha, beta)");
     // Duplicate and unsafe ids, unequal zip lists, a syntax error.
     EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"a\"\ntechnique = \"alpha\"\n"
                                  "[[stimuli]]\nid = \"a\"\ntechnique = \"beta\"\n")
@@ -150,10 +170,12 @@ TEST(StimulusSet, ErrorsNameFileLineAndKey) {
     EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"../x\"\ntechnique = \"alpha\"\n")
                   .find("not a valid id"),
               std::string::npos);
-    EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"z\"\ntechnique = \"alpha\"\nexpand = \"zip\"\n"
-                                 "[stimuli.vary]\nweight = [1, 2]\nrays = [16]\n")
-                  .find("zip needs lists of equal length"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of(kHeader +
+                 "[[stimuli]]\nid = \"z\"\ntechnique = \"alpha\"\nexpand = \"zip\"\n"
+                 "[stimuli.vary]\nweight = [1, 2]\nrays = [16]\n")
+            .find("zip needs lists of equal length"),
+        std::string::npos);
     EXPECT_NE(error_of("name = \n").find("set.toml:1:"), std::string::npos);
     EXPECT_NE(error_of(kHeader).find("stimuli: missing"), std::string::npos);
 }
@@ -164,8 +186,10 @@ TEST(StimulusSet, RelativeMeshPathsResolveAgainstTheConfigFile) {
     std::ofstream(dir / "set.toml") << "[meshes]\nshape = \"shape.obj\"\n"
                                        "[[stimuli]]\nid = \"a\"\ntechnique = \"beta\"\n";
     const auto set = load_stimulus_set(dir / "set.toml", fake_catalog());
-    EXPECT_EQ(std::filesystem::path(set.stimuli[0].mesh_spec), (dir / "shape.obj").lexically_normal());
-    EXPECT_THROW(load_stimulus_set(dir / "absent.toml", fake_catalog()), StimulusSetError);
+    EXPECT_EQ(std::filesystem::path(set.stimuli[0].mesh_spec),
+              (dir / "shape.obj").lexically_normal());
+    EXPECT_THROW(load_stimulus_set(dir / "absent.toml", fake_catalog()),
+                 StimulusSetError);
 }
 
 }  // namespace

@@ -15,13 +15,20 @@ std::vector<Knob> make_knobs(Variant variant) {
     albedo.default_value = d.albedo;
     ambient.default_value = d.ambient;
     rays.default_value = d.ao_rays;
-    Knob diffuse =
-        variant == Variant::ward
-            ? Knob{"diffuse_reflectance", "rho_d: Ward's diffuse reflectance (scalar)",
-                   KnobKind::scalar, 0.0, 10.0, d.diffuse}
-            : Knob{"reversed_diffuse",
-                   "w: weight of the reversed diffuse term Id*chroma(Kd)*(1 - Y(Kd)*max(N.L,0)) (scalar)",
-                   KnobKind::scalar, 0.0, 10.0, d.diffuse};
+    Knob diffuse = variant == Variant::ward
+                       ? Knob{"diffuse_reflectance",
+                              "rho_d: Ward's diffuse reflectance (scalar)",
+                              KnobKind::scalar,
+                              0.0,
+                              10.0,
+                              d.diffuse}
+                       : Knob{"reversed_diffuse",
+                              "w: weight of the reversed diffuse term Id*chroma(Kd)*(1 - "
+                              "Y(Kd)*max(N.L,0)) (scalar)",
+                              KnobKind::scalar,
+                              0.0,
+                              10.0,
+                              d.diffuse};
     return {albedo,
             ambient,
             diffuse,

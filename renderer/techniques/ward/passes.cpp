@@ -12,7 +12,8 @@ namespace lucent::ward {
 void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
     const Params p = params(scene, variant);
     const bool ambient_term = plan.full() || has_ambient_term(p, scene.light);
-    const bool diffuse_term = plan.full() || (p.diffuse != 0.0 && scene.light.diffuse != glm::vec3(0.0f));
+    const bool diffuse_term =
+        plan.full() || (p.diffuse != 0.0 && scene.light.diffuse != glm::vec3(0.0f));
     const bool specular_term = plan.full() || has_specular_term(p, scene.light);
 
     plan.create("vertex_ao", ResourceFormat::vertex_float);
@@ -20,19 +21,21 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
     plan.create("shade_depth", ResourceFormat::depth32f);
 
     // Per-vertex AO for the ambient term; culled when the shader does not read it.
-    Pass ao{"ambient_occlusion", "bake (or load cached) per-vertex AO for the ambient term",
+    Pass ao{"ambient_occlusion",
+            "bake (or load cached) per-vertex AO for the ambient term",
             PassKind::bake_ambient_occlusion};
     ao.writes = {"vertex_ao"};
     ao.ao_rays = p.ao_rays;
     plan.add(ao);
 
     const glm::mat4 view = scene.camera.view();
-    Pass shade{"shade",
-               variant == Variant::ward
-                   ? "Eq. 14: ambient*AO + Ward diffuse + Ward specular"
-                   : "Eq. 15: ambient*AO + reversed diffuse Id*chroma*(1 - Y(Kd)*N.L) + Ward specular",
-               PassKind::draw_mesh,
-               {"techniques/ward/shaders/mesh.vert", "techniques/ward/shaders/shade.frag", {}}};
+    Pass shade{
+        "shade",
+        variant == Variant::ward ? "Eq. 14: ambient*AO + Ward diffuse + Ward specular"
+                                 : "Eq. 15: ambient*AO + reversed diffuse Id*chroma*(1 - "
+                                   "Y(Kd)*N.L) + Ward specular",
+        PassKind::draw_mesh,
+        {"techniques/ward/shaders/mesh.vert", "techniques/ward/shaders/shade.frag", {}}};
     shade.uniforms = {{"u_model_view", view},
                       {"u_projection", scene.camera.projection()},
                       {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))},
@@ -49,14 +52,17 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
         shade.shader.defines.push_back("WITH_DIFFUSE");
         if (variant == Variant::contrast_reversed) {
             shade.shader.defines.push_back("REVERSED_DIFFUSE");
-            shade.uniforms.push_back({"u_albedo_chroma", glm::vec3(albedo_chroma(p.albedo))});
-            shade.uniforms.push_back({"u_albedo_luminance", static_cast<float>(albedo_luminance(p.albedo))});
+            shade.uniforms.push_back(
+                {"u_albedo_chroma", glm::vec3(albedo_chroma(p.albedo))});
+            shade.uniforms.push_back(
+                {"u_albedo_luminance", static_cast<float>(albedo_luminance(p.albedo))});
         }
         shade.uniforms.push_back({"u_diffuse", static_cast<float>(p.diffuse)});
     }
     if (specular_term) {
         shade.shader.defines.push_back("WITH_SPECULAR");
-        shade.uniforms.push_back({"u_specular_reflectance", static_cast<float>(p.specular_reflectance)});
+        shade.uniforms.push_back(
+            {"u_specular_reflectance", static_cast<float>(p.specular_reflectance)});
         shade.uniforms.push_back({"u_roughness", static_cast<float>(p.roughness)});
         shade.uniforms.push_back({"u_light_specular", scene.light.specular});
     }

@@ -3,7 +3,6 @@
 // and its contrast-reversed variant (Eq. 15): what the `ward` and `contrast_reversed`
 // techniques share (one shader with a variant define, one CPU reference). See README.md.
 #include <glm/glm.hpp>
-
 #include <vector>
 
 #include "core/frame_plan.h"
@@ -41,7 +40,8 @@ Params params(const Scene& scene, Variant variant);
 //   diffuse  = rho_d * Kd * Id * max(N.L, 0)                     (ward)
 //   reversed = w * Id * chroma * (1 - Y * max(N.L, 0))            (contrast_reversed)
 //              with Y = Rec. 709 luminance of Kd and chroma = Kd / Y (albedo_chroma())
-//   specular = pi * f_s(l, v) * Is * max(N.L, 0)                 (Ward's lobe, ward_brdf.h)
+//   specular = pi * f_s(l, v) * Is * max(N.L, 0)                 (Ward's lobe,
+//   ward_brdf.h)
 glm::dvec3 shade(const Params& p, const Light& light, Variant variant, glm::dvec3 n,
                  glm::dvec3 v, double ao);
 

@@ -24,6 +24,7 @@ inline constexpr float kPi = 3.14159265358979323846f;
 float ward_specular(glm::vec3 n, glm::vec3 l, glm::vec3 v, float rho_s, float alpha);
 
 // The whole BRDF f = rho_d / pi + f_s (1/sr); 0 below the surface.
-float ward_brdf(glm::vec3 n, glm::vec3 l, glm::vec3 v, float rho_d, float rho_s, float alpha);
+float ward_brdf(glm::vec3 n, glm::vec3 l, glm::vec3 v, float rho_d, float rho_s,
+                float alpha);
 
 }  // namespace lucent::ward

@@ -39,11 +39,13 @@ TEST(ContrastReversedShading, ReversesLuminanceAndKeepsHue) {
     const auto tilted = ward::shade(p, light, ward::Variant::contrast_reversed,
                                     glm::normalize(glm::dvec3(0, 0.6, 0.8)), v, 1.0);
     EXPECT_NEAR(tilted.b / tilted.r, 0.8 / 0.2, 1e-9);
-    EXPECT_NEAR(0.2126 * tilted.r + 0.7152 * tilted.g + 0.0722 * tilted.b, 0.7 * (1.0 - y * 0.8), 1e-9);
+    EXPECT_NEAR(0.2126 * tilted.r + 0.7152 * tilted.g + 0.0722 * tilted.b,
+                0.7 * (1.0 - y * 0.8), 1e-9);
     // A white albedo facing the light reverses to exactly 0, never negative; a black one
     // has no hue to keep and reverses to the light's colour.
     p.albedo = glm::dvec3(1.0);
-    EXPECT_EQ(ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0), glm::dvec3(0.0));
+    EXPECT_EQ(ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0),
+              glm::dvec3(0.0));
     p.albedo = glm::dvec3(0.0);
     const auto black = ward::shade(p, light, ward::Variant::contrast_reversed, n, v, 1.0);
     EXPECT_NEAR(black.g, 0.7, 1e-12);
@@ -54,9 +56,10 @@ class ContrastReversedGlTest : public test::HeadlessGlTest {};
 
 TEST_F(ContrastReversedGlTest, KeepsABlackBackgroundAndFiniteValues) {
     gl::FrameExecutor executor;
-    const Scene scene = scene_for("contrast_reversed",
-                                  {{"ao_rays", "16"}, {"roughness", "0"}, {"specular_reflectance", "1"}},
-                                  "torus:2k", 64);
+    const Scene scene =
+        scene_for("contrast_reversed",
+                  {{"ao_rays", "16"}, {"roughness", "0"}, {"specular_reflectance", "1"}},
+                  "torus:2k", 64);
     const Image image = render_image(executor, scene);
     std::size_t background = 0;
     for (int y = 0; y < image.height; ++y)
@@ -72,22 +75,23 @@ TEST_F(ContrastReversedGlTest, KeepsABlackBackgroundAndFiniteValues) {
     EXPECT_GT(background, 100u);
 }
 
-
 TEST_F(ContrastReversedGlTest, PrunedPlanEqualsFullPlan) {
     // Each prunable term off (AO bake, specular lobe, diffuse term): the pruned render
     // must equal the render with every pass and term compiled in.
     gl::FrameExecutor executor;
     for (const char* technique : {"ward", "contrast_reversed"}) {
-        const std::string diffuse = std::string(technique) == "ward" ? "diffuse_reflectance" : "reversed_diffuse";
-        for (const KnobAssignment& off : {KnobAssignment{"ambient", "0"},
-                                          KnobAssignment{"specular_reflectance", "0"},
-                                          KnobAssignment{diffuse, "0"}}) {
+        const std::string diffuse =
+            std::string(technique) == "ward" ? "diffuse_reflectance" : "reversed_diffuse";
+        for (const KnobAssignment& off :
+             {KnobAssignment{"ambient", "0"}, KnobAssignment{"specular_reflectance", "0"},
+              KnobAssignment{diffuse, "0"}}) {
             const Scene scene = scene_for(technique, {{"ao_rays", "8"}, off}, "torus:2k");
             const Image pruned = render_image(executor, scene);
             const Image full = render_image(executor, scene, PlanMode::full);
             double max_difference = 0.0;
             for (std::size_t i = 0; i < pruned.rgba.size(); ++i)
-                max_difference = std::max(max_difference, double(std::abs(pruned.rgba[i] - full.rgba[i])));
+                max_difference = std::max(
+                    max_difference, double(std::abs(pruned.rgba[i] - full.rgba[i])));
             EXPECT_LT(max_difference, 1e-6) << technique << " " << off.key;
         }
     }

@@ -1,10 +1,10 @@
 // Ward's isotropic BRDF against analytic values and numerical energy integrals.
+#include "techniques/ward/ward_brdf.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
-
-#include "techniques/ward/ward_brdf.h"
 
 namespace lucent::ward {
 namespace {
@@ -13,8 +13,8 @@ constexpr double kPiD = std::numbers::pi;
 const glm::vec3 kNormal{0.0f, 0.0f, 1.0f};
 
 glm::vec3 direction(double theta, double phi = 0.0) {
-    return {float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-            float(std::cos(theta))};
+    return {float(std::sin(theta) * std::cos(phi)),
+            float(std::sin(theta) * std::sin(phi)), float(std::cos(theta))};
 }
 
 TEST(WardBrdf, NormalIncidenceAndViewIsDiffusePlusPeakWithAlphaSquared) {
@@ -26,11 +26,14 @@ TEST(WardBrdf, NormalIncidenceAndViewIsDiffusePlusPeakWithAlphaSquared) {
 }
 
 TEST(WardBrdf, OffSpecularValueMatchesClosedForm) {
-    // l = n, v at theta: the half vector is at theta/2 from n, so tan(delta) = tan(theta/2).
+    // l = n, v at theta: the half vector is at theta/2 from n, so tan(delta) =
+    // tan(theta/2).
     const double theta = 0.6, alpha = 0.3, rho_s = 0.2;
-    const double expected = rho_s * std::exp(-std::pow(std::tan(theta / 2), 2) / (alpha * alpha)) /
-                            (4.0 * kPiD * alpha * alpha * std::sqrt(std::cos(theta)));
-    EXPECT_NEAR(ward_specular(kNormal, kNormal, direction(theta, 1.0), float(rho_s), float(alpha)),
+    const double expected =
+        rho_s * std::exp(-std::pow(std::tan(theta / 2), 2) / (alpha * alpha)) /
+        (4.0 * kPiD * alpha * alpha * std::sqrt(std::cos(theta)));
+    EXPECT_NEAR(ward_specular(kNormal, kNormal, direction(theta, 1.0), float(rho_s),
+                              float(alpha)),
                 expected, 1e-5 * expected);
 }
 
@@ -44,8 +47,8 @@ TEST(WardBrdf, GrazingAnglesAndZeroRoughnessStayFinite) {
     for (float alpha : {0.0f, 1e-6f, 1e-3f, 0.5f}) {
         for (double ti : {0.0, 1.0, grazing}) {
             for (double to : {0.0, 1.0, grazing}) {
-                const float f = ward_brdf(kNormal, direction(ti), direction(to, kPiD), 0.3f, 0.7f,
-                                          alpha);
+                const float f = ward_brdf(kNormal, direction(ti), direction(to, kPiD),
+                                          0.3f, 0.7f, alpha);
                 EXPECT_TRUE(std::isfinite(f)) << alpha << " " << ti << " " << to;
                 EXPECT_GE(f, 0.0f);
             }
@@ -56,8 +59,10 @@ TEST(WardBrdf, GrazingAnglesAndZeroRoughnessStayFinite) {
                     ward_specular(kNormal, kNormal, kNormal, 1.0f, kMinRoughness));
 }
 
-// Directional albedo: integral of f cos(theta_o) over the hemisphere, by the midpoint rule.
-double albedo(double theta_i, float rho_d, float rho_s, float alpha, int n_theta, int n_phi) {
+// Directional albedo: integral of f cos(theta_o) over the hemisphere, by the midpoint
+// rule.
+double albedo(double theta_i, float rho_d, float rho_s, float alpha, int n_theta,
+              int n_phi) {
     const glm::vec3 l = direction(theta_i);
     double sum = 0.0;
     const double d_theta = kPiD / 2 / n_theta, d_phi = 2 * kPiD / n_phi;
