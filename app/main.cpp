@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
     register_participants(app, exit_code);
     register_export(app, exit_code);
     register_merge(app, exit_code);
+    register_explore(app, exit_code);
 
     // CLI11 would only say "A subcommand is required"; name the word it did not know.
     if (argc > 1 && argv[1][0] != '-' && [&] { try { app.get_subcommand(argv[1]); return false; } catch (const CLI::OptionNotFound&) { return true; } }()) {
