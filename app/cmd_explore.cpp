@@ -5,7 +5,8 @@
 #include "commands.h"
 #include "core/mesh.h"
 #include "explorer/explorer.h"
-#include "gl/context.h"
+#include "core/image.h"
+#include "explorer/frame_stats.h"
 #include "stimulus_set.h"
 
 namespace lucent::app {
@@ -22,6 +23,23 @@ struct ExploreOptions {
     bool developer = false;
 };
 
+// "WxH" with each side in [64, 8192]; throws std::invalid_argument naming --size.
+void parse_window_size(const std::string& text, int& width, int& height) {
+    const auto x = text.find('x');
+    std::size_t used_w = 0, used_h = 0;
+    try {
+        if (x == std::string::npos) throw std::invalid_argument("");
+        width = std::stoi(text.substr(0, x), &used_w);
+        height = std::stoi(text.substr(x + 1), &used_h);
+    } catch (const std::exception&) {
+        used_w = used_h = 0;
+    }
+    if (x == std::string::npos || used_w != x || used_h != text.size() - x - 1 || width < 64 ||
+        height < 64 || width > 8192 || height > 8192)
+        throw std::invalid_argument("--size: '" + text +
+                                    "' is not WxH with each in [64, 8192] (e.g. 1280x720)");
+}
+
 int run_explore(const ExploreOptions& options) {
     explorer::ExplorerSession session;
     explorer::ExplorerOptions window;
@@ -33,20 +51,11 @@ int run_explore(const ExploreOptions& options) {
         std::vector<KnobAssignment> assignments;
         for (const auto& s : options.settings) assignments.push_back(parse_assignment(s));
         for (auto& set : session.sets) set.apply(assignments);
-        const auto x = options.size.find('x');
-        std::size_t used_w = 0, used_h = 0;
-        if (x == std::string::npos) throw std::invalid_argument("");
-        try {
-            window.width = std::stoi(options.size.substr(0, x), &used_w);
-            window.height = std::stoi(options.size.substr(x + 1), &used_h);
-        } catch (const std::exception&) {
-            used_w = 0;
-        }
-        if (used_w != x || used_h != options.size.size() - x - 1 || window.width < 64 ||
-            window.height < 64 || window.width > 8192 || window.height > 8192)
-            throw std::invalid_argument("--size: '" + options.size +
-                                        "' is not WxH with each in [64, 8192] (e.g. 1280x720)");
+        parse_window_size(options.size, window.width, window.height);
         if (options.frames < 0) throw std::invalid_argument("--frames: must be >= 0");
+        if (!options.screenshot.empty() && !is_supported_image_path(options.screenshot))
+            throw std::invalid_argument("--screenshot: '" + options.screenshot +
+                                        "' has an unsupported extension (accepted: .png, .tif, .exr)");
         session.developer_mode = options.developer;
     } catch (const KnobError& e) {
         std::cerr << "lucent explore: " << e.what() << "\n";
@@ -55,27 +64,32 @@ int run_explore(const ExploreOptions& options) {
         std::cerr << "lucent explore: " << e.what() << "\n";
         return kExitUsage;
     } catch (const std::invalid_argument& e) {
-        std::cerr << "lucent explore: "
-                  << (*e.what() ? e.what() : "--size: expected WxH (e.g. 1280x720)") << "\n";
+        std::cerr << "lucent explore: " << e.what() << "\n";
         return kExitUsage;
     }
     try {
         explorer::Explorer app(std::move(session), window);
         if (options.developer) app.reload_shaders();
-        explorer::run_explorer(app, options.frames);
+        // Frames that wait for an AO bake draw only the panels; they are not counted.
+        explorer::FrameStats rendered(1e12);
+        for (int counted = 0; !app.should_close() && (options.frames == 0 || counted < options.frames);) {
+            app.step();
+            if (!app.ambient_occlusion_pending() && app.shown().valid) rendered.add(counted++, app.last_frame_ms());
+        }
         if (!options.screenshot.empty()) {
             app.request_screenshot(options.screenshot);
             app.step();
             std::cout << "wrote " << options.screenshot << "\n";
         }
-        const auto t = app.frame_times();
-        std::cout << "frame ms over the last second: min " << t.min_ms << " mean " << t.mean_ms
-                  << " max " << t.max_ms << " (" << t.frames << " frames, " << app.mesh().face_count()
-                  << " faces)\n";
+        const auto all = rendered.summary(), last = app.frame_times();
+        std::cout << "frame ms (" << window.width << "x" << window.height << ", " << app.mesh().face_count()
+                  << " faces, " << all.frames << " rendered frames): min " << all.min_ms << " mean "
+                  << all.mean_ms << " max " << all.max_ms << "; last second: min " << last.min_ms
+                  << " mean " << last.mean_ms << " max " << last.max_ms << "\n";
     } catch (const MeshError& e) {
         std::cerr << "lucent explore: --mesh " << e.what() << "\n";
         return kExitUsage;
-    } catch (const gl::ContextError& e) {
+    } catch (const std::exception& e) {  // no window (gl::ContextError), GL or I/O failure
         std::cerr << "lucent explore: " << e.what() << "\n";
         return kExitFailure;
     }

@@ -259,13 +259,9 @@ void Explorer::step() {
     }
     window_->swap();
     const double end = glfwGetTime();
-    stats_.add(end, (end - start) * 1000.0);
+    last_frame_ms_ = (end - start) * 1000.0;
+    stats_.add(end, last_frame_ms_);
     last_frame_end_ = end;
-}
-
-void run_explorer(Explorer& explorer, int max_frames) {
-    for (int frame = 0; !explorer.should_close() && (max_frames <= 0 || frame < max_frames); ++frame)
-        explorer.step();
 }
 
 }  // namespace lucent::explorer

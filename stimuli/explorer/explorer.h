@@ -49,7 +49,8 @@ public:
     // The latest frame of the edited set (the left one when side by side shows both).
     const RenderedSide& shown() const;
     bool ambient_occlusion_pending() const;
-    FrameTimeSummary frame_times() const { return stats_.summary(); }
+    FrameTimeSummary frame_times() const { return stats_.summary(); }  // the last second
+    double last_frame_ms() const { return last_frame_ms_; }
     // Where the last frame drew a widget (knob name or button label).
     std::optional<WidgetRect> widget(const std::string& id) const;
     // The size one set renders at: the framebuffer, or half its width side by side.
@@ -82,11 +83,9 @@ private:
     std::map<std::string, WidgetRect> widgets_;
     std::filesystem::path screenshot_;
     double last_frame_end_ = -1.0;
+    double last_frame_ms_ = 0.0;
     std::mt19937 light_motion_{20110601};
     glm::vec2 light_velocity_{0.f};
 };
-
-// Runs `explorer` until its window closes or `max_frames` frames (0: no limit) have run.
-void run_explorer(Explorer& explorer, int max_frames);
 
 }  // namespace lucent::explorer
