@@ -67,6 +67,8 @@ bool Explorer::should_close() const { return glfwWindowShouldClose(window_->glfw
 
 const RenderedSide& Explorer::shown() const { return view_->side(session_.side_by_side ? 0 : session_.edited); }
 
+const RenderedSide& Explorer::side(int index) const { return view_->side(index); }
+
 bool Explorer::ambient_occlusion_pending() const { return view_->bakes().busy(); }
 
 std::optional<WidgetRect> Explorer::widget(const std::string& id) const {

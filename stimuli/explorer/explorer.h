@@ -48,6 +48,7 @@ public:
     const Mesh& mesh() const { return *mesh_; }
     // The latest frame of the edited set (the left one when side by side shows both).
     const RenderedSide& shown() const;
+    const RenderedSide& side(int index) const;  // set A (0) or B (1), as last rendered
     bool ambient_occlusion_pending() const;
     FrameTimeSummary frame_times() const { return stats_.summary(); }  // the last second
     double last_frame_ms() const { return last_frame_ms_; }

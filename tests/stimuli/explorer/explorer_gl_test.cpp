@@ -160,6 +160,33 @@ TEST_F(ExplorerTest, DragsOnTheViewOrbitAndMoveTheLight) {
     EXPECT_NEAR(explorer->session().yaw_degrees, 20.f, 1e-3f);  // 50 px at 0.4 deg/px
 }
 
+// A/B: side by side renders both sets at half width each; the space bar (a key event
+// through the router) flips which set the panels edit.
+TEST_F(ExplorerTest, SideBySideShowsBothSetsAndSpaceFlips) {
+    ExplorerSession session;
+    session.sets[1].set("backlight", 0.0);
+    session.side_by_side = true;
+    auto explorer = open(session);
+    settle(*explorer);
+    const RenderedSide &a = explorer->side(0), &b = explorer->side(1);
+    ASSERT_TRUE(a.valid && b.valid);
+    EXPECT_EQ(a.image.width, 400);
+    EXPECT_EQ(b.image.width, 400);
+    double sum_a = 0.0, sum_b = 0.0;  // B lacks the backlight term, which only adds light
+    for (std::size_t i = 0; i < a.image.rgba.size(); ++i) {
+        if (i % 4 == 3) continue;
+        sum_a += a.image.rgba[i];
+        sum_b += b.image.rgba[i];
+    }
+    EXPECT_GT(sum_a, sum_b);
+    EXPECT_EQ(explorer->session().edited, 0);
+    explorer->input().enqueue(MouseMove{700.f, 100.f});  // over the view, not a panel
+    explorer->input().enqueue(Key{GLFW_KEY_SPACE, true});
+    explorer->input().enqueue(Key{GLFW_KEY_SPACE, false});
+    while (!explorer->input().script_done()) explorer->step();
+    EXPECT_EQ(explorer->session().edited, 1);
+}
+
 TEST_F(ExplorerTest, SaveImageEqualsLucentRender) {
     ExplorerSession session;
     session.current().apply({{"backlight", "1.6"}, {"thickness_exponent", "18"}, {"albedo", "0.5,0.6,0.7"},
@@ -180,6 +207,38 @@ TEST_F(ExplorerTest, SaveImageEqualsLucentRender) {
         max_diff = std::max(max_diff, std::abs(saved.rgba[i] - rendered.rgba[i]));
     EXPECT_EQ(max_diff, 0.f);
     EXPECT_GT(covered_pixels(saved), 0u);
+}
+
+// Developer mode: shaders are read again from LUCENT_SHADER_DIR. A shade.frag that ends
+// by writing a fixed colour must show that colour on every covered pixel after reload.
+TEST_F(ExplorerTest, ReloadShadersReadsEditedShadersFromDisk) {
+    auto explorer = open(ExplorerSession{});
+    const Image before = settle(*explorer);
+    const auto dir = test::scratch_dir("explorer_shaders");
+    const std::string relative = "techniques/empirical/shaders/shade.frag";
+    std::ifstream in(test::source_dir() / "renderer" / relative);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string source = text.str();
+    source.insert(source.rfind('}'), "    out_colour = vec4(0.25, 0.5, 0.75, 1.0);\n");
+    std::filesystem::create_directories((dir / relative).parent_path());
+    std::ofstream(dir / relative) << source;
+
+    setenv("LUCENT_SHADER_DIR", dir.c_str(), 1);
+    explorer->reload_shaders();
+    const Image edited = settle(*explorer);
+    unsetenv("LUCENT_SHADER_DIR");
+    ASSERT_GT(covered_pixels(edited), 0u);
+    for (std::size_t i = 0; i < edited.rgba.size(); i += 4) {
+        if (edited.rgba[i + 3] < 1.f) continue;
+        ASSERT_EQ(edited.rgba[i], 0.25f);
+        ASSERT_EQ(edited.rgba[i + 1], 0.5f);
+        ASSERT_EQ(edited.rgba[i + 2], 0.75f);
+    }
+    explorer->reload_shaders();  // back to the embedded shaders
+    const Image restored = settle(*explorer);
+    unsetenv("LUCENT_SHADER_DIR");  // reload_shaders() pointed it at the source tree
+    EXPECT_EQ(restored.rgba, before.rgba);
 }
 
 TEST_F(ExplorerTest, AddToStimulusSetButtonWritesAConfigLucentRenderRenders) {
