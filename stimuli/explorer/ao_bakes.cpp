@@ -9,7 +9,8 @@ AmbientOcclusionBakes::~AmbientOcclusionBakes() {
 }
 
 std::string AmbientOcclusionBakes::key(const Mesh& mesh, int rays) {
-    return mesh.content_hash + "/" + std::to_string(mesh.vertex_count()) + "/r" + std::to_string(rays);
+    return mesh.content_hash + "/" + std::to_string(mesh.vertex_count()) + "/r" +
+           std::to_string(rays);
 }
 
 std::string AmbientOcclusionBakes::error() const {
@@ -26,8 +27,8 @@ void AmbientOcclusionBakes::collect() {
     finished_.clear();
 }
 
-const std::vector<float>* AmbientOcclusionBakes::find_or_start(const std::shared_ptr<const Mesh>& mesh,
-                                                               int rays) {
+const std::vector<float>* AmbientOcclusionBakes::find_or_start(
+    const std::shared_ptr<const Mesh>& mesh, int rays) {
     collect();
     if (forget_ && !running_) {
         results_.clear();
@@ -52,11 +53,13 @@ const std::vector<float>* AmbientOcclusionBakes::find_or_start(const std::shared
         AoBakeOptions options;
         options.rays = rays;
         options.progress = [this](std::size_t done, std::size_t total) {
-            progress_ = total ? static_cast<float>(done) / static_cast<float>(total) : 1.f;
+            progress_ =
+                total ? static_cast<float>(done) / static_cast<float>(total) : 1.f;
         };
         try {
-            std::vector<float> ao = fresh ? bake_ambient_occlusion(*mesh, options)
-                                          : load_or_bake_ambient_occlusion(*mesh, options);
+            std::vector<float> ao = fresh
+                                        ? bake_ambient_occlusion(*mesh, options)
+                                        : load_or_bake_ambient_occlusion(*mesh, options);
             std::lock_guard lock(mutex_);
             finished_key_ = wanted;
             finished_ = std::move(ao);

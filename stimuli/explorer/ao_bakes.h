@@ -23,7 +23,8 @@ public:
 
     // The per-vertex AO of (mesh, rays) when ready; otherwise starts its bake (one at a
     // time) and returns nullptr.
-    const std::vector<float>* find_or_start(const std::shared_ptr<const Mesh>& mesh, int rays);
+    const std::vector<float>* find_or_start(const std::shared_ptr<const Mesh>& mesh,
+                                            int rays);
     // Drops every result and bakes again without the disk cache ("re-bake").
     void forget_all() { forget_ = true; }
     bool busy() const { return running_; }

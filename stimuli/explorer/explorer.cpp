@@ -26,12 +26,14 @@ namespace {
 ImVec2 project(const Camera& camera, glm::vec3 point, ImVec2 origin, ImVec2 size) {
     const glm::vec4 clip = camera.projection() * camera.view() * glm::vec4(point, 1.f);
     const float w = clip.w > 1e-6f ? clip.w : 1e-6f;
-    return {origin.x + (clip.x / w * 0.5f + 0.5f) * size.x, origin.y + (0.5f - clip.y / w * 0.5f) * size.y};
+    return {origin.x + (clip.x / w * 0.5f + 0.5f) * size.x,
+            origin.y + (0.5f - clip.y / w * 0.5f) * size.y};
 }
 
 }  // namespace
 
-Explorer::Explorer(ExplorerSession session, const ExplorerOptions& options) : session_(std::move(session)) {
+Explorer::Explorer(ExplorerSession session, const ExplorerOptions& options)
+    : session_(std::move(session)) {
     load_mesh(session_.mesh);
     ui::ImGuiWindowOptions window;
     window.window.width = options.width;
@@ -65,7 +67,9 @@ Explorer::~Explorer() {
 
 bool Explorer::should_close() const { return glfwWindowShouldClose(window_->glfw()); }
 
-const RenderedSide& Explorer::shown() const { return view_->side(session_.side_by_side ? 0 : session_.edited); }
+const RenderedSide& Explorer::shown() const {
+    return view_->side(session_.side_by_side ? 0 : session_.edited);
+}
 
 const RenderedSide& Explorer::side(int index) const { return view_->side(index); }
 
@@ -96,20 +100,22 @@ void Explorer::load_mesh(const std::string& spec) {
 
 void Explorer::save_image(const std::filesystem::path& path) {
     if (!is_supported_image_path(path))
-        throw std::invalid_argument("image file: '" + path.string() +
-                                    "' has an unsupported extension (accepted: .exr, .png, .tif)");
+        throw std::invalid_argument(
+            "image file: '" + path.string() +
+            "' has an unsupported extension (accepted: .exr, .png, .tif)");
     int width = 0, height = 0;
     view_size(width, height);
     // The path of `lucent render`: request -> build_scene -> render_image -> write_image.
     Scene scene = build_scene(render_request(session_, session_.edited, width, height));
     if (!session_.default_view())
-        scene = make_scene(scene.mesh, find_technique(scene.technique), scene.values, width, height,
-                           view_direction(session_));
+        scene = make_scene(scene.mesh, find_technique(scene.technique), scene.values,
+                           width, height, view_direction(session_));
     gl::FrameExecutor executor;  // its own: disk-cached AO as `lucent render` uses
     write_image(path, render_image(executor, scene));
 }
 
-std::string Explorer::add_to_stimulus_set(const std::filesystem::path& config, const std::string& id) {
+std::string Explorer::add_to_stimulus_set(const std::filesystem::path& config,
+                                          const std::string& id) {
     StimulusEntry entry;
     entry.id = id;
     entry.technique = session_.current().technique();
@@ -122,7 +128,8 @@ std::string Explorer::add_to_stimulus_set(const std::filesystem::path& config, c
 void Explorer::reload_shaders() {
 #ifdef LUCENT_RENDERER_SOURCE_DIR
     // Developer mode reads shaders from the source tree unless told otherwise.
-    if (!std::getenv("LUCENT_SHADER_DIR")) setenv("LUCENT_SHADER_DIR", LUCENT_RENDERER_SOURCE_DIR, 0);
+    if (!std::getenv("LUCENT_SHADER_DIR"))
+        setenv("LUCENT_SHADER_DIR", LUCENT_RENDERER_SOURCE_DIR, 0);
 #endif
     view_->reset_programs();
     const char* dir = std::getenv("LUCENT_SHADER_DIR");
@@ -131,12 +138,16 @@ void Explorer::reload_shaders() {
 
 void Explorer::animate(float seconds) {
     if (session_.auto_rotate)
-        session_.yaw_degrees = std::fmod(session_.yaw_degrees + session_.rotate_degrees_per_second * seconds, 360.f);
+        session_.yaw_degrees = std::fmod(
+            session_.yaw_degrees + session_.rotate_degrees_per_second * seconds, 360.f);
     if (session_.random_light_motion) {
-        // A damped random walk of the light's angular velocity (pixels of "drag" per second).
+        // A damped random walk of the light's angular velocity (pixels of "drag" per
+        // second).
         std::normal_distribution<float> kick(0.f, 40.f);
-        light_velocity_ = 0.9f * light_velocity_ + glm::vec2(kick(light_motion_), kick(light_motion_)) * seconds;
-        drag_light(session_, light_velocity_.x * seconds * 60.f, light_velocity_.y * seconds * 60.f);
+        light_velocity_ = 0.9f * light_velocity_ +
+                          glm::vec2(kick(light_motion_), kick(light_motion_)) * seconds;
+        drag_light(session_, light_velocity_.x * seconds * 60.f,
+                   light_velocity_.y * seconds * 60.f);
     }
 }
 
@@ -151,8 +162,10 @@ void Explorer::handle(const PanelRequests& requests) {
             session_.message = "saved " + session_.save_image_path;
         }
         if (requests.add_to_stimulus_set) {
-            const std::string id = add_to_stimulus_set(session_.stimulus_config, session_.stimulus_id);
-            session_.message = "added stimulus '" + id + "' to " + session_.stimulus_config;
+            const std::string id =
+                add_to_stimulus_set(session_.stimulus_config, session_.stimulus_id);
+            session_.message =
+                "added stimulus '" + id + "' to " + session_.stimulus_config;
         }
         if (requests.reload_shaders) reload_shaders();
         if (requests.rebake_ambient_occlusion) view_->bakes().forget_all();
@@ -186,31 +199,39 @@ void Explorer::draw_view() {
     for (int index : view_->shown()) {
         const RenderedSide& side = view_->side(index);
         if (!side.valid || !side.texture.id()) continue;
-        const ImVec2 origin(x, 0.f), size(float(side.texture_width), float(side.texture_height));
-        draw->AddImage(ui::imgui_texture(side.texture), origin, ImVec2(x + size.x, size.y));
+        const ImVec2 origin(x, 0.f),
+            size(float(side.texture_width), float(side.texture_height));
+        draw->AddImage(ui::imgui_texture(side.texture), origin,
+                       ImVec2(x + size.x, size.y));
         if (view_->shown().size() > 1)
-            draw->AddText(ImVec2(x + size.x - 40.f, 8.f), IM_COL32(255, 255, 255, 255), index == 0 ? "A" : "B");
+            draw->AddText(ImVec2(x + size.x - 40.f, 8.f), IM_COL32(255, 255, 255, 255),
+                          index == 0 ? "A" : "B");
         const Camera& camera = side.scene.camera;
         if (session_.show_axes) {
             const glm::vec3 c = side.scene.bounds.centre;
             const float r = side.scene.bounds.radius;
-            const ImU32 colours[3] = {IM_COL32(230, 60, 60, 255), IM_COL32(60, 200, 60, 255), IM_COL32(70, 110, 240, 255)};
+            const ImU32 colours[3] = {IM_COL32(230, 60, 60, 255),
+                                      IM_COL32(60, 200, 60, 255),
+                                      IM_COL32(70, 110, 240, 255)};
             for (int axis = 0; axis < 3; ++axis) {
                 glm::vec3 end = c;
                 end[axis] += r;
-                draw->AddLine(project(camera, c, origin, size), project(camera, end, origin, size), colours[axis], 2.f);
+                draw->AddLine(project(camera, c, origin, size),
+                              project(camera, end, origin, size), colours[axis], 2.f);
             }
         }
         if (session_.show_bounds) {
             for (int edge = 0; edge < 12; ++edge) {
-                // Edge `edge` runs along axis edge/4 between corners differing in that axis.
+                // Edge `edge` runs along axis edge/4 between corners differing in that
+                // axis.
                 const int axis = edge / 4, a = (axis + 1) % 3, b = (axis + 2) % 3;
                 glm::vec3 p = mesh_min_, q;
                 p[a] = (edge & 1) ? mesh_max_[a] : mesh_min_[a];
                 p[b] = (edge & 2) ? mesh_max_[b] : mesh_min_[b];
                 q = p;
                 q[axis] = mesh_max_[axis];
-                draw->AddLine(project(camera, p, origin, size), project(camera, q, origin, size),
+                draw->AddLine(project(camera, p, origin, size),
+                              project(camera, q, origin, size),
                               IM_COL32(255, 220, 90, 200), 1.f);
             }
         }
@@ -220,7 +241,8 @@ void Explorer::draw_view() {
 
 void Explorer::step() {
     const double start = glfwGetTime();
-    const float seconds = last_frame_end_ < 0.0 ? 0.f : static_cast<float>(start - last_frame_end_);
+    const float seconds =
+        last_frame_end_ < 0.0 ? 0.f : static_cast<float>(start - last_frame_end_);
     // ImGuiWindow::begin_frame(), split so the router's pointer state reaches ImGui
     // between the back end's NewFrame (which polls GLFW) and ImGui::NewFrame.
     glfwPollEvents();
@@ -237,7 +259,8 @@ void Explorer::step() {
     try {
         view_->render(session_, mesh_, width, height);
     } catch (const std::exception& e) {
-        session_.message = e.what();  // e.g. a shader that no longer compiles after reload
+        session_.message =
+            e.what();  // e.g. a shader that no longer compiles after reload
     }
     draw_view();
 
@@ -247,11 +270,14 @@ void Explorer::step() {
     glClear(GL_COLOR_BUFFER_BIT);
     window_->render_imgui();
     if (!screenshot_.empty()) {
-        const std::vector<std::uint8_t> pixels = gl::read_framebuffer_rgba8(width, height);
-        Image image(width, height);  // GL rows bottom first; the window's bytes, unchanged
+        const std::vector<std::uint8_t> pixels =
+            gl::read_framebuffer_rgba8(width, height);
+        Image image(width,
+                    height);  // GL rows bottom first; the window's bytes, unchanged
         for (int y = 0; y < height; ++y)
             for (int x = 0; x < width; ++x) {
-                const std::uint8_t* p = &pixels[(static_cast<std::size_t>(height - 1 - y) * width + x) * 4];
+                const std::uint8_t* p =
+                    &pixels[(static_cast<std::size_t>(height - 1 - y) * width + x) * 4];
                 image.set(x, y, glm::vec4(p[0], p[1], p[2], 255.f) / 255.f);
             }
         ImageWriteOptions linear;

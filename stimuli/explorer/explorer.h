@@ -61,7 +61,8 @@ public:
     // render_image and write_image, as `lucent render` does. Throws on failure.
     void save_image(const std::filesystem::path& path);
     // "Add to stimulus set": returns the id written (explorer/stimulus_entry.h).
-    std::string add_to_stimulus_set(const std::filesystem::path& config, const std::string& id);
+    std::string add_to_stimulus_set(const std::filesystem::path& config,
+                                    const std::string& id);
     void load_mesh(const std::string& spec);  // MeshError: the old mesh stays
     void reload_shaders();
     // Writes the window's pixels (panels included) as PNG at the end of the next step().

@@ -6,7 +6,8 @@ namespace lucent::explorer {
 
 void FrameStats::add(double end_seconds, double ms) {
     frames_.push_back({end_seconds, ms});
-    while (frames_.size() > 1 && frames_.front().end_seconds <= end_seconds - window_seconds_)
+    while (frames_.size() > 1 &&
+           frames_.front().end_seconds <= end_seconds - window_seconds_)
         frames_.pop_front();
 }
 

@@ -19,7 +19,9 @@ public:
     FrameTimeSummary summary() const;
 
 private:
-    struct Frame { double end_seconds, ms; };
+    struct Frame {
+        double end_seconds, ms;
+    };
     double window_seconds_;
     std::deque<Frame> frames_;
 };

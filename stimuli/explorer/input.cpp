@@ -16,7 +16,8 @@ InputRouter* router_of(GLFWwindow* window) {
 
 }  // namespace
 
-InputRouter::InputRouter(GLFWwindow* window, ViewInput view) : window_(window), view_(std::move(view)) {
+InputRouter::InputRouter(GLFWwindow* window, ViewInput view)
+    : window_(window), view_(std::move(view)) {
     glfwSetWindowUserPointer(window, this);
     // Replaces the back end's callbacks: dispatch() forwards to them itself.
     glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
@@ -31,7 +32,8 @@ InputRouter::InputRouter(GLFWwindow* window, ViewInput view) : window_(window), 
     glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
         if (action != GLFW_REPEAT) router_of(w)->dispatch(Key{key, action == GLFW_PRESS});
     });
-    glfwSetCharCallback(window, [](GLFWwindow* w, unsigned c) { router_of(w)->dispatch(Character{c}); });
+    glfwSetCharCallback(
+        window, [](GLFWwindow* w, unsigned c) { router_of(w)->dispatch(Character{c}); });
 }
 
 InputRouter::~InputRouter() {
@@ -46,7 +48,8 @@ InputRouter::~InputRouter() {
 void InputRouter::dispatch(const InputEvent& event) {
     const ImGuiIO& io = ImGui::GetIO();
     if (const auto* move = std::get_if<MouseMove>(&event)) {
-        const float dx = x_ < 0.f ? 0.f : move->x - x_, dy = y_ < 0.f ? 0.f : move->y - y_;
+        const float dx = x_ < 0.f ? 0.f : move->x - x_,
+                    dy = y_ < 0.f ? 0.f : move->y - y_;
         x_ = move->x;
         y_ = move->y;
         if (view_drag_[0] && view_.orbit) view_.orbit(dx, dy);
@@ -61,8 +64,10 @@ void InputRouter::dispatch(const InputEvent& event) {
         ImGui_ImplGlfw_ScrollCallback(window_, 0.0, scroll->dy);
         if (!io.WantCaptureMouse && view_.zoom) view_.zoom(scroll->dy);
     } else if (const auto* key = std::get_if<Key>(&event)) {
-        ImGui_ImplGlfw_KeyCallback(window_, key->glfw_key, 0, key->pressed ? GLFW_PRESS : GLFW_RELEASE, 0);
-        if (key->pressed && !io.WantCaptureKeyboard && view_.key) view_.key(key->glfw_key);
+        ImGui_ImplGlfw_KeyCallback(window_, key->glfw_key, 0,
+                                   key->pressed ? GLFW_PRESS : GLFW_RELEASE, 0);
+        if (key->pressed && !io.WantCaptureKeyboard && view_.key)
+            view_.key(key->glfw_key);
     } else if (const auto* character = std::get_if<Character>(&event)) {
         ImGui_ImplGlfw_CharCallback(window_, character->codepoint);
     }
@@ -76,8 +81,10 @@ void InputRouter::run_script_step() {
     if (script_.empty()) return;
     const InputEvent event = script_.front();
     script_.pop_front();
-    if (const auto* wait = std::get_if<WaitFrames>(&event)) wait_frames_ = wait->frames - 1;
-    else dispatch(event);
+    if (const auto* wait = std::get_if<WaitFrames>(&event))
+        wait_frames_ = wait->frames - 1;
+    else
+        dispatch(event);
 }
 
 void InputRouter::update_imgui_pointer() {

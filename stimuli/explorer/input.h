@@ -12,20 +12,35 @@ struct GLFWwindow;
 
 namespace lucent::explorer {
 
-struct MouseMove { float x = 0, y = 0; };          // window coordinates, pixels
-struct MouseButton { int button = 0; bool pressed = false; };  // 0 left, 1 right
-struct Scroll { float dy = 0; };                    // wheel notches
-struct Key { int glfw_key = 0; bool pressed = false; };
-struct Character { unsigned codepoint = 0; };
-struct WaitFrames { int frames = 1; };              // script only: let frames pass
-using InputEvent = std::variant<MouseMove, MouseButton, Scroll, Key, Character, WaitFrames>;
+struct MouseMove {
+    float x = 0, y = 0;
+};  // window coordinates, pixels
+struct MouseButton {
+    int button = 0;
+    bool pressed = false;
+};  // 0 left, 1 right
+struct Scroll {
+    float dy = 0;
+};  // wheel notches
+struct Key {
+    int glfw_key = 0;
+    bool pressed = false;
+};
+struct Character {
+    unsigned codepoint = 0;
+};
+struct WaitFrames {
+    int frames = 1;
+};  // script only: let frames pass
+using InputEvent =
+    std::variant<MouseMove, MouseButton, Scroll, Key, Character, WaitFrames>;
 
 // What the view receives when ImGui does not want the event.
 struct ViewInput {
     std::function<void(float dx, float dy)> orbit;       // left drag
     std::function<void(float dx, float dy)> move_light;  // right drag
     std::function<void(float notches)> zoom;             // wheel
-    std::function<void(int glfw_key)> key;               // key press (not typing in ImGui)
+    std::function<void(int glfw_key)> key;  // key press (not typing in ImGui)
 };
 
 class InputRouter {

@@ -25,7 +25,7 @@ struct PanelInfo {
     std::size_t faces = 0, vertices = 0;
     float near_plane = 0, far_plane = 0;
     FrameTimeSummary frame_times;
-    const FramePlan* plan = nullptr;          // of the edited set's latest frame
+    const FramePlan* plan = nullptr;  // of the edited set's latest frame
     const gl::FrameTimings* timings = nullptr;
     bool baking = false;
     float bake_progress = 0;

@@ -1,9 +1,8 @@
 #include "explorer/session.h"
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "core/common_knobs.h"
 #include "stimulus_set.h"
@@ -20,14 +19,19 @@ void ParameterSet::set_technique(const std::string& name) {
         values_by_technique_[technique_] = resolve_knob_values(knobs_for(technique), {});
 }
 
-const KnobValues& ParameterSet::values() const { return values_by_technique_.at(technique_); }
+const KnobValues& ParameterSet::values() const {
+    return values_by_technique_.at(technique_);
+}
 
 void ParameterSet::set(const std::string& name, const KnobValue& value) {
     const std::vector<Knob> knobs = knobs_for(find_technique(technique_));
     const Knob* knob = find_knob(knobs, name);
-    if (!knob) throw KnobError(name + ": not a parameter of technique '" + technique_ + "'");
-    // Through text, as a config or --set would pass it: identical values, identical pixels.
-    values_by_technique_[technique_].set(name, parse_knob_value(*knob, format_knob_value(value)));
+    if (!knob)
+        throw KnobError(name + ": not a parameter of technique '" + technique_ + "'");
+    // Through text, as a config or --set would pass it: identical values, identical
+    // pixels.
+    values_by_technique_[technique_].set(
+        name, parse_knob_value(*knob, format_knob_value(value)));
 }
 
 void ParameterSet::apply(const std::vector<KnobAssignment>& assignments) {
@@ -35,7 +39,9 @@ void ParameterSet::apply(const std::vector<KnobAssignment>& assignments) {
     KnobValues updated = values();
     for (const auto& a : assignments) {
         const Knob* knob = find_knob(knobs, a.key);
-        if (!knob) throw KnobError(a.key + ": not a parameter of technique '" + technique_ + "'");
+        if (!knob)
+            throw KnobError(a.key + ": not a parameter of technique '" + technique_ +
+                            "'");
         updated.set(a.key, parse_knob_value(*knob, a.text));
     }
     values_by_technique_[technique_] = std::move(updated);
@@ -50,11 +56,16 @@ std::vector<KnobAssignment> ParameterSet::assignments() const {
 
 const char* buffer_view_name(BufferView view) {
     switch (view) {
-        case BufferView::shaded: return "shaded image";
-        case BufferView::front_depth: return "front depth";
-        case BufferView::second_layer: return "second layer depth";
-        case BufferView::smoothed_thickness: return "smoothed second layer";
-        case BufferView::ambient_occlusion: return "ambient occlusion";
+        case BufferView::shaded:
+            return "shaded image";
+        case BufferView::front_depth:
+            return "front depth";
+        case BufferView::second_layer:
+            return "second layer depth";
+        case BufferView::smoothed_thickness:
+            return "smoothed second layer";
+        case BufferView::ambient_occlusion:
+            return "ambient occlusion";
     }
     return "shaded image";
 }
@@ -62,12 +73,14 @@ const char* buffer_view_name(BufferView view) {
 glm::vec3 view_direction(const ExplorerSession& session) {
     const float yaw = glm::radians(session.yaw_degrees);
     const float pitch = glm::radians(session.pitch_degrees);
-    return {std::sin(yaw) * std::cos(pitch), std::sin(pitch), std::cos(yaw) * std::cos(pitch)};
+    return {std::sin(yaw) * std::cos(pitch), std::sin(pitch),
+            std::cos(yaw) * std::cos(pitch)};
 }
 
 void orbit(ExplorerSession& session, float dx_pixels, float dy_pixels) {
     constexpr float kDegreesPerPixel = 0.4f;
-    session.yaw_degrees = std::fmod(session.yaw_degrees - dx_pixels * kDegreesPerPixel, 360.f);
+    session.yaw_degrees =
+        std::fmod(session.yaw_degrees - dx_pixels * kDegreesPerPixel, 360.f);
     session.pitch_degrees =
         std::clamp(session.pitch_degrees + dy_pixels * kDegreesPerPixel, -89.f, 89.f);
 }
@@ -76,8 +89,10 @@ void drag_light(ExplorerSession& session, float dx_pixels, float dy_pixels) {
     constexpr float kRadiansPerPixel = 0.01f;
     ParameterSet& set = session.current();
     glm::vec3 direction = glm::normalize(glm::vec3(set.values().vec3("light_direction")));
-    // Eye space: dragging right turns the light about Y towards +X, dragging down about X.
-    glm::mat4 turn = glm::rotate(glm::mat4(1.f), dx_pixels * kRadiansPerPixel, {0.f, 1.f, 0.f});
+    // Eye space: dragging right turns the light about Y towards +X, dragging down about
+    // X.
+    glm::mat4 turn =
+        glm::rotate(glm::mat4(1.f), dx_pixels * kRadiansPerPixel, {0.f, 1.f, 0.f});
     turn = glm::rotate(turn, dy_pixels * kRadiansPerPixel, {1.f, 0.f, 0.f});
     direction = glm::normalize(glm::vec3(turn * glm::vec4(direction, 0.f)));
     set.set("light_direction", glm::dvec3(direction));
@@ -91,7 +106,8 @@ void zoom(ExplorerSession& session, float notches) {
     set.set("fov_y", std::clamp(value, fov->min, fov->max));
 }
 
-RenderRequest render_request(const ExplorerSession& session, int side, int width, int height) {
+RenderRequest render_request(const ExplorerSession& session, int side, int width,
+                             int height) {
     RenderRequest request;
     request.mesh = session.mesh;
     request.technique = session.sets[side].technique();
@@ -104,7 +120,8 @@ RenderRequest render_request(const ExplorerSession& session, int side, int width
 KnobGroup knob_group(const Knob& knob) {
     if (knob.name == "fov_y") return KnobGroup::camera;
     if (find_knob(scene_knobs(), knob.name)) return KnobGroup::light;
-    for (const Knob& material : {albedo_knob(), ambient_knob(), specular_knob(), shininess_knob()})
+    for (const Knob& material :
+         {albedo_knob(), ambient_knob(), specular_knob(), shininess_knob()})
         if (material.name == knob.name) return KnobGroup::material;
     if (knob.name == ao_rays_knob().name) return KnobGroup::ambient_occlusion;
     return KnobGroup::technique;
@@ -115,13 +132,16 @@ KnobGroup knob_group(const Knob& knob) {
 namespace lucent::explorer {
 
 ExplorerSession session_from_config(const std::string& config_path) {
-    const stimuli::StimulusSet set = stimuli::load_stimulus_set(config_path, stimuli::default_catalog());
-    const stimuli::Stimulus& first = set.stimuli.front();  // the loader rejects empty sets
+    const stimuli::StimulusSet set =
+        stimuli::load_stimulus_set(config_path, stimuli::default_catalog());
+    const stimuli::Stimulus& first =
+        set.stimuli.front();  // the loader rejects empty sets
     ExplorerSession session;
     session.mesh = first.mesh_spec;
     for (ParameterSet& parameters : session.sets) {
         parameters.set_technique(first.technique);
-        for (const auto& [name, value] : first.parameters.all()) parameters.set(name, value);
+        for (const auto& [name, value] : first.parameters.all())
+            parameters.set(name, value);
     }
     session.stimulus_config = config_path;
     session.stimulus_id = first.id + "_explored";

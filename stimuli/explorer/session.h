@@ -5,7 +5,6 @@
 // window. Parameters are knob values of the technique registry; nothing here lists the
 // parameters of a particular technique.
 #include <glm/glm.hpp>
-
 #include <map>
 #include <string>
 #include <vector>
@@ -40,7 +39,13 @@ private:
 };
 
 // Debug views of intermediate results instead of the shaded image.
-enum class BufferView { shaded, front_depth, second_layer, smoothed_thickness, ambient_occlusion };
+enum class BufferView {
+    shaded,
+    front_depth,
+    second_layer,
+    smoothed_thickness,
+    ambient_occlusion
+};
 const char* buffer_view_name(BufferView view);
 
 struct ExplorerSession {
@@ -85,7 +90,8 @@ void drag_light(ExplorerSession& session, float dx_pixels, float dy_pixels);
 void zoom(ExplorerSession& session, float notches);
 
 // What `lucent render` needs to make the same image as set `side` at width x height.
-RenderRequest render_request(const ExplorerSession& session, int side, int width, int height);
+RenderRequest render_request(const ExplorerSession& session, int side, int width,
+                             int height);
 
 // The panel a knob belongs to: scene knobs by their group, shared material knobs,
 // ao_rays under AO, and everything else under the technique.

@@ -31,7 +31,8 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
     }
     std::error_code error;
     std::filesystem::rename(temporary, path, error);
-    if (error) throw std::runtime_error(path.string() + ": cannot replace: " + error.message());
+    if (error)
+        throw std::runtime_error(path.string() + ": cannot replace: " + error.message());
 }
 
 std::string quoted(const std::string& text) {
@@ -45,7 +46,8 @@ std::string quoted(const std::string& text) {
 
 // A knob value as TOML: numbers, [a, b, c] arrays, strings for choices.
 std::string toml_value(const KnobValue& value) {
-    if (std::holds_alternative<std::string>(value)) return quoted(std::get<std::string>(value));
+    if (std::holds_alternative<std::string>(value))
+        return quoted(std::get<std::string>(value));
     std::string text = format_knob_value(value);
     if (!std::holds_alternative<glm::dvec3>(value)) return text;
     std::string array = "[";
@@ -77,7 +79,8 @@ std::string new_mesh_key(const toml::table& root, const std::string& spec) {
     for (char c : stem) key += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
     const auto* meshes = root["meshes"].as_table();
     std::string unique = key;
-    for (int n = 2; meshes && meshes->contains(unique); ++n) unique = key + "_" + std::to_string(n);
+    for (int n = 2; meshes && meshes->contains(unique); ++n)
+        unique = key + "_" + std::to_string(n);
     return unique;
 }
 
@@ -95,7 +98,8 @@ std::string stimulus_table_text(const StimulusEntry& entry, const std::string& i
     return out.str();
 }
 
-std::string append_stimulus(const std::filesystem::path& config, const StimulusEntry& entry) {
+std::string append_stimulus(const std::filesystem::path& config,
+                            const StimulusEntry& entry) {
     const stimuli::SetCatalog catalog = stimuli::default_catalog();
     std::error_code error;
     const bool exists = std::filesystem::exists(config, error);
@@ -117,28 +121,37 @@ std::string append_stimulus(const std::filesystem::path& config, const StimulusE
             const auto* stimuli = root["stimuli"].as_array();
             if (meshes && meshes->size() == 1 && stimuli)
                 for (const auto& node : *stimuli)
-                    if (const auto* table = node.as_table(); table && !table->contains("mesh"))
+                    if (const auto* table = node.as_table();
+                        table && !table->contains("mesh"))
                         throw stimuli::StimulusSetError(
-                            config.string() + ":" + std::to_string(table->source().begin.line) +
-                            ": mesh: adding mesh '" + entry.mesh + "' would leave this stimulus "
-                            "without one (name its mesh, or explore the config's own mesh)");
+                            config.string() + ":" +
+                            std::to_string(table->source().begin.line) +
+                            ": mesh: adding mesh '" + entry.mesh +
+                            "' would leave this stimulus "
+                            "without one (name its mesh, or explore the config's own "
+                            "mesh)");
             // A new mesh goes on the line after the [meshes] header.
             mesh_key = new_mesh_key(root, entry.mesh);
             std::smatch header;
             const std::regex meshes_header(R"((^|\n)[ \t]*\[meshes\][ \t]*(#[^\n]*)?\n)");
             if (!std::regex_search(text, header, meshes_header))
-                throw stimuli::StimulusSetError(config.string() +
-                                                ": meshes: no [meshes] table to add mesh '" +
-                                                entry.mesh + "' to");
-            const auto at = static_cast<std::size_t>(header.position(0) + header.length(0));
-            text.insert(at, mesh_key + " = " + quoted(entry.mesh) + "  # added by lucent explore\n");
+                throw stimuli::StimulusSetError(
+                    config.string() + ": meshes: no [meshes] table to add mesh '" +
+                    entry.mesh + "' to");
+            const auto at =
+                static_cast<std::size_t>(header.position(0) + header.length(0));
+            text.insert(at, mesh_key + " = " + quoted(entry.mesh) +
+                                "  # added by lucent explore\n");
         }
     } else {
         mesh_key = "explore_mesh";
-        text = "# Stimulus set started by lucent explore (format: stimuli/README.md).\n"
-               "name = \"explore\"\n"
-               "resolution = [" + std::to_string(entry.width) + ", " + std::to_string(entry.height) +
-               "]\nformats = [\"png\"]\n\n[meshes]\n" + mesh_key + " = " + quoted(entry.mesh) + "\n";
+        text =
+            "# Stimulus set started by lucent explore (format: stimuli/README.md).\n"
+            "name = \"explore\"\n"
+            "resolution = [" +
+            std::to_string(entry.width) + ", " + std::to_string(entry.height) +
+            "]\nformats = [\"png\"]\n\n[meshes]\n" + mesh_key + " = " +
+            quoted(entry.mesh) + "\n";
     }
     std::string id = entry.id;
     for (int n = 2; ids.count(id); ++n) id = entry.id + "_" + std::to_string(n);
@@ -149,8 +162,10 @@ std::string append_stimulus(const std::filesystem::path& config, const StimulusE
         stimuli::load_stimulus_set(config, catalog);
     } catch (...) {
         // Roll back: the file is exactly as before (or gone, when we created it).
-        if (exists) write_text(config, original);
-        else std::filesystem::remove(config, error);
+        if (exists)
+            write_text(config, original);
+        else
+            std::filesystem::remove(config, error);
         throw;
     }
     return id;

@@ -14,16 +14,17 @@ namespace lucent::explorer {
 struct StimulusEntry {
     std::string id = "explore";  // made unique in the set by a _2, _3, ... suffix
     std::string technique;
-    std::string mesh;            // built-in spec or file path
-    KnobValues values;           // every knob of the technique
-    int width = 512;             // resolution written when the file is created
+    std::string mesh;   // built-in spec or file path
+    KnobValues values;  // every knob of the technique
+    int width = 512;    // resolution written when the file is created
     int height = 512;
 };
 
 // Appends `entry` to `config` (created when missing); returns the id written. Throws
 // stimuli::StimulusSetError (the existing file or the result does not parse; the file is
 // left as it was) or std::runtime_error (I/O).
-std::string append_stimulus(const std::filesystem::path& config, const StimulusEntry& entry);
+std::string append_stimulus(const std::filesystem::path& config,
+                            const StimulusEntry& entry);
 
 // The [[stimuli]] table text for `entry` under `id` and mesh key `mesh_key`.
 std::string stimulus_table_text(const StimulusEntry& entry, const std::string& id,

@@ -20,12 +20,12 @@ namespace lucent::explorer {
 
 // One parameter set's latest frame.
 struct RenderedSide {
-    bool valid = false;          // false until the first frame (e.g. while AO bakes)
-    Scene scene;                 // its camera places overlays
+    bool valid = false;  // false until the first frame (e.g. while AO bakes)
+    Scene scene;         // its camera places overlays
     FramePlan plan;
-    Image image;                 // linear float, as `lucent render` writes it
-    gl::FrameTimings timings;    // per pass, when the session asks for them
-    gl::Texture texture;         // what is displayed (shaded image or buffer view), sRGB 8-bit
+    Image image;               // linear float, as `lucent render` writes it
+    gl::FrameTimings timings;  // per pass, when the session asks for them
+    gl::Texture texture;  // what is displayed (shaded image or buffer view), sRGB 8-bit
     int texture_width = 0, texture_height = 0;
 };
 
@@ -51,8 +51,9 @@ private:
     // Executes `scene`; false when its AO is still baking.
     bool execute(gl::FrameExecutor& executor, const Scene& scene, const FramePlan& plan,
                  bool ambient_occlusion, bool time_passes);
-    void render_side(const ExplorerSession& session, const std::shared_ptr<const Mesh>& mesh,
-                     int index, int width, int height);
+    void render_side(const ExplorerSession& session,
+                     const std::shared_ptr<const Mesh>& mesh, int index, int width,
+                     int height);
 
     std::map<std::string, std::unique_ptr<gl::FrameExecutor>> executors_;
     AmbientOcclusionBakes bakes_;

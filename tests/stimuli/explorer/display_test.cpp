@@ -24,16 +24,16 @@ TEST(Display, ShadedImageIsClampedSrgbWithOpaqueAlpha) {
     EXPECT_EQ(bytes[4], 0);  // NaN never reaches the screen
     EXPECT_EQ(bytes[5], 255);
     EXPECT_EQ(bytes[6], 0);
-    EXPECT_EQ(bytes[8], 10);  // 12.92 * 0.0031308 * 255 = 10.3 (linear segment)
+    EXPECT_EQ(bytes[8], 10);         // 12.92 * 0.0031308 * 255 = 10.3 (linear segment)
     EXPECT_NEAR(bytes[9], 124, 1);   // 0.2 -> 0.4845
     EXPECT_NEAR(bytes[10], 231, 1);  // 0.8 -> 0.9063
 }
 
 TEST(Display, DepthIsGreyNearBrightFarDarkBackgroundBlack) {
     const auto bytes = depth_for_display({1.f, 0.2f, 0.6f, 0.4f});
-    EXPECT_EQ(bytes[0], 0);                                   // background
-    EXPECT_EQ(bytes[4], 255);                                 // nearest
-    EXPECT_EQ(bytes[8], static_cast<int>(std::lround(0.15 * 255)));   // farthest
+    EXPECT_EQ(bytes[0], 0);                                            // background
+    EXPECT_EQ(bytes[4], 255);                                          // nearest
+    EXPECT_EQ(bytes[8], static_cast<int>(std::lround(0.15 * 255)));    // farthest
     EXPECT_EQ(bytes[12], static_cast<int>(std::lround(0.575 * 255)));  // halfway
     EXPECT_EQ(bytes[12], bytes[13]);
     EXPECT_EQ(bytes[15], 255);

@@ -2,8 +2,6 @@
 // events travel the same input path as real ones and change parameters with the
 // expected effect on the image, "Save image" equals `lucent render` bit for bit, and
 // "Add to stimulus set" writes a config `lucent render` renders. Skips without DISPLAY.
-#include "explorer/explorer.h"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -11,6 +9,8 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+
+#include "explorer/explorer.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -26,10 +26,12 @@ constexpr const char* kMesh = "torus_knot:4k";
 class ExplorerTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!std::getenv("DISPLAY")) GTEST_SKIP() << "no X display (scripts/test runs ctest under xvfb-run)";
+        if (!std::getenv("DISPLAY"))
+            GTEST_SKIP() << "no X display (scripts/test runs ctest under xvfb-run)";
     }
 
-    std::unique_ptr<Explorer> open(ExplorerSession session, int width = 800, int height = 560) {
+    std::unique_ptr<Explorer> open(ExplorerSession session, int width = 800,
+                                   int height = 560) {
         session.mesh = kMesh;
         ExplorerOptions options;
         options.width = width;
@@ -40,7 +42,8 @@ protected:
     // Steps until the shown set has a frame rendered with the current parameters (the
     // first frames may wait for the AO bake).
     static const Image& settle(Explorer& explorer) {
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+        const auto deadline =
+            std::chrono::steady_clock::now() + std::chrono::seconds(120);
         do {
             explorer.step();
         } while ((explorer.ambient_occlusion_pending() || !explorer.shown().valid) &&
@@ -69,8 +72,9 @@ int run(const std::string& command) {
 
 std::string render_command(const RenderRequest& request, const std::string& out) {
     std::ostringstream command;
-    command << LUCENT_EXECUTABLE << " render --mesh " << request.mesh << " --technique " << request.technique
-            << " --size " << request.width << "x" << request.height << " --out " << out;
+    command << LUCENT_EXECUTABLE << " render --mesh " << request.mesh << " --technique "
+            << request.technique << " --size " << request.width << "x" << request.height
+            << " --out " << out;
     for (const auto& s : request.settings) command << " --set " << s.key << "=" << s.text;
     return command.str() + " > /dev/null";
 }
@@ -89,12 +93,14 @@ TEST_F(ExplorerTest, StartsRendersFramesAndSavesAScreenshot) {
     EXPECT_EQ(image.width, width);
     EXPECT_EQ(image.height, height);
     const std::size_t covered = covered_pixels(image);
-    EXPECT_GT(covered, image.rgba.size() / 4 / 20);  // the knot fills a good part of the view
-    EXPECT_LT(covered, image.rgba.size() / 4);       // and background remains
+    EXPECT_GT(covered,
+              image.rgba.size() / 4 / 20);      // the knot fills a good part of the view
+    EXPECT_LT(covered, image.rgba.size() / 4);  // and background remains
     EXPECT_GT(explorer->frame_times().frames, 0);
     EXPECT_FALSE(explorer->shown().plan.passes.empty());
 
-    const auto path = test::binary_dir() / "test-output" / "explorer" / "explorer_window.png";
+    const auto path =
+        test::binary_dir() / "test-output" / "explorer" / "explorer_window.png";
     std::filesystem::create_directories(path.parent_path());
     explorer->session().show_axes = explorer->session().show_bounds = true;
     explorer->request_screenshot(path);
@@ -130,7 +136,8 @@ TEST_F(ExplorerTest, ScriptedSliderClickRaisesBacklightAndBrightensThinParts) {
         if (i % 4 == 3) continue;
         const double thickness_term = (half.rgba[i] - unlit.rgba[i]) / 0.5;  // T
         const double expected = unlit.rgba[i] + wb * thickness_term;
-        ASSERT_NEAR(raised.rgba[i], expected, 1e-4 + 1e-4 * std::abs(expected)) << "value " << i;
+        ASSERT_NEAR(raised.rgba[i], expected, 1e-4 + 1e-4 * std::abs(expected))
+            << "value " << i;
         EXPECT_GE(thickness_term, -1e-5);
         brighter += raised.rgba[i] > half.rgba[i] + 1e-3f;
         gain_sum += raised.rgba[i] - half.rgba[i];
@@ -142,7 +149,8 @@ TEST_F(ExplorerTest, ScriptedSliderClickRaisesBacklightAndBrightensThinParts) {
 TEST_F(ExplorerTest, DragsOnTheViewOrbitAndMoveTheLight) {
     auto explorer = open(ExplorerSession{});
     settle(*explorer);
-    const glm::dvec3 light = explorer->session().current().values().vec3("light_direction");
+    const glm::dvec3 light =
+        explorer->session().current().values().vec3("light_direction");
     InputRouter& input = explorer->input();
     // Right-drag to the right in the view (right of the panel): the light turns to +x.
     input.enqueue(MouseMove{700.f, 200.f});
@@ -155,7 +163,8 @@ TEST_F(ExplorerTest, DragsOnTheViewOrbitAndMoveTheLight) {
     input.enqueue(MouseMove{650.f, 300.f});
     input.enqueue(MouseButton{0, false});
     while (!input.script_done()) explorer->step();
-    const glm::dvec3 moved = explorer->session().current().values().vec3("light_direction");
+    const glm::dvec3 moved =
+        explorer->session().current().values().vec3("light_direction");
     EXPECT_GT(moved.x / glm::length(moved), light.x / glm::length(light) + 0.05);
     EXPECT_NEAR(explorer->session().yaw_degrees, 20.f, 1e-3f);  // 50 px at 0.4 deg/px
 }
@@ -189,7 +198,9 @@ TEST_F(ExplorerTest, SideBySideShowsBothSetsAndSpaceFlips) {
 
 TEST_F(ExplorerTest, SaveImageEqualsLucentRender) {
     ExplorerSession session;
-    session.current().apply({{"backlight", "1.6"}, {"thickness_exponent", "18"}, {"albedo", "0.5,0.6,0.7"},
+    session.current().apply({{"backlight", "1.6"},
+                             {"thickness_exponent", "18"},
+                             {"albedo", "0.5,0.6,0.7"},
                              {"blur_kernel", "3"}});
     auto explorer = open(session, 520, 400);
     settle(*explorer);
@@ -197,9 +208,11 @@ TEST_F(ExplorerTest, SaveImageEqualsLucentRender) {
     explorer->save_image(dir / "explorer.exr");
     int width = 0, height = 0;
     explorer->view_size(width, height);
-    const RenderRequest request = render_request(explorer->session(), explorer->session().edited, width, height);
+    const RenderRequest request =
+        render_request(explorer->session(), explorer->session().edited, width, height);
     ASSERT_EQ(run(render_command(request, (dir / "render.exr").string())), 0);
-    const Image saved = read_image(dir / "explorer.exr"), rendered = read_image(dir / "render.exr");
+    const Image saved = read_image(dir / "explorer.exr"),
+                rendered = read_image(dir / "render.exr");
     ASSERT_EQ(saved.width, rendered.width);
     ASSERT_EQ(saved.height, rendered.height);
     float max_diff = 0.f;
@@ -244,9 +257,12 @@ TEST_F(ExplorerTest, ReloadShadersReadsEditedShadersFromDisk) {
 TEST_F(ExplorerTest, AddToStimulusSetButtonWritesAConfigLucentRenderRenders) {
     const auto dir = test::scratch_dir("explorer_add");
     const auto config = dir / "set.toml";
-    std::ofstream(config) << "# kept comment\nname = \"t\"\nresolution = [64, 48]\nformats = [\"exr\"]\n"
-                             "[meshes]\nknot = \"" << kMesh << "\"\n[[stimuli]]\nid = \"base\"\n"
-                             "technique = \"ward\"\n";
+    std::ofstream(config)
+        << "# kept comment\nname = \"t\"\nresolution = [64, 48]\nformats = [\"exr\"]\n"
+           "[meshes]\nknot = \""
+        << kMesh
+        << "\"\n[[stimuli]]\nid = \"base\"\n"
+           "technique = \"ward\"\n";
     ExplorerSession session;
     session.stimulus_config = config.string();
     session.stimulus_id = "from_explorer";
@@ -256,17 +272,20 @@ TEST_F(ExplorerTest, AddToStimulusSetButtonWritesAConfigLucentRenderRenders) {
     const auto button = explorer->widget("Add to stimulus set");
     ASSERT_TRUE(button) << "button not drawn";
     click(*explorer, 0.5f * (button->x0 + button->x1), 0.5f * (button->y0 + button->y1));
-    EXPECT_NE(explorer->session().message.find("from_explorer"), std::string::npos) << explorer->session().message;
+    EXPECT_NE(explorer->session().message.find("from_explorer"), std::string::npos)
+        << explorer->session().message;
 
-    ASSERT_EQ(run(std::string(LUCENT_EXECUTABLE) + " render " + config.string() + " --out " +
-                  (dir / "out").string() + " > /dev/null 2>&1"),
+    ASSERT_EQ(run(std::string(LUCENT_EXECUTABLE) + " render " + config.string() +
+                  " --out " + (dir / "out").string() + " > /dev/null 2>&1"),
               0);
     ASSERT_TRUE(std::filesystem::exists(dir / "out" / "from_explorer.exr"));
     // The set's stimulus is the explorer's parameters at the set's size: `lucent render
     // --mesh` with the same request gives the same pixels.
-    const RenderRequest request = render_request(explorer->session(), explorer->session().edited, 64, 48);
+    const RenderRequest request =
+        render_request(explorer->session(), explorer->session().edited, 64, 48);
     ASSERT_EQ(run(render_command(request, (dir / "single.exr").string())), 0);
-    const Image a = read_image(dir / "out" / "from_explorer.exr"), b = read_image(dir / "single.exr");
+    const Image a = read_image(dir / "out" / "from_explorer.exr"),
+                b = read_image(dir / "single.exr");
     ASSERT_EQ(a.rgba.size(), b.rgba.size());
     for (std::size_t i = 0; i < a.rgba.size(); ++i) ASSERT_EQ(a.rgba[i], b.rgba[i]) << i;
 }

@@ -60,7 +60,8 @@ TEST(KnobGroups, EveryKnobOfEveryTechniqueLandsInOnePanel) {
         for (const Knob& knob : knobs_for(*technique)) {
             const bool scene_knob = find_knob(scene_knobs(), knob.name) != nullptr;
             const KnobGroup group = knob_group(knob);
-            EXPECT_EQ(scene_knob, group == KnobGroup::light || group == KnobGroup::camera) << knob.name;
+            EXPECT_EQ(scene_knob, group == KnobGroup::light || group == KnobGroup::camera)
+                << knob.name;
         }
     }
     EXPECT_EQ(knob_group(*find_knob(scene_knobs(), "fov_y")), KnobGroup::camera);
@@ -105,9 +106,11 @@ TEST(View, ZoomScalesFovAndStaysInItsRange) {
     zoom(session, 1.f);
     EXPECT_NEAR(session.current().values().scalar("fov_y"), fov * 0.95, 1e-6);
     zoom(session, 1000.f);
-    EXPECT_EQ(session.current().values().scalar("fov_y"), find_knob(scene_knobs(), "fov_y")->min);
+    EXPECT_EQ(session.current().values().scalar("fov_y"),
+              find_knob(scene_knobs(), "fov_y")->min);
     zoom(session, -100000.f);
-    EXPECT_EQ(session.current().values().scalar("fov_y"), find_knob(scene_knobs(), "fov_y")->max);
+    EXPECT_EQ(session.current().values().scalar("fov_y"),
+              find_knob(scene_knobs(), "fov_y")->max);
 }
 
 }  // namespace

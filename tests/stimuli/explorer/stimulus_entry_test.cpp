@@ -1,6 +1,7 @@
 // "Add to stimulus set" without a window: the entry is appended with the file's text and
 // comments kept, the stimulus-set loader reads back exactly the explorer's values, a new
-// mesh is added under [meshes], and a result that does not load leaves the file as it was.
+// mesh is added under [meshes], and a result that does not load leaves the file as it
+// was.
 #include "explorer/stimulus_entry.h"
 
 #include <gtest/gtest.h>
@@ -45,9 +46,10 @@ StimulusEntry entry_for(const std::string& technique, const std::string& mesh) {
     entry.id = "explored";
     entry.technique = technique;
     entry.mesh = mesh;
-    entry.values = resolve_knob_values(knobs_for(find_technique(technique)),
-                                       std::vector<KnobAssignment>{{"albedo", "0.25,0.5,0.75"},
-                                                                   {"light_direction", "-0.3,0.8,0.5"}});
+    entry.values = resolve_knob_values(
+        knobs_for(find_technique(technique)),
+        std::vector<KnobAssignment>{{"albedo", "0.25,0.5,0.75"},
+                                    {"light_direction", "-0.3,0.8,0.5"}});
     return entry;
 }
 
@@ -65,7 +67,8 @@ TEST(AppendStimulus, KeepsTheFileAndReadsBackTheExactValues) {
     entry.values.set("blur_kernel", std::string("3"));
     EXPECT_EQ(append_stimulus(config, entry), "explored");
     const std::string text = read(config);
-    EXPECT_EQ(text.substr(0, std::string(kConfig).size()), kConfig);  // nothing above changed
+    EXPECT_EQ(text.substr(0, std::string(kConfig).size()),
+              kConfig);  // nothing above changed
     const auto set = stimuli::load_stimulus_set(config, stimuli::default_catalog());
     ASSERT_EQ(set.stimuli.size(), 2u);
     const auto& added = find(set, "explored");
@@ -99,7 +102,8 @@ TEST(AppendStimulus, RefusesANewMeshThatWouldMakeOtherEntriesAmbiguous) {
         append_stimulus(config, entry_for("ward", "sphere:2k"));
         FAIL() << "expected an error";
     } catch (const stimuli::StimulusSetError& e) {
-        EXPECT_NE(std::string(e.what()).find("set.toml:9: mesh:"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("set.toml:9: mesh:"), std::string::npos)
+            << e.what();
     }
     EXPECT_EQ(read(config), kConfig);
 }
@@ -130,7 +134,8 @@ TEST(AppendStimulus, RefusesAnInvalidConfigWithoutTouchingIt) {
     const auto config = test::scratch_dir("explorer_append_invalid") / "set.toml";
     const std::string broken = std::string(kConfig) + "unknown_key = 1\n";
     write(config, broken);
-    EXPECT_THROW(append_stimulus(config, entry_for("empirical", "torus_knot:4k")), stimuli::StimulusSetError);
+    EXPECT_THROW(append_stimulus(config, entry_for("empirical", "torus_knot:4k")),
+                 stimuli::StimulusSetError);
     EXPECT_EQ(read(config), broken);
 }
 
