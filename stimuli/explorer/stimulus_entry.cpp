@@ -2,8 +2,8 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <fstream>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -84,6 +84,24 @@ std::string new_mesh_key(const toml::table& root, const std::string& spec) {
     return unique;
 }
 
+// The offset just past the line holding the `[meshes]` header (optionally followed by a
+// comment), or npos. `text` ends with a newline.
+std::size_t after_meshes_header(const std::string& text) {
+    for (std::size_t start = 0; start < text.size();) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        std::string_view line(text.data() + start, end - start);
+        line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
+        if (line.rfind("[meshes]", 0) == 0) {
+            line.remove_prefix(8);
+            line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
+            if (line.empty() || line.front() == '#')
+                return std::min(end + 1, text.size());
+        }
+        start = end + 1;
+    }
+    return std::string::npos;
+}
+
 }  // namespace
 
 std::string stimulus_table_text(const StimulusEntry& entry, const std::string& id,
@@ -132,14 +150,11 @@ std::string append_stimulus(const std::filesystem::path& config,
                             "mesh)");
             // A new mesh goes on the line after the [meshes] header.
             mesh_key = new_mesh_key(root, entry.mesh);
-            std::smatch header;
-            const std::regex meshes_header(R"((^|\n)[ \t]*\[meshes\][ \t]*(#[^\n]*)?\n)");
-            if (!std::regex_search(text, header, meshes_header))
+            const std::size_t at = after_meshes_header(text);
+            if (at == std::string::npos)
                 throw stimuli::StimulusSetError(
                     config.string() + ": meshes: no [meshes] table to add mesh '" +
                     entry.mesh + "' to");
-            const auto at =
-                static_cast<std::size_t>(header.position(0) + header.length(0));
             text.insert(at, mesh_key + " = " + quoted(entry.mesh) +
                                 "  # added by lucent explore\n");
         }
