@@ -1,0 +1,201 @@
+#include "explorer/view_renderer.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/technique.h"
+#include "techniques/registry.h"
+
+namespace lucent::explorer {
+namespace {
+
+// The frame resources each depth view shows (names from the empirical technique's plan).
+const char* buffer_resource(BufferView view) {
+    switch (view) {
+        case BufferView::front_depth:
+            return "front_depth";
+        case BufferView::second_layer:
+            return "second_depth";
+        case BufferView::smoothed_thickness:
+            return "smoothed_depth";
+        default:
+            return "";
+    }
+}
+
+// The AO view: the empirical technique lit by ambient light only with unit reflectance,
+// so Eq. 3.6 reduces to a * 1 * 1 * 1 = a, through the same passes as any frame.
+Scene ambient_occlusion_scene(const Scene& shown, const std::shared_ptr<const Mesh>& mesh,
+                              glm::vec3 view_direction) {
+    const Technique& empirical = find_technique("empirical");
+    KnobValues values = resolve_knob_values(
+        knobs_for(empirical), std::vector<KnobAssignment>{{"light_ambient", "1"},
+                                                          {"light_diffuse", "0"},
+                                                          {"light_specular", "0"},
+                                                          {"ambient", "1"},
+                                                          {"albedo", "1"},
+                                                          {"backlight", "0"}});
+    if (shown.values.contains("ao_rays"))
+        values.set("ao_rays", shown.values.get("ao_rays"));
+    values.set("fov_y", shown.values.get("fov_y"));
+    return make_scene(mesh, empirical, std::move(values), shown.width, shown.height,
+                      view_direction);
+}
+
+void upload(RenderedSide& side, const std::vector<std::uint8_t>& rgba, int width,
+            int height) {
+    if (side.texture_width != width || side.texture_height != height ||
+        !side.texture.id()) {
+        side.texture = gl::make_texture_2d(GL_RGBA8, width, height);
+        side.texture_width = width;
+        side.texture_height = height;
+    }
+    glTextureSubImage2D(side.texture.id(), 0, 0, 0, width, height, GL_RGBA,
+                        GL_UNSIGNED_BYTE, rgba.data());
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_for_display(const Image& image) {
+    static const std::array<std::uint8_t, 4096> table = [] {
+        std::array<std::uint8_t, 4096> t{};
+        for (std::size_t i = 0; i < t.size(); ++i)
+            t[i] = static_cast<std::uint8_t>(
+                std::lround(srgb_encode(float(i) / 4095.f) * 255.f));
+        return t;
+    }();
+    std::vector<std::uint8_t> out(image.rgba.size());
+    for (std::size_t i = 0; i < image.rgba.size(); ++i) {
+        const float v = image.rgba[i];
+        const float clamped = v > 0.f ? (v < 1.f ? v : 1.f) : 0.f;  // NaN -> 0
+        out[i] =
+            (i % 4 == 3) ? 255 : table[static_cast<std::size_t>(clamped * 4095.f + 0.5f)];
+    }
+    return out;
+}
+
+std::vector<std::uint8_t> depth_for_display(const std::vector<float>& depth) {
+    float near = 1.f, far = 0.f;
+    for (float d : depth)
+        if (d < 1.f) near = std::min(near, d), far = std::max(far, d);
+    const float span = far > near ? far - near : 1.f;
+    std::vector<std::uint8_t> out(depth.size() * 4, 255);
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        const float d = depth[i];
+        const float grey = d < 1.f ? 1.f - 0.85f * (d - near) / span : 0.f;
+        const auto g =
+            static_cast<std::uint8_t>(std::lround(std::clamp(grey, 0.f, 1.f) * 255.f));
+        out[i * 4] = out[i * 4 + 1] = out[i * 4 + 2] = g;
+    }
+    return out;
+}
+
+gl::FrameExecutor& ViewRenderer::executor(const std::string& key,
+                                          bool ambient_occlusion) {
+    const std::string full = key + (ambient_occlusion ? "" : "/no-ao");
+    auto& slot = executors_[full];
+    if (!slot) {
+        slot = std::make_unique<gl::FrameExecutor>();
+        if (ambient_occlusion)
+            // Only executed once find_or_start() returned the bake (see execute()).
+            slot->set_ambient_occlusion_source([this](const Mesh& mesh, int rays) {
+                for (const auto& side : sides_)
+                    if (side.scene.mesh &&
+                        side.scene.mesh->content_hash == mesh.content_hash)
+                        if (const auto* ao = bakes_.find_or_start(side.scene.mesh, rays))
+                            return *ao;
+                throw std::runtime_error(
+                    "ambient occlusion requested before its bake finished");
+            });
+        else
+            slot->set_ambient_occlusion_source([](const Mesh& mesh, int) {
+                return std::vector<float>(mesh.vertex_count(), 1.f);
+            });
+    }
+    return *slot;
+}
+
+bool ViewRenderer::execute(gl::FrameExecutor& executor, const Scene& scene,
+                           const FramePlan& plan, bool ambient_occlusion,
+                           bool time_passes) {
+    if (ambient_occlusion)
+        for (const Pass& pass : plan.passes)
+            if (pass.kind == PassKind::bake_ambient_occlusion &&
+                !bakes_.find_or_start(scene.mesh, pass.ao_rays))
+                return false;
+    executor.execute(scene, plan, time_passes);
+    return true;
+}
+
+void ViewRenderer::render_side(const ExplorerSession& session,
+                               const std::shared_ptr<const Mesh>& mesh, int index,
+                               int width, int height) {
+    RenderedSide& side = sides_[index];
+    const ParameterSet& set = session.sets[index];
+    const Technique& technique = find_technique(set.technique());
+    Scene scene =
+        make_scene(mesh, technique, set.values(), width, height, view_direction(session));
+    FramePlan plan = make_frame_plan(scene, technique);
+    // The scene is published first: the AO source looks the mesh up through it.
+    const Scene previous = std::move(side.scene);
+    side.scene = scene;
+    const std::string key = "side" + std::to_string(index);
+    gl::FrameExecutor& shading = executor(key, session.ambient_occlusion);
+    if (!execute(shading, scene, plan, session.ambient_occlusion,
+                 session.show_pass_times)) {
+        if (side.valid) side.scene = previous;  // keep showing the last complete frame
+        return;
+    }
+    side.image = shading.read_output(plan);
+    replace_non_finite(side.image);
+    side.timings = shading.last_timings();
+    side.plan = std::move(plan);
+    side.valid = true;
+
+    switch (session.buffer_view) {
+        case BufferView::shaded:
+            upload(side, encode_for_display(side.image), width, height);
+            break;
+        case BufferView::ambient_occlusion: {
+            const Scene ao_scene =
+                ambient_occlusion_scene(scene, mesh, view_direction(session));
+            const FramePlan ao_plan =
+                make_frame_plan(ao_scene, find_technique("empirical"));
+            gl::FrameExecutor& ao = executor(key + "/ao-view", true);
+            if (execute(ao, ao_scene, ao_plan, true, false)) {
+                Image image = ao.read_output(ao_plan);
+                replace_non_finite(image);
+                upload(side, encode_for_display(image), width, height);
+            }
+            break;
+        }
+        default: {
+            const std::string resource = buffer_resource(session.buffer_view);
+            const auto allocated = shading.allocated_resources();
+            if (std::find(allocated.begin(), allocated.end(), resource) ==
+                allocated.end()) {
+                buffer_message_ = std::string(buffer_view_name(session.buffer_view)) +
+                                  " is not in the current frame plan";
+                upload(side, encode_for_display(side.image), width, height);
+            } else {
+                upload(side, depth_for_display(shading.read_channel(resource)), width,
+                       height);
+            }
+        }
+    }
+}
+
+void ViewRenderer::render(const ExplorerSession& session,
+                          const std::shared_ptr<const Mesh>& mesh, int width,
+                          int height) {
+    buffer_message_.clear();
+    shown_ =
+        session.side_by_side ? std::vector<int>{0, 1} : std::vector<int>{session.edited};
+    const int each = session.side_by_side ? std::max(1, width / 2) : width;
+    for (int index : shown_) render_side(session, mesh, index, each, std::max(1, height));
+}
+
+}  // namespace lucent::explorer

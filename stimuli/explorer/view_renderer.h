@@ -1,0 +1,70 @@
+#pragma once
+// Renders what an explorer session shows: the edited parameter set, or sets A and B side
+// by side, each through the same scene -> frame plan -> FrameExecutor path as
+// `lucent render`, or a debug view of an intermediate buffer. Results are uploaded to
+// 8-bit sRGB textures for display. Needs the window's GL context to be current.
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/frame_plan.h"
+#include "core/image.h"
+#include "core/scene.h"
+#include "explorer/ao_bakes.h"
+#include "explorer/session.h"
+#include "gl/frame_executor.h"
+#include "gl/objects.h"
+
+namespace lucent::explorer {
+
+// One parameter set's latest frame.
+struct RenderedSide {
+    bool valid = false;  // false until the first frame (e.g. while AO bakes)
+    Scene scene;         // its camera places overlays
+    FramePlan plan;
+    Image image;               // linear float, as `lucent render` writes it
+    gl::FrameTimings timings;  // per pass, when the session asks for them
+    gl::Texture texture;  // what is displayed (shaded image or buffer view), sRGB 8-bit
+    int texture_width = 0, texture_height = 0;
+};
+
+class ViewRenderer {
+public:
+    ViewRenderer() = default;
+    // Renders the shown sets at width x height pixels in all (side by side: half each).
+    // A set whose AO is still baking keeps its previous frame.
+    void render(const ExplorerSession& session, const std::shared_ptr<const Mesh>& mesh,
+                int width, int height);
+    // The sets shown, in screen order (one, or A then B).
+    const std::vector<int>& shown() const { return shown_; }
+    const RenderedSide& side(int index) const { return sides_[index]; }
+    AmbientOcclusionBakes& bakes() { return bakes_; }
+    // Why the buffer view shows nothing (the buffer is not in the plan), else "".
+    const std::string& buffer_message() const { return buffer_message_; }
+    // Drops compiled programs and GPU resources: shaders compile again, read from
+    // LUCENT_SHADER_DIR when it is set.
+    void reset_programs() { executors_.clear(); }
+
+private:
+    gl::FrameExecutor& executor(const std::string& key, bool ambient_occlusion);
+    // Executes `scene`; false when its AO is still baking.
+    bool execute(gl::FrameExecutor& executor, const Scene& scene, const FramePlan& plan,
+                 bool ambient_occlusion, bool time_passes);
+    void render_side(const ExplorerSession& session,
+                     const std::shared_ptr<const Mesh>& mesh, int index, int width,
+                     int height);
+
+    std::map<std::string, std::unique_ptr<gl::FrameExecutor>> executors_;
+    AmbientOcclusionBakes bakes_;
+    RenderedSide sides_[2];
+    std::vector<int> shown_;
+    std::string buffer_message_;
+};
+
+// Linear float RGBA -> 8-bit sRGB RGBA for display (a 4096-entry table of srgb_encode).
+std::vector<std::uint8_t> encode_for_display(const Image& image);
+// A single-channel depth buffer as grey: near bright, far dark, background (1) black.
+std::vector<std::uint8_t> depth_for_display(const std::vector<float>& depth);
+
+}  // namespace lucent::explorer
