@@ -4,10 +4,9 @@
 // smoothing (Eq. C.1) and lighting (Eq. 3.6) run in double precision.
 #include <algorithm>
 #include <cmath>
-#include <glm/gtc/matrix_inverse.hpp>
-#include <thread>
 
 #include "core/ambient_occlusion.h"
+#include "cpu/pixel_rays.h"
 #include "cpu/ray_caster.h"
 #include "techniques/empirical/empirical.h"
 
@@ -30,27 +29,11 @@ double power(double x, double e) {
     return x <= 0.0 ? 0.0 : std::pow(x, e);
 }
 
-template <typename Function>
-void parallel_rows(int height, Function&& row) {
-    const int threads = std::max(1u, std::thread::hardware_concurrency());
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t)
-        pool.emplace_back([&, t] {
-            for (int y = t; y < height; y += threads) row(y);
-        });
-    for (auto& thread : pool) thread.join();
-}
-
 Layers cast_layers(const Scene& scene, const std::vector<float>& vertex_ao) {
     const Mesh& mesh = *scene.mesh;
     const int w = scene.width, h = scene.height;
     const double n = scene.camera.near_plane, f = scene.camera.far_plane;
-    const glm::dmat4 view = scene.camera.view();
-    const glm::dmat4 inverse_view_projection =
-        glm::inverse(glm::dmat4(scene.camera.projection()) * view);
-    const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(view));
-    const glm::dvec3 eye = scene.camera.eye;
-    const glm::dvec3 forward = glm::normalize(glm::dvec3(scene.camera.target) - eye);
+    const PixelRays rays(scene.camera, w, h);
     const double epsilon = 1e-6;  // the thesis's; the reference has exact depths
     const RayCaster caster(mesh);
 
@@ -65,37 +48,23 @@ Layers cast_layers(const Scene& scene, const std::vector<float>& vertex_ao) {
     layers.second.assign(count, kNoLayer);
     layers.normal.assign(count, glm::dvec3(0.0));
     layers.ao.assign(count, 0.0);
-    parallel_rows(h, [&](int row) {
-        const int gl_y = h - 1 - row;  // image rows are top first, GL's bottom first
+    for_each_row_parallel(h, [&](int row) {
         for (int x = 0; x < w; ++x) {
-            // Ray through the pixel centre, from the eye (un-projected far point).
-            const glm::dvec2 ndc((x + 0.5) / w * 2.0 - 1.0, (gl_y + 0.5) / h * 2.0 - 1.0);
-            const glm::dvec4 far_point =
-                inverse_view_projection * glm::dvec4(ndc, 1.0, 1.0);
-            const glm::dvec3 direction =
-                glm::normalize(glm::dvec3(far_point) / far_point.w - eye);
-            const double cos_forward = glm::dot(direction, forward);
-            const auto hits = caster.hits(glm::vec3(eye), glm::vec3(direction), 8);
+            const glm::dvec3 direction = rays.direction(x, row);
+            const auto hits = caster.hits(glm::vec3(rays.eye()), glm::vec3(direction), 8);
             const std::size_t i = static_cast<std::size_t>(row) * w + x;
             bool have_front = false;
             for (const RayHit& hit : hits) {
-                const double z = hit.distance * cos_forward;
+                const double z = rays.eye_depth(hit.distance, direction);
                 if (z < n || z > f) continue;  // clipped by the near/far planes
                 const double d = window_depth(z);
                 if (d >= 1.0) continue;  // fails the depth test against the clear
                 if (!have_front) {
                     have_front = true;
                     layers.front[i] = d;
-                    const glm::uvec3 tri = mesh.triangles[hit.triangle];
-                    const double u = hit.barycentric.x, v = hit.barycentric.y;
-                    const glm::dvec3 object_normal =
-                        (1.0 - u - v) * glm::dvec3(mesh.normals[tri.x]) +
-                        u * glm::dvec3(mesh.normals[tri.y]) +
-                        v * glm::dvec3(mesh.normals[tri.z]);
-                    layers.normal[i] = normal_matrix * object_normal;
-                    if (!vertex_ao.empty())
-                        layers.ao[i] = (1.0 - u - v) * vertex_ao[tri.x] +
-                                       u * vertex_ao[tri.y] + v * vertex_ao[tri.z];
+                    const SurfaceSample surface = interpolate_at(mesh, hit, vertex_ao);
+                    layers.normal[i] = rays.normal_matrix() * surface.normal;
+                    layers.ao[i] = surface.ao;
                 } else if (d > layers.front[i] + epsilon) {
                     layers.second[i] = d;  // App. B: nearest depth behind front + epsilon
                     break;

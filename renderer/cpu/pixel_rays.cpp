@@ -1,0 +1,48 @@
+#include "cpu/pixel_rays.h"
+
+#include <algorithm>
+#include <glm/gtc/matrix_inverse.hpp>
+#include <thread>
+
+namespace lucent {
+
+PixelRays::PixelRays(const Camera& camera, int width, int height)
+    : width_(width),
+      height_(height),
+      eye_(camera.eye),
+      forward_(glm::normalize(glm::dvec3(camera.target) - glm::dvec3(camera.eye))),
+      view_(camera.view()),
+      inverse_view_projection_(glm::inverse(glm::dmat4(camera.projection()) * view_)),
+      normal_matrix_(glm::inverseTranspose(glm::dmat3(view_))) {}
+
+glm::dvec3 PixelRays::direction(int x, int row) const {
+    const int gl_y = height_ - 1 - row;  // image rows are top first, GL's bottom first
+    // Un-project the pixel centre's far-plane point and aim at it from the eye.
+    const glm::dvec2 ndc((x + 0.5) / width_ * 2.0 - 1.0, (gl_y + 0.5) / height_ * 2.0 - 1.0);
+    const glm::dvec4 far_point = inverse_view_projection_ * glm::dvec4(ndc, 1.0, 1.0);
+    return glm::normalize(glm::dvec3(far_point) / far_point.w - eye_);
+}
+
+SurfaceSample interpolate_at(const Mesh& mesh, const RayHit& hit,
+                             const std::vector<float>& vertex_ao) {
+    const glm::uvec3 tri = mesh.triangles[hit.triangle];
+    const double u = hit.barycentric.x, v = hit.barycentric.y, t = 1.0 - u - v;
+    SurfaceSample sample;
+    sample.normal = t * glm::dvec3(mesh.normals[tri.x]) + u * glm::dvec3(mesh.normals[tri.y]) +
+                    v * glm::dvec3(mesh.normals[tri.z]);
+    if (!vertex_ao.empty())
+        sample.ao = t * vertex_ao[tri.x] + u * vertex_ao[tri.y] + v * vertex_ao[tri.z];
+    return sample;
+}
+
+void for_each_row_parallel(int height, const std::function<void(int)>& row) {
+    const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t)
+        pool.emplace_back([&, t] {
+            for (int y = t; y < height; y += threads) row(y);
+        });
+    for (auto& thread : pool) thread.join();
+}
+
+}  // namespace lucent

@@ -1,0 +1,52 @@
+#pragma once
+// What every CPU reference renderer needs to sample a scene as the GL rasteriser does:
+// one ray per pixel centre through the scene's camera (image rows top first), the
+// eye-space depth of a hit, vertex attributes interpolated at a hit, and rows rendered
+// in parallel.
+#include <glm/glm.hpp>
+
+#include <functional>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/mesh.h"
+#include "cpu/ray_caster.h"
+
+namespace lucent {
+
+class PixelRays {
+public:
+    PixelRays(const Camera& camera, int width, int height);
+
+    glm::dvec3 eye() const { return eye_; }
+    const glm::dmat4& view() const { return view_; }
+    // Object space -> eye space for normals (inverse transpose of the view).
+    const glm::dmat3& normal_matrix() const { return normal_matrix_; }
+    // Unit direction from the eye through the centre of pixel (x, row); row 0 is the top.
+    glm::dvec3 direction(int x, int row) const;
+    // Eye-space depth (distance along the viewing axis) of a point `distance` along a
+    // ray with unit `direction`: what the near/far planes and the depth buffer compare.
+    double eye_depth(double distance, glm::dvec3 direction) const {
+        return distance * glm::dot(direction, forward_);
+    }
+
+private:
+    int width_, height_;
+    glm::dvec3 eye_, forward_;
+    glm::dmat4 view_, inverse_view_projection_;
+    glm::dmat3 normal_matrix_;
+};
+
+// Vertex normal (object space, not normalised) and AO interpolated at a hit with the
+// barycentric weights the rasteriser uses; AO is 0 when `vertex_ao` is empty.
+struct SurfaceSample {
+    glm::dvec3 normal{0.0};
+    double ao = 0.0;
+};
+SurfaceSample interpolate_at(const Mesh& mesh, const RayHit& hit,
+                             const std::vector<float>& vertex_ao);
+
+// Calls `row(y)` for every y in [0, height), spread over the hardware threads.
+void for_each_row_parallel(int height, const std::function<void(int)>& row);
+
+}  // namespace lucent
