@@ -131,7 +131,7 @@ void Explorer::reload_shaders() {
     if (!std::getenv("LUCENT_SHADER_DIR"))
         setenv("LUCENT_SHADER_DIR", LUCENT_RENDERER_SOURCE_DIR, 0);
 #endif
-    view_->reset_programs();
+    view_->drop_executors();
     const char* dir = std::getenv("LUCENT_SHADER_DIR");
     session_.message = std::string("shaders reloaded from ") + (dir ? dir : "the binary");
 }
@@ -168,7 +168,10 @@ void Explorer::handle(const PanelRequests& requests) {
                 "added stimulus '" + id + "' to " + session_.stimulus_config;
         }
         if (requests.reload_shaders) reload_shaders();
-        if (requests.rebake_ambient_occlusion) view_->bakes().forget_all();
+        if (requests.rebake_ambient_occlusion) {
+            view_->bakes().forget_all();
+            view_->drop_executors();  // executors keep AO streams; fetch the new bake
+        }
     } catch (const std::exception& e) {
         session_.message = e.what();
     }

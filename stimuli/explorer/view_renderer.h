@@ -42,9 +42,9 @@ public:
     AmbientOcclusionBakes& bakes() { return bakes_; }
     // Why the buffer view shows nothing (the buffer is not in the plan), else "".
     const std::string& buffer_message() const { return buffer_message_; }
-    // Drops compiled programs and GPU resources: shaders compile again, read from
-    // LUCENT_SHADER_DIR when it is set.
-    void reset_programs() { executors_.clear(); }
+    // Drops every executor: shaders compile again (read from LUCENT_SHADER_DIR when it
+    // is set) and AO streams are fetched again from the bakes.
+    void drop_executors() { executors_.clear(); }
 
 private:
     gl::FrameExecutor& executor(const std::string& key, bool ambient_occlusion);
