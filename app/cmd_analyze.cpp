@@ -1,5 +1,5 @@
 // lucent analyze: one-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch reports with plots
-// from a long CSV of ratings (participant,stimulus,factor,level,question,rating).
+// from a study database or a long CSV of ratings (participant,stimulus,factor,level,question,rating).
 #include <iostream>
 
 #include "analyze.h"
@@ -50,7 +50,7 @@ void register_analyze(CLI::App& app, int& exit_code) {
     auto* cmd = app.add_subcommand(
         "analyze",
         "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
-        "with plots, from a long CSV of ratings");
+        "with plots, from a study database or a long CSV of ratings");
     cmd->add_option("input", args->input,
                     "Study database, or long CSV: participant,stimulus,factor,level,question,rating")
         ->required();

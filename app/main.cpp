@@ -5,6 +5,14 @@
 #include "commands.h"
 #include "lucent/version.h"
 
+namespace {
+bool is_subcommand(CLI::App& app, const std::string& name) {
+    for (const auto* sub : app.get_subcommands({}))
+        if (sub->get_name() == name) return true;
+    return false;
+}
+}  // namespace
+
 int main(int argc, char** argv) {
     using namespace lucent::app;
     CLI::App app{"Lucent: stimuli, participant sessions and analysis for perceptual studies "
@@ -29,7 +37,7 @@ int main(int argc, char** argv) {
     register_bench(app, exit_code);
 
     // CLI11 would only say "A subcommand is required"; name the word it did not know.
-    if (argc > 1 && argv[1][0] != '-' && [&] { try { app.get_subcommand(argv[1]); return false; } catch (const CLI::OptionNotFound&) { return true; } }()) {
+    if (argc > 1 && argv[1][0] != '-' && !is_subcommand(app, argv[1])) {
         std::string valid;
         for (const auto* sub : app.get_subcommands({}))
             valid += (valid.empty() ? "" : ", ") + sub->get_name();
