@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "gl_test_fixture.h"
+#include "scene_for_test.h"
 #include "image_statistics.h"
 #include "render.h"
 
@@ -14,12 +15,8 @@ class RmsContrastTest : public test::HeadlessGlTest {};
 ImageStatistics statistics_of(gl::FrameExecutor& executor, const std::string& mesh,
                               const std::string& technique,
                               std::vector<KnobAssignment> settings) {
-    RenderRequest request;
-    request.mesh = mesh;
-    request.technique = technique;
-    request.settings = std::move(settings);
-    request.width = request.height = 128;
-    const Image image = render_image(executor, build_scene(request));
+    const Image image =
+        render_image(executor, test::scene_for(technique, std::move(settings), mesh, 128));
     return compute_image_statistics(
         FloatImageView{image.width, image.height, 4, image.rgba});
 }

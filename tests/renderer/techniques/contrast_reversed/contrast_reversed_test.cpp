@@ -6,6 +6,7 @@
 
 #include "core/technique.h"
 #include "gl_test_fixture.h"
+#include "scene_for_test.h"
 #include "render.h"
 #include "techniques/registry.h"
 #include "techniques/ward/ward.h"
@@ -15,12 +16,7 @@ namespace {
 
 Scene scene_for(const std::string& technique, std::vector<KnobAssignment> settings,
                 const std::string& mesh = "sphere:2k", int size = 64) {
-    RenderRequest request;
-    request.mesh = mesh;
-    request.technique = technique;
-    request.settings = std::move(settings);
-    request.width = request.height = size;
-    return build_scene(request);
+    return test::scene_for(technique, std::move(settings), mesh, size);
 }
 
 TEST(ContrastReversedShading, ReversesLuminanceAndKeepsHue) {
