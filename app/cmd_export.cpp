@@ -26,8 +26,12 @@ int export_command(const std::string& db, const std::string& format, const std::
             for (const std::string& p : table.excluded_participants)
                 std::cerr << "lucent export: excluded " << p << "\n";
         } else {
+            std::vector<std::string> notes;  // on stderr: the CSV stays plain for readers
             rows = study::export_csv(db, format == "long" ? study::ExportFormat::Long
-                                                          : study::ExportFormat::Wide, out);
+                                                          : study::ExportFormat::Wide,
+                                     out, &notes);
+            for (const std::string& note : notes)
+                std::cerr << "lucent export: note: " << note << "\n";
         }
         out.close();
         if (!out) throw study::StoreError(out_path + ": write failed");

@@ -68,35 +68,61 @@ std::string csv_cell(const std::string& value) {
     return out + "\"";
 }
 
-int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out) {
+int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out,
+               std::vector<std::string>* notes) {
     Database db = open_read_only(db_path);
     const auto params = stimulus_parameters(db);
+    const auto resolved = read_resolved_stimuli(db);
     std::set<std::string> names;
     for (const auto& [stimulus, values] : params)
         for (const auto& [name, value] : values) names.insert(name);
+    for (const auto& [stimulus, r] : resolved)
+        for (const auto& [name, value] : r.values) names.insert(name);
     const auto failed = catch_failures(db);
     int rows = 0;
 
     if (format == ExportFormat::Long) {
         out << "participant,session,trial_position,block,stimulus,technique,mesh";
         for (const std::string& n : names) out << "," << csv_cell(n);
+        out << ",mesh_hash,stimulus_source,image_file,image_hash,renderer_version,"
+               "renderer_build";
         out << ",question,rating,rt_ms,changes,practice,catch,expected_rating,catch_passed\n";
+        // What the trial's segment showed (schema 3); NULL for older ratings.
+        const bool has_provenance = db.scalar_int("PRAGMA user_version") >= 3;
         Statement s = db.prepare(
-            "SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, st.technique, "
-            "st.mesh, r.question, r.rating, r.rt_ms, r.changes, t.practice, t.catch, "
-            "t.expected_rating, coalesce(t.tolerance, 0) FROM responses r "
+            std::string("SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, "
+                        "st.technique, st.mesh, r.question, r.rating, r.rt_ms, r.changes, "
+                        "t.practice, t.catch, t.expected_rating, coalesce(t.tolerance, 0), ") +
+            (has_provenance ? "shown.source, shown.file, shown.content_hash, "
+                              "shown.software_version, shown.build_hash "
+                            : "NULL, NULL, NULL, NULL, NULL ") +
+            "FROM responses r "
             "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
             "JOIN participants p ON p.id = se.participant_id "
-            "JOIN stimuli st ON st.id = t.stimulus_id "
+            "JOIN stimuli st ON st.id = t.stimulus_id " +
+            (has_provenance ? "LEFT JOIN segment_stimuli shown ON shown.segment_id = "
+                              "t.segment_id AND shown.stimulus_id = t.stimulus_id "
+                            : "") +
             "ORDER BY p.code, se.id, t.position, r.id");
+        int without_provenance = 0;
         while (s.step()) {
-            for (int c = 0; c < 7; ++c) out << (c ? "," : "") << csv_cell(s.text(c));
+            const auto known = s.is_null(15) ? resolved.end() : resolved.find(s.text(4));
+            const bool recorded = known != resolved.end();
+            without_provenance += recorded ? 0 : 1;
+            for (int c = 0; c < 6; ++c) out << (c ? "," : "") << csv_cell(s.text(c));
+            out << "," << csv_cell(recorded ? known->second.mesh : s.text(6));
             const auto it = params.find(s.text(4));
             for (const std::string& n : names) {
                 std::string v;
-                if (it != params.end() && it->second.count(n)) v = it->second.at(n);
+                if (recorded) {
+                    if (known->second.values.count(n)) v = known->second.values.at(n);
+                } else if (it != params.end() && it->second.count(n)) {
+                    v = it->second.at(n);
+                }
                 out << "," << csv_cell(v);
             }
+            out << "," << csv_cell(recorded ? known->second.mesh_hash : "");
+            for (int c = 15; c < 20; ++c) out << "," << csv_cell(s.text(c));
             const bool is_catch = s.integer(12) != 0;
             std::string passed;
             if (is_catch)
@@ -107,6 +133,13 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
                 << passed << "\n";
             ++rows;
         }
+        if (notes && without_provenance > 0)
+            notes->push_back(
+                db_path + ": " + std::to_string(without_provenance) + " of " +
+                std::to_string(rows) +
+                " ratings were recorded without provenance (a database written before "
+                "schema 3): only the protocol's own parameter values are known for them; "
+                "defaults, mesh_hash, stimulus_source, image and renderer cells are empty");
         return rows;
     }
 

@@ -11,7 +11,12 @@ enum class ExportFormat { Long, Wide };
 
 // Writes CSV (RFC 4180 quoting, one value per cell, never JSON) to `out`. Opens the
 // database read-only after check_database_file. Returns the number of data rows.
-int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out);
+// Long rows carry every resolved parameter of the stimulus shown, its mesh hash, where
+// the picture came from and the renderer; ratings recorded without that (a database
+// written before schema 3) keep only the protocol's values, the rest empty, and one line
+// saying so is appended to `notes` (the CSV itself stays plain for CSV readers).
+int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out,
+               std::vector<std::string>* notes = nullptr);
 
 // A row of the analysis input (issue 4): one per (rating, factor), practice and catch
 // trials excluded. Columns participant,stimulus,factor,level,question,rating.

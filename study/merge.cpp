@@ -5,6 +5,7 @@
 #include <set>
 
 #include "export.h"
+#include "merge_provenance.h"
 #include "sqlite.h"
 #include "store.h"
 
@@ -107,6 +108,7 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
                              " holds protocol " + first_hashes.begin()->substr(0, 12));
         }
     }
+    check_resolved_stimuli_agree(inputs);
 
     MergeReport report;
     Store out(out_path);
@@ -121,8 +123,10 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
                     ? db.scalar_int("SELECT count(*) FROM src.sessions")
                     : 0;
             if (offered > 0 || db.scalar_int("SELECT count(*) FROM src.sqlite_schema "
-                                             "WHERE name = 'studies'") > 0)
+                                             "WHERE name = 'studies'") > 0) {
                 for (const char* step : kCopySteps) db.exec(step);
+                copy_provenance(db);
+            }
             db.exec("DROP TABLE IF EXISTS temp.new_sessions");
             const int64_t added = db.scalar_int("SELECT count(*) FROM main.sessions") - before;
             tx.commit();

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 
 namespace lucent::study {
@@ -102,6 +103,52 @@ CREATE INDEX trials_by_session ON trials(session_id);
 ALTER TABLE sessions ADD COLUMN refresh_note TEXT;
 ALTER TABLE trials ADD COLUMN dropped_frames INTEGER;
 )sql",
+    // 3: provenance: every resolved value per stimulus, one environment row per session
+    // segment (start, each resume) and where each picture of a segment came from.
+    // Existing sessions get their first segment from the session row; trials answered
+    // before keep segment_id NULL (nothing was recorded about what they showed).
+    R"sql(
+ALTER TABLE stimuli ADD COLUMN resolved_mesh TEXT;
+ALTER TABLE stimuli ADD COLUMN mesh_hash TEXT;
+CREATE TABLE stimulus_values (
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id) ON DELETE CASCADE,
+    name TEXT NOT NULL,
+    value TEXT NOT NULL,
+    PRIMARY KEY (stimulus_id, name));
+CREATE TABLE session_segments (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+    segment INTEGER NOT NULL,
+    started_utc TEXT NOT NULL,
+    machine_id TEXT NOT NULL,
+    software_version TEXT NOT NULL,
+    build_hash TEXT NOT NULL,
+    gl_vendor TEXT,
+    gl_renderer TEXT,
+    display_mode TEXT,
+    display_refresh_hz REAL,
+    measured_refresh_hz REAL,
+    refresh_note TEXT,
+    stimulus_source TEXT CHECK (stimulus_source IN ('live', 'images', 'image', 'mixed')),
+    UNIQUE (session_id, segment));
+INSERT INTO session_segments (session_id, segment, started_utc, machine_id,
+    software_version, build_hash, gl_vendor, gl_renderer, display_mode, display_refresh_hz,
+    measured_refresh_hz, refresh_note)
+SELECT id, 1, started_utc, machine_id, software_version, build_hash, gl_vendor,
+    gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, refresh_note
+FROM sessions;
+CREATE TABLE segment_stimuli (
+    segment_id INTEGER NOT NULL REFERENCES session_segments(id) ON DELETE CASCADE,
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id) ON DELETE CASCADE,
+    source TEXT NOT NULL CHECK (source IN ('live', 'images', 'image')),
+    file TEXT,
+    content_hash TEXT,
+    software_version TEXT NOT NULL,
+    build_hash TEXT NOT NULL,
+    PRIMARY KEY (segment_id, stimulus_id));
+ALTER TABLE trials ADD COLUMN segment_id INTEGER REFERENCES session_segments(id);
+CREATE INDEX segments_by_session ON session_segments(session_id);
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 
@@ -118,7 +165,58 @@ int participant_number_from_code(const std::string& code) {
     return std::stoi(code.substr(begin));
 }
 
+int64_t first_int(Statement& s) { return s.step() ? s.integer(0) : 0; }
+
+ResolvedStimulus resolved_of(const StimulusProvenance& p) {
+    ResolvedStimulus r{p.technique, p.mesh, p.mesh_hash, {}};
+    for (const auto& [name, value] : p.values) r.values[name] = value;
+    return r;
+}
+
+// One word for a segment's pictures: the common source, "mixed", or NULL when unknown.
+std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli) {
+    std::set<std::string> sources;
+    for (const StimulusProvenance& p : stimuli) sources.insert(p.source);
+    if (sources.empty()) return std::nullopt;
+    return sources.size() == 1 ? *sources.begin() : std::string("mixed");
+}
+
 }  // namespace
+
+std::map<std::string, ResolvedStimulus> read_resolved_stimuli(Database& db) {
+    std::map<std::string, ResolvedStimulus> out;
+    if (db.scalar_int("PRAGMA user_version") < 3) return out;
+    Statement s = db.prepare("SELECT stimulus_key, technique, resolved_mesh, mesh_hash "
+                             "FROM stimuli WHERE resolved_mesh IS NOT NULL");
+    while (s.step()) out[s.text(0)] = {s.text(1), s.text(2), s.text(3), {}};
+    Statement v = db.prepare("SELECT st.stimulus_key, v.name, v.value FROM stimulus_values v "
+                             "JOIN stimuli st ON st.id = v.stimulus_id");
+    while (v.step()) out[v.text(0)].values[v.text(1)] = v.text(2);
+    return out;
+}
+
+std::string resolved_difference(const std::string& stimulus, const ResolvedStimulus& a,
+                                const std::string& a_name, const ResolvedStimulus& b,
+                                const std::string& b_name) {
+    auto differs = [&](const std::string& name, const std::string& x, const std::string& y) {
+        return "stimulus '" + stimulus + "': parameter '" + name + "' is " +
+               (x.empty() ? "(none)" : x) + " in " + a_name + " but " +
+               (y.empty() ? "(none)" : y) + " in " + b_name;
+    };
+    if (a.technique != b.technique) return differs("technique", a.technique, b.technique);
+    if (a.mesh != b.mesh) return differs("mesh", a.mesh, b.mesh);
+    if (a.mesh_hash != b.mesh_hash) return differs("mesh_hash", a.mesh_hash, b.mesh_hash);
+    std::set<std::string> names;
+    for (const auto& [name, value] : a.values) names.insert(name);
+    for (const auto& [name, value] : b.values) names.insert(name);
+    for (const std::string& name : names) {
+        const auto x = a.values.find(name), y = b.values.find(name);
+        const std::string vx = x == a.values.end() ? "" : x->second;
+        const std::string vy = y == b.values.end() ? "" : y->second;
+        if (vx != vy) return differs(name, vx, vy);
+    }
+    return "";
+}
 
 void check_database_file(const std::string& path) {
     namespace fs = std::filesystem;
@@ -285,6 +383,7 @@ SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
         .bind(16, env.refresh_note)
         .run();
     row.id = db_.last_insert_id();
+    insert_segment(row.id, 1, env);
     Statement insert = db_.prepare(
         "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, "
         "catch_id, prompt, expected_rating, tolerance, break_before) VALUES "
@@ -356,7 +455,91 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
     return out;
 }
 
+void Store::check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) {
+    const auto stored = read_resolved_stimuli(db_);
+    for (const StimulusProvenance& p : stimuli) {
+        const auto it = stored.find(p.stimulus);
+        if (it == stored.end()) continue;  // first recorded now
+        const std::string difference =
+            resolved_difference(p.stimulus, it->second, db_.path(), resolved_of(p), "this run");
+        if (!difference.empty())
+            throw StoreError(db_.path() + ": " + difference +
+                             ": its pictures would differ from the earlier sessions'; use a "
+                             "new database");
+    }
+}
+
+void Store::insert_segment(int64_t session_id, int segment, const SessionEnvironment& env) {
+    check_stimulus_values(env.stimuli);
+    const int64_t study_id =
+        first_int(db_.prepare("SELECT study_id FROM sessions WHERE id = ?").bind(1, session_id));
+    // The study's resolved values, recorded by the first session that shows a stimulus.
+    Statement first = db_.prepare(
+        "UPDATE stimuli SET resolved_mesh = ?, mesh_hash = ? "
+        "WHERE study_id = ? AND stimulus_key = ? AND resolved_mesh IS NULL");
+    Statement value = db_.prepare(
+        "INSERT INTO stimulus_values (stimulus_id, name, value) VALUES "
+        "((SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), ?, ?)");
+    for (const StimulusProvenance& p : env.stimuli) {
+        first.reset();
+        first.bind(1, p.mesh).bind(2, p.mesh_hash).bind(3, study_id).bind(4, p.stimulus).run();
+        if (sqlite3_changes(db_.handle()) == 0) continue;
+        for (const auto& [name, text] : p.values) {
+            value.reset();
+            value.bind(1, study_id).bind(2, p.stimulus).bind(3, name).bind(4, text).run();
+        }
+    }
+    db_.prepare(
+           "INSERT INTO session_segments (session_id, segment, started_utc, machine_id, "
+           "software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
+           "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) "
+           "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+        .bind(1, session_id).bind(2, segment).bind(3, utc_now_iso8601())
+        .bind(4, env.machine_id).bind(5, env.software_version).bind(6, env.build_hash)
+        .bind(7, env.gl_vendor).bind(8, env.gl_renderer).bind(9, env.display_mode)
+        .bind(10, env.display_refresh_hz).bind(11, env.measured_refresh_hz)
+        .bind(12, env.refresh_note).bind(13, segment_source(env.stimuli))
+        .run();
+    const int64_t segment_id = db_.last_insert_id();
+    Statement shown = db_.prepare(
+        "INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, content_hash, "
+        "software_version, build_hash) VALUES "
+        "(?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), ?, ?, ?, ?, ?)");
+    for (const StimulusProvenance& p : env.stimuli) {
+        shown.reset();
+        shown.bind(1, segment_id).bind(2, study_id).bind(3, p.stimulus).bind(4, p.source)
+            .bind(5, p.file).bind(6, p.content_hash).bind(7, p.software_version)
+            .bind(8, p.build_hash).run();
+    }
+}
+
+int Store::begin_segment(int64_t session_id, const SessionEnvironment& env) {
+    Transaction tx(db_);
+    const int segment = static_cast<int>(
+        first_int(db_.prepare("SELECT coalesce(max(segment), 0) + 1 FROM session_segments "
+                              "WHERE session_id = ?")
+                      .bind(1, session_id)));
+    insert_segment(session_id, segment, env);
+    tx.commit();
+    return segment;
+}
+
 void Store::update_environment(int64_t session_id, const SessionEnvironment& env) {
+    Transaction tx(db_);
+    db_.prepare("UPDATE session_segments SET machine_id = ?, software_version = ?, "
+                "build_hash = ?, gl_vendor = ?, gl_renderer = ?, display_mode = ?, "
+                "display_refresh_hz = ?, measured_refresh_hz = ?, refresh_note = ? "
+                "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = ?)")
+        .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
+        .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
+        .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
+        .bind(9, env.refresh_note).bind(10, session_id)
+        .run();
+    if (first_int(db_.prepare("SELECT count(*) FROM session_segments WHERE session_id = ?")
+                      .bind(1, session_id)) > 1) {
+        tx.commit();
+        return;
+    }
     db_.prepare("UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
                 "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
                 "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
@@ -365,6 +548,7 @@ void Store::update_environment(int64_t session_id, const SessionEnvironment& env
         .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
         .bind(9, env.refresh_note).bind(10, session_id)
         .run();
+    tx.commit();
 }
 
 void Store::set_consent(int64_t session_id) {
@@ -402,10 +586,12 @@ void Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcom
             .bind(5, r.rt_ms).bind(6, r.changes).bind(7, r.first_choice_ns)
             .bind(8, r.final_choice_ns).run();
     }
+    // The trial belongs to the segment on screen: the session's newest.
     db_.prepare("UPDATE trials SET onset_ns = ?, confirm_ns = ?, dropped_frames = ?, "
-                "answered_utc = ? WHERE id = ?")
+                "answered_utc = ?, segment_id = (SELECT max(id) FROM session_segments "
+                "WHERE session_id = ?) WHERE id = ?")
         .bind(1, outcome.onset_ns).bind(2, outcome.confirm_ns).bind(3, outcome.dropped_frames)
-        .bind(4, utc_now_iso8601()).bind(5, trial_id).run();
+        .bind(4, utc_now_iso8601()).bind(5, session_id).bind(6, trial_id).run();
     tx.commit();
 }
 

@@ -16,6 +16,9 @@ public:
     StimulusTexture render(const StimulusSpec& spec, int width, int height) override;
     // Without GL: every live stimulus's technique, parameters and mesh are valid.
     void check(const Protocol& protocol) const override;
+    std::vector<StimulusProvenance> provenance(const Protocol& protocol) const override {
+        return images_.provenance(protocol);
+    }
 
 private:
     PrerenderedStimuli images_;

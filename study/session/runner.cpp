@@ -190,7 +190,7 @@ void Session::start_or_resume_session() {
     if (resumable_) {
         session_ = *resumable_;
         store_->set_status(session_.id, "running", false);
-        store_->update_environment(session_.id, env_);
+        store_->begin_segment(session_.id, env_);  // a new row: earlier machines' kept
     } else {
         participant_id_ = store_->ensure_participant(study_id_, opt_.participant, &participant_number_);
         uint64_t seed = opt_.seed ? *opt_.seed : (uint64_t(std::random_device{}()) << 32 | std::random_device{}());
@@ -484,7 +484,14 @@ RunResult Session::run() {
     if (RunResult r = prepare_store(); r != RunResult::Completed) return r;
     try {
         stimuli_.check(p_);
+        // What will be shown, recorded with the session; refused when it differs from
+        // what this database's earlier sessions showed.
+        env_.stimuli = stimuli_.provenance(p_);
+        store_->check_stimulus_values(env_.stimuli);
     } catch (const StimulusError& e) {
+        log_ << "lucent run: " << e.what() << "\n";
+        return RunResult::UsageError;
+    } catch (const StoreError& e) {
         log_ << "lucent run: " << e.what() << "\n";
         return RunResult::UsageError;
     }

@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/image.h"
+#include "session/stimulus_provenance.h"
 
 #include <cmath>
 #include <filesystem>
@@ -88,6 +89,10 @@ void PrerenderedStimuli::check(const Protocol& protocol) const {
             throw StimulusError(protocol.source + ": stimulus '" + s.id + "': image " + path +
                                 " does not exist");
     }
+}
+
+std::vector<StimulusProvenance> PrerenderedStimuli::provenance(const Protocol& protocol) const {
+    return resolve_stimuli(protocol, images_dir_);
 }
 
 StimulusTexture PrerenderedStimuli::render(const StimulusSpec& spec, int, int) {

@@ -10,6 +10,7 @@
 
 #include "gl/objects.h"
 #include "protocol.h"
+#include "store.h"
 
 namespace lucent::study {
 
@@ -44,6 +45,9 @@ public:
     virtual StimulusTexture render(const StimulusSpec& spec, int width, int height) = 0;
     // Checks, before any window opens, that every stimulus can be provided.
     virtual void check(const Protocol& protocol) const = 0;
+    // What each stimulus will be, for the database: resolved values, mesh hash, and for
+    // pre-rendered files the manifest check (stimulus_provenance.h). Throws StimulusError.
+    virtual std::vector<StimulusProvenance> provenance(const Protocol& protocol) const = 0;
 };
 
 // Image stimuli from their `image` path; live stimuli from `images_dir/<id>.png|.tif|.exr`
@@ -54,7 +58,9 @@ public:
     explicit PrerenderedStimuli(std::string images_dir) : images_dir_(std::move(images_dir)) {}
     StimulusTexture render(const StimulusSpec& spec, int width, int height) override;
     void check(const Protocol& protocol) const override;
+    std::vector<StimulusProvenance> provenance(const Protocol& protocol) const override;
     std::string path_for(const StimulusSpec& spec) const;  // "" when none exists
+    const std::string& images_dir() const { return images_dir_; }
 
 private:
     std::string images_dir_;

@@ -17,6 +17,9 @@
 #include <thread>
 
 #include "../study_fixtures.h"
+#include "lucent/version.h"
+#include "manifest.h"
+#include "session/stimulus_provenance.h"
 #include "session/stimulus_source.h"
 #include "sha256.h"
 #include "sqlite.h"
@@ -82,6 +85,26 @@ void write_images(const fs::path& dir, const std::vector<std::string>& ids, int 
     }
 }
 
+// The stimulus-set manifest --images checks those pictures against: one row per
+// protocol stimulus with a file in `dir`, its values as the renderer resolves them.
+void write_manifest_for(const fs::path& dir, const Protocol& protocol) {
+    std::vector<stimuli::ManifestRow> rows;
+    for (const StimulusProvenance& p : resolve_stimuli(protocol, "")) {
+        const std::string file = p.stimulus + ".png";
+        if (!fs::exists(dir / file)) continue;
+        stimuli::ManifestRow row = {{"id", p.stimulus, false},     {"file", file, false},
+                                    {"files", file, false},        {"technique", p.technique, false},
+                                    {"mesh", p.mesh, false},       {"mesh_hash", p.mesh_hash, false}};
+        for (const auto& [name, value] : p.values) row.push_back({name, value, false});
+        row.push_back({"software_version", version_string(), false});
+        row.push_back({"build_hash", build_hash(), false});
+        row.push_back({"content_hash",
+                       stimuli::Hasher().add_field(stimuli::hash_file(dir / file)).hex(), false});
+        rows.push_back(std::move(row));
+    }
+    stimuli::write_manifest(dir, protocol.name, rows);
+}
+
 class SessionE2E : public ::testing::Test {
 protected:
     void SetUp() override {
@@ -89,6 +112,7 @@ protected:
         dir_ = lucent::test::scratch_dir(std::string("e2e_") +
                                          ::testing::UnitTest::GetInstance()->current_test_info()->name());
         write_images(dir_, {"a", "b", "c", "p"}, 128);
+        write_manifest_for(dir_, lucent::test::small_protocol());
     }
     // The small protocol with a short blank between trials; `repeats` per main stimulus.
     std::string write_protocol(int repeats) {
@@ -139,6 +163,18 @@ TEST_F(SessionE2E, FullSessionStoresEveryRatingWithSensibleResponseTimes) {
     }
     EXPECT_FALSE(s.text(3).empty());
     EXPECT_FALSE(s.text(4).empty());
+    // What was shown: each --images file with the manifest's content hash.
+    const auto manifest = stimuli::read_manifest_csv(dir_);
+    Statement shown = d.prepare("SELECT st.stimulus_key, x.source, x.content_hash FROM "
+                                "segment_stimuli x JOIN stimuli st ON st.id = x.stimulus_id");
+    int listed = 0;
+    for (; shown.step(); ++listed) {
+        EXPECT_EQ(shown.text(1), "images");
+        EXPECT_EQ(shown.text(2), manifest.at(shown.text(0)).at("content_hash"));
+    }
+    EXPECT_EQ(listed, 4);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM session_segments WHERE "
+                           "stimulus_source = 'images'"), 1);
     Statement rt = d.prepare("SELECT rt_ms FROM responses ORDER BY rt_ms");
     std::vector<double> rts;
     while (rt.step()) rts.push_back(rt.real(0));
@@ -227,6 +263,9 @@ TEST_F(SessionE2E, KilledAtARandomTrialAndResumedKeepsExactlyOneRatingEach) {
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM (SELECT trial_id, question FROM responses "
                            "GROUP BY 1, 2 HAVING count(*) != 1)"), 0);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    // The start and the resume each have their environment row.
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM session_segments"), 2);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE segment_id IS NULL"), 0);
     std::vector<std::pair<int, std::string>> order_after;
     Statement s = d.prepare("SELECT t.position, st.stimulus_key FROM trials t JOIN stimuli st "
                             "ON st.id = t.stimulus_id ORDER BY t.position");
@@ -278,6 +317,17 @@ TEST_F(SessionE2E, ForeignOrCorruptDatabaseIsRefusedAndLeftUnchanged) {
     }
 }
 
+TEST_F(SessionE2E, ATamperedImageIsRefusedInOneLineBeforeAnyWindow) {
+    std::ofstream(dir_ / "b.png", std::ios::binary | std::ios::app) << '\0';
+    const std::string db = (dir_ / "study.db").string();
+    const Process p = start_lucent(run_args(write_protocol(1), db, "1"), dir_);
+    EXPECT_EQ(wait_exit(p), 2);
+    const std::string err = read_file(p.stderr_path);
+    EXPECT_NE(err.find((dir_ / "b.png").string()), std::string::npos) << err;
+    EXPECT_NE(err.find("content hash"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
 TEST_F(SessionE2E, NoDisplayGivesOneLineSuggestingXvfb) {
     const std::string db = (dir_ / "study.db").string();
     const Process p = start_lucent(run_args(write_protocol(1), db, "1"), dir_, /*without_display=*/true);
@@ -295,6 +345,7 @@ TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
     std::vector<std::string> ids;
     for (const StimulusSpec& st : thesis.stimuli) ids.push_back(st.id);
     write_images(dir_, ids, 64);
+    write_manifest_for(dir_, thesis);
     const std::string db = (dir_ / "thesis.db").string();
     const Process p = start_lucent({"run", "--preset", "thesis", "--db", db, "--participant", "P4",
                                     "--images", dir_.string(), "--autopilot", "3",

@@ -1,0 +1,279 @@
+// What a session shows, resolved before it starts: every knob value of a stimulus's
+// technique (defaults from the knob registry), pre-rendered files checked against their
+// stimulus set's manifest, and the thesis protocol agreeing with the thesis stimulus set.
+#include "session/stimulus_provenance.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "batch_render.h"
+#include "core/mesh.h"
+#include "export.h"
+#include "session/stimulus_source.h"
+#include "store.h"
+#include "test_paths.h"
+#include "trial_plan.h"
+
+namespace lucent::study {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One empirical stimulus that sets one parameter.
+const char* kOneParameter = R"toml(
+[study]
+name = "one"
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+[[stimuli]]
+id = "e"
+technique = "empirical"
+mesh = "sphere:1k"
+params = { backlight = 1.5 }
+[[blocks]]
+id = "main"
+stimuli = ["e"]
+)toml";
+
+std::map<std::string, std::string> values_of(const StimulusProvenance& p) {
+    return {p.values.begin(), p.values.end()};
+}
+
+// Runs one answered session on `stimuli` into `path`.
+void store_session(const std::string& path, const Protocol& p,
+                   const std::vector<StimulusProvenance>& stimuli) {
+    Store store(path);
+    const int64_t study = store.ensure_study(p);
+    int number = 0;
+    const int64_t pid = store.ensure_participant(study, "P1", &number);
+    SessionEnvironment env;
+    env.stimuli = stimuli;
+    const SessionRow s =
+        store.create_session(study, pid, plan_trials(p, 1, number), 1, env);
+    for (const TrialRow& t : store.trials(s.id)) {
+        TrialOutcome o;
+        o.responses.push_back({"translucent", 4, 700.0, 0, 1, 2});
+        store.record_trial(s.id, t.id, o);
+    }
+}
+
+// The registry with one default changed, as a later build might.
+stimuli::SetCatalog catalog_with_albedo_default(glm::dvec3 albedo) {
+    stimuli::SetCatalog catalog = stimuli::default_catalog();
+    auto registry = catalog.knobs_of;
+    catalog.knobs_of = [registry, albedo](std::string_view name) {
+        auto knobs = registry(name);
+        if (knobs)
+            for (Knob& k : *knobs)
+                if (k.name == "albedo") k.default_value = albedo;
+        return knobs;
+    };
+    return catalog;
+}
+
+TEST(ResolveStimuli, AProtocolSettingOneParameterStoresEveryParameterOfTheTechnique) {
+    const Protocol p = parse_protocol(kOneParameter, "one.toml");
+    const std::vector<StimulusProvenance> resolved = resolve_stimuli(p, "");
+    ASSERT_EQ(resolved.size(), 1u);
+    // The README's parameter table: the scene knobs and empirical's own, with defaults.
+    const std::map<std::string, std::string> expected = {{"light_ambient", "0.6,0.6,0.6"},
+                                                         {"light_diffuse", "1,1,1"},
+                                                         {"light_specular", "1,1,1"},
+                                                         {"light_direction", "0.4,0.6,1"},
+                                                         {"fov_y", "60"},
+                                                         {"background", "0,0,0"},
+                                                         {"albedo", "0.8,0.55,0.35"},
+                                                         {"ambient", "0.3"},
+                                                         {"specular", "0.5"},
+                                                         {"shininess", "64"},
+                                                         {"diffuse_contribution", "0.6"},
+                                                         {"specular_contribution", "1"},
+                                                         {"backlight", "1.5"},
+                                                         {"thickness_exponent", "25"},
+                                                         {"diffuse_weight", "0.2"},
+                                                         {"ao_rays", "320"},
+                                                         {"blur_kernel", "5"},
+                                                         {"depth_precision", "32f"}};
+    EXPECT_EQ(values_of(resolved[0]), expected);
+    EXPECT_EQ(resolved[0].source, "live");
+    EXPECT_EQ(resolved[0].mesh_hash, load_mesh("sphere:1k").content_hash);
+
+    // Stored and exported: one column per parameter, every cell filled.
+    const auto dir = lucent::test::scratch_dir("provenance_one_parameter");
+    const std::string db = (dir / "study.db").string();
+    store_session(db, p, resolved);
+    std::ostringstream csv;
+    std::vector<std::string> notes;
+    ASSERT_EQ(export_csv(db, ExportFormat::Long, csv, &notes), 1);
+    EXPECT_TRUE(notes.empty());
+    std::istringstream lines(csv.str());
+    std::string header_line, row_line;
+    std::getline(lines, header_line);
+    std::getline(lines, row_line);
+    std::map<std::string, std::string> cells;
+    std::istringstream header(header_line), row(row_line);
+    std::vector<std::string> names;
+    for (std::string h; std::getline(header, h, ',');) names.push_back(h);
+    // rgb values are quoted ("0.8,0.55,0.35"): split on commas outside quotes.
+    std::vector<std::string> values(1);
+    bool quoted = false;
+    for (char c : row_line) {
+        if (c == '"')
+            quoted = !quoted;
+        else if (c == ',' && !quoted)
+            values.emplace_back();
+        else
+            values.back() += c;
+    }
+    ASSERT_EQ(values.size(), names.size()) << header_line << "\n" << row_line;
+    for (size_t i = 0; i < names.size(); ++i) cells[names[i]] = values[i];
+    for (const auto& [name, value] : expected) EXPECT_EQ(cells[name], value) << name;
+    EXPECT_EQ(cells["mesh_hash"], resolved[0].mesh_hash);
+    EXPECT_EQ(cells["stimulus_source"], "live");
+}
+
+TEST(ResolveStimuli, AChangedDefaultChangesTheStoredValuesAndMergeRefusesThem) {
+    const Protocol p = parse_protocol(kOneParameter, "one.toml");
+    const auto today = resolve_stimuli(p, "");
+    const auto later =
+        resolve_stimuli(p, "", catalog_with_albedo_default(glm::dvec3(0.5, 0.25, 0.125)));
+    EXPECT_EQ(values_of(later[0]).at("albedo"), "0.5,0.25,0.125");
+    EXPECT_EQ(values_of(later[0]).at("backlight"), "1.5");
+
+    const auto dir = lucent::test::scratch_dir("provenance_changed_default");
+    const std::string a = (dir / "a.db").string(), b = (dir / "b.db").string();
+    store_session(a, p, today);
+    store_session(b, p, later);
+    EXPECT_EQ(
+        Database(b, SQLITE_OPEN_READONLY)
+            .scalar_int("SELECT count(*) FROM stimulus_values WHERE name = 'albedo' "
+                        "AND value = '0.5,0.25,0.125'"),
+        1);
+    try {
+        merge_databases({a, b}, (dir / "all.db").string());
+        FAIL() << "merge joined two pictures under stimulus 'e'";
+    } catch (const StoreError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("stimulus 'e'"), std::string::npos) << what;
+        EXPECT_NE(what.find("parameter 'albedo'"), std::string::npos) << what;
+    }
+    EXPECT_FALSE(fs::exists(dir / "all.db"));
+}
+
+// A tiny stimulus set rendered for real, and a protocol naming the same picture.
+class ImagesAgainstManifest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = lucent::test::scratch_dir("provenance_images");
+        const auto set = stimuli::parse_stimulus_set(
+            "name = \"tiny\"\nresolution = [24, 24]\nformats = [\"png\"]\n"
+            "[meshes]\nball = \"sphere:1k\"\n[defaults]\nao_rays = 8\n"
+            "[[stimuli]]\nid = \"w\"\ntechnique = \"ward\"\nroughness = 0.2\n",
+            "tiny.toml", ".", stimuli::default_catalog());
+        stimuli::BatchOptions options;
+        options.out_dir = dir_;
+        options.progress = false;
+        stimuli::render_stimulus_set(set, options);
+    }
+    Protocol protocol(const std::string& roughness = "0.2") const {
+        return parse_protocol(std::string(R"toml(
+[study]
+name = "tiny"
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+[[stimuli]]
+id = "w"
+technique = "ward"
+mesh = "sphere:1k"
+params = { ao_rays = 8, roughness = )toml") +
+                                  roughness + R"toml( }
+[[blocks]]
+id = "main"
+stimuli = ["w"]
+)toml",
+                              "tiny_protocol.toml");
+    }
+    // The one-line refusal for `p`, or "" when accepted.
+    std::string refusal(const Protocol& p) const {
+        try {
+            resolve_stimuli(p, dir_.string());
+        } catch (const StimulusError& e) {
+            return e.what();
+        }
+        return "";
+    }
+    fs::path dir_;
+};
+
+TEST_F(ImagesAgainstManifest, AMatchingFileIsRecordedWithTheManifestsContentHash) {
+    const auto resolved = resolve_stimuli(protocol(), dir_.string());
+    ASSERT_EQ(resolved.size(), 1u);
+    const auto manifest = stimuli::read_manifest_csv(dir_);
+    EXPECT_EQ(resolved[0].source, "images");
+    EXPECT_EQ(resolved[0].file, (dir_ / "w.png").string());
+    EXPECT_EQ(resolved[0].content_hash, manifest.at("w").at("content_hash"));
+    EXPECT_EQ(resolved[0].software_version, manifest.at("w").at("software_version"));
+    EXPECT_EQ(values_of(resolved[0]).at("roughness"), "0.2");
+    // Without --images the same stimulus renders live, with the same values.
+    const auto live = resolve_stimuli(protocol(), "");
+    EXPECT_EQ(live[0].source, "live");
+    EXPECT_EQ(values_of(live[0]), values_of(resolved[0]));
+}
+
+TEST_F(ImagesAgainstManifest, ATamperedImageIsRefusedNamingTheFile) {
+    {
+        std::ofstream png(dir_ / "w.png", std::ios::binary | std::ios::app);
+        png << '\0';  // still a readable PNG, no longer the rendered bytes
+    }
+    const std::string why = refusal(protocol());
+    EXPECT_NE(why.find((dir_ / "w.png").string()), std::string::npos) << why;
+    EXPECT_NE(why.find("content hash"), std::string::npos) << why;
+    EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+}
+
+TEST_F(ImagesAgainstManifest, AParameterOtherThanTheProtocolsIsRefusedNamingIt) {
+    const std::string why = refusal(protocol("0.3"));
+    EXPECT_NE(why.find("w.png"), std::string::npos) << why;
+    EXPECT_NE(why.find("parameter 'roughness'"), std::string::npos) << why;
+    EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+}
+
+TEST_F(ImagesAgainstManifest, AFileWithoutAManifestRowIsRefused) {
+    fs::remove(dir_ / "manifest.csv");
+    const std::string why = refusal(protocol());
+    EXPECT_NE(why.find("w.png"), std::string::npos) << why;
+    EXPECT_NE(why.find("manifest.csv"), std::string::npos) << why;
+}
+
+TEST(ThesisPresets, TheStudyShowsTheStimulusSetsPicturesValueForValue) {
+    const auto set = stimuli::load_preset("thesis", stimuli::default_catalog());
+    const Protocol study = builtin_protocol("thesis");
+    std::map<std::string, StimulusProvenance> by_id;
+    for (StimulusProvenance& p : resolve_stimuli(study, "")) by_id[p.stimulus] = p;
+    for (const stimuli::Stimulus& s : set.stimuli) {
+        SCOPED_TRACE(s.id);
+        ASSERT_TRUE(by_id.count(s.id)) << "not in study/presets/thesis.toml";
+        const StimulusProvenance& p = by_id.at(s.id);
+        EXPECT_EQ(p.technique, s.technique);
+        EXPECT_EQ(p.mesh, s.mesh_spec);
+        std::map<std::string, std::string> set_values;
+        for (const auto& [name, value] : s.parameters.all())
+            set_values[name] = format_knob_value(value);
+        EXPECT_EQ(values_of(p), set_values);
+        by_id.erase(s.id);
+    }
+    // What only the study has: its practice pictures.
+    for (const auto& [id, p] : by_id)
+        EXPECT_NE(std::find(study.practice.begin(), study.practice.end(), id),
+                  study.practice.end())
+            << id << " is rated but not in stimuli/presets/thesis.toml";
+}
+
+}  // namespace
+}  // namespace lucent::study
