@@ -138,8 +138,9 @@ TEST(GlDebugContext, AddsTheDriversMessageToTheError) {
     ASSERT_NE(at, std::string::npos) << message;
     EXPECT_GT(message.size(), at + marker.size() + 4) << message;
     const std::string renderer = context->info().renderer;
-    if (renderer.find("llvmpipe") != std::string::npos)
+    if (renderer.find("llvmpipe") != std::string::npos) {
         EXPECT_NE(message.find("TextureSubImage2D"), std::string::npos) << message;
+    }
 }
 
 TEST(GlDebugContext, DefaultInDebugBuildsAndWhereLucentGlDebugIsOne) {
