@@ -86,18 +86,28 @@ int run_render(const RenderOptions& options) {
                   << plan.explain();
         if (options.out.empty()) return kExitOk;
     }
+    std::size_t non_finite = 0;
     try {
         auto context = gl::create_headless_context();
         gl::FrameExecutor executor;
-        const Image image = render_image(executor, scene, mode);
+        const RenderedImage rendered = render_image_counted(executor, scene, mode);
         ImageWriteOptions write;
         write.linear = options.linear;
-        write_image(options.out, image, write);
+        write_image(options.out, rendered.image, write);
+        non_finite = rendered.non_finite_pixels;
     } catch (const std::exception& e) {
         std::cerr << "lucent render: " << e.what() << "\n";
         return kExitFailure;
     }
     std::cout << "wrote " << options.out << "\n";
+    // The file is valid (values replaced), but NaN/Inf means a rendering bug: say so and
+    // fail, so scripts notice.
+    if (non_finite > 0) {
+        std::cerr << "lucent render: warning: " << non_finite << " pixels of "
+                  << options.out
+                  << " had NaN or Inf values (written as 0 or the largest float)\n";
+        return kExitFailure;
+    }
     return kExitOk;
 }
 

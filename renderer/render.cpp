@@ -22,12 +22,18 @@ Scene build_scene(const RenderRequest& request) {
                       request.height);
 }
 
-Image render_image(gl::FrameExecutor& executor, const Scene& scene, PlanMode mode) {
+RenderedImage render_image_counted(gl::FrameExecutor& executor, const Scene& scene,
+                                   PlanMode mode) {
     const Technique& technique = find_technique(scene.technique);
     const FramePlan plan = make_frame_plan(scene, technique, mode);
-    Image image = executor.render(scene, plan);
-    replace_non_finite(image);
-    return image;
+    RenderedImage rendered{executor.render(scene, plan), 0};
+    rendered.non_finite_pixels = count_non_finite_pixels(rendered.image);
+    replace_non_finite(rendered.image);
+    return rendered;
+}
+
+Image render_image(gl::FrameExecutor& executor, const Scene& scene, PlanMode mode) {
+    return render_image_counted(executor, scene, mode).image;
 }
 
 }  // namespace lucent

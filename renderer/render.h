@@ -25,7 +25,18 @@ struct RenderRequest {
 // non-positive size.
 Scene build_scene(const RenderRequest& request);
 
-// Plans `scene` under its technique and renders it with `executor` (current GL context).
+// A rendered image and what had to be repaired in it before anyone sees it.
+struct RenderedImage {
+    Image image;                        // finite everywhere
+    std::size_t non_finite_pixels = 0;  // pixels that had a NaN or Inf channel (a bug)
+};
+
+// Plans `scene` under its technique, renders it with `executor` (current GL context) and
+// replaces non-finite values (replace_non_finite), counting the pixels it repaired.
+// Throws gl::GlError naming the pass when GL reports an error.
+RenderedImage render_image_counted(gl::FrameExecutor& executor, const Scene& scene,
+                                   PlanMode mode = PlanMode::pruned);
+// render_image_counted() without the count, for callers that only display the image.
 Image render_image(gl::FrameExecutor& executor, const Scene& scene,
                    PlanMode mode = PlanMode::pruned);
 

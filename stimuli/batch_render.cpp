@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -97,27 +99,68 @@ std::string files_hash(const std::filesystem::path& dir, const StimulusSet& set,
     return hasher.hex();
 }
 
-// True when the previous run's files for `s` are present, unchanged and made from the
-// same inputs.
-bool reusable(const std::map<std::string, std::string>* previous,
-              const std::string& inputs, const std::filesystem::path& dir,
-              const StimulusSet& set, const Stimulus& s) {
-    if (!previous) return false;
+// A non-negative integer cell, e.g. a count; nullopt when the text is anything else.
+std::optional<std::size_t> parse_count(const std::string& text) {
+    std::size_t value = 0;
+    const auto [end, error] =
+        std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error != std::errc() || end != text.data() + text.size() || text.empty())
+        return std::nullopt;
+    return value;
+}
+
+// The content hash of the previous run's files for `s` when they are present, unchanged
+// and made from the same inputs (the stimulus is then reused); empty otherwise.
+std::string reusable_content_hash(const std::map<std::string, std::string>* previous,
+                                  const std::string& inputs,
+                                  const std::filesystem::path& dir,
+                                  const StimulusSet& set, const Stimulus& s) {
+    if (!previous) return {};
     const auto field = [&](const char* column) {
         const auto it = previous->find(column);
         return it == previous->end() ? std::string() : it->second;
     };
-    if (field("input_hash") != inputs) return false;
+    if (field("input_hash") != inputs || !parse_count(field("non_finite_pixels")))
+        return {};
     for (const auto format : set.formats) {
         std::error_code error;
-        if (!std::filesystem::is_regular_file(dir / file_of(s, format), error))
-            return false;
+        if (!std::filesystem::is_regular_file(dir / file_of(s, format), error)) return {};
     }
     try {
-        return files_hash(dir, set, s) == field("content_hash");
+        const std::string content = files_hash(dir, set, s);
+        return content == field("content_hash") ? content : std::string();
     } catch (const std::exception&) {
-        return false;
+        return {};
     }
+}
+
+// The columns measured on a rendered image: statistics, then the count of pixels that
+// had NaN or Inf values (replaced before writing; non-zero means a rendering bug).
+std::vector<ManifestField> measured_fields(const ImageStatistics& stats,
+                                           std::size_t non_finite_pixels) {
+    auto fields = statistics_fields(stats);
+    fields.push_back({"non_finite_pixels", std::to_string(non_finite_pixels), true});
+    return fields;
+}
+
+// The columns every row ends with: software, inputs and the files' content hash.
+void append_provenance(ManifestRow& row, const std::string& inputs,
+                       const std::string& content) {
+    row.push_back({"software_version", version_string(), false});
+    row.push_back({"build_hash", build_hash(), false});
+    row.push_back({"input_hash", inputs, false});
+    row.push_back({"content_hash", content, false});
+}
+
+// Writes the complete rows (non-empty; in set order) as the manifest, atomically. Called
+// before any file is replaced and after each stimulus, so an interrupted run leaves a
+// manifest that describes exactly the files it lists, and the next run resumes.
+void write_complete_rows(const std::filesystem::path& dir, const StimulusSet& set,
+                         const std::vector<ManifestRow>& rows) {
+    std::vector<ManifestRow> complete;
+    for (const auto& row : rows)
+        if (!row.empty()) complete.push_back(row);
+    write_manifest(dir, set.name, complete);
 }
 
 // A one-line progress display: stimuli done, time per stimulus, time left. Redrawn in
@@ -179,9 +222,9 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     std::filesystem::create_directories(dir);
     const auto previous = read_manifest_csv(dir);
 
-    // Decide what to render; reused rows keep the previous run's statistics verbatim.
+    // Decide what to render; reused rows keep the previous run's measurements verbatim.
     const std::size_t count = set.stimuli.size();
-    std::vector<ManifestRow> rows(count);
+    std::vector<ManifestRow> rows(count);  // empty until the stimulus is complete
     std::vector<std::string> inputs(count);
     std::vector<std::size_t> pending;
     for (std::size_t i = 0; i < count; ++i) {
@@ -190,20 +233,26 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
         inputs[i] = input_hash(set, s, mesh.content_hash);
         const auto it = previous.find(s.id);
         const auto* old = it == previous.end() ? nullptr : &it->second;
-        if (!options.force && reusable(old, inputs[i], dir, set, s)) {
+        const std::string content =
+            options.force ? std::string()
+                          : reusable_content_hash(old, inputs[i], dir, set, s);
+        if (!content.empty()) {
             rows[i] = identity_fields(set, s, mesh);
             ImageStatistics columns;
             columns.luminance_histogram.resize(kHistogramBins);
-            for (const auto& field : statistics_fields(columns)) {
+            for (const auto& field : measured_fields(columns, 0)) {
                 const auto found = old->find(field.column);
                 rows[i].push_back(
                     {field.column, found == old->end() ? "0" : found->second, true});
             }
+            append_provenance(rows[i], inputs[i], content);
             ++result.reused;
         } else {
             pending.push_back(i);
         }
     }
+    // Drop the rows of everything about to be re-rendered before any file is replaced.
+    write_complete_rows(dir, set, rows);
 
     // Bake (or load) the AO each pending plan reads once, here, so parallel workers never
     // bake the same mesh twice and the bake's own progress bar is not interleaved.
@@ -267,7 +316,8 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
                 const double ao_before = timings.ao_seconds;
                 const Scene scene =
                     make_scene(mesh, technique, s.parameters, set.width, set.height);
-                const Image image = render_image(executor, scene);
+                const RenderedImage rendered = render_image_counted(executor, scene);
+                const Image& image = rendered.image;
                 timings.gl_seconds +=
                     seconds_since(start) - (timings.ao_seconds - ao_before);
 
@@ -281,17 +331,21 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
                 const auto stats = compute_image_statistics(
                     FloatImageView{image.width, image.height, 4, image.rgba},
                     kHistogramBins);
-                const auto stat_fields = statistics_fields(stats);
-                row.insert(row.end(), stat_fields.begin(), stat_fields.end());
-                const std::string content = files_hash(dir, set, s);
+                const auto measured = measured_fields(stats, rendered.non_finite_pixels);
+                row.insert(row.end(), measured.begin(), measured.end());
+                append_provenance(row, inputs[i], files_hash(dir, set, s));
                 timings.statistics_seconds += seconds_since(start);
 
-                std::lock_guard lock(mutex);
-                rows[i] = std::move(row);
-                rows[i].push_back({"content_hash", content, false});
-                finished_ids.push_back(s.id);
-                ++finished;
-                finished_signal.notify_one();
+                std::size_t done = 0;
+                {
+                    std::lock_guard lock(mutex);
+                    rows[i] = std::move(row);
+                    write_complete_rows(dir, set, rows);
+                    finished_ids.push_back(s.id);
+                    done = ++finished;
+                    finished_signal.notify_one();
+                }
+                if (options.after_stimulus) options.after_stimulus(s.id, done);
             }
         } catch (const std::exception& e) {
             std::lock_guard lock(mutex);
@@ -321,22 +375,15 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     if (!failure.empty()) throw std::runtime_error(failure);
     result.rendered = pending.size();
 
-    // Hashes and software columns last, so every row ends the same way.
     for (std::size_t i = 0; i < count; ++i) {
-        std::string content;
-        auto& row = rows[i];
-        if (!row.empty() && row.back().column == "content_hash") {
-            content = row.back().text;
-            row.pop_back();
-        } else {
-            content = files_hash(dir, set, set.stimuli[i]);
-        }
-        row.push_back({"software_version", version_string(), false});
-        row.push_back({"build_hash", build_hash(), false});
-        row.push_back({"input_hash", inputs[i], false});
-        row.push_back({"content_hash", content, false});
+        const auto& row = rows[i];
+        const auto it = std::find_if(row.begin(), row.end(), [](const ManifestField& f) {
+            return f.column == "non_finite_pixels";
+        });
+        const auto pixels = it == row.end() ? std::nullopt : parse_count(it->text);
+        if (pixels && *pixels > 0)
+            result.non_finite.push_back({set.stimuli[i].id, *pixels});
     }
-    write_manifest(dir, set.name, rows);
     result.rows = std::move(rows);
     result.timings.ao_seconds = prebake_seconds;
     for (const auto& t : worker_timings) {
@@ -379,6 +426,11 @@ int run_render_set_command(const std::string& config_path, const std::string& pr
                   << " of " << set.stimuli.size() << " stimuli into " << out_dir
                   << " (manifest.csv, manifest.json) in " << result.timings.wall_seconds
                   << " s\n";
+        for (const auto& [id, pixels] : result.non_finite)
+            std::cerr << "lucent render: warning: stimulus '" << id << "': " << pixels
+                      << " pixels had NaN or Inf values (written as 0 or the largest "
+                         "float; manifest column non_finite_pixels)\n";
+        if (!result.non_finite.empty()) return 1;
     } catch (const MeshError& e) {
         std::cerr << "lucent render: " << set.source << ": mesh " << e.what() << "\n";
         return 2;

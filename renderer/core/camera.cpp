@@ -20,7 +20,13 @@ glm::mat4 Camera::projection() const {
     return glm::perspective(glm::radians(fov_y_degrees), aspect, near_plane, far_plane);
 }
 
-Camera fit_camera(const BoundingSphere& sphere, float fov_y_degrees, float aspect,
+float vertical_fov_degrees(float shorter_side_fov_degrees, float aspect) {
+    if (!(aspect < 1.0f) || !(aspect > 0.0f)) return shorter_side_fov_degrees;
+    const double half = glm::radians(double(shorter_side_fov_degrees)) / 2.0;
+    return static_cast<float>(glm::degrees(2.0 * std::atan(std::tan(half) / aspect)));
+}
+
+Camera fit_camera(const BoundingSphere& sphere, float fov_degrees, float aspect,
                   glm::vec3 view_direction) {
     // A point-like mesh (radius 0) still gets a valid frustum.
     const float radius = std::max(sphere.radius, 1e-6f);
@@ -32,7 +38,7 @@ Camera fit_camera(const BoundingSphere& sphere, float fov_y_degrees, float aspec
     Camera camera;
     camera.target = sphere.centre;
     camera.eye = sphere.centre + direction * distance;
-    camera.fov_y_degrees = fov_y_degrees;
+    camera.fov_y_degrees = vertical_fov_degrees(fov_degrees, aspect);
     camera.aspect = aspect;
     camera.near_plane = std::max(distance - radius, 1e-4f * radius);
     camera.far_plane = distance + radius;

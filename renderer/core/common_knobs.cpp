@@ -14,7 +14,9 @@ const std::vector<Knob>& scene_knobs() {
          "direction towards the key light in eye space (x right, y up, z towards the "
          "viewer); normalised on use",
          KnobKind::vec3, -1000.0, 1000.0, glm::dvec3(0.4, 0.6, 1.0)},
-        {"fov_y", "vertical field of view (degrees); 60 fits the bounding sphere exactly",
+        {"fov_y",
+         "field of view across the image's shorter side (degrees; vertical unless the "
+         "image is portrait); 60 fits the bounding sphere exactly",
          KnobKind::scalar, 1.0, 170.0, 60.0},
         {"background", "colour of pixels the object does not cover (linear rgb)",
          KnobKind::rgb, 0.0, 100.0, glm::dvec3(0.0)},

@@ -52,6 +52,15 @@ std::size_t replace_non_finite(Image& image) {
     return replaced;
 }
 
+std::size_t count_non_finite_pixels(const Image& image) {
+    std::size_t pixels = 0;
+    for (std::size_t i = 0; i + 3 < image.rgba.size(); i += 4)
+        if (!std::isfinite(image.rgba[i]) || !std::isfinite(image.rgba[i + 1]) ||
+            !std::isfinite(image.rgba[i + 2]) || !std::isfinite(image.rgba[i + 3]))
+            ++pixels;
+    return pixels;
+}
+
 bool is_supported_image_path(const std::filesystem::path& path) {
     const std::string ext = lower_extension(path);
     return ext == ".exr" || ext == ".png" || ext == ".tif" || ext == ".tiff";

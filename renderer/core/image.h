@@ -32,6 +32,9 @@ struct Image {
 // Replaces NaN with 0 and +-Inf with the largest finite float of that sign; returns how
 // many values it replaced. Every image passes through this before it is written.
 std::size_t replace_non_finite(Image& image);
+// Pixels with at least one NaN or Inf channel: what replace_non_finite() would repair,
+// counted per pixel for reports (manifests, `lucent render` warnings).
+std::size_t count_non_finite_pixels(const Image& image);
 
 class ImageError : public std::runtime_error {
 public:

@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "gl/errors.h"
+
 struct GLFWwindow;
 
 namespace lucent::gl {
@@ -23,7 +25,8 @@ public:
 struct ContextOptions {
     int gl_major = 4;  // OpenGL core profile version requested
     int gl_minor = 5;
-    bool debug = false;  // request a debug context (KHR_debug messages)
+    // A debug context: KHR_debug messages name the failing call in GlError (gl/errors.h).
+    bool debug = debug_contexts_by_default();
 };
 
 struct WindowOptions {

@@ -105,6 +105,7 @@ std::unique_ptr<Context> create_on_display(EGLDisplay display, const std::string
                     "." + std::to_string(options.gl_minor) + " core");
     auto result = std::make_unique<EglContext>(display, context, platform);
     result->make_current();
+    if (options.debug) install_debug_messages();
     return result;
 }
 

@@ -97,6 +97,7 @@ std::unique_ptr<WindowContext> create_window_context(const WindowOptions& window
     }
     glfwMakeContextCurrent(handle);
     glfwSwapInterval(window.vsync ? 1 : 0);
+    if (options.debug) install_debug_messages();
     return std::make_unique<GlfwContext>(handle, label);
 }
 

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/ambient_occlusion.h"
+#include "gl/errors.h"
 #include "gl/program.h"
 #include "gl/readback.h"
 
@@ -218,6 +219,9 @@ struct FrameExecutor::Impl {
             glBindVertexArray(empty_vao.id());
             glDrawArrays(GL_TRIANGLES, 0, 3);
         }
+        // Leave nothing of ours bound: code that saves and restores GL state (ImGui's
+        // back end) would otherwise restore names this executor has since deleted.
+        glUseProgram(0);
         glBindVertexArray(0);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         for (GLint u = 0; u < unit; ++u) glBindTextureUnit(static_cast<GLuint>(u), 0);
@@ -236,9 +240,13 @@ void FrameExecutor::set_ambient_occlusion_source(AmbientOcclusionSource source) 
 void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time_passes) {
     if (plan.width <= 0 || plan.height <= 0)
         throw std::runtime_error("frame plan has no pixels");
+    // Errors left by earlier calls are not this frame's: name them as such.
+    check_errors("GL calls before this frame");
     impl_->upload_mesh(*scene.mesh);
+    check_errors("upload of mesh '" + scene.mesh->name + "'");
     impl_->allocate(plan);
     glDisableVertexArrayAttrib(impl_->mesh_vao.id(), 2);
+    check_errors("allocation of the frame's textures");
 
     GLint timer_bits = 0;
     if (time_passes) glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &timer_bits);
@@ -262,6 +270,7 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
         if (gpu) glEndQuery(GL_TIME_ELAPSED);
         if (time_passes && !gpu && pass.kind != PassKind::bake_ambient_occlusion)
             glFinish();
+        check_errors("pass '" + pass.name + "'");
         wall_ms.push_back(std::chrono::duration<double, std::milli>(
                               std::chrono::steady_clock::now() - start)
                               .count());
@@ -278,12 +287,14 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
         timings_.passes.push_back({plan.passes[i].name, ms});
         timings_.total_milliseconds += ms;
     }
+    check_errors("reading the pass timer queries");
 }
 
 Image FrameExecutor::read_output(const FramePlan& plan) const {
     const auto& texture = impl_->textures.at(plan.output);
     const std::vector<float> pixels =
         read_texture_rgba32f(texture.texture, texture.width, texture.height);
+    check_errors("read-back of '" + plan.output + "'");
     Image image(texture.width, texture.height);
     const std::size_t row = static_cast<std::size_t>(texture.width) * 4;
     for (int y = 0; y < texture.height; ++y)  // GL rows are bottom first
@@ -297,6 +308,7 @@ std::vector<float> FrameExecutor::read_channel(const std::string& resource) cons
     const GLenum format = is_depth_format(texture.format) ? GL_DEPTH_COMPONENT : GL_RED;
     const std::vector<float> pixels =
         read_texture_r32f(texture.texture, format, texture.width, texture.height);
+    check_errors("read-back of '" + resource + "'");
     std::vector<float> flipped(pixels.size());
     const std::size_t row = static_cast<std::size_t>(texture.width);
     for (int y = 0; y < texture.height; ++y)
@@ -317,8 +329,10 @@ void FrameExecutor::present(const FramePlan& plan, int x, int y, int width, int 
     glProgramUniform1i(prog, glGetUniformLocation(prog, "image"), 0);
     glBindVertexArray(impl_->empty_vao.id());
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    glUseProgram(0);
     glBindVertexArray(0);
     glBindTextureUnit(0, 0);
+    check_errors("presenting '" + plan.output + "'");
 }
 
 Image FrameExecutor::render(const Scene& scene, const FramePlan& plan) {

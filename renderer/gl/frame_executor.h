@@ -44,8 +44,9 @@ public:
     void set_ambient_occlusion_source(AmbientOcclusionSource source);
 
     // Runs every pass of `plan` for `scene`. With `time_passes`, last_timings() holds
-    // per-pass times afterwards (this waits for the GPU). Throws ShaderError /
-    // std::runtime_error on GL failures.
+    // per-pass times afterwards (this waits for the GPU). Throws ShaderError, GlError
+    // naming the pass whose GL calls failed (gl/errors.h; checked after every pass,
+    // upload and read-back) or std::runtime_error.
     void execute(const Scene& scene, const FramePlan& plan, bool time_passes = false);
     // The plan's output after execute(), top row first.
     Image read_output(const FramePlan& plan) const;

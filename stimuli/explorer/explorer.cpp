@@ -15,6 +15,7 @@
 
 #include "core/technique.h"
 #include "explorer/stimulus_entry.h"
+#include "gl/default_framebuffer.h"
 #include "gl/readback.h"
 #include "render.h"
 #include "techniques/registry.h"
@@ -98,7 +99,7 @@ void Explorer::load_mesh(const std::string& spec) {
     session_.mesh = spec;
 }
 
-void Explorer::save_image(const std::filesystem::path& path) {
+std::size_t Explorer::save_image(const std::filesystem::path& path) {
     if (!is_supported_image_path(path))
         throw std::invalid_argument(
             "image file: '" + path.string() +
@@ -111,7 +112,9 @@ void Explorer::save_image(const std::filesystem::path& path) {
         scene = make_scene(scene.mesh, find_technique(scene.technique), scene.values,
                            width, height, view_direction(session_));
     gl::FrameExecutor executor;  // its own: disk-cached AO as `lucent render` uses
-    write_image(path, render_image(executor, scene));
+    const RenderedImage rendered = render_image_counted(executor, scene);
+    write_image(path, rendered.image);
+    return rendered.non_finite_pixels;
 }
 
 std::string Explorer::add_to_stimulus_set(const std::filesystem::path& config,
@@ -158,8 +161,12 @@ void Explorer::handle(const PanelRequests& requests) {
             session_.message = "loaded " + session_.mesh;
         }
         if (requests.save_image) {
-            save_image(session_.save_image_path);
+            const std::size_t non_finite = save_image(session_.save_image_path);
             session_.message = "saved " + session_.save_image_path;
+            if (non_finite > 0)
+                session_.message += " (warning: " + std::to_string(non_finite) +
+                                    " pixels had NaN or Inf values, written as 0 or the "
+                                    "largest float)";
         }
         if (requests.add_to_stimulus_set) {
             const std::string id =
@@ -267,10 +274,7 @@ void Explorer::step() {
     }
     draw_view();
 
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glViewport(0, 0, width, height);
-    glClearColor(0.f, 0.f, 0.f, 1.f);
-    glClear(GL_COLOR_BUFFER_BIT);
+    gl::clear_default_framebuffer(width, height, glm::vec3(0.0f));
     window_->render_imgui();
     if (!screenshot_.empty()) {
         const std::vector<std::uint8_t> pixels =

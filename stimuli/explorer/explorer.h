@@ -58,8 +58,9 @@ public:
     void view_size(int& width, int& height) const;
 
     // "Save image": the edited set at the view size through lucent::build_scene,
-    // render_image and write_image, as `lucent render` does. Throws on failure.
-    void save_image(const std::filesystem::path& path);
+    // render_image_counted and write_image, as `lucent render` does. Returns the number
+    // of pixels that had NaN or Inf values (replaced). Throws on failure.
+    std::size_t save_image(const std::filesystem::path& path);
     // "Add to stimulus set": returns the id written (explorer/stimulus_entry.h).
     std::string add_to_stimulus_set(const std::filesystem::path& config,
                                     const std::string& id);

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/technique.h"
+#include "gl/upload.h"
 #include "techniques/registry.h"
 
 namespace lucent::explorer {
@@ -53,8 +54,7 @@ void upload(RenderedSide& side, const std::vector<std::uint8_t>& rgba, int width
         side.texture_width = width;
         side.texture_height = height;
     }
-    glTextureSubImage2D(side.texture.id(), 0, 0, 0, width, height, GL_RGBA,
-                        GL_UNSIGNED_BYTE, rgba.data());
+    gl::upload_texture_rgba8(side.texture, width, height, rgba);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace lucent {
@@ -50,6 +51,33 @@ TEST(Camera, ViewLooksDownMinusZAndProjectionUsesTheFieldOfView) {
     // with aspect 2, a point at x = 2 * depth lands on the right edge.
     EXPECT_NEAR(to_ndc(camera, {0.0f, 2.0f, 0.0f}).y, 1.0f, 1e-5f);
     EXPECT_NEAR(to_ndc(camera, {4.0f, 0.0f, 0.0f}).x, 1.0f, 1e-5f);
+}
+
+// The tangent rays from the eye (distance 2 from a unit sphere) touch it at z = 1/2,
+// |x| or |y| = sqrt(3)/2, 30 degrees off the axis. With fov 60 across the shorter side
+// they land on that side's edges (ndc +-1) and the longer side's ndc is 1/aspect or
+// aspect times smaller, in both orientations.
+TEST(Camera, FieldOfViewSpansTheShorterSideSoTheSphereFitsBothAxes) {
+    const float s = std::sqrt(3.0f) / 2.0f;
+    for (const float aspect : {0.5f, 0.25f, 1.0f, 2.0f, 4.0f}) {
+        const Camera camera = fit_camera({{0.0f, 0.0f, 0.0f}, 1.0f}, 60.0f, aspect);
+        const float x = to_ndc(camera, {s, 0.0f, 0.5f}).x;
+        const float y = to_ndc(camera, {0.0f, s, 0.5f}).y;
+        EXPECT_NEAR(std::max(x, y), 1.0f, 1e-5f) << "aspect " << aspect;
+        EXPECT_NEAR(x, aspect < 1.0f ? 1.0f : 1.0f / aspect, 1e-5f)
+            << "aspect " << aspect;
+        EXPECT_NEAR(y, aspect < 1.0f ? aspect : 1.0f, 1e-5f) << "aspect " << aspect;
+    }
+    // Square and landscape images keep the knob as their vertical field of view.
+    EXPECT_EQ(fit_camera({{0, 0, 0}, 1.0f}, 60.0f, 1.0f).fov_y_degrees, 60.0f);
+    EXPECT_EQ(fit_camera({{0, 0, 0}, 1.0f}, 37.0f, 1.6f).fov_y_degrees, 37.0f);
+    // Portrait: tan(fov_y / 2) = tan(30 deg) / aspect.
+    EXPECT_NEAR(std::tan(glm::radians(vertical_fov_degrees(60.0f, 0.5f)) / 2.0f),
+                2.0f * std::tan(glm::radians(30.0f)), 1e-5f);
+    // Even the narrowest image keeps a finite projection below 180 degrees.
+    const float narrow = vertical_fov_degrees(170.0f, 1.0f / 16384.0f);
+    EXPECT_LT(narrow, 180.0f);
+    EXPECT_GT(narrow, 170.0f);
 }
 
 TEST(Camera, ViewFromStraightAboveIsStillAValidMatrix) {

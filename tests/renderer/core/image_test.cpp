@@ -64,7 +64,9 @@ TEST(ImageIo, NonFiniteValuesAreNeverWritten) {
     image.set(0, 0, {std::nanf(""), inf, -inf, 1.0f});
     image.set(1, 0, {0.5f, 0.5f, 0.5f, std::nanf("")});
     Image copy = image;
-    EXPECT_EQ(replace_non_finite(copy), 4u);
+    EXPECT_EQ(count_non_finite_pixels(image), 2u);  // per pixel: (0,0) and (1,0)
+    EXPECT_EQ(replace_non_finite(copy), 4u);        // per value
+    EXPECT_EQ(count_non_finite_pixels(copy), 0u);
     EXPECT_EQ(copy.at(0, 0).r, 0.0f);
     EXPECT_EQ(copy.at(0, 0).g, std::numeric_limits<float>::max());
     EXPECT_EQ(copy.at(0, 0).b, -std::numeric_limits<float>::max());
