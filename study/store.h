@@ -7,11 +7,13 @@
 // trial's ratings are committed in one transaction (record_trial) before the next trial
 // starts, so a crash loses at most the trial on screen and never duplicates a rating.
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "protocol.h"
+#include "question_scales.h"
 #include "sqlite.h"
 #include "trial_plan.h"
 
@@ -103,8 +105,16 @@ public:
     void update_environment(int64_t session_id, const SessionEnvironment& env);
     void set_consent(int64_t session_id);
     bool has_consent(int64_t session_id);
-    // Commits one trial's ratings atomically; refuses a trial that already has ratings.
-    void record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome);
+    // Commits one trial's ratings atomically; refuses a trial that already has ratings,
+    // a question the study does not ask, or a rating outside 1..points of its question.
+    // The trial that answers the session's last open trial also sets it `completed` (with
+    // ended_utc) in the same transaction, so no crash can leave it answered but open.
+    // Returns true when the session is now completed.
+    bool record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome);
+    // Sets `completed` when every planned trial has its ratings (repairs sessions written
+    // before completion was atomic); true when the session is completed afterwards.
+    bool complete_session_if_answered(int64_t session_id);
+    // A completed session is final: any other status for it throws StoreError.
     void set_status(int64_t session_id, const std::string& status, bool ended);
 
     // Deletes a participant and everything recorded for them; false when unknown.
@@ -113,7 +123,10 @@ public:
     Database& db() { return db_; }
 
 private:
+    const QuestionPoints& question_points_of_session(int64_t session_id);
+
     Database db_;
+    std::map<int64_t, QuestionPoints> question_points_by_session_;  // parsed once
 };
 
 std::string utc_now_iso8601();

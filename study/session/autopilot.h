@@ -14,9 +14,8 @@ namespace lucent::study {
 struct ScreenView {
     enum class Kind { Text, Rating, Blank, Pause };
     Kind kind = Kind::Blank;
-    int serial = 0;         // increases whenever a new screen appears
-    int questions = 0;      // rating screens
-    int points = 7;
+    int serial = 0;           // increases whenever a new screen appears
+    std::vector<int> points;  // rating screens: each question's scale length
     bool is_catch = false;  // catch trials: the prompt asks for `expected`
     int expected = 0;
 };
@@ -39,6 +38,8 @@ public:
     // Keys due at `now_ns` for the screen shown; call once per frame.
     std::vector<std::string> due(int64_t now_ns, const ScreenView& view);
     bool scripted() const { return scripted_; }
+    // A script's (delay ms after the previous key, key) lines, for XKeyboard::play.
+    const std::vector<std::pair<double, std::string>>& script() const { return script_; }
 
 private:
     void plan_screen(int64_t now_ns, const ScreenView& view);

@@ -66,6 +66,20 @@ expected = 7
 
 inline study::Protocol small_protocol() { return study::parse_protocol(kSmallProtocol, "small.toml"); }
 
+// The small protocol with mixed scales: 'translucent' keeps 7 points, 'realistic' gets 5
+// (the catch trial then asks for 5, the most every scale has).
+inline std::string mixed_scale_protocol_text() {
+    std::string text = kSmallProtocol;
+    const std::string realistic = "text = \"The object looks realistic.\"";
+    text.replace(text.find(realistic), realistic.size(),
+                 realistic + "\nlabels = [\"not at all\", \"\", \"\", \"\", \"fully\"]");
+    text.replace(text.find("expected = 7"), 12, "expected = 5");
+    return text;
+}
+inline study::Protocol mixed_scale_protocol() {
+    return study::parse_protocol(mixed_scale_protocol_text(), "mixed.toml");
+}
+
 // Deterministic rating for (trial position, question index): lets tests recompute
 // expected exports independently of the database.
 inline int rating_for(int position, int question) { return 1 + (position * 3 + question * 2) % 7; }
