@@ -1,5 +1,7 @@
 #include "question_scales.h"
 
+#include "store.h"
+
 namespace lucent::study {
 
 QuestionPoints question_points(const Protocol& protocol) {
@@ -45,6 +47,13 @@ void check_stored_ratings(Database& db) {
                               db.path() + ": participant '" + s.text(1) + "', session " +
                                   s.text(2) + ", trial " + std::to_string(s.integer(3)));
     }
+}
+
+void check_stored_ratings(const std::string& path) {
+    check_database_file(path);
+    Database db(path, SQLITE_OPEN_READONLY);
+    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'responses'") == 0) return;
+    check_stored_ratings(db);
 }
 
 }  // namespace lucent::study

@@ -137,15 +137,13 @@ RunResult Session::prepare_store() {
     resumable_ = store_->unfinished_session(opt_.participant);
     // Every trial answered but still open: left so by a build where completion was not
     // atomic. It is complete; mark it so instead of reopening it.
-    if (resumable_ && store_->complete_session_if_answered(resumable_->id)) {
-        log_ << "lucent run: session " << resumable_->uuid << " of participant '"
-             << opt_.participant << "' has every trial answered; marked completed\n";
-        resumable_.reset();
-    }
+    const bool repaired = resumable_ && store_->complete_session_if_answered(resumable_->id);
+    if (repaired) resumable_.reset();
     if (!resumable_ && store_->has_completed_session(opt_.participant)) {
         log_ << "lucent run: participant '" << opt_.participant << "' already completed this study in "
-             << opt_.db_path << "; nothing to " << (opt_.resume ? "resume" : "run")
-             << " (use a new participant code for a new session)\n";
+             << opt_.db_path << (repaired ? " (every trial answered; session now marked completed)" : "")
+             << "; nothing to " << (opt_.resume ? "resume" : "run")
+             << " (a new participant code starts a new session)\n";
         return RunResult::UsageError;
     }
     if (opt_.resume && !resumable_) {
@@ -172,7 +170,7 @@ void Session::open_window() {
     w.window.title = "Lucent study: " + p_.title;
     window_ = std::make_unique<ui::ImGuiWindow>(w);
     try {
-        x_keys_.emplace(window_->glfw());
+        x_keys_.emplace(window_->glfw(), opt_.key_trace_path);
     } catch (const std::exception& e) {
         log_ << "lucent run: " << e.what()
              << "; key times are taken per frame (up to one frame late)\n";

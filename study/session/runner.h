@@ -23,6 +23,7 @@ struct RunOptions {
     std::string autopilot;       // "" (a person), a seed, or a script file
     double autopilot_speed = 1.0;
     std::string screenshot_path;   // save the first rating screen as PNG (tests)
+    std::string key_trace_path;    // each key press's X event time and stamp (tests)
 };
 
 // Outcome: RunResult (session_flow.h), mapped to exit codes by the caller. A participant

@@ -1,5 +1,7 @@
 #include "session/x_key_events.h"
 
+#include "session/frame_timing.h"
+
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <X11/XKBlib.h>
@@ -49,7 +51,11 @@ std::optional<TimedKey> press_for(XKeyEvent& event, int64_t t_ns) {
 
 }  // namespace
 
-XKeyEvents::XKeyEvents(GLFWwindow* window) {
+XKeyEvents::XKeyEvents(GLFWwindow* window, const std::string& trace_path) {
+    if (!trace_path.empty()) {
+        trace_.open(trace_path);
+        if (!trace_) throw std::runtime_error(trace_path + ": cannot write the key trace");
+    }
     Display* glfw_display = glfwGetX11Display();
     if (!glfw_display) throw std::runtime_error("key timing needs an X11 display; none is in use");
     Display* dpy = XOpenDisplay(DisplayString(glfw_display));
@@ -104,9 +110,12 @@ void XKeyEvents::loop() {
             const unsigned code = event.xkey.keycode & 0xFF;
             if (down.test(code)) continue;
             down.set(code);
-            if (const auto press = press_for(event.xkey, t)) {
+            const int64_t stamped = key_press_time(t, static_cast<uint32_t>(event.xkey.time));
+            if (const auto press = press_for(event.xkey, stamped)) {
                 std::lock_guard<std::mutex> lock(mutex_);
                 pending_.push_back(*press);
+                if (trace_.is_open())
+                    trace_ << event.xkey.time << " " << t << " " << stamped << std::endl;
             }
         }
     }

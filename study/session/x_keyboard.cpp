@@ -69,18 +69,18 @@ void XKeyboard::tap(const std::string& key, int hold_ms) {
 
 void XKeyboard::play(const std::vector<std::pair<double, std::string>>& script) {
     Display* dpy = static_cast<Display*>(display_);
-    // Times in whole ms from the start, rounded once, so delays never drift.
-    std::vector<long> at;
+    // Each press waits its delay after the previous press on the server's timer, and is
+    // released at once: one timer per interval, so the intervals keep the timer's 1 ms
+    // steps (a held key would put the release's timer inside the next interval).
+    // Delays are rounded from the running total, so they never drift.
     double t = 0;
-    for (const auto& [delay, key] : script) at.push_back(std::lround(t += delay));
-    long sent = 0;  // when the last event sent is due, ms from the start
-    for (size_t i = 0; i < script.size(); ++i) {
-        const KeyCode code = keycode(dpy, script[i].second);
-        const long gap = i + 1 < at.size() ? at[i + 1] - at[i] : 80;
-        const long hold = std::min(40L, gap / 2);
-        XTestFakeKeyEvent(dpy, code, True, static_cast<unsigned long>(at[i] - sent));
-        XTestFakeKeyEvent(dpy, code, False, static_cast<unsigned long>(hold));
-        sent = at[i] + hold;
+    long sent = 0;  // ms from the start of the last press sent
+    for (const auto& [delay, key] : script) {
+        const long at = std::lround(t += delay);
+        const KeyCode code = keycode(dpy, key);
+        XTestFakeKeyEvent(dpy, code, True, static_cast<unsigned long>(at - sent));
+        XTestFakeKeyEvent(dpy, code, False, CurrentTime);
+        sent = at;
     }
     XFlush(dpy);
 }

@@ -28,8 +28,7 @@ public:
     // Hands a whole script of (delay ms after the previous key, key) to the X server at
     // once, each press scheduled by the server's XTest delay: the key times are then
     // as exact as the server's millisecond timer, independent of the frame loop (the
-    // response-time tests rely on it). Each key is held 40 ms, or half the gap to the
-    // next one when that is shorter.
+    // response-time tests rely on it). Each key is released as soon as it is pressed.
     void play(const std::vector<std::pair<double, std::string>>& script);
 
 private:
