@@ -69,12 +69,12 @@ inline study::Protocol small_protocol() { return study::parse_protocol(kSmallPro
 // The small protocol with mixed scales: 'translucent' keeps 7 points, 'realistic' gets 5
 // (the catch trial then asks for 5, the most every scale has).
 inline std::string mixed_scale_protocol_text() {
-    std::string text = kSmallProtocol;
-    const std::string realistic = "text = \"The object looks realistic.\"";
-    text.replace(text.find(realistic), realistic.size(),
-                 realistic + "\nlabels = [\"not at all\", \"\", \"\", \"\", \"fully\"]");
-    text.replace(text.find("expected = 7"), 12, "expected = 5");
-    return text;
+    const std::string text = kSmallProtocol;
+    const std::string realistic = "text = \"The object looks realistic.\"\n";
+    const size_t question = text.find(realistic) + realistic.size();
+    const size_t expected = text.find("expected = 7");
+    return text.substr(0, question) + "labels = [\"not at all\", \"\", \"\", \"\", \"fully\"]\n" +
+           text.substr(question, expected - question) + "expected = 5" + text.substr(expected + 12);
 }
 inline study::Protocol mixed_scale_protocol() {
     return study::parse_protocol(mixed_scale_protocol_text(), "mixed.toml");
