@@ -22,7 +22,16 @@
 
 namespace lucent::study {
 
-enum class Screen { Consent, Instructions, PracticeDone, Blank, Trial, Break, Debrief, Done };
+enum class Screen {
+    Consent,
+    Instructions,
+    PracticeDone,
+    Blank,
+    Trial,
+    Break,
+    Debrief,
+    Done
+};
 
 // How a session ended, mapped to exit codes by the caller.
 enum class RunResult { Completed, SavedAndQuit, Declined, UsageError, Failure };
@@ -70,7 +79,8 @@ public:
     // The trial on a Blank or Trial screen; the rating input once the stimulus is shown.
     const TrialRow* trial() const;
     const RatingInput* rating() const { return input_ ? &*input_ : nullptr; }
-    const std::string& text() const;  // Consent, Instructions, PracticeDone, Break, Debrief
+    const std::string& text()
+        const;  // Consent, Instructions, PracticeDone, Break, Debrief
     size_t answered_trials() const { return current_; }
     size_t total_trials() const { return trials_.size(); }
     int main_trials_done() const;

@@ -25,7 +25,8 @@ namespace {
 
 int64_t now_ns() {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch()).count();
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
 }
 
 std::optional<TimedKey> press_for(XKeyEvent& event, int64_t t_ns) {
@@ -33,19 +34,30 @@ std::optional<TimedKey> press_for(XKeyEvent& event, int64_t t_ns) {
     if (IsKeypadKey(sym) || (sym >= XK_KP_Home && sym <= XK_KP_Delete))
         sym = XLookupKeysym(&event, 1);  // keypad digits whatever the NumLock state
     if (sym >= XK_1 && sym <= XK_9) return TimedKey{Key::Digit, int(sym - XK_0), t_ns};
-    if (sym >= XK_KP_1 && sym <= XK_KP_9) return TimedKey{Key::Digit, int(sym - XK_KP_0), t_ns};
+    if (sym >= XK_KP_1 && sym <= XK_KP_9)
+        return TimedKey{Key::Digit, int(sym - XK_KP_0), t_ns};
     switch (sym) {
-    case XK_Return:
-    case XK_KP_Enter: return TimedKey{Key::Enter, 0, t_ns};
-    case XK_Escape: return TimedKey{Key::Escape, 0, t_ns};
-    case XK_Left: return TimedKey{Key::Left, 0, t_ns};
-    case XK_Right: return TimedKey{Key::Right, 0, t_ns};
-    case XK_Up: return TimedKey{Key::Up, 0, t_ns};
-    case XK_Down: return TimedKey{Key::Down, 0, t_ns};
-    case XK_q: return TimedKey{Key::Quit, 0, t_ns};
-    case XK_r: return TimedKey{Key::Resume, 0, t_ns};
-    case XK_n: return TimedKey{Key::Decline, 0, t_ns};
-    default: return std::nullopt;
+        case XK_Return:
+        case XK_KP_Enter:
+            return TimedKey{Key::Enter, 0, t_ns};
+        case XK_Escape:
+            return TimedKey{Key::Escape, 0, t_ns};
+        case XK_Left:
+            return TimedKey{Key::Left, 0, t_ns};
+        case XK_Right:
+            return TimedKey{Key::Right, 0, t_ns};
+        case XK_Up:
+            return TimedKey{Key::Up, 0, t_ns};
+        case XK_Down:
+            return TimedKey{Key::Down, 0, t_ns};
+        case XK_q:
+            return TimedKey{Key::Quit, 0, t_ns};
+        case XK_r:
+            return TimedKey{Key::Resume, 0, t_ns};
+        case XK_n:
+            return TimedKey{Key::Decline, 0, t_ns};
+        default:
+            return std::nullopt;
     }
 }
 
@@ -54,16 +66,21 @@ std::optional<TimedKey> press_for(XKeyEvent& event, int64_t t_ns) {
 XKeyEvents::XKeyEvents(GLFWwindow* window, const std::string& trace_path) {
     if (!trace_path.empty()) {
         trace_.open(trace_path);
-        if (!trace_) throw std::runtime_error(trace_path + ": cannot write the key trace");
+        if (!trace_)
+            throw std::runtime_error(trace_path + ": cannot write the key trace");
     }
     Display* glfw_display = glfwGetX11Display();
-    if (!glfw_display) throw std::runtime_error("key timing needs an X11 display; none is in use");
+    if (!glfw_display)
+        throw std::runtime_error("key timing needs an X11 display; none is in use");
     Display* dpy = XOpenDisplay(DisplayString(glfw_display));
-    if (!dpy) throw std::runtime_error("cannot open a second connection to the X display");
+    if (!dpy)
+        throw std::runtime_error("cannot open a second connection to the X display");
     display_ = dpy;
-    // Auto-repeat then sends presses without releases between them: a held key is one press.
+    // Auto-repeat then sends presses without releases between them: a held key is one
+    // press.
     XkbSetDetectableAutoRepeat(dpy, True, nullptr);
-    XSelectInput(dpy, glfwGetX11Window(window), KeyPressMask | KeyReleaseMask | FocusChangeMask);
+    XSelectInput(dpy, glfwGetX11Window(window),
+                 KeyPressMask | KeyReleaseMask | FocusChangeMask);
     XSync(dpy, False);
     if (pipe(wake_) != 0) {
         XCloseDisplay(dpy);
@@ -74,7 +91,8 @@ XKeyEvents::XKeyEvents(GLFWwindow* window, const std::string& trace_path) {
 
 XKeyEvents::~XKeyEvents() {
     const char stop = 1;
-    if (write(wake_[1], &stop, 1) != 1) {}
+    if (write(wake_[1], &stop, 1) != 1) {
+    }
     thread_.join();
     close(wake_[0]);
     close(wake_[1]);
@@ -110,7 +128,8 @@ void XKeyEvents::loop() {
             const unsigned code = event.xkey.keycode & 0xFF;
             if (down.test(code)) continue;
             down.set(code);
-            const int64_t stamped = key_press_time(t, static_cast<uint32_t>(event.xkey.time));
+            const int64_t stamped =
+                key_press_time(t, static_cast<uint32_t>(event.xkey.time));
             if (const auto press = press_for(event.xkey, stamped)) {
                 std::lock_guard<std::mutex> lock(mutex_);
                 pending_.push_back(*press);

@@ -34,7 +34,8 @@ namespace lucent::study {
 class XKeyEvents {
 public:
     // Throws std::runtime_error (one line) when the window is not on an X11 display.
-    // `trace_path`: when set, one line per press, "SERVER_MS RECEIPT_NS STAMP_NS" (tests).
+    // `trace_path`: when set, one line per press, "SERVER_MS RECEIPT_NS STAMP_NS"
+    // (tests).
     explicit XKeyEvents(GLFWwindow* window, const std::string& trace_path = "");
     ~XKeyEvents();
     XKeyEvents(const XKeyEvents&) = delete;

@@ -33,7 +33,8 @@ TrialOutcome outcome(int translucent, int realistic) {
     TrialOutcome o;
     o.onset_ns = 1;
     o.confirm_ns = 2;
-    for (const auto& [q, v] : {std::pair{"translucent", translucent}, {"realistic", realistic}})
+    for (const auto& [q, v] :
+         {std::pair{"translucent", translucent}, {"realistic", realistic}})
         o.responses.push_back({q, v, 100.0, 0, 1, 1});
     return o;
 }
@@ -56,7 +57,8 @@ TEST(QuestionScales, TheStoreRefusesARatingBeyondItsQuestionsScale) {
         EXPECT_NE(message.find("'realistic'"), std::string::npos) << message;
         EXPECT_NE(message.find("1..5"), std::string::npos) << message;
     }
-    EXPECT_THROW(store.record_trial(m.session.id, m.trials[1].id, outcome(0, 3)), StoreError);
+    EXPECT_THROW(store.record_trial(m.session.id, m.trials[1].id, outcome(0, 3)),
+                 StoreError);
     TrialOutcome unknown = outcome(3, 3);
     unknown.responses[1].question = "varnished";
     EXPECT_THROW(store.record_trial(m.session.id, m.trials[1].id, unknown), StoreError);
@@ -84,7 +86,8 @@ TEST(QuestionScales, StoredImpossibleRatingsAreFoundAndNamed) {
         const std::string message = e.what();
         EXPECT_NE(message.find("participant 'P1'"), std::string::npos) << message;
         EXPECT_NE(message.find(m.session.uuid), std::string::npos) << message;
-        EXPECT_NE(message.find("rating 7 for question 'realistic'"), std::string::npos) << message;
+        EXPECT_NE(message.find("rating 7 for question 'realistic'"), std::string::npos)
+            << message;
         EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
 }

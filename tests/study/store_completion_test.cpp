@@ -33,12 +33,16 @@ TEST(StoreCompletion, TheLastTrialCompletesTheSessionInItsTransaction) {
     Store store((dir / "s.db").string());
     const Protocol p = small_protocol();
     const SessionRow s = almost_done(store, p);
-    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'running' "
-                                    "AND ended_utc IS NULL"), 1);
+    EXPECT_EQ(
+        store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'running' "
+                              "AND ended_utc IS NULL"),
+        1);
     EXPECT_TRUE(store.record_trial(s.id, store.trials(s.id).back().id,
                                    outcome_for(p, store.trials(s.id).back())));
-    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
-                                    "AND ended_utc IS NOT NULL"), 1);
+    EXPECT_EQ(
+        store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
+                              "AND ended_utc IS NOT NULL"),
+        1);
     EXPECT_FALSE(store.unfinished_session("P1").has_value());
     EXPECT_TRUE(store.has_completed_session("P1"));
 }
@@ -51,8 +55,10 @@ TEST(StoreCompletion, ACompletedSessionIsNeverReopened) {
         EXPECT_THROW(store.set_status(id, status, false), StoreError) << status;
     }
     store.set_status(id, "completed", true);  // saying it again is harmless
-    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
-                                    "AND ended_utc IS NOT NULL"), 1);
+    EXPECT_EQ(
+        store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
+                              "AND ended_utc IS NOT NULL"),
+        1);
 }
 
 TEST(StoreCompletion, AnsweredButOpenSessionsFromOlderBuildsAreRepaired) {
@@ -61,12 +67,15 @@ TEST(StoreCompletion, AnsweredButOpenSessionsFromOlderBuildsAreRepaired) {
     const Protocol p = small_protocol();
     const SessionRow s = almost_done(store, p);
     EXPECT_FALSE(store.complete_session_if_answered(s.id));
-    store.record_trial(s.id, store.trials(s.id).back().id, outcome_for(p, store.trials(s.id).back()));
+    store.record_trial(s.id, store.trials(s.id).back().id,
+                       outcome_for(p, store.trials(s.id).back()));
     // What Escape on the debrief did before: completed turned back into paused.
     store.db().exec("UPDATE sessions SET status = 'paused', ended_utc = NULL");
     EXPECT_TRUE(store.complete_session_if_answered(s.id));
-    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
-                                    "AND ended_utc IS NOT NULL"), 1);
+    EXPECT_EQ(
+        store.db().scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
+                              "AND ended_utc IS NOT NULL"),
+        1);
 }
 
 TEST(StoreCompletion, FailingAnyWriteOfTheLastTrialLeavesItAllOrNothing) {
@@ -81,7 +90,8 @@ TEST(StoreCompletion, FailingAnyWriteOfTheLastTrialLeavesItAllOrNothing) {
     int faults = 0;
     for (int n = 1; n < 200; ++n) {
         const fs::path path = dir / "work.db";
-        for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(path.string() + suffix);
+        for (const char* suffix : {"", "-wal", "-shm"})
+            fs::remove(path.string() + suffix);
         fs::copy_file(baseline, path);
         bool failed = false;
         {
@@ -103,9 +113,11 @@ TEST(StoreCompletion, FailingAnyWriteOfTheLastTrialLeavesItAllOrNothing) {
             "SELECT count(*) FROM trials t WHERE NOT EXISTS "
             "(SELECT 1 FROM responses r WHERE r.trial_id = t.id)");
         const int64_t completed = db.scalar_int(
-            "SELECT count(*) FROM sessions WHERE status = 'completed' AND ended_utc IS NOT NULL");
-        EXPECT_EQ(open_trials == 0, completed == 1) << "write " << n << ": " << open_trials
-                                                    << " open trials, completed " << completed;
+            "SELECT count(*) FROM sessions WHERE status = 'completed' AND ended_utc IS "
+            "NOT NULL");
+        EXPECT_EQ(open_trials == 0, completed == 1)
+            << "write " << n << ": " << open_trials << " open trials, completed "
+            << completed;
         EXPECT_EQ(open_trials + completed, 1) << "write " << n;
         if (!failed) break;
         ++faults;

@@ -17,12 +17,13 @@ inline bool display_required() {
 
 }  // namespace lucent::test
 
-#define LUCENT_REQUIRE_DISPLAY()                                                           \
-    do {                                                                                   \
-        if (!std::getenv("DISPLAY")) {                                                     \
-            if (::lucent::test::display_required())                                        \
-                FAIL() << "no X display, but LUCENT_REQUIRE_DISPLAY is set (scripts/test " \
-                          "runs ctest under xvfb-run: is xvfb installed?)";                \
-            GTEST_SKIP() << "no X display (scripts/test runs ctest under xvfb-run)";       \
-        }                                                                                  \
+#define LUCENT_REQUIRE_DISPLAY()                                                        \
+    do {                                                                                \
+        if (!std::getenv("DISPLAY")) {                                                  \
+            if (::lucent::test::display_required())                                     \
+                FAIL()                                                                  \
+                    << "no X display, but LUCENT_REQUIRE_DISPLAY is set (scripts/test " \
+                       "runs ctest under xvfb-run: is xvfb installed?)";                \
+            GTEST_SKIP() << "no X display (scripts/test runs ctest under xvfb-run)";    \
+        }                                                                               \
     } while (0)

@@ -24,21 +24,24 @@ class Flow : public ::testing::Test {
 protected:
     void open(const std::string& protocol_text, bool consented = false) {
         protocol_ = parse_protocol(protocol_text, "flow.toml");
-        dir_ = lucent::test::scratch_dir(std::string("flow_") +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = lucent::test::scratch_dir(
+            std::string("flow_") +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
         db_path_ = (dir_ / "s.db").string();
         store_ = std::make_unique<Store>(db_path_);
         const int64_t study = store_->ensure_study(protocol_);
         int number = 0;
         const int64_t pid = store_->ensure_participant(study, "P1", &number);
-        session_ = store_->create_session(study, pid, plan_trials(protocol_, 5, number), 5, {});
+        session_ =
+            store_->create_session(study, pid, plan_trials(protocol_, 5, number), 5, {});
         if (consented) store_->set_consent(session_.id);
         restart(consented);
     }
     // A new flow over the stored session (as a resumed run builds it).
     void restart(bool consented) {
-        flow_ = std::make_unique<SessionFlow>(protocol_, *store_, session_.id,
-                                              store_->trials(session_.id), consented, now_);
+        flow_ =
+            std::make_unique<SessionFlow>(protocol_, *store_, session_.id,
+                                          store_->trials(session_.id), consented, now_);
     }
     // One frame: the clock advances 16 ms, time passes for the flow, the frame is shown.
     void frame() {
@@ -88,12 +91,15 @@ TEST_F(Flow, WalksConsentInstructionsPracticeTrialsBreaksAndDebrief) {
     // The expected screens, from the stored plan alone.
     std::vector<Screen> expected = {Screen::Consent, Screen::Instructions};
     for (size_t i = 0; i < plan.size(); ++i) {
-        if (i > 0 && plan[i - 1].practice && !plan[i].practice) expected.push_back(Screen::PracticeDone);
-        else if (plan[i].break_before) expected.push_back(Screen::Break);
+        if (i > 0 && plan[i - 1].practice && !plan[i].practice)
+            expected.push_back(Screen::PracticeDone);
+        else if (plan[i].break_before)
+            expected.push_back(Screen::Break);
         expected.push_back(Screen::Trial);
     }
     expected.push_back(Screen::Debrief);
-    ASSERT_NE(std::count(expected.begin(), expected.end(), Screen::Break), 0) << "plan has no break";
+    ASSERT_NE(std::count(expected.begin(), expected.end(), Screen::Break), 0)
+        << "plan has no break";
 
     std::vector<Screen> seen;  // each screen once, as it appears
     for (int step = 0; step < 2000 && !flow_->finished(); ++step) {
@@ -101,14 +107,17 @@ TEST_F(Flow, WalksConsentInstructionsPracticeTrialsBreaksAndDebrief) {
         const Screen s = flow_->screen();
         if (s == Screen::Blank || (s == Screen::Trial && !flow_->rating())) continue;
         seen.push_back(s);
-        if (s == Screen::Trial) answer(3);
-        else press(Key::Enter);
+        if (s == Screen::Trial)
+            answer(3);
+        else
+            press(Key::Enter);
     }
     EXPECT_EQ(seen, expected);
     EXPECT_TRUE(flow_->finished());
     EXPECT_EQ(flow_->result(), RunResult::Completed);
     EXPECT_EQ(stored_status(), "completed+ended");
-    EXPECT_EQ(count("SELECT count(*) FROM responses"), static_cast<int64_t>(plan.size() * 2));
+    EXPECT_EQ(count("SELECT count(*) FROM responses"),
+              static_cast<int64_t>(plan.size() * 2));
     EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE consent_utc IS NOT NULL"), 1);
 }
 
@@ -118,7 +127,8 @@ TEST_F(Flow, TheLastConfirmCompletesTheSessionBeforeAnythingElseHappens) {
     // Everything but the last trial answered straight in the store; the flow resumes.
     const std::vector<TrialRow> trials = store_->trials(session_.id);
     for (size_t i = 0; i + 1 < n; ++i)
-        store_->record_trial(session_.id, trials[i].id, lucent::test::outcome_for(protocol_, trials[i]));
+        store_->record_trial(session_.id, trials[i].id,
+                             lucent::test::outcome_for(protocol_, trials[i]));
     restart(true);
     EXPECT_EQ(stored_status(), "running");
     answer(trials.back().is_catch ? 7 : 2);
@@ -135,7 +145,8 @@ TEST_F(Flow, EscapeQuitAndWindowCloseOnTheDebriefNeverReopenTheSession) {
         const std::vector<TrialRow> trials = store_->trials(session_.id);
         for (const TrialRow& t : trials)
             if (&t != &trials.back())
-                store_->record_trial(session_.id, t.id, lucent::test::outcome_for(protocol_, t));
+                store_->record_trial(session_.id, t.id,
+                                     lucent::test::outcome_for(protocol_, t));
         restart(true);
         answer(trials.back().is_catch ? 7 : 4);
         ASSERT_EQ(flow_->screen(), Screen::Debrief);
@@ -205,7 +216,8 @@ TEST_F(Flow, AQuickDoubleEnterCannotSkipABreak) {
     ASSERT_LT(i, trials.size()) << "plan has no break";
     ASSERT_FALSE(trials[i - 1].practice);
     for (size_t k = 0; k + 1 < i; ++k)
-        store_->record_trial(session_.id, trials[k].id, lucent::test::outcome_for(protocol_, trials[k]));
+        store_->record_trial(session_.id, trials[k].id,
+                             lucent::test::outcome_for(protocol_, trials[k]));
     restart(true);
     until_rating();
     const Question& last = protocol_.questions.back();
@@ -248,9 +260,14 @@ TEST_F(Flow, BlankGivesWayToTheStimulusAfterTheInterTrialInterval) {
     flow_->key({Key::Enter, 0, onset + 900 * kMs});
     Database d(db_path_, SQLITE_OPEN_READONLY);
     EXPECT_EQ(d.scalar_int("SELECT onset_ns FROM trials WHERE position = 0"), onset);
-    EXPECT_EQ(d.scalar_int("SELECT confirm_ns FROM trials WHERE position = 0"), onset + 900 * kMs);
-    EXPECT_EQ(d.scalar_int("SELECT round(rt_ms) FROM responses WHERE question = 'translucent'"), 250);
-    EXPECT_EQ(d.scalar_int("SELECT round(rt_ms) FROM responses WHERE question = 'realistic'"), 650);
+    EXPECT_EQ(d.scalar_int("SELECT confirm_ns FROM trials WHERE position = 0"),
+              onset + 900 * kMs);
+    EXPECT_EQ(
+        d.scalar_int("SELECT round(rt_ms) FROM responses WHERE question = 'translucent'"),
+        250);
+    EXPECT_EQ(
+        d.scalar_int("SELECT round(rt_ms) FROM responses WHERE question = 'realistic'"),
+        650);
 }
 
 TEST_F(Flow, PauseRestartsTheTrialAndQuitSavesItPaused) {
@@ -276,7 +293,8 @@ TEST_F(Flow, PauseRestartsTheTrialAndQuitSavesItPaused) {
     press(Key::Digit, 1);
     press(Key::Enter);
     // Timed from the new onset: neither the first showing nor the pause counts.
-    EXPECT_EQ(count("SELECT round(rt_ms) FROM responses WHERE question = 'translucent'"), 300);
+    EXPECT_EQ(count("SELECT round(rt_ms) FROM responses WHERE question = 'translucent'"),
+              300);
     // Pause again on the next trial and quit: saved as paused, not ended.
     ASSERT_EQ(flow_->screen(), Screen::PracticeDone);  // the first trial was the practice
     frame();
@@ -310,13 +328,16 @@ TEST_F(Flow, WindowCloseMidSessionSavesAndDeclineAborts) {
 TEST_F(Flow, AResumedSessionStartsAtItsFirstOpenTrial) {
     open(lucent::test::kSmallProtocol, true);
     const std::vector<TrialRow> trials = store_->trials(session_.id);
-    store_->record_trial(session_.id, trials[0].id, lucent::test::outcome_for(protocol_, trials[0]));
-    store_->record_trial(session_.id, trials[1].id, lucent::test::outcome_for(protocol_, trials[1]));
+    store_->record_trial(session_.id, trials[0].id,
+                         lucent::test::outcome_for(protocol_, trials[0]));
+    store_->record_trial(session_.id, trials[1].id,
+                         lucent::test::outcome_for(protocol_, trials[1]));
     restart(true);
     EXPECT_EQ(flow_->screen(), Screen::Blank);
     EXPECT_EQ(flow_->answered_trials(), 2u);
     EXPECT_EQ(flow_->trial()->id, trials[2].id);
-    restart(false);  // no consent on record: from the start (no consent text: instructions)
+    restart(
+        false);  // no consent on record: from the start (no consent text: instructions)
     EXPECT_EQ(flow_->screen(), Screen::Instructions);
 }
 
@@ -331,11 +352,11 @@ TEST_F(Flow, EachQuestionKeepsItsOwnScale) {
     press(Key::Digit, 7);  // beyond the 5-point scale: ignored
     press(Key::Enter);     // so Enter does not confirm
     EXPECT_FALSE(flow_->rating()->rating(1).has_value());
-    press(Key::Right);     // the first arrow picks the middle of 1..5
+    press(Key::Right);  // the first arrow picks the middle of 1..5
     EXPECT_EQ(flow_->rating()->rating(1), 3);
     press(Key::Right);
     press(Key::Right);
-    press(Key::Right);     // clamped at 5
+    press(Key::Right);  // clamped at 5
     EXPECT_EQ(flow_->rating()->rating(1), 5);
     press(Key::Enter);
     EXPECT_EQ(count("SELECT rating FROM responses WHERE question = 'translucent'"), 7);
