@@ -87,16 +87,8 @@ void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
 
 std::vector<std::string> Autopilot::due(int64_t now_ns, const ScreenView& view) {
     std::vector<std::string> keys;
-    if (scripted_) {
-        if (script_start_ < 0) {
-            script_start_ = now_ns;
-            double t = 0;
-            for (const auto& [delay, key] : script_) {
-                t += delay;
-                queue_.push_back({now_ns + static_cast<int64_t>(t * 1e6), key});
-            }
-        }
-    } else if (view.serial != planned_serial_) {
+    if (scripted_) return keys;  // scripts are played by the X server (XKeyboard::play)
+    if (view.serial != planned_serial_) {
         planned_serial_ = view.serial;
         plan_screen(now_ns, view);
     }

@@ -83,10 +83,9 @@ TEST(Autopilot, ScriptsPlayInOrderAndBadLinesNameTheLine) {
     std::ofstream(bad) << "100 Enter\n20 Space\n";
     Autopilot a = Autopilot::from_argument(good, 1.0);
     EXPECT_TRUE(a.scripted());
-    ScreenView v;
-    EXPECT_TRUE(a.due(0, v).empty());
-    EXPECT_EQ(a.due(100'000'000, v), std::vector<std::string>{"Enter"});
-    EXPECT_EQ(a.due(200'000'000, v), (std::vector<std::string>{"3", "Escape"}));
+    using Script = std::vector<std::pair<double, std::string>>;
+    EXPECT_EQ(a.script(), (Script{{100, "Enter"}, {50, "3"}, {10, "Escape"}}));
+    EXPECT_TRUE(a.due(1'000'000'000, ScreenView{}).empty());  // played by the X server
     try {
         Autopilot::from_file(bad);
         FAIL();
