@@ -131,8 +131,8 @@ void SessionFlow::key(const TimedKey& press) {
         if (press.key == Key::Enter || press.key == Key::Resume) {
             paused_ = false;
             changed();
-            if (screen_ ==
-                Screen::Trial) {  // a new onset, no answers: RTs exclude the pause
+            // A trial starts again from a new onset, without answers: RTs skip the pause.
+            if (screen_ == Screen::Trial) {
                 input_.reset();
                 trial_frames_ns_.clear();
             }
