@@ -398,6 +398,10 @@ bool Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcom
     for (const Response& r : outcome.responses)
         check_rating_on_scale(points, r.question, r.rating,
                               db_.path() + ": trial " + std::to_string(trial_id));
+    if (outcome.responses.size() != points.size())  // with UNIQUE: each question once
+        throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) + " has " +
+                         std::to_string(outcome.responses.size()) + " ratings for " +
+                         std::to_string(points.size()) + " questions");
     Statement insert = db_.prepare(
         "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
         "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");

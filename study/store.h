@@ -106,7 +106,8 @@ public:
     void set_consent(int64_t session_id);
     bool has_consent(int64_t session_id);
     // Commits one trial's ratings atomically; refuses a trial that already has ratings,
-    // a question the study does not ask, or a rating outside 1..points of its question.
+    // lacks a question, names one the study does not ask, or has a rating outside
+    // 1..points of its question.
     // The trial that answers the session's last open trial also sets it `completed` (with
     // ended_utc) in the same transaction, so no crash can leave it answered but open.
     // Returns true when the session is now completed.

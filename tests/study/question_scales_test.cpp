@@ -62,6 +62,9 @@ TEST(QuestionScales, TheStoreRefusesARatingBeyondItsQuestionsScale) {
     TrialOutcome unknown = outcome(3, 3);
     unknown.responses[1].question = "varnished";
     EXPECT_THROW(store.record_trial(m.session.id, m.trials[1].id, unknown), StoreError);
+    TrialOutcome missing = outcome(3, 3);
+    missing.responses.pop_back();  // 'realistic' unanswered
+    EXPECT_THROW(store.record_trial(m.session.id, m.trials[1].id, missing), StoreError);
     EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM responses"), 2);
     EXPECT_FALSE(store.trials(m.session.id)[1].answered);
     store.record_trial(m.session.id, m.trials[1].id, outcome(1, 1));
