@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "export.h"
+#include "question_scales.h"
 #include "sqlite.h"
 
 namespace lucent::app {
@@ -20,6 +21,7 @@ int export_command(const std::string& db, const std::string& format, const std::
             return kExitFailure;
         }
         if (format == "analysis") {
+            study::check_stored_ratings(db);  // no impossible rating enters an analysis
             const study::LongTable table = study::analysis_long_table(db);
             study::write_long_table_csv(table, out);
             rows = static_cast<int>(table.rows.size());

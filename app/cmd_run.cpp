@@ -81,6 +81,8 @@ void register_run(CLI::App& app, int& exit_code) {
         ->check(CLI::PositiveNumber);
     cmd->add_option("--screenshot", args->options.screenshot_path,
                     "Save the first rating screen as a PNG (for tests)");
+    cmd->add_option("--key-trace", args->options.key_trace_path,
+                    "Write each key press as 'X_EVENT_MS RECEIPT_NS STAMP_NS' (for tests)");
     cmd->callback([args, &exit_code] { exit_code = run_command(*args); });
 }
 

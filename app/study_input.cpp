@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "export.h"
+#include "question_scales.h"
 #include "sqlite.h"
 
 namespace lucent::app {
@@ -19,6 +20,7 @@ analysis::LongTable read_ratings(const std::string& path, const analysis::Rating
     if (!is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
     study::LongTable rows;
     try {
+        study::check_stored_ratings(path);  // each rating on its own question's scale
         rows = study::analysis_long_table(path);
     } catch (const study::StoreError& e) {
         throw analysis::InputError(e.what());

@@ -562,7 +562,7 @@ bool Store::has_consent(int64_t session_id) {
     return s.step() && s.integer(0) != 0;
 }
 
-void Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) {
+bool Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) {
     Transaction tx(db_);
     {
         Statement check = db_.prepare(
@@ -577,6 +577,15 @@ void Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcom
             throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) +
                              " already has ratings; refusing to record it twice");
     }
+    // Each rating on its own question's scale: the schema's CHECK only knows 1..7.
+    const QuestionPoints& points = question_points_of_session(session_id);
+    for (const Response& r : outcome.responses)
+        check_rating_on_scale(points, r.question, r.rating,
+                              db_.path() + ": trial " + std::to_string(trial_id));
+    if (outcome.responses.size() != points.size())  // with UNIQUE: each question once
+        throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) + " has " +
+                         std::to_string(outcome.responses.size()) + " ratings for " +
+                         std::to_string(points.size()) + " questions");
     Statement insert = db_.prepare(
         "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
         "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
@@ -592,10 +601,41 @@ void Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcom
                 "WHERE session_id = ?) WHERE id = ?")
         .bind(1, outcome.onset_ns).bind(2, outcome.confirm_ns).bind(3, outcome.dropped_frames)
         .bind(4, utc_now_iso8601()).bind(5, session_id).bind(6, trial_id).run();
+    const bool completed = complete_session_if_answered(session_id);  // same transaction
     tx.commit();
+    return completed;
+}
+
+bool Store::complete_session_if_answered(int64_t session_id) {
+    db_.prepare("UPDATE sessions SET status = 'completed', ended_utc = coalesce(ended_utc, ?) "
+                "WHERE id = ? AND status != 'completed' AND NOT EXISTS (SELECT 1 FROM trials t "
+                "WHERE t.session_id = sessions.id AND NOT EXISTS "
+                "(SELECT 1 FROM responses r WHERE r.trial_id = t.id))")
+        .bind(1, utc_now_iso8601()).bind(2, session_id).run();
+    Statement s = db_.prepare("SELECT status = 'completed' FROM sessions WHERE id = ?");
+    s.bind(1, session_id);
+    return s.step() && s.integer(0) != 0;
+}
+
+const QuestionPoints& Store::question_points_of_session(int64_t session_id) {
+    auto it = question_points_by_session_.find(session_id);
+    if (it != question_points_by_session_.end()) return it->second;
+    Statement s = db_.prepare("SELECT study_id FROM sessions WHERE id = ?");
+    s.bind(1, session_id);
+    if (!s.step())
+        throw StoreError(db_.path() + ": no session " + std::to_string(session_id));
+    return question_points_by_session_.emplace(session_id, stored_question_points(db_, s.integer(0)))
+        .first->second;
 }
 
 void Store::set_status(int64_t session_id, const std::string& status, bool ended) {
+    {
+        Statement current = db_.prepare("SELECT status, uuid FROM sessions WHERE id = ?");
+        current.bind(1, session_id);
+        if (current.step() && current.text(0) == "completed" && status != "completed")
+            throw StoreError(db_.path() + ": session " + current.text(1) +
+                             " is completed; refusing to set it " + status);
+    }
     if (ended) {
         db_.prepare("UPDATE sessions SET status = ?, ended_utc = ? WHERE id = ?")
             .bind(1, status).bind(2, utc_now_iso8601()).bind(3, session_id).run();

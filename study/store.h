@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "protocol.h"
+#include "question_scales.h"
 #include "sqlite.h"
 #include "trial_plan.h"
 
@@ -153,8 +154,17 @@ public:
     void update_environment(int64_t session_id, const SessionEnvironment& env);
     void set_consent(int64_t session_id);
     bool has_consent(int64_t session_id);
-    // Commits one trial's ratings atomically; refuses a trial that already has ratings.
-    void record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome);
+    // Commits one trial's ratings atomically; refuses a trial that already has ratings,
+    // lacks a question, names one the study does not ask, or has a rating outside
+    // 1..points of its question.
+    // The trial that answers the session's last open trial also sets it `completed` (with
+    // ended_utc) in the same transaction, so no crash can leave it answered but open.
+    // Returns true when the session is now completed.
+    bool record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome);
+    // Sets `completed` when every planned trial has its ratings (repairs sessions written
+    // before completion was atomic); true when the session is completed afterwards.
+    bool complete_session_if_answered(int64_t session_id);
+    // A completed session is final: any other status for it throws StoreError.
     void set_status(int64_t session_id, const std::string& status, bool ended);
 
     // Deletes a participant and everything recorded for them; false when unknown.
@@ -165,7 +175,11 @@ public:
 private:
     // Stores (first time) or checks env.stimuli's resolved values, then the segment's rows.
     void insert_segment(int64_t session_id, int segment, const SessionEnvironment& env);
+
+    const QuestionPoints& question_points_of_session(int64_t session_id);
+
     Database db_;
+    std::map<int64_t, QuestionPoints> question_points_by_session_;  // parsed once
 };
 
 std::string utc_now_iso8601();

@@ -67,12 +67,13 @@ void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
     case ScreenView::Kind::Text: press(delay_ms(1500), "Enter"); break;
     case ScreenView::Kind::Pause: press(delay_ms(800), "Enter"); break;
     case ScreenView::Kind::Rating: {
-        std::uniform_int_distribution<int> point(1, std::max(1, view.points));
         std::bernoulli_distribution change_mind(0.15);
-        for (int q = 0; q < view.questions; ++q) {
+        for (size_t q = 0; q < view.points.size(); ++q) {
+            const int points = std::max(1, view.points[q]);  // this question's own scale
+            std::uniform_int_distribution<int> point(1, points);
             const int rating = view.is_catch ? view.expected : point(rng_);
             if (change_mind(rng_) && !view.is_catch) {  // first pick, then a correction
-                press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating % view.points + 1));
+                press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating % points + 1));
                 press(delay_ms(350), std::to_string(rating));
             } else {
                 press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating));
@@ -86,16 +87,8 @@ void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
 
 std::vector<std::string> Autopilot::due(int64_t now_ns, const ScreenView& view) {
     std::vector<std::string> keys;
-    if (scripted_) {
-        if (script_start_ < 0) {
-            script_start_ = now_ns;
-            double t = 0;
-            for (const auto& [delay, key] : script_) {
-                t += delay;
-                queue_.push_back({now_ns + static_cast<int64_t>(t * 1e6), key});
-            }
-        }
-    } else if (view.serial != planned_serial_) {
+    if (scripted_) return keys;  // scripts are played by the X server (XKeyboard::play)
+    if (view.serial != planned_serial_) {
         planned_serial_ = view.serial;
         plan_screen(now_ns, view);
     }

@@ -14,9 +14,8 @@ namespace lucent::study {
 struct ScreenView {
     enum class Kind { Text, Rating, Blank, Pause };
     Kind kind = Kind::Blank;
-    int serial = 0;         // increases whenever a new screen appears
-    int questions = 0;      // rating screens
-    int points = 7;
+    int serial = 0;           // increases whenever a new screen appears
+    std::vector<int> points;  // rating screens: each question's scale length
     bool is_catch = false;  // catch trials: the prompt asks for `expected`
     int expected = 0;
 };
@@ -31,14 +30,18 @@ public:
     // Seeded participant; `speed` divides every delay (1 = human-like, 20 = fast tests).
     static Autopilot from_seed(uint64_t seed, double speed = 1.0);
     // A script: one "DELAY_MS KEY" per line (# comments), played in order from the
-    // first call, whatever is on screen. Throws std::runtime_error naming file:line.
+    // session's first frame, whatever is on screen: the runner hands it to the X server
+    // at once (XKeyboard::play). Throws std::runtime_error naming file:line.
     static Autopilot from_file(const std::string& path);
     // The argument of --autopilot: digits are a seed, anything else a script file.
     static Autopilot from_argument(const std::string& argument, double speed);
 
-    // Keys due at `now_ns` for the screen shown; call once per frame.
+    // A seeded participant's keys due at `now_ns` for the screen shown; call once per
+    // frame. (A script's keys are not due here: see script().)
     std::vector<std::string> due(int64_t now_ns, const ScreenView& view);
     bool scripted() const { return scripted_; }
+    // A script's (delay ms after the previous key, key) lines, for XKeyboard::play.
+    const std::vector<std::pair<double, std::string>>& script() const { return script_; }
 
 private:
     void plan_screen(int64_t now_ns, const ScreenView& view);
@@ -48,7 +51,6 @@ private:
     std::mt19937_64 rng_;
     double speed_ = 1.0;
     int planned_serial_ = -1;
-    int64_t script_start_ = -1;
     std::vector<std::pair<double, std::string>> script_;  // (delay ms, key)
     std::vector<ScheduledKey> queue_;
 };

@@ -46,4 +46,14 @@ int dropped_frames(const std::vector<int64_t>& swaps_ns, double refresh_hz) {
     return dropped;
 }
 
+int64_t key_press_time(int64_t receipt_ns, uint32_t server_ms) {
+    constexpr int64_t kMs = 1'000'000;
+    // How far the receipt is behind the event, in ms, modulo the 32-bit counter.
+    const uint32_t behind = static_cast<uint32_t>(receipt_ns / kMs) - server_ms;
+    if (behind >= 1000) return receipt_ns;  // another clock: only the receipt is known
+    const int64_t event_ms_start = (receipt_ns / kMs - behind) * kMs;
+    if (receipt_ns < event_ms_start + kMs) return receipt_ns;
+    return event_ms_start + kMs / 2;
+}
+
 }  // namespace lucent::study

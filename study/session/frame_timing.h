@@ -1,5 +1,6 @@
 #pragma once
-// Display refresh from buffer-swap timestamps, and dropped frames (GL-free).
+// Display refresh from buffer-swap timestamps, dropped frames, and key press times from
+// X event times (GL-free).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -22,5 +23,13 @@ RefreshEstimate estimate_refresh(int mode_refresh_hz, const std::vector<int64_t>
 // Frames that took longer than 1.5 periods between consecutive swaps count as dropped
 // (an interval of k periods drops k-1 frames, rounded).
 int dropped_frames(const std::vector<int64_t>& swaps_ns, double refresh_hz);
+
+// The steady-clock time of a key press received at `receipt_ns` whose X event time is
+// `server_ms` (the server's 32-bit millisecond counter). When the server counts in ms of
+// the steady clock's base (local X.Org servers: CLOCK_MONOTONIC), recognised by the
+// receipt following the event time by under 1 s, the press lies in
+// [server_ms, server_ms + 1 ms): the receipt time when it falls in that millisecond,
+// else its middle. Otherwise the receipt time. See x_key_events.h for why.
+int64_t key_press_time(int64_t receipt_ns, uint32_t server_ms);
 
 }  // namespace lucent::study

@@ -4,11 +4,11 @@
 
 namespace lucent::study {
 
-RatingInput::RatingInput(int questions, int points, int64_t onset_ns)
-    : state_(questions), points_(points), onset_ns_(onset_ns) {}
+RatingInput::RatingInput(std::vector<int> points, int64_t onset_ns)
+    : state_(points.size()), points_(std::move(points)), onset_ns_(onset_ns) {}
 
 void RatingInput::set(int question, int value, int64_t t_ns) {
-    if (confirmed_ || value < 1 || value > points_) return;
+    if (confirmed_ || value < 1 || value > points_[question]) return;
     State& s = state_[question];
     if (!s.rating) s.first_ns = t_ns;
     else if (*s.rating != value) ++s.changes;
@@ -21,11 +21,12 @@ void RatingInput::key(RatingKey key, int digit, int64_t t_ns) {
     if (confirmed_) return;
     const int n = static_cast<int>(state_.size());
     State& s = state_[focus_];
+    const int points = points_[focus_];
     switch (key) {
     case RatingKey::Digit: set(focus_, digit, t_ns); break;
     // The first arrow press picks the middle point: nothing is chosen before a key.
-    case RatingKey::Left: set(focus_, s.rating ? std::max(1, *s.rating - 1) : (points_ + 1) / 2, t_ns); break;
-    case RatingKey::Right: set(focus_, s.rating ? std::min(points_, *s.rating + 1) : (points_ + 1) / 2, t_ns); break;
+    case RatingKey::Left: set(focus_, s.rating ? std::max(1, *s.rating - 1) : (points + 1) / 2, t_ns); break;
+    case RatingKey::Right: set(focus_, s.rating ? std::min(points, *s.rating + 1) : (points + 1) / 2, t_ns); break;
     case RatingKey::Up: focus_ = std::max(0, focus_ - 1); break;
     case RatingKey::Down: focus_ = std::min(n - 1, focus_ + 1); break;
     case RatingKey::Enter:

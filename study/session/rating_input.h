@@ -1,6 +1,7 @@
 #pragma once
 // The rating screen's input rules, GL-free so they are unit-tested: keys 1-7, arrows and
-// Enter, or clicks; no answer is preselected; every change is counted and timed.
+// Enter, or clicks; no answer is preselected; every change is counted and timed. Each
+// question has its own scale length (2 to 7 points).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -14,9 +15,14 @@ enum class RatingKey { Digit, Left, Right, Up, Down, Enter };
 
 class RatingInput {
 public:
-    RatingInput(int questions, int points, int64_t onset_ns);
+    // points[q]: the scale length of question q.
+    RatingInput(std::vector<int> points, int64_t onset_ns);
+    // `questions` questions on the same `points`-point scale.
+    RatingInput(int questions, int points, int64_t onset_ns)
+        : RatingInput(std::vector<int>(questions, points), onset_ns) {}
 
-    // digit: 1..9 for RatingKey::Digit (values above `points` are ignored).
+    // digit: 1..9 for RatingKey::Digit (values above the focused question's points are
+    // ignored).
     void key(RatingKey key, int digit, int64_t t_ns);
     void click(int question, int value, int64_t t_ns);  // a point on a scale
     void click_next(int64_t t_ns);                      // the "Next" button
@@ -38,7 +44,7 @@ private:
     void set(int question, int value, int64_t t_ns);
 
     std::vector<State> state_;
-    int points_;
+    std::vector<int> points_;
     int64_t onset_ns_;
     int focus_ = 0;
     bool confirmed_ = false;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "protocol.h"
+#include "session/session_flow.h"
 #include "session/stimulus_source.h"
 
 namespace lucent::study {
@@ -22,11 +23,11 @@ struct RunOptions {
     std::string autopilot;       // "" (a person), a seed, or a script file
     double autopilot_speed = 1.0;
     std::string screenshot_path;   // save the first rating screen as PNG (tests)
+    std::string key_trace_path;    // each key press's X event time and stamp (tests)
 };
 
-// Outcome of run_session, mapped to exit codes by the caller.
-enum class RunResult { Completed, SavedAndQuit, Declined, UsageError, Failure };
-
+// Outcome: RunResult (session_flow.h), mapped to exit codes by the caller. A participant
+// who already completed the study is refused (UsageError), with or without --resume.
 RunResult run_session(const RunOptions& options, StimulusRenderer& stimuli, std::ostream& log);
 
 }  // namespace lucent::study

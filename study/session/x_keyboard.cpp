@@ -6,6 +6,8 @@
 #include <X11/extensions/XTest.h>
 #include <X11/keysym.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
@@ -16,14 +18,36 @@ extern "C" Window glfwGetX11Window(GLFWwindow* window);
 
 namespace lucent::study {
 
-XKeyboard::XKeyboard(GLFWwindow* window) : window_(window), display_(glfwGetX11Display()) {
-    if (!display_)
+namespace {
+
+KeyCode keycode(Display* dpy, const std::string& key) {
+    static const std::map<std::string, KeySym> kSyms = {
+        {"1", XK_1}, {"2", XK_2}, {"3", XK_3}, {"4", XK_4}, {"5", XK_5}, {"6", XK_6},
+        {"7", XK_7}, {"8", XK_8}, {"9", XK_9}, {"Enter", XK_Return}, {"Escape", XK_Escape},
+        {"Left", XK_Left}, {"Right", XK_Right}, {"Up", XK_Up}, {"Down", XK_Down},
+        {"Q", XK_q}, {"R", XK_r}};
+    const auto it = kSyms.find(key);
+    if (it == kSyms.end()) throw std::runtime_error("autopilot: unknown key '" + key + "'");
+    return XKeysymToKeycode(dpy, it->second);
+}
+
+}  // namespace
+
+XKeyboard::XKeyboard(GLFWwindow* window) : window_(window) {
+    Display* glfw_display = glfwGetX11Display();
+    if (!glfw_display)
         throw std::runtime_error("autopilot needs an X11 display (XTest); none is in use");
+    display_ = XOpenDisplay(DisplayString(glfw_display));
+    if (!display_) throw std::runtime_error("autopilot: cannot open a second X connection");
     int event_base, error_base, major, minor;
     if (!XTestQueryExtension(static_cast<Display*>(display_), &event_base, &error_base, &major,
-                             &minor))
+                             &minor)) {
+        XCloseDisplay(static_cast<Display*>(display_));
         throw std::runtime_error("autopilot: the X server has no XTest extension");
+    }
 }
+
+XKeyboard::~XKeyboard() { XCloseDisplay(static_cast<Display*>(display_)); }
 
 void XKeyboard::focus_window() {
     Display* dpy = static_cast<Display*>(display_);
@@ -36,17 +60,28 @@ void XKeyboard::focus_window() {
 }
 
 void XKeyboard::tap(const std::string& key, int hold_ms) {
-    static const std::map<std::string, KeySym> kSyms = {
-        {"1", XK_1}, {"2", XK_2}, {"3", XK_3}, {"4", XK_4}, {"5", XK_5}, {"6", XK_6},
-        {"7", XK_7}, {"8", XK_8}, {"9", XK_9}, {"Enter", XK_Return}, {"Escape", XK_Escape},
-        {"Left", XK_Left}, {"Right", XK_Right}, {"Up", XK_Up}, {"Down", XK_Down},
-        {"Q", XK_q}, {"R", XK_r}};
-    const auto it = kSyms.find(key);
-    if (it == kSyms.end()) throw std::runtime_error("autopilot: unknown key '" + key + "'");
     Display* dpy = static_cast<Display*>(display_);
-    const KeyCode code = XKeysymToKeycode(dpy, it->second);
+    const KeyCode code = keycode(dpy, key);
     XTestFakeKeyEvent(dpy, code, True, CurrentTime);
     XTestFakeKeyEvent(dpy, code, False, static_cast<unsigned long>(hold_ms));
+    XFlush(dpy);
+}
+
+void XKeyboard::play(const std::vector<std::pair<double, std::string>>& script) {
+    Display* dpy = static_cast<Display*>(display_);
+    // Each press waits its delay after the previous press on the server's timer, and is
+    // released at once: one timer per interval, so the intervals keep the timer's 1 ms
+    // steps (a held key would put the release's timer inside the next interval).
+    // Delays are rounded from the running total, so they never drift.
+    double t = 0;
+    long sent = 0;  // ms from the start of the last press sent
+    for (const auto& [delay, key] : script) {
+        const long at = std::lround(t += delay);
+        const KeyCode code = keycode(dpy, key);
+        XTestFakeKeyEvent(dpy, code, True, static_cast<unsigned long>(at - sent));
+        XTestFakeKeyEvent(dpy, code, False, CurrentTime);
+        sent = at;
+    }
     XFlush(dpy);
 }
 

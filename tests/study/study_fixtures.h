@@ -66,6 +66,20 @@ expected = 7
 
 inline study::Protocol small_protocol() { return study::parse_protocol(kSmallProtocol, "small.toml"); }
 
+// The small protocol with mixed scales: 'translucent' keeps 7 points, 'realistic' gets 5
+// (the catch trial then asks for 5, the most every scale has).
+inline std::string mixed_scale_protocol_text() {
+    const std::string text = kSmallProtocol;
+    const std::string realistic = "text = \"The object looks realistic.\"\n";
+    const size_t question = text.find(realistic) + realistic.size();
+    const size_t expected = text.find("expected = 7");
+    return text.substr(0, question) + "labels = [\"not at all\", \"\", \"\", \"\", \"fully\"]\n" +
+           text.substr(question, expected - question) + "expected = 5" + text.substr(expected + 12);
+}
+inline study::Protocol mixed_scale_protocol() {
+    return study::parse_protocol(mixed_scale_protocol_text(), "mixed.toml");
+}
+
 // Deterministic rating for (trial position, question index): lets tests recompute
 // expected exports independently of the database.
 inline int rating_for(int position, int question) { return 1 + (position * 3 + question * 2) % 7; }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <set>
 
 #include "test_paths.h"
 
@@ -15,7 +16,8 @@ namespace {
 std::vector<std::pair<int64_t, std::string>> drive(Autopilot& a, ScreenView v) {
     std::vector<std::pair<int64_t, std::string>> out;
     int enters = 0;
-    for (int64_t t = 0; t < 60'000'000'000LL && enters < v.questions; t += 1'000'000) {
+    for (int64_t t = 0; t < 60'000'000'000LL && enters < static_cast<int>(v.points.size());
+         t += 1'000'000) {
         for (const std::string& k : a.due(t, v)) {
             out.emplace_back(t, k);
             enters += k == "Enter";
@@ -26,7 +28,7 @@ std::vector<std::pair<int64_t, std::string>> drive(Autopilot& a, ScreenView v) {
 
 TEST(Autopilot, AnswersEveryStatementWithHumanLikeDelays) {
     Autopilot a = Autopilot::from_seed(5, 1.0);
-    ScreenView v{ScreenView::Kind::Rating, 1, 3, 7, false, 0};
+    ScreenView v{ScreenView::Kind::Rating, 1, {7, 7, 7}, false, 0};
     const auto keys = drive(a, v);
     ASSERT_FALSE(keys.empty());
     EXPECT_EQ(std::count_if(keys.begin(), keys.end(), [](auto& k) { return k.second == "Enter"; }), 3);
@@ -43,11 +45,35 @@ TEST(Autopilot, AnswersEveryStatementWithHumanLikeDelays) {
 
 TEST(Autopilot, CatchTrialsGetTheExpectedAnswerAndSpeedScalesDelays) {
     Autopilot slow = Autopilot::from_seed(9, 1.0), fast = Autopilot::from_seed(9, 10.0);
-    ScreenView v{ScreenView::Kind::Rating, 1, 2, 7, true, 7};
+    ScreenView v{ScreenView::Kind::Rating, 1, {7, 7}, true, 7};
     const auto s = drive(slow, v), f = drive(fast, v);
     for (const auto& [t, k] : s) EXPECT_TRUE(k == "7" || k == "Enter");
     ASSERT_EQ(s.size(), f.size());
     EXPECT_NEAR(static_cast<double>(f.back().first), s.back().first / 10.0, 2e6);
+}
+
+TEST(Autopilot, MixedScalesGetRatingsWithinEachQuestionsOwnScale) {
+    // 7 points then 5, and the other order: over many seeded screens every digit lies
+    // on its question's scale, and the whole range of each scale is used.
+    for (const std::vector<int>& points : {std::vector<int>{7, 5}, std::vector<int>{5, 7}}) {
+        std::vector<std::set<int>> used(2);
+        for (uint64_t seed = 0; seed < 200; ++seed) {
+            Autopilot a = Autopilot::from_seed(seed, 50.0);
+            size_t question = 0;
+            for (const auto& [t, k] : drive(a, ScreenView{ScreenView::Kind::Rating, 1, points, false, 0})) {
+                if (k == "Enter") {
+                    ++question;
+                    continue;
+                }
+                const int digit = std::stoi(k);
+                ASSERT_LT(question, points.size());
+                EXPECT_GE(digit, 1);
+                EXPECT_LE(digit, points[question]) << "question " << question << " of " << points[0];
+                used[question].insert(digit);
+            }
+        }
+        for (size_t q = 0; q < 2; ++q) EXPECT_EQ(used[q].size(), size_t(points[q])) << q;
+    }
 }
 
 TEST(Autopilot, ScriptsPlayInOrderAndBadLinesNameTheLine) {
@@ -57,10 +83,9 @@ TEST(Autopilot, ScriptsPlayInOrderAndBadLinesNameTheLine) {
     std::ofstream(bad) << "100 Enter\n20 Space\n";
     Autopilot a = Autopilot::from_argument(good, 1.0);
     EXPECT_TRUE(a.scripted());
-    ScreenView v;
-    EXPECT_TRUE(a.due(0, v).empty());
-    EXPECT_EQ(a.due(100'000'000, v), std::vector<std::string>{"Enter"});
-    EXPECT_EQ(a.due(200'000'000, v), (std::vector<std::string>{"3", "Escape"}));
+    using Script = std::vector<std::pair<double, std::string>>;
+    EXPECT_EQ(a.script(), (Script{{100, "Enter"}, {50, "3"}, {10, "Escape"}}));
+    EXPECT_TRUE(a.due(1'000'000'000, ScreenView{}).empty());  // played by the X server
     try {
         Autopilot::from_file(bad);
         FAIL();

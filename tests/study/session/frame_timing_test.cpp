@@ -43,5 +43,24 @@ TEST(FrameTiming, DroppedFramesCountMissedVsyncs) {
     EXPECT_EQ(dropped_frames(s, 0), 0);
 }
 
+TEST(KeyPressTime, TheServersMillisecondBoundsAKeyThreadThatWokeLate) {
+    constexpr int64_t kMs = 1'000'000;
+    const int64_t t = 7'000'000 * kMs;  // 7000 s of steady clock
+    const uint32_t ms = 7'000'000;
+    // Received within the event's millisecond: the (sub-ms) receipt time.
+    EXPECT_EQ(key_press_time(t + 300'000, ms), t + 300'000);
+    // Received 4.2 ms after the event's millisecond began: the middle of it.
+    EXPECT_EQ(key_press_time(t + 4 * kMs + 200'000, ms), t + kMs / 2);
+    EXPECT_EQ(key_press_time(t + 999 * kMs, ms), t + kMs / 2);
+    // Across the 32-bit wrap of the server's counter (every 49.7 days).
+    const int64_t wrap = (int64_t(1) << 32) * kMs;
+    EXPECT_EQ(key_press_time(wrap + 3 * kMs, 0xFFFFFFFFu), wrap - kMs + kMs / 2);
+    // A server on another clock (remote, wall clock), or ahead of the receipt: the
+    // receipt time, the only one known.
+    EXPECT_EQ(key_press_time(t + 5 * kMs, 123), t + 5 * kMs);
+    EXPECT_EQ(key_press_time(t + 5 * kMs, ms + 6), t + 5 * kMs);
+    EXPECT_EQ(key_press_time(t + 1000 * kMs, ms), t + 1000 * kMs);
+}
+
 }  // namespace
 }  // namespace lucent::study

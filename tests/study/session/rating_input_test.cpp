@@ -77,5 +77,32 @@ TEST(RatingInput, ClicksAnswerAndNextConfirmsOnlyWhenAllAreAnswered) {
     EXPECT_EQ(in.responses({"a", "b"})[0].changes, 0);
 }
 
+TEST(RatingInput, EachQuestionHasItsOwnScaleLength) {
+    // 7 points, then 5, then 3: digits and arrows respect the focused question's scale.
+    RatingInput in({7, 5, 3}, 0);
+    in.key(RatingKey::Digit, 7, 10);
+    EXPECT_EQ(in.rating(0), 7);
+    in.key(RatingKey::Enter, 0, 20);
+    in.key(RatingKey::Digit, 6, 30);  // beyond 5: ignored
+    in.key(RatingKey::Digit, 7, 31);
+    EXPECT_FALSE(in.rating(1).has_value());
+    in.key(RatingKey::Right, 0, 40);  // the middle of 1..5
+    EXPECT_EQ(in.rating(1), 3);
+    for (int i = 0; i < 4; ++i) in.key(RatingKey::Right, 0, 50 + i);
+    EXPECT_EQ(in.rating(1), 5);
+    in.key(RatingKey::Enter, 0, 60);
+    in.key(RatingKey::Left, 0, 70);  // the middle of 1..3
+    EXPECT_EQ(in.rating(2), 2);
+    in.click(2, 4, 80);  // a point the 3-point scale does not have
+    EXPECT_EQ(in.rating(2), 2);
+    in.click(2, 3, 90);
+    in.key(RatingKey::Enter, 0, 100);
+    ASSERT_TRUE(in.confirmed());
+    const auto r = in.responses({"a", "b", "c"});
+    EXPECT_EQ(r[0].rating, 7);
+    EXPECT_EQ(r[1].rating, 5);
+    EXPECT_EQ(r[2].rating, 3);
+}
+
 }  // namespace
 }  // namespace lucent::study

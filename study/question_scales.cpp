@@ -1,0 +1,65 @@
+#include "question_scales.h"
+
+#include "store.h"
+
+namespace lucent::study {
+
+QuestionPoints question_points(const Protocol& protocol) {
+    QuestionPoints out;
+    for (const Question& q : protocol.questions) out[q.id] = q.points();
+    return out;
+}
+
+QuestionPoints stored_question_points(Database& db, int64_t study_id) {
+    Statement s = db.prepare("SELECT name, protocol_text FROM studies WHERE id = ?");
+    s.bind(1, study_id);
+    if (!s.step()) throw StoreError(db.path() + ": no study " + std::to_string(study_id));
+    try {
+        return question_points(
+            parse_protocol(s.text(1), db.path() + " (study '" + s.text(0) + "')"));
+    } catch (const ProtocolError& e) {
+        throw StoreError(db.path() +
+                         ": the stored protocol no longer parses: " + e.what());
+    }
+}
+
+void check_rating_on_scale(const QuestionPoints& points, const std::string& question,
+                           int rating, const std::string& where) {
+    const auto it = points.find(question);
+    if (it == points.end())
+        throw StoreError(where + ": question '" + question +
+                         "' is not in the study's protocol");
+    if (rating < 1 || rating > it->second)
+        throw StoreError(where + ": rating " + std::to_string(rating) +
+                         " for question '" + question + "' is outside its scale 1.." +
+                         std::to_string(it->second));
+}
+
+void check_stored_ratings(Database& db) {
+    std::map<int64_t, QuestionPoints> by_study;
+    Statement s = db.prepare(
+        "SELECT se.study_id, p.code, se.uuid, t.position, r.question, r.rating "
+        "FROM responses r JOIN trials t ON t.id = r.trial_id "
+        "JOIN sessions se ON se.id = r.session_id "
+        "JOIN participants p ON p.id = se.participant_id ORDER BY se.id, t.position, "
+        "r.id");
+    while (s.step()) {
+        const int64_t study = s.integer(0);
+        auto it = by_study.find(study);
+        if (it == by_study.end())
+            it = by_study.emplace(study, stored_question_points(db, study)).first;
+        check_rating_on_scale(it->second, s.text(4), static_cast<int>(s.integer(5)),
+                              db.path() + ": participant '" + s.text(1) + "', session " +
+                                  s.text(2) + ", trial " + std::to_string(s.integer(3)));
+    }
+}
+
+void check_stored_ratings(const std::string& path) {
+    check_database_file(path);
+    Database db(path, SQLITE_OPEN_READONLY);
+    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'responses'") == 0)
+        return;
+    check_stored_ratings(db);
+}
+
+}  // namespace lucent::study

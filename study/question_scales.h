@@ -1,0 +1,30 @@
+#pragma once
+// Each question's scale length (2 to 7 points, per question), from a protocol or from
+// the protocol text a study database stores, so that the store and the analysis refuse a
+// rating outside 1..points of *its* question (the schema's CHECK only knows 1..7).
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "protocol.h"
+#include "sqlite.h"
+
+namespace lucent::study {
+
+using QuestionPoints = std::map<std::string, int>;  // question id -> points
+
+QuestionPoints question_points(const Protocol& protocol);
+// The scales of study `study_id`, parsed from its stored protocol text. Throws
+// StoreError (one line, naming the database) when that text no longer parses.
+QuestionPoints stored_question_points(Database& db, int64_t study_id);
+// Throws StoreError naming the question when `rating` is not within its scale.
+void check_rating_on_scale(const QuestionPoints& points, const std::string& question,
+                           int rating, const std::string& where);
+// Checks every stored rating against its question's scale; throws StoreError naming the
+// first impossible one (participant, session, trial position, question, rating, scale).
+void check_stored_ratings(Database& db);
+// The same for the database file at `path`, opened read-only (check_database_file
+// first); a database without ratings passes.
+void check_stored_ratings(const std::string& path);
+
+}  // namespace lucent::study

@@ -1,0 +1,268 @@
+#include "session/session_flow.h"
+
+#include "session/frame_timing.h"
+
+namespace lucent::study {
+
+SessionFlow::SessionFlow(const Protocol& protocol, Store& store, int64_t session_id,
+                         std::vector<TrialRow> trials, bool consented, int64_t now_ns)
+    : protocol_(protocol),
+      store_(store),
+      session_id_(session_id),
+      trials_(std::move(trials)) {
+    while (current_ < trials_.size() && trials_[current_].answered) ++current_;
+    // A resumed session continues at its first open trial once consent is on record.
+    if (current_ == trials_.size())
+        enter(Screen::Debrief, now_ns);
+    else if (current_ > 0 && consented)
+        enter(Screen::Blank, now_ns);
+    else
+        enter(protocol_.screens.consent.empty() ? Screen::Instructions : Screen::Consent,
+              now_ns);
+}
+
+const TrialRow* SessionFlow::trial() const {
+    if ((screen_ != Screen::Blank && screen_ != Screen::Trial) ||
+        current_ >= trials_.size())
+        return nullptr;
+    return &trials_[current_];
+}
+
+const std::string& SessionFlow::text() const {
+    static const std::string none;
+    switch (screen_) {
+        case Screen::Consent:
+            return protocol_.screens.consent;
+        case Screen::Instructions:
+            return protocol_.screens.instructions;
+        case Screen::PracticeDone:
+            return protocol_.screens.practice_done;
+        case Screen::Break:
+            return protocol_.screens.break_text;
+        case Screen::Debrief:
+            return protocol_.screens.debrief;
+        default:
+            return none;
+    }
+}
+
+int SessionFlow::main_trials_done() const {
+    int n = 0;
+    for (size_t i = 0; i < current_; ++i) n += trials_[i].practice ? 0 : 1;
+    return n;
+}
+
+int SessionFlow::main_trials_total() const {
+    int n = 0;
+    for (const TrialRow& t : trials_) n += t.practice ? 0 : 1;
+    return n;
+}
+
+ScreenView SessionFlow::view() const {
+    ScreenView v;
+    v.serial = serial_;
+    if (paused_) {
+        v.kind = ScreenView::Kind::Pause;
+        return v;
+    }
+    switch (screen_) {
+        case Screen::Trial:
+            v.kind = input_ ? ScreenView::Kind::Rating : ScreenView::Kind::Blank;
+            for (const Question& q : protocol_.questions) v.points.push_back(q.points());
+            v.is_catch = trials_[current_].is_catch;
+            v.expected = trials_[current_].expected;
+            break;
+        case Screen::Blank:
+        case Screen::Done:
+            v.kind = ScreenView::Kind::Blank;
+            break;
+        default:
+            v.kind = ScreenView::Kind::Text;
+            break;
+    }
+    return v;
+}
+
+void SessionFlow::changed() {
+    ++serial_;
+    presented_ns_.reset();
+}
+
+void SessionFlow::enter(Screen screen, int64_t t_ns) {
+    screen_ = screen;
+    entered_ns_ = t_ns;
+    input_.reset();
+    trial_frames_ns_.clear();
+    changed();
+}
+
+void SessionFlow::begin_trial_or_debrief(int64_t t_ns) {
+    enter(current_ < trials_.size() ? Screen::Blank : Screen::Debrief, t_ns);
+}
+
+void SessionFlow::tick(int64_t now_ns) {
+    if (finished_ || paused_ || screen_ != Screen::Blank) return;
+    if (now_ns - entered_ns_ >= protocol_.inter_trial_ms * 1'000'000LL)
+        enter(Screen::Trial, now_ns);
+}
+
+void SessionFlow::presented(int serial, int64_t t_ns) {
+    if (finished_ || serial != serial_) return;  // a frame of a screen already left
+    if (!presented_ns_) {
+        presented_ns_ = t_ns;
+        if (screen_ == Screen::Trial && !paused_) {  // the stimulus onset
+            std::vector<int> points;
+            for (const Question& q : protocol_.questions) points.push_back(q.points());
+            input_.emplace(std::move(points), t_ns);
+            trial_frames_ns_.assign(1, t_ns);
+            ++serial_;  // the rating screen is a new view (same presentation)
+        }
+        return;
+    }
+    if (screen_ == Screen::Trial && input_ && !paused_) trial_frames_ns_.push_back(t_ns);
+}
+
+void SessionFlow::key(const TimedKey& press) {
+    if (finished_) return;
+    // Stale: the key went down before this screen reached the display (or it has not
+    // yet), so it was meant for what was on screen before.
+    if (!presented_ns_ || press.t_ns < *presented_ns_) return;
+    if (paused_) {
+        if (press.key == Key::Enter || press.key == Key::Resume) {
+            paused_ = false;
+            changed();
+            // A trial starts again from a new onset, without answers: RTs skip the pause.
+            if (screen_ == Screen::Trial) {
+                input_.reset();
+                trial_frames_ns_.clear();
+            }
+        } else if (press.key == Key::Quit) {
+            quit_saving();
+        }
+        return;
+    }
+    if (press.key == Key::Escape) {
+        // The debrief follows completion: nothing there can pause (or reopen) the
+        // session.
+        if (screen_ != Screen::Debrief && screen_ != Screen::Done) {
+            paused_ = true;
+            changed();
+        }
+        return;
+    }
+    switch (screen_) {
+        case Screen::Consent:
+            if (press.key == Key::Enter) {
+                store_.set_consent(session_id_);
+                if (protocol_.screens.instructions.empty())
+                    begin_trial_or_debrief(press.t_ns);
+                else
+                    enter(Screen::Instructions, press.t_ns);
+            } else if (press.key == Key::Decline) {
+                store_.set_status(session_id_, "aborted", true);
+                result_ = RunResult::Declined;
+                finished_ = true;
+            }
+            break;
+        case Screen::Instructions:
+        case Screen::PracticeDone:
+        case Screen::Break:
+            if (press.key == Key::Enter) begin_trial_or_debrief(press.t_ns);
+            break;
+        case Screen::Debrief:
+            if (press.key == Key::Enter) {
+                screen_ = Screen::Done;
+                changed();
+                finished_ = true;
+            }
+            break;
+        case Screen::Trial: {
+            if (!input_) break;  // before onset: nothing to answer
+            const int64_t t = press.t_ns;
+            switch (press.key) {
+                case Key::Digit:
+                    input_->key(RatingKey::Digit, press.digit, t);
+                    break;
+                case Key::Left:
+                    input_->key(RatingKey::Left, 0, t);
+                    break;
+                case Key::Right:
+                    input_->key(RatingKey::Right, 0, t);
+                    break;
+                case Key::Up:
+                    input_->key(RatingKey::Up, 0, t);
+                    break;
+                case Key::Down:
+                    input_->key(RatingKey::Down, 0, t);
+                    break;
+                case Key::Enter:
+                    input_->key(RatingKey::Enter, 0, t);
+                    break;
+                default:
+                    break;
+            }
+            if (input_->confirmed()) finish_trial();
+            break;
+        }
+        case Screen::Blank:
+        case Screen::Done:
+            break;
+    }
+}
+
+void SessionFlow::click_point(int question, int value, int64_t t_ns) {
+    if (finished_ || paused_ || !input_ || !presented_ns_ || t_ns < *presented_ns_)
+        return;
+    input_->click(question, value, t_ns);
+}
+
+void SessionFlow::click_next(int64_t t_ns) {
+    if (finished_ || paused_ || !input_ || !presented_ns_ || t_ns < *presented_ns_)
+        return;
+    input_->click_next(t_ns);
+    if (input_->confirmed()) finish_trial();
+}
+
+void SessionFlow::window_closed() {
+    if (finished_) return;
+    if (screen_ == Screen::Debrief || screen_ == Screen::Done) {  // already completed
+        finished_ = true;
+        return;
+    }
+    quit_saving();
+}
+
+void SessionFlow::quit_saving() {
+    store_.set_status(session_id_, "paused", false);
+    result_ = RunResult::SavedAndQuit;
+    finished_ = true;
+}
+
+void SessionFlow::finish_trial() {
+    const TrialRow& t = trials_[current_];
+    std::vector<std::string> ids;
+    for (const Question& q : protocol_.questions) ids.push_back(q.id);
+    TrialOutcome outcome;
+    outcome.onset_ns = *presented_ns_;
+    outcome.confirm_ns = input_->confirm_ns();
+    outcome.responses = input_->responses(ids);
+    if (refresh_hz_)
+        outcome.dropped_frames = dropped_frames(trial_frames_ns_, *refresh_hz_);
+    // Committed before the next trial; the last one completes the session in the same
+    // transaction.
+    store_.record_trial(session_id_, t.id, outcome);
+    const int64_t confirmed_ns = outcome.confirm_ns;
+    const bool was_practice = t.practice;
+    trials_[current_].answered = true;
+    ++current_;
+    if (current_ >= trials_.size())
+        enter(Screen::Debrief, confirmed_ns);
+    else if (was_practice && !trials_[current_].practice)
+        enter(Screen::PracticeDone, confirmed_ns);
+    else if (trials_[current_].break_before)
+        enter(Screen::Break, confirmed_ns);
+    else
+        enter(Screen::Blank, confirmed_ns);
+}
+
+}  // namespace lucent::study

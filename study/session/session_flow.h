@@ -1,0 +1,114 @@
+#pragma once
+// The session's state machine, GL-free so tests drive it with synthetic, timestamped
+// keys and a fake clock: consent, instructions, practice, trials with blanks and breaks,
+// debrief, and the pause screen over any of them. The runner (runner.cpp) only draws
+// what it says and feeds it keys, clicks, clock ticks and presentation times.
+//
+// Two rules hold on every screen:
+// - A key counts only on a screen that was on the display when the key went down: keys
+//   stamped before the screen's first presented frame are dropped as stale, so a quick
+//   double Enter cannot skip a break screen it never showed.
+// - The last trial's ratings and the status `completed` are one transaction
+//   (Store::record_trial), and nothing turns a completed session back into paused.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol.h"
+#include "session/autopilot.h"
+#include "session/rating_input.h"
+#include "store.h"
+
+namespace lucent::study {
+
+enum class Screen {
+    Consent,
+    Instructions,
+    PracticeDone,
+    Blank,
+    Trial,
+    Break,
+    Debrief,
+    Done
+};
+
+// How a session ended, mapped to exit codes by the caller.
+enum class RunResult { Completed, SavedAndQuit, Declined, UsageError, Failure };
+
+// The keys a session listens to (from X key events or GLFW, see runner.cpp).
+enum class Key { Digit, Enter, Escape, Left, Right, Up, Down, Quit, Resume, Decline };
+
+struct TimedKey {
+    Key key = Key::Enter;
+    int digit = 0;     // 1..9 for Key::Digit
+    int64_t t_ns = 0;  // steady clock, when the key went down
+};
+
+class SessionFlow {
+public:
+    // `trials`: the session's planned trials as stored; `consented`: consent already
+    // recorded (a resumed session). Starts at the first unanswered trial.
+    SessionFlow(const Protocol& protocol, Store& store, int64_t session_id,
+                std::vector<TrialRow> trials, bool consented, int64_t now_ns);
+
+    // ---- input -----------------------------------------------------------------------
+    // A key, or an on-screen button standing for one (clicked at `t_ns`).
+    void key(const TimedKey& press);
+    // The mouse on the rating screen: a point on a scale, the "Next" button.
+    void click_point(int question, int value, int64_t t_ns);
+    void click_next(int64_t t_ns);
+    void window_closed();  // by the window manager; saves and quits unless completed
+    // Time passes: the blank between trials gives way to the stimulus.
+    void tick(int64_t now_ns);
+    // A frame drawn while serial() was `serial` reached the display at `t_ns` (right
+    // after the swap, after glFinish). The first one is the screen's appearance, and on
+    // a trial the stimulus onset; later ones are the trial's frame times.
+    void presented(int serial, int64_t t_ns);
+    // The display's refresh rate, once measured: trials then record dropped frames.
+    void set_refresh_hz(std::optional<double> hz) { refresh_hz_ = hz; }
+
+    // ---- state -----------------------------------------------------------------------
+    Screen screen() const { return screen_; }
+    bool paused() const { return paused_; }
+    bool finished() const { return finished_; }
+    RunResult result() const { return result_; }
+    // Increases whenever what is on screen changes (screen, pause, stimulus onset).
+    int serial() const { return serial_; }
+    bool awaiting_presentation() const { return !presented_ns_.has_value(); }
+    // The trial on a Blank or Trial screen; the rating input once the stimulus is shown.
+    const TrialRow* trial() const;
+    const RatingInput* rating() const { return input_ ? &*input_ : nullptr; }
+    const std::string& text()
+        const;  // Consent, Instructions, PracticeDone, Break, Debrief
+    size_t answered_trials() const { return current_; }
+    size_t total_trials() const { return trials_.size(); }
+    int main_trials_done() const;
+    int main_trials_total() const;
+    ScreenView view() const;  // what the autopilot sees
+
+private:
+    void enter(Screen screen, int64_t t_ns);
+    void changed();
+    void begin_trial_or_debrief(int64_t t_ns);
+    void finish_trial();
+    void quit_saving();
+
+    const Protocol& protocol_;
+    Store& store_;
+    int64_t session_id_;
+    std::vector<TrialRow> trials_;
+    size_t current_ = 0;  // the first unanswered trial
+    Screen screen_ = Screen::Consent;
+    bool paused_ = false;
+    bool finished_ = false;
+    RunResult result_ = RunResult::Completed;
+    int serial_ = 0;
+    int64_t entered_ns_ = 0;
+    std::optional<int64_t> presented_ns_;
+    std::optional<RatingInput> input_;
+    std::vector<int64_t> trial_frames_ns_;
+    std::optional<double> refresh_hz_;
+};
+
+}  // namespace lucent::study
