@@ -52,11 +52,11 @@ std::string md_cell(const std::string& s) {
     return out;
 }
 
-std::string significance(const Statistic& p) {
+// "yes" / "no" at the report's alpha, the level the Tukey intervals are drawn at, so a
+// pair's verdict always agrees with whether its interval excludes 0.
+std::string significant_at(const Statistic& p, double alpha) {
     if (!p) return "undefined";
-    if (*p < 0.01) return "p < .01";
-    if (*p < 0.05) return "p < .05";
-    return "n.s.";
+    return *p < alpha ? "yes" : "no";
 }
 
 std::string configuration(const OneWayAnalysis& a) {
@@ -78,7 +78,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
     for (const OneWayAnalysis& a : analyses)
         summary.rows.push_back(
             {configuration(a), format_p_short(a.anova.p), format_short(a.anova.f),
-             a.anova.p ? (*a.anova.p < options.alpha ? "yes" : "no") : "undefined"});
+             significant_at(a.anova.p, options.alpha)});
     doc.push_back({Block::kHeading, "Summary", {}, {}, 2});
     doc.push_back({Block::kTable, "", summary});
 
@@ -122,13 +122,13 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
             doc.push_back({Block::kParagraph, "Not computed: " + tk.note});
         } else {
             Table tukey{{"level a", "level b", "diff (b - a)", "se", "q", "p adj",
-                         "lower", "upper", "significance"},
+                         "lower", "upper", "p adj < " + format_short(tk.alpha)},
                         {}};
             for (const TukeyPair& p : tk.pairs)
                 tukey.rows.push_back({p.level_a, p.level_b, format_short(p.diff),
                                       format_short(p.se), format_short(p.q),
                                       format_p_short(p.p_adj), format_short(p.lower),
-                                      format_short(p.upper), significance(p.p_adj)});
+                                      format_short(p.upper), significant_at(p.p_adj, tk.alpha)});
             doc.push_back({Block::kTable, "", tukey});
             std::string hsd = "q critical (alpha " + format_short(tk.alpha) +
                               ") = " + format_short(tk.q_critical);
