@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <map>
-#include <random>
 
 namespace lucent::study {
 namespace {
@@ -16,6 +15,23 @@ uint64_t uniform_below(std::mt19937_64& rng, uint64_t n) {
     do x = rng(); while (x >= limit);
     return x % n;
 }
+
+// Whether `level` may follow the placed prefix.
+bool may_place(const std::vector<const std::string*>& placed, const std::string& level,
+               const SequenceConstraints& c) {
+    const int n = static_cast<int>(placed.size());
+    if (c.min_distance > 1)
+        for (int back = 1; back < c.min_distance && back <= n; ++back)
+            if (*placed[n - back] == level) return false;
+    if (c.max_repeat > 0 && n >= c.max_repeat) {
+        bool run = true;
+        for (int back = 1; back <= c.max_repeat && run; ++back) run = *placed[n - back] == level;
+        if (run) return false;
+    }
+    return true;
+}
+
+}  // namespace
 
 // Necessary conditions on level counts; a violation means no order exists.
 void check_feasible(const std::vector<std::string>& levels, const SequenceConstraints& c) {
@@ -36,23 +52,6 @@ void check_feasible(const std::vector<std::string>& levels, const SequenceConstr
                             std::to_string(c.min_distance) + " apart");
     }
 }
-
-// Whether `level` may follow the placed prefix.
-bool may_place(const std::vector<const std::string*>& placed, const std::string& level,
-               const SequenceConstraints& c) {
-    const int n = static_cast<int>(placed.size());
-    if (c.min_distance > 1)
-        for (int back = 1; back < c.min_distance && back <= n; ++back)
-            if (*placed[n - back] == level) return false;
-    if (c.max_repeat > 0 && n >= c.max_repeat) {
-        bool run = true;
-        for (int back = 1; back <= c.max_repeat && run; ++back) run = *placed[n - back] == level;
-        if (run) return false;
-    }
-    return true;
-}
-
-}  // namespace
 
 int latin_square_rows(int n) { return n % 2 == 0 ? n : 2 * n; }
 
@@ -81,33 +80,49 @@ bool satisfies(const std::vector<std::string>& levels, const SequenceConstraints
     return true;
 }
 
+std::vector<std::vector<int>> constrained_block_shuffles(
+    const std::vector<std::vector<std::string>>& blocks, const SequenceConstraints& c,
+    std::mt19937_64& rng, int max_attempts) {
+    size_t total = 0;
+    for (const std::vector<std::string>& levels : blocks) {
+        check_feasible(levels, c);
+        total += levels.size();
+    }
+    std::vector<std::vector<int>> orders(blocks.size());
+    std::vector<const std::string*> placed;
+    placed.reserve(total);
+    for (int attempt = 0; attempt < max_attempts; ++attempt) {
+        // Fisher-Yates per block, checking each trial as it is placed: stopping at the
+        // first violation rejects the same shuffles as checking them whole, so the
+        // accepted ones stay uniform over the orders that meet the constraints.
+        placed.clear();
+        bool valid = true;
+        for (size_t b = 0; b < blocks.size() && valid; ++b) {
+            std::vector<int>& order = orders[b];
+            const int n = static_cast<int>(blocks[b].size());
+            order.resize(n);
+            for (int i = 0; i < n; ++i) order[i] = i;
+            for (int i = 0; i < n && valid; ++i) {
+                std::swap(order[i], order[i + uniform_below(rng, n - i)]);
+                const std::string& level = blocks[b][order[i]];
+                valid = may_place(placed, level, c);
+                placed.push_back(&level);
+            }
+        }
+        if (valid) return orders;
+    }
+    throw PlanError("randomisation: none of " + std::to_string(max_attempts) +
+                    " uniformly shuffled orders of " + std::to_string(total) +
+                    " trials met max_repeat = " + std::to_string(c.max_repeat) +
+                    " and min_distance = " + std::to_string(c.min_distance) +
+                    "; no order may exist, or too few to sample: relax the constraints");
+}
+
 std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,
                                      const SequenceConstraints& c, uint64_t seed,
                                      int max_attempts) {
-    check_feasible(levels, c);
     std::mt19937_64 rng(seed);
-    const int n = static_cast<int>(levels.size());
-    for (int attempt = 0; attempt < max_attempts; ++attempt) {
-        // Randomised greedy: place a random allowed trial; start over when stuck.
-        std::vector<int> remaining(n), order;
-        for (int i = 0; i < n; ++i) remaining[i] = i;
-        std::vector<const std::string*> placed;
-        while (!remaining.empty()) {
-            std::vector<int> allowed;
-            for (int k = 0; k < static_cast<int>(remaining.size()); ++k)
-                if (may_place(placed, levels[remaining[k]], c)) allowed.push_back(k);
-            if (allowed.empty()) break;
-            const int k = allowed[uniform_below(rng, allowed.size())];
-            order.push_back(remaining[k]);
-            placed.push_back(&levels[remaining[k]]);
-            remaining.erase(remaining.begin() + k);
-        }
-        if (static_cast<int>(order.size()) == n) return order;
-    }
-    throw PlanError("randomisation: no order of " + std::to_string(n) +
-                    " trials met max_repeat = " + std::to_string(c.max_repeat) +
-                    " and min_distance = " + std::to_string(c.min_distance) + " in " +
-                    std::to_string(max_attempts) + " attempts; relax the constraints");
+    return constrained_block_shuffles({levels}, c, rng, max_attempts).front();
 }
 
 TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_number) {
@@ -130,13 +145,11 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
     }
 
     const Randomisation& rz = protocol.randomisation;
-    const SequenceConstraints constraints{rz.max_repeat, rz.min_distance};
-    std::mt19937_64 seeds(seed);
-    int main_index = 0;
+    std::vector<std::vector<PlannedTrial>> block_trials;
     for (int b : order) {
         const Block& block = protocol.blocks[b];
         plan.block_order.push_back(block.id);
-        std::vector<PlannedTrial> trials;
+        std::vector<PlannedTrial>& trials = block_trials.emplace_back();
         for (int r = 0; r < block.repeats; ++r)
             for (const std::string& id : block.stimuli) {
                 PlannedTrial t;
@@ -156,28 +169,42 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
             t.tolerance = c.tolerance;
             trials.push_back(t);
         }
-        const uint64_t block_seed = seeds();  // drawn for every block: stable per block
-        if (rz.shuffle) {
-            std::vector<std::string> levels;
-            for (const PlannedTrial& t : trials)
-                levels.push_back(protocol.level_of(*protocol.find_stimulus(t.stimulus), rz.factor));
-            std::vector<int> perm;
+    }
+    if (rz.shuffle) {
+        const SequenceConstraints constraints{rz.max_repeat, rz.min_distance};
+        const std::map<std::string, std::string> level_of = protocol.levels_of(rz.factor);
+        std::vector<std::vector<std::string>> levels(block_trials.size());
+        for (size_t b = 0; b < block_trials.size(); ++b) {
+            for (const PlannedTrial& t : block_trials[b])
+                levels[b].push_back(level_of.at(t.stimulus));
             try {
-                perm = constrained_shuffle(levels, constraints, block_seed);
+                check_feasible(levels[b], constraints);
             } catch (const PlanError& e) {
-                throw PlanError(protocol.source + ": block '" + block.id + "': " + e.what());
+                throw PlanError(protocol.source + ": block '" + plan.block_order[b] +
+                                "': " + e.what());
             }
-            std::vector<PlannedTrial> shuffled;
-            for (int i : perm) shuffled.push_back(trials[i]);
-            trials = std::move(shuffled);
         }
+        std::mt19937_64 rng(seed);
+        std::vector<std::vector<int>> orders;
+        try {
+            orders = constrained_block_shuffles(levels, constraints, rng);
+        } catch (const PlanError& e) {
+            throw PlanError(protocol.source + ": " + e.what());
+        }
+        for (size_t b = 0; b < block_trials.size(); ++b) {
+            std::vector<PlannedTrial> shuffled;
+            for (int i : orders[b]) shuffled.push_back(block_trials[b][i]);
+            block_trials[b] = std::move(shuffled);
+        }
+    }
+    int main_index = 0;
+    for (std::vector<PlannedTrial>& trials : block_trials)
         for (PlannedTrial& t : trials) {
             t.break_before = protocol.break_every > 0 && main_index > 0 &&
                              main_index % protocol.break_every == 0;
             ++main_index;
             plan.trials.push_back(std::move(t));
         }
-    }
     for (int i = 0; i < static_cast<int>(plan.trials.size()); ++i) plan.trials[i].position = i;
     return plan;
 }
