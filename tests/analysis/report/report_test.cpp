@@ -147,6 +147,34 @@ TEST(Report, TukeySignificanceFollowsTheReportsAlphaAndItsInterval) {
     }
 }
 
+TEST(Report, NeverReplacesItsInputOrADatabaseAndWritesNothingThen) {
+    const auto dir = test::scratch_dir("report_protects_input");
+    // The ratings live in the report folder under a name the report also writes.
+    const auto input = dir / "anova.csv";
+    std::ofstream(input) << "participant,stimulus,factor,level,question,rating\n";
+    ReportOptions options;
+    options.inputs = {input};
+    const std::vector<OneWayAnalysis> analyses{
+        analyze_one_way("q", "f", groups({{1, 2}, {3, 4}}), 0.10)};
+    try {
+        write_report(analyses, dir, options);
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(input), "participant,stimulus,factor,level,question,rating\n");
+    EXPECT_FALSE(std::filesystem::exists(dir / "report.md"));  // refused before writing
+    // A database in the way is refused too; the folder itself must not be a file.
+    std::filesystem::remove(input);
+    std::ofstream(dir / "report.md") << std::string("SQLite format 3\0", 16) << "pages";
+    EXPECT_THROW(write_report(analyses, dir, ReportOptions{}), InputError);
+    EXPECT_THROW(write_report(analyses, dir / "report.md", ReportOptions{}), InputError);
+    std::filesystem::remove(dir / "report.md");
+    write_report(analyses, dir, ReportOptions{});  // a second run replaces its own files
+    write_report(analyses, dir, ReportOptions{});
+    EXPECT_TRUE(std::filesystem::exists(dir / "report.md"));
+}
+
 TEST(Report, FormatSelectionAndErrors) {
     ReportOptions options;
     parse_formats("csv", options);
