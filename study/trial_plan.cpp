@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <unordered_map>
 
 namespace lucent::study {
 namespace {
@@ -30,6 +31,103 @@ bool may_place(const std::vector<const std::string*>& placed, const std::string&
     }
     return true;
 }
+
+// Exact sampling by counting (the fallback when rejection is too rare): the number of
+// valid completions of a partial order depends only on the block, the trials left per
+// level and the last few levels placed, so it is memoised on that state, and each next
+// level is drawn with probability (trials left of it) x (completions after it) / (all
+// completions), then one of its trials uniformly: every valid order is equally likely
+// (up to the rounding of long double counts).
+class OrderCounter {
+public:
+    OrderCounter(const std::vector<std::vector<std::string>>& blocks,
+                 const SequenceConstraints& c, size_t max_states)
+        : c_(c), max_states_(max_states) {
+        std::map<std::string, int> ids;
+        for (const auto& block : blocks) {
+            std::vector<int>& levels = blocks_.emplace_back();
+            for (const std::string& l : block)
+                levels.push_back(ids.emplace(l, static_cast<int>(ids.size())).first->second);
+        }
+        levels_ = static_cast<int>(ids.size());
+        window_ = std::max(c.min_distance > 1 ? c.min_distance - 1 : 0, std::max(c.max_repeat, 0));
+    }
+
+    struct State {
+        size_t block = 0;
+        std::vector<int> left;    // trials left per level in this block
+        std::vector<int> recent;  // the last window_ levels placed, oldest first; -1: none
+    };
+    State start() const {
+        State s{0, counts(0), std::vector<int>(window_, -1)};
+        while (s.block + 1 < blocks_.size() && empty(s.left)) s.left = counts(++s.block);
+        return s;
+    }
+    // Whether `level` may be placed after `recent`.
+    bool allowed(const std::vector<int>& recent, int level) const {
+        const int n = static_cast<int>(recent.size());
+        if (c_.min_distance > 1)
+            for (int back = 1; back < c_.min_distance; ++back)
+                if (recent[n - back] == level) return false;
+        if (c_.max_repeat > 0) {
+            bool run = true;
+            for (int back = 1; back <= c_.max_repeat && run; ++back) run = recent[n - back] == level;
+            if (run) return false;
+        }
+        return true;
+    }
+    // `s` after placing a trial of `level`; moves to the next block when one is done.
+    State place(const State& s, int level) const {
+        State next = s;
+        --next.left[level];
+        if (window_ > 0) {
+            next.recent.erase(next.recent.begin());
+            next.recent.push_back(level);
+        }
+        while (next.block + 1 < blocks_.size() && empty(next.left))
+            next.left = counts(++next.block);
+        return next;
+    }
+    bool done(const State& s) const { return s.block + 1 >= blocks_.size() && empty(s.left); }
+    // Valid completions of `s`.
+    long double completions(const State& s) {
+        if (done(s)) return 1.0L;
+        std::string key(reinterpret_cast<const char*>(&s.block), sizeof s.block);
+        key.append(reinterpret_cast<const char*>(s.left.data()), s.left.size() * sizeof(int));
+        key.append(reinterpret_cast<const char*>(s.recent.data()), s.recent.size() * sizeof(int));
+        if (const auto it = memo_.find(key); it != memo_.end()) return it->second;
+        long double total = 0.0L;
+        for (int level = 0; level < levels_; ++level)
+            if (s.left[level] > 0 && allowed(s.recent, level))
+                total += s.left[level] * completions(place(s, level));
+        if (memo_.size() >= max_states_)
+            throw PlanError("randomisation: too many distinct states (over " +
+                            std::to_string(max_states_) +
+                            ") to count the valid orders exactly; relax the constraints");
+        memo_.emplace(std::move(key), total);
+        return total;
+    }
+    const std::vector<int>& block_levels(size_t b) const { return blocks_[b]; }
+    size_t blocks() const { return blocks_.size(); }
+    int levels() const { return levels_; }
+
+private:
+    std::vector<int> counts(size_t b) const {
+        std::vector<int> left(levels_, 0);
+        for (int l : blocks_[b]) ++left[l];
+        return left;
+    }
+    static bool empty(const std::vector<int>& left) {
+        return std::all_of(left.begin(), left.end(), [](int n) { return n == 0; });
+    }
+
+    SequenceConstraints c_;
+    size_t max_states_;
+    std::vector<std::vector<int>> blocks_;
+    int levels_ = 0;
+    int window_ = 0;
+    std::unordered_map<std::string, long double> memo_;
+};
 
 }  // namespace
 
@@ -111,11 +209,51 @@ std::vector<std::vector<int>> constrained_block_shuffles(
         }
         if (valid) return orders;
     }
-    throw PlanError("randomisation: none of " + std::to_string(max_attempts) +
-                    " uniformly shuffled orders of " + std::to_string(total) +
-                    " trials met max_repeat = " + std::to_string(c.max_repeat) +
-                    " and min_distance = " + std::to_string(c.min_distance) +
-                    "; no order may exist, or too few to sample: relax the constraints");
+    // Valid orders are rare among all orders (or absent): count them instead.
+    return exact_block_shuffles(blocks, c, rng);
+}
+
+std::vector<std::vector<int>> exact_block_shuffles(
+    const std::vector<std::vector<std::string>>& blocks, const SequenceConstraints& c,
+    std::mt19937_64& rng, size_t max_states) {
+    OrderCounter counter(blocks, c, max_states);
+    OrderCounter::State state = counter.start();
+    size_t trials = 0;
+    for (const auto& b : blocks) trials += b.size();
+    if (counter.completions(state) <= 0.0L)
+        throw PlanError("randomisation: no order of the " + std::to_string(trials) +
+                        " trials meets max_repeat = " + std::to_string(c.max_repeat) +
+                        " and min_distance = " + std::to_string(c.min_distance) +
+                        "; relax the constraints");
+    std::vector<std::vector<int>> orders(blocks.size());
+    std::vector<std::vector<int>> unplaced;  // the current block's trials, per level
+    size_t block = blocks.size();            // none yet
+    while (!counter.done(state)) {
+        if (state.block != block) {
+            block = state.block;
+            unplaced.assign(counter.levels(), {});
+            for (int i = 0; i < static_cast<int>(blocks[block].size()); ++i)
+                unplaced[counter.block_levels(block)[i]].push_back(i);
+        }
+        long double u =
+            static_cast<long double>(rng() >> 11) * 0x1p-53L * counter.completions(state);
+        int chosen = -1;
+        for (int level = 0; level < counter.levels(); ++level) {
+            if (state.left[level] == 0 || !counter.allowed(state.recent, level)) continue;
+            const long double weight =
+                state.left[level] * counter.completions(counter.place(state, level));
+            if (weight <= 0.0L) continue;
+            chosen = level;  // the last possible level takes any rounding remainder
+            if (u < weight) break;
+            u -= weight;
+        }
+        std::vector<int>& pool = unplaced[chosen];
+        const size_t k = uniform_below(rng, pool.size());
+        orders[block].push_back(pool[k]);
+        pool.erase(pool.begin() + static_cast<long>(k));
+        state = counter.place(state, chosen);
+    }
+    return orders;
 }
 
 std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,

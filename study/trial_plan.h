@@ -57,18 +57,29 @@ bool satisfies(const std::vector<std::string>& levels, const SequenceConstraints
 void check_feasible(const std::vector<std::string>& levels, const SequenceConstraints& c);
 
 // Rejection sampling gives up after this many uniform shuffles (each abandoned at its
-// first violation, so an attempt costs a few steps).
+// first violation, so an attempt costs a few steps) and counts instead.
 inline constexpr int kMaxShuffleAttempts = 2'000'000;
+// The exact sampler gives up beyond this many memoised states (block, trials left per
+// level, last levels placed): few levels or small blocks stay far below it.
+inline constexpr size_t kMaxCountedStates = 500'000;
 
 // Random orders of consecutive blocks, each block's trials (given as levels) permuted
 // within the block, such that the blocks' concatenation meets the constraints. Every
-// combination of block orders that meets them is equally likely: each attempt draws
-// every block uniformly (Fisher-Yates) and is rejected at its first violation. Throws
-// PlanError when check_feasible fails for a block, or when `max_attempts` attempts all
-// fail (the constraints are unsatisfiable, or satisfied by too few orders to sample).
+// combination of block orders that meets them is equally likely. First by rejection:
+// each attempt draws every block uniformly (Fisher-Yates) and is rejected at its first
+// violation; after `max_attempts` rejections by exact_block_shuffles. Throws PlanError
+// when check_feasible fails for a block, or from exact_block_shuffles.
 std::vector<std::vector<int>> constrained_block_shuffles(
     const std::vector<std::vector<std::string>>& blocks, const SequenceConstraints& c,
     std::mt19937_64& rng, int max_attempts = kMaxShuffleAttempts);
+
+// The same distribution by counting: the number of valid completions of a partial order
+// is memoised on (block, trials left per level, last levels placed), and each next trial
+// is drawn in proportion to the completions after it. Throws PlanError when no order
+// meets the constraints, or beyond `max_states` states.
+std::vector<std::vector<int>> exact_block_shuffles(
+    const std::vector<std::vector<std::string>>& blocks, const SequenceConstraints& c,
+    std::mt19937_64& rng, size_t max_states = kMaxCountedStates);
 
 // One block: a uniformly random permutation of `levels` (as indices) among those
 // meeting the constraints; the same seed gives the same order.

@@ -364,19 +364,75 @@ TEST(PlanTrials, EveryValidOrderOfASmallProtocolIsEquallyLikely) {
     ASSERT_EQ(index_of_order.size(), 40u);
 
     constexpr int kPlans = 20000;
+    const std::vector<double> uniform(index_of_order.size(), 1.0 / index_of_order.size());
     std::vector<double> observed(index_of_order.size(), 0.0);
+    auto tally = [&](const std::string& key) {
+        const auto it = index_of_order.find(key);
+        ASSERT_NE(it, index_of_order.end()) << "order breaks the constraints: " << key;
+        ++observed[it->second];
+    };
+    // The planner (rejection sampling for a protocol this loose).
     std::mt19937_64 seeds(7);
     for (int i = 0; i < kPlans; ++i) {
         std::string key;
         for (const PlannedTrial& t : plan_trials(p, seeds(), 0).trials)
             key += t.stimulus + (t.is_catch ? "*" : "") + " ";
-        const auto it = index_of_order.find(key);
-        ASSERT_NE(it, index_of_order.end()) << "plan breaks the constraints: " << key;
-        ++observed[it->second];
+        tally(key);
     }
-    const std::vector<double> uniform(observed.size(), 1.0 / observed.size());
-    const auto [statistic, df] = chi_square(observed, uniform);
+    auto [statistic, df] = chi_square(observed, uniform);
+    EXPECT_LT(statistic, chi_square_999(df)) << "planner: chi-square " << statistic << " on " << df;
+    // The exact sampler (the fallback for rare valid orders) on the same blocks.
+    std::vector<std::vector<std::string>> levels(2);
+    for (int i = 0; i < n; ++i) levels[i < 4 ? 0 : 1].push_back(p.level_of(*p.find_stimulus(ids[i]), "stimulus"));
+    std::fill(observed.begin(), observed.end(), 0.0);
+    std::mt19937_64 rng(8);
+    for (int i = 0; i < kPlans; ++i) {
+        const std::vector<std::vector<int>> orders = exact_block_shuffles(levels, c, rng);
+        std::string key;
+        for (int t : orders[0]) key += name(t) + " ";
+        for (int t : orders[1]) key += name(4 + t) + " ";
+        tally(key);
+    }
+    std::tie(statistic, df) = chi_square(observed, uniform);
+    EXPECT_LT(statistic, chi_square_999(df)) << "exact: chi-square " << statistic << " on " << df;
+}
+
+TEST(ConstrainedShuffle, RareValidOrdersAreCountedExactlyWhenRejectionGivesUp) {
+    // 20 a and 20 b with no repeats: only the 2 x 20! x 20! alternating orders of the
+    // 40! are valid (1 in 7e10), beyond rejection sampling.
+    std::vector<std::string> levels;
+    for (int i = 0; i < 40; ++i) levels.push_back(i < 20 ? "a" : "b");
+    const SequenceConstraints c{1, 0};
+    auto alternates = [&](const std::vector<int>& order) {
+        for (size_t i = 1; i < order.size(); ++i)
+            if (levels[order[i]] == levels[order[i - 1]]) return false;
+        return true;
+    };
+    EXPECT_TRUE(alternates(constrained_shuffle(levels, c, 3, /*max_attempts=*/1000)));
+    // Uniform over the valid orders: the first trial starts half the orders, and trial 0
+    // (an 'a') is equally likely in each of the 20 positions its level can hold.
+    constexpr int kOrders = 4000;
+    std::mt19937_64 rng(11);
+    int a_first = 0;
+    std::vector<double> slot_of_trial_0(20, 0.0);
+    for (int i = 0; i < kOrders; ++i) {
+        const std::vector<int> order = exact_block_shuffles({levels}, c, rng).front();
+        ASSERT_TRUE(alternates(order));
+        a_first += levels[order[0]] == "a";
+        const int at = static_cast<int>(std::find(order.begin(), order.end(), 0) - order.begin());
+        ++slot_of_trial_0[at / 2];
+    }
+    EXPECT_NEAR(a_first, kOrders / 2, 4 * std::sqrt(kOrders / 4.0));
+    const auto [statistic, df] = chi_square(slot_of_trial_0, std::vector<double>(20, 1.0 / 20));
     EXPECT_LT(statistic, chi_square_999(df)) << "chi-square " << statistic << " on " << df;
+    // And an impossible case that passes the count check is now a definite answer.
+    try {
+        exact_block_shuffles({{"a", "a", "b", "b"}}, {0, 3}, rng);
+        FAIL();
+    } catch (const PlanError& e) {
+        EXPECT_NE(std::string(e.what()).find("no order of the 4 trials meets"), std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(PlanTrials, PracticeFirstThenEveryBlockTrialAndCatchTrialOnce) {
