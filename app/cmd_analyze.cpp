@@ -26,6 +26,7 @@ int run_analyze(const AnalyzeArgs& args) {
         parse_formats(args.formats, options);
         options.alpha = args.alpha;
         options.source = args.input;
+        options.inputs = {args.input};  // a report file never replaces the input
         const LongTable table = read_ratings(args.input, parse_scale(args.scale));
         AnalysisRequest request{args.alpha, args.question, args.factor,
                                 [](const std::string& question, const std::string& factor,

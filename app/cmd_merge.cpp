@@ -11,12 +11,15 @@ void register_merge(CLI::App& app, int& exit_code) {
     auto inputs = std::make_shared<std::vector<std::string>>();
     auto out = std::make_shared<std::string>();
     auto* cmd = app.add_subcommand(
-        "merge", "Combine study databases (sessions de-duplicated by UUID; one protocol only)");
+        "merge",
+        "Combine study databases (sessions de-duplicated by UUID, a participant is a code on "
+        "one machine; one protocol only)");
     cmd->add_option("inputs", *inputs, "Databases to merge")->required()->check(CLI::ExistingFile);
-    cmd->add_option("--out", *out, "New database to write")->required();
+    cmd->add_option("--out", *out, "New database to write (must not exist)")->required();
     cmd->callback([=, &exit_code] {
         try {
             const study::MergeReport r = study::merge_databases(*inputs, *out);
+            for (const std::string& note : r.notes) std::cout << "lucent merge: " << note << "\n";
             std::cout << "merged " << inputs->size() << " databases into " << *out << ": "
                       << r.sessions_added << " sessions, " << r.sessions_already_present
                       << " duplicates skipped\n";

@@ -1,9 +1,9 @@
 // lucent simulate: writes a seeded synthetic study (long CSV) from a latent normal model,
 // so the analysis pipeline can be exercised without a lab.
-#include <fstream>
 #include <iostream>
 
 #include "commands.h"
+#include "output_file.h"
 #include "simulate/simulate.h"
 
 namespace lucent::app {
@@ -37,12 +37,16 @@ void register_simulate(CLI::App& app, int& exit_code) {
     cmd->callback([spec, out, &exit_code] {
         try {
             const analysis::LongTable table = analysis::simulate_study(*spec);
-            std::ofstream file(*out, std::ios::binary);
-            if (!file) throw analysis::InputError(*out + ": cannot open for writing");
-            analysis::write_long_csv(file, table);
+            // Replaces an earlier simulated CSV, never a database; atomically.
+            output::check_output_file(*out, {}, true);
+            output::write_file_atomically(
+                *out, true, [&](std::ostream& file) { analysis::write_long_csv(file, table); });
             std::cerr << "wrote " << table.rows.size() << " ratings to " << *out << "\n";
             exit_code = kExitOk;
         } catch (const analysis::InputError& e) {
+            std::cerr << "lucent simulate: " << e.what() << "\n";
+            exit_code = kExitUsage;
+        } catch (const output::OutputError& e) {
             std::cerr << "lucent simulate: " << e.what() << "\n";
             exit_code = kExitUsage;
         }

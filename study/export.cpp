@@ -5,6 +5,8 @@
 #include <set>
 #include <sstream>
 
+#include "output_file.h"
+#include "question_scales.h"
 #include "sqlite.h"
 #include "store.h"
 
@@ -239,6 +241,33 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
                                   static_cast<int>(s.integer(3))});
     }
     return table;
+}
+
+ExportFileResult export_file(const std::string& db_path, const std::string& format,
+                             const std::string& out_path, bool force) {
+    ExportFileResult result;
+    try {
+        output::check_output_file(out_path, {db_path}, force);
+        output::write_file_atomically(out_path, force, [&](std::ostream& out) {
+            if (format == "analysis") {
+                check_stored_ratings(db_path);  // no impossible rating enters an analysis
+                const LongTable table = analysis_long_table(db_path);
+                write_long_table_csv(table, out);
+                result.rows = static_cast<int>(table.rows.size());
+                result.excluded_participants = table.excluded_participants;
+            } else if (format == "long" || format == "wide") {
+                result.rows = export_csv(
+                    db_path, format == "long" ? ExportFormat::Long : ExportFormat::Wide, out,
+                    &result.notes);
+            } else {
+                throw StoreError("export: unknown format '" + format +
+                                 "' (valid: long, wide, analysis)");
+            }
+        });
+    } catch (const output::OutputError& e) {
+        throw StoreError(e.what());
+    }
+    return result;
 }
 
 void write_long_table_csv(const LongTable& table, std::ostream& out) {

@@ -18,6 +18,19 @@ enum class ExportFormat { Long, Wide };
 int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out,
                std::vector<std::string>* notes = nullptr);
 
+struct ExportFileResult {
+    int rows = 0;
+    std::vector<std::string> excluded_participants;  // format "analysis" only
+    std::vector<std::string> notes;  // long, wide: values older databases did not record
+};
+
+// Writes format "long", "wide" or "analysis" of `db_path` to the CSV file `out_path`:
+// never the database itself (by inode: symlinks, hard links and relative paths
+// included) nor any other database; an existing file only with `force`. Written to a
+// temporary file in the same folder and renamed into place. Throws StoreError (one line).
+ExportFileResult export_file(const std::string& db_path, const std::string& format,
+                             const std::string& out_path, bool force);
+
 // A row of the analysis input (issue 4): one per (rating, factor), practice and catch
 // trials excluded. Columns participant,stimulus,factor,level,question,rating.
 struct LongRow {
@@ -47,11 +60,21 @@ void write_long_table_csv(const LongTable& table, std::ostream& out);
 struct MergeReport {
     int sessions_added = 0;
     int sessions_already_present = 0;  // same UUID seen in an earlier input
+    // One line each: a code from several machines kept apart as several participants
+    // ("P01: sessions from 2 machines are different people, kept apart as P01@3f2a9c1e
+    // P01@77b0d2aa"), an older input read through an upgraded copy.
+    std::vector<std::string> notes;
 };
 
-// Combines databases into `out_path` (which must not exist): sessions are de-duplicated
-// by UUID; inputs holding different protocols (hashes) are refused before anything is
-// written. Inputs are opened read-only and never modified.
+// Combines databases into `out_path`, a new file (never an input or any database),
+// written under a temporary name and renamed when complete. Sessions are de-duplicated
+// by UUID. A participant is a code on one machine (sessions.machine_id): a code whose
+// sessions come from several machines becomes one participant per machine, coded
+// CODE@MACHINE (the shortest machine-id prefix of at least 8 characters that tells them
+// apart), so two people are never fused. Inputs of an older schema are read through a
+// migrated temporary copy; inputs holding different protocols (hashes), newer schemas
+// or foreign files are refused before anything is written. Inputs are opened read-only
+// and never modified.
 MergeReport merge_databases(const std::vector<std::string>& inputs, const std::string& out_path);
 
 // One CSV cell, quoted when it holds a comma, quote or line break.

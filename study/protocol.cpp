@@ -330,8 +330,37 @@ const StimulusSpec* Protocol::find_stimulus(std::string_view id) const {
     return nullptr;
 }
 
+std::string Protocol::picture_key(const StimulusSpec& stimulus) {
+    if (!stimulus.live()) {
+        std::ifstream in(stimulus.image, std::ios::binary);
+        std::ostringstream bytes;
+        if (in && (bytes << in.rdbuf()))
+            return "image sha256:" + sha256_hex(bytes.str());
+        return "image path:" + std::filesystem::absolute(stimulus.image).lexically_normal().string();
+    }
+    std::string key = "live " + stimulus.technique + " " + stimulus.mesh;
+    for (const auto& [name, value] : stimulus.parameters) key += " " + name + "=" + value;
+    return key;
+}
+
+std::map<std::string, std::string> Protocol::levels_of(std::string_view factor) const {
+    std::map<std::string, std::string> levels;
+    if (factor != "stimulus") {
+        for (const StimulusSpec& s : stimuli) levels[s.id] = level_of(s, factor);
+        return levels;
+    }
+    std::map<std::string, std::string> first_id_of_picture;
+    for (const StimulusSpec& s : stimuli)
+        levels[s.id] = first_id_of_picture.emplace(picture_key(s), s.id).first->second;
+    return levels;
+}
+
 std::string Protocol::level_of(const StimulusSpec& stimulus, std::string_view factor) const {
-    if (factor == "stimulus") return stimulus.id;
+    if (factor == "stimulus") {
+        const auto levels = levels_of(factor);
+        const auto it = levels.find(stimulus.id);
+        return it == levels.end() ? stimulus.id : it->second;
+    }
     if (factor == "technique") return stimulus.technique.empty() ? "image" : stimulus.technique;
     auto it = stimulus.parameters.find(std::string(factor));
     return it == stimulus.parameters.end() ? std::string() : it->second;

@@ -93,8 +93,16 @@ struct Protocol {
 
     const StimulusSpec* find_stimulus(std::string_view id) const;
     // Level of `factor` for a stimulus ("stimulus", "technique" or a parameter); empty
-    // when the stimulus has no such parameter.
+    // when the stimulus has no such parameter. The level of "stimulus" is the picture:
+    // the id of the first stimulus with the same picture_key, so ids that show the same
+    // picture (the thesis's rows 1, 4 and 7) share a level.
     std::string level_of(const StimulusSpec& stimulus, std::string_view factor) const;
+    // level_of for every stimulus at once (stimulus id -> level), hashing each image once.
+    std::map<std::string, std::string> levels_of(std::string_view factor) const;
+    // What the participant sees, independent of the id: a live stimulus's technique,
+    // mesh and parameters (as written; a default spelled out counts as different), or a
+    // pre-rendered image's content hash (its path when the file cannot be read).
+    static std::string picture_key(const StimulusSpec& stimulus);
 };
 
 // Parses and validates a protocol. `source` names the file in error messages; image

@@ -349,7 +349,10 @@ int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int
         return find.integer(0);
     }
     int n = participant_number_from_code(code);
-    if (n < 0) n = static_cast<int>(db_.scalar_int("SELECT count(*) FROM participants")) + 1;
+    // Enrolment order: one past the highest number held, not the count, which falls
+    // after a withdrawal and would hand out a number (a Latin-square row) still in use.
+    if (n < 0)
+        n = static_cast<int>(db_.scalar_int("SELECT coalesce(max(number), 0) FROM participants")) + 1;
     db_.prepare("INSERT INTO participants (study_id, code, number, created_utc) "
                 "VALUES (?, ?, ?, ?)")
         .bind(1, study_id).bind(2, code).bind(3, n).bind(4, utc_now_iso8601()).run();

@@ -132,7 +132,8 @@ public:
     // holds one protocol: a different hash is refused with a one-line error.
     int64_t ensure_study(const Protocol& protocol);
     // Participant by code, created when new. Number: the code's trailing digits, else
-    // the enrolment order in this database; it selects the Latin-square row.
+    // one past the highest number in this database (so never one a participant holds);
+    // it selects the Latin-square row.
     int64_t ensure_participant(int64_t study_id, const std::string& code, int* number);
 
     // Throws StoreError naming the stimulus and parameter when `stimuli` resolve to other

@@ -3,6 +3,7 @@
 // number). Pure and GL-free; the store writes the plan before trial 1 so a resumed
 // session continues in the same order.
 #include <cstdint>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -42,20 +43,53 @@ struct TrialPlan {
 std::vector<int> latin_square_row(int n, int participant_number);
 int latin_square_rows(int n);
 
-// Constraints on the sequence of factor levels of a shuffled block.
+// Constraints on the sequence of factor levels of the rated trials. With the factor
+// `stimulus` a level is the picture shown (Protocol::picture_key), so stimuli that are
+// the same picture under different ids, and a catch trial and its stimulus, count as
+// one level.
 struct SequenceConstraints {
     int max_repeat = 0;    // longest run of one level allowed (0: unlimited)
     int min_distance = 0;  // two equal levels at least this many positions apart (0: off)
 };
 bool satisfies(const std::vector<std::string>& levels, const SequenceConstraints& c);
 
-// A random permutation of `levels` (as indices) meeting the constraints. Throws PlanError
-// naming the offending level when the counts make it impossible, or after
-// `max_attempts` randomised restarts; never loops forever.
+// Throws PlanError naming a level whose count alone makes the constraints impossible.
+void check_feasible(const std::vector<std::string>& levels, const SequenceConstraints& c);
+
+// Rejection sampling gives up after this many uniform shuffles (each abandoned at its
+// first violation, so an attempt costs a few steps) and counts instead.
+inline constexpr int kMaxShuffleAttempts = 2'000'000;
+// The exact sampler gives up beyond this many memoised states (block, trials left per
+// level, last levels placed): few levels or small blocks stay far below it.
+inline constexpr size_t kMaxCountedStates = 500'000;
+
+// Random orders of consecutive blocks, each block's trials (given as levels) permuted
+// within the block, such that the blocks' concatenation meets the constraints. Every
+// combination of block orders that meets them is equally likely. First by rejection:
+// each attempt draws every block uniformly (Fisher-Yates) and is rejected at its first
+// violation; after `max_attempts` rejections by exact_block_shuffles. Throws PlanError
+// when check_feasible fails for a block, or from exact_block_shuffles.
+std::vector<std::vector<int>> constrained_block_shuffles(
+    const std::vector<std::vector<std::string>>& blocks, const SequenceConstraints& c,
+    std::mt19937_64& rng, int max_attempts = kMaxShuffleAttempts);
+
+// The same distribution by counting: the number of valid completions of a partial order
+// is memoised on (block, trials left per level, last levels placed), and each next trial
+// is drawn in proportion to the completions after it. Throws PlanError when no order
+// meets the constraints, or beyond `max_states` states.
+std::vector<std::vector<int>> exact_block_shuffles(
+    const std::vector<std::vector<std::string>>& blocks, const SequenceConstraints& c,
+    std::mt19937_64& rng, size_t max_states = kMaxCountedStates);
+
+// One block: a uniformly random permutation of `levels` (as indices) among those
+// meeting the constraints; the same seed gives the same order.
 std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,
                                      const SequenceConstraints& c, uint64_t seed,
-                                     int max_attempts = 2000);
+                                     int max_attempts = kMaxShuffleAttempts);
 
+// Practice trials first, in protocol order; then the blocks in Latin-square order,
+// shuffled by constrained_block_shuffles with the protocol's constraints on the whole
+// rated sequence (across block boundaries too, catch trials included).
 TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_number);
 
 }  // namespace lucent::study

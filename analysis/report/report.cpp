@@ -1,10 +1,10 @@
 #include "report/report.h"
 
 #include <cctype>
-#include <fstream>
 #include <sstream>
 
 #include "data/long_table.h"
+#include "output_file.h"
 #include "report/format.h"
 #include "report/svg_plot.h"
 
@@ -52,11 +52,11 @@ std::string md_cell(const std::string& s) {
     return out;
 }
 
-std::string significance(const Statistic& p) {
+// "yes" / "no" at the report's alpha, the level the Tukey intervals are drawn at, so a
+// pair's verdict always agrees with whether its interval excludes 0.
+std::string significant_at(const Statistic& p, double alpha) {
     if (!p) return "undefined";
-    if (*p < 0.01) return "p < .01";
-    if (*p < 0.05) return "p < .05";
-    return "n.s.";
+    return *p < alpha ? "yes" : "no";
 }
 
 std::string configuration(const OneWayAnalysis& a) {
@@ -78,7 +78,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
     for (const OneWayAnalysis& a : analyses)
         summary.rows.push_back(
             {configuration(a), format_p_short(a.anova.p), format_short(a.anova.f),
-             a.anova.p ? (*a.anova.p < options.alpha ? "yes" : "no") : "undefined"});
+             significant_at(a.anova.p, options.alpha)});
     doc.push_back({Block::kHeading, "Summary", {}, {}, 2});
     doc.push_back({Block::kTable, "", summary});
 
@@ -122,13 +122,13 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
             doc.push_back({Block::kParagraph, "Not computed: " + tk.note});
         } else {
             Table tukey{{"level a", "level b", "diff (b - a)", "se", "q", "p adj",
-                         "lower", "upper", "significance"},
+                         "lower", "upper", "p adj < " + format_short(tk.alpha)},
                         {}};
             for (const TukeyPair& p : tk.pairs)
                 tukey.rows.push_back({p.level_a, p.level_b, format_short(p.diff),
                                       format_short(p.se), format_short(p.q),
                                       format_p_short(p.p_adj), format_short(p.lower),
-                                      format_short(p.upper), significance(p.p_adj)});
+                                      format_short(p.upper), significant_at(p.p_adj, tk.alpha)});
             doc.push_back({Block::kTable, "", tukey});
             std::string hsd = "q critical (alpha " + format_short(tk.alpha) +
                               ") = " + format_short(tk.q_critical);
@@ -227,31 +227,17 @@ void render_html(const std::vector<Block>& doc, std::ostream& out) {
     out << "</body></html>\n";
 }
 
-std::ofstream open_output(const std::filesystem::path& path) {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw InputError(path.string() + ": cannot open for writing");
-    return out;
-}
+// The report's files by name, rendered in memory and written once all are checked.
+using ReportFiles = std::vector<std::pair<std::string, std::string>>;
 
-void write_csv_tables(const std::vector<OneWayAnalysis>& analyses,
-                      const std::filesystem::path& dir,
-                      std::vector<std::filesystem::path>& written) {
-    auto open = [&](const char* name, const char* header) {
-        written.push_back(dir / name);
-        auto out = open_output(written.back());
-        out << header << '\n';
-        return out;
-    };
-    auto anova =
-        open("anova.csv",
-             "question,factor,ss_between,ss_within,df_between,df_within,ms_between,"
-             "ms_within,f,p,eta_sq,omega_sq");
-    auto tukey =
-        open("tukey.csv", "question,factor,level_a,level_b,diff,se,q,p_adj,lower,upper");
-    auto kruskal = open("kruskal.csv", "question,factor,h,df,p");
-    auto welch = open("welch.csv", "question,factor,f,df1,df2,p");
-    auto desc = open("descriptives.csv",
-                     "question,factor,level,n,mean,sd,se,median,ci_low,ci_high");
+void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& files) {
+    std::ostringstream anova, tukey, kruskal, welch, desc;
+    anova << "question,factor,ss_between,ss_within,df_between,df_within,ms_between,"
+             "ms_within,f,p,eta_sq,omega_sq\n";
+    tukey << "question,factor,level_a,level_b,diff,se,q,p_adj,lower,upper\n";
+    kruskal << "question,factor,h,df,p\n";
+    welch << "question,factor,f,df1,df2,p\n";
+    desc << "question,factor,level,n,mean,sd,se,median,ci_low,ci_high\n";
     for (const OneWayAnalysis& a : analyses) {
         const std::string key = csv_field(a.question) + ',' + csv_field(a.factor) + ',';
         const AnovaResult& r = a.anova;
@@ -275,6 +261,11 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses,
                  << format_full(d.median) << ',' << format_full(d.ci_low) << ','
                  << format_full(d.ci_high) << '\n';
     }
+    files.emplace_back("anova.csv", anova.str());
+    files.emplace_back("tukey.csv", tukey.str());
+    files.emplace_back("kruskal.csv", kruskal.str());
+    files.emplace_back("welch.csv", welch.str());
+    files.emplace_back("descriptives.csv", desc.str());
 }
 
 }  // namespace
@@ -312,30 +303,45 @@ std::vector<std::filesystem::path> write_report(
     const std::vector<OneWayAnalysis>& analyses, const std::filesystem::path& directory,
     const ReportOptions& options) {
     std::error_code error;
+    if (std::filesystem::exists(directory, error) &&
+        !std::filesystem::is_directory(directory, error))
+        throw InputError(directory.string() +
+                         ": is a file; the report is written into a folder (refusing to touch it)");
     std::filesystem::create_directories(directory, error);
     if (error)
         throw InputError(directory.string() +
                          ": cannot create directory: " + error.message());
-    std::vector<std::filesystem::path> written;
     const std::vector<Block> doc = build_document(analyses, options);
+    ReportFiles files;
     if (options.markdown || options.html) {
         for (const Block& b : doc)
-            if (b.kind == Block::kPlot) {
-                written.push_back(directory / b.text);
-                open_output(written.back()) << b.svg;
-            }
+            if (b.kind == Block::kPlot) files.emplace_back(b.text, b.svg);
     }
     if (options.markdown) {
-        written.push_back(directory / "report.md");
-        auto out = open_output(written.back());
+        std::ostringstream out;
         render_markdown(doc, out);
+        files.emplace_back("report.md", out.str());
     }
     if (options.html) {
-        written.push_back(directory / "report.html");
-        auto out = open_output(written.back());
+        std::ostringstream out;
         render_html(doc, out);
+        files.emplace_back("report.html", out.str());
     }
-    if (options.csv) write_csv_tables(analyses, directory, written);
+    if (options.csv) write_csv_tables(analyses, files);
+    // Refuse before writing anything: a report file that is the input or a database.
+    // Earlier report files are replaced, atomically (readers see the old or the new).
+    std::vector<std::filesystem::path> written;
+    try {
+        for (const auto& [name, text] : files)
+            output::check_output_file(directory / name, options.inputs, true);
+        for (const auto& [name, text] : files) {
+            written.push_back(directory / name);
+            output::write_file_atomically(written.back(), true,
+                                          [&](std::ostream& out) { out << text; });
+        }
+    } catch (const output::OutputError& e) {
+        throw InputError(e.what());
+    }
     return written;
 }
 

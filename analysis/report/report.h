@@ -15,12 +15,16 @@ struct ReportOptions {
         0.10;  // significance level (the thesis used 0.10); Tukey CI at 1 - alpha
     bool markdown = true, csv = true, html = true;
     std::string source;  // input description printed in the header
+    // Files the report must never replace (its input): a report file that is one of
+    // them, or any SQLite database, is refused before anything is written.
+    std::vector<std::filesystem::path> inputs;
 };
 
 // "md,csv,html" (any subset, comma-separated); throws InputError naming a bad entry.
 void parse_formats(const std::string& list, ReportOptions& options);
 
-// Writes into `directory` (created if needed); returns the files written.
+// Writes into `directory` (created if needed), each file to a temporary name first and
+// renamed; returns the files written. Throws InputError (one line) on a refused file.
 std::vector<std::filesystem::path> write_report(
     const std::vector<OneWayAnalysis>& analyses, const std::filesystem::path& directory,
     const ReportOptions& options);

@@ -3,9 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "store.h"
 #include "study_fixtures.h"
@@ -134,6 +137,70 @@ TEST_F(ExportTest, AnalysisLongTableExcludesPracticeCatchAndFailedParticipants) 
               "participant,stimulus,factor,level,question,rating");
 }
 
+// Bytes of a file, to show it is untouched.
+std::string file_bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// Temporary output files left in a folder (none, once a command has finished).
+int temporaries_in(const fs::path& dir) {
+    int n = 0;
+    for (const auto& entry : fs::directory_iterator(dir))
+        n += entry.path().filename().string().find(".partial") != std::string::npos;
+    return n;
+}
+
+TEST_F(ExportTest, ExportFileNeverReplacesTheDatabaseOrAnyDatabase) {
+    const int64_t ratings = Store(path_).db().scalar_int("SELECT count(*) FROM responses");
+    const std::string before = file_bytes(path_);
+    fs::create_symlink(path_, dir_ / "ratings.csv");
+    fs::create_directories(dir_ / "sub");
+    const fs::path cwd = fs::current_path();
+    fs::current_path(dir_ / "sub");
+    for (const std::string& out :
+         {path_, (dir_ / "ratings.csv").string(), (dir_ / "sub" / ".." / "study.db").string(),
+          std::string("../study.db")}) {
+        for (const char* format : {"long", "wide", "analysis"}) {
+            try {
+                export_file(path_, format, out, /*force=*/true);
+                ADD_FAILURE() << "exported over " << out;
+            } catch (const StoreError& e) {
+                EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos)
+                    << e.what();
+            }
+        }
+    }
+    fs::current_path(cwd);
+    EXPECT_EQ(file_bytes(path_), before);
+    EXPECT_EQ(Store(path_).db().scalar_int("SELECT count(*) FROM responses"), ratings);
+    // Another study database is refused as well, even with force.
+    const std::string other = (dir_ / "other.db").string();
+    Store(other).db();
+    EXPECT_THROW(export_file(path_, "long", other, true), StoreError);
+    EXPECT_EQ(Store(other).db().scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'responses'"), 1);
+}
+
+TEST_F(ExportTest, ExportFileReplacesAnExistingCsvOnlyWithForce) {
+    const fs::path out = dir_ / "long.csv";
+    std::ofstream(out) << "earlier export\n";
+    try {
+        export_file(path_, "long", out.string(), false);
+        FAIL();
+    } catch (const StoreError& e) {
+        EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(file_bytes(out), "earlier export\n");
+    const ExportFileResult r = export_file(path_, "long", out.string(), true);
+    EXPECT_EQ(r.rows, 2 * 5 * 2);
+    std::ostringstream direct;
+    export_csv(path_, ExportFormat::Long, direct);
+    EXPECT_EQ(file_bytes(out), direct.str());
+    EXPECT_EQ(temporaries_in(dir_), 0);
+}
+
 TEST_F(ExportTest, MergeDeduplicatesSessionsByUuid) {
     // Machine B: a copy of this database (same sessions) plus one new participant.
     const std::string b = (dir_ / "b.db").string();
@@ -156,6 +223,126 @@ TEST_F(ExportTest, MergeDeduplicatesSessionsByUuid) {
     // The merged long export equals the union of the inputs' rows.
     std::ostringstream merged_csv;
     EXPECT_EQ(export_csv(out, ExportFormat::Long, merged_csv), 3 * 5 * 2);
+}
+
+// Every rating with what identifies it, read straight from a database: session UUID,
+// trial position, question, participant code and machine, stimulus, then the values.
+using RatingRow = std::tuple<std::string, int64_t, std::string, std::string, std::string,
+                             std::string, int64_t, double, int64_t, int64_t, int64_t>;
+std::vector<RatingRow> rating_rows(const std::string& path) {
+    Database db(path, SQLITE_OPEN_READONLY);
+    Statement s = db.prepare(
+        "SELECT se.uuid, t.position, r.question, p.code, se.machine_id, st.stimulus_key, "
+        "r.rating, r.rt_ms, r.changes, r.first_choice_ns, r.final_choice_ns FROM responses r "
+        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
+        "JOIN participants p ON p.id = se.participant_id "
+        "JOIN stimuli st ON st.id = t.stimulus_id");
+    std::vector<RatingRow> rows;
+    while (s.step())
+        rows.emplace_back(s.text(0), s.integer(1), s.text(2), s.text(3), s.text(4), s.text(5),
+                          s.integer(6), s.real(7), s.integer(8), s.integer(9), s.integer(10));
+    std::sort(rows.begin(), rows.end());
+    return rows;
+}
+
+// A wide export as participant -> (column -> cell).
+std::map<std::string, std::map<std::string, std::string>> wide_rows(const std::string& path) {
+    std::ostringstream out;
+    export_csv(path, ExportFormat::Wide, out);
+    const auto rows = parse_csv(out.str());
+    std::map<std::string, std::map<std::string, std::string>> by_participant;
+    for (size_t r = 1; r < rows.size(); ++r)
+        for (size_t c = 1; c < rows[0].size(); ++c) by_participant[rows[r][0]][rows[0][c]] = rows[r][c];
+    return by_participant;
+}
+
+TEST_F(ExportTest, MergeKeepsOneCodeFromTwoMachinesApartAsTwoPeople) {
+    // Two lab machines, both starting at P01 (the normal case).
+    const std::string a = (dir_ / "lab_a.db").string(), b = (dir_ / "lab_b.db").string();
+    {
+        Store store(a);
+        lucent::test::run_full_session(store, p_, "P01", 21);
+        lucent::test::run_full_session(store, p_, "P02", 22);
+        store.db().exec("UPDATE sessions SET machine_id = 'aaaaaaaa11112222'");
+    }
+    {
+        Store store(b);
+        lucent::test::run_full_session(store, p_, "P01", 31);
+        lucent::test::run_full_session(store, p_, "P03", 32);
+        store.db().exec("UPDATE sessions SET machine_id = 'bbbbbbbb33334444'");
+        // Different answers from the second P01, so averaging would show.
+        store.db().exec("UPDATE responses SET rating = 8 - rating WHERE trial_id IN "
+                        "(SELECT id FROM trials WHERE catch = 0)");
+    }
+    const std::string out = (dir_ / "all.db").string();
+    const MergeReport report = merge_databases({a, b}, out);
+    EXPECT_EQ(report.sessions_added, 4);
+    ASSERT_EQ(report.notes.size(), 1u);
+    EXPECT_NE(report.notes[0].find("P01@aaaaaaaa P01@bbbbbbbb"), std::string::npos)
+        << report.notes[0];
+    EXPECT_EQ(report.notes[0].find('\n'), std::string::npos);
+
+    // Row by row: every input rating is in the merge once, under its person's code.
+    const std::map<std::pair<std::string, std::string>, std::string> code_of = {
+        {{"P01", "aaaaaaaa11112222"}, "P01@aaaaaaaa"}, {{"P02", "aaaaaaaa11112222"}, "P02"},
+        {{"P01", "bbbbbbbb33334444"}, "P01@bbbbbbbb"}, {{"P03", "bbbbbbbb33334444"}, "P03"}};
+    std::vector<RatingRow> expected;
+    for (const std::string& input : {a, b})
+        for (RatingRow row : rating_rows(input)) {
+            std::get<3>(row) = code_of.at({std::get<3>(row), std::get<4>(row)});
+            expected.push_back(row);
+        }
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(rating_rows(out), expected);
+
+    // The wide export keeps the two people's rows as each machine had them.
+    const auto merged_wide = wide_rows(out);
+    EXPECT_EQ(merged_wide.size(), 4u);
+    EXPECT_EQ(merged_wide.at("P01@aaaaaaaa"), wide_rows(a).at("P01"));
+    EXPECT_EQ(merged_wide.at("P01@bbbbbbbb"), wide_rows(b).at("P01"));
+    EXPECT_EQ(merged_wide.at("P03"), wide_rows(b).at("P03"));
+}
+
+TEST_F(ExportTest, MergeReadsAnOlderSchemaThroughAnUpgradedCopyAndLeavesItAlone) {
+    const std::string old_db = (dir_ / "old.db").string();
+    {
+        Store store(old_db);
+        lucent::test::run_full_session(store, p_, "P05", 41);
+        // Back to schema 1: drop what migration 2 added.
+        store.db().exec("ALTER TABLE sessions DROP COLUMN refresh_note");
+        store.db().exec("ALTER TABLE trials DROP COLUMN dropped_frames");
+        store.db().exec("PRAGMA user_version = 1");
+    }
+    ASSERT_EQ(Database(old_db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"), 1);
+    const std::string before = file_bytes(old_db);
+    const std::string out = (dir_ / "all.db").string();
+    const MergeReport report = merge_databases({old_db, path_}, out);
+    EXPECT_EQ(report.sessions_added, 3);
+    ASSERT_EQ(report.notes.size(), 1u);
+    EXPECT_NE(report.notes[0].find("schema 1"), std::string::npos) << report.notes[0];
+    EXPECT_EQ(file_bytes(old_db), before);
+    EXPECT_EQ(Database(old_db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"), 1);
+    std::vector<RatingRow> expected = rating_rows(old_db);
+    for (const RatingRow& row : rating_rows(path_)) expected.push_back(row);
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(rating_rows(out), expected);
+    EXPECT_EQ(temporaries_in(dir_), 0);
+}
+
+TEST_F(ExportTest, MergeNeverWritesOverAnInputOrAnotherDatabase) {
+    const std::string b = (dir_ / "b.db").string();
+    fs::copy_file(path_, b);
+    const std::string before = file_bytes(path_);
+    for (const std::string& out : {path_, (dir_ / "sub" / ".." / "b.db").string()}) {
+        fs::create_directories(dir_ / "sub");
+        try {
+            merge_databases({path_, b}, out);
+            ADD_FAILURE() << "merged over " << out;
+        } catch (const StoreError& e) {
+            EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_EQ(file_bytes(path_), before);
 }
 
 TEST_F(ExportTest, MergeRefusesDifferentProtocolsAndWritesNothing) {

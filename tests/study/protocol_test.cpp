@@ -3,8 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "sha256.h"
 #include "study_fixtures.h"
+#include "test_paths.h"
 
 namespace lucent::study {
 namespace {
@@ -130,6 +133,47 @@ TEST(ProtocolErrors, ImpossibleRandomisationIsReportedWhenPlanning) {
     text += "\n[randomisation]\nfactor = \"backlight\"\nmax_repeat = 1\n";
     const Protocol p = parse_protocol(text, "bad.toml");
     EXPECT_THROW(plan_trials(p, 1, 1), PlanError);
+}
+
+TEST(Protocol, StimulusLevelIsThePictureNotTheId) {
+    const Protocol p = builtin_protocol("thesis");
+    // Rows 1, 4 and 7 of Table 4.3 are one picture (r 25, wb 1.2, Kb 0.2) under three ids.
+    for (const char* id : {"empirical_row_1", "empirical_row_4", "empirical_row_7"})
+        EXPECT_EQ(p.level_of(*p.find_stimulus(id), "stimulus"), "empirical_row_1") << id;
+    for (const char* id : {"empirical_row_2", "empirical_row_5", "ward_jade", "contrast_reversed_jade"})
+        EXPECT_EQ(p.level_of(*p.find_stimulus(id), "stimulus"), id);
+    EXPECT_EQ(p.levels_of("stimulus").size(), p.stimuli.size());
+}
+
+TEST(Protocol, PreRenderedStimuliAreTheSamePictureWhenTheirBytesAre) {
+    const auto dir = lucent::test::scratch_dir("picture_identity");
+    auto write = [&](const char* name, const std::string& bytes) {
+        std::ofstream(dir / name, std::ios::binary) << bytes;
+    };
+    write("one.png", "same pixels");
+    write("copy.png", "same pixels");
+    write("other.png", "other pixels");
+    const Protocol p = parse_protocol(R"toml(
+[study]
+name = "images"
+[[questions]]
+id = "q"
+text = "Q"
+[[stimuli]]
+id = "one"
+image = "one.png"
+[[stimuli]]
+id = "copy"
+image = "copy.png"
+[[stimuli]]
+id = "other"
+image = "other.png"
+[[blocks]]
+id = "main"
+stimuli = ["one", "copy", "other"]
+)toml", "images.toml", dir.string());
+    EXPECT_EQ(p.level_of(*p.find_stimulus("copy"), "stimulus"), "one");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("other"), "stimulus"), "other");
 }
 
 TEST(Protocol, LevelsAreCanonicalNumbers) {

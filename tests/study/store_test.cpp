@@ -129,6 +129,29 @@ TEST(Store, WithdrawDeletesEverythingOfThatParticipantOnly) {
               0);
 }
 
+TEST(Store, EnrolmentNumbersAreNeverSharedAfterAWithdrawal) {
+    const auto dir = lucent::test::scratch_dir("store_enrolment_numbers");
+    Store store((dir / "s.db").string());
+    const Protocol p = small_protocol();
+    const int64_t study = store.ensure_study(p);
+    auto number_of = [&](const std::string& code) {
+        int n = -1;
+        store.ensure_participant(study, code, &n);
+        return n;
+    };
+    EXPECT_EQ(number_of("anna"), 1);
+    EXPECT_EQ(number_of("bob"), 2);
+    EXPECT_EQ(number_of("carl"), 3);
+    ASSERT_TRUE(store.withdraw_participant("anna"));
+    // Two participants remain (numbers 2 and 3): the next is 4, not a second 3.
+    EXPECT_EQ(number_of("dave"), 4);
+    EXPECT_EQ(number_of("P7"), 7);  // trailing digits choose the number
+    EXPECT_EQ(number_of("eve"), 8);
+    EXPECT_EQ(number_of("bob"), 2);  // known codes keep theirs
+    EXPECT_EQ(store.db().scalar_int("SELECT count(DISTINCT number) FROM participants"),
+              store.db().scalar_int("SELECT count(*) FROM participants"));
+}
+
 TEST(Store, MigratesAVersion1DatabaseKeepingItsRows) {
     const auto dir = lucent::test::scratch_dir("store_migrate");
     const std::string path = (dir / "old.db").string();

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <random>
 #include <set>
@@ -30,6 +31,54 @@ int closest_repeat(const std::vector<std::string>& s) {
         for (size_t j = i + 1; j < s.size(); ++j)
             if (s[i] == s[j]) best = std::min(best, static_cast<int>(j - i));
     return best;
+}
+
+// Independent picture identity: what is drawn, whatever the stimulus id.
+bool same_picture(const StimulusSpec& a, const StimulusSpec& b) {
+    return a.technique == b.technique && a.mesh == b.mesh && a.parameters == b.parameters &&
+           a.image == b.image;
+}
+
+// Whether a sequence of trials (indices into `pictures`, a same-picture matrix) keeps
+// equal pictures min_distance apart and runs to max_repeat.
+bool meets(const std::vector<int>& order, const std::vector<std::vector<bool>>& same,
+           const SequenceConstraints& c) {
+    for (size_t i = 0; i < order.size(); ++i) {
+        for (size_t j = i + 1; j < order.size() && static_cast<int>(j - i) < c.min_distance; ++j)
+            if (same[order[i]][order[j]]) return false;
+        if (c.max_repeat > 0 && i + c.max_repeat < order.size()) {
+            bool run = true;
+            for (int k = 1; k <= c.max_repeat && run; ++k) run = same[order[i]][order[i + k]];
+            if (run) return false;
+        }
+    }
+    return true;
+}
+
+// Upper quantile of chi-square with `df` degrees of freedom at P = 0.001
+// (Wilson-Hilferty; within about 1% for df >= 3).
+double chi_square_999(double df) {
+    const double z = 3.0902, h = 2.0 / (9.0 * df);
+    return df * std::pow(1.0 - h + z * std::sqrt(h), 3.0);
+}
+
+// Pearson's statistic of observed counts against probabilities; cells expected to be
+// empty must be empty. Returns {statistic, degrees of freedom}.
+std::pair<double, int> chi_square(const std::vector<double>& observed,
+                                  const std::vector<double>& probability) {
+    double n = 0.0, statistic = 0.0;
+    for (double o : observed) n += o;
+    int cells = 0;
+    for (size_t i = 0; i < observed.size(); ++i) {
+        if (probability[i] == 0.0) {
+            EXPECT_EQ(observed[i], 0.0) << "cell " << i << " cannot occur";
+            continue;
+        }
+        const double e = n * probability[i];
+        statistic += (observed[i] - e) * (observed[i] - e) / e;
+        ++cells;
+    }
+    return {statistic, cells - 1};
 }
 
 TEST(LatinSquare, EveryConditionOncePerPositionAndEachOrderedPairEquallyOften) {
@@ -117,6 +166,272 @@ TEST(ConstrainedShuffle, TightButFeasibleConstraintsAreMet) {
         std::vector<std::string> seq;
         for (int i : constrained_shuffle(levels, {1, 0}, seed)) seq.push_back(levels[i]);
         EXPECT_EQ(seq, (std::vector<std::string>{"a", "b", "a", "b", "a"}));
+    }
+}
+
+TEST(ConstrainedShuffle, UnmeetableConstraintsWithFeasibleCountsEndInAClearError) {
+    // Each of a and b alone fits min_distance 3 in four positions (0 and 3), both cannot.
+    try {
+        constrained_shuffle({"a", "a", "b", "b"}, {0, 3}, 1);
+        FAIL();
+    } catch (const PlanError& e) {
+        EXPECT_NE(std::string(e.what()).find("relax the constraints"), std::string::npos)
+            << e.what();
+    }
+}
+
+// The thesis protocol's trials per block (stimulus specs, catch flags) in plan order.
+struct BlockTrials {
+    std::vector<const StimulusSpec*> stimuli;
+    std::vector<bool> is_catch;
+};
+
+TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
+    const Protocol p = builtin_protocol("thesis");
+    const SequenceConstraints c{p.randomisation.max_repeat, p.randomisation.min_distance};
+    ASSERT_GE(c.min_distance, 2);
+    // Expected position of each block's catch trial over all its valid orders, by brute
+    // force over every permutation of the block.
+    std::map<std::string, std::vector<double>> catch_position_probability;
+    std::map<std::string, std::vector<const StimulusSpec*>> pictures_of_block;
+    for (const Block& block : p.blocks) {
+        BlockTrials trials;
+        for (const std::string& id : block.stimuli) {
+            trials.stimuli.push_back(p.find_stimulus(id));
+            trials.is_catch.push_back(false);
+        }
+        for (const CatchTrial& ct : p.catch_trials)
+            if (ct.block == block.id) {
+                trials.stimuli.push_back(p.find_stimulus(ct.stimulus));
+                trials.is_catch.push_back(true);
+            }
+        const int n = static_cast<int>(trials.stimuli.size());
+        std::vector<std::vector<bool>> same(n, std::vector<bool>(n));
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) same[i][j] = same_picture(*trials.stimuli[i], *trials.stimuli[j]);
+        std::vector<int> order(n);
+        for (int i = 0; i < n; ++i) order[i] = i;
+        std::vector<double> at(n, 0.0);
+        double valid = 0.0;
+        do {
+            if (!meets(order, same, c)) continue;
+            ++valid;
+            for (int pos = 0; pos < n; ++pos)
+                if (trials.is_catch[order[pos]]) ++at[pos];
+        } while (std::next_permutation(order.begin(), order.end()));
+        ASSERT_GT(valid, 0.0) << block.id;
+        for (double& a : at) a /= valid;
+        catch_position_probability[block.id] = at;
+        pictures_of_block[block.id] = trials.stimuli;
+    }
+    // Blocks share no picture, so the blocks' orders are independent of each other.
+    for (const StimulusSpec* a : pictures_of_block["empirical"])
+        for (const StimulusSpec* b : pictures_of_block["contrast_reversal"])
+            ASSERT_FALSE(same_picture(*a, *b)) << a->id << " " << b->id;
+
+    constexpr int kPlans = 20000;
+    std::mt19937_64 seeds(2026);
+    std::map<std::string, std::vector<double>> catch_at;
+    for (const auto& [block, probability] : catch_position_probability)
+        catch_at[block].assign(probability.size(), 0.0);
+    int same_picture_adjacent = 0, catch_next_to_own_picture = 0, too_close = 0;
+    for (int plan_index = 0; plan_index < kPlans; ++plan_index) {
+        const TrialPlan plan = plan_trials(p, seeds(), plan_index);
+        std::map<std::string, int> block_position;
+        for (size_t i = 0; i < plan.trials.size(); ++i) {
+            const PlannedTrial& t = plan.trials[i];
+            const StimulusSpec& here = *p.find_stimulus(t.stimulus);
+            if (i > 0) {
+                const PlannedTrial& before = plan.trials[i - 1];
+                const bool same = same_picture(*p.find_stimulus(before.stimulus), here);
+                same_picture_adjacent += same;
+                catch_next_to_own_picture += same && (t.is_catch || before.is_catch);
+            }
+            for (size_t back = 1; back < static_cast<size_t>(c.min_distance) && back <= i; ++back)
+                too_close += !plan.trials[i - back].practice && !t.practice &&
+                             same_picture(*p.find_stimulus(plan.trials[i - back].stimulus), here);
+            if (t.practice) continue;
+            const int pos = block_position[t.block]++;
+            if (t.is_catch) ++catch_at[t.block][pos];
+        }
+    }
+    EXPECT_EQ(same_picture_adjacent, 0);
+    EXPECT_EQ(catch_next_to_own_picture, 0);
+    EXPECT_EQ(too_close, 0);
+    for (const auto& [block, probability] : catch_position_probability) {
+        const auto [statistic, df] = chi_square(catch_at[block], probability);
+        ASSERT_GE(df, 1) << block;
+        EXPECT_LT(statistic, chi_square_999(std::max(df, 3))) << block << ": chi-square "
+                                                              << statistic << " on " << df << " df";
+    }
+}
+
+// Two blocks sharing a picture (a, a_again and a_third are one picture; the catch trial
+// shows b): the constraint spans the block boundary.
+const char* kSharedPictureProtocol = R"toml(
+[study]
+name = "uniform"
+
+[[questions]]
+id = "q"
+text = "Q"
+
+[[stimuli]]
+id = "a"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 18 }
+
+[[stimuli]]
+id = "a_again"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 18 }
+
+[[stimuli]]
+id = "a_third"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 18 }
+
+[[stimuli]]
+id = "b"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 25 }
+
+[[stimuli]]
+id = "c"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 30 }
+
+[[stimuli]]
+id = "d"
+technique = "ward"
+mesh = "sphere"
+params = { roughness = 0.2 }
+
+[[blocks]]
+id = "one"
+stimuli = ["a", "b", "a_again"]
+
+[[blocks]]
+id = "two"
+stimuli = ["c", "a_third", "d"]
+
+[[catch_trials]]
+id = "attention"
+stimulus = "b"
+block = "one"
+prompt = "Choose 7"
+expected = 7
+
+[randomisation]
+factor = "stimulus"
+max_repeat = 1
+min_distance = 2
+counterbalance_blocks = false
+)toml";
+
+TEST(PlanTrials, EveryValidOrderOfASmallProtocolIsEquallyLikely) {
+    const Protocol p = parse_protocol(kSharedPictureProtocol, "uniform.toml");
+    const SequenceConstraints c{1, 2};
+    // Trials in protocol order: block one (a, b, a_again, catch on b), block two.
+    const std::vector<std::string> ids = {"a", "b", "a_again", "b", "c", "a_third", "d"};
+    const std::vector<bool> is_catch = {false, false, false, true, false, false, false};
+    auto name = [&](int i) { return ids[i] + (is_catch[i] ? "*" : ""); };
+    const int n = static_cast<int>(ids.size());
+    std::vector<std::vector<bool>> same(n, std::vector<bool>(n));
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            same[i][j] = same_picture(*p.find_stimulus(ids[i]), *p.find_stimulus(ids[j]));
+    // Brute force: every (order of block one, order of block two) meeting the constraints.
+    std::map<std::string, int> index_of_order;
+    std::vector<int> one = {0, 1, 2, 3};
+    do {
+        std::vector<int> two = {4, 5, 6};
+        do {
+            std::vector<int> whole = one;
+            whole.insert(whole.end(), two.begin(), two.end());
+            if (!meets(whole, same, c)) continue;
+            std::string key;
+            for (int i : whole) key += name(i) + " ";
+            index_of_order.emplace(key, static_cast<int>(index_of_order.size()));
+        } while (std::next_permutation(two.begin(), two.end()));
+    } while (std::next_permutation(one.begin(), one.end()));
+    // By hand: one alternates A/B (8 orders); after a final A, two must not start with A.
+    ASSERT_EQ(index_of_order.size(), 40u);
+
+    constexpr int kPlans = 20000;
+    const std::vector<double> uniform(index_of_order.size(), 1.0 / index_of_order.size());
+    std::vector<double> observed(index_of_order.size(), 0.0);
+    auto tally = [&](const std::string& key) {
+        const auto it = index_of_order.find(key);
+        ASSERT_NE(it, index_of_order.end()) << "order breaks the constraints: " << key;
+        ++observed[it->second];
+    };
+    // The planner (rejection sampling for a protocol this loose).
+    std::mt19937_64 seeds(7);
+    for (int i = 0; i < kPlans; ++i) {
+        std::string key;
+        for (const PlannedTrial& t : plan_trials(p, seeds(), 0).trials)
+            key += t.stimulus + (t.is_catch ? "*" : "") + " ";
+        tally(key);
+    }
+    auto [statistic, df] = chi_square(observed, uniform);
+    EXPECT_LT(statistic, chi_square_999(df)) << "planner: chi-square " << statistic << " on " << df;
+    // The exact sampler (the fallback for rare valid orders) on the same blocks.
+    std::vector<std::vector<std::string>> levels(2);
+    for (int i = 0; i < n; ++i) levels[i < 4 ? 0 : 1].push_back(p.level_of(*p.find_stimulus(ids[i]), "stimulus"));
+    std::fill(observed.begin(), observed.end(), 0.0);
+    std::mt19937_64 rng(8);
+    for (int i = 0; i < kPlans; ++i) {
+        const std::vector<std::vector<int>> orders = exact_block_shuffles(levels, c, rng);
+        std::string key;
+        for (int t : orders[0]) key += name(t) + " ";
+        for (int t : orders[1]) key += name(4 + t) + " ";
+        tally(key);
+    }
+    std::tie(statistic, df) = chi_square(observed, uniform);
+    EXPECT_LT(statistic, chi_square_999(df)) << "exact: chi-square " << statistic << " on " << df;
+}
+
+TEST(ConstrainedShuffle, RareValidOrdersAreCountedExactlyWhenRejectionGivesUp) {
+    // 20 a and 20 b with no repeats: only the 2 x 20! x 20! alternating orders of the
+    // 40! are valid (1 in 7e10), beyond rejection sampling.
+    std::vector<std::string> levels;
+    for (int i = 0; i < 40; ++i) levels.push_back(i < 20 ? "a" : "b");
+    const SequenceConstraints c{1, 0};
+    auto alternates = [&](const std::vector<int>& order) {
+        for (size_t i = 1; i < order.size(); ++i)
+            if (levels[order[i]] == levels[order[i - 1]]) return false;
+        return true;
+    };
+    EXPECT_TRUE(alternates(constrained_shuffle(levels, c, 3, /*max_attempts=*/1000)));
+    // Uniform over the valid orders: the first trial starts half the orders, and trial 0
+    // (an 'a') is equally likely in each of the 20 positions its level can hold.
+    constexpr int kOrders = 4000;
+    std::mt19937_64 rng(11);
+    int a_first = 0;
+    std::vector<double> slot_of_trial_0(20, 0.0);
+    for (int i = 0; i < kOrders; ++i) {
+        const std::vector<int> order = exact_block_shuffles({levels}, c, rng).front();
+        ASSERT_TRUE(alternates(order));
+        a_first += levels[order[0]] == "a";
+        const int at = static_cast<int>(std::find(order.begin(), order.end(), 0) - order.begin());
+        ++slot_of_trial_0[at / 2];
+    }
+    EXPECT_NEAR(a_first, kOrders / 2, 4 * std::sqrt(kOrders / 4.0));
+    const auto [statistic, df] = chi_square(slot_of_trial_0, std::vector<double>(20, 1.0 / 20));
+    EXPECT_LT(statistic, chi_square_999(df)) << "chi-square " << statistic << " on " << df;
+    // And an impossible case that passes the count check is now a definite answer.
+    try {
+        exact_block_shuffles({{"a", "a", "b", "b"}}, {0, 3}, rng);
+        FAIL();
+    } catch (const PlanError& e) {
+        EXPECT_NE(std::string(e.what()).find("no order of the 4 trials meets"), std::string::npos)
+            << e.what();
     }
 }
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -88,6 +89,90 @@ TEST(Report, WritesEveryFormatWithExactHeaders) {
     const auto svg = dir / plot_file_name("translucent", "thickness");
     ASSERT_TRUE(std::filesystem::exists(svg));
     EXPECT_NE(slurp(svg).find("<circle"), std::string::npos);
+}
+
+// Two-sided p of Student's t with even df, in closed form (Abramowitz & Stegun 26.7.3):
+// p = 1 - sqrt(x) * sum_{j < df/2} c_j (1 - x)^j, x = t^2 / (df + t^2), c_j = prod (2i-1)/(2i).
+double student_t_two_sided_p_even_df(double t, int df) {
+    const double x = t * t / (df + t * t);
+    double c = 1.0, sum = 0.0, power = 1.0;
+    for (int j = 0; j < df / 2; ++j) {
+        if (j > 0) c *= (2.0 * j - 1.0) / (2.0 * j);
+        sum += c * power;
+        power *= 1.0 - x;
+    }
+    return 1.0 - std::sqrt(x) * sum;
+}
+
+// The Tukey table's row for levels (a, b) of report.md, split into cells.
+std::vector<std::string> tukey_row(const std::string& md, const std::string& a,
+                                   const std::string& b) {
+    const std::string start = "| " + a + " | " + b + " |";
+    const std::size_t at = md.find(start);
+    if (at == std::string::npos) return {};
+    std::vector<std::string> cells;
+    std::stringstream line(md.substr(at + 1, md.find('\n', at) - at - 1));
+    for (std::string cell; std::getline(line, cell, '|');)
+        cells.push_back(cell.substr(1, cell.size() - 2));
+    return cells;
+}
+
+TEST(Report, TukeySignificanceFollowsTheReportsAlphaAndItsInterval) {
+    // Two groups: Tukey's p adj equals the pooled two-sample t-test's p. Means 3 and 5,
+    // pooled variance 2.5, se 1: t = 2 on 8 df, p = 0.0805 (between .05 and .10).
+    const OneWayData data = groups({{1, 2, 3, 4, 5}, {3, 4, 5, 6, 7}});
+    const double p_t = student_t_two_sided_p_even_df(2.0, 8);
+    ASSERT_GT(p_t, 0.05);
+    ASSERT_LT(p_t, 0.10);
+    for (const double alpha : {0.10, 0.05}) {
+        const auto dir = test::scratch_dir(alpha > 0.07 ? "tukey_alpha_10" : "tukey_alpha_05");
+        const OneWayAnalysis a = analyze_one_way("translucent", "r", data, alpha);
+        ASSERT_EQ(a.tukey.pairs.size(), 1u);
+        EXPECT_NEAR(*a.tukey.pairs[0].p_adj, p_t, 1e-6);
+        ReportOptions options;
+        options.alpha = alpha;
+        write_report({a}, dir, options);
+        const std::string md = slurp(dir / "report.md");
+        const std::vector<std::string> row = tukey_row(md, "1", "2");
+        ASSERT_EQ(row.size(), 9u) << md;
+        const double lower = std::stod(row[6]), upper = std::stod(row[7]);
+        const bool excludes_zero = lower > 0.0 || upper < 0.0;
+        // At .10 the 90% interval excludes 0 and the pair is significant; at .05 neither.
+        EXPECT_EQ(excludes_zero, alpha > 0.07) << row[6] << " " << row[7];
+        EXPECT_EQ(row[8], excludes_zero ? "yes" : "no") << md;
+        EXPECT_NE(md.find("p adj < " + std::string(alpha > 0.07 ? "0.1" : "0.05")),
+                  std::string::npos)
+            << md;
+        EXPECT_EQ(md.find("n.s."), std::string::npos) << md;
+    }
+}
+
+TEST(Report, NeverReplacesItsInputOrADatabaseAndWritesNothingThen) {
+    const auto dir = test::scratch_dir("report_protects_input");
+    // The ratings live in the report folder under a name the report also writes.
+    const auto input = dir / "anova.csv";
+    std::ofstream(input) << "participant,stimulus,factor,level,question,rating\n";
+    ReportOptions options;
+    options.inputs = {input};
+    const std::vector<OneWayAnalysis> analyses{
+        analyze_one_way("q", "f", groups({{1, 2}, {3, 4}}), 0.10)};
+    try {
+        write_report(analyses, dir, options);
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(input), "participant,stimulus,factor,level,question,rating\n");
+    EXPECT_FALSE(std::filesystem::exists(dir / "report.md"));  // refused before writing
+    // A database in the way is refused too; the folder itself must not be a file.
+    std::filesystem::remove(input);
+    std::ofstream(dir / "report.md") << std::string("SQLite format 3\0", 16) << "pages";
+    EXPECT_THROW(write_report(analyses, dir, ReportOptions{}), InputError);
+    EXPECT_THROW(write_report(analyses, dir / "report.md", ReportOptions{}), InputError);
+    std::filesystem::remove(dir / "report.md");
+    write_report(analyses, dir, ReportOptions{});  // a second run replaces its own files
+    write_report(analyses, dir, ReportOptions{});
+    EXPECT_TRUE(std::filesystem::exists(dir / "report.md"));
 }
 
 TEST(Report, FormatSelectionAndErrors) {

@@ -650,6 +650,26 @@ TEST_F(DataCommands, ExportWritesEachFormatAndMergeDeduplicates) {
     EXPECT_NE(read_file(dir_ / "stdout.txt").find("2 duplicates skipped"), std::string::npos);
 }
 
+TEST_F(DataCommands, ExportNeverReplacesTheDatabaseAndOverwritesOnlyWithForce) {
+    const int64_t ratings = count("SELECT count(*) FROM responses");
+    // The command: --out is the database itself, also through a relative path.
+    EXPECT_EQ(run({"export", db_, "--format", "long", "--out", db_}), 2);
+    const std::string err = read_file(dir_ / "stderr.txt");
+    EXPECT_NE(err.find("is the input"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_EQ(run({"export", db_, "--out", (dir_ / "." / "study.db").string(), "--force"}), 2);
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), ratings);
+    const fs::path csv = dir_ / "long.csv";
+    ASSERT_EQ(run({"export", db_, "--out", csv.string()}), 0);
+    EXPECT_EQ(run({"export", db_, "--out", csv.string()}), 2);
+    EXPECT_NE(read_file(dir_ / "stderr.txt").find("--force"), std::string::npos);
+    EXPECT_EQ(run({"export", db_, "--out", csv.string(), "--force"}), 0);
+    // merge and analyze refuse the database as their output too.
+    EXPECT_EQ(run({"merge", db_, "--out", db_}), 2);
+    EXPECT_EQ(run({"analyze", db_, "--out", db_}), 2);
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), ratings);
+}
+
 TEST_F(DataCommands, AnalyzeReadsTheStudyDatabaseDirectly) {
     // Two participants x 3 levels of thickness_exponent x 2 questions (see study_fixtures).
     const fs::path out = dir_ / "report";
