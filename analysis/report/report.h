@@ -15,6 +15,7 @@ struct ReportOptions {
         0.10;  // significance level (the thesis used 0.10); Tukey CI at 1 - alpha
     bool markdown = true, csv = true, html = true;
     std::string source;  // input description printed in the header
+    Design primary = Design::Between;  // shown first in the summary and in each section
 };
 
 // "md,csv,html" (any subset, comma-separated); throws InputError naming a bad entry.
