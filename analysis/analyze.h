@@ -2,6 +2,7 @@
 // The analysis entry point: a long table of ratings in (from the CSV reader, the study
 // database reader or the simulator), one analysis per (question, factor) pair out.
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,10 +19,16 @@ struct AnalysisRequest {
     std::function<void(const std::string& question, const std::string& factor,
                        std::size_t levels)>
         on_pair;
+    // The primary design; empty: within when every pair has a within-subject layout.
+    std::optional<Design> primary;
+};
+
+struct AnalysisResult {
+    std::vector<OneWayAnalysis> pairs;
+    Design primary = Design::Between;  // the request's, or the one the data allow
 };
 
 // Throws InputError when no rating matches the filters.
-std::vector<OneWayAnalysis> analyze_table(const LongTable& table,
-                                          const AnalysisRequest& request);
+AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& request);
 
 }  // namespace lucent::analysis

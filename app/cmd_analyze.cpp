@@ -14,6 +14,7 @@ namespace {
 
 struct AnalyzeArgs {
     std::string input, out_dir, factor, question, formats = "md,csv,html", scale = "1..7";
+    std::string design;  // "", "between" or "within"
     double alpha = 0.10;
 };
 
@@ -27,15 +28,20 @@ int run_analyze(const AnalyzeArgs& args) {
         options.alpha = args.alpha;
         options.source = args.input;
         options.inputs = {args.input};  // a report file never replaces the input
-        const LongTable table = read_ratings(args.input, parse_scale(args.scale));
+        std::optional<Design> plan_design;
+        const LongTable table = read_ratings(args.input, parse_scale(args.scale), &plan_design);
         AnalysisRequest request{args.alpha, args.question, args.factor,
                                 [](const std::string& question, const std::string& factor,
                                    std::size_t levels) {
                                     std::cerr << "analyzing " << question << " ~ "
                                               << factor << " (" << levels << " levels)\n";
                                 }};
-        const std::vector<OneWayAnalysis> analyses = analyze_table(table, request);
-        for (const auto& path : write_report(analyses, args.out_dir, options))
+        if (args.design == "within") request.primary = Design::Within;
+        if (args.design == "between") request.primary = Design::Between;
+        if (!request.primary) request.primary = plan_design;
+        const AnalysisResult result = analyze_table(table, request);
+        options.primary = result.primary;
+        for (const auto& path : write_report(result.pairs, args.out_dir, options))
             std::cout << path.string() << "\n";
         return kExitOk;
     } catch (const InputError& e) {
@@ -62,6 +68,10 @@ void register_analyze(CLI::App& app, int& exit_code) {
     cmd->add_option("--question", args->question, "Analyze only this question");
     cmd->add_option("--format", args->formats, "Comma-separated subset of md,csv,html")
         ->capture_default_str();
+    cmd->add_option("--design", args->design,
+                    "Primary design: between or within (default: the protocol's analysis "
+                    "plan; for a CSV, within when every participant rated every level)")
+        ->check(CLI::IsMember({"between", "within"}));
     cmd->add_option("--scale", args->scale,
                     "Accepted ratings: MIN..MAX, or 'any' for any finite number")
         ->capture_default_str();

@@ -15,6 +15,7 @@ void register_bench(CLI::App& app, int& exit_code);
 void register_analyze(CLI::App& app, int& exit_code);
 void register_stats(CLI::App& app, int& exit_code);
 void register_simulate(CLI::App& app, int& exit_code);
+void register_power(CLI::App& app, int& exit_code);
 void register_render(CLI::App& app, int& exit_code);
 void register_run(CLI::App& app, int& exit_code);
 void register_participants(CLI::App& app, int& exit_code);

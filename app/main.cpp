@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
     register_analyze(app, exit_code);
     register_stats(app, exit_code);
     register_simulate(app, exit_code);
+    register_power(app, exit_code);
     register_explore(app, exit_code);
     register_bench(app, exit_code);
 

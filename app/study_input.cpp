@@ -16,7 +16,8 @@ bool is_sqlite_file(const std::string& path) {
     return in.gcount() == 16 && std::string(magic, 16) == std::string("SQLite format 3\0", 16);
 }
 
-analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale) {
+analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale,
+                                 std::optional<analysis::Design>* plan_design) {
     if (!is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
     study::LongTable rows;
     try {
@@ -25,6 +26,9 @@ analysis::LongTable read_ratings(const std::string& path, const analysis::Rating
     } catch (const study::StoreError& e) {
         throw analysis::InputError(e.what());
     }
+    if (plan_design && !rows.primary_design.empty())
+        *plan_design = rows.primary_design == "within" ? analysis::Design::Within
+                                                       : analysis::Design::Between;
     for (const std::string& p : rows.excluded_participants)
         std::cerr << "lucent analyze: excluded participant " << p << "\n";
     analysis::LongTable table;

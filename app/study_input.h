@@ -3,13 +3,18 @@
 // stimulus's parameters as factors; practice, catch and excluded participants dropped).
 #include <string>
 
+#include <optional>
+
 #include "data/long_table.h"
+#include "stats/one_way_analysis.h"
 
 namespace lucent::app {
 
 // True when `path` starts with the SQLite header.
 bool is_sqlite_file(const std::string& path);
-// Reads either kind; throws analysis::InputError (one line) on bad input.
-analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale);
+// Reads either kind; throws analysis::InputError (one line) on bad input. For a study
+// database, `plan_design` receives the stored protocol's primary design.
+analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale,
+                                 std::optional<analysis::Design>* plan_design = nullptr);
 
 }  // namespace lucent::app

@@ -2,6 +2,7 @@
 #include "export.h"
 
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -44,14 +45,21 @@ std::map<std::string, int> catch_failures(Database& db) {
     return failed;
 }
 
-int max_failed_catch(Database& db) {
+// The protocol the database was made with; empty when absent or no longer parseable
+// (a database from an older build whose keys this one does not know).
+std::optional<Protocol> stored_protocol(Database& db) {
     Statement s = db.prepare("SELECT protocol_text, name FROM studies LIMIT 1");
-    if (!s.step()) return 0;
+    if (!s.step()) return std::nullopt;
     try {
-        return parse_protocol(s.text(0), db.path() + " (stored protocol)").max_failed_catch;
+        return parse_protocol(s.text(0), db.path() + " (stored protocol)");
     } catch (const ProtocolError&) {
-        return 0;
+        return std::nullopt;
     }
+}
+
+int max_failed_catch(Database& db) {
+    const std::optional<Protocol> protocol = stored_protocol(db);
+    return protocol ? protocol->max_failed_catch : 0;
 }
 
 std::string format_number(double v) {
@@ -203,6 +211,8 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
         }
     }
     LongTable table;
+    if (const std::optional<Protocol> protocol = stored_protocol(db))
+        table.primary_design = protocol->analysis.primary_design;
     std::set<std::string> excluded;
     if (options.exclude_failed_catch) {
         const int allowed = max_failed_catch(db);

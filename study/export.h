@@ -50,6 +50,7 @@ struct LongTableOptions {
 struct LongTable {
     std::vector<LongRow> rows;
     std::vector<std::string> excluded_participants;  // with the reason, "P3 (2 catch failed)"
+    std::string primary_design;  // the stored protocol's [analysis] plan; "" if unreadable
 };
 
 // Factors of a stimulus: the parameters it `varies` (or all its parameters when it

@@ -322,6 +322,17 @@ void read_randomisation(Protocol& p, TableReader& root) {
     r.reject_unknown();
 }
 
+void read_analysis_plan(Protocol& p, TableReader& root) {
+    const toml::table* table = root.table("analysis");
+    if (!table) return;
+    TableReader r(*table, "analysis", p.source);
+    p.analysis.primary_design = r.string("primary_design", "within");
+    if (p.analysis.primary_design != "within" && p.analysis.primary_design != "between")
+        r.fail(r.raw().get("primary_design"), "primary_design",
+               "must be \"within\" or \"between\", got '" + p.analysis.primary_design + "'");
+    r.reject_unknown();
+}
+
 }  // namespace
 
 const StimulusSpec* Protocol::find_stimulus(std::string_view id) const {
@@ -387,6 +398,7 @@ Protocol parse_protocol(std::string_view text, const std::string& source,
     read_stimuli(p, root, base_dir);
     read_trials(p, root);
     read_randomisation(p, root);
+    read_analysis_plan(p, root);
     root.reject_unknown();
     return p;
 }

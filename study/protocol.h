@@ -64,6 +64,13 @@ struct Randomisation {
     bool counterbalance_blocks = true;  // Latin square of block order by participant
 };
 
+// [analysis]: how `lucent analyze` reads the study's ratings.
+struct AnalysisPlan {
+    // "within": every participant rates every level (the thesis's survey), so the
+    // repeated-measures tests lead the report; "between": independent groups lead.
+    std::string primary_design = "within";
+};
+
 struct Screens {
     std::string consent;
     std::string instructions;
@@ -90,6 +97,7 @@ struct Protocol {
     std::vector<Block> blocks;
     std::vector<CatchTrial> catch_trials;
     Randomisation randomisation;
+    AnalysisPlan analysis;
 
     const StimulusSpec* find_stimulus(std::string_view id) const;
     // Level of `factor` for a stimulus ("stimulus", "technique" or a parameter); empty

@@ -63,6 +63,84 @@ std::string configuration(const OneWayAnalysis& a) {
     return a.question + " ~ " + a.factor;
 }
 
+// The within-subject test a summary shows: the repeated-measures F with the
+// Greenhouse-Geisser p (the uncorrected p where epsilon is undefined, e.g. two levels).
+Statistic within_summary_p(const WithinSubjectAnalysis& w) {
+    return w.anova.p_gg ? w.anova.p_gg : w.anova.p;
+}
+
+std::vector<std::string> summary_cells(const OneWayAnalysis& a, Design design,
+                                       double alpha) {
+    if (design == Design::Between)
+        return {"one-way ANOVA", format_p_short(a.anova.p), format_short(a.anova.f),
+                significant_at(a.anova.p, alpha)};
+    if (!a.within.computed) return {"repeated measures", "undefined", "undefined", "undefined"};
+    const Statistic p = within_summary_p(a.within);
+    return {"repeated measures (G-G)", format_p_short(p), format_short(a.within.anova.f),
+            significant_at(p, alpha)};
+}
+
+std::string participants_note(const WithinSubjectAnalysis& w) {
+    std::string text = std::to_string(w.participants) + " participants rated every level";
+    if (!w.excluded_participants.empty()) {
+        text += "; left out (a level missing): ";
+        for (std::size_t i = 0; i < w.excluded_participants.size(); ++i)
+            text += (i ? ", " : "") + w.excluded_participants[i];
+    }
+    return text;
+}
+
+std::vector<Block> within_subject_blocks(const OneWayAnalysis& a, double alpha) {
+    const WithinSubjectAnalysis& w = a.within;
+    std::vector<Block> doc;
+    doc.push_back({Block::kHeading, "Within-subject tests", {}, {}, 3});
+    if (!w.computed) {
+        doc.push_back({Block::kParagraph, "Not computed: " + w.note + "."});
+        return doc;
+    }
+    doc.push_back({Block::kParagraph,
+                   participants_note(w) + ". A participant's value at a level is the mean "
+                   "of their ratings of that level's stimuli."});
+    const RepeatedMeasuresAnova& r = w.anova;
+    Table rm{{"source", "SS", "df", "MS", "F", "p", "p (G-G)", "p (H-F)"}, {}};
+    rm.rows.push_back({a.factor, format_short(r.ss_effect), format_short(r.df_effect),
+                       format_short(r.ss_effect / r.df_effect), format_short(r.f),
+                       format_p_short(r.p), format_p_short(r.p_gg), format_p_short(r.p_hf)});
+    rm.rows.push_back({"participants", format_short(r.ss_participants),
+                       format_short(static_cast<double>(r.participants - 1)), "", "", "", "", ""});
+    rm.rows.push_back({"error (" + a.factor + " x participants)", format_short(r.ss_error),
+                       format_short(r.df_error),
+                       r.df_error > 0 ? format_short(r.ss_error / r.df_error) : "undefined",
+                       "", "", "", ""});
+    doc.push_back({Block::kHeading, "Repeated-measures ANOVA", {}, {}, 4});
+    doc.push_back({Block::kTable, "", rm});
+    doc.push_back({Block::kParagraph,
+                   "Mauchly's W = " + format_short(r.mauchly_w) + ", p = " +
+                       format_p_short(r.mauchly_p) + "; Greenhouse-Geisser epsilon = " +
+                       format_short(r.gg_epsilon) + ", Huynh-Feldt epsilon = " +
+                       format_short(r.hf_epsilon) + " (its p uses min(1, epsilon)); " +
+                       "partial eta squared = " + format_short(r.partial_eta_sq) +
+                       ", generalized eta squared = " + format_short(r.generalized_eta_sq) +
+                       (r.note.empty() ? "" : ". Note: " + r.note)});
+    const FriedmanResult& f = w.friedman;
+    doc.push_back({Block::kParagraph,
+                   "Friedman (tie-corrected): chi squared = " + format_short(f.chi_sq) +
+                       ", df = " + format_short(f.df) + ", p = " + format_p_short(f.p) +
+                       ", Kendall's W = " + format_short(f.kendall_w) +
+                       (f.note.empty() ? "" : " (" + f.note + ")")});
+    Table paired{{"level a", "level b", "diff (b - a)", "t", "df", "p", "p (Holm)",
+                  "significant at alpha"},
+                 {}};
+    for (const PairedComparison& c : w.paired)
+        paired.rows.push_back({c.level_a, c.level_b, format_short(c.diff), format_short(c.t),
+                               format_short(c.df), format_p_short(c.p),
+                               format_p_short(c.p_holm),
+                               c.note.empty() ? significant_at(c.p_holm, alpha) : c.note});
+    doc.push_back({Block::kHeading, "Paired t-tests, Holm-adjusted", {}, {}, 4});
+    doc.push_back({Block::kTable, "", paired});
+    return doc;
+}
+
 std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                                   const ReportOptions& options) {
     std::vector<Block> doc;
@@ -73,13 +151,26 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                                           ", Tukey HSD intervals at " +
                                           format_short(1.0 - options.alpha) +
                                           " confidence, descriptive intervals at 95%."});
-    // Summary in the layout of the thesis's Table 4.4.
-    Table summary{{"configuration", "p", "F", "significant at alpha"}, {}};
+    // Summary in the layout of the thesis's Table 4.4, both designs, the primary first.
+    const Design primary = options.primary;
+    const Design secondary = primary == Design::Within ? Design::Between : Design::Within;
+    Table summary{{"configuration", "design", "test", "p", "F", "significant at alpha"}, {}};
     for (const OneWayAnalysis& a : analyses)
-        summary.rows.push_back(
-            {configuration(a), format_p_short(a.anova.p), format_short(a.anova.f),
-             significant_at(a.anova.p, options.alpha)});
+        for (Design design : {primary, secondary}) {
+            std::vector<std::string> row{configuration(a),
+                                         std::string(design_name(design)) +
+                                             (design == primary ? " (primary)" : "")};
+            for (std::string& cell : summary_cells(a, design, options.alpha))
+                row.push_back(std::move(cell));
+            summary.rows.push_back(std::move(row));
+        }
     doc.push_back({Block::kHeading, "Summary", {}, {}, 2});
+    doc.push_back({Block::kParagraph,
+                   std::string("Primary design: ") + design_name(primary) +
+                       (primary == Design::Within
+                            ? " (every participant rated every level; repeated-measures "
+                              "tests on participants' means)."
+                            : " (levels compared as independent groups of ratings).")});
     doc.push_back({Block::kTable, "", summary});
 
     for (const OneWayAnalysis& a : analyses) {
@@ -87,6 +178,8 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         Block plot{Block::kPlot, plot_file_name(a.question, a.factor), {}, {}};
         plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives);
         doc.push_back(plot);
+        const std::vector<Block> within = within_subject_blocks(a, options.alpha);
+        if (primary == Design::Within) doc.insert(doc.end(), within.begin(), within.end());
 
         Table desc{{"level", "n", "mean", "SD", "SE", "median", "95% CI"}, {}};
         for (const Descriptives& d : a.descriptives)
@@ -159,6 +252,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         if (a.missing_ratings > 0)
             notes += std::to_string(a.missing_ratings) + " missing ratings were skipped.";
         if (!notes.empty()) doc.push_back({Block::kParagraph, notes});
+        if (primary == Design::Between) doc.insert(doc.end(), within.begin(), within.end());
     }
     return doc;
 }
@@ -238,6 +332,11 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
     kruskal << "question,factor,h,df,p\n";
     welch << "question,factor,f,df1,df2,p\n";
     desc << "question,factor,level,n,mean,sd,se,median,ci_low,ci_high\n";
+    std::ostringstream rm_anova, friedman, paired;
+    rm_anova << "question,factor,n_participants,f,df_effect,df_error,p,mauchly_w,mauchly_p,"
+                "gg_epsilon,p_gg,hf_epsilon,p_hf,partial_eta_sq,generalized_eta_sq\n";
+    friedman << "question,factor,n_participants,chi_sq,df,p,kendall_w\n";
+    paired << "question,factor,level_a,level_b,diff,t,df,p,p_holm\n";
     for (const OneWayAnalysis& a : analyses) {
         const std::string key = csv_field(a.question) + ',' + csv_field(a.factor) + ',';
         const AnovaResult& r = a.anova;
@@ -260,12 +359,34 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
                  << ',' << format_full(d.sd) << ',' << format_full(d.se) << ','
                  << format_full(d.median) << ',' << format_full(d.ci_low) << ','
                  << format_full(d.ci_high) << '\n';
+        const WithinSubjectAnalysis& w = a.within;
+        if (!w.computed) continue;  // no row: not a within-subject layout
+        const RepeatedMeasuresAnova& rm = w.anova;
+        rm_anova << key << w.participants << ',' << format_full(rm.f) << ','
+                 << format_full(rm.df_effect) << ',' << format_full(rm.df_error) << ','
+                 << format_p_full(rm.p) << ',' << format_full(rm.mauchly_w) << ','
+                 << format_p_full(rm.mauchly_p) << ',' << format_full(rm.gg_epsilon) << ','
+                 << format_p_full(rm.p_gg) << ',' << format_full(rm.hf_epsilon) << ','
+                 << format_p_full(rm.p_hf) << ',' << format_full(rm.partial_eta_sq) << ','
+                 << format_full(rm.generalized_eta_sq) << '\n';
+        const FriedmanResult& f = w.friedman;
+        friedman << key << w.participants << ',' << format_full(f.chi_sq) << ','
+                 << format_full(f.df) << ',' << format_p_full(f.p) << ','
+                 << format_full(f.kendall_w) << '\n';
+        for (const PairedComparison& c : w.paired)
+            paired << key << csv_field(c.level_a) << ',' << csv_field(c.level_b) << ','
+                   << format_full(c.diff) << ',' << format_full(c.t) << ','
+                   << format_full(c.df) << ',' << format_p_full(c.p) << ','
+                   << format_p_full(c.p_holm) << '\n';
     }
     files.emplace_back("anova.csv", anova.str());
     files.emplace_back("tukey.csv", tukey.str());
     files.emplace_back("kruskal.csv", kruskal.str());
     files.emplace_back("welch.csv", welch.str());
     files.emplace_back("descriptives.csv", desc.str());
+    files.emplace_back("rm_anova.csv", rm_anova.str());
+    files.emplace_back("friedman.csv", friedman.str());
+    files.emplace_back("posthoc_paired.csv", paired.str());
 }
 
 }  // namespace

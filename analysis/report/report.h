@@ -18,6 +18,7 @@ struct ReportOptions {
     // Files the report must never replace (its input): a report file that is one of
     // them, or any SQLite database, is refused before anything is written.
     std::vector<std::filesystem::path> inputs;
+    Design primary = Design::Between;  // shown first in the summary and in each section
 };
 
 // "md,csv,html" (any subset, comma-separated); throws InputError naming a bad entry.

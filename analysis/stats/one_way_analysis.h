@@ -3,9 +3,29 @@
 #include "stats/anova.h"
 #include "stats/descriptives.h"
 #include "stats/kruskal_wallis.h"
+#include "stats/repeated_measures.h"
 #include "stats/tukey.h"
 
 namespace lucent::analysis {
+
+// Which analysis a study's plan names primary: levels rated by different participants
+// (between) or every participant rating every level (within, the thesis's survey).
+enum class Design { Between, Within };
+const char* design_name(Design design);
+
+// The within-subject tests of a pair, on each participant's mean rating per level.
+struct WithinSubjectAnalysis {
+    bool computed = false;  // false: fewer than two participants rated every level
+    std::string note;       // why it was not computed
+    int participants = 0;   // complete participants used
+    std::vector<std::string> excluded_participants;  // rated some levels, not all
+    RepeatedMeasuresAnova anova;
+    FriedmanResult friedman;
+    std::vector<PairedComparison> paired;
+};
+
+WithinSubjectAnalysis analyze_within_subject(const SubjectByLevel& complete,
+                                             std::vector<std::string> excluded);
 
 struct OneWayAnalysis {
     std::string question, factor;
@@ -16,6 +36,7 @@ struct OneWayAnalysis {
     WelchResult welch;
     std::vector<std::string> empty_levels;  // levels without observations (left out)
     std::size_t missing_ratings = 0;
+    WithinSubjectAnalysis within;
 };
 
 // alpha sets the Tukey intervals' confidence (1 - alpha); descriptives use 95% CIs.

@@ -37,6 +37,10 @@ add_test(NAME app.analyze_bad_format_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/out_of_scale.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/bad_format;--format;pdf"
                  -DEXPECT_CODE=2 -DEXPECT_STDERR=pdf -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.analyze_bad_design_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/out_of_scale.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/bad_design;--design;mixed"
+                 -DEXPECT_CODE=2 -DEXPECT_STDERR=--design -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
 add_test(NAME app.analyze_missing_input_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=analyze;/nonexistent/ratings.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/missing"
@@ -55,5 +59,17 @@ add_test(NAME app.simulate_bad_effects_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=simulate;--out;${CMAKE_CURRENT_BINARY_DIR}/x.csv;--participants;0"
                  -DEXPECT_CODE=2 -DEXPECT_STDERR=participants -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+# lucent power: a balanced between design's closed form (noncentral F) is printed next to
+# the simulation; lambda = 10 * 0.5 / 1, df 2 and 27: R's
+# 1 - pf(qf(0.95, 2, 27), 2, 27, ncp = 5) = 0.4579922755.
+add_test(NAME app.power_between_prints_closed_form
+         COMMAND lucent power --design between --participants 10 --means 0,0.5,1
+                 --residual-sd 1 --alpha 0.05 --simulations 200)
+set_tests_properties(app.power_between_prints_closed_form PROPERTIES
+    PASS_REGULAR_EXPRESSION "closed form \\(noncentral F\\) of the one-way ANOVA: 0\\.4580")
+add_test(NAME app.power_bad_means_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=power;--means;3"
+                 -DEXPECT_CODE=2 -DEXPECT_STDERR=--means -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
 add_test(NAME app.bench_stats_small COMMAND lucent bench stats --ratings 20000 --cdf-seconds 0.02)
 set_tests_properties(app.bench_stats_small PROPERTIES PASS_REGULAR_EXPRESSION "evals/s")

@@ -128,6 +128,20 @@ TEST(ProtocolErrors, EachKindIsOneLineNamingTheKey) {
     }
 }
 
+TEST(Protocol, AnalysisPlanNamesThePrimaryDesign) {
+    EXPECT_EQ(parse_protocol(lucent::test::kSmallProtocol, "p.toml").analysis.primary_design,
+              "within");  // every participant sees every stimulus
+    std::string text = lucent::test::kSmallProtocol;
+    text += "\n[analysis]\nprimary_design = \"between\"\n";
+    EXPECT_EQ(parse_protocol(text, "p.toml").analysis.primary_design, "between");
+    EXPECT_EQ(builtin_protocol("thesis").analysis.primary_design, "within");
+    const std::string e = error_of(std::string(lucent::test::kSmallProtocol) +
+                                   "\n[analysis]\nprimary_design = \"mixed\"\n");
+    EXPECT_NE(e.find("analysis.primary_design"), std::string::npos) << e;
+    EXPECT_NE(e.find("'mixed'"), std::string::npos) << e;
+    EXPECT_EQ(e.rfind("bad.toml:", 0), 0u) << e;
+}
+
 TEST(ProtocolErrors, ImpossibleRandomisationIsReportedWhenPlanning) {
     std::string text = lucent::test::kSmallProtocol;
     text += "\n[randomisation]\nfactor = \"backlight\"\nmax_repeat = 1\n";

@@ -9,6 +9,7 @@
 #include <regex>
 #include <sstream>
 
+#include "analyze.h"
 #include "data/long_table.h"
 #include "test_paths.h"
 
@@ -80,7 +81,7 @@ TEST(Report, WritesEveryFormatWithExactHeaders) {
         EXPECT_FALSE(std::regex_search(text, std::regex("[0-9.]inf|infinity"))) << name;
     }
     const std::string md = slurp(dir / "report.md");
-    EXPECT_NE(md.find("| configuration | p | F |"), std::string::npos);
+    EXPECT_NE(md.find("| configuration | design | test | p | F |"), std::string::npos);
     EXPECT_NE(md.find("translucent ~ thickness"), std::string::npos);
     EXPECT_NE(md.find("undefined"), std::string::npos);
     EXPECT_NE(md.find("no observations"), std::string::npos);
@@ -173,6 +174,59 @@ TEST(Report, NeverReplacesItsInputOrADatabaseAndWritesNothingThen) {
     write_report(analyses, dir, ReportOptions{});  // a second run replaces its own files
     write_report(analyses, dir, ReportOptions{});
     EXPECT_TRUE(std::filesystem::exists(dir / "report.md"));
+
+std::vector<std::string> csv_cells(const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream s(line);
+    for (std::string cell; std::getline(s, cell, ',');) cells.push_back(cell);
+    return cells;
+}
+
+TEST(Report, WithinSubjectTablesLeadWhenPrimaryAndParseBack) {
+    // Four participants rate three levels; P5 rates only one level and is left out.
+    std::istringstream csv(
+        "participant,stimulus,factor,level,question,rating\n"
+        "P1,a,r,18,q,2\nP1,b,r,25,q,4\nP1,c,r,30,q,5\n"
+        "P2,a,r,18,q,3\nP2,b,r,25,q,3\nP2,c,r,30,q,6\n"
+        "P3,a,r,18,q,1\nP3,b,r,25,q,4\nP3,c,r,30,q,4\n"
+        "P4,a,r,18,q,2\nP4,b,r,25,q,5\nP4,c,r,30,q,7\n"
+        "P5,a,r,18,q,6\n");
+    const LongTable table = read_long_csv(csv, "within.csv", RatingScale{});
+    const AnalysisResult result = analyze_table(table, AnalysisRequest{});
+    ASSERT_EQ(result.primary, Design::Within);
+    const auto dir = test::scratch_dir("report_within");
+    ReportOptions options;
+    options.primary = result.primary;
+    write_report(result.pairs, dir, options);
+
+    const std::string rm = slurp(dir / "rm_anova.csv");
+    EXPECT_EQ(first_line(rm),
+              "question,factor,n_participants,f,df_effect,df_error,p,mauchly_w,mauchly_p,"
+              "gg_epsilon,p_gg,hf_epsilon,p_hf,partial_eta_sq,generalized_eta_sq");
+    const std::vector<std::string> row = csv_cells(rm.substr(rm.find('\n') + 1));
+    ASSERT_EQ(row.size(), 15u) << rm;
+    const RepeatedMeasuresAnova& r = result.pairs[0].within.anova;
+    EXPECT_EQ(row[2], "4");
+    EXPECT_EQ(std::stod(row[3]), *r.f);
+    EXPECT_EQ(std::stod(row[10]), *r.p_gg);
+    EXPECT_EQ(first_line(slurp(dir / "friedman.csv")),
+              "question,factor,n_participants,chi_sq,df,p,kendall_w");
+    const std::string paired = slurp(dir / "posthoc_paired.csv");
+    EXPECT_EQ(first_line(paired), "question,factor,level_a,level_b,diff,t,df,p,p_holm");
+    EXPECT_EQ(std::count(paired.begin(), paired.end(), '\n'), 4);  // header + 3 pairs
+
+    const std::string md = slurp(dir / "report.md");
+    const std::size_t within_row = md.find("| q ~ r | within (primary) |");
+    const std::size_t between_row = md.find("| q ~ r | between |");
+    ASSERT_NE(within_row, std::string::npos) << md;
+    ASSERT_NE(between_row, std::string::npos) << md;
+    EXPECT_LT(within_row, between_row);
+    EXPECT_NE(md.find("left out (a level missing): P5"), std::string::npos);
+    // The section of the primary design comes before the between-subject tables.
+    EXPECT_LT(md.find("### Within-subject tests"), md.find("### One-way ANOVA"));
+    for (const char* name : {"rm_anova.csv", "friedman.csv", "posthoc_paired.csv", "report.md"})
+        EXPECT_FALSE(std::regex_search(slurp(dir / name), std::regex("nan", std::regex::icase)))
+            << name;
 }
 
 TEST(Report, FormatSelectionAndErrors) {
