@@ -148,6 +148,9 @@ CREATE TABLE segment_stimuli (
     PRIMARY KEY (segment_id, stimulus_id));
 ALTER TABLE trials ADD COLUMN segment_id INTEGER REFERENCES session_segments(id);
 CREATE INDEX segments_by_session ON session_segments(session_id);
+-- Enrolment numbers of withdrawn participants (the number only, nothing personal): a
+-- number, and with it a Latin-square row, is never handed out twice.
+CREATE TABLE retired_participant_numbers (number INTEGER PRIMARY KEY);
 )sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
@@ -352,7 +355,9 @@ int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int
     // Enrolment order: one past the highest number held, not the count, which falls
     // after a withdrawal and would hand out a number (a Latin-square row) still in use.
     if (n < 0)
-        n = static_cast<int>(db_.scalar_int("SELECT coalesce(max(number), 0) FROM participants")) + 1;
+        n = static_cast<int>(db_.scalar_int(
+                "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
+                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) + 1;
     db_.prepare("INSERT INTO participants (study_id, code, number, created_utc) "
                 "VALUES (?, ?, ?, ?)")
         .bind(1, study_id).bind(2, code).bind(3, n).bind(4, utc_now_iso8601()).run();
@@ -650,6 +655,9 @@ void Store::set_status(int64_t session_id, const std::string& status, bool ended
 
 bool Store::withdraw_participant(const std::string& code) {
     Transaction tx(db_);
+    db_.prepare("INSERT OR IGNORE INTO retired_participant_numbers (number) "
+                "SELECT number FROM participants WHERE code = ?")
+        .bind(1, code).run();
     db_.prepare("DELETE FROM participants WHERE code = ?").bind(1, code).run();
     const bool deleted = sqlite3_changes(db_.handle()) > 0;
     tx.commit();

@@ -150,6 +150,13 @@ TEST(Store, EnrolmentNumbersAreNeverSharedAfterAWithdrawal) {
     EXPECT_EQ(number_of("bob"), 2);  // known codes keep theirs
     EXPECT_EQ(store.db().scalar_int("SELECT count(DISTINCT number) FROM participants"),
               store.db().scalar_int("SELECT count(*) FROM participants"));
+    // Withdrawing the newest participant retires their number too: eve had 8, so the
+    // next enrolment is 9, never a second 8 (and a second Latin-square row 8).
+    ASSERT_TRUE(store.withdraw_participant("eve"));
+    EXPECT_EQ(number_of("fay"), 9);
+    ASSERT_TRUE(store.withdraw_participant("fay"));
+    ASSERT_TRUE(store.withdraw_participant("P7"));
+    EXPECT_EQ(number_of("gus"), 10);
 }
 
 TEST(Store, MigratesAVersion1DatabaseKeepingItsRows) {
