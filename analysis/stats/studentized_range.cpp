@@ -281,22 +281,27 @@ struct RangeTable {
     std::array<ChebyshevPanel, kPanels> panels;
     double g_at_end = 0;  // g(60)
     double median = 0;    // U(median) = 1/2
-    double negligible = 0;  // W(w) < 1e-17 for w below this: U is 1 to rounding
+    // Small ranges: h(w) = h0 + h2 w^2 + O(w^4) (h is even), and below closed_range
+    // W(w) = e^h0 w^m (1 + h2 w^2) to 1e-17 absolute.
+    double h0 = 0, h2 = 0, closed_range = 0;
 
-    double log_upper(double w) const {
+    double log_upper(double w) const { return log_upper(w, std::log(w)); }
+    double log_lower(double w) const { return log_lower(w, std::log(w)); }
+    // With log w known (the trapezoid nodes have it for free).
+    double log_upper(double w, double log_w) const {
         if (!(w > 0.0)) return 0.0;
-        if (w >= kTableEnd) return g_at_end - std::log(w / kTableEnd) - 0.25 * w * w;
+        if (w >= kTableEnd) return g_at_end - (log_w - std::log(kTableEnd)) - 0.25 * w * w;
         const int p = panel_of(w);
         const double v = panels[p].at(w);
         if (p >= first_upper_panel) return v - 0.25 * w * w;
-        return std::log1p(-std::exp(v + m * std::log(w)));
+        return std::log1p(-std::exp(v + m * log_w));
     }
-    double log_lower(double w) const {
+    double log_lower(double w, double log_w) const {
         if (!(w > 0.0)) return kNegInf;
-        if (w >= kTableEnd) return std::log1p(-std::exp(log_upper(w)));
+        if (w >= kTableEnd) return std::log1p(-std::exp(log_upper(w, log_w)));
         const int p = panel_of(w);
         const double v = panels[p].at(w);
-        if (p < first_upper_panel) return v + m * std::log(w);
+        if (p < first_upper_panel) return v + m * log_w;
         return std::log(-std::expm1(v - 0.25 * w * w));
     }
     // log of the range density -U'(w) = W'(w).
@@ -338,19 +343,41 @@ std::unique_ptr<RangeTable> build_range_table(int k) {
             });
     }
     table->g_at_end = table->panels[kPanels - 1].at(kTableEnd);
-    // Both U and log W are monotone: bisect on the table (in log w for the small one).
+    // h0 and h2 = h''(0) / 2 from panel 0's series (differentiated once more).
+    {
+        const ChebyshevPanel& first = table->panels[0];
+        std::array<double, kChebyshevTerms> curvature{};
+        std::array<double, kChebyshevTerms + 1> d{};
+        for (int i = kChebyshevTerms - 1; i >= 1; --i)
+            d[i - 1] = d[i + 1] + 2.0 * i * first.slope[i];
+        for (int i = 0; i < kChebyshevTerms; ++i) curvature[i] = d[i] / first.half;
+        curvature[0] *= 0.5;
+        table->h0 = first.at(0.0);
+        table->h2 = 0.5 * ChebyshevPanel::sum(curvature, -1.0);
+    }
+    // The two-term form's error |W - e^h0 w^m (1 + h2 w^2)| falls with w: bisect in
+    // log w for where it reaches 1e-17.
+    {
+        auto error = [&](double w) {
+            const double h = table->panels[0].at(w);
+            const double ratio = std::exp(table->h0 - h);
+            return std::exp(h + m * std::log(w)) *
+                   std::fabs(-std::expm1(table->h0 - h) - ratio * table->h2 * w * w);
+        };
+        double lo = -60.0, hi = 0.0;  // log w
+        for (int i = 0; i < 60; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            (error(std::exp(mid)) < 1e-17 ? lo : hi) = mid;
+        }
+        table->closed_range = std::exp(lo);
+    }
+    // U is monotone: bisect on the table.
     double lo = 0.0, hi = kTableEnd;
     for (int i = 0; i < 80; ++i) {
         const double mid = 0.5 * (lo + hi);
         (table->log_upper(mid) > std::log(0.5) ? lo : hi) = mid;
     }
     table->median = 0.5 * (lo + hi);
-    double log_lo = -700.0, log_hi = std::log(table->median);
-    for (int i = 0; i < 80; ++i) {
-        const double mid = 0.5 * (log_lo + log_hi);
-        (table->log_lower(std::exp(mid)) < std::log(1e-17) ? log_lo : log_hi) = mid;
-    }
-    table->negligible = std::exp(log_lo);
     return table;
 }
 
@@ -473,18 +500,24 @@ enum class Mix { kLower, kUpper, kDensity };
 // Terms below e^-34 of the largest are dropped (the rest of a tail adds < 1e-13).
 constexpr double kDrop = 34.0;
 
-// h * sum_{j <= i} gd(u_j) in closed form: with x = nu e^(2u)/2 small,
+// h * sum_{j <= i} gd(u_j) U(q e^(u_j)) in closed form, where the range is small enough
+// that W(w) = e^h0 w^m (1 + h2 w^2) to rounding: with x = nu e^(2u)/2 small,
 //   gd(u) = e^(c + nu/2 + nu u) sum_n (-x)^n / n!,
-// and each power of e^u sums over the grid as a geometric series.
-double log_left_tail_mass(const ScaleGrid& grid, int i) {
-    const double df = grid.df(), h = grid.step(), u = i * h;
+// and each power of e^u (times 1, w^m = q^m e^(m u) or w^(m+2)) sums over the grid as a
+// geometric series.
+double log_left_tail(const ScaleGrid& grid, int i, double log_q, const RangeTable& table) {
+    const double df = grid.df(), h = grid.step(), u = i * h, m = table.m;
     const double x = 0.5 * df * std::exp(2.0 * u);
-    double term = 1.0, sum = 0.0;
+    const double log_w = log_q + u, w2 = std::exp(2.0 * log_w);
+    const double small_range = std::exp(table.h0 + m * log_w);
+    double term = 1.0, density = 0.0, lower = 0.0;
     for (int n = 0; n < 30 && std::fabs(term) > 1e-18; ++n) {
-        sum += term / -std::expm1(-(df + 2.0 * n) * h);
+        density += term / -std::expm1(-(df + 2.0 * n) * h);
+        lower += term * (1.0 / -std::expm1(-(df + m + 2.0 * n) * h) +
+                         table.h2 * w2 / -std::expm1(-(df + m + 2.0 + 2.0 * n) * h));
         term *= -x / (n + 1);
     }
-    return grid.log_constant() + 0.5 * df + df * u + std::log(sum);
+    return grid.log_constant() + 0.5 * df + df * u + std::log(density - small_range * lower);
 }
 
 // log of h * sum_i gd(u_i) f(q e^(u_i)) with f = W, U or w * (range density).
@@ -500,18 +533,18 @@ double log_mix(double q, const RangeTable& table, double df, Mix mix, bool upper
     ScaleGrid& grid = scale_grid(df, h, start);
     auto log_term = [&](int i) {
         const ScaleGrid::Node node = grid.node(i);
-        const double w = q * node.scale;
+        const double w = q * node.scale, log_w = log_q + i * h;
         switch (mix) {
-            case Mix::kLower: return node.log_weight + table.log_lower(w);
-            case Mix::kUpper: return node.log_weight + table.log_upper(w);
+            case Mix::kLower: return node.log_weight + table.log_lower(w, log_w);
+            case Mix::kUpper: return node.log_weight + table.log_upper(w, log_w);
             case Mix::kDensity: return node.log_weight + std::log(w) + table.log_density(w);
         }
         return kNegInf;
     };
-    // Where U = 1 to rounding and gd is a short power series, the rest of the (slow,
+    // Where W is a short power series in w and so is gd, the rest of the (slow,
     // ~e^(nu u)) upper-tail integrand to the left has a closed form.
-    const double closed_form_u = std::min(0.5 * std::log(0.1 / df),
-                                          std::log(table.negligible) - log_q);
+    const double closed_u =
+        std::min(0.5 * std::log(0.1 / df), std::log(table.closed_range) - log_q);
     constexpr int kMaxNodes = 200000;  // a guard: ~1000 suffice for any argument
     LogSum sum;
     double top = kNegInf;
@@ -522,8 +555,8 @@ double log_mix(double q, const RangeTable& table, double df, Mix mix, bool upper
         if (t < top - kDrop) break;
     }
     for (int i = start - 1; i > start - kMaxNodes; --i) {
-        if (mix == Mix::kUpper && i * h <= closed_form_u) {
-            sum.add(log_left_tail_mass(grid, i));
+        if (mix == Mix::kUpper && i * h <= closed_u) {
+            sum.add(log_left_tail(grid, i, log_q, table));
             break;
         }
         const double t = log_term(i);
