@@ -51,9 +51,6 @@ double log_normal_upper(double x) {
 
 double log_normal_pdf(double x) { return -0.5 * x * x - kLogSqrt2Pi; }
 
-// log(e^a + e^b) for a >= b.
-double log_add_ordered(double a, double b) { return a + std::log1p(std::exp(b - a)); }
-
 // Gauss-Legendre rule on [-1, 1] (Boost stores the nonnegative half).
 template <unsigned N>
 struct GaussRule {
@@ -282,7 +279,8 @@ struct RangeTable {
     double g_at_end = 0;  // g(60)
     double median = 0;    // U(median) = 1/2
     // Small ranges: h(w) = h0 + h2 w^2 + O(w^4) (h is even), and below closed_range
-    // W(w) = e^h0 w^m (1 + h2 w^2) to 1e-17 absolute.
+    // W(w) = e^h0 w^m (1 + h2 w^2) to 1e-17 absolute (for large k because both are
+    // below that).
     double h0 = 0, h2 = 0, closed_range = 0;
 
     double log_upper(double w) const { return log_upper(w, std::log(w)); }
@@ -359,12 +357,13 @@ std::unique_ptr<RangeTable> build_range_table(int k) {
     // log w for where it reaches 1e-17.
     {
         auto error = [&](double w) {
-            const double h = table->panels[0].at(w);
+            const double h = table->panels[panel_of(w)].at(w);
             const double ratio = std::exp(table->h0 - h);
             return std::exp(h + m * std::log(w)) *
                    std::fabs(-std::expm1(table->h0 - h) - ratio * table->h2 * w * w);
         };
-        double lo = -60.0, hi = 0.0;  // log w
+        // (Up to the first U panel; with many groups W is far below 1e-17 there.)
+        double lo = -60.0, hi = std::log(static_cast<double>(split));  // log w
         for (int i = 0; i < 60; ++i) {
             const double mid = 0.5 * (lo + hi);
             (error(std::exp(mid)) < 1e-17 ? lo : hi) = mid;

@@ -112,10 +112,15 @@ TEST(Decimal, PlainDecimalsRoundOnceLikeStrtod) {
     std::mt19937_64 engine(9);
     for (int i = 0; i < 20000; ++i) {
         const int digits = 1 + static_cast<int>(engine() % 17);
-        std::string text = (engine() % 2) ? "-" : "";
-        for (int d = 0; d < digits; ++d) text += static_cast<char>('0' + engine() % 10);
-        const int point = static_cast<int>(engine() % (digits + 1));
-        if (point < digits) text.insert(text.size() - point, ".");
+        const int fraction = static_cast<int>(engine() % digits);  // digits after '.'
+        char buffer[24];
+        int length = 0;
+        if (engine() % 2) buffer[length++] = '-';
+        for (int d = 0; d < digits; ++d) {
+            if (fraction > 0 && d == digits - fraction) buffer[length++] = '.';
+            buffer[length++] = static_cast<char>('0' + engine() % 10);
+        }
+        const std::string text(buffer, length);
         EXPECT_EQ(exact_difference(text, "0"), std::strtod(text.c_str(), nullptr)) << text;
     }
     // Differences that are exact in binary come back exactly, whatever the magnitudes.
