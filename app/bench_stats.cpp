@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <vector>
 
@@ -96,12 +97,25 @@ void bench_in_process(long ratings, int groups, Results& results) {
                 tukey.pairs.size(), kw.h.value_or(-1));
 }
 
-// Wall time of a shell command, or a negative number when it fails.
-double time_command(const std::string& command) {
+// CPU time (user + system) of all finished child processes so far.
+double children_cpu_seconds() {
+    rusage usage{};
+    getrusage(RUSAGE_CHILDREN, &usage);
+    auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+    return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+// Wall and CPU time of a shell command (CPU time is what a loaded machine does not
+// inflate); negative when it fails.
+struct CommandTime {
+    double wall, cpu;
+};
+CommandTime time_command(const std::string& command) {
     const auto start = Clock::now();
+    const double cpu_start = children_cpu_seconds();
     const int status = std::system(command.c_str());
-    const double seconds = seconds_since(start);
-    return status == 0 ? seconds : -1.0;
+    const CommandTime t{seconds_since(start), children_cpu_seconds() - cpu_start};
+    return status == 0 ? t : CommandTime{-1.0, -1.0};
 }
 
 std::string quoted(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
@@ -132,15 +146,22 @@ int bench_whole_process(long ratings, int groups, Results& results) {
     std::printf("whole process on %zu ratings in %d levels (%s)\n", table.rows.size(), groups,
                 csv.c_str());
     const fs::path self = fs::read_symlink("/proc/self/exe");
-    const double t_lucent = time_command(quoted(self) + " analyze " + quoted(csv) + " --out " +
-                                         quoted(dir / "report") +
-                                         " --format csv >/dev/null 2>&1");
-    if (t_lucent < 0) {
+    const CommandTime t_lucent = time_command(quoted(self) + " analyze " + quoted(csv) +
+                                              " --out " + quoted(dir / "report") +
+                                              " --format csv >/dev/null 2>&1");
+    if (t_lucent.wall < 0) {
         std::fprintf(stderr, "lucent bench stats: lucent analyze failed on %s\n", csv.c_str());
         return kExitFailure;
     }
-    std::printf("  %-40s %10.3f s\n", "lucent analyze --format csv", t_lucent);
-    results.add("whole_process", "lucent analyze --format csv", t_lucent, "s");
+    const CommandTime t_start = time_command(quoted(self) + " --help >/dev/null 2>&1");
+    std::printf("  %-40s %10s %10s\n", "process", "wall s", "CPU s");
+    std::printf("  %-40s %10.3f %10.3f\n", "lucent analyze --format csv", t_lucent.wall,
+                t_lucent.cpu);
+    std::printf("  %-40s %10.3f %10.3f\n", "  of which starting lucent (--help)", t_start.wall,
+                t_start.cpu);
+    results.add("whole_process", "lucent analyze --format csv (wall)", t_lucent.wall, "s");
+    results.add("whole_process", "lucent analyze --format csv (cpu)", t_lucent.cpu, "s");
+    results.add("whole_process", "lucent --help (cpu)", t_start.cpu, "s");
     if (std::system("command -v Rscript >/dev/null 2>&1") != 0) {
         std::printf("  R comparison skipped: Rscript is not on the PATH (the bench installs nothing)\n");
     } else {
@@ -153,15 +174,19 @@ int bench_whole_process(long ratings, int groups, Results& results) {
                "print(TukeyHSD(fit))\n"
                "print(kruskal.test(rating ~ level, data = d))\n"
                "print(oneway.test(rating ~ level, data = d))\n";
-        const double t_r =
+        const CommandTime t_r =
             time_command("Rscript " + quoted(script) + " " + quoted(csv) + " >/dev/null 2>&1");
-        if (t_r < 0) {
+        if (t_r.wall < 0) {
             std::printf("  R comparison failed: Rscript exited with an error\n");
         } else {
-            std::printf("  %-40s %10.3f s   (lucent x%.1f faster)\n",
-                        "R read.csv+aov+TukeyHSD+kruskal+oneway", t_r, t_r / t_lucent);
-            results.add("whole_process", "R read.csv+aov+TukeyHSD+kruskal.test+oneway.test", t_r, "s");
-            results.add("whole_process", "R / lucent", t_r / t_lucent, "ratio");
+            std::printf("  %-40s %10.3f %10.3f\n", "R read.csv+aov+TukeyHSD+kruskal+oneway",
+                        t_r.wall, t_r.cpu);
+            std::printf("  %-40s %9.1fx %9.1fx\n", "R / lucent", t_r.wall / t_lucent.wall,
+                        t_r.cpu / t_lucent.cpu);
+            results.add("whole_process", "R (wall)", t_r.wall, "s");
+            results.add("whole_process", "R (cpu)", t_r.cpu, "s");
+            results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall, "ratio");
+            results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu, "ratio");
         }
     }
     std::error_code ignored;

@@ -26,22 +26,23 @@ std::string format_exact(double value) {
     return error == std::errc() ? std::string(buffer, end) : std::to_string(value);
 }
 
-// Splits one CSV record into `fields` (reusing their storage: a million rows cost no
-// allocations). Quotes may span lines: more lines are then pulled from `in`.
+// Splits one CSV record into `fields`. A record without quotes (the common case) is cut
+// at its commas in place: the views point into `line`, and a million rows cost no copies.
+// A quoted record is decoded into `decoded` (quotes may span lines: more lines are then
+// pulled from `in`).
 void split_record(std::string& line, std::istream& in, std::size_t& line_no,
-                  const std::string& source, std::vector<std::string>& fields) {
-    if (line.find('"') == std::string::npos) {  // the common case: split at commas
-        std::size_t count = 0, start = 0;
-        for (;;) {
+                  const std::string& source, std::vector<std::string>& decoded,
+                  std::vector<std::string_view>& views) {
+    views.clear();
+    if (line.find('"') == std::string::npos) {
+        for (std::size_t start = 0;;) {
             const std::size_t comma = std::min(line.find(',', start), line.size());
-            if (fields.size() <= count) fields.emplace_back();
-            fields[count++].assign(line, start, comma - start);
-            if (comma == line.size()) break;
+            views.emplace_back(line.data() + start, comma - start);
+            if (comma == line.size()) return;
             start = comma + 1;
         }
-        fields.resize(count);
-        return;
     }
+    std::vector<std::string>& fields = decoded;
     fields.assign(1, std::string());
     bool quoted = false;
     for (std::size_t i = 0;; ++i) {
@@ -74,6 +75,7 @@ void split_record(std::string& line, std::istream& in, std::size_t& line_no,
             fields.back() += c;
         }
     }
+    for (const std::string& field : fields) views.emplace_back(field);
 }
 
 std::string_view trimmed(std::string_view s) {
@@ -146,13 +148,14 @@ LongTable read_long_csv(std::istream& in, const std::string& source,
     column.fill(-1);
     std::size_t header_fields = 0;
     std::string origin_text;
-    std::vector<std::string> fields;
+    std::vector<std::string> decoded;
+    std::vector<std::string_view> fields;
     while (std::getline(in, line)) {
         ++line_no;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // BOM
         if (trimmed(line).empty()) continue;
-        split_record(line, in, line_no, source, fields);
+        split_record(line, in, line_no, source, decoded, fields);
         if (header_fields == 0) {
             // Header: find each required column by name.
             header_fields = fields.size();
