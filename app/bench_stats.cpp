@@ -2,17 +2,18 @@
 // Kruskal-Wallis on 10^6 ratings in 10 groups, in process and as a whole `lucent analyze`
 // process, against R when Rscript is on the PATH) and of the studentized range
 // distribution (evaluations per second on one core, and the per-k table build).
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
-#include <sys/resource.h>
-#include <unistd.h>
 #include <vector>
 
 #include "commands.h"
@@ -53,7 +54,9 @@ struct Results {
         std::ofstream out(path);
         if (!out) return false;
         out << "section,name,value,unit\n";
-        for (const Row& r : rows) out << r.section << ",\"" << r.name << "\"," << r.value << ',' << r.unit << '\n';
+        for (const Row& r : rows)
+            out << r.section << ",\"" << r.name << "\"," << r.value << ',' << r.unit
+                << '\n';
         return static_cast<bool>(out);
     }
 };
@@ -70,8 +73,8 @@ void bench_in_process(long ratings, int groups, Results& results) {
         data.groups[g].values.push_back(
             base(engine) + (engine() % 10 < static_cast<unsigned>(g % 3) ? 1 : 0));
     }
-    std::printf("analysis of %ld ratings in %d groups, in process (one run each)\n", ratings,
-                groups);
+    std::printf("analysis of %ld ratings in %d groups, in process (one run each)\n",
+                ratings, groups);
     auto start = Clock::now();
     const AnovaResult anova = one_way_anova(data);
     const double t_anova = seconds_since(start);
@@ -91,7 +94,8 @@ void bench_in_process(long ratings, int groups, Results& results) {
         std::printf("  %-40s %10.2f %7.1f%%\n", name.c_str(), 1e3 * t, 100 * t / total);
         results.add("in_process", name, 1e3 * t, "ms");
     }
-    std::printf("  %-40s %10.2f   (%.3g ratings/s)\n", "total", 1e3 * total, ratings / total);
+    std::printf("  %-40s %10.2f   (%.3g ratings/s)\n", "total", 1e3 * total,
+                ratings / total);
     results.add("in_process", "total", 1e3 * total, "ms");
     std::printf("  (F = %.6g, %zu Tukey pairs, H = %.6g)\n", anova.f.value_or(-1),
                 tukey.pairs.size(), kw.h.value_or(-1));
@@ -118,14 +122,17 @@ CommandTime time_command(const std::string& command) {
     return status == 0 ? t : CommandTime{-1.0, -1.0};
 }
 
-std::string quoted(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
+std::string quoted(const std::filesystem::path& path) {
+    return "'" + path.string() + "'";
+}
 
 // `lucent analyze` as a whole process on a simulated long CSV (one question, one factor,
 // `groups` levels), and R's read.csv + aov + TukeyHSD + kruskal.test + oneway.test on the
 // same file when Rscript is on the PATH (nothing is installed).
 int bench_whole_process(long ratings, int groups, Results& results) {
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / ("lucent-bench-stats-" + std::to_string(getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("lucent-bench-stats-" + std::to_string(getpid()));
     fs::create_directories(dir);
     const fs::path csv = dir / "ratings.csv";
     analysis::SimulationSpec spec;
@@ -143,50 +150,55 @@ int bench_whole_process(long ratings, int groups, Results& results) {
             return kExitFailure;
         }
     }
-    std::printf("whole process on %zu ratings in %d levels (%s)\n", table.rows.size(), groups,
-                csv.c_str());
+    std::printf("whole process on %zu ratings in %d levels (%s)\n", table.rows.size(),
+                groups, csv.c_str());
     const fs::path self = fs::read_symlink("/proc/self/exe");
-    const CommandTime t_lucent = time_command(quoted(self) + " analyze " + quoted(csv) +
-                                              " --out " + quoted(dir / "report") +
-                                              " --format csv >/dev/null 2>&1");
+    const CommandTime t_lucent =
+        time_command(quoted(self) + " analyze " + quoted(csv) + " --out " +
+                     quoted(dir / "report") + " --format csv >/dev/null 2>&1");
     if (t_lucent.wall < 0) {
-        std::fprintf(stderr, "lucent bench stats: lucent analyze failed on %s\n", csv.c_str());
+        std::fprintf(stderr, "lucent bench stats: lucent analyze failed on %s\n",
+                     csv.c_str());
         return kExitFailure;
     }
     const CommandTime t_start = time_command(quoted(self) + " --help >/dev/null 2>&1");
     std::printf("  %-40s %10s %10s\n", "process", "wall s", "CPU s");
     std::printf("  %-40s %10.3f %10.3f\n", "lucent analyze --format csv", t_lucent.wall,
                 t_lucent.cpu);
-    std::printf("  %-40s %10.3f %10.3f\n", "  of which starting lucent (--help)", t_start.wall,
-                t_start.cpu);
-    results.add("whole_process", "lucent analyze --format csv (wall)", t_lucent.wall, "s");
+    std::printf("  %-40s %10.3f %10.3f\n", "  of which starting lucent (--help)",
+                t_start.wall, t_start.cpu);
+    results.add("whole_process", "lucent analyze --format csv (wall)", t_lucent.wall,
+                "s");
     results.add("whole_process", "lucent analyze --format csv (cpu)", t_lucent.cpu, "s");
     results.add("whole_process", "lucent --help (cpu)", t_start.cpu, "s");
     if (std::system("command -v Rscript >/dev/null 2>&1") != 0) {
-        std::printf("  R comparison skipped: Rscript is not on the PATH (the bench installs nothing)\n");
+        std::printf(
+            "  R comparison skipped: Rscript is not on the PATH (the bench installs "
+            "nothing)\n");
     } else {
         const fs::path script = dir / "analysis.R";
-        std::ofstream(script)
-            << "d <- read.csv(commandArgs(trailingOnly = TRUE)[1])\n"
-               "d$level <- factor(d$level)\n"
-               "fit <- aov(rating ~ level, data = d)\n"
-               "print(summary(fit))\n"
-               "print(TukeyHSD(fit))\n"
-               "print(kruskal.test(rating ~ level, data = d))\n"
-               "print(oneway.test(rating ~ level, data = d))\n";
-        const CommandTime t_r =
-            time_command("Rscript " + quoted(script) + " " + quoted(csv) + " >/dev/null 2>&1");
+        std::ofstream(script) << "d <- read.csv(commandArgs(trailingOnly = TRUE)[1])\n"
+                                 "d$level <- factor(d$level)\n"
+                                 "fit <- aov(rating ~ level, data = d)\n"
+                                 "print(summary(fit))\n"
+                                 "print(TukeyHSD(fit))\n"
+                                 "print(kruskal.test(rating ~ level, data = d))\n"
+                                 "print(oneway.test(rating ~ level, data = d))\n";
+        const CommandTime t_r = time_command("Rscript " + quoted(script) + " " +
+                                             quoted(csv) + " >/dev/null 2>&1");
         if (t_r.wall < 0) {
             std::printf("  R comparison failed: Rscript exited with an error\n");
         } else {
-            std::printf("  %-40s %10.3f %10.3f\n", "R read.csv+aov+TukeyHSD+kruskal+oneway",
-                        t_r.wall, t_r.cpu);
+            std::printf("  %-40s %10.3f %10.3f\n",
+                        "R read.csv+aov+TukeyHSD+kruskal+oneway", t_r.wall, t_r.cpu);
             std::printf("  %-40s %9.1fx %9.1fx\n", "R / lucent", t_r.wall / t_lucent.wall,
                         t_r.cpu / t_lucent.cpu);
             results.add("whole_process", "R (wall)", t_r.wall, "s");
             results.add("whole_process", "R (cpu)", t_r.cpu, "s");
-            results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall, "ratio");
-            results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu, "ratio");
+            results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall,
+                        "ratio");
+            results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu,
+                        "ratio");
         }
     }
     std::error_code ignored;
@@ -210,7 +222,8 @@ std::vector<RangeArgs> sweep(int k, double df, double q_low, double q_high) {
 
 void bench_distribution(double seconds, Results& results) {
     using namespace lucent::analysis;
-    std::printf("studentized range table build (once per k, on first use; thread CPU time)\n");
+    std::printf(
+        "studentized range table build (once per k, on first use; thread CPU time)\n");
     for (int k : {50, 200}) {
         const double start = thread_seconds();
         studentized_range_prepare(k);
@@ -245,7 +258,8 @@ void bench_distribution(double seconds, Results& results) {
     for (const RangeArgs& a : random.args) studentized_range_prepare(a.k);  // not timed
     rows.push_back(std::move(random));
 
-    std::printf("studentized range P(Q > q) evaluations, one core (%.1f CPU s per row)\n", seconds);
+    std::printf("studentized range P(Q > q) evaluations, one core (%.1f CPU s per row)\n",
+                seconds);
     std::printf("  %-40s %12s %10s\n", "arguments", "evals/s", "us/eval");
     for (const Row& row : rows) {
         for (const RangeArgs& a : row.args) studentized_range_prepare(a.k);
@@ -304,12 +318,14 @@ void register_bench_stats(CLI::App& bench, int& exit_code) {
     cmd->add_option("--ratings", args->ratings, "Ratings in the synthetic study")
         ->capture_default_str();
     cmd->add_option("--groups", args->groups, "Groups (levels)")->capture_default_str();
-    cmd->add_option("--cdf-seconds", args->cdf_seconds, "Seconds per distribution timing row")
+    cmd->add_option("--cdf-seconds", args->cdf_seconds,
+                    "Seconds per distribution timing row")
         ->capture_default_str();
     cmd->add_flag("--no-process", args->no_process,
                   "Skip the whole-process 'lucent analyze' (and R) timing");
-    cmd->add_option("--csv", args->csv,
-                    "Also write every timing as CSV (section,name,value,unit) to this file");
+    cmd->add_option(
+        "--csv", args->csv,
+        "Also write every timing as CSV (section,name,value,unit) to this file");
     cmd->callback([args, &exit_code] {
         exit_code = run_bench_stats(args->ratings, args->groups, args->cdf_seconds,
                                     !args->no_process, args->csv);

@@ -1,11 +1,11 @@
 #include "data/decimal.h"
 
-#include <boost/multiprecision/cpp_dec_float.hpp>
 #include <algorithm>
+#include <boost/multiprecision/cpp_dec_float.hpp>
 #include <cctype>
-#include <cstdint>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 namespace lucent::analysis {
@@ -51,7 +51,8 @@ std::optional<ScaledInteger> plain_decimal(std::string_view text) {
     ScaledInteger r;
     bool negative = false, point = false;
     std::size_t i = 0;
-    if (i < text.size() && (text[i] == '-' || text[i] == '+')) negative = text[i++] == '-';
+    if (i < text.size() && (text[i] == '-' || text[i] == '+'))
+        negative = text[i++] == '-';
     if (i == text.size()) return std::nullopt;
     for (; i < text.size(); ++i) {
         const char c = text[i];
@@ -81,9 +82,9 @@ double exact_difference(std::string_view value, std::string_view origin) {
         const int d = std::max(a->fraction_digits, b->fraction_digits);
         const int a_shift = d - a->fraction_digits, b_shift = d - b->fraction_digits;
         if (a->digits + a_shift <= 17 && b->digits + b_shift <= 17) {
-            static constexpr double kPowers[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6,
-                                                 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13,
-                                                 1e14, 1e15, 1e16, 1e17};
+            static constexpr double kPowers[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,
+                                                 1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                                 1e12, 1e13, 1e14, 1e15, 1e16, 1e17};
             std::int64_t ai = a->integer, bi = b->integer;
             for (int i = 0; i < a_shift; ++i) ai *= 10;
             for (int i = 0; i < b_shift; ++i) bi *= 10;

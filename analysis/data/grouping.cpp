@@ -20,8 +20,8 @@ std::vector<FactorData> split_by_question_and_factor(const LongTable& table,
     for (const RatingRow& row : table.rows) {
         if (!question_filter.empty() && row.question != question_filter) continue;
         if (!factor_filter.empty() && row.factor != factor_filter) continue;
-        const bool same_pair =
-            previous && row.question == previous->question && row.factor == previous->factor;
+        const bool same_pair = previous && row.question == previous->question &&
+                               row.factor == previous->factor;
         if (!same_pair) {
             auto [it, inserted] =
                 pair_index.emplace(std::pair{row.question, row.factor}, pairs.size());

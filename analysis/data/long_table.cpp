@@ -189,8 +189,8 @@ LongTable read_long_csv(std::istream& in, const std::string& source,
         const std::string_view rating_text = trimmed(fields[column[5]]);
         if (!rating_text.empty() && rating_text != "NA") {
             if (!parse_finite_number(rating_text))
-                throw InputError(location(source, line_no) + ": rating '" + std::string(rating_text) +
-                                 "' is not a finite number");
+                throw InputError(location(source, line_no) + ": rating '" +
+                                 std::string(rating_text) + "' is not a finite number");
             if (origin_text.empty()) {
                 origin_text = rating_text;
                 table.origin = *parse_finite_number(rating_text);

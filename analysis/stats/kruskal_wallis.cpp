@@ -42,7 +42,8 @@ KruskalWallisResult kruskal_wallis(const OneWayData& data) {
     if (!few) {
         std::vector<double> pooled;
         pooled.reserve(total);
-        for (const Group* g : groups) pooled.insert(pooled.end(), g->values.begin(), g->values.end());
+        for (const Group* g : groups)
+            pooled.insert(pooled.end(), g->values.begin(), g->values.end());
         std::sort(pooled.begin(), pooled.end());
         distinct.clear();
         counts.clear();
@@ -59,7 +60,9 @@ KruskalWallisResult kruskal_wallis(const OneWayData& data) {
     CompensatedSum tie_terms;
     std::size_t below = 0;
     for (std::size_t d = 0; d < distinct.size(); ++d) {
-        mid_ranks[d] = 0.5 * static_cast<double>(below + 1 + below + counts[d]);  // ranks below+1 .. below+count
+        mid_ranks[d] =
+            0.5 * static_cast<double>(below + 1 + below +
+                                      counts[d]);  // ranks below+1 .. below+count
         const double t = static_cast<double>(counts[d]);
         tie_terms.add(t * t * t - t);
         below += counts[d];
@@ -69,9 +72,11 @@ KruskalWallisResult kruskal_wallis(const OneWayData& data) {
         // Within a group, add each distinct value's mid-rank times its count there.
         std::vector<std::size_t> in_group(distinct.size(), 0);
         for (double x : groups[g]->values)
-            ++in_group[std::lower_bound(distinct.begin(), distinct.end(), x) - distinct.begin()];
+            ++in_group[std::lower_bound(distinct.begin(), distinct.end(), x) -
+                       distinct.begin()];
         for (std::size_t d = 0; d < distinct.size(); ++d)
-            if (in_group[d] > 0) rank_sums[g].add(mid_ranks[d] * static_cast<double>(in_group[d]));
+            if (in_group[d] > 0)
+                rank_sums[g].add(mid_ranks[d] * static_cast<double>(in_group[d]));
     }
     const double tie_correction = 1.0 - tie_terms.value() / (n * n * n - n);
     r.df = static_cast<double>(groups.size() - 1);

@@ -99,8 +99,8 @@ double log_normal_mass(double z, double w) {
 }
 
 // ---------------------------------------------------------------------------------------
-// df = infinity by quadrature (only to build the tables). Conditioning on the minimum z of
-// the k normals, the other m = k - 1 lie above it:
+// df = infinity by quadrature (only to build the tables). Conditioning on the minimum z
+// of the k normals, the other m = k - 1 lie above it:
 //   U(w) = k Int phi(z) Qbar(z)^m [1 - (1 - Qbar(z+w)/Qbar(z))^m] dz
 //   W(w) = k Int phi(z) P(z < Z <= z + w)^m dz.
 
@@ -212,7 +212,7 @@ double log_range_lower_by_quadrature(double w, int k) {
 // The per-k table.
 
 constexpr int kChebyshevTerms = 17;  // degree 16
-constexpr std::array<double, 15> kBreaks = {0,  1,  2,  3,  4,  5,  6, 7,
+constexpr std::array<double, 15> kBreaks = {0, 1,  2,  3,  4,  5,  6, 7,
                                             8, 10, 12, 16, 24, 40, 60};
 constexpr int kPanels = static_cast<int>(kBreaks.size()) - 1;
 constexpr double kTableEnd = 60.0;  // U(60) ~ 1e-390: beyond, g falls like -log w
@@ -288,7 +288,8 @@ struct RangeTable {
     // With log w known (the trapezoid nodes have it for free).
     double log_upper(double w, double log_w) const {
         if (!(w > 0.0)) return 0.0;
-        if (w >= kTableEnd) return g_at_end - (log_w - std::log(kTableEnd)) - 0.25 * w * w;
+        if (w >= kTableEnd)
+            return g_at_end - (log_w - std::log(kTableEnd)) - 0.25 * w * w;
         const int p = panel_of(w);
         const double v = panels[p].at(w);
         if (p >= first_upper_panel) return v - 0.25 * w * w;
@@ -309,7 +310,8 @@ struct RangeTable {
         const int p = panel_of(w);
         const ChebyshevPanel& panel = panels[p];
         if (p >= first_upper_panel)
-            return panel.at(w) - 0.25 * w * w + std::log(0.5 * w - panel.derivative_at(w));
+            return panel.at(w) - 0.25 * w * w +
+                   std::log(0.5 * w - panel.derivative_at(w));
         return panel.at(w) + m * std::log(w) + std::log(panel.derivative_at(w) + m / w);
     }
 };
@@ -336,9 +338,8 @@ std::unique_ptr<RangeTable> build_range_table(int k) {
                 return log_range_lower_by_quadrature(w, k) - m * std::log(w);
             });
         else
-            table->panels[p] = fit_panel(a, b, [&](double w) {
-                return upper.log_upper(w) + 0.25 * w * w;
-            });
+            table->panels[p] = fit_panel(
+                a, b, [&](double w) { return upper.log_upper(w) + 0.25 * w * w; });
     }
     table->g_at_end = table->panels[kPanels - 1].at(kTableEnd);
     // h0 and h2 = h''(0) / 2 from panel 0's series (differentiated once more).
@@ -396,8 +397,8 @@ const RangeTable& range_table(int k) {
 double stirling_remainder(double a) {
     if (a < 20.0) return std::lgamma(a) - ((a - 0.5) * std::log(a) - a + kLogSqrt2Pi);
     const double r = 1.0 / a, r2 = r * r;
-    return r * (1.0 / 12 - r2 * (1.0 / 360 - r2 * (1.0 / 1260 - r2 * (1.0 / 1680 -
-                                                                      r2 / 1188))));
+    return r * (1.0 / 12 -
+                r2 * (1.0 / 360 - r2 * (1.0 / 1260 - r2 * (1.0 / 1680 - r2 / 1188))));
 }
 
 // e^x - 1 - x without cancellation near 0.
@@ -412,7 +413,8 @@ double exp_minus_one_minus_x(double x) {
 }
 
 double log_scale_density_constant(double df) {
-    return std::log(2.0) + 0.5 * std::log(df / (4.0 * kPi)) - stirling_remainder(0.5 * df);
+    return std::log(2.0) + 0.5 * std::log(df / (4.0 * kPi)) -
+           stirling_remainder(0.5 * df);
 }
 
 // The trapezoid grid u_i = i * step for one (df, step): log(step * gd(u_i)) and e^(u_i),
@@ -425,7 +427,9 @@ public:
     };
     ScaleGrid() = default;
     ScaleGrid(double df, double step, int anchor)
-        : df_(df), step_(step), anchor_(anchor),
+        : df_(df),
+          step_(step),
+          anchor_(anchor),
           log_constant_(log_scale_density_constant(df) + std::log(step)) {}
     bool matches(double df, double step) const { return df_ == df && step_ == step; }
     double df() const { return df_; }
@@ -435,11 +439,13 @@ public:
     Node node(int i) {
         if (i >= anchor_) {
             const std::size_t at = static_cast<std::size_t>(i - anchor_);
-            while (right_.size() <= at) right_.push_back(compute(anchor_ + int(right_.size())));
+            while (right_.size() <= at)
+                right_.push_back(compute(anchor_ + int(right_.size())));
             return right_[at];
         }
         const std::size_t at = static_cast<std::size_t>(anchor_ - 1 - i);
-        while (left_.size() <= at) left_.push_back(compute(anchor_ - 1 - int(left_.size())));
+        while (left_.size() <= at)
+            left_.push_back(compute(anchor_ - 1 - int(left_.size())));
         return left_[at];
     }
 
@@ -488,7 +494,9 @@ public:
             sum_ += std::exp(log_term - reference_);
         }
     }
-    double log_value() const { return reference_ == kNegInf ? kNegInf : reference_ + std::log(sum_); }
+    double log_value() const {
+        return reference_ == kNegInf ? kNegInf : reference_ + std::log(sum_);
+    }
 
 private:
     double reference_ = kNegInf, sum_ = 0.0;
@@ -504,7 +512,8 @@ constexpr double kDrop = 34.0;
 //   gd(u) = e^(c + nu/2 + nu u) sum_n (-x)^n / n!,
 // and each power of e^u (times 1, w^m = q^m e^(m u) or w^(m+2)) sums over the grid as a
 // geometric series.
-double log_left_tail(const ScaleGrid& grid, int i, double log_q, const RangeTable& table) {
+double log_left_tail(const ScaleGrid& grid, int i, double log_q,
+                     const RangeTable& table) {
     const double df = grid.df(), h = grid.step(), u = i * h, m = table.m;
     const double x = 0.5 * df * std::exp(2.0 * u);
     const double log_w = log_q + u, w2 = std::exp(2.0 * log_w);
@@ -516,7 +525,8 @@ double log_left_tail(const ScaleGrid& grid, int i, double log_q, const RangeTabl
                          table.h2 * w2 / -std::expm1(-(df + m + 2.0 + 2.0 * n) * h));
         term *= -x / (n + 1);
     }
-    return grid.log_constant() + 0.5 * df + df * u + std::log(density - small_range * lower);
+    return grid.log_constant() + 0.5 * df + df * u +
+           std::log(density - small_range * lower);
 }
 
 // log of h * sum_i gd(u_i) f(q e^(u_i)) with f = W, U or w * (range density).
@@ -525,18 +535,21 @@ double log_mix(double q, const RangeTable& table, double df, Mix mix, bool upper
     const double log_q = std::log(q);
     // Peak of the integrand in u: where gd's curvature meets e^(-(q S)^2/4) (upper tail;
     // not below where q S is a typical range), or (q S)^m (lower tail).
-    const double peak_u =
-        upper_peak ? std::max(0.5 * std::log(df / (df + 0.5 * q * q)), std::log(table.median) - log_q)
-                   : 0.5 * std::log1p(table.m / df);
+    const double peak_u = upper_peak ? std::max(0.5 * std::log(df / (df + 0.5 * q * q)),
+                                                std::log(table.median) - log_q)
+                                     : 0.5 * std::log1p(table.m / df);
     const int start = static_cast<int>(std::lround(peak_u / h));
     ScaleGrid& grid = scale_grid(df, h, start);
     auto log_term = [&](int i) {
         const ScaleGrid::Node node = grid.node(i);
         const double w = q * node.scale, log_w = log_q + i * h;
         switch (mix) {
-            case Mix::kLower: return node.log_weight + table.log_lower(w, log_w);
-            case Mix::kUpper: return node.log_weight + table.log_upper(w, log_w);
-            case Mix::kDensity: return node.log_weight + std::log(w) + table.log_density(w);
+            case Mix::kLower:
+                return node.log_weight + table.log_lower(w, log_w);
+            case Mix::kUpper:
+                return node.log_weight + table.log_upper(w, log_w);
+            case Mix::kDensity:
+                return node.log_weight + std::log(w) + table.log_density(w);
         }
         return kNegInf;
     };
@@ -594,7 +607,8 @@ bool sum_upper_tail(double q, const RangeTable& table, double df) {
     // P(a, x) <= x^a e^-x / Gamma(a + 1) / (1 - x / (a + 1)) for x < a + 1: decides the
     // far tail without Boost, which throws where P underflows at huge a.
     const double a = 0.5 * df, x = a * s * s;
-    const double log_bound = a * std::log(x) - x - std::lgamma(a + 1.0) - std::log1p(-x / (a + 1.0));
+    const double log_bound =
+        a * std::log(x) - x - std::lgamma(a + 1.0) - std::log1p(-x / (a + 1.0));
     if (log_bound < std::log(2e-4)) return true;
     return 0.5 * boost::math::gamma_p(a, x) <= 1e-4;
 }
@@ -603,12 +617,15 @@ Tails tails(double q, int k, double df) {
     if (q == 0.0) return {0.0, 1.0};
     if (std::isinf(q)) return {1.0, 0.0};
     const RangeTable& table = range_table(k);
-    if (df_is_infinite(df)) return {std::exp(table.log_lower(q)), std::exp(table.log_upper(q))};
+    if (df_is_infinite(df))
+        return {std::exp(table.log_lower(q)), std::exp(table.log_upper(q))};
     if (sum_upper_tail(q, table, df)) {
-        const double upper = std::min(1.0, std::exp(log_mix(q, table, df, Mix::kUpper, true)));
+        const double upper =
+            std::min(1.0, std::exp(log_mix(q, table, df, Mix::kUpper, true)));
         return {1.0 - upper, upper};
     }
-    const double lower = std::min(1.0, std::exp(log_mix(q, table, df, Mix::kLower, false)));
+    const double lower =
+        std::min(1.0, std::exp(log_mix(q, table, df, Mix::kLower, false)));
     return {lower, 1.0 - lower};
 }
 
@@ -619,7 +636,8 @@ double density(double q, int k, double df) {
     if (q == 0.0) {  // only k = 2 has mass near 0: f(0) = E[S] f_R(0)
         if (k != 2) return 0.0;
         const double log_mean_scale = 0.5 * std::log(2.0 / df) +
-                                      std::lgamma(0.5 * (df + 1.0)) - std::lgamma(0.5 * df);
+                                      std::lgamma(0.5 * (df + 1.0)) -
+                                      std::lgamma(0.5 * df);
         return std::exp(log_mean_scale + table.log_density(0.0));
     }
     const bool upper = sum_upper_tail(q, table, df);
@@ -677,7 +695,8 @@ double solve_quantile(double upper_p, int k, double df) {
                 next = std::isfinite(bracket_lo) ? x + 3.0 : x - 3.0;
         }
         // Newton converges quadratically: a step this small leaves rounding noise only.
-        if (std::fabs(next - x) <= 1e-13 * std::max(1.0, std::fabs(x))) return std::exp(next);
+        if (std::fabs(next - x) <= 1e-13 * std::max(1.0, std::fabs(x)))
+            return std::exp(next);
         x = next;
     }
     throw std::domain_error("studentized range: the quantile did not converge");

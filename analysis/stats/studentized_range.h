@@ -5,7 +5,8 @@
 // U_k(w) = P(range > w) and W_k = 1 - U_k are read from a table per k (piecewise
 // Chebyshev series of log W_k(w) - (k-1) log w below the median range and of
 // log U_k(w) + w^2/4 above it, built once on first use from quadrature of
-//   U_k(w) = k Int phi(z) [Qbar(z)^(k-1) - (Qbar(z) - Qbar(z + w))^(k-1)] dz   (min at z)).
+//   U_k(w) = k Int phi(z) [Qbar(z)^(k-1) - (Qbar(z) - Qbar(z + w))^(k-1)] dz   (min at
+//   z)).
 // At finite df, P(Q > q) = Int g(u) U_k(q e^u) du over u = log S, summed by the
 // trapezoid rule on a fixed grid whose density values are cached per (df, step). Either
 // tail is summed directly (never 1 - cdf where the result is tiny), so both keep their

@@ -121,7 +121,8 @@ TEST(Decimal, PlainDecimalsRoundOnceLikeStrtod) {
             buffer[length++] = static_cast<char>('0' + engine() % 10);
         }
         const std::string text(buffer, length);
-        EXPECT_EQ(exact_difference(text, "0"), std::strtod(text.c_str(), nullptr)) << text;
+        EXPECT_EQ(exact_difference(text, "0"), std::strtod(text.c_str(), nullptr))
+            << text;
     }
     // Differences that are exact in binary come back exactly, whatever the magnitudes.
     EXPECT_EQ(exact_difference("123456789012345.75", "123456789012345.5"), 0.25);

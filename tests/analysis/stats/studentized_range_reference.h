@@ -123,12 +123,14 @@ inline RangeProbabilities reference_studentized_range(long double q, int k,
     // below 1e-40 the inner integrals are 0 and 1 to far beyond double precision, unless
     // the lower tail itself is tiny. It is not when P(range <= q) > 1e-25, since then
     // P(Q <= q) >= P(S >= 1) P(range <= q) > 1e-26.
-    const long double log_phi0 = -0.5L * std::log(2.0L * 3.14159265358979323846264338327950288L);
+    const long double log_phi0 =
+        -0.5L * std::log(2.0L * 3.14159265358979323846264338327950288L);
     const bool may_skip = range_infinite_df(q, k).lower > 1e-25L;
     auto both = [&](long double t) -> RangeProbabilities {
         const long double density = std::exp(log_density(t));
         const long double w = q * std::exp(t);
-        if (may_skip && std::log((long double)k) + (k - 1) * (std::log(w) + log_phi0) < -92.0L)
+        if (may_skip &&
+            std::log((long double)k) + (k - 1) * (std::log(w) + log_phi0) < -92.0L)
             return {0.0L, density};
         const RangeProbabilities inner = range_infinite_df(w, k);
         return {density * inner.lower, density * inner.upper};

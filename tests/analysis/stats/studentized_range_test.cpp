@@ -46,10 +46,12 @@ ExactTails exact_k2(double q, double df) {
     ExactTails t{};
     if (x > df) {
         const double small = df / (df + x);
-        t = {boost::math::ibetac(0.5 * df, 0.5, small), boost::math::ibeta(0.5 * df, 0.5, small)};
+        t = {boost::math::ibetac(0.5 * df, 0.5, small),
+             boost::math::ibeta(0.5 * df, 0.5, small)};
     } else {
         const double small = x / (df + x);
-        t = {boost::math::ibeta(0.5, 0.5 * df, small), boost::math::ibetac(0.5, 0.5 * df, small)};
+        t = {boost::math::ibeta(0.5, 0.5 * df, small),
+             boost::math::ibetac(0.5, 0.5 * df, small)};
     }
     if (t.upper < 0.5)
         t.lower = 1.0 - t.upper;
@@ -73,11 +75,12 @@ TEST(StudentizedRange, TwoGroupsExactFromTinyToHugeQ) {
             const ExactTails exact = exact_k2(q, df);
             const double upper = studentized_range_upper(q, 2, df);
             const double cdf = studentized_range_cdf(q, 2, df);
-            const double abs_error = std::max(std::fabs(upper - exact.upper),
-                                              std::fabs(cdf - exact.lower));
+            const double abs_error =
+                std::max(std::fabs(upper - exact.upper), std::fabs(cdf - exact.lower));
             worst_abs = std::max(worst_abs, abs_error);
             EXPECT_LT(abs_error, 1e-9) << "df=" << df << " q=" << q;
-            const double rel = exact.upper > 0 ? std::fabs(upper / exact.upper - 1.0) : 0.0;
+            const double rel =
+                exact.upper > 0 ? std::fabs(upper / exact.upper - 1.0) : 0.0;
             if (exact.upper >= 1e-15) {
                 worst_rel = std::max(worst_rel, rel);
                 EXPECT_LT(rel, 1e-6) << "df=" << df << " q=" << q << ": " << upper
@@ -95,8 +98,9 @@ TEST(StudentizedRange, TwoGroupsExactFromTinyToHugeQ) {
                 EXPECT_NEAR(cdf / exact.lower, 1.0, 1e-9) << "df=" << df << " q=" << q;
         }
     EXPECT_GT(checked_tiny, 50);
-    std::printf("[ EXACT    ] k=2 worst abs %.2e, rel %.2e (tails >= 1e-15), %.2e (to 1e-300)\n",
-                worst_abs, worst_rel, worst_rel_tiny);
+    std::printf(
+        "[ EXACT    ] k=2 worst abs %.2e, rel %.2e (tails >= 1e-15), %.2e (to 1e-300)\n",
+        worst_abs, worst_rel, worst_rel_tiny);
 }
 
 // The grid: k <= 100, df >= 2 (and infinity), 0 < q <= 100. The default run
@@ -234,7 +238,6 @@ TEST(StudentizedRange, EdgesAndBadArguments) {
     EXPECT_THROW(studentized_range_quantile_upper(1.0, 3, 10.0), std::domain_error);
 }
 
-
 TEST(StudentizedRange, ManyGroupsAtTinyDfMatchIndependentQuadrature) {
     // The corners the grid does not reach: df = 1 with k = 200, df = 2 with k = 100
     // (typical, tail and far-tail q), against the extended-precision reference.
@@ -276,7 +279,8 @@ TEST(StudentizedRange, TailsAddUpAndAreMonotone) {
                 const double upper = studentized_range_upper(q, k, df);
                 ASSERT_TRUE(cdf >= 0 && cdf <= 1 && upper >= 0 && upper <= 1);
                 EXPECT_NEAR(cdf + upper, 1.0, 2e-16) << "k=" << k << " df=" << df;
-                EXPECT_GE(cdf, previous_cdf - 1e-15) << "k=" << k << " df=" << df << " q=" << q;
+                EXPECT_GE(cdf, previous_cdf - 1e-15)
+                    << "k=" << k << " df=" << df << " q=" << q;
                 EXPECT_LE(upper, previous_upper * (1 + 1e-12) + 1e-300)
                     << "k=" << k << " df=" << df << " q=" << q;
                 previous_cdf = cdf;
@@ -298,8 +302,8 @@ TEST(StudentizedRange, DensityIntegratesToOneAndIsTheCdfSlope) {
                 const double weight = (i == 0 || i == 3200) ? 0.5 : 1.0;
                 integral += weight * step * q * studentized_range_density(q, k, df);
             }
-            const double total =
-                integral + studentized_range_cdf(a, k, df) + studentized_range_upper(b, k, df);
+            const double total = integral + studentized_range_cdf(a, k, df) +
+                                 studentized_range_upper(b, k, df);
             EXPECT_NEAR(total, 1.0, 1e-9) << "k=" << k << " df=" << df;
             // Central differences of the smaller tail (4th order), on a step short
             // against the tails' scales (W ~ q^(k-1), U ~ e^(-q^2/4)) but long enough
@@ -311,9 +315,9 @@ TEST(StudentizedRange, DensityIntegratesToOneAndIsTheCdfSlope) {
                     return use_upper ? -studentized_range_upper(x, k, df)
                                      : studentized_range_cdf(x, k, df);
                 };
-                const double slope =
-                    (8 * (tail(q + d) - tail(q - d)) - (tail(q + 2 * d) - tail(q - 2 * d))) /
-                    (12 * d);
+                const double slope = (8 * (tail(q + d) - tail(q - d)) -
+                                      (tail(q + 2 * d) - tail(q - 2 * d))) /
+                                     (12 * d);
                 const double density = studentized_range_density(q, k, df);
                 if (density < 1e-280) continue;
                 EXPECT_NEAR(slope / density, 1.0, 1e-6)
@@ -330,7 +334,8 @@ TEST(StudentizedRange, ContinuousWhereDfBecomesInfinite) {
             EXPECT_NEAR(studentized_range_cdf(q, k, 0.999999e12), at_inf, 1e-11);
             EXPECT_EQ(studentized_range_cdf(q, k, 1e12), at_inf);
             const double upper_inf = studentized_range_upper(q, k, kInf);
-            EXPECT_NEAR(studentized_range_upper(q, k, 0.999999e12) / upper_inf, 1.0, 1e-9);
+            EXPECT_NEAR(studentized_range_upper(q, k, 0.999999e12) / upper_inf, 1.0,
+                        1e-9);
         }
 }
 
@@ -345,18 +350,19 @@ TEST(StudentizedRange, QuantileRoundTripsToTwelveDigits) {
                 // Either q0 comes back to 12 digits, or the CDF is flat to rounding
                 // (1e-14 in P) over the gap, and q reproduces p to 13 digits.
                 const double p_again = studentized_range_upper(q, k, df);
-                EXPECT_TRUE(std::fabs(q / q0 - 1.0) < 1e-12 || std::fabs(p_again / p - 1.0) < 1e-13)
-                    << "k=" << k << " df=" << df << " q=" << q0 << ": " << q << ", p " << p
-                    << " vs " << p_again;
+                EXPECT_TRUE(std::fabs(q / q0 - 1.0) < 1e-12 ||
+                            std::fabs(p_again / p - 1.0) < 1e-13)
+                    << "k=" << k << " df=" << df << " q=" << q0 << ": " << q << ", p "
+                    << p << " vs " << p_again;
             }
     // k = 2: the quantile is sqrt 2 times Student's t (or normal) quantile at p / 2.
     for (double df : {1.0, 2.0, 7.0, 100.0, kInf})
         for (double p : {0.9, 0.5, 0.05, 1e-3, 1e-8}) {
             const double expected =
-                std::isinf(df) ? 2.0 * boost::math::erfc_inv(p)
-                               : std::sqrt(2.0) *
-                                     boost::math::quantile(boost::math::complement(
-                                         boost::math::students_t(df), 0.5 * p));
+                std::isinf(df)
+                    ? 2.0 * boost::math::erfc_inv(p)
+                    : std::sqrt(2.0) * boost::math::quantile(boost::math::complement(
+                                           boost::math::students_t(df), 0.5 * p));
             EXPECT_NEAR(studentized_range_quantile_upper(p, 2, df) / expected, 1.0, 1e-12)
                 << "df=" << df << " p=" << p;
         }
@@ -376,7 +382,8 @@ TEST(StudentizedRange, ThreadsBuildTablesOnceAndAgree) {
     };
     std::vector<std::vector<double>> results(4);
     std::vector<std::thread> threads;
-    for (auto& result : results) threads.emplace_back([&result, &evaluate] { result = evaluate(); });
+    for (auto& result : results)
+        threads.emplace_back([&result, &evaluate] { result = evaluate(); });
     for (auto& t : threads) t.join();
     const std::vector<double> single = evaluate();
     for (const auto& result : results) EXPECT_EQ(result, single);  // bit for bit
