@@ -1,10 +1,24 @@
 // lucent bench stats: the cost of the analysis on a large study (ANOVA + Tukey HSD +
-// Kruskal-Wallis on 10^6 ratings in 10 groups) and of the studentized-range CDF.
+// Kruskal-Wallis on 10^6 ratings in 10 groups, in process and as a whole `lucent analyze`
+// process, against R when Rscript is on the PATH) and of the studentized range
+// distribution (evaluations per second on one core, and the per-k table build).
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "commands.h"
+#include "data/long_table.h"
+#include "simulate/simulate.h"
 #include "stats/anova.h"
 #include "stats/kruskal_wallis.h"
 #include "stats/studentized_range.h"
@@ -18,13 +32,37 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-int run_bench_stats(long ratings, int groups, double cdf_seconds) {
-    using namespace lucent::analysis;
-    if (ratings < 2L * groups || groups < 2 || groups > kMaxRangeGroups) {
-        std::fprintf(stderr,
-                     "lucent bench stats: need 2..200 groups and 2+ ratings each\n");
-        return kExitUsage;
+// CPU time of this thread: rates on one core, whatever else the machine runs.
+double thread_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// Every printed number, also written to --csv as section,name,value,unit.
+struct Results {
+    struct Row {
+        std::string section, name;
+        double value;
+        std::string unit;
+    };
+    std::vector<Row> rows;
+    void add(std::string section, std::string name, double value, std::string unit) {
+        rows.push_back({std::move(section), std::move(name), value, std::move(unit)});
     }
+    bool write_csv(const std::string& path) const {
+        std::ofstream out(path);
+        if (!out) return false;
+        out << "section,name,value,unit\n";
+        for (const Row& r : rows)
+            out << r.section << ",\"" << r.name << "\"," << r.value << ',' << r.unit
+                << '\n';
+        return static_cast<bool>(out);
+    }
+};
+
+void bench_in_process(long ratings, int groups, Results& results) {
+    using namespace lucent::analysis;
     // Likert ratings 1..7 with a small effect per group, seeded.
     OneWayData data;
     std::mt19937_64 engine(7);
@@ -35,7 +73,8 @@ int run_bench_stats(long ratings, int groups, double cdf_seconds) {
         data.groups[g].values.push_back(
             base(engine) + (engine() % 10 < static_cast<unsigned>(g % 3) ? 1 : 0));
     }
-    std::printf("analysis of %ld ratings in %d groups (one run each)\n", ratings, groups);
+    std::printf("analysis of %ld ratings in %d groups, in process (one run each)\n",
+                ratings, groups);
     auto start = Clock::now();
     const AnovaResult anova = one_way_anova(data);
     const double t_anova = seconds_since(start);
@@ -46,44 +85,217 @@ int run_bench_stats(long ratings, int groups, double cdf_seconds) {
     const KruskalWallisResult kw = kruskal_wallis(data);
     const double t_kw = seconds_since(start);
     const double total = t_anova + t_tukey + t_kw;
-    std::printf("  %-26s %10s %8s\n", "step", "ms", "share");
-    std::printf("  %-26s %10.2f %7.1f%%\n", "one-way ANOVA", 1e3 * t_anova,
-                100 * t_anova / total);
-    std::printf("  %-26s %10.2f %7.1f%%\n", "Tukey HSD (45 p-values)", 1e3 * t_tukey,
-                100 * t_tukey / total);
-    std::printf("  %-26s %10.2f %7.1f%%\n", "Kruskal-Wallis", 1e3 * t_kw,
-                100 * t_kw / total);
-    std::printf("  %-26s %10.2f   (%.3g ratings/s)\n", "total", 1e3 * total,
+    const std::string tukey_name = "Tukey HSD (" + std::to_string(tukey.pairs.size()) +
+                                   " p-values, incl. table build)";
+    std::printf("  %-40s %10s %8s\n", "step", "ms", "share");
+    for (auto [name, t] : {std::pair<std::string, double>{"one-way ANOVA", t_anova},
+                           {tukey_name, t_tukey},
+                           {"Kruskal-Wallis", t_kw}}) {
+        std::printf("  %-40s %10.2f %7.1f%%\n", name.c_str(), 1e3 * t, 100 * t / total);
+        results.add("in_process", name, 1e3 * t, "ms");
+    }
+    std::printf("  %-40s %10.2f   (%.3g ratings/s)\n", "total", 1e3 * total,
                 ratings / total);
+    results.add("in_process", "total", 1e3 * total, "ms");
     std::printf("  (F = %.6g, %zu Tukey pairs, H = %.6g)\n", anova.f.value_or(-1),
                 tukey.pairs.size(), kw.h.value_or(-1));
+}
 
-    // Studentized-range CDF over a spread of arguments, finite and infinite df.
-    std::printf("studentized-range CDF evaluations (%.1f s per row)\n", cdf_seconds);
-    std::printf("  %-28s %12s %10s\n", "arguments", "evals/s", "us/eval");
+// CPU time (user + system) of all finished child processes so far.
+double children_cpu_seconds() {
+    rusage usage{};
+    getrusage(RUSAGE_CHILDREN, &usage);
+    auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+    return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+// Wall and CPU time of a shell command (CPU time is what a loaded machine does not
+// inflate); negative when it fails.
+struct CommandTime {
+    double wall, cpu;
+};
+CommandTime time_command(const std::string& command) {
+    const auto start = Clock::now();
+    const double cpu_start = children_cpu_seconds();
+    const int status = std::system(command.c_str());
+    const CommandTime t{seconds_since(start), children_cpu_seconds() - cpu_start};
+    return status == 0 ? t : CommandTime{-1.0, -1.0};
+}
+
+std::string quoted(const std::filesystem::path& path) {
+    return "'" + path.string() + "'";
+}
+
+// `lucent analyze` as a whole process on a simulated long CSV (one question, one factor,
+// `groups` levels), and R's read.csv + aov + TukeyHSD + kruskal.test + oneway.test on the
+// same file when Rscript is on the PATH (nothing is installed).
+int bench_whole_process(long ratings, int groups, Results& results) {
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("lucent-bench-stats-" + std::to_string(getpid()));
+    fs::create_directories(dir);
+    const fs::path csv = dir / "ratings.csv";
+    analysis::SimulationSpec spec;
+    spec.stimuli_per_level = 100;
+    spec.participants = static_cast<int>(std::max(1L, ratings / (100L * groups)));
+    spec.level_effects.clear();
+    for (int g = 0; g < groups; ++g) spec.level_effects.push_back(0.1 * g);
+    spec.seed = 7;
+    const analysis::LongTable table = analysis::simulate_study(spec);
+    {
+        std::ofstream out(csv, std::ios::binary);
+        analysis::write_long_csv(out, table);
+        if (!out) {
+            std::fprintf(stderr, "lucent bench stats: cannot write %s\n", csv.c_str());
+            return kExitFailure;
+        }
+    }
+    std::printf("whole process on %zu ratings in %d levels (%s)\n", table.rows.size(),
+                groups, csv.c_str());
+    const fs::path self = fs::read_symlink("/proc/self/exe");
+    const CommandTime t_lucent =
+        time_command(quoted(self) + " analyze " + quoted(csv) + " --out " +
+                     quoted(dir / "report") + " --format csv >/dev/null 2>&1");
+    if (t_lucent.wall < 0) {
+        std::fprintf(stderr, "lucent bench stats: lucent analyze failed on %s\n",
+                     csv.c_str());
+        return kExitFailure;
+    }
+    const CommandTime t_start = time_command(quoted(self) + " --help >/dev/null 2>&1");
+    std::printf("  %-40s %10s %10s\n", "process", "wall s", "CPU s");
+    std::printf("  %-40s %10.3f %10.3f\n", "lucent analyze --format csv", t_lucent.wall,
+                t_lucent.cpu);
+    std::printf("  %-40s %10.3f %10.3f\n", "  of which starting lucent (--help)",
+                t_start.wall, t_start.cpu);
+    results.add("whole_process", "lucent analyze --format csv (wall)", t_lucent.wall,
+                "s");
+    results.add("whole_process", "lucent analyze --format csv (cpu)", t_lucent.cpu, "s");
+    results.add("whole_process", "lucent --help (cpu)", t_start.cpu, "s");
+    if (std::system("command -v Rscript >/dev/null 2>&1") != 0) {
+        std::printf(
+            "  R comparison skipped: Rscript is not on the PATH (the bench installs "
+            "nothing)\n");
+    } else {
+        const fs::path script = dir / "analysis.R";
+        std::ofstream(script) << "d <- read.csv(commandArgs(trailingOnly = TRUE)[1])\n"
+                                 "d$level <- factor(d$level)\n"
+                                 "fit <- aov(rating ~ level, data = d)\n"
+                                 "print(summary(fit))\n"
+                                 "print(TukeyHSD(fit))\n"
+                                 "print(kruskal.test(rating ~ level, data = d))\n"
+                                 "print(oneway.test(rating ~ level, data = d))\n";
+        const CommandTime t_r = time_command("Rscript " + quoted(script) + " " +
+                                             quoted(csv) + " >/dev/null 2>&1");
+        if (t_r.wall < 0) {
+            std::printf("  R comparison failed: Rscript exited with an error\n");
+        } else {
+            std::printf("  %-40s %10.3f %10.3f\n",
+                        "R read.csv+aov+TukeyHSD+kruskal+oneway", t_r.wall, t_r.cpu);
+            std::printf("  %-40s %9.1fx %9.1fx\n", "R / lucent", t_r.wall / t_lucent.wall,
+                        t_r.cpu / t_lucent.cpu);
+            results.add("whole_process", "R (wall)", t_r.wall, "s");
+            results.add("whole_process", "R (cpu)", t_r.cpu, "s");
+            results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall,
+                        "ratio");
+            results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu,
+                        "ratio");
+        }
+    }
+    std::error_code ignored;
+    fs::remove_all(dir, ignored);
+    return kExitOk;
+}
+
+struct RangeArgs {
+    double q;
+    int k;
+    double df;
+};
+
+// q spread log-uniformly over [q_low, q_high] (12 points, cycled).
+std::vector<RangeArgs> sweep(int k, double df, double q_low, double q_high) {
+    std::vector<RangeArgs> args;
+    for (int i = 0; i < 12; ++i)
+        args.push_back({q_low * std::pow(q_high / q_low, i / 11.0), k, df});
+    return args;
+}
+
+void bench_distribution(double seconds, Results& results) {
+    using namespace lucent::analysis;
+    std::printf(
+        "studentized range table build (once per k, on first use; thread CPU time)\n");
+    for (int k : {50, 200}) {
+        const double start = thread_seconds();
+        studentized_range_prepare(k);
+        const double t = thread_seconds() - start;
+        std::printf("  %-40s %10.2f ms\n", ("k=" + std::to_string(k)).c_str(), 1e3 * t);
+        results.add("table_build", "k=" + std::to_string(k), 1e3 * t, "ms");
+    }
     struct Row {
-        const char* name;
-        int k;
-        double df;
+        std::string name;
+        std::vector<RangeArgs> args;
     };
-    const Row rows[] = {{"k=3, df=inf, q in 0.5..8", 3, kInfiniteDf},
-                        {"k=10, df=inf, q in 0.5..8", 10, kInfiniteDf},
-                        {"k=3, df=30, q in 0.5..8", 3, 30.0},
-                        {"k=10, df=30, q in 0.5..8", 10, 30.0},
-                        {"k=10, df=999990, q in 0.5..8", 10, 999990.0},
-                        {"k=100, df=2, q in 0.5..8", 100, 2.0}};
-    double first_rate = 0.0;
+    std::vector<Row> rows = {
+        {"k=10, df=30, q 0.5..8", sweep(10, 30, 0.5, 8)},
+        {"k=3, df=inf, q 0.5..8", sweep(3, kInfiniteDf, 0.5, 8)},
+        {"k=10, df=999990, q 0.5..8", sweep(10, 999990, 0.5, 8)},
+        {"k=100, df=2, q 0.5..8", sweep(100, 2, 0.5, 8)},
+        {"k=200, df=1, q 0.5..8", sweep(200, 1, 0.5, 8)},
+        {"k=10, df=30, q 8..40 (p to 1e-21)", sweep(10, 30, 8, 40)},
+        {"k=2, df=1, q 1e2..1e10", sweep(2, 1, 1e2, 1e10)},
+        {"k=100, df=2, q 1e2..1e10", sweep(100, 2, 1e2, 1e10)},
+        {"k=200, df=1, q 1e2..1e10", sweep(200, 1, 1e2, 1e10)},
+    };
+    // Random arguments: k 2..200, df 1..1e4 log-uniform, q 0.1..100 log-uniform, a new
+    // df at every call (no cached density nodes to reuse).
+    std::mt19937_64 engine(11);
+    std::uniform_int_distribution<int> random_k(2, 200);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    Row random{"random k 2..200, df 1..1e4, q 0.1..100", {}};
+    for (int i = 0; i < 4096; ++i)
+        random.args.push_back({0.1 * std::pow(1e3, unit(engine)), random_k(engine),
+                               std::pow(1e4, unit(engine))});
+    for (const RangeArgs& a : random.args) studentized_range_prepare(a.k);  // not timed
+    rows.push_back(std::move(random));
+
+    std::printf("studentized range P(Q > q) evaluations, one core (%.1f CPU s per row)\n",
+                seconds);
+    std::printf("  %-40s %12s %10s\n", "arguments", "evals/s", "us/eval");
     for (const Row& row : rows) {
+        for (const RangeArgs& a : row.args) studentized_range_prepare(a.k);
         long evals = 0;
-        double sink = 0.0;
-        start = Clock::now();
-        while (seconds_since(start) < cdf_seconds)
-            for (double q = 0.5; q <= 8.0; q += 0.75, ++evals)
-                sink += studentized_range_cdf(q, row.k, row.df);
-        const double rate = evals / seconds_since(start);
-        if (first_rate == 0.0) first_rate = rate;
-        std::printf("  %-28s %12.0f %10.1f   (x%.3g vs first row; checksum %.3g)\n",
-                    row.name, rate, 1e6 / rate, first_rate / rate, sink);
+        double checksum = 0.0;
+        const double start = thread_seconds();
+        while (thread_seconds() - start < seconds)
+            for (const RangeArgs& a : row.args) {
+                checksum += studentized_range_upper(a.q, a.k, a.df);
+                ++evals;
+            }
+        const double rate = evals / (thread_seconds() - start);
+        std::printf("  %-40s %12.0f %10.2f   (checksum %.6g)\n", row.name.c_str(), rate,
+                    1e6 / rate, checksum / evals);
+        results.add("evals", row.name, rate, "evals/s");
+    }
+}
+
+int run_bench_stats(long ratings, int groups, double cdf_seconds, bool whole_process,
+                    const std::string& csv_path) {
+    using namespace lucent::analysis;
+    if (ratings < 2L * groups || groups < 2 || groups > kMaxRangeGroups) {
+        std::fprintf(stderr,
+                     "lucent bench stats: need 2..200 groups and 2+ ratings each\n");
+        return kExitUsage;
+    }
+    Results results;
+    bench_in_process(ratings, groups, results);
+    if (whole_process) {
+        const int status = bench_whole_process(ratings, groups, results);
+        if (status != kExitOk) return status;
+    }
+    bench_distribution(cdf_seconds, results);
+    if (!csv_path.empty() && !results.write_csv(csv_path)) {
+        std::fprintf(stderr, "lucent bench stats: cannot write %s\n", csv_path.c_str());
+        return kExitFailure;
     }
     return kExitOk;
 }
@@ -95,18 +307,28 @@ void register_bench_stats(CLI::App& bench, int& exit_code) {
         long ratings = 1000000;
         int groups = 10;
         double cdf_seconds = 1.0;
+        bool no_process = false;
+        std::string csv;
     };
     auto args = std::make_shared<Args>();
     auto* cmd = bench.add_subcommand(
         "stats",
-        "ANOVA + Tukey + Kruskal-Wallis on 10^6 ratings; studentized-range CDF rate");
+        "ANOVA + Tukey + Kruskal-Wallis on 10^6 ratings (in process, as a whole 'lucent "
+        "analyze', and R when Rscript is on the PATH); studentized-range rates");
     cmd->add_option("--ratings", args->ratings, "Ratings in the synthetic study")
         ->capture_default_str();
     cmd->add_option("--groups", args->groups, "Groups (levels)")->capture_default_str();
-    cmd->add_option("--cdf-seconds", args->cdf_seconds, "Seconds per CDF timing row")
+    cmd->add_option("--cdf-seconds", args->cdf_seconds,
+                    "Seconds per distribution timing row")
         ->capture_default_str();
+    cmd->add_flag("--no-process", args->no_process,
+                  "Skip the whole-process 'lucent analyze' (and R) timing");
+    cmd->add_option(
+        "--csv", args->csv,
+        "Also write every timing as CSV (section,name,value,unit) to this file");
     cmd->callback([args, &exit_code] {
-        exit_code = run_bench_stats(args->ratings, args->groups, args->cdf_seconds);
+        exit_code = run_bench_stats(args->ratings, args->groups, args->cdf_seconds,
+                                    !args->no_process, args->csv);
     });
 }
 

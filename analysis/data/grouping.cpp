@@ -13,21 +13,34 @@ std::vector<FactorData> split_by_question_and_factor(const LongTable& table,
     std::vector<FactorData> pairs;
     std::map<std::pair<std::string, std::string>, std::size_t> pair_index;
     std::vector<std::map<std::string, std::size_t>> level_index;
+    // Rows mostly come in runs of one (question, factor, level): the previous row's
+    // indices are checked first, and the maps only consulted when the run changes.
+    const RatingRow* previous = nullptr;
+    std::size_t pair_at = 0, group_at = 0;
     for (const RatingRow& row : table.rows) {
         if (!question_filter.empty() && row.question != question_filter) continue;
         if (!factor_filter.empty() && row.factor != factor_filter) continue;
-        auto [it, inserted] =
-            pair_index.emplace(std::pair{row.question, row.factor}, pairs.size());
-        if (inserted) {
-            pairs.push_back({row.question, row.factor, {table.origin, {}}, 0});
-            level_index.emplace_back();
+        const bool same_pair = previous && row.question == previous->question &&
+                               row.factor == previous->factor;
+        if (!same_pair) {
+            auto [it, inserted] =
+                pair_index.emplace(std::pair{row.question, row.factor}, pairs.size());
+            if (inserted) {
+                pairs.push_back({row.question, row.factor, {table.origin, {}}, 0});
+                level_index.emplace_back();
+            }
+            pair_at = it->second;
         }
-        FactorData& pair = pairs[it->second];
-        auto [level, new_level] =
-            level_index[it->second].emplace(row.level, pair.data.groups.size());
-        if (new_level) pair.data.groups.push_back({row.level, {}});
+        FactorData& pair = pairs[pair_at];
+        if (!same_pair || row.level != previous->level) {
+            auto [level, new_level] =
+                level_index[pair_at].emplace(row.level, pair.data.groups.size());
+            if (new_level) pair.data.groups.push_back({row.level, {}});
+            group_at = level->second;
+        }
+        previous = &row;
         if (row.rating)
-            pair.data.groups[level->second].values.push_back(*row.rating);
+            pair.data.groups[group_at].values.push_back(*row.rating);
         else
             ++pair.missing_ratings;
     }

@@ -1,5 +1,6 @@
 #include "data/long_table.h"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -25,10 +26,24 @@ std::string format_exact(double value) {
     return error == std::errc() ? std::string(buffer, end) : std::to_string(value);
 }
 
-// Splits one CSV record (quotes may span lines: more lines are pulled from `in`).
-std::vector<std::string> split_record(std::string line, std::istream& in,
-                                      std::size_t& line_no, const std::string& source) {
-    std::vector<std::string> fields(1);
+// Splits one CSV record into `fields`. A record without quotes (the common case) is cut
+// at its commas in place: the views point into `line`, and a million rows cost no copies.
+// A quoted record is decoded into `decoded` (quotes may span lines: more lines are then
+// pulled from `in`).
+void split_record(std::string& line, std::istream& in, std::size_t& line_no,
+                  const std::string& source, std::vector<std::string>& decoded,
+                  std::vector<std::string_view>& views) {
+    views.clear();
+    if (line.find('"') == std::string::npos) {
+        for (std::size_t start = 0;;) {
+            const std::size_t comma = std::min(line.find(',', start), line.size());
+            views.emplace_back(line.data() + start, comma - start);
+            if (comma == line.size()) return;
+            start = comma + 1;
+        }
+    }
+    std::vector<std::string>& fields = decoded;
+    fields.assign(1, std::string());
     bool quoted = false;
     for (std::size_t i = 0;; ++i) {
         if (i == line.size()) {
@@ -60,13 +75,29 @@ std::vector<std::string> split_record(std::string line, std::istream& in,
             fields.back() += c;
         }
     }
-    return fields;
+    for (const std::string& field : fields) views.emplace_back(field);
 }
 
-std::string trimmed(const std::string& s) {
+std::string_view trimmed(std::string_view s) {
     const auto first = s.find_first_not_of(" \t");
-    if (first == std::string::npos) return "";
+    if (first == std::string_view::npos) return {};
     return s.substr(first, s.find_last_not_of(" \t") - first + 1);
+}
+
+// Rows still to come, estimated from the bytes left and one line's length, when the
+// stream can tell its size (a file); 0 otherwise.
+std::size_t estimated_rows(std::istream& in, std::size_t line_length) {
+    const auto here = in.tellg();
+    if (here < 0 || line_length == 0) return 0;
+    in.seekg(0, std::ios::end);
+    const auto end = in.tellg();
+    in.seekg(here);
+    if (end < here || !in) {
+        in.clear();
+        in.seekg(here);
+        return 0;
+    }
+    return static_cast<std::size_t>(end - here) / (line_length + 1) + 16;
 }
 
 }  // namespace
@@ -117,12 +148,14 @@ LongTable read_long_csv(std::istream& in, const std::string& source,
     column.fill(-1);
     std::size_t header_fields = 0;
     std::string origin_text;
+    std::vector<std::string> decoded;
+    std::vector<std::string_view> fields;
     while (std::getline(in, line)) {
         ++line_no;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // BOM
         if (trimmed(line).empty()) continue;
-        auto fields = split_record(line, in, line_no, source);
+        split_record(line, in, line_no, source, decoded, fields);
         if (header_fields == 0) {
             // Header: find each required column by name.
             header_fields = fields.size();
@@ -138,6 +171,7 @@ LongTable read_long_csv(std::istream& in, const std::string& source,
                                      "question,rating)");
             continue;
         }
+        if (table.rows.empty()) table.rows.reserve(estimated_rows(in, line.size()));
         if (fields.size() != header_fields)
             throw InputError(location(source, line_no) + ": expected " +
                              std::to_string(header_fields) + " fields, found " +
@@ -152,11 +186,11 @@ LongTable read_long_csv(std::istream& in, const std::string& source,
         if (row.factor.empty() || row.level.empty() || row.question.empty())
             throw InputError(location(source, line_no) +
                              ": factor, level and question must not be empty");
-        const std::string rating_text = trimmed(fields[column[5]]);
+        const std::string_view rating_text = trimmed(fields[column[5]]);
         if (!rating_text.empty() && rating_text != "NA") {
             if (!parse_finite_number(rating_text))
-                throw InputError(location(source, line_no) + ": rating '" + rating_text +
-                                 "' is not a finite number");
+                throw InputError(location(source, line_no) + ": rating '" +
+                                 std::string(rating_text) + "' is not a finite number");
             if (origin_text.empty()) {
                 origin_text = rating_text;
                 table.origin = *parse_finite_number(rating_text);

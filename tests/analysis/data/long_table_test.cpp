@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <random>
 #include <sstream>
 
 #include "data/decimal.h"
@@ -102,6 +104,33 @@ TEST(Decimal, DifferencesAreExact) {
     EXPECT_FALSE(parse_finite_number("1e400").has_value());
     EXPECT_FALSE(parse_finite_number("").has_value());
     EXPECT_EQ(*parse_finite_number(" 2.5 "), 2.5);
+}
+
+TEST(Decimal, PlainDecimalsRoundOnceLikeStrtod) {
+    // Short plain decimals take an integer fast path; its result must be the correctly
+    // rounded difference. Against origin 0 that is what strtod (correctly rounded) gives.
+    std::mt19937_64 engine(9);
+    for (int i = 0; i < 20000; ++i) {
+        const int digits = 1 + static_cast<int>(engine() % 17);
+        const int fraction = static_cast<int>(engine() % digits);  // digits after '.'
+        char buffer[24];
+        int length = 0;
+        if (engine() % 2) buffer[length++] = '-';
+        for (int d = 0; d < digits; ++d) {
+            if (fraction > 0 && d == digits - fraction) buffer[length++] = '.';
+            buffer[length++] = static_cast<char>('0' + engine() % 10);
+        }
+        const std::string text(buffer, length);
+        EXPECT_EQ(exact_difference(text, "0"), std::strtod(text.c_str(), nullptr))
+            << text;
+    }
+    // Differences that are exact in binary come back exactly, whatever the magnitudes.
+    EXPECT_EQ(exact_difference("123456789012345.75", "123456789012345.5"), 0.25);
+    EXPECT_EQ(exact_difference("-3", "4.125"), -7.125);
+    EXPECT_EQ(exact_difference("7", "1"), 6.0);
+    // Longer texts and exponents take the decimal path.
+    EXPECT_EQ(exact_difference("1234567890123456789.5", "1234567890123456789"), 0.5);
+    EXPECT_EQ(exact_difference("2.5e1", "5"), 20.0);
 }
 
 TEST(LongTable, OriginKeepsDigitsOfHugeValues) {

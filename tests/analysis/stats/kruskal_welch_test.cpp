@@ -67,6 +67,19 @@ TEST(KruskalWallis, LikertTiesMatchRankVarianceFormula) {
     }
 }
 
+TEST(KruskalWallis, ManyDistinctValuesWithTiesMatchRankVarianceFormula) {
+    // Past 64 distinct values the ranks come from one sort of the pooled values.
+    std::mt19937 engine(5);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    std::vector<std::vector<double>> values(4);
+    for (int g = 0; g < 4; ++g)
+        for (int i = 0; i < 60; ++i)
+            values[g].push_back(std::round(20 * (normal(engine) + 0.2 * g)) / 20);
+    const auto r = kruskal_wallis(groups(values));
+    ASSERT_TRUE(r.h);
+    EXPECT_NEAR(*r.h, h_by_rank_variance(values), 1e-10);
+}
+
 TEST(KruskalWallis, AllTiedIsUndefined) {
     const auto r = kruskal_wallis(groups({{3, 3}, {3, 3, 3}}));
     EXPECT_FALSE(r.h.has_value());

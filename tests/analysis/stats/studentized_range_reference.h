@@ -59,8 +59,15 @@ inline RangeProbabilities range_infinite_df(long double q, int k) {
     };
     // The narrowest integrand (tiny q: phi(z)^k) has a width near 1/sqrt(k); the
     // trapezoid error falls like exp(-2 pi^2 (width / step)^2).
-    const long double a = -0.5L * q - 12.0L - std::log((long double)k);
-    return trapezoid(both, a, 12.0L, std::min(0.1L, 0.5L / std::sqrt((long double)k)));
+    const long double step = std::min(0.1L, 0.5L / std::sqrt((long double)k));
+    const long double log_k = std::log((long double)k);
+    const long double a = -0.5L * q - 12.0L - log_k;
+    if (q <= 48) return trapezoid(both, a, 12.0L, step);
+    // A large range: the lower integrand lives where the minimum of k normals does, the
+    // upper one near z = -q/2 (it falls like e^(-d^2) a distance d away), so each gets
+    // its own stretch.
+    return {trapezoid(both, -12.0L - log_k, 12.0L, step).lower,
+            trapezoid(both, a, -0.5L * q + 12.0L, step).upper};
 }
 
 // Finds [lo, hi] where a concave log-density L(t) lies within `drop` of its maximum.
@@ -110,10 +117,22 @@ inline RangeProbabilities reference_studentized_range(long double q, int k,
                     40);
     // Narrowest peak: the tiny lower tail's, with curvature 2 (df + k - 1) in t.
     const long double sd = 1.0L / std::sqrt(2.0L * (df + k - 1));
-    const long double step = std::min(0.1L, sd / 2.5L);
+    // Trapezoid error ~ exp(-2 pi^2 (sd / step)^2) = e^-50 at this step.
+    const long double step = std::min(0.1L, sd / 1.6L);
+    // P(range <= w) <= k (w phi(0))^(k-1) (every other normal within w of the minimum):
+    // below 1e-40 the inner integrals are 0 and 1 to far beyond double precision, unless
+    // the lower tail itself is tiny. It is not when P(range <= q) > 1e-25, since then
+    // P(Q <= q) >= P(S >= 1) P(range <= q) > 1e-26.
+    const long double log_phi0 =
+        -0.5L * std::log(2.0L * 3.14159265358979323846264338327950288L);
+    const bool may_skip = range_infinite_df(q, k).lower > 1e-25L;
     auto both = [&](long double t) -> RangeProbabilities {
         const long double density = std::exp(log_density(t));
-        const RangeProbabilities inner = range_infinite_df(q * std::exp(t), k);
+        const long double w = q * std::exp(t);
+        if (may_skip &&
+            std::log((long double)k) + (k - 1) * (std::log(w) + log_phi0) < -92.0L)
+            return {0.0L, density};
+        const RangeProbabilities inner = range_infinite_df(w, k);
         return {density * inner.lower, density * inner.upper};
     };
     return trapezoid(both, lo, hi, step);
