@@ -38,15 +38,21 @@ void LiveOrPrerenderedStimuli::check(const Protocol& protocol) const {
 
 StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int width, int height) {
     if (!images_.path_for(spec).empty()) return images_.render(spec, width, height);
-    Image image;
+    RenderedImage rendered;
     try {
         // One executor per stimulus: its GL objects are gone before the window closes.
         gl::FrameExecutor executor;
-        image = render_image(executor, build_scene(request_for(spec, width, height)));
+        rendered = render_image_counted(executor, build_scene(request_for(spec, width, height)));
     } catch (const std::exception& e) {
         throw StimulusError("stimulus '" + spec.id + "': " + e.what());
     }
-    replace_non_finite(image);
+    // NaN or Inf is a renderer or driver bug: participants never see a repaired picture.
+    if (rendered.non_finite_pixels > 0)
+        throw StimulusError("stimulus '" + spec.id + "': " +
+                            std::to_string(rendered.non_finite_pixels) +
+                            " pixels had NaN or Inf values (a renderer or driver bug); "
+                            "refusing to show a repaired picture");
+    const Image& image = rendered.image;
     CpuImage out{image.width, image.height, std::vector<uint8_t>(size_t(image.width) * image.height * 4)};
     for (size_t i = 0; i < size_t(image.width) * image.height; ++i) {
         for (int c = 0; c < 3; ++c)  // as write_image encodes PNG stimuli

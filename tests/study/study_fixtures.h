@@ -1,12 +1,57 @@
 #pragma once
 // A small protocol and helpers that fill a study database the way the runner does.
+#include <algorithm>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "protocol.h"
 #include "store.h"
 #include "trial_plan.h"
 
 namespace lucent::test {
+
+// Turns a database written by this build into one of schema `version`, as an older build
+// left it: every table and index rebuilt from migrations 1..version with the columns
+// those had, later tables dropped. Rows of the kept columns stay.
+inline void downgrade_schema(study::Database& db, int version) {
+    study::Database model(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+    study::migrate(model, version);
+    std::vector<std::pair<std::string, std::string>> tables, indexes;  // name, sql
+    {
+        study::Statement s = model.prepare(
+            "SELECT type, name, sql FROM sqlite_schema WHERE sql IS NOT NULL ORDER BY rowid");
+        while (s.step())
+            (s.text(0) == "table" ? tables : indexes).emplace_back(s.text(1), s.text(2));
+    }
+    db.exec("PRAGMA foreign_keys = OFF");
+    std::vector<std::string> later;
+    {
+        study::Statement s = db.prepare("SELECT name FROM sqlite_schema WHERE type = 'table'");
+        while (s.step()) later.push_back(s.text(0));
+    }
+    for (const std::string& name : later) {
+        const bool kept = std::any_of(tables.begin(), tables.end(),
+                                      [&](const auto& t) { return t.first == name; });
+        if (!kept) db.exec("DROP TABLE " + name);
+    }
+    for (const auto& [name, sql] : tables) {
+        std::string columns;
+        study::Statement info = model.prepare("SELECT name FROM pragma_table_info(?)");
+        info.bind(1, name);
+        while (info.step()) columns += (columns.empty() ? "" : ", ") + info.text(0);
+        std::string rebuilt = sql;
+        rebuilt.replace(rebuilt.find(name), name.size(), name + "_old_schema");
+        db.exec(rebuilt);
+        db.exec("INSERT INTO " + name + "_old_schema (" + columns + ") SELECT " + columns +
+                " FROM " + name);
+        db.exec("DROP TABLE " + name);
+        db.exec("ALTER TABLE " + name + "_old_schema RENAME TO " + name);
+    }
+    for (const auto& [name, sql] : indexes) db.exec(sql);
+    db.exec("PRAGMA user_version = " + std::to_string(version));
+    db.exec("PRAGMA foreign_keys = ON");
+}
 
 // 3 rated stimuli varying thickness_exponent, 1 practice, 1 catch (expected 7), 2 questions.
 inline const char* kSmallProtocol = R"toml(

@@ -174,6 +174,7 @@ TEST(Report, NeverReplacesItsInputOrADatabaseAndWritesNothingThen) {
     write_report(analyses, dir, ReportOptions{});  // a second run replaces its own files
     write_report(analyses, dir, ReportOptions{});
     EXPECT_TRUE(std::filesystem::exists(dir / "report.md"));
+}
 
 std::vector<std::string> csv_cells(const std::string& line) {
     std::vector<std::string> cells;

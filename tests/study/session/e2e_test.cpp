@@ -569,6 +569,27 @@ TEST_F(SessionE2E, LiveStimuliAreRenderedLikeLucentRender) {
     EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM responses"), 10);
 }
 
+TEST_F(SessionE2E, ALiveStimulusWithNaNPixelsStopsTheSessionBeforeTrialOne) {
+    LUCENT_REQUIRE_DISPLAY();
+    // A ward shader that writes NaN (the same one app.render_nan_pixels_warn_and_exit_1
+    // uses): the session must refuse to show a repaired picture and store nothing.
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("break_every = 2"), 15, "inter_trial_ms = 100\nstimulus_size = [48, 48]");
+    const fs::path protocol = dir_ / "nan.toml";
+    std::ofstream(protocol) << text;
+    const std::string db = (dir_ / "nan.db").string();
+    setenv("LUCENT_SHADER_DIR", LUCENT_SOURCE_DIR "/tests/app/data/nan_shaders", 1);
+    const Process run = start_lucent({"run", protocol.string(), "--db", db, "--participant", "P1",
+                                      "--autopilot", "5", "--autopilot-speed", "12"}, dir_);
+    unsetenv("LUCENT_SHADER_DIR");
+    EXPECT_EQ(wait_exit(run), 1);
+    const std::string err = read_file(run.stderr_path);
+    EXPECT_NE(err.find("stimulus '"), std::string::npos) << err;
+    EXPECT_NE(err.find("NaN or Inf values"), std::string::npos) << err;
+    if (fs::exists(db))
+        EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM responses"), 0);
+}
+
 TEST_F(SessionE2E, BadLiveParametersAreRefusedBeforeAnyWindow) {
     std::string text = lucent::test::kSmallProtocol;
     text.replace(text.find("roughness = 0.2"), 15, "roughness = 0.2, sparkle = 3");
