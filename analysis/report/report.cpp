@@ -1,5 +1,6 @@
 #include "report/report.h"
 
+#include <algorithm>
 #include <cctype>
 #include <sstream>
 
@@ -173,10 +174,25 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                             : " (levels compared as independent groups of ratings).")});
     doc.push_back({Block::kTable, "", summary});
 
+    // One figure per factor, its questions side by side on one scale (thesis Fig. 4.5).
+    std::vector<std::string> factors;
+    for (const OneWayAnalysis& a : analyses)
+        if (std::find(factors.begin(), factors.end(), a.factor) == factors.end())
+            factors.push_back(a.factor);
+    doc.push_back({Block::kHeading, "Figures by factor", {}, {}, 2});
+    for (const std::string& factor : factors) {
+        std::vector<QuestionPanel> panels;
+        for (const OneWayAnalysis& a : analyses)
+            if (a.factor == factor) panels.push_back({a.question, a.descriptives});
+        Block figure{Block::kPlot, figure_file_name(factor), {}, {}};
+        figure.svg = factor_figure_svg(factor, panels);
+        doc.push_back(figure);
+    }
+
     for (const OneWayAnalysis& a : analyses) {
         doc.push_back({Block::kHeading, configuration(a), {}, {}, 2});
         Block plot{Block::kPlot, plot_file_name(a.question, a.factor), {}, {}};
-        plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives);
+        plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives, a.factor);
         doc.push_back(plot);
         const std::vector<Block> within = within_subject_blocks(a, options.alpha);
         if (primary == Design::Within) doc.insert(doc.end(), within.begin(), within.end());
@@ -412,12 +428,22 @@ void parse_formats(const std::string& list, ReportOptions& result) {
     result = options;
 }
 
-std::string plot_file_name(const std::string& question, const std::string& factor) {
-    std::string name = "plot_";
-    for (char c : question + "__" + factor)
-        name +=
-            std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '-';
+namespace {
+// prefix + text with every character but letters, digits, '-' and '_' as '-', + ".svg".
+std::string svg_file_name(const std::string& prefix, const std::string& text) {
+    std::string name = prefix;
+    for (char c : text)
+        name += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '-';
     return name + ".svg";
+}
+}  // namespace
+
+std::string figure_file_name(const std::string& factor) {
+    return svg_file_name("figure_", factor);
+}
+
+std::string plot_file_name(const std::string& question, const std::string& factor) {
+    return svg_file_name("plot_", question + "__" + factor);
 }
 
 std::vector<std::filesystem::path> write_report(

@@ -32,5 +32,7 @@ std::vector<std::filesystem::path> write_report(
 
 // File-name-safe slug for plot names: letters, digits, '-', '_'.
 std::string plot_file_name(const std::string& question, const std::string& factor);
+// The per-factor figure (every question of the factor side by side).
+std::string figure_file_name(const std::string& factor);
 
 }  // namespace lucent::analysis

@@ -37,58 +37,56 @@ std::string num(double x) {
     return buffer;
 }
 
-}  // namespace
-
-std::string mean_ci_plot_svg(const std::string& title, const std::string& y_label,
-                             const std::vector<Descriptives>& levels) {
-    constexpr double kWidth = 480, kHeight = 320, kLeft = 60, kRight = 20, kTop = 40,
-                     kBottom = 60;
-    // Vertical range: every mean and CI end that is defined, padded by 5%.
-    double lo = INFINITY, hi = -INFINITY;
-    for (const Descriptives& d : levels) {
+// The defined means and CI ends of `levels`, widened into [lo, hi].
+void widen_range(const std::vector<Descriptives>& levels, double& lo, double& hi) {
+    for (const Descriptives& d : levels)
         for (const Statistic& v : {d.mean, d.ci_low, d.ci_high})
             if (v && std::isfinite(*v)) {
                 lo = std::min(lo, *v);
                 hi = std::max(hi, *v);
             }
-    }
+}
+
+// A range that can be drawn: a default when nothing is defined, never zero-height,
+// padded by 5%.
+void padded_range(double& lo, double& hi) {
     if (!(lo <= hi)) lo = 0, hi = 1;
     if (hi - lo < 1e-12 * std::max(1.0, std::fabs(hi))) lo -= 0.5, hi += 0.5;
     const double pad = 0.05 * (hi - lo);
     lo -= pad;
     hi += pad;
-    const double plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
-    auto y_of = [&](double v) { return kTop + plot_h * (hi - v) / (hi - lo); };
-    const std::size_t n = std::max<std::size_t>(levels.size(), 1);
-    auto x_of = [&](std::size_t i) { return kLeft + plot_w * (i + 0.5) / n; };
+}
 
-    std::ostringstream svg;
-    svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kWidth
-        << "\" height=\"" << kHeight << "\" viewBox=\"0 0 " << kWidth << ' ' << kHeight
-        << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-        << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-        << "<text x=\"" << kWidth / 2
-        << "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" << escape_xml(title)
-        << "</text>\n"
-        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop << "\" x2=\"" << kLeft
-        << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/>\n"
-        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop + plot_h << "\" x2=\""
-        << kLeft + plot_w << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/>\n";
-    // Five ticks on the y axis.
+// One panel's axes, ticks, level labels and mean/CI marks, at (x0, y0), size w x h.
+void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double h, double lo,
+                double hi, const std::string& title, const std::string& y_label,
+                const std::vector<Descriptives>& levels, const std::string& x_label) {
+    constexpr double kLeft = 60, kRight = 20, kTop = 40, kBottom = 60;
+    const double left = x0 + kLeft, top = y0 + kTop;
+    const double plot_w = w - kLeft - kRight, plot_h = h - kTop - kBottom;
+    auto y_of = [&](double v) { return top + plot_h * (hi - v) / (hi - lo); };
+    const std::size_t n = std::max<std::size_t>(levels.size(), 1);
+    auto x_of = [&](std::size_t i) { return left + plot_w * (i + 0.5) / n; };
+    svg << "<text x=\"" << num(x0 + w / 2) << "\" y=\"" << num(y0 + 20)
+        << "\" text-anchor=\"middle\" font-size=\"14\">" << escape_xml(title) << "</text>\n"
+        << "<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left
+        << "\" y2=\"" << top + plot_h << "\" stroke=\"black\"/>\n"
+        << "<line x1=\"" << left << "\" y1=\"" << top + plot_h << "\" x2=\""
+        << left + plot_w << "\" y2=\"" << top + plot_h << "\" stroke=\"black\"/>\n";
     for (int t = 0; t <= 4; ++t) {
         const double v = lo + (hi - lo) * t / 4.0;
-        svg << "<line x1=\"" << kLeft - 4 << "\" y1=\"" << num(y_of(v)) << "\" x2=\""
-            << kLeft << "\" y2=\"" << num(y_of(v)) << "\" stroke=\"black\"/>"
-            << "<text x=\"" << kLeft - 6 << "\" y=\"" << num(y_of(v) + 4)
+        svg << "<line x1=\"" << left - 4 << "\" y1=\"" << num(y_of(v)) << "\" x2=\""
+            << left << "\" y2=\"" << num(y_of(v)) << "\" stroke=\"black\"/>"
+            << "<text x=\"" << left - 6 << "\" y=\"" << num(y_of(v) + 4)
             << "\" text-anchor=\"end\">" << num(v) << "</text>\n";
     }
-    svg << "<text x=\"14\" y=\"" << kTop + plot_h / 2 << "\" text-anchor=\"middle\" "
-        << "transform=\"rotate(-90 14 " << kTop + plot_h / 2 << ")\">"
-        << escape_xml(y_label) << "</text>\n";
+    svg << "<text x=\"" << num(x0 + 14) << "\" y=\"" << num(top + plot_h / 2)
+        << "\" text-anchor=\"middle\" transform=\"rotate(-90 " << num(x0 + 14) << ' '
+        << num(top + plot_h / 2) << ")\">" << escape_xml(y_label) << "</text>\n";
     for (std::size_t i = 0; i < levels.size(); ++i) {
         const Descriptives& d = levels[i];
         const double x = x_of(i);
-        svg << "<text x=\"" << num(x) << "\" y=\"" << kTop + plot_h + 18
+        svg << "<text x=\"" << num(x) << "\" y=\"" << num(top + plot_h + 18)
             << "\" text-anchor=\"middle\">" << escape_xml(d.level) << "</text>\n";
         if (d.ci_low && d.ci_high) {
             svg << "<line x1=\"" << num(x) << "\" y1=\"" << num(y_of(*d.ci_low))
@@ -104,8 +102,50 @@ std::string mean_ci_plot_svg(const std::string& title, const std::string& y_labe
             svg << "<circle cx=\"" << num(x) << "\" cy=\"" << num(y_of(*d.mean))
                 << "\" r=\"4\" fill=\"#1f77b4\"/>\n";
     }
-    svg << "<text x=\"" << kLeft + plot_w / 2 << "\" y=\"" << kHeight - 12
-        << "\" text-anchor=\"middle\">level (mean with 95% CI)</text>\n</svg>\n";
+    svg << "<text x=\"" << num(left + plot_w / 2) << "\" y=\"" << num(y0 + h - 12)
+        << "\" text-anchor=\"middle\">" << escape_xml(x_label)
+        << " (mean with 95% CI)</text>\n";
+}
+
+std::string svg_header(double width, double height) {
+    std::ostringstream svg;
+    svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\""
+        << height << "\" viewBox=\"0 0 " << width << ' ' << height
+        << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+        << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+    return svg.str();
+}
+
+}  // namespace
+
+std::string mean_ci_plot_svg(const std::string& title, const std::string& y_label,
+                             const std::vector<Descriptives>& levels,
+                             const std::string& x_label) {
+    constexpr double kWidth = 480, kHeight = 320;
+    double lo = INFINITY, hi = -INFINITY;
+    widen_range(levels, lo, hi);
+    padded_range(lo, hi);
+    std::ostringstream svg;
+    svg << svg_header(kWidth, kHeight);
+    draw_panel(svg, 0, 0, kWidth, kHeight, lo, hi, title, y_label, levels, x_label);
+    svg << "</svg>\n";
+    return svg.str();
+}
+
+std::string factor_figure_svg(const std::string& factor, const std::vector<QuestionPanel>& panels) {
+    constexpr double kPanelWidth = 320, kHeight = 320;
+    double lo = INFINITY, hi = -INFINITY;  // shared, so panels compare at a glance
+    for (const QuestionPanel& p : panels) widen_range(p.levels, lo, hi);
+    padded_range(lo, hi);
+    const double width = kPanelWidth * std::max<std::size_t>(panels.size(), 1);
+    std::ostringstream svg;
+    svg << svg_header(width, kHeight + 24);
+    svg << "<text x=\"" << num(width / 2) << "\" y=\"16\" text-anchor=\"middle\" "
+        << "font-size=\"15\" font-weight=\"bold\">" << escape_xml(factor) << "</text>\n";
+    for (std::size_t i = 0; i < panels.size(); ++i)
+        draw_panel(svg, kPanelWidth * i, 24, kPanelWidth, kHeight, lo, hi, panels[i].question,
+                   "mean rating", panels[i].levels, factor);
+    svg << "</svg>\n";
     return svg.str();
 }
 

@@ -2,6 +2,8 @@
 // SVG beside the HTML and embedded in it, hard cases spelled out.
 #include "report/report.h"
 
+#include "report/svg_plot.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -225,9 +227,44 @@ TEST(Report, WithinSubjectTablesLeadWhenPrimaryAndParseBack) {
     EXPECT_NE(md.find("left out (a level missing): P5"), std::string::npos);
     // The section of the primary design comes before the between-subject tables.
     EXPECT_LT(md.find("### Within-subject tests"), md.find("### One-way ANOVA"));
+    // The factor's figure: one panel per question, the factor named under the levels,
+    // which read in parameter order (18, 25, 30), each level's mean drawn once per panel.
+    const std::string figure = slurp(dir / figure_file_name("r"));
+    EXPECT_NE(figure.find(">q</text>"), std::string::npos) << figure;
+    EXPECT_NE(figure.find(">r (mean with 95% CI)</text>"), std::string::npos) << figure;
+    EXPECT_LT(figure.find(">18</text>"), figure.find(">25</text>"));
+    EXPECT_LT(figure.find(">25</text>"), figure.find(">30</text>"));
+    std::size_t circles = 0;
+    for (std::size_t at = figure.find("<circle"); at != std::string::npos;
+         at = figure.find("<circle", at + 1))
+        ++circles;
+    EXPECT_EQ(circles, 3u);
+    EXPECT_NE(slurp(dir / "report.html").find(figure.substr(0, 40)), std::string::npos)
+        << "the HTML embeds the figure";
     for (const char* name : {"rm_anova.csv", "friedman.csv", "posthoc_paired.csv", "report.md"})
         EXPECT_FALSE(std::regex_search(slurp(dir / name), std::regex("nan", std::regex::icase)))
             << name;
+}
+
+TEST(Report, FactorFigurePutsQuestionsSideBySideOnOneScale) {
+    // Two questions of one factor: two panels 320 wide, one y range for both, so the
+    // same value sits at the same height in each panel.
+    std::vector<Descriptives> low = describe_all(groups({{1, 2, 3}, {2, 3, 4}}), 0.95);
+    std::vector<Descriptives> high = describe_all(groups({{5, 6, 7}, {2, 3, 4}}), 0.95);
+    const std::string svg = factor_figure_svg("backlight", {{"translucent", low}, {"realistic", high}});
+    EXPECT_NE(svg.find("width=\"640\""), std::string::npos) << svg;
+    EXPECT_NE(svg.find(">translucent</text>"), std::string::npos);
+    EXPECT_NE(svg.find(">realistic</text>"), std::string::npos);
+    // Level 2 has mean 3 in both panels: both circles at the same y.
+    std::vector<std::string> ys;
+    for (std::size_t at = svg.find("<circle"); at != std::string::npos; at = svg.find("<circle", at + 1)) {
+        const std::size_t cy = svg.find("cy=\"", at) + 4;
+        ys.push_back(svg.substr(cy, svg.find('"', cy) - cy));
+    }
+    ASSERT_EQ(ys.size(), 4u);
+    EXPECT_EQ(ys[1], ys[3]) << svg;
+    EXPECT_NE(ys[0], ys[2]);  // means 2 and 6
+    EXPECT_FALSE(std::regex_search(svg, std::regex("nan|inf", std::regex::icase)));
 }
 
 TEST(Report, FormatSelectionAndErrors) {
