@@ -15,6 +15,7 @@ namespace {
 struct AnalyzeArgs {
     std::string input, out_dir, factor, question, formats = "md,csv,html", scale = "1..7";
     std::string design;  // "", "between" or "within"
+    std::string images;  // folder of rendered stimuli for thumbnails
     double alpha = 0.10;
 };
 
@@ -30,6 +31,8 @@ int run_analyze(const AnalyzeArgs& args) {
         options.inputs = {args.input};  // a report file never replaces the input
         std::optional<Design> plan_design;
         const LongTable table = read_ratings(args.input, parse_scale(args.scale), &plan_design);
+        if (!args.images.empty())
+            options.level_images = level_images_from_directory(table, args.images);
         AnalysisRequest request{args.alpha, args.question, args.factor,
                                 [](const std::string& question, const std::string& factor,
                                    std::size_t levels) {
@@ -72,6 +75,9 @@ void register_analyze(CLI::App& app, int& exit_code) {
                     "Primary design: between or within (default: the protocol's analysis "
                     "plan; for a CSV, within when every participant rated every level)")
         ->check(CLI::IsMember({"between", "within"}));
+    cmd->add_option("--images", args->images,
+                    "Folder of rendered stimuli (lucent render's output): each level's "
+                    "picture is shown beside its descriptives, embedded in report.html");
     cmd->add_option("--scale", args->scale,
                     "Accepted ratings: MIN..MAX, or 'any' for any finite number")
         ->capture_default_str();

@@ -1,7 +1,10 @@
 #include "report/report.h"
 
 #include <algorithm>
+#include <boost/archive/iterators/base64_from_binary.hpp>
+#include <boost/archive/iterators/transform_width.hpp>
 #include <cctype>
+#include <fstream>
 #include <sstream>
 
 #include "data/long_table.h"
@@ -18,11 +21,16 @@ struct Table {
     std::vector<std::vector<std::string>> rows;
 };
 struct Block {
-    enum Kind { kHeading, kParagraph, kTable, kPlot } kind;
+    enum Kind { kHeading, kParagraph, kTable, kPlot, kImages } kind;
     std::string text;  // heading/paragraph text, or plot file name
     Table table;
     std::string svg;
     int level = 2;
+    struct Image {
+        std::string caption;
+        std::filesystem::path path;
+    };
+    std::vector<Image> images;  // kImages: thumbnails in a row
 };
 
 std::string csv_field(const std::string& s) {
@@ -194,6 +202,15 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         Block plot{Block::kPlot, plot_file_name(a.question, a.factor), {}, {}};
         plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives, a.factor);
         doc.push_back(plot);
+        Block thumbnails{Block::kImages, "", {}, {}};
+        for (const Descriptives& d : a.descriptives) {
+            const auto image = options.level_images.find({a.factor, d.level});
+            if (image != options.level_images.end())
+                thumbnails.images.push_back(
+                    {a.factor + " " + d.level + " (" + image->second.first + ")",
+                     image->second.second});
+        }
+        if (!thumbnails.images.empty()) doc.push_back(thumbnails);
         const std::vector<Block> within = within_subject_blocks(a, options.alpha);
         if (primary == Design::Within) doc.insert(doc.end(), within.begin(), within.end());
 
@@ -285,6 +302,11 @@ void render_markdown(const std::vector<Block>& doc, std::ostream& out) {
             case Block::kPlot:
                 out << "![" << b.text << "](" << b.text << ")\n\n";
                 break;
+            case Block::kImages:
+                for (const Block::Image& image : b.images)
+                    out << "![" << image.caption << "](" << image.path.string() << ") ";
+                out << "\n\n";
+                break;
             case Block::kTable:
                 out << '|';
                 for (const auto& h : b.table.header) out << ' ' << md_cell(h) << " |";
@@ -319,6 +341,23 @@ void render_html(const std::vector<Block>& doc, std::ostream& out) {
             case Block::kPlot:
                 out << "<figure>" << b.svg << "<figcaption>saved as "
                     << html_escape(b.text) << "</figcaption></figure>\n";
+                break;
+            case Block::kImages:
+                out << "<div class=\"thumbnails\">";
+                for (const Block::Image& image : b.images) {
+                    out << "<figure style=\"display:inline-block;margin:4px\">";
+                    std::ifstream in(image.path, std::ios::binary);
+                    std::ostringstream bytes;
+                    bytes << in.rdbuf();
+                    if (in && !bytes.str().empty())
+                        out << "<img width=\"128\" alt=\"" << html_escape(image.caption)
+                            << "\" src=\"data:image/png;base64," << base64_encode(bytes.str())
+                            << "\">";
+                    else
+                        out << "(image unreadable: " << html_escape(image.path.string()) << ")";
+                    out << "<figcaption>" << html_escape(image.caption) << "</figcaption></figure>";
+                }
+                out << "</div>\n";
                 break;
             case Block::kTable:
                 out << "<table><tr>";
@@ -437,6 +476,30 @@ std::string svg_file_name(const std::string& prefix, const std::string& text) {
     return name + ".svg";
 }
 }  // namespace
+
+std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
+level_images_from_directory(const LongTable& table, const std::filesystem::path& directory) {
+    std::error_code error;
+    if (!std::filesystem::is_directory(directory, error))
+        throw InputError("--images " + directory.string() + ": not a directory");
+    std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
+        images;
+    for (const RatingRow& row : table.rows) {
+        const std::pair<std::string, std::string> key{row.factor, row.level};
+        if (images.count(key)) continue;
+        const std::filesystem::path png = directory / (row.stimulus + ".png");
+        if (std::filesystem::is_regular_file(png, error)) images[key] = {row.stimulus, png};
+    }
+    return images;
+}
+
+std::string base64_encode(std::string_view bytes) {
+    using namespace boost::archive::iterators;
+    using Encoder = base64_from_binary<transform_width<const char*, 6, 8>>;
+    std::string out(Encoder(bytes.data()), Encoder(bytes.data() + bytes.size()));
+    out.append((3 - bytes.size() % 3) % 3, '=');
+    return out;
+}
 
 std::string figure_file_name(const std::string& factor) {
     return svg_file_name("figure_", factor);

@@ -3,9 +3,13 @@
 // thesis's Table 4.4, then per (question, factor): plot, descriptives, ANOVA, Tukey HSD,
 // Kruskal-Wallis and Welch), machine-readable CSV tables, and one SVG plot per pair.
 #include <filesystem>
+#include <map>
+#include <string_view>
+#include <utility>
 #include <string>
 #include <vector>
 
+#include "data/long_table.h"
 #include "stats/one_way_analysis.h"
 
 namespace lucent::analysis {
@@ -19,7 +23,20 @@ struct ReportOptions {
     // them, or any SQLite database, is refused before anything is written.
     std::vector<std::filesystem::path> inputs;
     Design primary = Design::Between;  // shown first in the summary and in each section
+    // A picture of each level's stimulus, shown beside its descriptives (HTML embeds the
+    // PNG, so the report stays one file): (factor, level) -> (stimulus id, PNG path).
+    std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
+        level_images;
 };
+
+// The picture of each (factor, level) from a folder of rendered stimuli (`lucent render`'s
+// output): the first stimulus rated at that level that has `DIR/<stimulus>.png`. Throws
+// InputError naming the folder when it is not one.
+std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
+level_images_from_directory(const LongTable& table, const std::filesystem::path& directory);
+
+// RFC 4648 base64 of `bytes` (for images embedded in the HTML report).
+std::string base64_encode(std::string_view bytes);
 
 // "md,csv,html" (any subset, comma-separated); throws InputError naming a bad entry.
 void parse_formats(const std::string& list, ReportOptions& options);

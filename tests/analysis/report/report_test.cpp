@@ -267,6 +267,44 @@ TEST(Report, FactorFigurePutsQuestionsSideBySideOnOneScale) {
     EXPECT_FALSE(std::regex_search(svg, std::regex("nan|inf", std::regex::icase)));
 }
 
+TEST(Report, Base64MatchesRfc4648TestVectors) {
+    // RFC 4648 section 10.
+    EXPECT_EQ(base64_encode(""), "");
+    EXPECT_EQ(base64_encode("f"), "Zg==");
+    EXPECT_EQ(base64_encode("fo"), "Zm8=");
+    EXPECT_EQ(base64_encode("foo"), "Zm9v");
+    EXPECT_EQ(base64_encode("foob"), "Zm9vYg==");
+    EXPECT_EQ(base64_encode("fooba"), "Zm9vYmE=");
+    EXPECT_EQ(base64_encode("foobar"), "Zm9vYmFy");
+    EXPECT_EQ(base64_encode(std::string("\xff\x00\xfe", 3)), "/wD+");
+}
+
+TEST(Report, LevelPicturesAreEmbeddedBesideTheirDescriptives) {
+    const auto dir = test::scratch_dir("report_thumbnails");
+    const auto images = dir / "stimuli";
+    std::filesystem::create_directories(images);
+    // Two stand-in PNG files (the report embeds bytes, it does not decode them).
+    std::ofstream(images / "thin.png", std::ios::binary) << "PNG-thin";
+    std::ofstream(images / "thick.png", std::ios::binary) << "PNG-thick";
+    std::istringstream csv(
+        "participant,stimulus,factor,level,question,rating\n"
+        "P1,thin,r,18,q,2\nP1,thick,r,30,q,5\nP2,thin,r,18,q,3\nP2,thick,r,30,q,6\n"
+        "P1,nopicture,b,0.8,q,4\nP2,nopicture,b,0.8,q,4\n");
+    const LongTable table = read_long_csv(csv, "t.csv", RatingScale{});
+    ReportOptions options;
+    options.level_images = level_images_from_directory(table, images);
+    ASSERT_EQ(options.level_images.size(), 2u);  // the 'b' level has no picture
+    EXPECT_EQ(options.level_images.at({"r", "30"}).first, "thick");
+    options.csv = false;
+    write_report(analyze_table(table, AnalysisRequest{}).pairs, dir / "out", options);
+    const std::string html = slurp(dir / "out" / "report.html");
+    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thin")), std::string::npos);
+    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thick")), std::string::npos);
+    EXPECT_LT(html.find(base64_encode("PNG-thin")), html.find(base64_encode("PNG-thick")));
+    EXPECT_NE(html.find("r 30 (thick)"), std::string::npos);
+    EXPECT_THROW(level_images_from_directory(table, dir / "missing"), InputError);
+}
+
 TEST(Report, FormatSelectionAndErrors) {
     ReportOptions options;
     parse_formats("csv", options);
