@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
     register_simulate(app, exit_code);
     register_power(app, exit_code);
     register_explore(app, exit_code);
+    register_stimuli(app, exit_code);
     register_bench(app, exit_code);
 
     // CLI11 would only say "A subcommand is required"; name the word it did not know.

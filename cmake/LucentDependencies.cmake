@@ -16,6 +16,8 @@ pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
 pkg_check_modules(SQLITE3 REQUIRED IMPORTED_TARGET sqlite3)
 pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
+# littleCMS: sRGB -> Lab and CIEDE2000 for the stimulus-set report.
+pkg_check_modules(LCMS2 REQUIRED IMPORTED_TARGET lcms2)
 
 if(LUCENT_BUILD_TESTS)
   find_package(GTest REQUIRED)

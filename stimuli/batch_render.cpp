@@ -28,6 +28,7 @@
 #include "gl/context.h"
 #include "lucent/version.h"
 #include "render.h"
+#include "set_report/set_report.h"
 #include "techniques/registry.h"
 
 namespace lucent::stimuli {
@@ -76,6 +77,7 @@ ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mes
                        {"file", file_of(s, set.formats.front()).string(), false},
                        {"files", files, false},
                        {"technique", s.technique, false},
+                       {"series", s.series, false},
                        {"mesh", s.mesh_spec, false},
                        {"mesh_faces", std::to_string(mesh.face_count()), true},
                        {"mesh_hash", mesh.content_hash, false},
@@ -438,7 +440,9 @@ int run_render_set_command(const std::string& config_path, const std::string& pr
         std::cerr << "lucent render: " << e.what() << "\n";
         return 1;
     }
-    return 0;
+    // The complete set's report (report.html, contact-sheet.png), as `lucent stimuli
+    // report DIR` writes it; a set that cannot be reported is a failure of the run.
+    return run_stimuli_report(out_dir, {}, "lucent render") == 0 ? 0 : 1;
 }
 
 }  // namespace lucent::stimuli

@@ -349,7 +349,7 @@ private:
             const std::string name(key.str());
             if (name == "id" || name == "technique" || name == "mesh" ||
                 name == "light" || name == "material" || name == "vary" ||
-                name == "expand")
+                name == "expand" || name == "series")
                 continue;
             const Knob* knob = find_knob(*knobs, name);
             if (!knob)
@@ -429,6 +429,15 @@ private:
                              "expands to too many stimuli");
         }
 
+        // The factor series: named, or the id pattern of an entry with several stimuli.
+        std::string series = count > 1 ? id : std::string();
+        if (const auto* node = table.get("series")) {
+            series = as_string(*node, prefix + "series", errors_);
+            if (!is_safe_name(series))
+                errors_.fail(*node, prefix + "series",
+                             "'" + series + "' is not a valid name (letters, digits, _ - . only)");
+        }
+
         for (std::size_t index = 0; index < count; ++index) {
             Stimulus stimulus{id,   technique, mesh_name, meshes_.at(mesh_name),
                               base, line};
@@ -440,6 +449,7 @@ private:
                 stimulus.parameters.set(axis->first, axis->second[pick]);
             }
             stimulus.id = expanded_id(id, stimulus.parameters, index, count);
+            stimulus.series = series;
             check_id(stimulus.id, *id_node, prefix + "id");
             set.stimuli.push_back(std::move(stimulus));
         }
@@ -471,15 +481,21 @@ private:
         return out;
     }
 
+    static bool is_safe_name(const std::string& name) {
+        return !name.empty() && name.front() != '.' &&
+               std::all_of(name.begin(), name.end(), [](char c) {
+                   return std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
+                          c == '-' || c == '.';
+               });
+    }
+
     void check_id(const std::string& id, const toml::node& node, const std::string& key) {
-        const bool safe = !id.empty() && id.front() != '.' &&
-                          std::all_of(id.begin(), id.end(), [](char c) {
-                              return std::isalnum(static_cast<unsigned char>(c)) ||
-                                     c == '_' || c == '-' || c == '.';
-                          });
-        if (!safe)
+        if (!is_safe_name(id))
             errors_.fail(node, key,
                          "'" + id + "' is not a valid id (letters, digits, _ - . only)");
+        // The set report writes DIR/contact-sheet.png beside the stimuli's images.
+        if (id == "contact-sheet")
+            errors_.fail(node, key, "'contact-sheet' is reserved (the report's contact sheet)");
         if (!ids_.insert(id).second) errors_.fail(node, key, "duplicate id '" + id + "'");
     }
 

@@ -31,6 +31,10 @@ struct Stimulus {
     std::string mesh_spec;  // built-in spec ("torus_knot:60k") or absolute file path
     KnobValues parameters;  // every knob of the technique, defaults filled in
     int source_line = 0;    // line of the [[stimuli]] entry it expanded from
+    // The factor series it belongs to (the entry's `series`; by default the id pattern
+    // of an entry that expands into several stimuli); empty for none. The report
+    // compares the levels of each series.
+    std::string series;
 };
 
 struct StimulusSet {

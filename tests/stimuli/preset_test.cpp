@@ -47,6 +47,35 @@ TEST(ThesisPreset, NineEmpiricalRendersOfTable43) {
     }
 }
 
+TEST(ThesisPreset, EachSeriesIsOneColourAndRows147DifferOnlyInColour) {
+    // "the first row (purple) ... the second row (green) ... the third row (blue)"
+    // (thesis Sec. 4.2): saturated albedos, one per factor series.
+    const auto set = load_preset("thesis", default_catalog());
+    const char* series[3] = {"thickness_exponent", "backlight", "diffuse_weight"};
+    for (int row = 0; row < 9; ++row) {
+        const auto& s = find(set, "empirical_row_" + std::to_string(row + 1));
+        EXPECT_EQ(s.series, series[row / 3]) << row;
+        const glm::dvec3 c = s.parameters.vec3("albedo");
+        if (row / 3 == 0) EXPECT_TRUE(c.r > 2 * c.g && c.b > 2 * c.g) << "purple " << row;
+        if (row / 3 == 1) EXPECT_TRUE(c.g > 2 * c.r && c.g > 2 * c.b) << "green " << row;
+        if (row / 3 == 2) EXPECT_TRUE(c.b > 2 * c.r && c.b > 2 * c.g) << "blue " << row;
+        EXPECT_EQ(format_knob_value(s.parameters.get("albedo")),
+                  format_knob_value(find(set, "empirical_row_" + std::to_string(row / 3 * 3 + 1))
+                                        .parameters.get("albedo")))
+            << "one colour per series, row " << row;
+    }
+    const auto& one = find(set, "empirical_row_1");
+    for (const char* other : {"empirical_row_4", "empirical_row_7"}) {
+        const auto& s = find(set, other);
+        EXPECT_NE(format_knob_value(s.parameters.get("albedo")),
+                  format_knob_value(one.parameters.get("albedo")));
+        for (const auto& [name, value] : one.parameters.all())
+            if (name != "albedo")
+                EXPECT_EQ(format_knob_value(value), format_knob_value(s.parameters.get(name)))
+                    << other << " " << name;
+    }
+}
+
 TEST(ThesisPreset, WardAndContrastReversedPairsShareEveryParameter) {
     const auto set = load_preset("thesis", default_catalog());
     for (const char* material : {"jade", "wax", "jade_strong"}) {

@@ -277,3 +277,38 @@ TEST(ThesisPresets, TheStudyShowsTheStimulusSetsPicturesValueForValue) {
 
 }  // namespace
 }  // namespace lucent::study
+
+namespace lucent::study {
+namespace {
+
+// Each factor series of Table 4.3 has its colour (issue 13): rows 1, 4 and 7 share r, wb
+// and Kb, and a session's database tells them apart by the stored albedo.
+TEST(ThesisPresets, TheDatabaseRecordsEachRowsColour) {
+    const Protocol study = builtin_protocol("thesis");
+    const auto dir = lucent::test::scratch_dir("provenance_thesis_colour");
+    const std::string db = (dir / "thesis.db").string();
+    store_session(db, study, resolve_stimuli(study, ""));
+    Database database(db, SQLITE_OPEN_READONLY);
+    const auto stored = read_resolved_stimuli(database);
+    const std::map<std::string, std::string> colour = {
+        {"empirical_row_1", "0.5,0.1,0.7"},  {"empirical_row_2", "0.5,0.1,0.7"},
+        {"empirical_row_3", "0.5,0.1,0.7"},  {"empirical_row_4", "0.1,0.6,0.15"},
+        {"empirical_row_5", "0.1,0.6,0.15"}, {"empirical_row_6", "0.1,0.6,0.15"},
+        {"empirical_row_7", "0.1,0.25,0.8"}, {"empirical_row_8", "0.1,0.25,0.8"},
+        {"empirical_row_9", "0.1,0.25,0.8"}};
+    for (const auto& [id, albedo] : colour) {
+        ASSERT_TRUE(stored.count(id)) << id;
+        EXPECT_EQ(stored.at(id).values.at("albedo"), albedo) << id;
+    }
+    // The rows that share Table 4.3's values differ only in colour.
+    auto without_albedo = [&](const std::string& id) {
+        auto values = stored.at(id).values;
+        values.erase("albedo");
+        return values;
+    };
+    EXPECT_EQ(without_albedo("empirical_row_1"), without_albedo("empirical_row_4"));
+    EXPECT_EQ(without_albedo("empirical_row_1"), without_albedo("empirical_row_7"));
+}
+
+}  // namespace
+}  // namespace lucent::study

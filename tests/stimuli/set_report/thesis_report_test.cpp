@@ -1,0 +1,75 @@
+// The built-in thesis set against its own report: every pair of levels of each factor
+// series differs by at least the report's threshold (mean Delta E00 3), no two stimuli
+// are the same picture, each series has its colour, and the report opens in a browser
+// with every picture drawn. The screenshot stays in the build tree for people to look at
+// (test-scratch/thesis_report/report-screenshot.png).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <iostream>
+#include <map>
+
+#include "batch_render.h"
+#include "browser.h"
+#include "set_report/set_report.h"
+#include "test_paths.h"
+
+namespace lucent::stimuli {
+namespace {
+
+TEST(ThesisSetReport, EveryPairOfLevelsPassesTheThresholdAndTheReportDrawsInABrowser) {
+    const auto dir = test::scratch_dir("thesis_report");
+    BatchOptions options;
+    options.out_dir = dir;
+    options.progress = false;
+    render_stimulus_set(load_preset("thesis", default_catalog()), options);
+
+    const SetReport report = measure_stimulus_set(dir);
+    EXPECT_TRUE(report.warnings.empty()) << ::testing::PrintToString(report.warnings);
+    // Table 4.3's three series (three levels each: three pairs) and the three
+    // ward / contrast_reversed pairs.
+    std::map<std::string, int> pairs;
+    for (const auto& p : report.pairs) {
+        ++pairs[p.series];
+        const std::string what = report.stimuli[p.first].id + " vs " + report.stimuli[p.second].id;
+        EXPECT_GE(p.delta_e.mean, 3.0) << what;
+        EXPECT_FALSE(p.identical) << what;
+        EXPECT_GT(p.delta_e.pixels, 10000u) << what;
+    }
+    const std::map<std::string, int> expected = {{"thickness_exponent", 3}, {"backlight", 3},
+                                                 {"diffuse_weight", 3},     {"jade", 1},
+                                                 {"wax", 1},                {"jade_strong", 1}};
+    EXPECT_EQ(pairs, expected);
+
+    // Each series's colour: the hue that dominates its object pixels' albedo.
+    const std::map<std::string, std::string> colour = {
+        {"thickness_exponent", "purple"}, {"backlight", "green"}, {"diffuse_weight", "blue"}};
+    for (const auto& s : report.stimuli) {
+        if (!colour.count(s.series)) continue;
+        const auto albedo = s.cells.at("albedo");
+        double r = 0, g = 0, b = 0;
+        ASSERT_EQ(std::sscanf(albedo.c_str(), "%lf,%lf,%lf", &r, &g, &b), 3) << albedo;
+        const std::string& want = colour.at(s.series);
+        SCOPED_TRACE(s.id + " albedo " + albedo);
+        if (want == "purple") EXPECT_TRUE(r > 2 * g && b > 2 * g && b >= r);
+        if (want == "green") EXPECT_TRUE(g > 2 * r && g > 2 * b);
+        if (want == "blue") EXPECT_TRUE(b > 2 * r && b > 2 * g);
+    }
+
+    write_set_report(report);
+    const auto page = test::open_in_browser(dir / "report.html", dir / "report-screenshot.png",
+                                            1280, 1800);
+    ASSERT_TRUE(page.ok) << page.error;
+    EXPECT_EQ(page.images_drawn, "15/15");
+    // The purple, green and blue objects are on screen: only the thumbnails have them.
+    const auto purple = page.count_pixels(
+        [](float r, float g, float b) { return r > g + 0.15f && b > g + 0.15f; });
+    const auto green = page.count_pixels(
+        [](float r, float g, float b) { return g > r + 0.15f && g > b + 0.15f; });
+    EXPECT_GT(purple, 2000u);
+    EXPECT_GT(green, 2000u);
+    std::cout << "thesis report screenshot: " << (dir / "report-screenshot.png").string() << "\n";
+}
+
+}  // namespace
+}  // namespace lucent::stimuli
