@@ -101,7 +101,10 @@ void write_contact_sheet(const std::filesystem::path& file,
         widest = std::max(widest, std::min<std::size_t>(n, kPerRow));
         height += kHeadingHeight + int((n + kPerRow - 1) / kPerRow) * cell_h;
     }
-    const int width = kPadding + int(widest) * cell_w;
+    // Wide enough for the cells and, roughly (10 px a character at size 17), the headings.
+    int width = kPadding + int(widest) * cell_w;
+    for (const auto& group : groups)
+        width = std::max(width, 2 * kPadding + 10 * int(group.heading.size()));
     OIIO::ImageBuf sheet = grey_buffer(width, height);
 
     int y = kPadding;

@@ -403,13 +403,14 @@ namespace {
 
 // ---- [SECTION] writing -------------------------------------------------------------
 
-// id, technique, then one line per varying parameter.
+// id, technique, then one line per varying parameter (but the technique).
 std::vector<std::string> label_of(const ReportStimulus& s) {
     std::vector<std::string> lines = {s.id, s.technique};
     if (s.level.empty()) return lines;
     for (std::size_t start = 0; start <= s.level.size();) {
         const std::size_t end = std::min(s.level.find(", ", start), s.level.size());
-        lines.push_back(s.level.substr(start, end - start));
+        const std::string part = s.level.substr(start, end - start);
+        if (part.rfind("technique=", 0) != 0) lines.push_back(part);  // the line above
         start = end + 2;
     }
     return lines;

@@ -1,6 +1,7 @@
 # Script for tests/app/stimuli.cmake. MODE=preset|config renders a set into OUT (fresh),
-# checks EXPECT_IMAGES images and manifest rows, that a second run renders nothing and
-# that --force reproduces every image byte for byte. MODE=error expects exit 2, a first
+# checks EXPECT_IMAGES images and manifest rows, the set's report (report.html,
+# contact-sheet.png; no warnings: every pair of levels differs enough), that a second run
+# renders nothing and that --force reproduces every image byte for byte. MODE=error expects exit 2, a first
 # stderr line matching EXPECT_STDERR, and OUT not created.
 file(REMOVE_RECURSE "${OUT}")
 if(MODE STREQUAL "preset")
@@ -25,7 +26,12 @@ execute_process(COMMAND ${LUCENT} ${args} RESULT_VARIABLE code OUTPUT_VARIABLE o
 if(NOT code EQUAL 0)
   message(FATAL_ERROR "render failed (${code}): ${out}${err}")
 endif()
+if(NOT EXISTS "${OUT}/report.html" OR NOT EXISTS "${OUT}/contact-sheet.png" OR
+   NOT out MATCHES "wrote [^\n]*report.html" OR err MATCHES "warning")
+  message(FATAL_ERROR "expected the set's report without warnings: ${out}${err}")
+endif()
 file(GLOB images "${OUT}/*.png")
+list(REMOVE_ITEM images "${OUT}/contact-sheet.png")
 list(LENGTH images count)
 file(STRINGS "${OUT}/manifest.csv" lines)
 list(LENGTH lines rows)

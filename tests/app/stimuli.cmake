@@ -2,8 +2,9 @@
 set(LUCENT_STIMULI_CLI_DIR ${CMAKE_BINARY_DIR}/test-scratch/app_stimuli)
 set(LUCENT_RENDER_SET_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/render_set_check.cmake)
 
-# The built-in thesis set renders headless: 15 images and a manifest row for each; a
-# second run re-renders nothing; --force re-renders every image byte for byte.
+# The built-in thesis set renders headless: 15 images and a manifest row for each, and
+# its report without warnings; a second run re-renders nothing; --force re-renders every
+# image byte for byte.
 add_test(NAME app.render_preset_thesis
          COMMAND ${CMAKE_COMMAND} -DLUCENT=$<TARGET_FILE:lucent> -DMODE=preset
                  -DOUT=${LUCENT_STIMULI_CLI_DIR}/thesis -DEXPECT_IMAGES=15
@@ -45,6 +46,20 @@ add_test(NAME app.render_mesh_and_config_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=render;x.toml;--mesh;sphere;--out;${LUCENT_STIMULI_CLI_DIR}/both"
                  -DEXPECT_CODE=2 "-DEXPECT_STDERR=one of --mesh, CONFIG or --preset"
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+
+# lucent stimuli report: a folder that is not a rendered set is refused in one line
+# naming the file, and nothing is written.
+add_test(NAME app.stimuli_report_without_manifest_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=stimuli;report;${LUCENT_STIMULI_CLI_DIR}"
+                 -DEXPECT_CODE=2
+                 "-DEXPECT_STDERR=lucent stimuli report: ${LUCENT_STIMULI_CLI_DIR}/manifest.csv: missing"
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+add_test(NAME app.stimuli_report_bad_threshold_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=stimuli;report;${LUCENT_STIMULI_CLI_DIR};--min-delta-e;-1"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=--min-delta-e"
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
 
 # lucent bench render runs end to end (small images; the figures come from a full run).

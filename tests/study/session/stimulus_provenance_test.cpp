@@ -287,7 +287,17 @@ TEST(ThesisPresets, TheDatabaseRecordsEachRowsColour) {
     const Protocol study = builtin_protocol("thesis");
     const auto dir = lucent::test::scratch_dir("provenance_thesis_colour");
     const std::string db = (dir / "thesis.db").string();
-    store_session(db, study, resolve_stimuli(study, ""));
+    {
+        // A session as `lucent run --preset thesis` starts it (its stimuli are stored
+        // when the session is created).
+        Store store(db);
+        const int64_t id = store.ensure_study(study);
+        int number = 0;
+        const int64_t participant = store.ensure_participant(id, "P1", &number);
+        SessionEnvironment env;
+        env.stimuli = resolve_stimuli(study, "");
+        store.create_session(id, participant, plan_trials(study, 1, number), 1, env);
+    }
     Database database(db, SQLITE_OPEN_READONLY);
     const auto stored = read_resolved_stimuli(database);
     const std::map<std::string, std::string> colour = {
