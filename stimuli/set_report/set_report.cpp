@@ -21,6 +21,7 @@
 #include "manifest.h"
 #include "output_file.h"
 #include "set_report/contact_sheet.h"
+#include "report/html_page.h"
 #include "report/report.h"
 #include "set_report/ssim.h"
 #include "report/svg_plot.h"
@@ -467,10 +468,7 @@ void write_html(std::ostream& out, const SetReport& r) {
         << "padding:.2em .5em;text-align:right}td:first-child,th:first-child{text-align:left}"
         << ".warn{color:#a00}.plots svg{margin:.2em}</style>\n"
         // Marks the page once every picture has decoded, for headless-browser checks.
-        << "<script>window.addEventListener('load',function(){var im=document.images,n=0;"
-        << "for(var i=0;i<im.length;++i)if(im[i].complete&&im[i].naturalWidth>0)++n;"
-        << "document.documentElement.setAttribute('data-images-drawn',n+'/'+im.length);});"
-        << "</script>\n</head><body>\n";
+        << analysis::images_drawn_script() << "</head><body>\n";
     out << "<h1>Stimulus set " << markup_escape(r.set_name) << "</h1>\n<p>"
         << r.stimuli.size() << " stimuli from <code>"
         << markup_escape((r.directory / "manifest.csv").string()) << "</code>, rendered by lucent "
