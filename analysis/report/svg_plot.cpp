@@ -181,7 +181,8 @@ std::string histogram_svg(const std::string& title, const std::vector<double>& s
         << "<line x1=\"" << kLeft << "\" y1=\"" << kTop << "\" x2=\"" << kLeft
         << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/>\n"
         << "<text x=\"" << kLeft - 3 << "\" y=\"" << kTop + 8
-        << "\" text-anchor=\"end\" font-size=\"9\">" << num(100.0 * top_share) << "%</text>"
+        << "\" text-anchor=\"end\" font-size=\"9\">" << std::lround(100.0 * top_share)
+        << "%</text>"
         << "<text x=\"" << kLeft - 3 << "\" y=\"" << kTop + plot_h
         << "\" text-anchor=\"end\" font-size=\"9\">0</text>\n"
         << "<text x=\"" << kLeft << "\" y=\"" << kTop + plot_h + 11
@@ -194,9 +195,9 @@ std::string histogram_svg(const std::string& title, const std::vector<double>& s
 }
 
 std::string level_values_svg(const std::string& title, const std::vector<std::string>& levels,
-                             const std::vector<double>& values) {
-    constexpr double kWidth = 240, kHeight = 150, kLeft = 48, kRight = 12, kTop = 22,
-                     kBottom = 34;
+                             const std::vector<double>& values, const std::string& x_label) {
+    constexpr double kWidth = 240, kHeight = 160, kLeft = 48, kRight = 12, kTop = 22,
+                     kBottom = 44;
     const double plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
     double lo = INFINITY, hi = -INFINITY;
     for (double v : values)
@@ -229,7 +230,10 @@ std::string level_values_svg(const std::string& title, const std::vector<std::st
             << "\" r=\"3.5\" fill=\"#1f77b4\"/>";
     }
     svg << "\n<polyline points=\"" << points
-        << "\" fill=\"none\" stroke=\"#1f77b4\" stroke-width=\"1.5\"/>\n</svg>\n";
+        << "\" fill=\"none\" stroke=\"#1f77b4\" stroke-width=\"1.5\"/>\n"
+        << "<text x=\"" << num(kLeft + plot_w / 2) << "\" y=\"" << num(kHeight - 6)
+        << "\" text-anchor=\"middle\" font-size=\"10\">" << escape_xml(x_label)
+        << "</text>\n</svg>\n";
     return svg.str();
 }
 

@@ -34,8 +34,10 @@ std::string markup_escape(const std::string& text);
 // of the pixels), titled, with the bins' range under the axis;
 std::string histogram_svg(const std::string& title, const std::vector<double>& shares,
                           const std::string& x_label = "luminance");
-// one value per level, as dots joined by a line, on an axis spanning the values.
+// one value per level, as dots joined by a line, on an axis spanning the values; the
+// levels' names under the axis, `x_label` (e.g. the factor) below them.
 std::string level_values_svg(const std::string& title, const std::vector<std::string>& levels,
-                             const std::vector<double>& values);
+                             const std::vector<double>& values,
+                             const std::string& x_label = "");
 
 }  // namespace lucent::analysis

@@ -526,9 +526,20 @@ void write_html(std::ostream& out, const SetReport& r) {
                 << (p.identical ? "identical" : low ? "below threshold" : "") << "</td></tr>\n";
         }
         out << "</table>\n<div class=\"plots\">";
+        // Tick labels: the value of the one varying parameter, else the technique, else
+        // the id; the axis names what varies.
+        const bool technique_varies =
+            std::find(series.varying.begin(), series.varying.end(), "technique") !=
+            series.varying.end();
         std::vector<std::string> levels;
         for (std::size_t m : series.members)
-            levels.push_back(r.stimuli[m].level.empty() ? r.stimuli[m].id : r.stimuli[m].level);
+            levels.push_back(series.varying.size() == 1
+                                 ? cell(r.stimuli[m].cells, series.varying.front())
+                             : technique_varies ? r.stimuli[m].technique
+                                                : r.stimuli[m].id);
+        const std::string axis = series.varying.size() == 1 ? series.varying.front()
+                                 : technique_varies         ? "technique"
+                                                            : "stimulus";
         for (const auto& [column, title] :
              std::vector<std::pair<std::string, std::string>>{
                  {"mean_luminance", "mean luminance"},
@@ -537,7 +548,7 @@ void write_html(std::ostream& out, const SetReport& r) {
                  {"saturation_intensity_correlation", "saturation-intensity r"}}) {
             std::vector<double> values;
             for (std::size_t m : series.members) values.push_back(statistic(r.stimuli[m], column));
-            out << analysis::level_values_svg(title, levels, values);
+            out << analysis::level_values_svg(title, levels, values, axis);
         }
         out << "</div>\n";
     }
