@@ -135,7 +135,13 @@ std::vector<fs::path> checked_files(const fs::path& directory,
         fail(manifest + ": stimulus '" + cell(row, "id") + "' lists no files");
     // The content hash as the batch renderer computes it: each file's hash as a field.
     Hasher hasher;
-    for (const auto& path : files) hasher.add_field(hash_file(path));
+    for (const auto& path : files) {
+        try {
+            hasher.add_field(hash_file(path));
+        } catch (const std::runtime_error& e) {
+            fail(e.what());  // "PATH: cannot read"
+        }
+    }
     if (hasher.hex() != cell(row, "content_hash")) {
         std::string names;
         for (const auto& path : files) names += (names.empty() ? "" : ", ") + path.string();

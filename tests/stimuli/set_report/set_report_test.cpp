@@ -225,6 +225,21 @@ TEST_F(SmallSet, AnImageChangedSinceTheManifestIsNamed) {
     EXPECT_FALSE(wrote_anything());
 }
 
+TEST_F(SmallSet, AnUndecodableImageListedWithItsHashIsNamed) {
+    const auto hash = [&] { return Hasher().add_field(hash_file(dir_ / "white.png")).hex(); };
+    const std::string before = hash();
+    std::ofstream(dir_ / "white.png", std::ios::trunc) << "not a picture";
+    std::ifstream in(dir_ / "manifest.csv");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    ASSERT_NE(text.find(before), std::string::npos);
+    text.replace(text.find(before), before.size(), hash());
+    std::ofstream(dir_ / "manifest.csv", std::ios::trunc) << text;
+    const std::string why = refusal();
+    EXPECT_EQ(why.rfind((dir_ / "white.png").string() + ": ", 0), 0u) << why;
+    EXPECT_FALSE(wrote_anything());
+}
+
 TEST_F(SmallSet, AFileNameOutsideTheDirectoryIsRefused) {
     std::ifstream in(dir_ / "manifest.csv");
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
