@@ -150,11 +150,36 @@ TEST(ProtocolErrors, ImpossibleRandomisationIsReportedWhenPlanning) {
 }
 
 TEST(Protocol, StimulusLevelIsThePictureNotTheId) {
+    // Two ids with the same technique, mesh and parameters are one picture.
+    const Protocol twins = parse_protocol(R"toml(
+[study]
+name = "twins"
+[[questions]]
+id = "q"
+text = "Q"
+[[stimuli]]
+id = "a"
+technique = "empirical"
+params = { backlight = 1.2, albedo = [0.5, 0.1, 0.7] }
+[[stimuli]]
+id = "b"
+technique = "empirical"
+params = { backlight = 1.2, albedo = [0.5, 0.1, 0.7] }
+[[stimuli]]
+id = "c"
+technique = "empirical"
+params = { backlight = 1.2, albedo = [0.1, 0.6, 0.15] }
+[[blocks]]
+id = "main"
+stimuli = ["a", "b", "c"]
+)toml", "twins.toml");
+    EXPECT_EQ(twins.level_of(*twins.find_stimulus("b"), "stimulus"), "a");
+    EXPECT_EQ(twins.level_of(*twins.find_stimulus("c"), "stimulus"), "c");  // its colour
+    // The thesis's rows 1, 4 and 7 share Table 4.3's r, wb and Kb but each series has its
+    // colour (purple, green, blue): three pictures, as every stimulus of the protocol.
     const Protocol p = builtin_protocol("thesis");
-    // Rows 1, 4 and 7 of Table 4.3 are one picture (r 25, wb 1.2, Kb 0.2) under three ids.
-    for (const char* id : {"empirical_row_1", "empirical_row_4", "empirical_row_7"})
-        EXPECT_EQ(p.level_of(*p.find_stimulus(id), "stimulus"), "empirical_row_1") << id;
-    for (const char* id : {"empirical_row_2", "empirical_row_5", "ward_jade", "contrast_reversed_jade"})
+    for (const char* id : {"empirical_row_1", "empirical_row_4", "empirical_row_7",
+                           "empirical_row_2", "ward_jade", "contrast_reversed_jade"})
         EXPECT_EQ(p.level_of(*p.find_stimulus(id), "stimulus"), id);
     EXPECT_EQ(p.levels_of("stimulus").size(), p.stimuli.size());
 }
