@@ -57,13 +57,28 @@ BrowserPage open_in_browser(const std::filesystem::path& html,
                             const std::filesystem::path& screenshot, int width, int height) {
     BrowserPage page;
     const auto url = "file://" + std::filesystem::absolute(html).lexically_normal().string();
-    const auto work = screenshot.parent_path();
-    std::filesystem::create_directories(work);
+    if (!screenshot.parent_path().empty())
+        std::filesystem::create_directories(screenshot.parent_path());
+    // Chromium's output and log in a scratch folder of their own, removed afterwards.
+    char work_template[] = "/tmp/lucent-browser-XXXXXX";
+    const char* work_dir = mkdtemp(work_template);
+    if (!work_dir) {
+        page.error = "cannot create a scratch folder in /tmp";
+        return page;
+    }
+    const std::filesystem::path work = work_dir;
+    struct Cleanup {
+        std::filesystem::path dir;
+        ~Cleanup() {
+            std::error_code ignored;
+            std::filesystem::remove_all(dir, ignored);
+        }
+    } cleanup{work};
     if (std::system("command -v chromium > /dev/null 2>&1") != 0) {
         page.error = "chromium is not installed (Debian package chromium; scripts/install-deps)";
         return page;
     }
-    const auto dom_file = work / (screenshot.stem().string() + ".dom.html");
+    const auto dom_file = work / "dom.html";
     if (run_chromium("--dump-dom " + quoted(url), work, dom_file) != 0) {
         page.error = "chromium --dump-dom failed: " + last_line(read_text(work / "chromium.log"));
         return page;
