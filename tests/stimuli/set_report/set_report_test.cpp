@@ -175,6 +175,22 @@ TEST_F(SmallSet, WritesTheReportAndTheContactSheet) {
     EXPECT_GT(text, 100u);
 }
 
+TEST_F(SmallSet, TheCommandPrintsEachWarningAndWritesBothFiles) {
+    ::testing::internal::CaptureStderr();
+    ::testing::internal::CaptureStdout();
+    EXPECT_EQ(run_stimuli_report(dir_, {}), 0);  // warnings inform, they do not fail
+    const std::string out = ::testing::internal::GetCapturedStdout();
+    const std::string err = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(err,
+              "lucent stimuli report: warning: series 'grey': a vs b: mean Delta E00 0.00 is "
+              "below 3.00 (adjacent levels)\n"
+              "lucent stimuli report: warning: a and b are identical images (separate "
+              "stimuli, meant to differ)\n");
+    EXPECT_NE(out.find("wrote " + (dir_ / "report.html").string()), std::string::npos) << out;
+    EXPECT_NE(out.find("wrote " + (dir_ / "contact-sheet.png").string()), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir_ / "report.html") && fs::exists(dir_ / "contact-sheet.png"));
+}
+
 TEST_F(SmallSet, TheReportOpensInABrowserWithItsPicturesDrawn) {
     write_set_report(measure_stimulus_set(dir_));
     const auto page = test::open_in_browser(dir_ / "report.html", dir_ / "screenshot.png", 1280, 1400);
