@@ -4,11 +4,11 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
-#include <unordered_map>
 
 #include "data/decimal.h"
 
@@ -52,8 +52,14 @@ public:
         return line;
     }
     std::size_t line_no() const { return line_no_; }
-    std::size_t bytes_left() const {
-        return position_ < text_.size() ? text_.size() - position_ : 0;
+    // Lines after this one (at least as many as the records still to come): counted
+    // once so that a million rows are placed without a reallocation.
+    std::size_t lines_left() const {
+        if (position_ >= text_.size()) return 0;
+        return static_cast<std::size_t>(
+                   std::count(text_.begin() + static_cast<std::ptrdiff_t>(position_),
+                              text_.end(), '\n')) +
+               1;
     }
 
 private:
@@ -156,25 +162,49 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
 // Interns one column's texts for the parse. Long tables repeat a column's text for runs
 // of rows (one participant, factor and question for many ratings), so the previous text
-// is checked first; a local map then spares the shared pool's lock.
+// is checked first; a small open-addressing table (FNV-1a, linear probing) then spares
+// the shared pool's lock and std::hash's cost for the column that changes every row.
 class ColumnLabels {
 public:
     Label operator()(std::string_view text) {
-        if (has_previous_ && text == previous_text_) return previous_;
-        auto found = seen_.find(text);
-        if (found == seen_.end()) {
-            const Label label(text);
-            found = seen_.emplace(label.str(), label).first;  // key views the pool's text
+        if (has_previous_ && text == previous_.str()) return previous_;
+        if (4 * (used_ + 1) > 3 * slots_.size()) grow();
+        const std::uint64_t hash = fnv1a(text);
+        std::size_t at = hash & (slots_.size() - 1);
+        while (slots_[at].used && !(slots_[at].hash == hash && slots_[at].label == text))
+            at = (at + 1) & (slots_.size() - 1);
+        if (!slots_[at].used) {
+            slots_[at] = {hash, Label(text), true};
+            ++used_;
         }
-        previous_text_ = found->first;
-        previous_ = found->second;
+        previous_ = slots_[at].label;
         has_previous_ = true;
         return previous_;
     }
 
 private:
-    std::unordered_map<std::string_view, Label> seen_;
-    std::string_view previous_text_;
+    struct Slot {
+        std::uint64_t hash = 0;
+        Label label;
+        bool used = false;
+    };
+    static std::uint64_t fnv1a(std::string_view text) {
+        std::uint64_t hash = 0xcbf29ce484222325ULL;
+        for (const char c : text) hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+        return hash;
+    }
+    void grow() {
+        std::vector<Slot> old(std::max<std::size_t>(64, 2 * slots_.size()));
+        old.swap(slots_);
+        for (const Slot& slot : old) {
+            if (!slot.used) continue;
+            std::size_t at = slot.hash & (slots_.size() - 1);
+            while (slots_[at].used) at = (at + 1) & (slots_.size() - 1);
+            slots_[at] = slot;
+        }
+    }
+    std::vector<Slot> slots_;
+    std::size_t used_ = 0;
     Label previous_;
     bool has_previous_ = false;
 };
@@ -209,8 +239,7 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
                                      ": header lacks column '" + kColumns[c] +
                                      "' (expected participant,stimulus,factor,level,"
                                      "question,rating)");
-            // Rows still to come, estimated from the bytes left and the header's length.
-            table.rows.reserve(lines.bytes_left() / (line.size() + 1) + 16);
+            table.rows.reserve(lines.lines_left());
             continue;
         }
         if (fields.size() != header_fields)
