@@ -1,69 +1,13 @@
-// The lucent executable: parses the command line and hands over to one subcommand.
-#include <exception>
-#include <iostream>
-
-#include "commands.h"
-#include "lucent/version.h"
-
-namespace {
-bool is_subcommand(CLI::App& app, const std::string& name) {
-    for (const auto* sub : app.get_subcommands({}))
-        if (sub->get_name() == name) return true;
-    return false;
-}
-}  // namespace
+// lucent-full: every subcommand. Users run `lucent` (main_dispatch.cpp), which hands
+// everything but the analysis subcommands to this program.
+#include "cli_main.h"
+#include "light_commands.h"
 
 int main(int argc, char** argv) {
     using namespace lucent::app;
-    CLI::App app{"Lucent: stimuli, participant sessions and analysis for perceptual studies "
-                 "of translucent-looking objects",
-                 "lucent"};
-    app.set_version_flag("--version", std::string("lucent ") + lucent::version_string() +
-                                          " (" + lucent::build_hash() + ")");
-    app.require_subcommand(1);
-    app.fallthrough(false);
-
-    int exit_code = kExitOk;
-    register_info(app, exit_code);
-    register_render(app, exit_code);
-    register_run(app, exit_code);
-    register_participants(app, exit_code);
-    register_export(app, exit_code);
-    register_merge(app, exit_code);
-    register_analyze(app, exit_code);
-    register_stats(app, exit_code);
-    register_simulate(app, exit_code);
-    register_power(app, exit_code);
-    register_explore(app, exit_code);
-    register_stimuli(app, exit_code);
-    register_bench(app, exit_code);
-
-    // CLI11 would only say "A subcommand is required"; name the word it did not know.
-    if (argc > 1 && argv[1][0] != '-' && !is_subcommand(app, argv[1])) {
-        std::string valid;
-        for (const auto* sub : app.get_subcommands({}))
-            valid += (valid.empty() ? "" : ", ") + sub->get_name();
-        std::cerr << "lucent: unknown subcommand '" << argv[1] << "' (valid: " << valid
-                  << ")\n";
-        return kExitUsage;
-    }
-
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForAllHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForVersion& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        // One line, then the usual hint; usage errors always exit 2.
-        std::cerr << "lucent: " << e.what() << "\n"
-                  << "Run 'lucent --help' (or 'lucent SUBCOMMAND --help') for usage.\n";
-        return kExitUsage;
-    } catch (const std::exception& e) {
-        std::cerr << "lucent: " << e.what() << "\n";
-        return kExitFailure;
-    }
-    return exit_code;
+    std::vector<Registration> subcommands = {register_info,    register_render,
+                                             register_run,     register_explore,
+                                             register_stimuli, register_bench};
+    for (const LightCommand& light : light_commands()) subcommands.push_back(light.registration);
+    return run_cli(argc, argv, subcommands);
 }

@@ -4,11 +4,18 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "data/decimal.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace lucent::analysis {
 namespace {
@@ -26,40 +33,77 @@ std::string format_exact(double value) {
     return error == std::errc() ? std::string(buffer, end) : std::to_string(value);
 }
 
-// Splits one CSV record into `fields`. A record without quotes (the common case) is cut
-// at its commas in place: the views point into `line`, and a million rows cost no copies.
-// A quoted record is decoded into `decoded` (quotes may span lines: more lines are then
-// pulled from `in`).
-void split_record(std::string& line, std::istream& in, std::size_t& line_no,
-                  const std::string& source, std::vector<std::string>& decoded,
-                  std::vector<std::string_view>& views) {
-    views.clear();
-    if (line.find('"') == std::string::npos) {
-        for (std::size_t start = 0;;) {
-            const std::size_t comma = std::min(line.find(',', start), line.size());
-            views.emplace_back(line.data() + start, comma - start);
-            if (comma == line.size()) return;
-            start = comma + 1;
-        }
+// The CSV text, walked line by line without copying: a million rows cost no per-line
+// allocation. `line_no` counts physical lines (a quoted field may span several).
+class LineCursor {
+public:
+    explicit LineCursor(std::string_view text) : text_(text) {}
+    // The next line without its LF (and CR), or nullopt at the end.
+    std::optional<std::string_view> next() {
+        if (position_ >= text_.size()) return std::nullopt;
+        const char* begin = text_.data() + position_;
+        const void* newline = std::memchr(begin, '\n', text_.size() - position_);
+        const std::size_t length =
+            newline ? static_cast<const char*>(newline) - begin : text_.size() - position_;
+        position_ += length + 1;
+        ++line_no_;
+        std::string_view line(begin, length);
+        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+        return line;
     }
+    std::size_t line_no() const { return line_no_; }
+    // Lines after this one (at least as many as the records still to come): counted
+    // once so that a million rows are placed without a reallocation.
+    std::size_t lines_left() const {
+        if (position_ >= text_.size()) return 0;
+        return static_cast<std::size_t>(
+                   std::count(text_.begin() + static_cast<std::ptrdiff_t>(position_),
+                              text_.end(), '\n')) +
+               1;
+    }
+
+private:
+    std::string_view text_;
+    std::size_t position_ = 0, line_no_ = 0;
+};
+
+// Splits one CSV record into `views`. A record without quotes (the common case) is cut
+// at its commas in place: the views point into the text. A quoted record is decoded into
+// `decoded` (quotes may span lines: more lines are then pulled from `lines`).
+void split_record(std::string_view line, LineCursor& lines, const std::string& source,
+                  std::vector<std::string>& decoded, std::vector<std::string_view>& views) {
+    views.clear();
+    if (std::memchr(line.data(), '"', line.size()) == nullptr) {
+        // Fields are short: one pass over the characters beats a memchr per field.
+        const char* start = line.data();
+        const char* const end = line.data() + line.size();
+        for (const char* c = start; c != end; ++c)
+            if (*c == ',') {
+                views.emplace_back(start, c - start);
+                start = c + 1;
+            }
+        views.emplace_back(start, end - start);
+        return;
+    }
+    const std::size_t first_line = lines.line_no();
     std::vector<std::string>& fields = decoded;
     fields.assign(1, std::string());
     bool quoted = false;
+    std::string joined(line);
     for (std::size_t i = 0;; ++i) {
-        if (i == line.size()) {
+        if (i == joined.size()) {
             if (!quoted) break;
-            std::string more;
-            if (!std::getline(in, more))
-                throw InputError(location(source, line_no) +
+            const auto more = lines.next();
+            if (!more)
+                throw InputError(location(source, first_line) +
                                  ": unterminated quoted field");
-            ++line_no;
-            if (!more.empty() && more.back() == '\r') more.pop_back();
-            line += "\n" + more;
+            joined += '\n';
+            joined += *more;
         }
-        if (i == line.size()) break;
-        const char c = line[i];
+        if (i == joined.size()) break;
+        const char c = joined[i];
         if (quoted) {
-            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+            if (c == '"' && i + 1 < joined.size() && joined[i + 1] == '"') {
                 fields.back() += '"';
                 ++i;
             } else if (c == '"') {
@@ -79,25 +123,173 @@ void split_record(std::string& line, std::istream& in, std::size_t& line_no,
 }
 
 std::string_view trimmed(std::string_view s) {
-    const auto first = s.find_first_not_of(" \t");
-    if (first == std::string_view::npos) return {};
-    return s.substr(first, s.find_last_not_of(" \t") - first + 1);
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+    return s;
 }
 
-// Rows still to come, estimated from the bytes left and one line's length, when the
-// stream can tell its size (a file); 0 otherwise.
-std::size_t estimated_rows(std::istream& in, std::size_t line_length) {
-    const auto here = in.tellg();
-    if (here < 0 || line_length == 0) return 0;
-    in.seekg(0, std::ios::end);
-    const auto end = in.tellg();
-    in.seekg(here);
-    if (end < here || !in) {
-        in.clear();
-        in.seekg(here);
-        return 0;
+// A whole file mapped read-only (no copy into the heap); unmapped on destruction.
+class MappedFile {
+public:
+    explicit MappedFile(const std::filesystem::path& path) {
+        const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) throw InputError(path.string() + ": cannot open for reading");
+        struct stat info {};
+        if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_size > 0) {
+            size_ = static_cast<std::size_t>(info.st_size);
+            void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+            if (map != MAP_FAILED) data_ = static_cast<const char*>(map);
+        }
+        ::close(fd);
     }
-    return static_cast<std::size_t>(end - here) / (line_length + 1) + 16;
+    ~MappedFile() {
+        if (data_) ::munmap(const_cast<char*>(data_), size_);
+    }
+    MappedFile(const MappedFile&) = delete;
+    MappedFile& operator=(const MappedFile&) = delete;
+    // Empty when the file could not be mapped (empty, not regular): read it instead.
+    std::optional<std::string_view> text() const {
+        if (!data_) return std::nullopt;
+        return std::string_view(data_, size_);
+    }
+
+private:
+    const char* data_ = nullptr;
+    std::size_t size_ = 0;
+};
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+// Interns one column's texts for the parse. Long tables repeat a column's text for runs
+// of rows (one participant, factor and question for many ratings), so the previous text
+// is checked first; a small open-addressing table (FNV-1a, linear probing) then spares
+// the shared pool's lock and std::hash's cost for the column that changes every row.
+class ColumnLabels {
+public:
+    Label operator()(std::string_view text) {
+        if (has_previous_ && text == previous_.str()) return previous_;
+        if (4 * (used_ + 1) > 3 * slots_.size()) grow();
+        const std::uint64_t hash = fnv1a(text);
+        std::size_t at = hash & (slots_.size() - 1);
+        while (slots_[at].used && !(slots_[at].hash == hash && slots_[at].label == text))
+            at = (at + 1) & (slots_.size() - 1);
+        if (!slots_[at].used) {
+            slots_[at] = {hash, Label(text), true};
+            ++used_;
+        }
+        previous_ = slots_[at].label;
+        has_previous_ = true;
+        return previous_;
+    }
+
+private:
+    struct Slot {
+        std::uint64_t hash = 0;
+        Label label;
+        bool used = false;
+    };
+    static std::uint64_t fnv1a(std::string_view text) {
+        std::uint64_t hash = 0xcbf29ce484222325ULL;
+        for (const char c : text) hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+        return hash;
+    }
+    void grow() {
+        std::vector<Slot> old(std::max<std::size_t>(64, 2 * slots_.size()));
+        old.swap(slots_);
+        for (const Slot& slot : old) {
+            if (!slot.used) continue;
+            std::size_t at = slot.hash & (slots_.size() - 1);
+            while (slots_[at].used) at = (at + 1) & (slots_.size() - 1);
+            slots_[at] = slot;
+        }
+    }
+    std::vector<Slot> slots_;
+    std::size_t used_ = 0;
+    Label previous_;
+    bool has_previous_ = false;
+};
+
+LongTable parse_long_csv(std::string_view text, const std::string& source,
+                         const RatingScale& scale) {
+    LongTable table;
+    LineCursor lines(text);
+    std::array<int, kColumns.size()> column{};
+    column.fill(-1);
+    std::size_t header_fields = 0;
+    std::string origin_text;
+    std::vector<std::string> decoded;
+    std::vector<std::string_view> fields;
+    std::array<ColumnLabels, 5> labels;
+    while (const auto next = lines.next()) {
+        std::string_view line = *next;
+        const std::size_t line_no = lines.line_no();
+        if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // BOM
+        if (trimmed(line).empty()) continue;
+        split_record(line, lines, source, decoded, fields);
+        if (header_fields == 0) {
+            // Header: find each required column by name.
+            header_fields = fields.size();
+            for (std::size_t f = 0; f < fields.size(); ++f)
+                for (std::size_t c = 0; c < kColumns.size(); ++c)
+                    if (trimmed(fields[f]) == kColumns[c])
+                        column[c] = static_cast<int>(f);
+            for (std::size_t c = 0; c < kColumns.size(); ++c)
+                if (column[c] < 0)
+                    throw InputError(location(source, line_no) +
+                                     ": header lacks column '" + kColumns[c] +
+                                     "' (expected participant,stimulus,factor,level,"
+                                     "question,rating)");
+            table.rows.reserve(lines.lines_left());
+            continue;
+        }
+        if (fields.size() != header_fields)
+            throw InputError(location(source, line_no) + ": expected " +
+                             std::to_string(header_fields) + " fields, found " +
+                             std::to_string(fields.size()));
+        const std::string_view factor = trimmed(fields[column[2]]),
+                               level = trimmed(fields[column[3]]),
+                               question = trimmed(fields[column[4]]);
+        if (factor.empty() || level.empty() || question.empty())
+            throw InputError(location(source, line_no) +
+                             ": factor, level and question must not be empty");
+        RatingRow& row = table.rows.emplace_back();
+        row.participant = labels[0](trimmed(fields[column[0]]));
+        row.stimulus = labels[1](trimmed(fields[column[1]]));
+        row.factor = labels[2](factor);
+        row.level = labels[3](level);
+        row.question = labels[4](question);
+        row.source_line = line_no;
+        const std::string_view rating_text = trimmed(fields[column[5]]);
+        if (rating_text.empty() || rating_text == "NA") continue;
+        if (origin_text.empty()) {
+            const auto value = parse_finite_number(rating_text);
+            if (!value)
+                throw InputError(location(source, line_no) + ": rating '" +
+                                 std::string(rating_text) + "' is not a finite number");
+            origin_text = rating_text;
+            table.origin = *value;
+        }
+        if (rating_text.size() == 1 && is_digit(rating_text[0]) && origin_text.size() == 1) {
+            // Every Likert rating: one digit against a one-digit origin, exact.
+            row.rating = static_cast<double>(rating_text[0] - origin_text[0]);
+            continue;
+        }
+        if (!parse_finite_number(rating_text))
+            throw InputError(location(source, line_no) + ": rating '" +
+                             std::string(rating_text) + "' is not a finite number");
+        row.rating = exact_difference(rating_text, origin_text);
+    }
+    if (header_fields == 0) throw InputError(source + ": empty file (no header)");
+    // The origin is the first rating rounded to double; the stored differences are exact
+    // relative to its text, so add back what that rounding dropped.
+    if (!origin_text.empty()) {
+        const double rounding = exact_difference(origin_text, format_exact(table.origin));
+        if (rounding != 0.0)
+            for (RatingRow& row : table.rows)
+                if (row.rating) *row.rating += rounding;
+    }
+    check_scale(table, scale, source);
+    return table;
 }
 
 }  // namespace
@@ -141,79 +333,16 @@ void check_scale(const LongTable& table, const RatingScale& scale,
 
 LongTable read_long_csv(std::istream& in, const std::string& source,
                         const RatingScale& scale) {
-    LongTable table;
-    std::string line;
-    std::size_t line_no = 0;
-    std::array<int, kColumns.size()> column{};
-    column.fill(-1);
-    std::size_t header_fields = 0;
-    std::string origin_text;
-    std::vector<std::string> decoded;
-    std::vector<std::string_view> fields;
-    while (std::getline(in, line)) {
-        ++line_no;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // BOM
-        if (trimmed(line).empty()) continue;
-        split_record(line, in, line_no, source, decoded, fields);
-        if (header_fields == 0) {
-            // Header: find each required column by name.
-            header_fields = fields.size();
-            for (std::size_t f = 0; f < fields.size(); ++f)
-                for (std::size_t c = 0; c < kColumns.size(); ++c)
-                    if (trimmed(fields[f]) == kColumns[c])
-                        column[c] = static_cast<int>(f);
-            for (std::size_t c = 0; c < kColumns.size(); ++c)
-                if (column[c] < 0)
-                    throw InputError(location(source, line_no) +
-                                     ": header lacks column '" + kColumns[c] +
-                                     "' (expected participant,stimulus,factor,level,"
-                                     "question,rating)");
-            continue;
-        }
-        if (table.rows.empty()) table.rows.reserve(estimated_rows(in, line.size()));
-        if (fields.size() != header_fields)
-            throw InputError(location(source, line_no) + ": expected " +
-                             std::to_string(header_fields) + " fields, found " +
-                             std::to_string(fields.size()));
-        RatingRow row;
-        row.participant = trimmed(fields[column[0]]);
-        row.stimulus = trimmed(fields[column[1]]);
-        row.factor = trimmed(fields[column[2]]);
-        row.level = trimmed(fields[column[3]]);
-        row.question = trimmed(fields[column[4]]);
-        row.source_line = line_no;
-        if (row.factor.empty() || row.level.empty() || row.question.empty())
-            throw InputError(location(source, line_no) +
-                             ": factor, level and question must not be empty");
-        const std::string_view rating_text = trimmed(fields[column[5]]);
-        if (!rating_text.empty() && rating_text != "NA") {
-            if (!parse_finite_number(rating_text))
-                throw InputError(location(source, line_no) + ": rating '" +
-                                 std::string(rating_text) + "' is not a finite number");
-            if (origin_text.empty()) {
-                origin_text = rating_text;
-                table.origin = *parse_finite_number(rating_text);
-            }
-            row.rating = exact_difference(rating_text, origin_text);
-        }
-        table.rows.push_back(std::move(row));
-    }
-    if (header_fields == 0) throw InputError(source + ": empty file (no header)");
-    // The origin is the first rating rounded to double; the stored differences are exact
-    // relative to its text, so add back what that rounding dropped.
-    if (!origin_text.empty()) {
-        const double rounding = exact_difference(origin_text, format_exact(table.origin));
-        if (rounding != 0.0)
-            for (RatingRow& row : table.rows)
-                if (row.rating) *row.rating += rounding;
-    }
-    check_scale(table, scale, source);
-    return table;
+    std::ostringstream whole;
+    whole << in.rdbuf();
+    if (in.bad()) throw InputError(source + ": read error");
+    return parse_long_csv(whole.view(), source, scale);
 }
 
 LongTable read_long_csv(const std::filesystem::path& path, const RatingScale& scale) {
-    std::ifstream in(path, std::ios::binary);
+    const MappedFile mapped(path);
+    if (const auto text = mapped.text()) return parse_long_csv(*text, path.string(), scale);
+    std::ifstream in(path, std::ios::binary);  // a pipe or an empty file
     if (!in) throw InputError(path.string() + ": cannot open for reading");
     return read_long_csv(in, path.string(), scale);
 }

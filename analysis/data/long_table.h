@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "data/label.h"
+
 namespace lucent::analysis {
 
 // Bad input data: the message names the file and line (or row) and the field.
@@ -20,7 +22,7 @@ public:
 };
 
 struct RatingRow {
-    std::string participant, stimulus, factor, level, question;
+    Label participant, stimulus, factor, level, question;
     std::optional<double> rating;  // relative to LongTable::origin; empty: missing rating
     std::size_t source_line = 0;   // CSV line (or database row) for error messages
 };

@@ -7,25 +7,39 @@ namespace lucent::analysis {
 SubjectMatrix subject_by_level(const LongTable& table, const std::string& question,
                                const std::string& factor,
                                const std::vector<std::string>& levels) {
-    std::unordered_map<std::string, std::size_t> level_column;
+    // Labels are interned: the maps hash and compare pointers, not texts.
+    const Label question_label(question), factor_label(factor);
+    std::unordered_map<Label, std::size_t> level_column;
     for (std::size_t j = 0; j < levels.size(); ++j) level_column.emplace(levels[j], j);
     std::vector<std::string> participants;
-    std::unordered_map<std::string, std::size_t> participant_row;
+    std::unordered_map<Label, std::size_t> participant_row;
     struct Cell {
         long double sum = 0.0L;
         std::size_t count = 0;
     };
     std::vector<std::vector<Cell>> cells;
+    // Rows come in runs of one participant and level: the previous row's cell is
+    // checked first.
+    const RatingRow* previous = nullptr;
+    std::size_t row_at = 0, column_at = 0;
     for (const RatingRow& row : table.rows) {
-        if (!row.rating || row.question != question || row.factor != factor) continue;
-        const auto column = level_column.find(row.level);
-        if (column == level_column.end()) continue;
-        auto [it, inserted] = participant_row.emplace(row.participant, participants.size());
-        if (inserted) {
-            participants.push_back(row.participant);
-            cells.emplace_back(levels.size());
+        if (!row.rating || row.question != question_label || row.factor != factor_label)
+            continue;
+        if (!previous || row.level != previous->level) {
+            const auto column = level_column.find(row.level);
+            if (column == level_column.end()) continue;
+            column_at = column->second;
         }
-        Cell& cell = cells[it->second][column->second];
+        if (!previous || row.participant != previous->participant) {
+            auto [it, inserted] = participant_row.emplace(row.participant, participants.size());
+            if (inserted) {
+                participants.push_back(row.participant);
+                cells.emplace_back(levels.size());
+            }
+            row_at = it->second;
+        }
+        previous = &row;
+        Cell& cell = cells[row_at][column_at];
         cell.sum += *row.rating;
         ++cell.count;
     }

@@ -7,7 +7,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <random>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
+
+#include <unistd.h>
 
 #include "data/decimal.h"
 #include "data/grouping.h"
@@ -152,6 +156,82 @@ TEST(Grouping, NumericLevelsSortNumerically) {
     ASSERT_EQ(pairs[0].data.groups.size(), 3u);
     EXPECT_EQ(pairs[0].data.groups[0].level, "18");
     EXPECT_EQ(pairs[0].data.groups[2].level, "30");
+}
+
+
+TEST(LongTable, QuotedFieldsSpanLinesAndUnterminatedQuotesNameTheirLine) {
+    const LongTable t = read(
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,s1,f,1,\"two\nlines, \"\"quoted\"\"\",4\n"
+        "p1,s2,f,2,q,5\n");
+    ASSERT_EQ(t.rows.size(), 2u);
+    EXPECT_EQ(t.rows[0].question, "two\nlines, \"quoted\"");
+    EXPECT_EQ(t.rows[1].source_line, 4u);  // physical lines: the quoted field took two
+    const std::string message =
+        error_of("participant,stimulus,factor,level,question,rating\n"
+                 "p1,s1,f,1,q,4\n"
+                 "p1,s2,f,2,\"open,5\n"
+                 "p1,s3,f,3,q,6\n");
+    EXPECT_NE(message.find("ratings.csv:3: unterminated quoted field"), std::string::npos)
+        << message;
+}
+
+TEST(LongTable, FileAndStreamReadersAgree) {
+    // read_long_csv(path) maps the file; the stream reader copies it: same table.
+    std::ostringstream csv;
+    csv << "\xEF\xBB\xBFparticipant , stimulus,factor,level,question,rating\r\n";
+    std::mt19937 random(5);
+    for (int i = 0; i < 2000; ++i) {
+        csv << 'p' << i % 17 << ", s" << i % 101 << ",f," << i % 3 << ",q" << i % 2 << ',';
+        if (i % 97 == 0)
+            csv << "NA";
+        else
+            csv << 1 + random() % 7;
+        csv << (i % 2 ? "\r\n" : "\n");
+    }
+    csv << "p1,s1,f,0,q0,2.5\n";  // one non-integer rating takes the exact decimal path
+    const std::string text = csv.str();
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("lucent-long-table-" + std::to_string(::getpid()) + ".csv");
+    {
+        std::ofstream out(path, std::ios::binary);
+        out << text;
+    }
+    const LongTable from_file = read_long_csv(path, RatingScale{});
+    const LongTable from_stream = read(text);
+    std::filesystem::remove(path);
+    ASSERT_EQ(from_file.rows.size(), 2001u);
+    ASSERT_EQ(from_stream.rows.size(), from_file.rows.size());
+    EXPECT_EQ(from_file.origin, from_stream.origin);
+    for (std::size_t i = 0; i < from_file.rows.size(); ++i) {
+        const RatingRow &a = from_file.rows[i], &b = from_stream.rows[i];
+        ASSERT_EQ(a.participant, b.participant) << i;
+        ASSERT_EQ(a.stimulus, b.stimulus) << i;
+        ASSERT_EQ(a.level, b.level) << i;
+        ASSERT_EQ(a.question, b.question) << i;
+        ASSERT_EQ(a.rating, b.rating) << i;
+        ASSERT_EQ(a.source_line, b.source_line) << i;
+    }
+    EXPECT_EQ(from_file.rows[0].participant, "p0");  // trimmed, after the BOM
+    EXPECT_EQ(from_file.rows[1].stimulus, "s1");
+    EXPECT_FALSE(from_file.rows[0].rating.has_value());  // i = 0 is NA
+    EXPECT_DOUBLE_EQ(from_file.origin + *from_file.rows.back().rating, 2.5);
+    EXPECT_THROW(read_long_csv(path, RatingScale{}), InputError);  // gone: one line
+}
+
+TEST(Label, EqualTextsAreOneLabelAndOrderByText) {
+    const Label a("thickness"), b(std::string("thick") + "ness"), c("backlight"), empty;
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(a.identity(), b.identity());
+    EXPECT_NE(a, c);
+    EXPECT_LT(c, a);  // "backlight" < "thickness"
+    EXPECT_EQ(a, "thickness");
+    EXPECT_EQ(a, std::string("thickness"));
+    EXPECT_TRUE(empty.empty());
+    EXPECT_EQ(Label(""), empty);
+    EXPECT_EQ(a.str().size(), 9u);
+    EXPECT_EQ(std::hash<Label>{}(a), std::hash<Label>{}(b));
+    EXPECT_EQ("level " + a, "level thickness");
 }
 
 }  // namespace
