@@ -12,6 +12,8 @@
 namespace lucent::app {
 namespace {
 
+ThumbnailMaker thumbnail_maker = nullptr;
+
 struct AnalyzeArgs {
     std::string input, out_dir, factor, question, formats = "md,csv,html", scale = "1..7";
     std::string design;  // "", "between" or "within"
@@ -31,8 +33,10 @@ int run_analyze(const AnalyzeArgs& args) {
         options.inputs = {args.input};  // a report file never replaces the input
         std::optional<Design> plan_design;
         const LongTable table = read_ratings(args.input, parse_scale(args.scale), &plan_design);
-        if (!args.images.empty())
+        if (!args.images.empty()) {
             options.level_images = level_images_from_directory(table, args.images);
+            if (thumbnail_maker) options.thumbnail_png = thumbnail_maker;
+        }
         AnalysisRequest request{args.alpha, args.question, args.factor,
                                 [](const std::string& question, const std::string& factor,
                                    std::size_t levels) {
@@ -54,6 +58,8 @@ int run_analyze(const AnalyzeArgs& args) {
 }
 
 }  // namespace
+
+void set_analyze_thumbnail_maker(ThumbnailMaker maker) { thumbnail_maker = maker; }
 
 void register_analyze(CLI::App& app, int& exit_code) {
     auto args = std::make_shared<AnalyzeArgs>();

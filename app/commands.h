@@ -2,6 +2,8 @@
 // Each subcommand lives in its own cmd_<name>.cpp and registers itself here; main.cpp only
 // lists them. A subcommand's callback returns the process exit code through `exit_code`.
 #include <CLI/CLI.hpp>
+#include <filesystem>
+#include <string>
 
 namespace lucent::app {
 
@@ -23,6 +25,11 @@ void register_export(CLI::App& app, int& exit_code);
 void register_merge(CLI::App& app, int& exit_code);
 void register_explore(CLI::App& app, int& exit_code);
 void register_stimuli(CLI::App& app, int& exit_code);
+
+// `lucent analyze --images`: how a level's picture becomes a thumbnail (PNG bytes).
+// lucent-full sets it (it links the image library); unset, the picture itself is embedded.
+using ThumbnailMaker = std::string (*)(const std::filesystem::path& picture);
+void set_analyze_thumbnail_maker(ThumbnailMaker maker);
 
 // `lucent bench <family>`: registered from bench_families.cpp, one function per family.
 void register_bench_families(CLI::App& bench, int& exit_code);

@@ -13,12 +13,14 @@ namespace lucent::app {
 struct LightCommand {
     std::string_view name;
     Registration registration;
+    // Options that need lucent-full after all (`analyze --images` decodes pictures).
+    std::vector<std::string_view> full_options = {};
 };
 
 inline const std::vector<LightCommand>& light_commands() {
     static const std::vector<LightCommand> commands = {
         {"participants", register_participants}, {"export", register_export},
-        {"merge", register_merge},               {"analyze", register_analyze},
+        {"merge", register_merge},               {"analyze", register_analyze, {"--images"}},
         {"stats", register_stats},               {"simulate", register_simulate},
         {"power", register_power},
     };

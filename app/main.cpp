@@ -1,10 +1,12 @@
 // lucent-full: every subcommand. Users run `lucent` (main_dispatch.cpp), which hands
 // everything but the analysis subcommands to this program.
 #include "cli_main.h"
+#include "level_thumbnail.h"
 #include "light_commands.h"
 
 int main(int argc, char** argv) {
     using namespace lucent::app;
+    set_analyze_thumbnail_maker(level_thumbnail_png);
     std::vector<Registration> subcommands = {register_info,    register_render,
                                              register_run,     register_explore,
                                              register_stimuli, register_bench};

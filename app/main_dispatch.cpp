@@ -14,9 +14,22 @@
 
 namespace {
 
-bool is_light(std::string_view subcommand) {
-    for (const auto& light : lucent::app::light_commands())
-        if (light.name == subcommand) return true;
+// True when this process can run the command line: a light subcommand without any of
+// the options that need lucent-full.
+bool is_light(int argc, char** argv) {
+    if (argc < 2) return false;
+    for (const auto& light : lucent::app::light_commands()) {
+        if (light.name != argv[1]) continue;
+        for (int i = 2; i < argc; ++i) {
+            const std::string_view arg = argv[i];
+            for (const std::string_view option : light.full_options)
+                if (arg == option || (arg.size() > option.size() &&
+                                      arg.substr(0, option.size()) == option &&
+                                      arg[option.size()] == '='))
+                    return false;
+        }
+        return true;
+    }
     return false;
 }
 
@@ -40,7 +53,7 @@ int exec_full(char** argv) {
 
 int main(int argc, char** argv) {
     using namespace lucent::app;
-    if (argc < 2 || !is_light(argv[1])) return exec_full(argv);
+    if (!is_light(argc, argv)) return exec_full(argv);
     std::vector<Registration> subcommands;
     for (const LightCommand& light : light_commands()) subcommands.push_back(light.registration);
     return run_cli(argc, argv, subcommands);

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "data/long_table.h"
+#include "report/html_page.h"
 #include "output_file.h"
 #include "report/format.h"
 #include "report/svg_plot.h"
@@ -323,12 +324,31 @@ void render_markdown(const std::vector<Block>& doc, std::ostream& out) {
     }
 }
 
-void render_html(const std::vector<Block>& doc, std::ostream& out) {
+// The PNG bytes shown for a level's picture: a thumbnail when the caller can make one
+// (lucent-full decodes images; the analysis library does not), else the file itself,
+// scaled by the browser. Empty when neither can be read.
+std::string embedded_picture(const std::filesystem::path& path, const ReportOptions& options) {
+    if (options.thumbnail_png) {
+        try {
+            return options.thumbnail_png(path);
+        } catch (const std::exception&) {
+            return {};
+        }
+    }
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return in ? bytes.str() : std::string();
+}
+
+void render_html(const std::vector<Block>& doc, const ReportOptions& options,
+                 std::ostream& out) {
     out << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Lucent analysis "
            "report</"
            "title>\n<style>body{font-family:sans-serif;max-width:60em;margin:auto}"
            "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 8px;"
-           "text-align:right}</style></head><body>\n";
+           "text-align:right}</style>"
+        << images_drawn_script() << "</head><body>\n";
     for (const Block& b : doc) {
         switch (b.kind) {
             case Block::kHeading:
@@ -346,12 +366,10 @@ void render_html(const std::vector<Block>& doc, std::ostream& out) {
                 out << "<div class=\"thumbnails\">";
                 for (const Block::Image& image : b.images) {
                     out << "<figure style=\"display:inline-block;margin:4px\">";
-                    std::ifstream in(image.path, std::ios::binary);
-                    std::ostringstream bytes;
-                    bytes << in.rdbuf();
-                    if (in && !bytes.str().empty())
+                    const std::string png = embedded_picture(image.path, options);
+                    if (!png.empty())
                         out << "<img width=\"128\" alt=\"" << html_escape(image.caption)
-                            << "\" src=\"data:image/png;base64," << base64_encode(bytes.str())
+                            << "\" src=\"data:image/png;base64," << base64_encode(png)
                             << "\">";
                     else
                         out << "(image unreadable: " << html_escape(image.path.string()) << ")";
@@ -534,7 +552,7 @@ std::vector<std::filesystem::path> write_report(
     }
     if (options.html) {
         std::ostringstream out;
-        render_html(doc, out);
+        render_html(doc, options, out);
         files.emplace_back("report.html", out.str());
     }
     if (options.csv) write_csv_tables(analyses, files);

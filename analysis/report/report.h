@@ -3,6 +3,7 @@
 // thesis's Table 4.4, then per (question, factor): plot, descriptives, ANOVA, Tukey HSD,
 // Kruskal-Wallis and Welch), machine-readable CSV tables, and one SVG plot per pair.
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string_view>
 #include <utility>
@@ -27,6 +28,9 @@ struct ReportOptions {
     // PNG, so the report stays one file): (factor, level) -> (stimulus id, PNG path).
     std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
         level_images;
+    // Makes the PNG bytes of a small thumbnail of a picture file (throws when it cannot
+    // be decoded). Unset: the file itself is embedded and the browser scales it.
+    std::function<std::string(const std::filesystem::path&)> thumbnail_png;
 };
 
 // The picture of each (factor, level) from a folder of rendered stimuli (`lucent render`'s
