@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/ambient_occlusion.h"
+#include "core/pass_reuse.h"
 #include "gl/errors.h"
 #include "gl/program.h"
 #include "gl/readback.h"
@@ -139,6 +140,8 @@ struct FrameExecutor::Impl {
     std::map<std::string, FrameTexture> textures;
     std::map<std::string, Sampler> samplers;  // by sampler_key
     std::size_t uploads = 0;
+    PassReuse reuse;
+    bool reuse_enabled = false;
     std::map<std::string, Program> programs;
     std::vector<Query> queries;
     AmbientOcclusionSource ao_source = [](const Mesh& mesh, int rays) {
@@ -402,7 +405,11 @@ FrameExecutor::~FrameExecutor() = default;
 
 void FrameExecutor::set_ambient_occlusion_source(AmbientOcclusionSource source) {
     impl_->ao_source = std::move(source);
+    impl_->reuse.forget();  // the AO stream may differ now
+    impl_->ao_streams.clear();
 }
+
+void FrameExecutor::set_reuse_unchanged_passes(bool reuse) { impl_->reuse_enabled = reuse; }
 
 void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time_passes) {
     if (plan.width <= 0 || plan.height <= 0)
@@ -423,39 +430,50 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
     while (impl_->queries.size() < plan.passes.size())
         impl_->queries.push_back(make_query(GL_TIME_ELAPSED));
 
+    const std::vector<bool> run =
+        impl_->reuse.schedule(plan, impl_->mesh_key, impl_->reuse_enabled);
     std::vector<double> wall_ms;
     std::size_t index = 0;
-    for_each_pass(plan, [&](const Pass& pass) {
-        const auto start = std::chrono::steady_clock::now();
-        const bool gpu =
-            time_passes && gpu_timer && !cpu_pass(pass.kind);
-        if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
-        switch (pass.kind) {
-            case PassKind::bake_ambient_occlusion:
-                impl_->bake(scene, pass);
-                break;
-            case PassKind::upload:
-                impl_->upload(pass);
-                break;
-            case PassKind::build_mips:
-                impl_->build_mips(pass);
-                break;
-            case PassKind::draw_mesh:
-            case PassKind::fullscreen:
-                impl_->draw(pass, plan);
-                break;
-        }
-        if (gpu) glEndQuery(GL_TIME_ELAPSED);
-        if (time_passes && !gpu && !cpu_pass(pass.kind))
-            glFinish();
-        check_errors("pass '" + pass.name + "'");
-        wall_ms.push_back(std::chrono::duration<double, std::milli>(
-                              std::chrono::steady_clock::now() - start)
-                              .count());
-        ++index;
-    });
+    try {
+        for_each_pass(plan, [&](const Pass& pass) {
+            const auto start = std::chrono::steady_clock::now();
+            const bool runs = run[index];
+            const bool gpu = runs && time_passes && gpu_timer && !cpu_pass(pass.kind);
+            if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
+            switch (pass.kind) {
+                case PassKind::bake_ambient_occlusion:
+                    // The stream is cached; binding it is needed even when reused.
+                    impl_->bake(scene, pass);
+                    break;
+                case PassKind::upload:
+                    if (runs) impl_->upload(pass);
+                    break;
+                case PassKind::build_mips:
+                    if (runs) impl_->build_mips(pass);
+                    break;
+                case PassKind::draw_mesh:
+                case PassKind::fullscreen:
+                    if (runs) impl_->draw(pass, plan);
+                    break;
+            }
+            if (gpu) glEndQuery(GL_TIME_ELAPSED);
+            if (runs && time_passes && !gpu && !cpu_pass(pass.kind)) glFinish();
+            check_errors("pass '" + pass.name + "'");
+            wall_ms.push_back(std::chrono::duration<double, std::milli>(
+                                  std::chrono::steady_clock::now() - start)
+                                  .count());
+            ++index;
+        });
+    } catch (...) {
+        impl_->reuse.forget();  // what the failed pass left is unknown: rerun everything
+        throw;
+    }
     if (!time_passes) return;
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+        if (!run[i]) {
+            timings_.passes.push_back({plan.passes[i].name, 0.0, true});
+            continue;
+        }
         double ms = wall_ms[i];
         if (gpu_timer && !cpu_pass(plan.passes[i].kind)) {
             GLuint64 ns = 0;

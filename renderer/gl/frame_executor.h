@@ -43,6 +43,11 @@ public:
     FrameExecutor& operator=(const FrameExecutor&) = delete;
 
     void set_ambient_occlusion_source(AmbientOcclusionSource source);
+    // On: a pass whose inputs (description, uniforms, versions of what it reads, upload
+    // hash, mesh) are those of its last run, and whose outputs still hold that run's
+    // results, is not run again (core/pass_reuse.h); last_timings() marks it cached. For
+    // the explorer. Off (the default): every pass runs every frame, as benchmarks need.
+    void set_reuse_unchanged_passes(bool reuse);
 
     // Runs every pass of `plan` for `scene`. With `time_passes`, last_timings() holds
     // per-pass times afterwards (this waits for the GPU). Throws ShaderError, GlError
