@@ -185,11 +185,11 @@ std::string FramePlan::explain() const {
     std::string text;
     for (const auto& r : resources) {
         text += "resource " + r.name + ": ";
-        if (r.format == ResourceFormat::vertex_float)
-            text += "per vertex";
-        else
-            text += size_text(r.size, is_3d(r));
-        text += std::string(" ") + format_name(r.format);
+        if (r.format == ResourceFormat::vertex_float) {
+            text += "one float per vertex\n";
+            continue;
+        }
+        text += size_text(r.size, is_3d(r)) + " " + format_name(r.format);
         if (r.levels > 1) text += ", " + std::to_string(r.levels) + " levels";
         if (r.shape == ResourceShape::frame && r.format != ResourceFormat::vertex_float)
             text += " (frame)";

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "core/recording_executor.h"
 #include "core/technique.h"
 #include "techniques/registry.h"
 
@@ -351,6 +352,50 @@ TEST(PlanBuilder, KeptContentsAndMipsKeepTheirProducers) {
     EXPECT_NE(text.find("front_layer: - -> layers (rgba32f)  <keeps contents>  <blend over>"),
               std::string::npos)
         << text;
+}
+
+// The new pass kinds take part in culling like the others, --plan full keeps them, and
+// the recording executor runs them (calling a kept upload's producer once).
+TEST(PlanBuilder, NewPassKindsAreCulledWhenUnreadAndKeptInFullMode) {
+    int produced = 0;
+    const auto build = [&](PlanMode mode) {
+        PlanBuilder builder(mode, 8, 8);
+        builder.create(texture_2d("unused_table", ResourceFormat::r32f, 4, 1));
+        builder.create(texture_2d("unused_mips", ResourceFormat::r32f, 8, 8, 0));
+        builder.create(frame_texture("out", ResourceFormat::rgba32f));
+        Pass table{"unused_table", "", PassKind::upload};
+        table.writes = {"unused_table"};
+        table.data = {"h", [&produced] {
+                          ++produced;
+                          return TextureData{{4, 1, 1}, {std::vector<float>(4, 0.5f)}};
+                      }};
+        builder.add(table);
+        builder.add(pass_writing("level_zero", {"unused_mips"}, {{"unused_table", ""}}));
+        Pass mips{"mips", "", PassKind::build_mips};
+        mips.writes = {"unused_mips"};
+        builder.add(mips);
+        builder.add(pass_writing("final", {"out"}));
+        builder.set_output("out");
+        return builder.compile();
+    };
+    const FramePlan pruned = build(PlanMode::pruned);
+    EXPECT_EQ(pass_names(pruned), std::vector<std::string>{"final"});
+    EXPECT_EQ(pruned.culled,
+              (std::vector<std::string>{"unused_table", "level_zero", "mips"}));
+    EXPECT_EQ(pruned.resource("unused_mips"), nullptr);
+    RecordingExecutor recorder;
+    EXPECT_EQ(recorder.execute(pruned), std::vector<std::string>{"final"});
+    EXPECT_EQ(produced, 0);  // a culled upload never produces its data
+
+    const FramePlan full = build(PlanMode::full);
+    EXPECT_TRUE(full.culled.empty());
+    RecordingExecutor full_recorder;
+    EXPECT_EQ(full_recorder.execute(full),
+              (std::vector<std::string>{"unused_table", "level_zero", "mips", "final"}));
+    EXPECT_EQ(produced, 1);
+    EXPECT_NE(full.explain().find("resource unused_mips: 8x8 r32f, 4 levels"),
+              std::string::npos)
+        << full.explain();
 }
 
 TEST(TextureData, ChecksSizeLevelsAndTexelCounts) {
