@@ -115,9 +115,11 @@ std::vector<bool> PassReuse::schedule(const FramePlan& plan, const std::string& 
             const int levels = desc ? desc->levels : 1;
             if (pass.kind == PassKind::build_mips) {
                 inputs.push_back({w, 0});
-                for (int level = 1; level < levels; ++level) step.writes.push_back({w, level});
+                for (int level = 1; level < levels; ++level)
+                    step.writes.push_back({w, level});
             } else if (pass.kind == PassKind::upload) {
-                for (int level = 0; level < levels; ++level) step.writes.push_back({w, level});
+                for (int level = 0; level < levels; ++level)
+                    step.writes.push_back({w, level});
             } else {
                 step.writes.push_back({w, pass.level});
                 if (!pass.clear) inputs.push_back({w, pass.level});

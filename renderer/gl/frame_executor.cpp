@@ -77,8 +77,9 @@ GLenum wrap_mode(Wrap wrap) {
 }
 
 std::string sampler_key(const Sampling& s) {
-    return describe(s) + "/" + std::to_string(s.border.r) + "," + std::to_string(s.border.g) +
-           "," + std::to_string(s.border.b) + "," + std::to_string(s.border.a);
+    return describe(s) + "/" + std::to_string(s.border.r) + "," +
+           std::to_string(s.border.g) + "," + std::to_string(s.border.b) + "," +
+           std::to_string(s.border.a);
 }
 
 bool same_storage(const ResourceDesc& a, const ResourceDesc& b) {
@@ -207,12 +208,12 @@ struct FrameExecutor::Impl {
                 kept.emplace(r.name, std::move(it->second));
             } else {
                 const bool three_d = r.shape == ResourceShape::fixed_3d;
-                kept.emplace(r.name,
-                             FrameTexture{r,
-                                          make_texture(internal_format(r.format), r.size.x,
-                                                       r.size.y, three_d ? r.size.z : 0,
-                                                       r.levels),
-                                          ""});
+                kept.emplace(
+                    r.name,
+                    FrameTexture{r,
+                                 make_texture(internal_format(r.format), r.size.x,
+                                              r.size.y, three_d ? r.size.z : 0, r.levels),
+                                 ""});
             }
         }
         textures = std::move(kept);
@@ -225,8 +226,9 @@ struct FrameExecutor::Impl {
             const GLenum mag =
                 sampling.filter == TexelFilter::linear ? GL_LINEAR : GL_NEAREST;
             it = samplers
-                     .emplace(key, make_sampler(min_filter(sampling), mag,
-                                                wrap_mode(sampling.wrap), &sampling.border[0]))
+                     .emplace(key,
+                              make_sampler(min_filter(sampling), mag,
+                                           wrap_mode(sampling.wrap), &sampling.border[0]))
                      .first;
         }
         return it->second.id();
@@ -247,11 +249,12 @@ struct FrameExecutor::Impl {
         for (std::size_t l = 0; l < data.levels.size(); ++l) {
             const glm::ivec3 s = mip_size(target.desc.size, static_cast<int>(l), three_d);
             if (three_d)
-                glTextureSubImage3D(target.texture.id(), static_cast<GLint>(l), 0, 0, 0, s.x,
-                                    s.y, s.z, format, GL_FLOAT, data.levels[l].data());
+                glTextureSubImage3D(target.texture.id(), static_cast<GLint>(l), 0, 0, 0,
+                                    s.x, s.y, s.z, format, GL_FLOAT,
+                                    data.levels[l].data());
             else
-                glTextureSubImage2D(target.texture.id(), static_cast<GLint>(l), 0, 0, s.x, s.y,
-                                    format, GL_FLOAT, data.levels[l].data());
+                glTextureSubImage2D(target.texture.id(), static_cast<GLint>(l), 0, 0, s.x,
+                                    s.y, format, GL_FLOAT, data.levels[l].data());
         }
         target.uploaded_hash = pass.data.content_hash;
         ++uploads;
@@ -261,7 +264,8 @@ struct FrameExecutor::Impl {
     // made visible (base = max level), so the draw reads no level it writes.
     void build_mips(const Pass& pass) {
         FrameTexture& target = textures.at(pass.writes.at(0));
-        const GLuint prog = program({"gl/shaders/fullscreen.vert", "gl/shaders/box_mip.frag", {}});
+        const GLuint prog =
+            program({"gl/shaders/fullscreen.vert", "gl/shaders/box_mip.frag", {}});
         const GLuint id = target.texture.id();
         glUseProgram(prog);
         glProgramUniform1i(prog, glGetUniformLocation(prog, "source"), 0);
@@ -409,7 +413,9 @@ void FrameExecutor::set_ambient_occlusion_source(AmbientOcclusionSource source) 
     impl_->ao_streams.clear();
 }
 
-void FrameExecutor::set_reuse_unchanged_passes(bool reuse) { impl_->reuse_enabled = reuse; }
+void FrameExecutor::set_reuse_unchanged_passes(bool reuse) {
+    impl_->reuse_enabled = reuse;
+}
 
 void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time_passes) {
     if (plan.width <= 0 || plan.height <= 0)
@@ -494,34 +500,37 @@ Image FrameExecutor::read_output(const FramePlan& plan) const {
     Image image(texture.width(), texture.height());
     const std::size_t row = static_cast<std::size_t>(texture.width()) * 4;
     for (int y = 0; y < texture.height(); ++y)  // GL rows are bottom first
-        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row], row,
-                    &image.rgba[static_cast<std::size_t>(y) * row]);
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row],
+                    row, &image.rgba[static_cast<std::size_t>(y) * row]);
     return image;
 }
 
 std::vector<float> FrameExecutor::read_channel(const std::string& resource) const {
     const auto& texture = impl_->textures.at(resource);
-    const GLenum format = is_depth_format(texture.desc.format) ? GL_DEPTH_COMPONENT : GL_RED;
+    const GLenum format =
+        is_depth_format(texture.desc.format) ? GL_DEPTH_COMPONENT : GL_RED;
     const std::vector<float> pixels =
         read_texture_r32f(texture.texture, format, texture.width(), texture.height());
     check_errors("read-back of '" + resource + "'");
     std::vector<float> flipped(pixels.size());
     const std::size_t row = static_cast<std::size_t>(texture.width());
     for (int y = 0; y < texture.height(); ++y)
-        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row], row,
-                    &flipped[static_cast<std::size_t>(y) * row]);
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row],
+                    row, &flipped[static_cast<std::size_t>(y) * row]);
     return flipped;
 }
 
 TextureData FrameExecutor::read_texture(const std::string& resource, int level) const {
     auto it = impl_->textures.find(resource);
     if (it == impl_->textures.end())
-        throw std::runtime_error("read-back: no texture '" + resource + "' in this frame");
+        throw std::runtime_error("read-back: no texture '" + resource +
+                                 "' in this frame");
     const ResourceDesc& desc = it->second.desc;
     if (level < 0 || level >= desc.levels)
         throw std::runtime_error("read-back: '" + resource + "' has no level " +
                                  std::to_string(level));
-    const glm::ivec3 size = mip_size(desc.size, level, desc.shape == ResourceShape::fixed_3d);
+    const glm::ivec3 size =
+        mip_size(desc.size, level, desc.shape == ResourceShape::fixed_3d);
     TextureData data;
     data.size = size;
     data.levels.emplace_back(static_cast<std::size_t>(size.x) * size.y * size.z *

@@ -1,9 +1,10 @@
 #pragma once
 // Runs a FramePlan with OpenGL: allocates exactly the resources the plan names (textures
-// of each resource's shape and levels, the AO vertex stream, CPU data), compiles each pass's shader variant once, binds
-// reads to samplers and writes to a framebuffer, and draws. Optional per-pass GPU timer
-// queries feed `lucent bench frame` and the explorer's status bar. Needs a current GL 4.5
-// context; every GL object is owned by an RAII wrapper held here.
+// of each resource's shape and levels, the AO vertex stream, CPU data), compiles each
+// pass's shader variant once, binds reads to samplers and writes to a framebuffer, and
+// draws. Optional per-pass GPU timer queries feed `lucent bench frame` and the explorer's
+// status bar. Needs a current GL 4.5 context; every GL object is owned by an RAII wrapper
+// held here.
 #include <functional>
 #include <map>
 #include <memory>

@@ -5,8 +5,8 @@
 namespace lucent::explorer {
 
 std::string pass_times_text(const gl::FrameTimings& timings) {
-    std::string line =
-        timings.gpu_timer ? "GPU pass times (timer queries):" : "pass times (wall, glFinish):";
+    std::string line = timings.gpu_timer ? "GPU pass times (timer queries):"
+                                         : "pass times (wall, glFinish):";
     std::size_t ran = 0;
     for (const auto& pass : timings.passes) {
         char text[128];

@@ -8,7 +8,8 @@
 
 namespace lucent::explorer {
 
-// "GPU pass times (timer queries): front_depth cached  shade 1.23 ms  (1 of 2 passes ran)".
+// "GPU pass times (timer queries): front_depth cached  shade 1.23 ms  (1 of 2 passes
+// ran)".
 std::string pass_times_text(const gl::FrameTimings& timings);
 
 }  // namespace lucent::explorer

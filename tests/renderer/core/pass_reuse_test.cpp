@@ -147,9 +147,9 @@ protected:
                           glm::vec3 view = {0.0f, 0.0f, 1.0f}) {
         static const auto mesh = std::make_shared<const Mesh>(load_mesh("sphere:200"));
         const Technique& technique = find_technique(technique_name);
-        const Scene scene = make_scene(
-            mesh, technique, resolve_knob_values(knobs_for(technique), settings), 64, 48,
-            view);
+        const Scene scene =
+            make_scene(mesh, technique,
+                       resolve_knob_values(knobs_for(technique), settings), 64, 48, view);
         return make_frame_plan(scene, technique);
     }
 };
@@ -163,24 +163,26 @@ TEST_F(TechniqueReuse, EmpiricalSlidersRerunOnlyThePassesTheyTouch) {
     // A shading uniform: the shade pass only.
     EXPECT_EQ(executor.execute(plan("empirical", {{"shininess", "30"}})), Names{"shade"});
     // The smoothing kernel (a define): smoothing and shading, not the layers or the AO.
-    EXPECT_EQ(executor.execute(plan("empirical", {{"shininess", "30"}, {"blur_kernel", "3"}})),
-              (Names{"smooth_back_layer", "shade"}));
+    EXPECT_EQ(
+        executor.execute(plan("empirical", {{"shininess", "30"}, {"blur_kernel", "3"}})),
+        (Names{"smooth_back_layer", "shade"}));
     // AO rays: the bake and shading.
-    EXPECT_EQ(executor.execute(plan("empirical", {{"shininess", "30"}, {"blur_kernel", "3"},
-                                                  {"ao_rays", "64"}})),
-              (Names{"ambient_occlusion", "shade"}));
+    EXPECT_EQ(
+        executor.execute(plan(
+            "empirical", {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}})),
+        (Names{"ambient_occlusion", "shade"}));
     // Orbiting the camera: every drawing pass, never the AO bake.
-    EXPECT_EQ(executor.execute(plan("empirical",
-                                    {{"shininess", "30"}, {"blur_kernel", "3"},
-                                     {"ao_rays", "64"}},
-                                    {1.0f, 0.0f, 0.0f})),
-              (Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}));
+    EXPECT_EQ(
+        executor.execute(plan(
+            "empirical", {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}},
+            {1.0f, 0.0f, 0.0f})),
+        (Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}));
     // Another mesh: everything that depends on it.
-    EXPECT_EQ(executor.execute(plan("empirical",
-                                    {{"shininess", "30"}, {"blur_kernel", "3"},
-                                     {"ao_rays", "64"}},
-                                    {1.0f, 0.0f, 0.0f}),
-                               "another mesh"),
+    EXPECT_EQ(executor.execute(
+                  plan("empirical",
+                       {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}},
+                       {1.0f, 0.0f, 0.0f}),
+                  "another mesh"),
               (Names{"ambient_occlusion", "front_depth", "second_layer",
                      "smooth_back_layer", "shade"}));
 }

@@ -9,11 +9,13 @@ namespace {
 TEST(PassTimes, CachedPassesShowAsCachedAndTheCountOfPassesThatRan) {
     gl::FrameTimings timings;
     timings.gpu_timer = true;
-    timings.passes = {{"ambient_occlusion", 0.0, true}, {"front_depth", 0.0, true},
+    timings.passes = {{"ambient_occlusion", 0.0, true},
+                      {"front_depth", 0.0, true},
                       {"shade", 1.234, false}};
-    EXPECT_EQ(pass_times_text(timings),
-              "GPU pass times (timer queries):  ambient_occlusion cached  front_depth cached"
-              "  shade 1.23 ms  (1 of 3 passes ran)");
+    EXPECT_EQ(
+        pass_times_text(timings),
+        "GPU pass times (timer queries):  ambient_occlusion cached  front_depth cached"
+        "  shade 1.23 ms  (1 of 3 passes ran)");
     timings.gpu_timer = false;
     timings.passes = {{"shade", 0.5, false}};
     EXPECT_EQ(pass_times_text(timings),
