@@ -424,9 +424,14 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
     check_errors("GL calls before this frame");
     impl_->upload_mesh(*scene.mesh);
     check_errors("upload of mesh '" + scene.mesh->name + "'");
-    impl_->allocate(plan);
-    glDisableVertexArrayAttrib(impl_->mesh_vao.id(), 2);
-    check_errors("allocation of the frame's textures");
+    try {
+        impl_->allocate(plan);
+        glDisableVertexArrayAttrib(impl_->mesh_vao.id(), 2);
+        check_errors("allocation of the frame's textures");
+    } catch (...) {
+        impl_->reuse.forget();  // textures may have been dropped: trust none of them
+        throw;
+    }
 
     GLint timer_bits = 0;
     if (time_passes) glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &timer_bits);
