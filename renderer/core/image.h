@@ -1,6 +1,7 @@
 #pragma once
 // Linear float RGBA images, top row first (as image files store them). Alpha is coverage:
 // 1 where the object is, 0 on the background.
+#include <cstdint>
 #include <filesystem>
 #include <glm/glm.hpp>
 #include <stdexcept>
@@ -60,5 +61,8 @@ bool is_supported_image_path(const std::filesystem::path& path);
 
 // sRGB transfer function (IEC 61966-2-1) of one linear value clamped to [0, 1].
 float srgb_encode(float linear);
+// lround(srgb_encode(v) * 255) by table (what 8-bit files store), NaN as 0: the same
+// codes, several times faster.
+std::uint8_t srgb_encode_8bit(float linear);
 
 }  // namespace lucent
