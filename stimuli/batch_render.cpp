@@ -305,6 +305,41 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
         queue_changed.notify_all();
     };
 
+    // Files, statistics and the manifest row of one rendered stimulus; false when the run
+    // has stopped meanwhile (the row is then not written). Throws on I/O failure.
+    const auto finish_stimulus = [&](const RenderedStimulus& item, BatchTimings& timings) {
+        const std::size_t i = item.index;
+        const Stimulus& s = set.stimuli[i];
+        const Image& image = item.rendered.image;
+
+        auto start = Clock::now();
+        for (const auto format : set.formats)
+            write_image(dir / file_of(s, format), image, {.png = options.png});
+        timings.encode_seconds += seconds_since(start);
+
+        start = Clock::now();
+        ManifestRow row = identity_fields(set, s, *meshes.at(s.mesh_spec));
+        const auto stats = compute_image_statistics(
+            FloatImageView{image.width, image.height, 4, image.rgba}, kHistogramBins);
+        const auto measured = measured_fields(stats, item.rendered.non_finite_pixels);
+        row.insert(row.end(), measured.begin(), measured.end());
+        append_provenance(row, inputs[i], files_hash(dir, set, s));
+        timings.statistics_seconds += seconds_since(start);
+
+        std::size_t done = 0;
+        {
+            std::lock_guard lock(mutex);
+            if (!failure.empty()) return false;  // another worker failed meanwhile
+            rows[i] = std::move(row);
+            write_complete_rows(dir, set, rows);
+            finished_ids.push_back(s.id);
+            done = ++finished;
+            finished_signal.notify_one();
+        }
+        if (options.after_stimulus) options.after_stimulus(s.id, done);
+        return true;
+    };
+
     auto render_worker = [&](int index) {
         BatchTimings& timings = render_timings[std::size_t(index)];
         try {
@@ -336,6 +371,10 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
                 timings.gl_seconds +=
                     seconds_since(start) - (timings.ao_seconds - ao_before);
 
+                if (!options.overlap_encode) {  // encode here, before the next render
+                    if (!finish_stimulus(item, timings)) break;
+                    continue;
+                }
                 std::unique_lock lock(mutex);
                 queue_changed.wait(lock, [&] {
                     return queue.size() < std::size_t(jobs) || !failure.empty();
@@ -368,37 +407,7 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
                     queue.pop_front();
                     queue_changed.notify_all();
                 }
-                const std::size_t i = item->index;
-                const Stimulus& s = set.stimuli[i];
-                const Image& image = item->rendered.image;
-
-                auto start = Clock::now();
-                for (const auto format : set.formats)
-                    write_image(dir / file_of(s, format), image);
-                timings.encode_seconds += seconds_since(start);
-
-                start = Clock::now();
-                ManifestRow row = identity_fields(set, s, *meshes.at(s.mesh_spec));
-                const auto stats = compute_image_statistics(
-                    FloatImageView{image.width, image.height, 4, image.rgba},
-                    kHistogramBins);
-                const auto measured =
-                    measured_fields(stats, item->rendered.non_finite_pixels);
-                row.insert(row.end(), measured.begin(), measured.end());
-                append_provenance(row, inputs[i], files_hash(dir, set, s));
-                timings.statistics_seconds += seconds_since(start);
-
-                std::size_t done = 0;
-                {
-                    std::lock_guard lock(mutex);
-                    if (!failure.empty()) return;  // another worker failed meanwhile
-                    rows[i] = std::move(row);
-                    write_complete_rows(dir, set, rows);
-                    finished_ids.push_back(s.id);
-                    done = ++finished;
-                    finished_signal.notify_one();
-                }
-                if (options.after_stimulus) options.after_stimulus(s.id, done);
+                if (!finish_stimulus(*item, timings)) return;
             }
         } catch (const std::exception& e) {
             std::lock_guard lock(mutex);
@@ -408,7 +417,7 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     std::vector<std::thread> workers;
     for (int w = 0; w < jobs && !pending.empty(); ++w) {
         workers.emplace_back(render_worker, w);
-        workers.emplace_back(encode_worker, w);
+        if (options.overlap_encode) workers.emplace_back(encode_worker, w);
     }
 
     BatchProgress progress(pending.size(), options.progress);

@@ -32,17 +32,23 @@ std::uint16_t encode_channel(float v, bool linear, float scale) {
     return static_cast<std::uint16_t>(std::lround((linear ? u : srgb_encode(u)) * scale));
 }
 
+struct Srgb8Table;
+const Srgb8Table& srgb8_table();
+std::uint8_t encode_srgb8(const Srgb8Table& table, float v);
+
 // Rows stay top first; both OIIO and Image store them so.
 template <typename T>
 std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
     std::vector<T> out(static_cast<std::size_t>(image.width) * image.height * 3);
-    const bool srgb8 = !linear && sizeof(T) == 1;  // the common case: a table
-    for (std::size_t i = 0, n = out.size() / 3; i < n; ++i)
-        for (int c = 0; c < 3; ++c) {
-            const float v = image.rgba[i * 4 + c];
-            out[i * 3 + c] = srgb8 ? static_cast<T>(srgb_encode_8bit(v))
-                                   : static_cast<T>(encode_channel(v, linear, scale));
-        }
+    const std::size_t values = out.size();
+    if (!linear && sizeof(T) == 1) {  // the common case: by table
+        const Srgb8Table& table = srgb8_table();
+        for (std::size_t i = 0; i < values; ++i)
+            out[i] = static_cast<T>(encode_srgb8(table, image.rgba[i / 3 * 4 + i % 3]));
+        return out;
+    }
+    for (std::size_t i = 0; i < values; ++i)
+        out[i] = static_cast<T>(encode_channel(image.rgba[i / 3 * 4 + i % 3], linear, scale));
     return out;
 }
 
@@ -93,20 +99,23 @@ struct Srgb8Table {
             bucket[b] = static_cast<std::uint8_t>(k);
         }
     }
-    std::uint8_t encode(float v) const {
-        const float u = clamp_unit(v);  // non-negative: bit patterns order as values
-        int k = bucket[bits(u) >> kShift];
-        while (threshold[k + 1] <= u) ++k;
-        return static_cast<std::uint8_t>(k);
-    }
 };
+
+const Srgb8Table& srgb8_table() {
+    static const Srgb8Table table;
+    return table;
+}
+
+std::uint8_t encode_srgb8(const Srgb8Table& table, float v) {
+    const float u = clamp_unit(v);  // non-negative: bit patterns order as values
+    int k = table.bucket[Srgb8Table::bits(u) >> Srgb8Table::kShift];
+    while (table.threshold[k + 1] <= u) ++k;
+    return static_cast<std::uint8_t>(k);
+}
 
 }  // namespace
 
-std::uint8_t srgb_encode_8bit(float linear) {
-    static const Srgb8Table table;
-    return table.encode(linear);
-}
+std::uint8_t srgb_encode_8bit(float linear) { return encode_srgb8(srgb8_table(), linear); }
 
 std::size_t replace_non_finite(Image& image) {
     std::size_t replaced = 0;
@@ -164,8 +173,10 @@ void write_image(const std::filesystem::path& path, const Image& input,
     } else if (ext == ".png") {
         OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
         spec.attribute("oiio:ColorSpace", options.linear ? "linear" : "sRGB");
-        spec.attribute("compression", kPngStrategy);
-        spec.attribute("png:filter", kPngFilterPaeth);
+        if (options.png == PngEncoding::fast) {
+            spec.attribute("compression", kPngStrategy);
+            spec.attribute("png:filter", kPngFilterPaeth);
+        }
         const auto pixels = encode_rgb<std::uint8_t>(image, options.linear, 255.0f);
         ok = out->open(temporary.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
