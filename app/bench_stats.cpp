@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_results.h"
 #include "commands.h"
 #include "data/long_table.h"
 #include "simulate/simulate.h"
@@ -39,27 +40,7 @@ double thread_seconds() {
     return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
-// Every printed number, also written to --csv as section,name,value,unit.
-struct Results {
-    struct Row {
-        std::string section, name;
-        double value;
-        std::string unit;
-    };
-    std::vector<Row> rows;
-    void add(std::string section, std::string name, double value, std::string unit) {
-        rows.push_back({std::move(section), std::move(name), value, std::move(unit)});
-    }
-    bool write_csv(const std::string& path) const {
-        std::ofstream out(path);
-        if (!out) return false;
-        out << "section,name,value,unit\n";
-        for (const Row& r : rows)
-            out << r.section << ",\"" << r.name << "\"," << r.value << ',' << r.unit
-                << '\n';
-        return static_cast<bool>(out);
-    }
-};
+using Results = BenchResults;  // every printed number, also written to --csv
 
 void bench_in_process(long ratings, int groups, Results& results) {
     using namespace lucent::analysis;

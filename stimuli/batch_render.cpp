@@ -13,6 +13,7 @@
 #include <charconv>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -279,19 +280,70 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
         prebake_seconds = seconds_since(start);
     }
 
-    // Render the pending stimuli on `jobs` workers, each with its own GL context.
-    std::mutex mutex;
-    std::condition_variable finished_signal;
+    // Render the pending stimuli on `jobs` render workers, each with its own GL context,
+    // and encode them on `jobs` encode workers, so files are written while the next
+    // image renders. A bounded queue between them holds at most `jobs` images. The first
+    // failure anywhere (GL, I/O, after_stimulus) stops both sides: rendered but not yet
+    // encoded images are dropped, so the manifest lists only finished stimuli.
+    struct RenderedStimulus {
+        std::size_t index;  // into set.stimuli
+        RenderedImage rendered;
+    };
+    std::mutex mutex;  // guards everything below and the manifest rows
+    std::condition_variable finished_signal, queue_changed;
     std::size_t finished = 0;
     std::atomic<std::size_t> next{0};
     std::string failure;
     std::vector<std::string> finished_ids;
+    std::deque<RenderedStimulus> queue;
     const int jobs =
         std::clamp(options.jobs, 1, int(std::max<std::size_t>(pending.size(), 1)));
-    std::vector<BatchTimings> worker_timings(static_cast<std::size_t>(jobs));
+    int rendering = jobs;  // render workers still running; 0 closes the queue
+    std::vector<BatchTimings> render_timings(static_cast<std::size_t>(jobs)),
+        encode_timings(static_cast<std::size_t>(jobs));
+    const auto fail = [&](const std::string& what) {  // caller holds `mutex`
+        if (failure.empty()) failure = what;
+        finished_signal.notify_all();
+        queue_changed.notify_all();
+    };
 
-    auto worker = [&](int index) {
-        BatchTimings& timings = worker_timings[std::size_t(index)];
+    // Files, statistics and the manifest row of one rendered stimulus; false when the run
+    // has stopped meanwhile (the row is then not written). Throws on I/O failure.
+    const auto finish_stimulus = [&](const RenderedStimulus& item, BatchTimings& timings) {
+        const std::size_t i = item.index;
+        const Stimulus& s = set.stimuli[i];
+        const Image& image = item.rendered.image;
+
+        auto start = Clock::now();
+        for (const auto format : set.formats)
+            write_image(dir / file_of(s, format), image, {.png = options.png});
+        timings.encode_seconds += seconds_since(start);
+
+        start = Clock::now();
+        ManifestRow row = identity_fields(set, s, *meshes.at(s.mesh_spec));
+        const auto stats = compute_image_statistics(
+            FloatImageView{image.width, image.height, 4, image.rgba}, kHistogramBins);
+        const auto measured = measured_fields(stats, item.rendered.non_finite_pixels);
+        row.insert(row.end(), measured.begin(), measured.end());
+        append_provenance(row, inputs[i], files_hash(dir, set, s));
+        timings.statistics_seconds += seconds_since(start);
+
+        std::size_t done = 0;
+        {
+            std::lock_guard lock(mutex);
+            if (!failure.empty()) return false;  // another worker failed meanwhile
+            rows[i] = std::move(row);
+            write_complete_rows(dir, set, rows);
+            finished_ids.push_back(s.id);
+            done = ++finished;
+            finished_signal.notify_one();
+        }
+        if (options.after_stimulus) options.after_stimulus(s.id, done);
+        return true;
+    };
+
+    auto render_worker = [&](int index) {
+        BatchTimings& timings = render_timings[std::size_t(index)];
         try {
             auto context = gl::create_headless_context();
             gl::FrameExecutor executor;
@@ -306,57 +358,69 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
             for (std::size_t k; (k = next++) < pending.size();) {
                 {
                     std::lock_guard lock(mutex);
-                    if (!failure.empty()) return;
+                    if (!failure.empty()) break;
                 }
                 const std::size_t i = pending[k];
                 const Stimulus& s = set.stimuli[i];
-                const auto mesh = meshes.at(s.mesh_spec);
                 const Technique& technique = find_technique(s.technique);
 
                 // The single-image path of `lucent render --mesh`.
-                auto start = Clock::now();
+                const auto start = Clock::now();
                 const double ao_before = timings.ao_seconds;
-                const Scene scene =
-                    make_scene(mesh, technique, s.parameters, set.width, set.height);
-                const RenderedImage rendered = render_image_counted(executor, scene);
-                const Image& image = rendered.image;
+                const Scene scene = make_scene(meshes.at(s.mesh_spec), technique,
+                                               s.parameters, set.width, set.height);
+                RenderedStimulus item{i, render_image_counted(executor, scene)};
                 timings.gl_seconds +=
                     seconds_since(start) - (timings.ao_seconds - ao_before);
 
-                start = Clock::now();
-                for (const auto format : set.formats)
-                    write_image(dir / file_of(s, format), image);
-                timings.encode_seconds += seconds_since(start);
-
-                start = Clock::now();
-                ManifestRow row = identity_fields(set, s, *mesh);
-                const auto stats = compute_image_statistics(
-                    FloatImageView{image.width, image.height, 4, image.rgba},
-                    kHistogramBins);
-                const auto measured = measured_fields(stats, rendered.non_finite_pixels);
-                row.insert(row.end(), measured.begin(), measured.end());
-                append_provenance(row, inputs[i], files_hash(dir, set, s));
-                timings.statistics_seconds += seconds_since(start);
-
-                std::size_t done = 0;
-                {
-                    std::lock_guard lock(mutex);
-                    rows[i] = std::move(row);
-                    write_complete_rows(dir, set, rows);
-                    finished_ids.push_back(s.id);
-                    done = ++finished;
-                    finished_signal.notify_one();
+                if (!options.overlap_encode) {  // encode here, before the next render
+                    if (!finish_stimulus(item, timings)) break;
+                    continue;
                 }
-                if (options.after_stimulus) options.after_stimulus(s.id, done);
+                std::unique_lock lock(mutex);
+                queue_changed.wait(lock, [&] {
+                    return queue.size() < std::size_t(jobs) || !failure.empty();
+                });
+                if (!failure.empty()) break;
+                queue.push_back(std::move(item));
+                queue_changed.notify_all();
             }
         } catch (const std::exception& e) {
             std::lock_guard lock(mutex);
-            if (failure.empty()) failure = e.what();
-            finished_signal.notify_one();
+            fail(e.what());
+        }
+        std::lock_guard lock(mutex);
+        --rendering;
+        queue_changed.notify_all();
+    };
+
+    auto encode_worker = [&](int index) {
+        BatchTimings& timings = encode_timings[std::size_t(index)];
+        try {
+            for (;;) {
+                std::optional<RenderedStimulus> item;
+                {
+                    std::unique_lock lock(mutex);
+                    queue_changed.wait(lock, [&] {
+                        return !queue.empty() || rendering == 0 || !failure.empty();
+                    });
+                    if (!failure.empty() || queue.empty()) return;
+                    item = std::move(queue.front());
+                    queue.pop_front();
+                    queue_changed.notify_all();
+                }
+                if (!finish_stimulus(*item, timings)) return;
+            }
+        } catch (const std::exception& e) {
+            std::lock_guard lock(mutex);
+            fail(e.what());
         }
     };
     std::vector<std::thread> workers;
-    for (int w = 0; w < jobs && !pending.empty(); ++w) workers.emplace_back(worker, w);
+    for (int w = 0; w < jobs && !pending.empty(); ++w) {
+        workers.emplace_back(render_worker, w);
+        if (options.overlap_encode) workers.emplace_back(encode_worker, w);
+    }
 
     BatchProgress progress(pending.size(), options.progress);
     {
@@ -388,12 +452,13 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     }
     result.rows = std::move(rows);
     result.timings.ao_seconds = prebake_seconds;
-    for (const auto& t : worker_timings) {
-        result.timings.ao_seconds += t.ao_seconds;
-        result.timings.gl_seconds += t.gl_seconds;
-        result.timings.encode_seconds += t.encode_seconds;
-        result.timings.statistics_seconds += t.statistics_seconds;
-    }
+    for (const auto* timings : {&render_timings, &encode_timings})
+        for (const auto& t : *timings) {
+            result.timings.ao_seconds += t.ao_seconds;
+            result.timings.gl_seconds += t.gl_seconds;
+            result.timings.encode_seconds += t.encode_seconds;
+            result.timings.statistics_seconds += t.statistics_seconds;
+        }
     result.timings.wall_seconds = seconds_since(wall_start);
     return result;
 }

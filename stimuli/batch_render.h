@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/image.h"
 #include "manifest.h"
 #include "stimulus_set.h"
 
@@ -20,15 +21,23 @@ namespace lucent::stimuli {
 
 struct BatchOptions {
     std::filesystem::path out_dir;
-    int jobs = 1;          // worker threads, each with its own headless GL context
+    // Render workers, each with its own headless GL context, and as many encode workers
+    // (image files, statistics, manifest), which write one image while the next renders.
+    int jobs = 1;
     bool force = false;    // re-render every stimulus
+    // false: each render worker encodes its own images before rendering the next (no
+    // encode workers; `lucent bench render` times both ways).
+    bool overlap_encode = true;
+    PngEncoding png = PngEncoding::fast;  // how PNG files are compressed (same pixels)
     bool progress = true;  // progress line on stderr
-    // Called on the worker's thread after each rendered stimulus is in the manifest, with
-    // its id and how many have finished (tests interrupt a set here; may throw).
+    // Called on an encode worker's thread after each rendered stimulus is in the
+    // manifest, with its id and how many have finished (tests interrupt a set here; may
+    // throw: the run then stops and throws).
     std::function<void(const std::string& id, std::size_t finished)> after_stimulus;
 };
 
-// Where the time went (seconds, summed over workers).
+// Where the time went (seconds, summed over workers; render and encode workers run at
+// once, so the stages can add up to more than the wall time).
 struct BatchTimings {
     double ao_seconds = 0.0;          // AO bakes and cache loads
     double gl_seconds = 0.0;          // plan + GL passes + read-back, AO excluded

@@ -16,7 +16,17 @@
 namespace lucent {
 
 // Bumped whenever the bake's results change, so stale cache files are never used.
-inline constexpr int kAoAlgorithmVersion = 1;
+// 2: each vertex's rays traced as one Embree stream; the phi shift applied by rotating
+// the tangent frame (the same directions up to float rounding).
+inline constexpr int kAoAlgorithmVersion = 2;
+
+// Where a bake's time went, summed over its threads (thread CPU time); filled when
+// AoBakeOptions::timings is set (costs two clock reads per vertex).
+struct AoBakeTimings {
+    double setup_cpu_seconds = 0.0;  // ray directions and origins
+    double trace_cpu_seconds = 0.0;  // Embree occlusion queries (the ceiling's rate)
+    double rays = 0.0;               // rays traced
+};
 
 struct AoBakeOptions {
     int rays = 320;  // rays per vertex, >= 1
@@ -26,6 +36,8 @@ struct AoBakeOptions {
     // Called now and then with (vertices done, total) from the calling thread; may be
     // empty.
     std::function<void(std::size_t, std::size_t)> progress;
+    // Accumulated into when non-null (benchmarks); results do not depend on it.
+    AoBakeTimings* timings = nullptr;
 };
 
 // One value in [0, 1] per vertex (1 = fully open). Never reads or writes a cache.

@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -22,18 +23,41 @@ std::string lower_extension(const std::filesystem::path& path) {
     throw ImageError(path.string() + ": " + why);
 }
 
+// A channel value as written to 8/16-bit files: NaN as 0, clamped to [0, 1] (so -Inf
+// is 0 and +Inf is 1: what replace_non_finite() followed by the clamp gives).
+float clamp_unit(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
+
+std::uint16_t encode_channel(float v, bool linear, float scale) {
+    const float u = clamp_unit(v);
+    return static_cast<std::uint16_t>(std::lround((linear ? u : srgb_encode(u)) * scale));
+}
+
+struct Srgb8Table;
+const Srgb8Table& srgb8_table();
+std::uint8_t encode_srgb8(const Srgb8Table& table, float v);
+
 // Rows stay top first; both OIIO and Image store them so.
 template <typename T>
 std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
     std::vector<T> out(static_cast<std::size_t>(image.width) * image.height * 3);
-    for (std::size_t i = 0, n = out.size() / 3; i < n; ++i)
-        for (int c = 0; c < 3; ++c) {
-            const float v = std::clamp(image.rgba[i * 4 + c], 0.0f, 1.0f);
-            out[i * 3 + c] =
-                static_cast<T>(std::lround((linear ? v : srgb_encode(v)) * scale));
-        }
+    const std::size_t values = out.size();
+    if (!linear && sizeof(T) == 1) {  // the common case: by table
+        const Srgb8Table& table = srgb8_table();
+        for (std::size_t i = 0; i < values; ++i)
+            out[i] = static_cast<T>(encode_srgb8(table, image.rgba[i / 3 * 4 + i % 3]));
+        return out;
+    }
+    for (std::size_t i = 0; i < values; ++i)
+        out[i] = static_cast<T>(encode_channel(image.rgba[i / 3 * 4 + i % 3], linear, scale));
     return out;
 }
+
+// PNG settings: zlib's run-length strategy after the Paeth filter on every row. Lossless
+// like any PNG, deterministic (same pixels, same bytes), and about 4x faster to encode
+// than libpng's default (level 6, adaptive filters) on renders with flat backgrounds,
+// for files ~15% larger (measured on the thesis set; stimuli/README.md).
+constexpr const char* kPngStrategy = "rle";
+constexpr int kPngFilterPaeth = 0x80;  // libpng's PNG_FILTER_PAETH
 
 }  // namespace
 
@@ -41,6 +65,57 @@ float srgb_encode(float linear) {
     const float v = std::clamp(linear, 0.0f, 1.0f);
     return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
+
+namespace {
+
+// The 8-bit sRGB encoding by table: threshold[k] is the smallest float whose
+// lround(srgb_encode(v) * 255) is at least k (binary search over the float bit
+// patterns, as the encoding is monotone), and bucket[] the code at the start of each
+// run of 2^16 bit patterns, so a lookup is one index plus at most a few compares.
+struct Srgb8Table {
+    static constexpr int kShift = 16;
+    float threshold[257];
+    std::vector<std::uint8_t> bucket;
+
+    static int direct(float v) { return int(std::lround(srgb_encode(v) * 255.0f)); }
+    static std::uint32_t bits(float v) { return std::bit_cast<std::uint32_t>(v); }
+
+    Srgb8Table() {
+        threshold[0] = 0.0f;
+        for (int k = 1; k <= 255; ++k) {
+            std::uint32_t lo = 0, hi = bits(1.0f);  // direct(lo) < k <= direct(hi)
+            while (hi - lo > 1) {
+                const std::uint32_t mid = lo + (hi - lo) / 2;
+                (direct(std::bit_cast<float>(mid)) >= k ? hi : lo) = mid;
+            }
+            threshold[k] = std::bit_cast<float>(hi);
+        }
+        threshold[256] = std::numeric_limits<float>::infinity();
+        bucket.resize((bits(1.0f) >> kShift) + 1);
+        int k = 0;
+        for (std::size_t b = 0; b < bucket.size(); ++b) {
+            const float start = std::bit_cast<float>(std::uint32_t(b << kShift));
+            while (k < 255 && threshold[k + 1] <= start) ++k;
+            bucket[b] = static_cast<std::uint8_t>(k);
+        }
+    }
+};
+
+const Srgb8Table& srgb8_table() {
+    static const Srgb8Table table;
+    return table;
+}
+
+std::uint8_t encode_srgb8(const Srgb8Table& table, float v) {
+    const float u = clamp_unit(v);  // non-negative: bit patterns order as values
+    int k = table.bucket[Srgb8Table::bits(u) >> Srgb8Table::kShift];
+    while (table.threshold[k + 1] <= u) ++k;
+    return static_cast<std::uint8_t>(k);
+}
+
+}  // namespace
+
+std::uint8_t srgb_encode_8bit(float linear) { return encode_srgb8(srgb8_table(), linear); }
 
 std::size_t replace_non_finite(Image& image) {
     std::size_t replaced = 0;
@@ -74,8 +149,14 @@ void write_image(const std::filesystem::path& path, const Image& input,
     if (input.width <= 0 || input.height <= 0 ||
         input.rgba.size() != static_cast<std::size_t>(input.width) * input.height * 4)
         fail(path, "image has no pixels");
-    Image image = input;
-    replace_non_finite(image);
+    // Only EXR stores floats as they are; 8/16-bit encoders map NaN and Inf themselves
+    // (encode_rgb), so the image is copied for EXR alone.
+    Image repaired;
+    if (ext == ".exr") {
+        repaired = input;
+        replace_non_finite(repaired);
+    }
+    const Image& image = ext == ".exr" ? repaired : input;
 
     // Write to a temporary sibling, then rename: readers never see a half-written file.
     std::filesystem::path temporary = path;
@@ -92,6 +173,10 @@ void write_image(const std::filesystem::path& path, const Image& input,
     } else if (ext == ".png") {
         OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
         spec.attribute("oiio:ColorSpace", options.linear ? "linear" : "sRGB");
+        if (options.png == PngEncoding::fast) {
+            spec.attribute("compression", kPngStrategy);
+            spec.attribute("png:filter", kPngFilterPaeth);
+        }
         const auto pixels = encode_rgb<std::uint8_t>(image, options.linear, 255.0f);
         ok = out->open(temporary.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT8, pixels.data());

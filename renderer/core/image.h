@@ -1,6 +1,7 @@
 #pragma once
 // Linear float RGBA images, top row first (as image files store them). Alpha is coverage:
 // 1 where the object is, 0 on the background.
+#include <cstdint>
 #include <filesystem>
 #include <glm/glm.hpp>
 #include <stdexcept>
@@ -41,9 +42,17 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// How PNG data is compressed; both are lossless and deterministic (same pixels, same
+// bytes on every write), they differ in encoding time and file size.
+enum class PngEncoding {
+    fast,     // Paeth filter on every row, zlib run-length strategy
+    compact,  // libpng's defaults: adaptive filters, zlib level 6 (~4x slower, ~15% smaller)
+};
+
 struct ImageWriteOptions {
     // PNG / TIFF: store linear values instead of sRGB-encoding them.
     bool linear = false;
+    PngEncoding png = PngEncoding::fast;
 };
 
 // Writes by extension: ".exr" 32-bit float linear RGBA; ".png" 8-bit RGB,
@@ -60,5 +69,8 @@ bool is_supported_image_path(const std::filesystem::path& path);
 
 // sRGB transfer function (IEC 61966-2-1) of one linear value clamped to [0, 1].
 float srgb_encode(float linear);
+// lround(srgb_encode(v) * 255) by table (what 8-bit files store), NaN as 0: the same
+// codes, several times faster.
+std::uint8_t srgb_encode_8bit(float linear);
 
 }  // namespace lucent

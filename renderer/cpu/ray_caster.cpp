@@ -155,19 +155,57 @@ bool RayCaster::occluded(glm::vec3 origin, glm::vec3 direction, float t_min,
 
 std::size_t RayCaster::count_escaping(glm::vec3 origin,
                                       const std::vector<glm::vec3>& directions,
-                                      float t_min) const {
+                                      float t_min, OcclusionQuery query) const {
     if (!finite(origin)) return directions.size();  // an unusable ray hits nothing
-    // One ray at a time: measured faster here than rtcOccluded16 packets, since AO rays
-    // fan out over a hemisphere and share little traversal.
     RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+    rtcInitIntersectContext(&context);  // incoherent: the rays fan out over a hemisphere
+    const float near = exclusive_near(t_min);
+    constexpr float kFar = std::numeric_limits<float>::infinity();
+    constexpr float kBlocked = -std::numeric_limits<float>::infinity();  // Embree's mark
     std::size_t escaped = 0;
-    for (const glm::vec3& direction : directions) {
-        RTCRay ray = make_ray(origin, direction, exclusive_near(t_min),
-                              std::numeric_limits<float>::infinity())
-                         .ray;
-        rtcOccluded1(impl_->scene, &context, &ray);
-        if (ray.tfar != -std::numeric_limits<float>::infinity()) ++escaped;
+    switch (query) {
+        case OcclusionQuery::single:
+            for (const glm::vec3& direction : directions) {
+                RTCRay ray = make_ray(origin, direction, near, kFar).ray;
+                rtcOccluded1(impl_->scene, &context, &ray);
+                if (ray.tfar != kBlocked) ++escaped;
+            }
+            break;
+        case OcclusionQuery::packet8:
+            for (std::size_t first = 0; first < directions.size(); first += 8) {
+                alignas(32) int valid[8];
+                RTCRay8 packet{};
+                for (std::size_t k = 0; k < 8; ++k) {
+                    const bool used = first + k < directions.size();
+                    valid[k] = used ? -1 : 0;
+                    const glm::vec3 d = used ? directions[first + k] : glm::vec3(0, 0, 1);
+                    packet.org_x[k] = origin.x;
+                    packet.org_y[k] = origin.y;
+                    packet.org_z[k] = origin.z;
+                    packet.dir_x[k] = d.x;
+                    packet.dir_y[k] = d.y;
+                    packet.dir_z[k] = d.z;
+                    packet.tnear[k] = near;
+                    packet.tfar[k] = kFar;
+                    packet.mask[k] = ~0u;
+                }
+                rtcOccluded8(valid, impl_->scene, &context, &packet);
+                for (std::size_t k = 0; k < 8 && first + k < directions.size(); ++k)
+                    if (packet.tfar[k] != kBlocked) ++escaped;
+            }
+            break;
+        case OcclusionQuery::stream: {
+            // Reused per thread: the bake calls this once per vertex.
+            thread_local std::vector<RTCRay> rays;
+            rays.resize(directions.size());
+            for (std::size_t i = 0; i < directions.size(); ++i)
+                rays[i] = make_ray(origin, directions[i], near, kFar).ray;
+            rtcOccluded1M(impl_->scene, &context, rays.data(),
+                          static_cast<unsigned>(rays.size()), sizeof(RTCRay));
+            for (const RTCRay& ray : rays)
+                if (ray.tfar != kBlocked) ++escaped;
+            break;
+        }
     }
     return escaped;
 }

@@ -65,4 +65,10 @@ add_test(NAME app.stimuli_report_bad_threshold_exits_2
 # lucent bench render runs end to end (small images; the figures come from a full run).
 add_test(NAME app.bench_render_smoke COMMAND lucent bench render --size 64x64)
 set_tests_properties(app.bench_render_smoke PROPERTIES
-    PASS_REGULAR_EXPRESSION "15 stimuli at 64x64.*empty +[0-9.]+ .*filled +[0-9.]+ .*throughput")
+    PASS_REGULAR_EXPRESSION "15 stimuli at 64x64.*empty +[0-9.]+ .*filled, before +[0-9.]+ .*filled +[0-9.]+ .*throughput.*now / before: [0-9.]+x")
+add_test(NAME app.bench_render_csv
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=bench;render;--size;32x32"
+                 -DCSV=${CMAKE_CURRENT_BINARY_DIR}/bench-render.csv
+                 "-DEXPECT_CSV=\"AO cache filled\",\"stimuli per CPU-second\",[0-9.e+]+,1/CPUs;\"AO cache filled, before\",\"encode\",;\"summary\",\"filled now / before, stimuli per second\",[0-9.e+]+,ratio"
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/bench_csv_check.cmake)

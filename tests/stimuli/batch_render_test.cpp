@@ -124,6 +124,38 @@ TEST(BatchRender, SecondRunReusesForceRerendersByteIdentically) {
     EXPECT_EQ(read_bytes(dir / "manifest.csv"), manifest);
 }
 
+// Encoding runs beside rendering: a file that cannot be written (here a directory sits
+// where w_0.3.png goes) stops the whole run with an error naming it, on one worker or
+// three; the stimulus before it stays finished and listed, nothing after it is.
+TEST(BatchRender, AnEncodeFailureStopsTheRunAndKeepsWhatFinished) {
+    for (const int jobs : {1, 3}) {
+        const auto dir = test::scratch_dir("batch_encode_failure_" + std::to_string(jobs));
+        std::filesystem::create_directories(dir / "w_0.3.png" / "blocker");
+        try {
+            render(small_set(), dir, /*force=*/false, jobs);
+            ADD_FAILURE() << "the run should fail (" << jobs << " jobs)";
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find("w_0.3.png"), std::string::npos)
+                << e.what();
+        }
+        const auto rows = read_manifest_csv(dir);
+        EXPECT_FALSE(rows.count("w_0.3"));
+        for (const auto& [id, row] : rows)
+            for (const char* ext : {".exr", ".png", ".tif"})
+                EXPECT_TRUE(std::filesystem::is_regular_file(dir / (id + ext))) << id;
+        if (jobs == 1) {  // one encoder, in set order: w_0.1 before, cr after
+            EXPECT_TRUE(rows.count("w_0.1"));
+            EXPECT_FALSE(rows.count("cr"));
+        }
+        // Once the obstacle is gone the set completes, reusing what finished.
+        std::filesystem::remove_all(dir / "w_0.3.png");
+        const auto resumed = render(small_set(), dir, /*force=*/false, jobs);
+        EXPECT_EQ(resumed.reused, rows.size());
+        EXPECT_EQ(resumed.rendered + resumed.reused, 3u);
+        EXPECT_EQ(read_manifest_csv(dir).size(), 3u);
+    }
+}
+
 TEST(BatchRender, RerendersOnlyChangedOrDamagedStimuli) {
     const auto dir = test::scratch_dir("batch_changed");
     render(small_set("0.6"), dir);

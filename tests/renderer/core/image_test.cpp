@@ -3,7 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
 #include <limits>
 
 #include "core/image_compare.h"
@@ -45,6 +50,74 @@ TEST(ImageIo, PngIsEightBitSrgbUnlessLinear) {
     EXPECT_FLOAT_EQ(srgb.at(1, 0).g, 1.0f);  // clamped
     EXPECT_FLOAT_EQ(srgb.at(1, 0).b, 0.0f);
     EXPECT_FLOAT_EQ(linear.at(0, 0).r, 128.0f / 255.0f);
+}
+
+// The table gives exactly the codes of the formula, lround(srgb_encode(v) * 255): at
+// every code transition (found here by scanning the formula), over random values, and
+// for out-of-range and non-finite input.
+TEST(ImageIo, EightBitSrgbTableMatchesTheFormulaEverywhere) {
+    const auto formula = [](float v) {
+        return int(std::lround(srgb_encode(v) * 255.0f));
+    };
+    // Transitions by stepping through the codes' preimages with nextafter near each
+    // analytic crossing: sRGB^-1((k - 0.5) / 255).
+    for (int k = 1; k <= 255; ++k) {
+        const double s = (k - 0.5) / 255.0;
+        const double x = s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+        float v = static_cast<float>(x);
+        for (int step = 0; step < 2000; ++step) v = std::nextafter(v, 0.0f);
+        ASSERT_LT(formula(v), k);  // the scan below crosses the transition to k
+        for (int step = 0; step < 4000; ++step, v = std::nextafter(v, 2.0f))
+            ASSERT_EQ(srgb_encode_8bit(v), formula(v)) << "v = " << v << ", code " << k;
+        ASSERT_GE(formula(v), k);
+    }
+    std::mt19937 engine(17);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (int i = 0; i < 1'000'000; ++i) {
+        const float v = unit(engine);
+        ASSERT_EQ(srgb_encode_8bit(v), formula(v)) << "v = " << v;
+    }
+    // Denormals and exact ends.
+    for (float v : {0.0f, -0.0f, std::numeric_limits<float>::denorm_min(),
+                    std::numeric_limits<float>::min(), 1.0f, std::nextafter(1.0f, 0.0f)})
+        EXPECT_EQ(srgb_encode_8bit(v), formula(v)) << v;
+    const float inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(srgb_encode_8bit(-0.5f), 0);
+    EXPECT_EQ(srgb_encode_8bit(7.0f), 255);
+    EXPECT_EQ(srgb_encode_8bit(inf), 255);
+    EXPECT_EQ(srgb_encode_8bit(-inf), 0);
+    EXPECT_EQ(srgb_encode_8bit(std::nanf("")), 0);
+}
+
+// PNG is lossless with either encoding: every pixel of a noisy image (no runs for the
+// encoder to exploit) reads back as the formula's 8-bit code, and writing it again gives
+// the same bytes.
+TEST(ImageIo, PngStoresTheEightBitCodesLosslesslyAndDeterministically) {
+    const auto dir = test::scratch_dir("image_png_lossless");
+    Image image(67, 45);  // odd sizes: no row or filter alignment to lean on
+    std::mt19937 engine(3);
+    std::uniform_real_distribution<float> value(-0.1f, 1.1f);
+    for (float& v : image.rgba) v = value(engine);
+    const auto bytes = [](const std::filesystem::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    for (const PngEncoding png : {PngEncoding::fast, PngEncoding::compact}) {
+        write_image(dir / "a.png", image, {.png = png});
+        write_image(dir / "b.png", image, {.png = png});
+        EXPECT_EQ(bytes(dir / "a.png"), bytes(dir / "b.png"));
+        const Image back = read_image(dir / "a.png");
+        ASSERT_EQ(back.width, image.width);
+        ASSERT_EQ(back.height, image.height);
+        for (int y = 0; y < image.height; ++y)
+            for (int x = 0; x < image.width; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const float v = std::clamp(image.at(x, y)[c], 0.0f, 1.0f);
+                    const long code = std::lround(srgb_encode(v) * 255.0f);
+                    ASSERT_EQ(std::lround(back.at(x, y)[c] * 255.0f), code)
+                        << x << "," << y << " channel " << c << ", encoding " << int(png);
+                }
+    }
 }
 
 TEST(ImageIo, TiffIsSixteenBit) {

@@ -13,6 +13,7 @@
 #include <numbers>
 #include <thread>
 
+#include "cpu/ambient_occlusion_directions.h"
 #include "test_paths.h"
 
 namespace lucent {
@@ -46,6 +47,52 @@ double open_fraction(double a, double b, double d) {
     const double solid_angle =
         4.0 * std::asin(a * b / std::sqrt((a * a + 4 * d * d) * (b * b + 4 * d * d)));
     return solid_angle / (2.0 * std::numbers::pi);
+}
+
+// The directions are the rank-1 lattice whatever the per-vertex shift: unit, inside the
+// hemisphere, one cos(theta) in each of the N strata ((k, k+1]/N), and azimuths (about
+// the normal) that step by 2 pi / golden ratio from one ray to the next, as the closed
+// form phi_i = 2 pi frac(i / golden ratio + shift) says.
+TEST(AmbientOcclusion, DirectionsAreTheShiftedStratifiedLattice) {
+    constexpr int kRays = 320;
+    const AoDirections lattice(kRays);
+    std::vector<glm::vec3> directions;
+    const glm::vec3 normals[] = {glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f)),
+                                 {0.0f, 0.0f, -1.0f},  // the frame's sign flip
+                                 glm::normalize(glm::vec3(1.0f, 1e-4f, -1e-4f))};
+    for (std::size_t vertex : {0u, 1u, 12345u})
+        for (const glm::vec3 n : normals) {
+            lattice.generate(vertex, n, directions);
+            ASSERT_EQ(directions.size(), std::size_t(kRays));
+            // Any unit vector perpendicular to n measures the azimuth.
+            const glm::vec3 helper =
+                std::abs(n.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+            const glm::dvec3 e1 = glm::normalize(glm::cross(n, helper));
+            const glm::dvec3 e2 = glm::cross(glm::dvec3(n), e1);
+            std::vector<int> strata(kRays, 0);
+            double first_phi = 0.0;
+            for (int i = 0; i < kRays; ++i) {
+                const glm::dvec3 d = directions[i];
+                EXPECT_NEAR(glm::length(d), 1.0, 1e-6);
+                const double cos_theta = glm::dot(d, glm::dvec3(n));
+                ASSERT_GT(cos_theta, 0.0) << i;
+                // Stratum of cos(theta); 1e-9 slack for a value on a boundary.
+                ++strata[std::min(kRays - 1, int(std::ceil(cos_theta * kRays - 1e-9)) - 1)];
+                const double phi = std::atan2(glm::dot(d, e2), glm::dot(d, e1));
+                if (i == 0) first_phi = phi;
+                double expected = 2.0 * std::numbers::pi * (i * 0.6180339887498949);
+                double gap = std::remainder(phi - first_phi - expected,
+                                            2.0 * std::numbers::pi);
+                EXPECT_NEAR(gap, 0.0, 2e-5) << "vertex " << vertex << " ray " << i;
+            }
+            EXPECT_EQ(strata, std::vector<int>(kRays, 1)) << "vertex " << vertex;
+        }
+    // Different vertices get different shifts (not one pattern for all).
+    std::vector<glm::vec3> other;
+    lattice.generate(0, normals[0], directions);
+    lattice.generate(1, normals[0], other);
+    EXPECT_NE(directions, other);
+    EXPECT_THROW(AoDirections(0), std::invalid_argument);
 }
 
 TEST(AmbientOcclusion, ConvexSphereIsFullyOpenAtEveryVertex) {
