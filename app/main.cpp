@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
     register_participants(app, exit_code);
     register_export(app, exit_code);
     register_merge(app, exit_code);
+    register_store(app, exit_code);
     register_analyze(app, exit_code);
     register_stats(app, exit_code);
     register_simulate(app, exit_code);
