@@ -30,6 +30,8 @@ struct BenchRow {
     int commits = 0;
     double seconds = 0;
     double p50_ms = 0, p99_ms = 0;
+    int failed_writers = 0;  // writers that stopped on an error (e.g. SQLite's busy timeout)
+    std::string first_error;
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -87,11 +89,15 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
         });
     }
     for (std::thread& t : threads) t.join();
-    BenchRow row{backend, writers, 0, 0, 0, 0};
+    BenchRow row;
+    row.backend = backend;
+    row.writers = writers;
     row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::vector<double> all;
     for (int w = 0; w < writers; ++w) {
-        if (!errors[w].empty()) throw study::StoreError("writer " + std::to_string(w) + ": " + errors[w]);
+        if (!errors[w].empty()) {
+            if (row.failed_writers++ == 0) row.first_error = errors[w];
+        }
         all.insert(all.end(), latencies[w].begin(), latencies[w].end());
     }
     row.commits = static_cast<int>(all.size());
@@ -124,21 +130,27 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials, const std
     std::error_code ec;
     fs::remove_all(scratch, ec);
 
-    std::printf("%-34s %7s %8s %9s %10s %8s %8s\n", "backend", "writers", "commits", "seconds",
-                "commits/s", "p50 ms", "p99 ms");
+    std::printf("%-34s %7s %8s %9s %10s %8s %8s %7s\n", "backend", "writers", "commits",
+                "seconds", "commits/s", "p50 ms", "p99 ms", "failed");
     for (const BenchRow& r : rows)
-        std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f\n", r.backend.c_str(), r.writers,
-                    r.commits, r.seconds, r.commits / r.seconds, r.p50_ms, r.p99_ms);
+        std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d\n", r.backend.c_str(), r.writers,
+                    r.commits, r.seconds, r.commits / r.seconds, r.p50_ms, r.p99_ms,
+                    r.failed_writers);
+    for (const BenchRow& r : rows)
+        if (r.failed_writers)
+            std::printf("%s, %d writers: %d stopped, first: %s\n", r.backend.c_str(), r.writers,
+                        r.failed_writers, r.first_error.c_str());
     // Ratios within this run: the server against the file at the same writer count.
     for (size_t i = 0; i + 1 < rows.size(); i += 2)
         std::printf("writers %d: postgresql/sqlite throughput ratio %.2f\n", rows[i].writers,
                     (rows[i + 1].commits / rows[i + 1].seconds) / (rows[i].commits / rows[i].seconds));
     if (!csv.empty()) {
         std::ofstream out(csv);
-        out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms\n";
+        out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,failed_writers\n";
         for (const BenchRow& r : rows)
             out << '"' << r.backend << "\"," << r.writers << ',' << r.commits << ',' << r.seconds
-                << ',' << r.commits / r.seconds << ',' << r.p50_ms << ',' << r.p99_ms << "\n";
+                << ',' << r.commits / r.seconds << ',' << r.p50_ms << ',' << r.p99_ms << ','
+                << r.failed_writers << "\n";
         if (!out) throw study::StoreError(csv + ": cannot write");
     }
     return kExitOk;

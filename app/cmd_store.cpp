@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "sqlite.h"
+#include "postgres/trial_journal.h"
 #include "study_store.h"
 
 namespace lucent::app {
@@ -48,20 +49,26 @@ void register_store(CLI::App& app, int& exit_code) {
                 throw study::StoreError("--db " + *db +
                                         ": a file store has no journal; sync is for servers");
             study::StoreOptions options;
-            options.journal_path = *journal;
-            const std::unique_ptr<study::StudyStore> store = study::open_study_store(*db, options);
-            const int before = store->pending_trials();
-            int sent = 0;
+            options.journal_path = journal->empty() ? study::default_journal_path(*db) : *journal;
+            // Counted from the journal itself, so an unreachable server still gets a count.
+            const int before = study::TrialJournal(options.journal_path, *db).count();
+            int left = before;
             try {
-                sent = store->sync();
+                const std::unique_ptr<study::StudyStore> store = study::open_study_store(*db, options);
+                try {
+                    store->sync();
+                } catch (const study::StoreError&) {
+                    left = store->pending_trials();
+                    throw;
+                }
+                left = store->pending_trials();
             } catch (const study::StoreError& e) {
                 std::cerr << "lucent store sync: " << e.what() << "\n";
-                sent = before - store->pending_trials();
-                std::cout << "sent " << sent << " of " << before << " trials; "
-                          << store->pending_trials() << " still held\n";
+                std::cout << "sent " << before - left << " of " << before << " trials; " << left
+                          << " still held in " << options.journal_path << "\n";
                 return kExitFailure;
             }
-            std::cout << "sent " << sent << " of " << before << " trials to " << *db
+            std::cout << "sent " << before - left << " of " << before << " trials to " << *db
                       << "; 0 still held\n";
             return kExitOk;
         });

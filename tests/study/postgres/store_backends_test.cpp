@@ -1,8 +1,6 @@
 // The study store's guarantees, one suite over every backend (SQLite file, PostgreSQL
-// server), as SQLite runs one suite over several VFS layers. The server is real: a
-// throwaway local PostgreSQL (initdb + pg_ctl on a Unix socket in a temporary folder, as
-// `nobody` when the tests run as root) started once by a gtest environment for this
-// binary and stopped at its end; every test gets a new database on it.
+// server), as SQLite runs one suite over several VFS layers. The server is real
+// (server_environment.h); every test gets a new database on it.
 //
 // Expected values come from the protocol and plan (trial counts, questions, the
 // deterministic rating_for()), never from the store under test.
@@ -18,7 +16,7 @@
 #include <thread>
 
 #include "../study_fixtures.h"
-#include "postgres/local_server.h"
+#include "server_environment.h"
 #include "postgres/postgres_store.h"
 #include "postgres/trial_journal.h"
 #include "session/autopilot.h"
@@ -30,17 +28,7 @@
 namespace lucent::study {
 namespace {
 
-LocalPostgres* g_server = nullptr;
-
-class ServerEnvironment : public ::testing::Environment {
-public:
-    void SetUp() override { g_server = new LocalPostgres(); }
-    void TearDown() override {
-        delete g_server;
-        g_server = nullptr;
-    }
-};
-const auto* const g_environment = ::testing::AddGlobalTestEnvironment(new ServerEnvironment);
+LocalPostgres& server() { return lucent::test::postgres_server(); }
 
 // Two blocks, counterbalanced: participants alternate between 2 Latin-square cells.
 std::string two_block_protocol_text() {
@@ -63,9 +51,7 @@ protected:
         if (GetParam() == "sqlite") {
             db_ = (dir_ / "study.db").string();
         } else {
-            static std::atomic<int> counter{0};
-            db_ = g_server->create_database("t" + std::to_string(counter++) + "_" +
-                                            slug.substr(0, 40));
+            db_ = lucent::test::new_postgres_database(slug);
             init_study_store(db_);
         }
     }
@@ -75,7 +61,7 @@ protected:
         options.retry_interval_ms = 0;
         return open_study_store(db_, options);
     }
-    bool server() const { return GetParam() == "postgresql"; }
+    bool is_server() const { return GetParam() == "postgresql"; }
 
     std::filesystem::path dir_;
     std::string db_;
@@ -380,13 +366,12 @@ INSTANTIATE_TEST_SUITE_P(Stores, Backend, ::testing::Values("sqlite", "postgresq
 class Server : public ::testing::Test {
 protected:
     void SetUp() override {
-        static std::atomic<int> counter{0};
         const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
         dir_ = lucent::test::scratch_dir("server_" + test);
-        uri_ = g_server->create_database("s" + std::to_string(counter++));
+        uri_ = lucent::test::new_postgres_database(test);
     }
     void TearDown() override {
-        if (!g_server->running()) g_server->start();
+        if (!server().running()) server().start();
     }
     StoreOptions options(const std::string& station) {
         StoreOptions o;
@@ -514,10 +499,10 @@ TEST_F(Server, StoppedMidSessionEveryCommittedRatingArrivesOnce) {
                 if (k == 0 && answered == 2) {
                     while (started.load() < kStations)
                         std::this_thread::sleep_for(std::chrono::milliseconds(5));
-                    g_server->stop();
+                    server().stop();
                 }
-                if (k == 0 && answered == 4) g_server->start();
-                if (!g_server->running()) ++journaled_during_outage;
+                if (k == 0 && answered == 4) server().start();
+                if (!server().running()) ++journaled_during_outage;
                 std::this_thread::sleep_for(std::chrono::milliseconds(30));
             };
             results[k] = run_station([&] { return open_study_store(uri_, options("st" + std::to_string(k))); },
