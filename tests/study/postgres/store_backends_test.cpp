@@ -244,6 +244,128 @@ TEST_P(Backend, RacingStationsNeverShareAParticipantNumber) {
     EXPECT_EQ(*all.rbegin(), kStations * kEach);
 }
 
+TEST_P(Backend, RefusesASecondProtocolInOneStudyStore) {
+    auto store = open();
+    store->ensure_study(lucent::test::small_protocol());
+    EXPECT_THROW(store->ensure_study(builtin_protocol("thesis")), StoreError);
+    EXPECT_EQ(store->ensure_study(lucent::test::small_protocol()),
+              store->ensure_study(lucent::test::small_protocol()));
+}
+
+TEST_P(Backend, EachRatingIsCheckedAgainstItsOwnQuestionsScale) {
+    auto store = open();
+    const Protocol p = lucent::test::mixed_scale_protocol();  // 7 points, then 5
+    const int64_t study = store->ensure_study(p);
+    const int64_t pid = store->ensure_participant(study, "P1", nullptr);
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 3, 1), 3, {});
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    auto outcome = [&](int translucent, int realistic) {
+        TrialOutcome o;
+        o.onset_ns = 1;
+        o.confirm_ns = 2;
+        o.responses = {{"translucent", translucent, 500, 0, 1, 2}, {"realistic", realistic, 500, 0, 1, 2}};
+        return o;
+    };
+    store->record_trial(s.id, trials[0].id, outcome(7, 5));
+    try {
+        store->record_trial(s.id, trials[1].id, outcome(4, 6));
+        ADD_FAILURE() << "a 6 on a 5-point scale was stored";
+    } catch (const StoreError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("'realistic'"), std::string::npos) << message;
+        EXPECT_NE(message.find("1..5"), std::string::npos) << message;
+    }
+    TrialOutcome unknown = outcome(3, 3);
+    unknown.responses[1].question = "varnished";
+    EXPECT_THROW(store->record_trial(s.id, trials[1].id, unknown), StoreError);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 2);
+    EXPECT_EQ(store->pending_trials(), 0);  // refused trials leave no journal entry
+    store->record_trial(s.id, trials[1].id, outcome(1, 1));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 4);
+}
+
+std::vector<StimulusProvenance> provenance_for(const Protocol& p, const std::string& albedo) {
+    std::vector<StimulusProvenance> out;
+    for (const StimulusSpec& s : p.stimuli) {
+        StimulusProvenance v;
+        v.stimulus = s.id;
+        v.source = "live";
+        v.technique = s.technique;
+        v.mesh = s.mesh;
+        v.mesh_hash = "00000000000000aa";
+        v.values = {{"albedo", albedo}, {"fov_y", "60"}};
+        for (const auto& [name, value] : s.parameters) v.values.emplace_back(name, value);
+        v.software_version = "9.9.9";
+        v.build_hash = "test";
+        out.push_back(v);
+    }
+    return out;
+}
+
+SessionEnvironment environment(const std::string& machine, const std::string& gpu, double hz) {
+    SessionEnvironment env;
+    env.machine_id = machine;
+    env.software_version = "9.9.9";
+    env.build_hash = "test";
+    env.gl_vendor = "vendor " + machine;
+    env.gl_renderer = gpu;
+    env.display_mode = "1280x1024 fullscreen";
+    env.display_refresh_hz = hz;
+    return env;
+}
+
+TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    int number = 0;
+    const int64_t pid = store->ensure_participant(study, "P1", &number);
+    SessionEnvironment first = environment("lab-a", "GPU A", 60);
+    first.stimuli = provenance_for(p, "0.8,0.55,0.35");
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 5, number), 5, first);
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
+    SessionEnvironment second = environment("lab-b", "GPU B", 144);
+    second.stimuli = first.stimuli;
+    EXPECT_EQ(store->begin_segment(s.id, second), 2);
+    second.measured_refresh_hz = 143.9;
+    store->update_environment(s.id, second);
+    store->record_trial(s.id, trials[1].id, lucent::test::outcome_for(p, trials[1]));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments WHERE segment = 1 AND "
+                               "machine_id = 'lab-a' AND gl_renderer = 'GPU A' AND "
+                               "display_refresh_hz = 60 AND measured_refresh_hz IS NULL AND "
+                               "stimulus_source = 'live'"),
+              1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments WHERE segment = 2 AND "
+                               "machine_id = 'lab-b' AND measured_refresh_hz = 143.9"),
+              1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE gl_renderer = 'GPU A' AND "
+                               "display_refresh_hz = 60"),
+              1);
+    // Each trial knows the segment it was answered in.
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM trials t JOIN session_segments g ON "
+                               "g.id = t.segment_id WHERE (t.position = 0 AND g.segment = 1) OR "
+                               "(t.position = 1 AND g.segment = 2)"),
+              2);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM segment_stimuli"),
+              2 * static_cast<int64_t>(p.stimuli.size()));
+    // Values are recorded once per stimulus (albedo, fov_y and its own parameters), not
+    // again by the second segment.
+    int64_t values = 0;
+    for (const StimulusSpec& spec : p.stimuli) values += 2 + static_cast<int64_t>(spec.parameters.size());
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM stimulus_values"), values);
+    try {
+        store->check_stimulus_values(provenance_for(p, "0.7,0.55,0.35"));
+        FAIL() << "different resolved values accepted";
+    } catch (const StoreError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("stimulus 'a'"), std::string::npos) << what;
+        EXPECT_NE(what.find("'albedo'"), std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+    EXPECT_NO_THROW(store->check_stimulus_values(provenance_for(p, "0.8,0.55,0.35")));
+}
+
 // ---- stations driven by the simulated participant --------------------------------------
 
 Key key_of(const std::string& name, int* digit) {
