@@ -102,6 +102,26 @@ TEST_F(Commands, StoreInitMigratesOnceAndExportMatchesTheSameSessionsInAFile) {
     EXPECT_EQ(std::count(server_csv.begin(), server_csv.end(), '\n'), 19) << server_csv;
 }
 
+TEST_F(Commands, AnalyzeReadsAServerAsItReadsTheSameSessionsInAFile) {
+    init_study_store(uri_);
+    fill(uri_);
+    const std::string file = (dir_ / "reference.db").string();
+    fill(file);
+    const auto from_server = dir_ / "server_report", from_file = dir_ / "file_report";
+    const Ran a = lucent({"analyze", uri_, "--out", from_server.string(), "--format", "csv"});
+    const Ran b = lucent({"analyze", file, "--out", from_file.string(), "--format", "csv"});
+    ASSERT_EQ(a.exit_code, 0) << a.output;
+    ASSERT_EQ(b.exit_code, 0) << b.output;
+    int compared = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(from_file)) {
+        if (entry.path().extension() != ".csv") continue;
+        EXPECT_EQ(read_file(from_server / entry.path().filename()), read_file(entry.path()))
+            << entry.path().filename();
+        ++compared;
+    }
+    EXPECT_GT(compared, 0);
+}
+
 TEST_F(Commands, ParticipantsListAndWithdrawWorkOnAServer) {
     init_study_store(uri_);
     fill(uri_);
