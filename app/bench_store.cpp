@@ -28,11 +28,14 @@ struct BenchRow {
     std::string backend;
     int writers = 0;
     int commits = 0;
-    double seconds = 0;
+    double seconds = 0;  // the commit phase: first commit's start to the last one's end
     double p50_ms = 0, p99_ms = 0;
     int failed_writers = 0;  // writers that stopped on an error (e.g. SQLite's busy timeout)
     std::string first_error;
 };
+
+// Commits per second; 0 for a row without commits (never Inf or NaN in the table).
+double rate(const BenchRow& r) { return r.seconds > 0 ? r.commits / r.seconds : 0.0; }
 
 double percentile(std::vector<double> v, double q) {
     if (v.empty()) return 0;
@@ -50,8 +53,10 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
         store->ensure_study(protocol);
     }
     std::vector<std::vector<double>> latencies(writers);
+    using Clock = std::chrono::steady_clock;
+    std::vector<Clock::time_point> first_start(writers, Clock::time_point::max()),
+        last_end(writers, Clock::time_point::min());
     std::vector<std::string> errors(writers);
-    const auto start = std::chrono::steady_clock::now();
     std::vector<std::thread> threads;
     for (int w = 0; w < writers; ++w) {
         threads.emplace_back([&, w] {
@@ -75,11 +80,12 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
                         o.responses.push_back({q.id, rows[i].is_catch ? rows[i].expected
                                                                       : 1 + (i % q.points()),
                                                500.0, 0, 1, 2});
-                    const auto t0 = std::chrono::steady_clock::now();
+                    const auto t0 = Clock::now();
                     store->record_trial(s.id, rows[i].id, o);
-                    latencies[w].push_back(
-                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                            .count());
+                    const auto t1 = Clock::now();
+                    first_start[w] = std::min(first_start[w], t0);
+                    last_end[w] = std::max(last_end[w], t1);
+                    latencies[w].push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
                 }
                 if (store->pending_trials() != 0)
                     errors[w] = std::to_string(store->pending_trials()) + " trials unconfirmed";
@@ -92,7 +98,9 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
     BenchRow row;
     row.backend = backend;
     row.writers = writers;
-    row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const auto begin = *std::min_element(first_start.begin(), first_start.end());
+    const auto end = *std::max_element(last_end.begin(), last_end.end());
+    row.seconds = end > begin ? std::chrono::duration<double>(end - begin).count() : 0.0;
     std::vector<double> all;
     for (int w = 0; w < writers; ++w) {
         if (!errors[w].empty()) {
@@ -134,7 +142,7 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials, const std
                 "seconds", "commits/s", "p50 ms", "p99 ms", "failed");
     for (const BenchRow& r : rows)
         std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d\n", r.backend.c_str(), r.writers,
-                    r.commits, r.seconds, r.commits / r.seconds, r.p50_ms, r.p99_ms,
+                    r.commits, r.seconds, rate(r), r.p50_ms, r.p99_ms,
                     r.failed_writers);
     for (const BenchRow& r : rows)
         if (r.failed_writers)
@@ -142,14 +150,15 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials, const std
                         r.failed_writers, r.first_error.c_str());
     // Ratios within this run: the server against the file at the same writer count.
     for (size_t i = 0; i + 1 < rows.size(); i += 2)
-        std::printf("writers %d: postgresql/sqlite throughput ratio %.2f\n", rows[i].writers,
-                    (rows[i + 1].commits / rows[i + 1].seconds) / (rows[i].commits / rows[i].seconds));
+        if (rate(rows[i]) > 0)
+            std::printf("writers %d: postgresql/sqlite throughput ratio %.2f\n", rows[i].writers,
+                        rate(rows[i + 1]) / rate(rows[i]));
     if (!csv.empty()) {
         std::ofstream out(csv);
         out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,failed_writers\n";
         for (const BenchRow& r : rows)
             out << '"' << r.backend << "\"," << r.writers << ',' << r.commits << ',' << r.seconds
-                << ',' << r.commits / r.seconds << ',' << r.p50_ms << ',' << r.p99_ms << ','
+                << ',' << rate(r) << ',' << r.p50_ms << ',' << r.p99_ms << ','
                 << r.failed_writers << "\n";
         if (!out) throw study::StoreError(csv + ": cannot write");
     }

@@ -261,6 +261,10 @@ void check_database_file(const std::string& path) {
     struct Closer { sqlite3* db; ~Closer() { sqlite3_close_v2(db); } } closer{raw};
     if (rc != SQLITE_OK)
         throw StoreError(path + ": cannot open read-only: " + sqlite3_errstr(rc));
+    // Other stations' writers may hold the lock a moment: wait as the store itself does,
+    // and never call a busy database corrupt.
+    sqlite3_busy_timeout(raw, 5000);
+    bool busy = false;
     auto query_int = [&](const char* sql, int64_t& out) -> std::string {
         sqlite3_stmt* stmt = nullptr;
         int r = sqlite3_prepare_v2(raw, sql, -1, &stmt, nullptr);
@@ -269,6 +273,7 @@ void check_database_file(const std::string& path) {
             if (r == SQLITE_ROW) { out = sqlite3_column_int64(stmt, 0); r = SQLITE_OK; }
         }
         std::string why = r == SQLITE_OK ? "" : sqlite3_errmsg(raw);
+        busy = busy || (r & 0xFF) == SQLITE_BUSY || (r & 0xFF) == SQLITE_LOCKED;
         sqlite3_finalize(stmt);
         return why;
     };
@@ -276,6 +281,9 @@ void check_database_file(const std::string& path) {
     std::string why = query_int("PRAGMA application_id", app_id);
     if (why.empty()) why = query_int("PRAGMA user_version", version);
     if (why.empty()) why = query_int("SELECT count(*) FROM sqlite_schema", tables);
+    if (!why.empty() && busy)
+        throw StoreError(path + ": database is locked by another process for over 5 s (" + why +
+                         "); try again");
     if (!why.empty())
         throw StoreError(path + ": database is corrupt (" + why + "); left unchanged");
     if (app_id == 0 && version == 0 && tables == 0) return;  // an empty SQLite file
