@@ -5,6 +5,8 @@
 #include "export.h"
 #include "question_scales.h"
 #include "sqlite.h"
+#include "study_db_option.h"
+#include "study_store.h"
 
 namespace lucent::app {
 
@@ -14,7 +16,9 @@ void register_export(CLI::App& app, int& exit_code) {
     auto out = std::make_shared<std::string>();
     auto force = std::make_shared<bool>(false);
     auto* cmd = app.add_subcommand("export", "Write a study database's ratings as CSV");
-    cmd->add_option("db", *db, "Study database")->required()->check(CLI::ExistingFile);
+    cmd->add_option("db", *db, "Study database: FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
+        ->required()
+        ->check(study_db_validator());
     cmd->add_option("--format", *format,
                     "long: one row per rating; wide: one row per participant; analysis: "
                     "participant,stimulus,factor,level,question,rating for lucent analyze")
@@ -26,7 +30,9 @@ void register_export(CLI::App& app, int& exit_code) {
     cmd->add_flag("--force", *force, "Replace an existing --out file (never a database)");
     cmd->callback([=, &exit_code] {
         try {
-            const study::ExportFileResult r = study::export_file(*db, *format, *out, *force);
+            const study::ReadableStudyFile source(*db);  // a server: one snapshot of it
+            const study::ExportFileResult r =
+                study::export_file(source.path(), *format, *out, *force);
             for (const std::string& p : r.excluded_participants)
                 std::cerr << "lucent export: excluded " << p << "\n";
             for (const std::string& note : r.notes)  // on stderr: the CSV stays plain

@@ -3,7 +3,12 @@
 
 #include "commands.h"
 #include "export.h"
+#include "postgres/merge_into_server.h"
 #include "sqlite.h"
+#include "study_db_option.h"
+#include "study_store.h"
+
+#include <memory>
 
 namespace lucent::app {
 
@@ -14,11 +19,32 @@ void register_merge(CLI::App& app, int& exit_code) {
         "merge",
         "Combine study databases (sessions de-duplicated by UUID, a participant is a code on "
         "one machine; one protocol only)");
-    cmd->add_option("inputs", *inputs, "Databases to merge")->required()->check(CLI::ExistingFile);
-    cmd->add_option("--out", *out, "New database to write (must not exist)")->required();
+    cmd->add_option("inputs", *inputs, "Databases to merge: FILE.db or postgresql://... URIs")
+        ->required()
+        ->check(study_db_validator());
+    cmd->add_option("--out", *out,
+                    "New database to write (must not exist), or a postgresql:// server to add "
+                    "the sessions it lacks to")
+        ->required();
     cmd->callback([=, &exit_code] {
         try {
-            const study::MergeReport r = study::merge_databases(*inputs, *out);
+            // Servers are read through one snapshot each, so merge sees only files.
+            std::vector<std::unique_ptr<study::ReadableStudyFile>> sources;
+            std::vector<std::string> files;
+            for (const std::string& in : *inputs) {
+                sources.push_back(std::make_unique<study::ReadableStudyFile>(in));
+                files.push_back(sources.back()->path());
+            }
+            if (study::is_server_uri(*out)) {
+                const study::MergeReport r = study::merge_into_server(files, *out);
+                for (const std::string& note : r.notes) std::cout << "lucent merge: " << note << "\n";
+                std::cout << "merged " << inputs->size() << " databases into " << *out << ": "
+                          << r.sessions_added << " sessions added, " << r.sessions_already_present
+                          << " already there\n";
+                exit_code = kExitOk;
+                return;
+            }
+            const study::MergeReport r = study::merge_databases(files, *out);
             for (const std::string& note : r.notes) std::cout << "lucent merge: " << note << "\n";
             std::cout << "merged " << inputs->size() << " databases into " << *out << ": "
                       << r.sessions_added << " sessions, " << r.sessions_already_present

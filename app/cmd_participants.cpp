@@ -4,11 +4,18 @@
 #include "commands.h"
 #include "sqlite.h"
 #include "store.h"
+#include "study_db_option.h"
+#include "study_store.h"
+
+#include <memory>
+#include <optional>
 
 namespace lucent::app {
 namespace {
 
-int list_participants(const std::string& db_path) {
+int list_participants(const std::string& db_name) {
+    const study::ReadableStudyFile source(db_name);  // a server: one snapshot of it
+    const std::string& db_path = source.path();
     study::check_database_file(db_path);
     study::Database db(db_path, SQLITE_OPEN_READONLY);
     if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'participants'") == 0) {
@@ -29,26 +36,16 @@ int list_participants(const std::string& db_path) {
 }
 
 int withdraw(const std::string& db_path, const std::string& code, bool yes) {
-    study::Store store(db_path);
-    study::Statement s = store.db().prepare(
-        "SELECT count(DISTINCT se.id), count(r.id) FROM participants p "
-        "LEFT JOIN sessions se ON se.participant_id = p.id "
-        "LEFT JOIN responses r ON r.session_id = se.id WHERE p.code = ?");
-    s.bind(1, code);
-    s.step();
-    if (store.db().scalar_int("SELECT count(*) FROM participants") == 0 || s.integer(0) == 0) {
-        study::Statement exists = store.db().prepare("SELECT count(*) FROM participants WHERE code = ?");
-        exists.bind(1, code);
-        exists.step();
-        if (exists.integer(0) == 0) {
-            std::cerr << "lucent participants withdraw: no participant '" << code << "' in "
-                      << db_path << "\n";
-            return kExitUsage;
-        }
+    const std::unique_ptr<study::StudyStore> store = study::open_study_store(db_path);
+    const std::optional<study::ParticipantCounts> counts = store->participant_counts(code);
+    if (!counts) {
+        std::cerr << "lucent participants withdraw: no participant '" << code << "' in "
+                  << db_path << "\n";
+        return kExitUsage;
     }
     if (!yes) {
-        std::cout << "Delete all data of participant '" << code << "' (" << s.integer(0)
-                  << " sessions, " << s.integer(1) << " ratings) from " << db_path
+        std::cout << "Delete all data of participant '" << code << "' (" << counts->sessions
+                  << " sessions, " << counts->ratings << " ratings) from " << db_path
                   << "? This cannot be undone. Type 'yes' to confirm: " << std::flush;
         std::string answer;
         std::getline(std::cin, answer);
@@ -57,7 +54,7 @@ int withdraw(const std::string& db_path, const std::string& code, bool yes) {
             return kExitFailure;
         }
     }
-    store.withdraw_participant(code);
+    store->withdraw_participant(code);
     std::cout << "withdrew participant '" << code << "': their sessions and ratings are deleted\n";
     return kExitOk;
 }
@@ -71,10 +68,10 @@ void register_participants(CLI::App& app, int& exit_code) {
     auto code = std::make_shared<std::string>();
     auto yes = std::make_shared<bool>(false);
     auto* list = cmd->add_subcommand("list", "List participants with their sessions and ratings");
-    list->add_option("--db", *db, "Study database")->required()->check(CLI::ExistingFile);
+    list->add_option("--db", *db, "Study database: FILE.db or postgresql://...")->required()->check(study_db_validator());
     auto* wd = cmd->add_subcommand("withdraw", "Delete a participant and all their data (asks first)");
     wd->add_option("id", *code, "Participant code")->required();
-    wd->add_option("--db", *db, "Study database")->required()->check(CLI::ExistingFile);
+    wd->add_option("--db", *db, "Study database: FILE.db or postgresql://...")->required()->check(study_db_validator());
     wd->add_flag("--yes", *yes, "Do not ask for confirmation (scripts)");
     auto guarded = [&exit_code](auto fn) {
         try {

@@ -60,11 +60,15 @@ int run_command(RunArgs& args) {
 void register_run(CLI::App& app, int& exit_code) {
     auto args = std::make_shared<RunArgs>();
     auto* cmd = app.add_subcommand(
-        "run", "Run a participant session full-screen (ratings stored in an SQLite database)");
+        "run", "Run a participant session full-screen (ratings stored in an SQLite file or a "
+               "PostgreSQL study server)");
     cmd->add_option("protocol", args->protocol_file, "Study protocol file (TOML)");
     cmd->add_option("--preset", args->preset, "Built-in protocol instead of a file")
         ->check(CLI::IsMember(study::builtin_protocol_names()));
-    cmd->add_option("--db", args->options.db_path, "Study database (created when absent)")->required();
+    cmd->add_option("--db", args->options.db_path,
+                    "Study database: FILE.db (created when absent) or "
+                    "postgresql://USER@HOST[:PORT]/DBNAME (after 'lucent store init')")
+        ->required();
     cmd->add_option("--participant", args->options.participant, "Participant code, e.g. P07")->required();
     cmd->add_flag("--windowed", args->options.windowed, "A 1280x1024 window instead of full screen");
     cmd->add_option("--monitor", args->options.monitor, "Monitor index for full screen")->check(CLI::NonNegativeNumber);

@@ -24,6 +24,7 @@ void register_participants(CLI::App& app, int& exit_code);
 void register_export(CLI::App& app, int& exit_code);
 void register_merge(CLI::App& app, int& exit_code);
 void register_explore(CLI::App& app, int& exit_code);
+void register_store(CLI::App& app, int& exit_code);
 void register_stimuli(CLI::App& app, int& exit_code);
 
 // `lucent analyze --images`: how a level's picture becomes a thumbnail (PNG bytes).
@@ -38,5 +39,6 @@ void register_bench_accuracy(CLI::App& bench, int& exit_code);
 void register_bench_ao(CLI::App& bench, int& exit_code);
 void register_bench_stats(CLI::App& bench, int& exit_code);
 void register_bench_render(CLI::App& bench, int& exit_code);
+void register_bench_store(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app

@@ -1,5 +1,7 @@
 #include "study_input.h"
 
+#include "study_store.h"
+
 #include <fstream>
 #include <iostream>
 
@@ -18,11 +20,13 @@ bool is_sqlite_file(const std::string& path) {
 
 analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale,
                                  std::optional<analysis::Design>* plan_design) {
-    if (!is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
+    const bool server = study::is_server_uri(path);
+    if (!server && !is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
     study::LongTable rows;
     try {
-        study::check_stored_ratings(path);  // each rating on its own question's scale
-        rows = study::analysis_long_table(path);
+        const study::ReadableStudyFile source(path);  // a server: one snapshot of it
+        study::check_stored_ratings(source.path());  // each rating on its own question's scale
+        rows = study::analysis_long_table(source.path());
     } catch (const study::StoreError& e) {
         throw analysis::InputError(e.what());
     }

@@ -156,10 +156,10 @@ const char* const kCopySteps[] = {
 
     "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, catch_id, "
     "prompt, expected_rating, tolerance, break_before, onset_ns, confirm_ns, answered_utc, "
-    "dropped_frames) "
+    "dropped_frames, uuid) "
     "SELECT msn.id, t.position, t.block, mst.id, t.practice, t.catch, t.catch_id, t.prompt, "
     "t.expected_rating, t.tolerance, t.break_before, t.onset_ns, t.confirm_ns, "
-    "t.answered_utc, t.dropped_frames FROM src.trials t "
+    "t.answered_utc, t.dropped_frames, t.uuid FROM src.trials t "
     "JOIN src.sessions s ON s.id = t.session_id JOIN temp.new_sessions n ON n.uuid = s.uuid "
     "JOIN main.sessions msn ON msn.uuid = s.uuid "
     "JOIN src.stimuli st ON st.id = t.stimulus_id "

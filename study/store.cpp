@@ -2,7 +2,11 @@
 // trials and responses.
 #include "store.h"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <chrono>
 #include <cstdio>
@@ -152,6 +156,12 @@ CREATE INDEX segments_by_session ON session_segments(session_id);
 -- number, and with it a Latin-square row, is never handed out twice.
 CREATE TABLE retired_participant_numbers (number INTEGER PRIMARY KEY);
 )sql",
+    // 4: a UUID per planned trial, so a station's journal can resend a trial to a server
+    // idempotently and a merge can tell one trial from another. Earlier trials keep NULL.
+    R"sql(
+ALTER TABLE trials ADD COLUMN uuid TEXT;
+CREATE UNIQUE INDEX trials_by_uuid ON trials(uuid);
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 
@@ -161,14 +171,16 @@ std::string hex32(uint32_t v) {
     return out;
 }
 
+int64_t first_int(Statement& s) { return s.step() ? s.integer(0) : 0; }
+
+}  // namespace
+
 int participant_number_from_code(const std::string& code) {
     size_t end = code.size(), begin = end;
     while (begin > 0 && std::isdigit(static_cast<unsigned char>(code[begin - 1]))) --begin;
     if (begin == end || end - begin > 9) return -1;
     return std::stoi(code.substr(begin));
 }
-
-int64_t first_int(Statement& s) { return s.step() ? s.integer(0) : 0; }
 
 ResolvedStimulus resolved_of(const StimulusProvenance& p) {
     ResolvedStimulus r{p.technique, p.mesh, p.mesh_hash, {}};
@@ -184,7 +196,10 @@ std::optional<std::string> segment_source(const std::vector<StimulusProvenance>&
     return sources.size() == 1 ? *sources.begin() : std::string("mixed");
 }
 
-}  // namespace
+const std::vector<std::string>& schema_migrations() {
+    static const std::vector<std::string> steps(std::begin(kMigrations), std::end(kMigrations));
+    return steps;
+}
 
 std::map<std::string, ResolvedStimulus> read_resolved_stimuli(Database& db) {
     std::map<std::string, ResolvedStimulus> out;
@@ -246,6 +261,10 @@ void check_database_file(const std::string& path) {
     struct Closer { sqlite3* db; ~Closer() { sqlite3_close_v2(db); } } closer{raw};
     if (rc != SQLITE_OK)
         throw StoreError(path + ": cannot open read-only: " + sqlite3_errstr(rc));
+    // Other stations' writers may hold the lock a moment: wait as the store itself does,
+    // and never call a busy database corrupt.
+    sqlite3_busy_timeout(raw, 5000);
+    bool busy = false;
     auto query_int = [&](const char* sql, int64_t& out) -> std::string {
         sqlite3_stmt* stmt = nullptr;
         int r = sqlite3_prepare_v2(raw, sql, -1, &stmt, nullptr);
@@ -254,6 +273,7 @@ void check_database_file(const std::string& path) {
             if (r == SQLITE_ROW) { out = sqlite3_column_int64(stmt, 0); r = SQLITE_OK; }
         }
         std::string why = r == SQLITE_OK ? "" : sqlite3_errmsg(raw);
+        busy = busy || (r & 0xFF) == SQLITE_BUSY || (r & 0xFF) == SQLITE_LOCKED;
         sqlite3_finalize(stmt);
         return why;
     };
@@ -261,6 +281,9 @@ void check_database_file(const std::string& path) {
     std::string why = query_int("PRAGMA application_id", app_id);
     if (why.empty()) why = query_int("PRAGMA user_version", version);
     if (why.empty()) why = query_int("SELECT count(*) FROM sqlite_schema", tables);
+    if (!why.empty() && busy)
+        throw StoreError(path + ": database is locked by another process for over 5 s (" + why +
+                         "); try again");
     if (!why.empty())
         throw StoreError(path + ": database is corrupt (" + why + "); left unchanged");
     if (app_id == 0 && version == 0 && tables == 0) return;  // an empty SQLite file
@@ -345,11 +368,14 @@ int64_t Store::ensure_study(const Protocol& protocol) {
 }
 
 int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int* number) {
+    // BEGIN IMMEDIATE: the number is read and taken under one write lock, so two
+    // processes on this file never take the same one.
+    Transaction tx(db_);
     Statement find = db_.prepare("SELECT id, number FROM participants WHERE code = ?");
     find.bind(1, code);
     if (find.step()) {
         if (number) *number = static_cast<int>(find.integer(1));
-        return find.integer(0);
+        return find.integer(0);  // nothing written: the rollback is a no-op
     }
     int n = participant_number_from_code(code);
     // Enrolment order: one past the highest number held, not the count, which falls
@@ -361,8 +387,10 @@ int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int
     db_.prepare("INSERT INTO participants (study_id, code, number, created_utc) "
                 "VALUES (?, ?, ?, ?)")
         .bind(1, study_id).bind(2, code).bind(3, n).bind(4, utc_now_iso8601()).run();
+    const int64_t id = db_.last_insert_id();
+    tx.commit();
     if (number) *number = n;
-    return db_.last_insert_id();
+    return id;
 }
 
 SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
@@ -394,9 +422,9 @@ SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
     insert_segment(row.id, 1, env);
     Statement insert = db_.prepare(
         "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, "
-        "catch_id, prompt, expected_rating, tolerance, break_before) VALUES "
+        "catch_id, prompt, expected_rating, tolerance, break_before, uuid) VALUES "
         "(?, ?, ?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), "
-        "?, ?, ?, ?, ?, ?, ?)");
+        "?, ?, ?, ?, ?, ?, ?, ?)");
     for (const PlannedTrial& t : plan.trials) {
         insert.reset();
         insert.bind(1, row.id).bind(2, t.position).bind(3, t.block).bind(4, study_id)
@@ -405,7 +433,7 @@ SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
             insert.bind(8, t.catch_id).bind(9, t.prompt).bind(10, t.expected)
                 .bind(11, t.tolerance);
         }
-        insert.bind(12, t.break_before ? 1 : 0).run();
+        insert.bind(12, t.break_before ? 1 : 0).bind(13, new_uuid_v4()).run();
     }
     tx.commit();
     return row;
@@ -441,7 +469,7 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
     Statement s = db_.prepare(
         "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
         "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
-        "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id) "
+        "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), coalesce(t.uuid, '') "
         "FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
         "WHERE t.session_id = ? ORDER BY t.position");
     s.bind(1, session_id);
@@ -458,6 +486,7 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
         t.expected = static_cast<int>(s.integer(7));
         t.break_before = s.integer(8) != 0;
         t.answered = s.integer(9) != 0;
+        t.uuid = s.text(10);
         out.push_back(std::move(t));
     }
     return out;
@@ -662,6 +691,45 @@ bool Store::withdraw_participant(const std::string& code) {
     const bool deleted = sqlite3_changes(db_.handle()) > 0;
     tx.commit();
     return deleted;
+}
+
+std::optional<ParticipantCounts> Store::participant_counts(const std::string& code) {
+    Statement s = db_.prepare(
+        "SELECT count(DISTINCT se.id), count(r.id) FROM participants p "
+        "LEFT JOIN sessions se ON se.participant_id = p.id "
+        "LEFT JOIN responses r ON r.session_id = se.id WHERE p.code = ? GROUP BY p.id");
+    s.bind(1, code);
+    if (!s.step()) return std::nullopt;
+    return ParticipantCounts{s.integer(0), s.integer(1)};
+}
+
+void Store::snapshot_to_sqlite(const std::string& sqlite_path) {
+    db_.prepare("VACUUM INTO ?").bind(1, sqlite_path).run();
+}
+
+void Store::claim_participant(const std::string& code) {
+    if (claim_fd_ < 0) {
+        const std::string lock_path = db_.path() + "-participants.lock";
+        claim_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        if (claim_fd_ < 0)
+            throw StoreError(lock_path + ": cannot open the participant lock file: " +
+                             std::strerror(errno));
+    }
+    // One byte per code (a 62-bit hash of it) locked for this open file description:
+    // a second store, in this process or another, cannot take it while this one lives.
+    struct flock lock {};
+    lock.l_type = F_WRLCK;
+    lock.l_whence = SEEK_SET;
+    lock.l_start = static_cast<off_t>(std::hash<std::string>{}(code) & 0x3FFFFFFFFFFFFFFFull);
+    lock.l_len = 1;
+    if (fcntl(claim_fd_, F_OFD_SETLK, &lock) != 0)
+        throw StoreError(db_.path() + ": participant '" + code +
+                         "' is in a session on this machine now; refusing to run it twice "
+                         "at once");
+}
+
+Store::~Store() {
+    if (claim_fd_ >= 0) ::close(claim_fd_);  // releases the claims
 }
 
 std::string utc_now_iso8601() {

@@ -107,7 +107,7 @@ private:
     StimulusRenderer& stimuli_;
     std::ostream& log_;
 
-    std::optional<Store> store_;
+    std::unique_ptr<StudyStore> store_;
     int64_t study_id_ = 0;
     std::optional<SessionRow> resumable_;
     SessionRow session_;
@@ -132,8 +132,11 @@ private:
 };
 
 RunResult Session::prepare_store() {
-    store_.emplace(opt_.db_path);
+    store_ = open_study_store(opt_.db_path);
     study_id_ = store_->ensure_study(p_);
+    // Before anything of the participant is read: a second station running this code
+    // now is refused here, with one line.
+    store_->claim_participant(opt_.participant);
     resumable_ = store_->unfinished_session(opt_.participant);
     // Every trial answered but still open: left so by a build where completion was not
     // atomic. It is complete; mark it so instead of reopening it.
@@ -499,6 +502,19 @@ RunResult Session::run() {
         log_ << "lucent run: consent declined; session closed\n";
     } else {
         log_ << "lucent run: session complete (" << flow_->total_trials() << " trials)\n";
+    }
+    // A server store: one last send of what the journal holds; what the server still
+    // lacks stays journaled for `lucent store sync`.
+    if (store_->pending_trials() > 0) {
+        try {
+            store_->sync();
+        } catch (const StoreError& e) {
+            log_ << "lucent run: " << e.what() << "\n";
+        }
+        if (const int left = store_->pending_trials(); left > 0)
+            log_ << "lucent run: " << left << " trials are kept in the local journal until "
+                 << store_->name() << " confirms them; send them with 'lucent store sync --db "
+                 << store_->name() << "'\n";
     }
     return result;
 }

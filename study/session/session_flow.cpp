@@ -4,7 +4,7 @@
 
 namespace lucent::study {
 
-SessionFlow::SessionFlow(const Protocol& protocol, Store& store, int64_t session_id,
+SessionFlow::SessionFlow(const Protocol& protocol, StudyStore& store, int64_t session_id,
                          std::vector<TrialRow> trials, bool consented, int64_t now_ns)
     : protocol_(protocol),
       store_(store),

@@ -9,7 +9,7 @@
 //   stamped before the screen's first presented frame are dropped as stale, so a quick
 //   double Enter cannot skip a break screen it never showed.
 // - The last trial's ratings and the status `completed` are one transaction
-//   (Store::record_trial), and nothing turns a completed session back into paused.
+//   (StudyStore::record_trial), and nothing turns a completed session back into paused.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -49,7 +49,7 @@ class SessionFlow {
 public:
     // `trials`: the session's planned trials as stored; `consented`: consent already
     // recorded (a resumed session). Starts at the first unanswered trial.
-    SessionFlow(const Protocol& protocol, Store& store, int64_t session_id,
+    SessionFlow(const Protocol& protocol, StudyStore& store, int64_t session_id,
                 std::vector<TrialRow> trials, bool consented, int64_t now_ns);
 
     // ---- input -----------------------------------------------------------------------
@@ -95,7 +95,7 @@ private:
     void quit_saving();
 
     const Protocol& protocol_;
-    Store& store_;
+    StudyStore& store_;
     int64_t session_id_;
     std::vector<TrialRow> trials_;
     size_t current_ = 0;  // the first unanswered trial

@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <memory>
+#include <thread>
+
 #include "study_fixtures.h"
 #include "test_paths.h"
 
@@ -175,6 +179,30 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRows) {
     EXPECT_EQ(store.db().scalar_int(
                   "SELECT count(*) FROM pragma_table_info('sessions') WHERE name = 'refresh_note'"),
               1);
+}
+
+}  // namespace
+}  // namespace lucent::study
+
+namespace lucent::study {
+namespace {
+
+// Another process holding the file a moment (here: exclusive locking mode for 300 ms)
+// is waited for; before, the read-only check named such a database corrupt.
+TEST(Store, ABusyDatabaseIsWaitedForNotCalledCorrupt) {
+    const auto dir = lucent::test::scratch_dir("store_busy");
+    const std::string path = (dir / "s.db").string();
+    { Store store(path); }
+    auto holder = std::make_unique<Database>(path, SQLITE_OPEN_READWRITE);
+    holder->exec("PRAGMA locking_mode = EXCLUSIVE");
+    holder->exec("BEGIN EXCLUSIVE");
+    holder->exec("COMMIT");  // the exclusive lock stays until the connection closes
+    std::thread release([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        holder.reset();
+    });
+    EXPECT_NO_THROW(check_database_file(path));
+    release.join();
 }
 
 }  // namespace

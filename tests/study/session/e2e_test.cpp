@@ -23,7 +23,10 @@
 #include "display.h"
 #include "session/stimulus_source.h"
 #include "sha256.h"
+#include "postgres/local_server.h"
+#include "postgres/trial_journal.h"
 #include "sqlite.h"
+#include "study_store.h"
 #include "test_paths.h"
 
 namespace lucent::study {
@@ -245,6 +248,109 @@ TEST_F(SessionE2E, MixedScalesAreDrawnAndAnsweredPerQuestion) {
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses WHERE rating < 1 OR "
                            "(question = 'realistic' AND rating > 5)"), 0);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+}
+
+// `lucent run` into a real PostgreSQL server (a throwaway local one): the session
+// completes with every rating on the server and nothing left in the station's journal,
+// and the same participant started on a second station while the first runs is refused
+// in one line before any window opens.
+TEST_F(SessionE2E, AServerStoreRunsTheSessionAndRefusesTheSameCodeOnASecondStation) {
+    LUCENT_REQUIRE_DISPLAY();
+    LocalPostgres server;
+    const std::string uri = server.create_database("e2e");
+    init_study_store(uri);
+    setenv("LUCENT_JOURNAL_DIR", (dir_ / "journals").c_str(), 1);  // inherited by the runs
+    const std::string station_journal = default_journal_path(uri);
+    const std::string protocol = write_protocol(3);  // 1 practice + 9 rated + 1 catch
+    const Process first = start_lucent(run_args(protocol, uri, "5"), dir_);
+    StoreOptions watch_options;
+    watch_options.journal_path = (dir_ / "watch-journal.db").string();
+    auto watch = open_study_store(uri, watch_options);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (watch->query_int("SELECT count(*) FROM sessions") == 0 &&
+           std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    ASSERT_EQ(watch->query_int("SELECT count(*) FROM sessions"), 1) << read_file(first.stderr_path);
+    const Process second = start_lucent(run_args(protocol, uri, "6"), dir_);
+    EXPECT_EQ(wait_exit(second), 2);
+    const std::string refused = read_file(second.stderr_path);
+    EXPECT_NE(refused.find("participant 'P1' is in a session on another station now"),
+              std::string::npos)
+        << refused;
+    EXPECT_EQ(std::count(refused.begin(), refused.end(), '\n'), 1) << refused;
+    ASSERT_EQ(wait_exit(first), 0) << read_file(first.stderr_path);
+    unsetenv("LUCENT_JOURNAL_DIR");
+    EXPECT_EQ(watch->query_int("SELECT count(*) FROM trials"), 11);
+    EXPECT_EQ(watch->query_int("SELECT count(*) FROM responses"), 22);
+    EXPECT_EQ(watch->query_int("SELECT count(*) FROM sessions WHERE status = 'completed' AND "
+                               "consent_utc IS NOT NULL"),
+              1);
+    EXPECT_EQ(watch->query_int("SELECT count(*) FROM responses r JOIN trials t ON t.id = "
+                               "r.trial_id WHERE t.catch = 1 AND r.rating <> t.expected_rating"),
+              0);
+    ASSERT_TRUE(fs::exists(station_journal));  // the station journaled, then emptied it
+    EXPECT_EQ(TrialJournal(station_journal, uri).count(), 0);
+}
+
+// The server goes away mid-session, the station keeps running on its journal and is then
+// killed (SIGKILL) with trials the server never saw. The server comes back, `lucent store
+// sync` sends the journal, `--resume` finishes the session: every trial has exactly one
+// rating per question on the server.
+TEST_F(SessionE2E, AStationKilledWhileTheServerIsDownLosesNothingAfterSyncAndResume) {
+    LUCENT_REQUIRE_DISPLAY();
+    LocalPostgres server;
+    const std::string uri = server.create_database("e2e_outage");
+    init_study_store(uri);
+    setenv("LUCENT_JOURNAL_DIR", (dir_ / "journals").c_str(), 1);  // inherited by the runs
+    const std::string journal_path = default_journal_path(uri);
+    const std::string protocol = write_protocol(3);  // 1 practice + 9 rated + 1 catch
+    const Process first = start_lucent(run_args(protocol, uri, "21"), dir_);
+    StoreOptions watch_options;
+    watch_options.journal_path = (dir_ / "watch-journal.db").string();
+    int64_t on_server = 0;
+    {
+        auto watch = open_study_store(uri, watch_options);
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (on_server < 2 && std::chrono::steady_clock::now() < deadline) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            on_server = watch->query_int("SELECT count(DISTINCT trial_id) FROM responses");
+        }
+    }
+    ASSERT_GE(on_server, 2) << read_file(first.stderr_path);
+    server.stop();
+    // Trials answered now are journaled; kill the station once it holds two.
+    int64_t journaled = 0;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (journaled < 2 && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        try {
+            journaled = Database(journal_path, SQLITE_OPEN_READONLY)
+                            .scalar_int("SELECT count(*) FROM pending_trials");
+        } catch (const StoreError&) {
+        }
+    }
+    kill(first.pid, SIGKILL);
+    EXPECT_EQ(wait_exit(first), 128 + SIGKILL);
+    ASSERT_GE(journaled, 2) << read_file(first.stderr_path);
+    server.start();
+    const Process sync = start_lucent({"store", "sync", "--db", uri}, dir_);
+    EXPECT_EQ(wait_exit(sync), 0) << read_file(sync.stderr_path);
+    EXPECT_EQ(TrialJournal(journal_path, uri).count(), 0);
+    auto resume_args = run_args(protocol, uri, "22");
+    resume_args.push_back("--resume");
+    const Process second = start_lucent(resume_args, dir_);
+    ASSERT_EQ(wait_exit(second), 0) << read_file(second.stderr_path);
+    unsetenv("LUCENT_JOURNAL_DIR");
+    auto check = open_study_store(uri, watch_options);
+    EXPECT_EQ(check->query_int("SELECT count(*) FROM trials"), 11);
+    EXPECT_EQ(check->query_int("SELECT count(*) FROM responses"), 22);
+    EXPECT_EQ(check->query_int("SELECT count(*) FROM (SELECT DISTINCT trial_id, question FROM "
+                               "responses) d"),
+              22);
+    EXPECT_EQ(check->query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    EXPECT_EQ(check->query_int("SELECT count(*) FROM session_segments"), 2);
+    std::printf("outage: %lld trials on the server before the stop, %lld journaled when killed\n",
+                static_cast<long long>(on_server), static_cast<long long>(journaled));
 }
 
 TEST_F(SessionE2E, TheDebriefCannotReopenACompletedSessionNorCanResume) {

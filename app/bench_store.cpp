@@ -1,0 +1,201 @@
+// lucent bench store: trial commits per second and commit latency (p50, p99) of each
+// study store backend with 1, 8 and 50 concurrent writers (stations), each its own
+// connection, participant and session, measured in one run on this machine.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "commands.h"
+#include "postgres/local_server.h"
+#include "protocol.h"
+#include "sqlite.h"
+#include "store.h"
+#include "study_store.h"
+#include "trial_plan.h"
+
+namespace lucent::app {
+namespace {
+
+struct BenchRow {
+    std::string backend;
+    int writers = 0;
+    int commits = 0;
+    double seconds = 0;  // the commit phase: first commit's start to the last one's end
+    double p50_ms = 0, p99_ms = 0;
+    int failed_writers = 0;  // writers that stopped on an error (e.g. SQLite's busy timeout)
+    std::string first_error;
+};
+
+// Commits per second; 0 for a row without commits (never Inf or NaN in the table).
+double rate(const BenchRow& r) { return r.seconds > 0 ? r.commits / r.seconds : 0.0; }
+
+double percentile(std::vector<double> v, double q) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
+    return v[i];
+}
+
+// `writers` stations at once, each answering `trials` trials of its own session.
+BenchRow run_writers(const std::string& backend, const std::string& db, int writers, int trials,
+                     const std::string& journal_dir) {
+    const study::Protocol protocol = study::builtin_protocol("thesis");
+    {
+        auto store = study::open_study_store(db);  // the study row, before the clock starts
+        store->ensure_study(protocol);
+    }
+    std::vector<std::vector<double>> latencies(writers);
+    using Clock = std::chrono::steady_clock;
+    std::vector<Clock::time_point> first_start(writers, Clock::time_point::max()),
+        last_end(writers, Clock::time_point::min());
+    std::vector<std::string> errors(writers);
+    std::vector<std::thread> threads;
+    for (int w = 0; w < writers; ++w) {
+        threads.emplace_back([&, w] {
+            try {
+                study::StoreOptions options;
+                options.journal_path = journal_dir + "/journal-" + std::to_string(w) + ".db";
+                auto store = study::open_study_store(db, options);
+                const int64_t study_id = store->ensure_study(protocol);
+                const std::string code = "bench" + std::to_string(writers) + "w" + std::to_string(w);
+                int number = 0;
+                const int64_t pid = store->ensure_participant(study_id, code, &number);
+                const study::SessionRow s = store->create_session(
+                    study_id, pid, study::plan_trials(protocol, 1000 + w, number), 1000 + w, {});
+                const std::vector<study::TrialRow> rows = store->trials(s.id);
+                const int n = std::min<int>(trials, static_cast<int>(rows.size()));
+                for (int i = 0; i < n; ++i) {
+                    study::TrialOutcome o;
+                    o.onset_ns = 1;
+                    o.confirm_ns = 2;
+                    for (const study::Question& q : protocol.questions)
+                        o.responses.push_back({q.id, rows[i].is_catch ? rows[i].expected
+                                                                      : 1 + (i % q.points()),
+                                               500.0, 0, 1, 2});
+                    const auto t0 = Clock::now();
+                    store->record_trial(s.id, rows[i].id, o);
+                    const auto t1 = Clock::now();
+                    first_start[w] = std::min(first_start[w], t0);
+                    last_end[w] = std::max(last_end[w], t1);
+                    latencies[w].push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+                }
+                if (store->pending_trials() != 0)
+                    errors[w] = std::to_string(store->pending_trials()) + " trials unconfirmed";
+            } catch (const std::exception& e) {
+                errors[w] = e.what();
+            }
+        });
+    }
+    for (std::thread& t : threads) t.join();
+    BenchRow row;
+    row.backend = backend;
+    row.writers = writers;
+    const auto begin = *std::min_element(first_start.begin(), first_start.end());
+    const auto end = *std::max_element(last_end.begin(), last_end.end());
+    row.seconds = end > begin ? std::chrono::duration<double>(end - begin).count() : 0.0;
+    std::vector<double> all;
+    for (int w = 0; w < writers; ++w) {
+        if (!errors[w].empty()) {
+            if (row.failed_writers++ == 0) row.first_error = errors[w];
+        }
+        all.insert(all.end(), latencies[w].begin(), latencies[w].end());
+    }
+    row.commits = static_cast<int>(all.size());
+    row.p50_ms = percentile(all, 0.50);
+    row.p99_ms = percentile(all, 0.99);
+    return row;
+}
+
+int run_bench_store(const std::vector<int>& writer_counts, int trials, const std::string& server,
+                    const std::string& csv) {
+    namespace fs = std::filesystem;
+    std::string pattern = (fs::temp_directory_path() / "lucent-bench-store-XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw study::StoreError("cannot create a scratch folder");
+    const std::string scratch = pattern;
+    std::vector<BenchRow> rows;
+    {
+        std::unique_ptr<study::LocalPostgres> local;
+        if (server.empty()) local = std::make_unique<study::LocalPostgres>();
+        int k = 0;
+        for (int writers : writer_counts) {
+            const std::string file = scratch + "/w" + std::to_string(writers) + ".db";
+            rows.push_back(run_writers("sqlite (WAL, synchronous=FULL)", file, writers, trials, scratch));
+            std::string uri = server;
+            if (local) uri = local->create_database("bench_" + std::to_string(k++));
+            study::init_study_store(uri);
+            rows.push_back(run_writers(local ? "postgresql (unix socket)" : "postgresql " + server,
+                                       uri, writers, trials, scratch));
+        }
+    }
+    std::error_code ec;
+    fs::remove_all(scratch, ec);
+
+    std::printf("%-34s %7s %8s %9s %10s %8s %8s %7s\n", "backend", "writers", "commits",
+                "seconds", "commits/s", "p50 ms", "p99 ms", "failed");
+    for (const BenchRow& r : rows)
+        std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d\n", r.backend.c_str(), r.writers,
+                    r.commits, r.seconds, rate(r), r.p50_ms, r.p99_ms,
+                    r.failed_writers);
+    for (const BenchRow& r : rows)
+        if (r.failed_writers)
+            std::printf("%s, %d writers: %d stopped, first: %s\n", r.backend.c_str(), r.writers,
+                        r.failed_writers, r.first_error.c_str());
+    // Ratios within this run: the server against the file at the same writer count.
+    for (size_t i = 0; i + 1 < rows.size(); i += 2)
+        if (rate(rows[i]) > 0)
+            std::printf("writers %d: postgresql/sqlite throughput ratio %.2f\n", rows[i].writers,
+                        rate(rows[i + 1]) / rate(rows[i]));
+    if (!csv.empty()) {
+        std::ofstream out(csv);
+        out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,failed_writers\n";
+        for (const BenchRow& r : rows)
+            out << '"' << r.backend << "\"," << r.writers << ',' << r.commits << ',' << r.seconds
+                << ',' << rate(r) << ',' << r.p50_ms << ',' << r.p99_ms << ','
+                << r.failed_writers << "\n";
+        if (!out) throw study::StoreError(csv + ": cannot write");
+    }
+    return kExitOk;
+}
+
+}  // namespace
+
+void register_bench_store(CLI::App& bench, int& exit_code) {
+    struct Args {
+        std::vector<int> writers{1, 8, 50};
+        int trials = 40;
+        std::string server;
+        std::string csv;
+    };
+    auto args = std::make_shared<Args>();
+    auto* cmd = bench.add_subcommand(
+        "store",
+        "Trial commits per second and p50/p99 commit latency: SQLite file and PostgreSQL over "
+        "a Unix socket (a throwaway local server unless --server), 1, 8 and 50 writers");
+    cmd->add_option("--writers", args->writers, "Concurrent writers per row")
+        ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_option("--trials", args->trials, "Trials each writer commits")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    cmd->add_option("--server", args->server,
+                    "An initialised, empty postgresql:// server instead of a local one");
+    cmd->add_option("--csv", args->csv, "Also write the table as CSV to this file");
+    cmd->callback([args, &exit_code] {
+        try {
+            exit_code = run_bench_store(args->writers, args->trials, args->server, args->csv);
+        } catch (const study::StoreError& e) {
+            std::cerr << "lucent bench store: " << e.what() << "\n";
+            exit_code = kExitFailure;
+        }
+    });
+}
+
+}  // namespace lucent::app

@@ -1,0 +1,849 @@
+// The PostgreSQL study store (postgres_store.h). Every statement goes through
+// exec_params with $n parameters; the only SQL built from strings is constant text.
+//
+// [1] connection and errors  [2] studies, participants, claims  [3] sessions, segments
+// [4] trials: journal, send, sync  [5] status, withdrawal, counts  [6] snapshot
+#include "postgres/postgres_store.h"
+
+#include <pqxx/pqxx>
+
+#include <chrono>
+
+#include "store.h"
+
+namespace lucent::study {
+namespace {
+
+// Advisory lock keys (two-key form, class 0x4C55 'LU'): the study rows, and participant
+// numbers. Participant claims use the one-key form over a hash of the code.
+constexpr int kLockClass = 0x4C55;
+constexpr int kStudyLock = 1;
+constexpr int kNumberLock = 2;
+
+// The server could not be reached, or went away mid-transaction: the caller may journal
+// and retry. Anything else is a real refusal.
+class Unreachable : public StoreError {
+public:
+    using StoreError::StoreError;
+};
+
+std::string first_line(const std::string& s) {
+    std::string out = s.substr(0, s.find('\n'));
+    while (!out.empty() && (out.back() == ' ' || out.back() == '\r')) out.pop_back();
+    return out;
+}
+
+// SQLSTATE classes 08 (connection exception) and 57 (operator intervention: shutdown).
+bool is_connection_state(const std::string& state) {
+    return state.rfind("08", 0) == 0 || state.rfind("57", 0) == 0;
+}
+
+int64_t steady_ns() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+
+std::string flag_list(const std::vector<std::string>& items) {
+    std::string out;
+    for (const std::string& v : items) out += (out.empty() ? "" : ",") + v;
+    return out;
+}
+
+}  // namespace
+
+// ---- [1] connection and errors --------------------------------------------------------
+
+struct PostgresStore::Connection : pqxx::connection {
+    using pqxx::connection::connection;
+};
+
+template <class F>
+auto PostgresStore::guarded(const char* what, F&& body) {
+    try {
+        return body();
+    } catch (const StoreError&) {
+        throw;
+    } catch (const pqxx::broken_connection& e) {
+        drop_connection();
+        throw Unreachable(name_ + ": lost the server while " + what + ": " + first_line(e.what()));
+    } catch (const pqxx::in_doubt_error& e) {
+        drop_connection();
+        throw Unreachable(name_ + ": lost the server during a commit (" + what +
+                          "): " + first_line(e.what()));
+    } catch (const pqxx::sql_error& e) {
+        if (is_connection_state(e.sqlstate()) || !conn_ || !conn_->is_open()) {
+            drop_connection();
+            throw Unreachable(name_ + ": lost the server while " + what + ": " +
+                              first_line(e.what()));
+        }
+        throw StoreError(name_ + ": " + what + ": " + first_line(e.what()));
+    } catch (const pqxx::failure& e) {
+        drop_connection();
+        throw Unreachable(name_ + ": " + what + ": " + first_line(e.what()));
+    }
+}
+
+std::string checked_server_uri(const std::string& uri) {
+    const size_t scheme_end = uri.find("://");
+    if (scheme_end == std::string::npos) throw StoreError(uri + ": not a postgresql:// URI");
+    const size_t authority_end = uri.find_first_of("/?", scheme_end + 3);
+    const std::string authority = uri.substr(scheme_end + 3, authority_end - scheme_end - 3);
+    const size_t at = authority.rfind('@');
+    const bool password_in_user =
+        at != std::string::npos && authority.substr(0, at).find(':') != std::string::npos;
+    const size_t query = uri.find('?');
+    const bool password_param = query != std::string::npos &&
+                                (uri.find("?password=", query) != std::string::npos ||
+                                 uri.find("&password=", query) != std::string::npos);
+    if (password_in_user || password_param)
+        throw StoreError("--db: the server URI holds a password; give it through PGPASSWORD or "
+                         "~/.pgpass (PGPASSFILE), never on the command line");
+    if (uri.find("connect_timeout=") != std::string::npos) return uri;
+    return uri + (query == std::string::npos ? "?" : "&") + "connect_timeout=5";
+}
+
+PostgresStore::PostgresStore(const std::string& uri, const StoreOptions& options)
+    : uri_(checked_server_uri(uri)),
+      name_(uri),
+      options_(options),
+      journal_(options.journal_path.empty() ? default_journal_path(uri) : options.journal_path,
+               uri) {
+    // Refuse an uninitialised or newer schema now, with one line, before any session.
+    guarded("opening", [&] {
+        pqxx::work tx(connection());
+        const pqxx::result has = tx.exec_params(
+            "SELECT to_regclass('lucent_schema') IS NOT NULL, to_regclass('studies') IS NOT NULL");
+        if (!has[0][0].as<bool>()) {
+            throw StoreError(name_ + (has[0][1].as<bool>()
+                                          ? ": holds tables but no lucent_schema: not a Lucent "
+                                            "study database; left unchanged"
+                                          : ": no Lucent schema yet; run 'lucent store init "
+                                            "--db URI' first"));
+        }
+        const pqxx::result v = tx.exec_params("SELECT application_id, version FROM lucent_schema");
+        if (v.empty() || v[0][0].as<int64_t>() != kApplicationId)
+            throw StoreError(name_ + ": lucent_schema is not Lucent's; left unchanged");
+        const int version = v[0][1].as<int>();
+        if (version > kSchemaVersion)
+            throw StoreError(name_ + ": written by a newer Lucent (schema " +
+                             std::to_string(version) + ", this build knows " +
+                             std::to_string(kSchemaVersion) + "); left unchanged");
+        if (version < kSchemaVersion)
+            throw StoreError(name_ + ": schema " + std::to_string(version) +
+                             " is older than this build's " + std::to_string(kSchemaVersion) +
+                             "; run 'lucent store init --db URI' to migrate it");
+        tx.commit();
+        return 0;
+    });
+}
+
+PostgresStore::~PostgresStore() = default;  // closing the connection releases claims
+
+PostgresStore::Connection& PostgresStore::connection() {
+    if (conn_ && conn_->is_open()) return *conn_;
+    conn_.reset();
+    try {
+        conn_ = std::make_unique<Connection>(uri_);
+    } catch (const pqxx::broken_connection& e) {
+        throw Unreachable(name_ + ": cannot reach the server: " + first_line(e.what()));
+    } catch (const std::exception& e) {
+        throw Unreachable(name_ + ": cannot connect: " + first_line(e.what()));
+    }
+    // Claims live as long as a connection: take them again on the new one.
+    for (const std::string& code : claimed_) {
+        pqxx::nontransaction n(*conn_);
+        n.exec_params("SELECT pg_try_advisory_lock(hashtextextended($1, 0))",
+                      "lucent participant " + code);
+    }
+    return *conn_;
+}
+
+void PostgresStore::drop_connection() { conn_.reset(); }
+
+std::vector<std::string> postgres_migrations() {
+    // The SQLite steps with PostgreSQL's types: an identity column for each row id,
+    // 64-bit integers for INTEGER, double precision for REAL. The text is otherwise the
+    // same, so the two schemas cannot drift apart.
+    std::vector<std::string> out;
+    auto replace_all = [](std::string s, const std::string& from, const std::string& to) {
+        for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size()))
+            s.replace(at, from.size(), to);
+        return s;
+    };
+    for (std::string step : schema_migrations()) {
+        step = replace_all(step, "id INTEGER PRIMARY KEY",
+                           "id BIGINT GENERATED BY DEFAULT AS IDENTITY PRIMARY KEY");
+        step = replace_all(step, " INTEGER", " BIGINT");
+        step = replace_all(step, " REAL", " DOUBLE PRECISION");
+        out.push_back(step);
+    }
+    return out;
+}
+
+std::pair<int, int> init_postgres_schema(const std::string& uri) {
+    const std::string checked = checked_server_uri(uri);
+    try {
+        pqxx::connection c(checked);
+        pqxx::work tx(c);
+        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kStudyLock);
+        const pqxx::result has = tx.exec_params(
+            "SELECT to_regclass('lucent_schema') IS NOT NULL, to_regclass('studies') IS NOT NULL");
+        int version = 0;
+        if (has[0][0].as<bool>()) {
+            const pqxx::result v = tx.exec_params("SELECT application_id, version FROM lucent_schema");
+            if (v.empty() || v[0][0].as<int64_t>() != kApplicationId)
+                throw StoreError(uri + ": lucent_schema is not Lucent's; left unchanged");
+            version = v[0][1].as<int>();
+        } else if (has[0][1].as<bool>()) {
+            throw StoreError(uri + ": holds tables but no lucent_schema: not a Lucent study "
+                             "database; left unchanged");
+        }
+        if (version > kSchemaVersion)
+            throw StoreError(uri + ": written by a newer Lucent (schema " + std::to_string(version) +
+                             ", this build knows " + std::to_string(kSchemaVersion) +
+                             "); left unchanged");
+        if (version == 0)
+            tx.exec("CREATE TABLE lucent_schema (application_id BIGINT NOT NULL, "
+                    "version INTEGER NOT NULL)");
+        const std::vector<std::string> steps = postgres_migrations();
+        for (int v = version + 1; v <= kSchemaVersion; ++v) tx.exec(steps[v - 1]);
+        tx.exec_params("DELETE FROM lucent_schema");
+        tx.exec_params("INSERT INTO lucent_schema (application_id, version) VALUES ($1, $2)",
+                       static_cast<int64_t>(kApplicationId), kSchemaVersion);
+        tx.commit();
+        return {version, kSchemaVersion};
+    } catch (const StoreError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw StoreError(uri + ": " + first_line(e.what()));
+    }
+}
+
+// ---- [2] studies, participants, claims -----------------------------------------------
+
+int64_t PostgresStore::ensure_study(const Protocol& protocol) {
+    const std::string hash = protocol_hash(protocol.text);
+    return guarded("storing the study", [&]() -> int64_t {
+        pqxx::work tx(connection());
+        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kStudyLock);
+        for (const pqxx::row& r : tx.exec_params("SELECT id, protocol_hash, name FROM studies")) {
+            if (r[1].as<std::string>() == hash) return r[0].as<int64_t>();
+            throw StoreError(name_ + ": holds study '" + r[2].as<std::string>() + "' (protocol " +
+                             r[1].as<std::string>().substr(0, 12) + "), not this protocol (" +
+                             hash.substr(0, 12) + "); use a new database per protocol");
+        }
+        const int64_t study_id =
+            tx.exec_params1("INSERT INTO studies (name, protocol_text, protocol_hash, "
+                            "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
+                            protocol.name, protocol.text, hash, utc_now_iso8601())[0]
+                .as<int64_t>();
+        for (const StimulusSpec& s : protocol.stimuli) {
+            std::string varies;
+            for (const std::string& v : s.varies) varies += (varies.empty() ? "" : " ") + v;
+            const int64_t stimulus_id =
+                tx.exec_params1("INSERT INTO stimuli (study_id, stimulus_key, technique, mesh, "
+                                "image, varies) VALUES ($1, $2, $3, $4, $5, $6) RETURNING id",
+                                study_id, s.id, s.technique, s.mesh, s.image, varies)[0]
+                    .as<int64_t>();
+            for (const auto& [name, value] : s.parameters)
+                tx.exec_params("INSERT INTO stimulus_parameters (stimulus_id, name, value) "
+                               "VALUES ($1, $2, $3)",
+                               stimulus_id, name, value);
+        }
+        tx.commit();
+        return study_id;
+    });
+}
+
+int64_t PostgresStore::ensure_participant(int64_t study_id, const std::string& code,
+                                          int* number) {
+    return guarded("enrolling the participant", [&]() -> int64_t {
+        pqxx::work tx(connection());
+        // One station at a time reads the highest number and takes the next: no two
+        // participants get one number (one Latin-square row) from racing stations.
+        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kNumberLock);
+        const pqxx::result found =
+            tx.exec_params("SELECT id, number FROM participants WHERE code = $1", code);
+        if (!found.empty()) {
+            if (number) *number = found[0][1].as<int>();
+            return found[0][0].as<int64_t>();
+        }
+        int n = participant_number_from_code(code);
+        if (n < 0)
+            n = tx.exec_params1("SELECT greatest(coalesce((SELECT max(number) FROM participants), 0), "
+                                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")[0]
+                    .as<int>() +
+                1;
+        const int64_t id =
+            tx.exec_params1("INSERT INTO participants (study_id, code, number, created_utc) "
+                            "VALUES ($1, $2, $3, $4) RETURNING id",
+                            study_id, code, n, utc_now_iso8601())[0]
+                .as<int64_t>();
+        tx.commit();
+        if (number) *number = n;
+        return id;
+    });
+}
+
+void PostgresStore::claim_participant(const std::string& code) {
+    if (claimed_.count(code)) return;
+    const bool taken = guarded("claiming the participant", [&] {
+        pqxx::nontransaction n(connection());
+        return n.exec_params1("SELECT pg_try_advisory_lock(hashtextextended($1, 0))",
+                              "lucent participant " + code)[0]
+            .as<bool>();
+    });
+    if (!taken)
+        throw StoreError(name_ + ": participant '" + code +
+                         "' is in a session on another station now; refusing to run it twice "
+                         "at once");
+    claimed_.insert(code);
+}
+
+void PostgresStore::check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) {
+    guarded("checking stimulus values", [&] {
+        pqxx::work tx(connection());
+        std::map<std::string, ResolvedStimulus> stored;
+        for (const pqxx::row& r : tx.exec_params(
+                 "SELECT stimulus_key, technique, resolved_mesh, mesh_hash FROM stimuli "
+                 "WHERE resolved_mesh IS NOT NULL"))
+            stored[r[0].as<std::string>()] = {r[1].as<std::string>(), r[2].as<std::string>(),
+                                              r[3].is_null() ? "" : r[3].as<std::string>(), {}};
+        for (const pqxx::row& r : tx.exec_params(
+                 "SELECT st.stimulus_key, v.name, v.value FROM stimulus_values v "
+                 "JOIN stimuli st ON st.id = v.stimulus_id"))
+            stored[r[0].as<std::string>()].values[r[1].as<std::string>()] = r[2].as<std::string>();
+        for (const StimulusProvenance& p : stimuli) {
+            const auto it = stored.find(p.stimulus);
+            if (it == stored.end()) continue;
+            const std::string difference =
+                resolved_difference(p.stimulus, it->second, name_, resolved_of(p), "this run");
+            if (!difference.empty())
+                throw StoreError(name_ + ": " + difference +
+                                 ": its pictures would differ from the earlier sessions'; use a "
+                                 "new database");
+        }
+        return 0;
+    });
+}
+
+// ---- [3] sessions, segments ------------------------------------------------------------
+
+namespace {
+
+// The segment rows and (first time) the study's resolved values, inside `tx`.
+void insert_segment(pqxx::work& tx, int64_t session_id, int segment,
+                    const SessionEnvironment& env) {
+    const int64_t study_id =
+        tx.exec_params1("SELECT study_id FROM sessions WHERE id = $1", session_id)[0].as<int64_t>();
+    for (const StimulusProvenance& p : env.stimuli) {
+        // Row lock: a station racing to record the same stimulus first waits, then sees
+        // it recorded (affected rows 0) and does not add values twice.
+        const pqxx::result first = tx.exec_params(
+            "UPDATE stimuli SET resolved_mesh = $1, mesh_hash = $2 WHERE study_id = $3 AND "
+            "stimulus_key = $4 AND resolved_mesh IS NULL",
+            p.mesh, p.mesh_hash, study_id, p.stimulus);
+        if (first.affected_rows() == 0) continue;
+        for (const auto& [name, text] : p.values)
+            tx.exec_params("INSERT INTO stimulus_values (stimulus_id, name, value) VALUES "
+                           "((SELECT id FROM stimuli WHERE study_id = $1 AND stimulus_key = $2), "
+                           "$3, $4)",
+                           study_id, p.stimulus, name, text);
+    }
+    const int64_t segment_id =
+        tx.exec_params1(
+              "INSERT INTO session_segments (session_id, segment, started_utc, machine_id, "
+              "software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
+              "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) VALUES "
+              "($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13) RETURNING id",
+              session_id, segment, utc_now_iso8601(), env.machine_id, env.software_version,
+              env.build_hash, env.gl_vendor, env.gl_renderer, env.display_mode,
+              env.display_refresh_hz, env.measured_refresh_hz, env.refresh_note,
+              segment_source(env.stimuli))[0]
+            .as<int64_t>();
+    for (const StimulusProvenance& p : env.stimuli)
+        tx.exec_params("INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, "
+                       "content_hash, software_version, build_hash) VALUES ($1, (SELECT id FROM "
+                       "stimuli WHERE study_id = $2 AND stimulus_key = $3), $4, $5, $6, $7, $8)",
+                       segment_id, study_id, p.stimulus, p.source, p.file, p.content_hash,
+                       p.software_version, p.build_hash);
+}
+
+SessionRow session_row(const pqxx::row& r) {
+    SessionRow row;
+    row.id = r[0].as<int64_t>();
+    row.uuid = r[1].as<std::string>();
+    row.participant_id = r[2].as<int64_t>();
+    row.participant = r[3].as<std::string>();
+    row.seed = std::stoull(r[4].as<std::string>());
+    row.cell = r[5].as<int>();
+    row.status = r[6].as<std::string>();
+    return row;
+}
+
+}  // namespace
+
+SessionRow PostgresStore::create_session(int64_t study_id, int64_t participant_id,
+                                         const TrialPlan& plan, uint64_t seed,
+                                         const SessionEnvironment& env) {
+    check_stimulus_values(env.stimuli);
+    SessionRow row;
+    row.uuid = new_uuid_v4();
+    row.participant_id = participant_id;
+    row.seed = seed;
+    row.cell = plan.cell;
+    row.status = "running";
+    guarded("creating the session", [&] {
+        pqxx::work tx(connection());
+        row.id = tx.exec_params1(
+                       "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, "
+                       "cell, block_order, status, started_utc, software_version, build_hash, "
+                       "gl_vendor, gl_renderer, display_mode, display_refresh_hz, "
+                       "measured_refresh_hz, refresh_note) VALUES ($1, $2, $3, $4, $5, $6, $7, "
+                       "'running', $8, $9, $10, $11, $12, $13, $14, $15, $16) RETURNING id",
+                       row.uuid, study_id, participant_id, env.machine_id, std::to_string(seed),
+                       plan.cell, flag_list(plan.block_order), utc_now_iso8601(),
+                       env.software_version, env.build_hash, env.gl_vendor, env.gl_renderer,
+                       env.display_mode, env.display_refresh_hz, env.measured_refresh_hz,
+                       env.refresh_note)[0]
+                     .as<int64_t>();
+        row.participant = tx.exec_params1("SELECT code FROM participants WHERE id = $1",
+                                          participant_id)[0]
+                              .as<std::string>();
+        insert_segment(tx, row.id, 1, env);
+        for (const PlannedTrial& t : plan.trials) {
+            std::optional<std::string> catch_id, prompt;
+            std::optional<int> expected, tolerance;
+            if (t.is_catch) {
+                catch_id = t.catch_id;
+                prompt = t.prompt;
+                expected = t.expected;
+                tolerance = t.tolerance;
+            }
+            tx.exec_params("INSERT INTO trials (session_id, position, block, stimulus_id, "
+                           "practice, catch, catch_id, prompt, expected_rating, tolerance, "
+                           "break_before, uuid) VALUES ($1, $2, $3, (SELECT id FROM stimuli "
+                           "WHERE study_id = $4 AND stimulus_key = $5), $6, $7, $8, $9, $10, "
+                           "$11, $12, $13)",
+                           row.id, t.position, t.block, study_id, t.stimulus, t.practice ? 1 : 0,
+                           t.is_catch ? 1 : 0, catch_id, prompt, expected, tolerance,
+                           t.break_before ? 1 : 0, new_uuid_v4());
+        }
+        tx.commit();
+        return 0;
+    });
+    return row;
+}
+
+std::optional<SessionRow> PostgresStore::unfinished_session(const std::string& code) {
+    return guarded("finding the session", [&]() -> std::optional<SessionRow> {
+        pqxx::work tx(connection());
+        const pqxx::result r = tx.exec_params(
+            "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
+            "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+            "WHERE p.code = $1 AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT 1",
+            code);
+        if (r.empty()) return std::nullopt;
+        return session_row(r[0]);
+    });
+}
+
+bool PostgresStore::has_completed_session(const std::string& code) {
+    return guarded("finding the session", [&] {
+        pqxx::work tx(connection());
+        return tx.exec_params1("SELECT count(*) FROM sessions s JOIN participants p ON "
+                               "p.id = s.participant_id WHERE p.code = $1 AND "
+                               "s.status = 'completed'",
+                               code)[0]
+                   .as<int64_t>() > 0;
+    });
+}
+
+std::vector<TrialRow> PostgresStore::trials(int64_t session_id) {
+    std::vector<TrialRow> out = guarded("reading the trials", [&] {
+        pqxx::work tx(connection());
+        std::vector<TrialRow> rows;
+        for (const pqxx::row& r : tx.exec_params(
+                 "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
+                 "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
+                 "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), "
+                 "coalesce(t.uuid, '') FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
+                 "WHERE t.session_id = $1 ORDER BY t.position",
+                 session_id)) {
+            TrialRow t;
+            t.id = r[0].as<int64_t>();
+            t.position = r[1].as<int>();
+            t.block = r[2].as<std::string>();
+            t.stimulus = r[3].as<std::string>();
+            t.practice = r[4].as<int>() != 0;
+            t.is_catch = r[5].as<int>() != 0;
+            t.prompt = r[6].as<std::string>();
+            t.expected = r[7].as<int>();
+            t.break_before = r[8].as<int>() != 0;
+            t.answered = r[9].as<bool>();
+            t.uuid = r[10].as<std::string>();
+            rows.push_back(std::move(t));
+        }
+        return rows;
+    });
+    // What this station journaled but the server has not confirmed counts as answered.
+    SessionCache& cache = session_cache(session_id);
+    for (TrialRow& t : out) {
+        cache.trial_uuid[t.id] = t.uuid;
+        if (t.answered || journal_.contains(t.uuid)) {
+            t.answered = true;
+            cache.answered.insert(t.id);
+        }
+    }
+    return out;
+}
+
+PostgresStore::SessionCache& PostgresStore::session_cache(int64_t session_id) {
+    auto it = sessions_.find(session_id);
+    if (it != sessions_.end()) return it->second;
+    SessionCache cache = guarded("reading the session", [&] {
+        pqxx::work tx(connection());
+        const pqxx::result r = tx.exec_params(
+            "SELECT s.uuid, st.name, st.protocol_text FROM sessions s JOIN studies st ON "
+            "st.id = s.study_id WHERE s.id = $1",
+            session_id);
+        if (r.empty()) throw StoreError(name_ + ": no session " + std::to_string(session_id));
+        SessionCache c;
+        c.uuid = r[0][0].as<std::string>();
+        try {
+            c.points = question_points(parse_protocol(
+                r[0][2].as<std::string>(), name_ + " (study '" + r[0][1].as<std::string>() + "')"));
+        } catch (const ProtocolError& e) {
+            throw StoreError(name_ + ": the stored protocol no longer parses: " + e.what());
+        }
+        for (const pqxx::row& t : tx.exec_params(
+                 "SELECT t.id, coalesce(t.uuid, ''), EXISTS (SELECT 1 FROM responses x WHERE "
+                 "x.trial_id = t.id) FROM trials t WHERE t.session_id = $1",
+                 session_id)) {
+            c.trial_uuid[t[0].as<int64_t>()] = t[1].as<std::string>();
+            if (t[2].as<bool>()) c.answered.insert(t[0].as<int64_t>());
+        }
+        return c;
+    });
+    return sessions_.emplace(session_id, std::move(cache)).first->second;
+}
+
+int PostgresStore::begin_segment(int64_t session_id, const SessionEnvironment& env) {
+    check_stimulus_values(env.stimuli);
+    return guarded("starting a segment", [&] {
+        pqxx::work tx(connection());
+        const int segment = tx.exec_params1("SELECT coalesce(max(segment), 0) + 1 FROM "
+                                            "session_segments WHERE session_id = $1",
+                                            session_id)[0]
+                                .as<int>();
+        insert_segment(tx, session_id, segment, env);
+        tx.commit();
+        return segment;
+    });
+}
+
+void PostgresStore::update_environment(int64_t session_id, const SessionEnvironment& env) {
+    guarded("updating the environment", [&] {
+        pqxx::work tx(connection());
+        tx.exec_params("UPDATE session_segments SET machine_id = $1, software_version = $2, "
+                       "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
+                       "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
+                       "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = $10)",
+                       env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
+                       env.gl_renderer, env.display_mode, env.display_refresh_hz,
+                       env.measured_refresh_hz, env.refresh_note, session_id);
+        if (tx.exec_params1("SELECT count(*) FROM session_segments WHERE session_id = $1",
+                            session_id)[0]
+                .as<int64_t>() == 1)
+            tx.exec_params("UPDATE sessions SET machine_id = $1, software_version = $2, "
+                           "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
+                           "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
+                           "WHERE id = $10",
+                           env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
+                           env.gl_renderer, env.display_mode, env.display_refresh_hz,
+                           env.measured_refresh_hz, env.refresh_note, session_id);
+        tx.commit();
+        return 0;
+    });
+}
+
+void PostgresStore::set_consent(int64_t session_id) {
+    guarded("recording consent", [&] {
+        pqxx::work tx(connection());
+        tx.exec_params("UPDATE sessions SET consent_utc = $1 WHERE id = $2", utc_now_iso8601(),
+                       session_id);
+        tx.commit();
+        return 0;
+    });
+}
+
+bool PostgresStore::has_consent(int64_t session_id) {
+    return guarded("reading consent", [&] {
+        pqxx::work tx(connection());
+        const pqxx::result r = tx.exec_params(
+            "SELECT consent_utc IS NOT NULL FROM sessions WHERE id = $1", session_id);
+        return !r.empty() && r[0][0].as<bool>();
+    });
+}
+
+// ---- [4] trials: journal, send, sync -------------------------------------------------
+
+namespace {
+
+// Sets the session completed when every planned trial has ratings, inside `tx`.
+bool complete_if_answered(pqxx::work& tx, int64_t session_id) {
+    tx.exec_params("UPDATE sessions SET status = 'completed', ended_utc = coalesce(ended_utc, $1) "
+                   "WHERE id = $2 AND status <> 'completed' AND NOT EXISTS (SELECT 1 FROM trials t "
+                   "WHERE t.session_id = sessions.id AND NOT EXISTS (SELECT 1 FROM responses r "
+                   "WHERE r.trial_id = t.id))",
+                   utc_now_iso8601(), session_id);
+    const pqxx::result r =
+        tx.exec_params("SELECT status = 'completed' FROM sessions WHERE id = $1", session_id);
+    return !r.empty() && r[0][0].as<bool>();
+}
+
+}  // namespace
+
+PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict, bool* completed) {
+    return guarded("sending a trial", [&] {
+        pqxx::work tx(connection());
+        const pqxx::result t = tx.exec_params(
+            "SELECT id, session_id FROM trials WHERE uuid = $1 FOR UPDATE", j.trial_uuid);
+        if (t.empty())
+            throw StoreError(name_ + ": trial " + j.trial_uuid + " (session " + j.session_uuid +
+                             ") is not on the server (participant withdrawn?); kept in " +
+                             journal_.path());
+        const int64_t trial_id = t[0][0].as<int64_t>(), session_id = t[0][1].as<int64_t>();
+        const pqxx::result held = tx.exec_params(
+            "SELECT question, rating FROM responses WHERE trial_id = $1 ORDER BY question",
+            trial_id);
+        if (!held.empty()) {
+            if (strict)
+                throw StoreError(name_ + ": trial " + std::to_string(trial_id) +
+                                 " already has ratings; refusing to record it twice");
+            // A resend of a commit whose reply was lost: the same ratings confirm it.
+            std::map<std::string, int> mine, theirs;
+            for (const Response& r : j.outcome.responses) mine[r.question] = r.rating;
+            for (const pqxx::row& r : held) theirs[r[0].as<std::string>()] = r[1].as<int>();
+            if (mine != theirs)
+                throw StoreError(name_ + ": trial " + j.trial_uuid +
+                                 " holds other ratings on the server than in " + journal_.path() +
+                                 "; kept in the journal");
+            if (completed) *completed = complete_if_answered(tx, session_id);
+            tx.commit();
+            return Sent::AlreadyThere;
+        }
+        for (const Response& r : j.outcome.responses)
+            tx.exec_params("INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, "
+                           "changes, first_choice_ns, final_choice_ns) VALUES ($1, $2, $3, $4, $5, "
+                           "$6, $7, $8)",
+                           session_id, trial_id, r.question, r.rating, r.rt_ms, r.changes,
+                           r.first_choice_ns, r.final_choice_ns);
+        tx.exec_params("UPDATE trials SET onset_ns = $1, confirm_ns = $2, dropped_frames = $3, "
+                       "answered_utc = $4, segment_id = (SELECT max(id) FROM session_segments "
+                       "WHERE session_id = $5) WHERE id = $6",
+                       j.outcome.onset_ns, j.outcome.confirm_ns, j.outcome.dropped_frames,
+                       j.recorded_utc, session_id, trial_id);
+        const bool done = complete_if_answered(tx, session_id);
+        tx.commit();
+        if (completed) *completed = done;
+        return Sent::Stored;
+    });
+}
+
+bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
+                                 const TrialOutcome& outcome) {
+    SessionCache& cache = session_cache(session_id);
+    const auto uuid = cache.trial_uuid.find(trial_id);
+    if (uuid == cache.trial_uuid.end())
+        throw StoreError(name_ + ": trial " + std::to_string(trial_id) +
+                         " is not part of session " + std::to_string(session_id));
+    if (uuid->second.empty())
+        throw StoreError(name_ + ": trial " + std::to_string(trial_id) +
+                         " has no UUID (planned before schema 4); cannot journal it");
+    const std::string where = name_ + ": trial " + std::to_string(trial_id);
+    if (cache.answered.count(trial_id) || journal_.contains(uuid->second))
+        throw StoreError(where + " already has ratings; refusing to record it twice");
+    for (const Response& r : outcome.responses) check_rating_on_scale(cache.points, r.question, r.rating, where);
+    std::set<std::string> questions;
+    for (const Response& r : outcome.responses) questions.insert(r.question);
+    if (outcome.responses.size() != cache.points.size() || questions.size() != cache.points.size())
+        throw StoreError(where + " has " + std::to_string(outcome.responses.size()) +
+                         " ratings for " + std::to_string(cache.points.size()) + " questions");
+
+    // Durable on this machine first; only then the network.
+    const JournaledTrial journaled{uuid->second, cache.uuid, utc_now_iso8601(), outcome};
+    journal_.add(journaled);
+    cache.answered.insert(trial_id);
+    const bool local_completed = cache.answered.size() == cache.trial_uuid.size();
+    if (steady_ns() < next_attempt_ns_) return local_completed;
+    bool completed = local_completed;
+    try {
+        send(journaled, true, &completed);
+        journal_.remove(journaled.trial_uuid);
+    } catch (const Unreachable&) {
+        next_attempt_ns_ = steady_ns() + int64_t(options_.retry_interval_ms) * 1'000'000;
+        return local_completed;
+    } catch (const StoreError&) {
+        // The server refused this trial (not a network failure): nothing of it is kept.
+        journal_.remove(journaled.trial_uuid);
+        cache.answered.erase(trial_id);
+        throw;
+    }
+    flush(journaled.trial_uuid);  // and any older ones, now the server answers
+    return completed;
+}
+
+int PostgresStore::flush(const std::string& skip_uuid) {
+    int confirmed = 0;
+    for (const JournaledTrial& j : journal_.pending()) {
+        if (j.trial_uuid == skip_uuid) continue;
+        try {
+            send(j, false, nullptr);
+            journal_.remove(j.trial_uuid);
+            ++confirmed;
+        } catch (const Unreachable&) {
+            next_attempt_ns_ = steady_ns() + int64_t(options_.retry_interval_ms) * 1'000'000;
+            break;
+        } catch (const StoreError&) {
+            continue;  // refused (e.g. withdrawn): kept for `lucent store sync` to report
+        }
+    }
+    return confirmed;
+}
+
+int PostgresStore::sync() {
+    int confirmed = 0;
+    for (const JournaledTrial& j : journal_.pending()) {
+        send(j, false, nullptr);  // unreachable or refused: one line, the rest stays
+        journal_.remove(j.trial_uuid);
+        ++confirmed;
+    }
+    next_attempt_ns_ = 0;
+    return confirmed;
+}
+
+bool PostgresStore::complete_session_if_answered(int64_t session_id) {
+    return guarded("completing the session", [&] {
+        pqxx::work tx(connection());
+        const bool done = complete_if_answered(tx, session_id);
+        tx.commit();
+        return done;
+    });
+}
+
+// ---- [5] status, withdrawal, counts ---------------------------------------------------
+
+void PostgresStore::set_status(int64_t session_id, const std::string& status, bool ended) {
+    try {
+        guarded("setting the session status", [&] {
+            pqxx::work tx(connection());
+            const pqxx::result current = tx.exec_params(
+                "SELECT status, uuid FROM sessions WHERE id = $1 FOR UPDATE", session_id);
+            if (!current.empty() && current[0][0].as<std::string>() == "completed" &&
+                status != "completed")
+                throw StoreError(name_ + ": session " + current[0][1].as<std::string>() +
+                                 " is completed; refusing to set it " + status);
+            if (ended)
+                tx.exec_params("UPDATE sessions SET status = $1, ended_utc = $2 WHERE id = $3",
+                               status, utc_now_iso8601(), session_id);
+            else
+                tx.exec_params("UPDATE sessions SET status = $1, ended_utc = NULL WHERE id = $2",
+                               status, session_id);
+            tx.commit();
+            return 0;
+        });
+    } catch (const Unreachable&) {
+        if (status != "paused") throw;
+        // Left 'running' on the server; a resume treats both alike.
+    }
+}
+
+bool PostgresStore::withdraw_participant(const std::string& code) {
+    return guarded("withdrawing the participant", [&] {
+        pqxx::work tx(connection());
+        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kNumberLock);
+        tx.exec_params("INSERT INTO retired_participant_numbers (number) SELECT number FROM "
+                       "participants WHERE code = $1 ON CONFLICT DO NOTHING",
+                       code);
+        const pqxx::result gone =
+            tx.exec_params("DELETE FROM participants WHERE code = $1", code);
+        tx.commit();
+        return gone.affected_rows() > 0;
+    });
+}
+
+std::optional<ParticipantCounts> PostgresStore::participant_counts(const std::string& code) {
+    return guarded("counting", [&]() -> std::optional<ParticipantCounts> {
+        pqxx::work tx(connection());
+        const pqxx::result r = tx.exec_params(
+            "SELECT count(DISTINCT se.id), count(r.id) FROM participants p "
+            "LEFT JOIN sessions se ON se.participant_id = p.id "
+            "LEFT JOIN responses r ON r.session_id = se.id WHERE p.code = $1 GROUP BY p.id",
+            code);
+        if (r.empty()) return std::nullopt;
+        return ParticipantCounts{r[0][0].as<int64_t>(), r[0][1].as<int64_t>()};
+    });
+}
+
+int64_t PostgresStore::query_int(const std::string& sql) {
+    return guarded("querying", [&] {
+        pqxx::read_transaction tx(connection());
+        const pqxx::result r = tx.exec_params(sql);
+        return r.empty() || r[0][0].is_null() ? int64_t(0) : r[0][0].as<int64_t>();
+    });
+}
+
+// ---- [6] snapshot --------------------------------------------------------------------
+
+void PostgresStore::snapshot_to_sqlite(const std::string& sqlite_path) {
+    // Parents before children, so every foreign key finds its row.
+    static const char* const kTables[] = {
+        "studies",         "stimuli",         "stimulus_parameters", "stimulus_values",
+        "participants",    "retired_participant_numbers",            "sessions",
+        "session_segments", "segment_stimuli", "trials",              "responses"};
+    Store out(sqlite_path);
+    Database& db = out.db();
+    guarded("taking a snapshot", [&] {
+        // One snapshot of the whole server: stations may be writing meanwhile.
+        pqxx::transaction<pqxx::repeatable_read, pqxx::read_only> tx(connection());
+        Transaction write(db);
+        for (const char* table : kTables) {
+            std::vector<std::pair<std::string, std::string>> columns;  // name, declared type
+            {
+                Statement info = db.prepare("SELECT name, type FROM pragma_table_info(?)");
+                info.bind(1, table);
+                while (info.step()) columns.emplace_back(info.text(0), info.text(1));
+            }
+            std::string names, marks;
+            for (const auto& [name, type] : columns) {
+                names += (names.empty() ? "" : ", ") + name;
+                marks += marks.empty() ? "?" : ", ?";
+            }
+            Statement insert = db.prepare(std::string("INSERT INTO ") + table + " (" + names +
+                                          ") VALUES (" + marks + ")");
+            // Table and column names are this build's constants, never input.
+            for (const pqxx::row& r : tx.exec(std::string("SELECT ") + names + " FROM " + table +
+                                              " ORDER BY 1")) {
+                insert.reset();
+                for (pqxx::row::size_type c = 0; c < pqxx::row::size_type(columns.size()); ++c) {
+                    const int index = static_cast<int>(c) + 1;
+                    if (r[c].is_null())
+                        insert.bind_null(index);
+                    else if (columns[c].second == "INTEGER")
+                        insert.bind(index, r[c].as<int64_t>());
+                    else if (columns[c].second == "REAL")
+                        insert.bind(index, r[c].as<double>());
+                    else
+                        insert.bind(index, std::string_view(r[c].c_str(), r[c].size()));
+                }
+                insert.run();
+            }
+        }
+        write.commit();
+        return 0;
+    });
+}
+
+}  // namespace lucent::study

@@ -1,0 +1,47 @@
+#pragma once
+// A station's local journal (an SQLite file) of trials recorded for a server but not yet
+// confirmed by it. A trial is committed here (synchronous=FULL) before the server is
+// tried, so the network or the server may fail at any moment without losing a rating;
+// it leaves the journal only once the server's transaction holding it has committed.
+// Resends are matched on the trial's UUID, so a trial whose commit reply was lost is
+// recognised, never stored twice.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sqlite.h"
+#include "store_types.h"
+
+namespace lucent::study {
+
+struct JournaledTrial {
+    std::string trial_uuid;
+    std::string session_uuid;
+    std::string recorded_utc;  // when the station recorded it (the trial's answered_utc)
+    TrialOutcome outcome;
+};
+
+class TrialJournal {
+public:
+    // Opens or creates the journal for `server` (the URI without password). Throws
+    // StoreError naming the file when it is another kind of file.
+    TrialJournal(const std::string& path, const std::string& server);
+
+    bool contains(const std::string& trial_uuid);
+    void add(const JournaledTrial& trial);  // committed when it returns
+    void remove(const std::string& trial_uuid);
+    // This server's pending trials, oldest first.
+    std::vector<JournaledTrial> pending();
+    int count();
+    const std::string& path() const { return db_.path(); }
+
+private:
+    Database db_;
+    std::string server_;
+};
+
+// $LUCENT_JOURNAL_DIR, else $XDG_STATE_HOME/lucent, else ~/.local/state/lucent, then
+// journal-<first 16 hex digits of sha256(server)>.db: one journal per server and machine.
+std::string default_journal_path(const std::string& server);
+
+}  // namespace lucent::study

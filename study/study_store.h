@@ -1,0 +1,124 @@
+#pragma once
+// The study store as the runner, the tools and the tests see it: one interface, two
+// backends chosen by the --db argument's name (as Polyscope picks a render backend):
+//
+//   FILE.db                          SQLite file on this machine (store.h)
+//   postgresql://USER@HOST[:PORT]/DB a PostgreSQL server for many stations (postgres/)
+//
+// Both keep the same schema (the same migrations, same version numbers) and the same
+// guarantees: the planned trial order written before trial 1, each trial's ratings
+// committed in one transaction before the next trial starts, nothing recorded twice.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol.h"
+#include "store_types.h"
+#include "trial_plan.h"
+
+namespace lucent::study {
+
+class StudyStore {
+public:
+    virtual ~StudyStore() = default;
+
+    // What messages call this store: the file path, or the URI (never a password).
+    virtual const std::string& name() const = 0;
+
+    // The study row for this protocol, created with its stimuli on first use. A store
+    // holds one protocol: a different hash is refused with a one-line error.
+    virtual int64_t ensure_study(const Protocol& protocol) = 0;
+    // Participant by code, created when new. Number: the code's trailing digits, else
+    // one past the highest number held or retired (allocated atomically, so two stations
+    // never hand out one number); it selects the Latin-square row (the cell).
+    virtual int64_t ensure_participant(int64_t study_id, const std::string& code,
+                                       int* number) = 0;
+    // Marks `code` as being run by this process until the store is closed. Throws
+    // StoreError (one line) when another station or process runs that participant now.
+    virtual void claim_participant(const std::string& code) = 0;
+
+    // Throws StoreError naming the stimulus and parameter when `stimuli` resolve to other
+    // values than the earlier sessions recorded (new values are not stored).
+    virtual void check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) = 0;
+    // Writes the session, its first segment (env, env.stimuli) and its full planned trial
+    // order (each trial with a new UUID) in one transaction.
+    virtual SessionRow create_session(int64_t study_id, int64_t participant_id,
+                                      const TrialPlan& plan, uint64_t seed,
+                                      const SessionEnvironment& env) = 0;
+    // The participant's newest running or paused session (not completed, not declined).
+    virtual std::optional<SessionRow> unfinished_session(const std::string& code) = 0;
+    virtual bool has_completed_session(const std::string& code) = 0;
+    virtual std::vector<TrialRow> trials(int64_t session_id) = 0;
+    // A resume: adds segment n+1 with `env` and what it shows. Returns its number.
+    virtual int begin_segment(int64_t session_id, const SessionEnvironment& env) = 0;
+    // Updates the newest segment's environment (e.g. the measured refresh); the session
+    // row's copy (the first segment's) only while the session has one segment.
+    virtual void update_environment(int64_t session_id, const SessionEnvironment& env) = 0;
+    virtual void set_consent(int64_t session_id) = 0;
+    virtual bool has_consent(int64_t session_id) = 0;
+    // Commits one trial's ratings atomically; refuses a trial that already has ratings,
+    // lacks a question, names one the study does not ask, or has a rating outside
+    // 1..points of its question. The trial that answers the session's last open trial
+    // also sets it `completed` in the same transaction. Returns true when the session is
+    // now completed.
+    virtual bool record_trial(int64_t session_id, int64_t trial_id,
+                              const TrialOutcome& outcome) = 0;
+    // Sets `completed` when every planned trial has its ratings; true when completed.
+    virtual bool complete_session_if_answered(int64_t session_id) = 0;
+    // A completed session is final: any other status for it throws StoreError.
+    virtual void set_status(int64_t session_id, const std::string& status, bool ended) = 0;
+    // Deletes a participant and everything recorded for them; false when unknown.
+    virtual bool withdraw_participant(const std::string& code) = 0;
+    // Sessions and ratings held for `code`; nullopt when no such participant.
+    virtual std::optional<ParticipantCounts> participant_counts(const std::string& code) = 0;
+
+    // One integer from a constant, read-only SQL query both backends accept (tests and
+    // diagnostics; never user input).
+    virtual int64_t query_int(const std::string& sql) = 0;
+    // Writes a consistent copy of everything (one snapshot) as a new SQLite study file at
+    // `sqlite_path`, so export, analyze and merge read a server as they read a file.
+    virtual void snapshot_to_sqlite(const std::string& sqlite_path) = 0;
+    // Trials recorded here but not yet confirmed by the server (0 for local files).
+    virtual int pending_trials() { return 0; }
+    // Sends what is pending; returns how many trials the server confirmed now.
+    virtual int sync() { return 0; }
+};
+
+struct StoreOptions {
+    // PostgreSQL: the local SQLite journal keeping trials until the server confirms them;
+    // "" = default_journal_path(uri).
+    std::string journal_path;
+    // PostgreSQL: after a failed send, the next attempt waits at least this long (a
+    // trial is journaled meanwhile, so the session runs on).
+    int retry_interval_ms = 1000;
+    // SQLite: the VFS (fault tests).
+    std::string vfs;
+};
+
+// True for postgresql:// and postgres:// URIs (libpq's names).
+bool is_server_uri(const std::string& db);
+// Opens a store by the name of `db`. SQLite files are created and migrated on open; a
+// server must be initialised first (`lucent store init`). A scheme this build does not
+// know is refused with one line listing the valid ones.
+std::unique_ptr<StudyStore> open_study_store(const std::string& db,
+                                             const StoreOptions& options = {});
+// Creates or migrates the schema (SQLite or server); returns (version before, after).
+std::pair<int, int> init_study_store(const std::string& db);
+// A read-only SQLite file for `db`: the file itself, or a snapshot of the server in a
+// temporary file removed when the returned object dies.
+class ReadableStudyFile {
+public:
+    explicit ReadableStudyFile(const std::string& db);
+    ~ReadableStudyFile();
+    ReadableStudyFile(const ReadableStudyFile&) = delete;
+    ReadableStudyFile& operator=(const ReadableStudyFile&) = delete;
+    const std::string& path() const { return path_; }
+
+private:
+    std::string path_;
+    std::string temporary_dir_;
+};
+
+}  // namespace lucent::study

@@ -1,0 +1,674 @@
+// The study store's guarantees, one suite over every backend (SQLite file, PostgreSQL
+// server), as SQLite runs one suite over several VFS layers. The server is real
+// (server_environment.h); every test gets a new database on it.
+//
+// Expected values come from the protocol and plan (trial counts, questions, the
+// deterministic rating_for()), never from the store under test.
+#include <gtest/gtest.h>
+#include <pqxx/pqxx>
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <set>
+#include <thread>
+
+#include "../study_fixtures.h"
+#include "server_environment.h"
+#include "postgres/postgres_store.h"
+#include "postgres/trial_journal.h"
+#include "session/autopilot.h"
+#include "session/session_flow.h"
+#include "store.h"
+#include "study_store.h"
+#include "test_paths.h"
+
+namespace lucent::study {
+namespace {
+
+LocalPostgres& server() { return lucent::test::postgres_server(); }
+
+// Two blocks, counterbalanced: participants alternate between 2 Latin-square cells.
+std::string two_block_protocol_text() {
+    std::string text = lucent::test::kSmallProtocol;
+    const std::string main = "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
+    text.replace(text.find(main), main.size(),
+                 "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\"]\n\n"
+                 "[[blocks]]\nid = \"second\"\nstimuli = [\"c\", \"b\"]\n");
+    return text;
+}
+
+// A fresh, empty store of the backend under test; the same one again with reopen().
+class Backend : public ::testing::TestWithParam<std::string> {
+protected:
+    void SetUp() override {
+        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        std::string slug;
+        for (char c : test) slug += std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
+        dir_ = lucent::test::scratch_dir("backend_" + slug);
+        if (GetParam() == "sqlite") {
+            db_ = (dir_ / "study.db").string();
+        } else {
+            db_ = lucent::test::new_postgres_database(slug);
+            init_study_store(db_);
+        }
+    }
+    std::unique_ptr<StudyStore> open(const std::string& station = "station") {
+        StoreOptions options;
+        options.journal_path = (dir_ / (station + "-journal.db")).string();
+        options.retry_interval_ms = 0;
+        return open_study_store(db_, options);
+    }
+    bool is_server() const { return GetParam() == "postgresql"; }
+
+    std::filesystem::path dir_;
+    std::string db_;
+};
+
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
+
+TEST_P(Backend, WritesTheWholePlanWithTrialUuidsBeforeTheFirstTrial) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    int number = -1;
+    const int64_t pid = store->ensure_participant(study, "P7", &number);
+    EXPECT_EQ(number, 7);  // the code's digits
+    const TrialPlan plan = plan_trials(p, 42, number);
+    const SessionRow s = store->create_session(study, pid, plan, 42, {});
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    ASSERT_EQ(trials.size(), plan.trials.size());
+    std::set<std::string> uuids;
+    for (size_t i = 0; i < trials.size(); ++i) {
+        EXPECT_EQ(trials[i].stimulus, plan.trials[i].stimulus);
+        EXPECT_EQ(trials[i].is_catch, plan.trials[i].is_catch);
+        EXPECT_FALSE(trials[i].answered);
+        ASSERT_EQ(trials[i].uuid.size(), 36u);
+        EXPECT_EQ(trials[i].uuid[14], '4');
+        uuids.insert(trials[i].uuid);
+    }
+    EXPECT_EQ(uuids.size(), trials.size());
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM stimulus_parameters sp JOIN stimuli s ON "
+                               "s.id = sp.stimulus_id WHERE s.stimulus_key = 'b' AND "
+                               "sp.name = 'thickness_exponent' AND sp.value = '25'"),
+              1);
+}
+
+TEST_P(Backend, RecordsEachTrialOnceAndRefusesDuplicatesAndBadRatings) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    const int64_t pid = store->ensure_participant(study, "anna", nullptr);
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 1, 1), 1, {});
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
+    EXPECT_THROW(store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0])),
+                 StoreError);
+    TrialOutcome bad = lucent::test::outcome_for(p, trials[1]);
+    bad.responses[1].rating = 8;
+    EXPECT_THROW(store->record_trial(s.id, trials[1].id, bad), StoreError);
+    bad.responses[1].rating = 0;
+    EXPECT_THROW(store->record_trial(s.id, trials[1].id, bad), StoreError);
+    TrialOutcome missing = lucent::test::outcome_for(p, trials[1]);
+    missing.responses.pop_back();
+    EXPECT_THROW(store->record_trial(s.id, trials[1].id, missing), StoreError);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 2);  // 1 trial x 2 questions
+    EXPECT_EQ(store->pending_trials(), 0);
+    // A fresh connection sees the same: committed, not cached.
+    auto again = open("second");
+    const std::vector<TrialRow> seen = again->trials(s.id);
+    EXPECT_TRUE(seen[0].answered);
+    EXPECT_FALSE(seen[1].answered);
+}
+
+TEST_P(Backend, ResumeFindsTheUnfinishedSessionAndTheLastTrialCompletesIt) {
+    const Protocol p = lucent::test::small_protocol();
+    int64_t session_id = 0;
+    size_t planned = 0;
+    {
+        auto store = open();
+        const int64_t study = store->ensure_study(p);
+        int number = 0;
+        const int64_t pid = store->ensure_participant(study, "P3", &number);
+        const SessionRow s = store->create_session(study, pid, plan_trials(p, 9, number), 9, {});
+        session_id = s.id;
+        const std::vector<TrialRow> trials = store->trials(s.id);
+        planned = trials.size();
+        for (size_t i = 0; i < 2; ++i)
+            EXPECT_FALSE(store->record_trial(s.id, trials[i].id, lucent::test::outcome_for(p, trials[i])));
+        store->set_status(s.id, "paused", false);
+    }
+    auto store = open();
+    const std::optional<SessionRow> resumed = store->unfinished_session("P3");
+    ASSERT_TRUE(resumed);
+    EXPECT_EQ(resumed->id, session_id);
+    EXPECT_EQ(resumed->seed, 9u);
+    EXPECT_FALSE(store->has_completed_session("P3"));
+    EXPECT_EQ(store->begin_segment(session_id, {}), 2);
+    const std::vector<TrialRow> trials = store->trials(session_id);
+    ASSERT_EQ(trials.size(), planned);
+    bool completed = false;
+    for (const TrialRow& t : trials) {
+        if (t.answered) continue;
+        EXPECT_FALSE(completed) << "completed before the last trial";
+        completed = store->record_trial(session_id, t.id, lucent::test::outcome_for(p, t));
+    }
+    EXPECT_TRUE(completed);
+    EXPECT_TRUE(store->has_completed_session("P3"));
+    EXPECT_FALSE(store->unfinished_session("P3"));
+    EXPECT_THROW(store->set_status(session_id, "paused", false), StoreError);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"),
+              static_cast<int64_t>(planned * p.questions.size()));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE status = 'completed' AND "
+                               "ended_utc IS NOT NULL"),
+              1);
+}
+
+TEST_P(Backend, WithdrawalDeletesEverythingAndRetiresTheNumber) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    int first = 0, second = 0, third = 0;
+    store->ensure_participant(study, "anna", &first);
+    const int64_t bob = store->ensure_participant(study, "bob", &second);
+    EXPECT_EQ(first, 1);
+    EXPECT_EQ(second, 2);
+    const SessionRow s = store->create_session(study, bob, plan_trials(p, 2, second), 2, {});
+    const TrialRow t = store->trials(s.id)[0];
+    store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
+    ASSERT_TRUE(store->participant_counts("bob"));
+    EXPECT_EQ(store->participant_counts("bob")->ratings, 2);
+    EXPECT_TRUE(store->withdraw_participant("bob"));
+    EXPECT_FALSE(store->withdraw_participant("bob"));
+    EXPECT_FALSE(store->participant_counts("bob"));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 0);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM trials"), 0);
+    store->ensure_participant(study, "carl", &third);
+    EXPECT_EQ(third, 3);  // 2 is retired, never handed out again
+}
+
+TEST_P(Backend, AParticipantRunningOnOneStationIsRefusedOnAnother) {
+    auto a = open("a");
+    auto b = open("b");
+    a->claim_participant("P5");
+    try {
+        b->claim_participant("P5");
+        FAIL() << "second station was allowed to run P5";
+    } catch (const StoreError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("'P5'"), std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;  // one line
+    }
+    b->claim_participant("P6");  // others are free
+    a.reset();                   // station A ends: P5 may be resumed elsewhere
+    // A server ends a closed connection's backend (and its locks) a moment after the
+    // close; a station starting then is refused, so ask again for up to 5 s.
+    bool claimed = false;
+    for (int attempt = 0; attempt < 100 && !claimed; ++attempt) {
+        try {
+            b->claim_participant("P5");
+            claimed = true;
+        } catch (const StoreError&) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+    }
+    EXPECT_TRUE(claimed);
+}
+
+TEST_P(Backend, RacingStationsNeverShareAParticipantNumber) {
+    const Protocol p = lucent::test::small_protocol();
+    open()->ensure_study(p);
+    constexpr int kStations = 8, kEach = 5;
+    std::vector<std::vector<int>> numbers(kStations);
+    std::vector<std::thread> threads;
+    for (int k = 0; k < kStations; ++k)
+        threads.emplace_back([&, k] {
+            auto store = open("s" + std::to_string(k));
+            const int64_t study = store->ensure_study(p);
+            for (int i = 0; i < kEach; ++i) {
+                int n = 0;
+                // No trailing digits: the number is allocated by the store.
+                store->ensure_participant(study, "st" + std::string(1, char('a' + k)) + "-" +
+                                                     std::string(1, char('a' + i)),
+                                          &n);
+                numbers[k].push_back(n);
+            }
+        });
+    for (std::thread& t : threads) t.join();
+    std::set<int> all;
+    for (const auto& v : numbers) all.insert(v.begin(), v.end());
+    EXPECT_EQ(all.size(), size_t(kStations * kEach));
+    EXPECT_EQ(*all.begin(), 1);
+    EXPECT_EQ(*all.rbegin(), kStations * kEach);
+}
+
+TEST_P(Backend, RefusesASecondProtocolInOneStudyStore) {
+    auto store = open();
+    store->ensure_study(lucent::test::small_protocol());
+    EXPECT_THROW(store->ensure_study(builtin_protocol("thesis")), StoreError);
+    EXPECT_EQ(store->ensure_study(lucent::test::small_protocol()),
+              store->ensure_study(lucent::test::small_protocol()));
+}
+
+TEST_P(Backend, EachRatingIsCheckedAgainstItsOwnQuestionsScale) {
+    auto store = open();
+    const Protocol p = lucent::test::mixed_scale_protocol();  // 7 points, then 5
+    const int64_t study = store->ensure_study(p);
+    const int64_t pid = store->ensure_participant(study, "P1", nullptr);
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 3, 1), 3, {});
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    auto outcome = [&](int translucent, int realistic) {
+        TrialOutcome o;
+        o.onset_ns = 1;
+        o.confirm_ns = 2;
+        o.responses = {{"translucent", translucent, 500, 0, 1, 2}, {"realistic", realistic, 500, 0, 1, 2}};
+        return o;
+    };
+    store->record_trial(s.id, trials[0].id, outcome(7, 5));
+    try {
+        store->record_trial(s.id, trials[1].id, outcome(4, 6));
+        ADD_FAILURE() << "a 6 on a 5-point scale was stored";
+    } catch (const StoreError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("'realistic'"), std::string::npos) << message;
+        EXPECT_NE(message.find("1..5"), std::string::npos) << message;
+    }
+    TrialOutcome unknown = outcome(3, 3);
+    unknown.responses[1].question = "varnished";
+    EXPECT_THROW(store->record_trial(s.id, trials[1].id, unknown), StoreError);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 2);
+    EXPECT_EQ(store->pending_trials(), 0);  // refused trials leave no journal entry
+    store->record_trial(s.id, trials[1].id, outcome(1, 1));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 4);
+}
+
+std::vector<StimulusProvenance> provenance_for(const Protocol& p, const std::string& albedo) {
+    std::vector<StimulusProvenance> out;
+    for (const StimulusSpec& s : p.stimuli) {
+        StimulusProvenance v;
+        v.stimulus = s.id;
+        v.source = "live";
+        v.technique = s.technique;
+        v.mesh = s.mesh;
+        v.mesh_hash = "00000000000000aa";
+        v.values = {{"albedo", albedo}, {"fov_y", "60"}};
+        for (const auto& [name, value] : s.parameters) v.values.emplace_back(name, value);
+        v.software_version = "9.9.9";
+        v.build_hash = "test";
+        out.push_back(v);
+    }
+    return out;
+}
+
+SessionEnvironment environment(const std::string& machine, const std::string& gpu, double hz) {
+    SessionEnvironment env;
+    env.machine_id = machine;
+    env.software_version = "9.9.9";
+    env.build_hash = "test";
+    env.gl_vendor = "vendor " + machine;
+    env.gl_renderer = gpu;
+    env.display_mode = "1280x1024 fullscreen";
+    env.display_refresh_hz = hz;
+    return env;
+}
+
+TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    int number = 0;
+    const int64_t pid = store->ensure_participant(study, "P1", &number);
+    SessionEnvironment first = environment("lab-a", "GPU A", 60);
+    first.stimuli = provenance_for(p, "0.8,0.55,0.35");
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 5, number), 5, first);
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
+    SessionEnvironment second = environment("lab-b", "GPU B", 144);
+    second.stimuli = first.stimuli;
+    EXPECT_EQ(store->begin_segment(s.id, second), 2);
+    second.measured_refresh_hz = 143.9;
+    store->update_environment(s.id, second);
+    store->record_trial(s.id, trials[1].id, lucent::test::outcome_for(p, trials[1]));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments WHERE segment = 1 AND "
+                               "machine_id = 'lab-a' AND gl_renderer = 'GPU A' AND "
+                               "display_refresh_hz = 60 AND measured_refresh_hz IS NULL AND "
+                               "stimulus_source = 'live'"),
+              1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments WHERE segment = 2 AND "
+                               "machine_id = 'lab-b' AND measured_refresh_hz = 143.9"),
+              1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE gl_renderer = 'GPU A' AND "
+                               "display_refresh_hz = 60"),
+              1);
+    // Each trial knows the segment it was answered in.
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM trials t JOIN session_segments g ON "
+                               "g.id = t.segment_id WHERE (t.position = 0 AND g.segment = 1) OR "
+                               "(t.position = 1 AND g.segment = 2)"),
+              2);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM segment_stimuli"),
+              2 * static_cast<int64_t>(p.stimuli.size()));
+    // Values are recorded once per stimulus (albedo, fov_y and its own parameters), not
+    // again by the second segment.
+    int64_t values = 0;
+    for (const StimulusSpec& spec : p.stimuli) values += 2 + static_cast<int64_t>(spec.parameters.size());
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM stimulus_values"), values);
+    try {
+        store->check_stimulus_values(provenance_for(p, "0.7,0.55,0.35"));
+        FAIL() << "different resolved values accepted";
+    } catch (const StoreError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("stimulus 'a'"), std::string::npos) << what;
+        EXPECT_NE(what.find("'albedo'"), std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+    EXPECT_NO_THROW(store->check_stimulus_values(provenance_for(p, "0.8,0.55,0.35")));
+}
+
+// ---- stations driven by the simulated participant --------------------------------------
+
+Key key_of(const std::string& name, int* digit) {
+    *digit = 0;
+    if (name.size() == 1 && name[0] >= '1' && name[0] <= '9') {
+        *digit = name[0] - '0';
+        return Key::Digit;
+    }
+    if (name == "Escape") return Key::Escape;
+    if (name == "Left") return Key::Left;
+    if (name == "Right") return Key::Right;
+    if (name == "Up") return Key::Up;
+    if (name == "Down") return Key::Down;
+    if (name == "Q") return Key::Quit;
+    if (name == "R") return Key::Resume;
+    return Key::Enter;
+}
+
+struct StationResult {
+    std::string error;
+    int cell = -1;
+    std::map<std::string, int> ratings;  // "trial uuid/question" -> rating, as answered
+};
+
+// One lab station: opens the store, claims and enrols `code`, plans and stores a session,
+// then lets a seeded autopilot answer every screen on a simulated clock (16 ms frames).
+// `after_trial` runs after each answered trial (tests stop the server there).
+StationResult run_station(const std::function<std::unique_ptr<StudyStore>()>& open_store,
+                          const Protocol& p, const std::string& code, uint64_t seed,
+                          const std::function<void(int)>& after_trial = {}) {
+    StationResult out;
+    try {
+        auto store = open_store();
+        const int64_t study = store->ensure_study(p);
+        store->claim_participant(code);
+        int number = 0;
+        const int64_t pid = store->ensure_participant(study, code, &number);
+        const SessionRow s = store->create_session(study, pid, plan_trials(p, seed, number), seed, {});
+        out.cell = s.cell;
+        const std::vector<TrialRow> trials = store->trials(s.id);
+        int64_t now = 1'000'000'000;
+        SessionFlow flow(p, *store, s.id, trials, false, now);
+        Autopilot pilot = Autopilot::from_seed(seed, 40.0);
+        size_t answered = 0;
+        if (after_trial) after_trial(0);  // the session is on screen
+        for (int frame = 0; frame < 200000 && !flow.finished(); ++frame) {
+            now += 16'000'000;
+            flow.tick(now);
+            flow.presented(flow.serial(), now);
+            for (const std::string& name : pilot.due(now, flow.view())) {
+                int digit = 0;
+                const Key k = key_of(name, &digit);
+                flow.key({k, digit, now});
+            }
+            if (flow.answered_trials() != answered) {
+                answered = flow.answered_trials();
+                if (after_trial) after_trial(static_cast<int>(answered));
+            }
+        }
+        if (!flow.finished()) throw StoreError("station " + code + " did not finish");
+        for (int attempt = 0; attempt < 200 && store->pending_trials() > 0; ++attempt) {
+            try {
+                store->sync();
+            } catch (const StoreError&) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(50));
+            }
+        }
+        if (store->pending_trials() != 0) throw StoreError(code + ": journal not empty");
+    } catch (const std::exception& e) {
+        out.error = e.what();
+    }
+    return out;
+}
+
+// Every planned trial of every session has exactly one rating per question, and the
+// number of responses is exactly trials x questions: nothing lost, nothing twice.
+void expect_every_rating_once(StudyStore& store, const Protocol& p, int sessions) {
+    const int64_t trials = store.query_int("SELECT count(*) FROM trials");
+    const int64_t per_session = static_cast<int64_t>(plan_trials(p, 1, 1).trials.size());
+    EXPECT_EQ(trials, sessions * per_session);
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM responses"),
+              trials * static_cast<int64_t>(p.questions.size()));
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM (SELECT DISTINCT trial_id, question FROM "
+                              "responses) d"),
+              trials * static_cast<int64_t>(p.questions.size()));
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM trials t WHERE NOT EXISTS (SELECT 1 FROM "
+                              "responses r WHERE r.trial_id = t.id)"),
+              0);
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), sessions);
+}
+
+TEST_P(Backend, EightStationsAtOnceLoseNothingAndBalanceTheCells) {
+    const Protocol p = parse_protocol(two_block_protocol_text(), "two_blocks.toml");
+    open()->ensure_study(p);
+    constexpr int kStations = 8;
+    std::vector<StationResult> results(kStations);
+    std::vector<std::thread> threads;
+    for (int k = 0; k < kStations; ++k)
+        threads.emplace_back([&, k] {
+            results[k] = run_station([&] { return open("station" + std::to_string(k)); }, p,
+                                     "lab-" + std::string(1, char('a' + k)), 100 + k);
+        });
+    for (std::thread& t : threads) t.join();
+    std::map<int, int> per_cell;
+    for (const StationResult& r : results) {
+        EXPECT_EQ(r.error, "");
+        ++per_cell[r.cell];
+    }
+    // 2 blocks: a 2-row Latin square; 8 consecutive numbers fill each row 4 times.
+    EXPECT_EQ(per_cell, (std::map<int, int>{{0, 4}, {1, 4}}));
+    auto store = open();
+    expect_every_rating_once(*store, p, kStations);
+    EXPECT_EQ(store->query_int("SELECT count(DISTINCT number) FROM participants"), kStations);
+}
+
+INSTANTIATE_TEST_SUITE_P(Stores, Backend, ::testing::Values("sqlite", "postgresql"), param_name);
+
+// ---- the server alone: schema, URI, outages ----------------------------------------------
+
+class Server : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        dir_ = lucent::test::scratch_dir("server_" + test);
+        uri_ = lucent::test::new_postgres_database(test);
+    }
+    void TearDown() override {
+        if (!server().running()) server().start();
+    }
+    StoreOptions options(const std::string& station) {
+        StoreOptions o;
+        o.journal_path = (dir_ / (station + "-journal.db")).string();
+        o.retry_interval_ms = 0;
+        return o;
+    }
+    std::filesystem::path dir_;
+    std::string uri_;
+};
+
+TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
+    init_study_store(uri_);
+    const auto sqlite_path = (dir_ / "model.db").string();
+    Store model(sqlite_path);
+    auto server = open_study_store(uri_, options("x"));
+    int tables = 0;
+    Statement t = model.db().prepare(
+        "SELECT name FROM sqlite_schema WHERE type = 'table' AND name NOT LIKE 'sqlite_%'");
+    while (t.step()) {
+        ++tables;
+        Statement c = model.db().prepare("SELECT name FROM pragma_table_info(?)");
+        c.bind(1, t.text(0));
+        while (c.step()) {
+            // Names are the model's (this build's constants): a column missing on the
+            // server counts 0.
+            EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.columns WHERE "
+                                        "table_schema = 'public' AND table_name = '" +
+                                        t.text(0) + "' AND column_name = '" + c.text(0) + "'"),
+                      1)
+                << t.text(0) << "." << c.text(0);
+        }
+    }
+    EXPECT_EQ(tables, 11);
+    // The server has the same tables plus lucent_schema, nothing else.
+    EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.tables WHERE "
+                                "table_schema = 'public'"),
+              tables + 1);
+}
+
+TEST_F(Server, UninitialisedOlderAndNewerSchemasAreRefusedWithOneLine) {
+    auto message = [&] {
+        try {
+            open_study_store(uri_, options("x"));
+        } catch (const StoreError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(message().find("lucent store init"), std::string::npos);
+    EXPECT_EQ(init_study_store(uri_), std::make_pair(0, kSchemaVersion));
+    EXPECT_EQ(init_study_store(uri_), std::make_pair(kSchemaVersion, kSchemaVersion));
+    EXPECT_EQ(message(), "");
+    {
+        pqxx::connection c(uri_);
+        pqxx::work w(c);
+        w.exec_params("UPDATE lucent_schema SET version = $1", kSchemaVersion + 1);
+        w.commit();
+    }
+    const std::string newer = message();
+    EXPECT_NE(newer.find("newer Lucent (schema " + std::to_string(kSchemaVersion + 1)),
+              std::string::npos)
+        << newer;
+    EXPECT_EQ(newer.find('\n'), std::string::npos);
+    EXPECT_THROW(init_study_store(uri_), StoreError);  // never downgraded
+}
+
+TEST_F(Server, PasswordsAndUnknownSchemesAreRefusedBeforeConnecting) {
+    EXPECT_THROW(open_study_store("postgresql://anna:secret@localhost/study"), StoreError);
+    EXPECT_THROW(open_study_store("postgresql://anna@localhost/study?password=secret"), StoreError);
+    try {
+        open_study_store("mysql://anna@localhost/study");
+        FAIL();
+    } catch (const StoreError& e) {
+        EXPECT_NE(std::string(e.what()).find("postgresql://"), std::string::npos);
+    }
+}
+
+TEST_F(Server, AResendOfAConfirmedTrialIsRecognisedNotStoredTwice) {
+    init_study_store(uri_);
+    const Protocol p = lucent::test::small_protocol();
+    auto store = open_study_store(uri_, options("a"));
+    const int64_t study = store->ensure_study(p);
+    const int64_t pid = store->ensure_participant(study, "P1", nullptr);
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 4, 1), 4, {});
+    const TrialRow t = store->trials(s.id)[0];
+    const TrialOutcome o = lucent::test::outcome_for(p, t);
+    store->record_trial(s.id, t.id, o);
+    // The server committed, but say the reply was lost: the journal still holds it.
+    TrialJournal journal(options("a").journal_path, uri_);
+    journal.add({t.uuid, s.uuid, utc_now_iso8601(), o});
+    EXPECT_EQ(store->pending_trials(), 1);
+    EXPECT_EQ(store->sync(), 1);
+    EXPECT_EQ(store->pending_trials(), 0);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 2);
+    // Other ratings under the same UUID are a conflict: refused, kept, nothing changed.
+    TrialOutcome other = o;
+    other.responses[0].rating = o.responses[0].rating % 7 + 1;
+    journal.add({t.uuid, s.uuid, utc_now_iso8601(), other});
+    EXPECT_THROW(store->sync(), StoreError);
+    EXPECT_EQ(store->pending_trials(), 1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 2);
+}
+
+TEST_F(Server, StoppedMidSessionEveryCommittedRatingArrivesOnce) {
+    init_study_store(uri_);
+    const Protocol p = parse_protocol(two_block_protocol_text(), "two_blocks.toml");
+    open_study_store(uri_, options("setup"))->ensure_study(p);
+    const int per_session = static_cast<int>(plan_trials(p, 1, 1).trials.size());
+    ASSERT_GE(per_session, 6);
+    constexpr int kStations = 4;
+    // Station 0 stops the server after its 2nd trial, once every station's session is on
+    // screen, and starts it again after its 4th; stations take 30 ms per trial, so the
+    // others record trials while the server is down (journaled; their sessions run on).
+    std::atomic<int> journaled_during_outage{0}, started{0};
+    std::vector<StationResult> results(kStations);
+    std::vector<std::thread> threads;
+    for (int k = 0; k < kStations; ++k)
+        threads.emplace_back([&, k] {
+            auto after = [&, k](int answered) {
+                if (answered == 0) {
+                    ++started;
+                    return;
+                }
+                if (k == 0 && answered == 2) {
+                    while (started.load() < kStations)
+                        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+                    server().stop();
+                }
+                if (k == 0 && answered == 4) server().start();
+                if (!server().running()) ++journaled_during_outage;
+                std::this_thread::sleep_for(std::chrono::milliseconds(30));
+            };
+            results[k] = run_station([&] { return open_study_store(uri_, options("st" + std::to_string(k))); },
+                                     p, "out-" + std::string(1, char('a' + k)), 300 + k, after);
+        });
+    for (std::thread& t : threads) t.join();
+    for (const StationResult& r : results) EXPECT_EQ(r.error, "");
+    EXPECT_GE(journaled_during_outage.load(), 2);
+    auto store = open_study_store(uri_, options("check"));
+    expect_every_rating_once(*store, p, kStations);
+}
+
+TEST_F(Server, SnapshotHoldsEveryRowTheServerHolds) {
+    init_study_store(uri_);
+    const Protocol p = lucent::test::small_protocol();
+    auto store = open_study_store(uri_, options("a"));
+    const int64_t study = store->ensure_study(p);
+    for (const char* code : {"P1", "P2"}) {
+        int number = 0;
+        const int64_t pid = store->ensure_participant(study, code, &number);
+        const SessionRow s = store->create_session(study, pid, plan_trials(p, number, number), number, {});
+        for (const TrialRow& t : store->trials(s.id))
+            store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
+    }
+    const ReadableStudyFile snapshot(uri_);
+    Database copy(snapshot.path(), SQLITE_OPEN_READONLY);
+    for (const char* table : {"studies", "stimuli", "stimulus_parameters", "participants",
+                              "sessions", "session_segments", "trials", "responses"})
+        EXPECT_EQ(copy.scalar_int(std::string("SELECT count(*) FROM ") + table),
+                  store->query_int(std::string("SELECT count(*) FROM ") + table))
+            << table;
+    // The ratings themselves, against the deterministic answers given.
+    Statement s = copy.prepare(
+        "SELECT t.position, r.question, r.rating, t.catch FROM responses r JOIN trials t ON "
+        "t.id = r.trial_id");
+    int checked = 0;
+    while (s.step()) {
+        const int q = s.text(1) == p.questions[0].id ? 0 : 1;
+        const int expected = s.integer(3) ? 7 : lucent::test::rating_for(static_cast<int>(s.integer(0)), q);
+        EXPECT_EQ(s.integer(2), expected);
+        ++checked;
+    }
+    EXPECT_GT(checked, 0);
+}
+
+}  // namespace
+}  // namespace lucent::study
