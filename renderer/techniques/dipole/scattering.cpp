@@ -142,4 +142,88 @@ HybridSplit make_hybrid_split(const DipoleRgb& d, double c, double k) {
     return split;
 }
 
+namespace {
+
+// 2 pi r Rd_l(r) of one channel tabulated on r = r_max t^2, with its cumulative
+// (trapezoid); r_max = Rp + 40 / K, beyond which Wl < e^-40 / 2.
+struct LocalProfile {
+    std::vector<double> r, cumulative;
+};
+LocalProfile local_profile(const Dipole& d, double rp, double k) {
+    constexpr int n = 40000;
+    const double r_max = rp + 40.0 / k;
+    LocalProfile p;
+    p.r.resize(n + 1);
+    p.cumulative.assign(n + 1, 0.0);
+    double previous = 0.0;
+    for (int i = 0; i <= n; ++i) {
+        const double t = double(i) / n;
+        p.r[i] = r_max * t * t;
+        const double density = d.radial_density(p.r[i]) * local_weight(p.r[i], rp, k);
+        if (i > 0)
+            p.cumulative[i] =
+                p.cumulative[i - 1] + 0.5 * (density + previous) * (p.r[i] - p.r[i - 1]);
+        previous = density;
+    }
+    return p;
+}
+
+}  // namespace
+
+glm::dvec3 local_mass(const DipoleRgb& d, const HybridSplit& split) {
+    glm::dvec3 z(0.0);
+    for (int c = 0; c < 3; ++c)
+        if (split.rp[c]) z[c] = local_profile(d[c], *split.rp[c], split.k).cumulative.back();
+    return z;
+}
+
+RingPattern make_ring_pattern(const DipoleRgb& d, const HybridSplit& split, int rings,
+                              int per_ring) {
+    RingPattern pattern;
+    for (int c = 0; c < 3; ++c)
+        if (split.rp[c] && (pattern.widest < 0 || *split.rp[c] > *split.rp[pattern.widest]))
+            pattern.widest = c;
+    if (pattern.widest < 0 || rings < 1 || per_ring < 1) {
+        pattern.offset = {glm::dvec2(0.0)};
+        pattern.radius = {0.0};
+        pattern.weight = {0.0};
+        pattern.widest = -1;
+        return pattern;
+    }
+    const Dipole& w = d[pattern.widest];
+    const double rp = *split.rp[pattern.widest];
+    const LocalProfile profile = local_profile(w, rp, split.k);
+    const double z = profile.cumulative.back();
+    const int m = rings * per_ring + 1;
+    const auto inverse = [&](double share) {  // P^-1 by bisection + linear interpolation
+        const double target = share * z;
+        const auto it =
+            std::lower_bound(profile.cumulative.begin(), profile.cumulative.end(), target);
+        const std::size_t i = std::clamp<std::size_t>(
+            std::size_t(it - profile.cumulative.begin()), 1, profile.r.size() - 1);
+        const double c0 = profile.cumulative[i - 1], c1 = profile.cumulative[i];
+        const double f = c1 > c0 ? (target - c0) / (c1 - c0) : 0.0;
+        return profile.r[i - 1] + f * (profile.r[i] - profile.r[i - 1]);
+    };
+    const auto weight_at = [&](double rho) {
+        const double rd_local = w.rd(rho) * local_weight(rho, rp, split.k);
+        return rd_local > 0.0 ? z / (double(m) * rd_local) : 0.0;
+    };
+    pattern.offset.push_back(glm::dvec2(0.0));
+    pattern.radius.push_back(0.0);
+    pattern.weight.push_back(weight_at(0.0));
+    constexpr double golden = 0.6180339887498949;
+    for (int l = 1; l <= rings; ++l) {
+        const double rho = inverse((1.0 + (double(l) - 0.5) * per_ring) / double(m));
+        const double turn = std::fmod(double(l) * golden, 1.0);
+        for (int j = 0; j < per_ring; ++j) {
+            const double angle = 2.0 * kPi * (double(j) + turn) / per_ring;
+            pattern.offset.push_back(rho * glm::dvec2(std::cos(angle), std::sin(angle)));
+            pattern.radius.push_back(rho);
+            pattern.weight.push_back(weight_at(rho));
+        }
+    }
+    return pattern;
+}
+
 }  // namespace lucent::dipole

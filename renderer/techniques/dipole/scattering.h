@@ -95,4 +95,23 @@ struct HybridSplit {
 };
 HybridSplit make_hybrid_split(const DipoleRgb& d, double c, double k);
 
+// integral_0^inf 2 pi r Rd(r) Wl(r) dr per channel (mm^-2 * mm^2): the local mass Z_l.
+glm::dvec3 local_mass(const DipoleRgb& d, const HybridSplit& split);
+
+// The local part's pattern on the light plane (README.md): M = L C + 1 samples of equal
+// mass under the widest channel's radial density 2 pi r Rd_l(r) / Z_l (the channel with
+// the largest Rp): a centre sample and L rings of C at radii P^-1((1 + (l - 1/2) C) / M),
+// ring l turned by frac(l * golden ratio). Sample k carries offset (mm, on the plane) and
+// weight Z_l,w / (M Rd_l,w(rho_k)) (mm^2), so that
+//   B_l,c ~= sum_k w_k phi(u_k) Rd_l,c(|X(u_k) - xo|).
+// Without any Rp it is one sample of weight 0.
+struct RingPattern {
+    std::vector<glm::dvec2> offset;  // mm
+    std::vector<double> radius;      // |offset|, mm
+    std::vector<double> weight;      // mm^2 / (mm^-2 of Rd): see above
+    int widest = -1;                 // channel, -1 without any Rp
+};
+RingPattern make_ring_pattern(const DipoleRgb& d, const HybridSplit& split, int rings,
+                              int per_ring);
+
 }  // namespace lucent::dipole
