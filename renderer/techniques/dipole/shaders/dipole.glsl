@@ -2,8 +2,12 @@
 // Fresnel transmittance and Jensen's dipole Rd, with the guards of
 // renderer/techniques/dipole/scattering.cpp.
 
-// 1 - Fr(eta, mu) for unpolarised light from outside; exactly 1 for eta = 1.
+// 1 - Fr(eta, mu) for unpolarised light from outside; exactly 1 for eta = 1, and 1
+// without WITH_FRESNEL (the planner's prune for eta = 1).
 float fresnel_transmittance(float eta, float mu) {
+#ifndef WITH_FRESNEL
+    return 1.0;
+#endif
     if (eta == 1.0) return 1.0;
     mu = clamp(mu, 0.0, 1.0);
     if (mu == 0.0) return 0.0;
