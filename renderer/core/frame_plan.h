@@ -3,37 +3,101 @@
 // resources it reads and writes. A technique adds the passes a scene calls for; compile()
 // then culls every pass whose outputs nobody reads, so an effect that is off costs no
 // pass and no texture. Pure data, no GL: renderer/gl/frame_executor runs it.
+//
+// Resource/pass model (design notes, with what each coming technique uses, are in
+// renderer/core/README.md):
+//  - a resource is described once (ResourceDesc): format, shape (frame-sized, fixed 2D,
+//    fixed 3D), size, mip levels. Sampler state travels with each Read, not the texture.
+//  - a pass writes attachments at one mip level; the viewport is their common size.
+//  - CPU-made data is a resource written by an `upload` pass whose DataSource carries a
+//    content hash and a producer; the producer runs only when the hash changes.
+//  - `build_mips` fills levels 1.. of a 2D resource by an exact 2x2 box mean.
 #include <functional>
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <variant>
 #include <vector>
 
 namespace lucent {
 
-// Resource formats. Textures are frame-sized; the vertex stream is one float per vertex.
+// [SECTION] Resources
+
+// Texture formats (float or normalised: shaders read them with float samplers), plus the
+// per-vertex AO stream.
 enum class ResourceFormat {
     depth16,
     depth24,
     depth32f,
+    r8,  // normalised [0, 1]: a binary texture, a density stored coarsely
     r32f,
+    rg32f,
+    rgba8,  // normalised [0, 1]: colour textures
+    rgba16f,
     rgba32f,
     vertex_float,  // per-vertex attribute at location 2 (ambient occlusion)
 };
 bool is_depth_format(ResourceFormat format);
 const char* format_name(ResourceFormat format);
+// Floats per texel (1 for depth, 0 for the vertex stream).
+int format_channels(ResourceFormat format);
+
+enum class ResourceShape {
+    frame,     // the plan's width x height (every resource of the first techniques)
+    fixed_2d,  // size.x x size.y
+    fixed_3d,  // size.x x size.y x size.z (a volume; sampled with sampler3D)
+};
 
 struct ResourceDesc {
     std::string name;
     ResourceFormat format;
+    ResourceShape shape = ResourceShape::frame;
+    glm::ivec3 size{0, 0, 1};  // fixed shapes only; compile() fills it for frame-sized
+    // Mip levels, 1 = base only, 0 = the full chain down to 1x1 (compile() resolves 0).
+    // Level l is max(1, floor(size / 2^l)) per axis, as in GL.
+    int levels = 1;
 };
+// Descriptions for PlanBuilder::create.
+ResourceDesc frame_texture(std::string name, ResourceFormat format, int levels = 1);
+ResourceDesc texture_2d(std::string name, ResourceFormat format, int width, int height,
+                        int levels = 1);
+ResourceDesc texture_3d(std::string name, ResourceFormat format, int width, int height,
+                        int depth);
+// Size of `level` of a texture whose level 0 is `base` (2D textures keep z = 1).
+glm::ivec3 mip_size(glm::ivec3 base, int level, bool three_d);
+// Number of levels of a full chain for `base`.
+int full_mip_levels(glm::ivec3 base, bool three_d);
+
+// CPU-made texels for an upload: level 0 first, optionally further levels (a count
+// pyramid that is not a box mean). Texels are x fastest, then y, then z, format_channels
+// floats each; row y = 0 is the one GL samples at t = 0.
+struct TextureData {
+    glm::ivec3 size{0, 0, 1};
+    std::vector<std::vector<float>> levels;
+};
+// Describes why `data` cannot fill `desc` (resolved by compile()), or "" when it fits.
+std::string check_texture_data(const ResourceDesc& desc, const TextureData& data);
+
+// What an upload pass supplies: equal hashes promise equal texels, so the executor calls
+// `produce` (maybe expensive: an atlas bake) only when the hash differs from the one it
+// uploaded last for the resource.
+struct DataSource {
+    std::string content_hash;
+    std::function<TextureData()> produce;
+};
+
+// [SECTION] Passes
 
 enum class PassKind {
     bake_ambient_occlusion,  // CPU: per-vertex AO (cached bake) uploaded as a vertex
                              // stream
     draw_mesh,               // rasterise the mesh: attributes 0 position, 1 normal, 2 AO
     fullscreen,              // one full-screen triangle (gl/shaders/fullscreen.vert)
+    upload,                  // CPU data (Pass::data) into the one written resource
+    build_mips,              // levels 1.. of the one written 2D resource: exact 2x2 box
+                             // mean of the level above (reads that same resource)
 };
+const char* pass_kind_name(PassKind kind);
 
 // Paths relative to renderer/; `defines` select the compiled variant ("NAME" or "NAME
 // 5").
@@ -49,11 +113,37 @@ struct Uniform {
     UniformValue value;
 };
 
+// Sampler state of one read (GL sampler objects, so two passes may read one texture
+// differently). The defaults are the first techniques' texelFetch-like reads.
+enum class TexelFilter { nearest, linear };
+enum class MipFilter {
+    none,     // base level only
+    nearest,  // nearest level
+    linear,   // blend two levels (with TexelFilter::linear: trilinear)
+};
+enum class Wrap { clamp_to_edge, repeat, clamp_to_border };
+struct Sampling {
+    TexelFilter filter = TexelFilter::nearest;
+    MipFilter mip = MipFilter::none;
+    Wrap wrap = Wrap::clamp_to_edge;
+    glm::vec4 border{0.0f};  // Wrap::clamp_to_border only
+};
+std::string describe(const Sampling& sampling);  // "nearest clamp", "linear/linear border"
+
 // A resource a pass reads; textures are bound to the sampler uniform `sampler` (the
 // resource name when empty).
 struct Read {
     std::string resource;
     std::string sampler;
+    Sampling sampling{};
+};
+
+// How a pass combines its fragments with its colour attachments.
+enum class Blend {
+    none,                // replace
+    additive,            // dst + src (accumulate samples or lights)
+    premultiplied_over,   // src + (1 - src.a) dst (layers drawn back to front)
+    premultiplied_under,  // (1 - dst.a) src + dst (layers drawn front to back)
 };
 
 struct Pass {
@@ -66,6 +156,12 @@ struct Pass {
     std::vector<Uniform> uniforms;
     glm::vec4 clear_colour{0.0f};  // colour attachments are cleared to this, depth to 1
     int ao_rays = 0;               // bake_ambient_occlusion only
+    int level = 0;                 // the mip level the attachments are written at
+    // False: keep the attachments' contents (compositing onto an earlier pass's output;
+    // the attachments then count as read too).
+    bool clear = true;
+    Blend blend = Blend::none;
+    DataSource data;  // upload only
 };
 
 enum class PlanMode {
@@ -76,13 +172,16 @@ enum class PlanMode {
 struct FramePlan {
     int width = 0;
     int height = 0;
-    std::vector<ResourceDesc> resources;  // only those the kept passes touch
+    std::vector<ResourceDesc> resources;  // only those the kept passes touch, resolved
     std::vector<Pass> passes;             // in execution order
     std::vector<std::string> culled;      // names of passes removed by compile()
     std::string output;                   // the rgba32f image resource
 
     const ResourceDesc* resource(const std::string& name) const;
-    // One pass per line: "name: reads a, b -> writes c  [purpose]", then culled passes.
+    // Size of `pass`'s attachments (its viewport); compile() checked that they agree.
+    glm::ivec2 viewport(const Pass& pass) const;
+    // The resources, one per line ("resource name: 64x48 rgba32f, 7 levels"), then one
+    // pass per line: "name: reads a, b -> writes c  [purpose]", then culled passes.
     std::string explain() const;
 };
 
@@ -91,11 +190,14 @@ public:
     PlanBuilder(PlanMode mode, int width, int height);
     // True for PlanMode::full: techniques then add every pass and enable every term.
     bool full() const { return mode_ == PlanMode::full; }
-    void create(std::string name, ResourceFormat format);
+    void create(std::string name, ResourceFormat format);  // frame-sized, one level
+    void create(ResourceDesc desc);
     void add(Pass pass);
     void set_output(std::string resource);
-    // Checks that every read names a resource written earlier and every write a created
-    // resource (std::logic_error otherwise), then culls unread passes (pruned mode).
+    // Checks the plan (std::logic_error naming the pass or resource otherwise): every read
+    // names a resource written earlier, every write a created resource, a pass's
+    // attachments agree in size at its level, upload and build_mips passes write exactly
+    // one fitting resource, sizes are positive. Then culls unread passes (pruned mode).
     FramePlan compile() const;
 
 private:

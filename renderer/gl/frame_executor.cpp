@@ -19,14 +19,70 @@ GLenum internal_format(ResourceFormat format) {
             return GL_DEPTH_COMPONENT24;
         case ResourceFormat::depth32f:
             return GL_DEPTH_COMPONENT32F;
+        case ResourceFormat::r8:
+            return GL_R8;
         case ResourceFormat::r32f:
             return GL_R32F;
+        case ResourceFormat::rg32f:
+            return GL_RG32F;
+        case ResourceFormat::rgba8:
+            return GL_RGBA8;
+        case ResourceFormat::rgba16f:
+            return GL_RGBA16F;
         case ResourceFormat::rgba32f:
             return GL_RGBA32F;
         case ResourceFormat::vertex_float:
             break;
     }
     throw std::logic_error("not a texture format");
+}
+
+// Client format of `channels` floats per texel.
+GLenum pixel_format(ResourceFormat format) {
+    if (is_depth_format(format)) return GL_DEPTH_COMPONENT;
+    switch (format_channels(format)) {
+        case 1:
+            return GL_RED;
+        case 2:
+            return GL_RG;
+        default:
+            return GL_RGBA;
+    }
+}
+
+GLenum min_filter(const Sampling& s) {
+    const bool linear = s.filter == TexelFilter::linear;
+    switch (s.mip) {
+        case MipFilter::none:
+            return linear ? GL_LINEAR : GL_NEAREST;
+        case MipFilter::nearest:
+            return linear ? GL_LINEAR_MIPMAP_NEAREST : GL_NEAREST_MIPMAP_NEAREST;
+        case MipFilter::linear:
+            return linear ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST_MIPMAP_LINEAR;
+    }
+    return GL_NEAREST;
+}
+
+GLenum wrap_mode(Wrap wrap) {
+    switch (wrap) {
+        case Wrap::clamp_to_edge:
+            return GL_CLAMP_TO_EDGE;
+        case Wrap::repeat:
+            return GL_REPEAT;
+        case Wrap::clamp_to_border:
+            return GL_CLAMP_TO_BORDER;
+    }
+    return GL_CLAMP_TO_EDGE;
+}
+
+std::string sampler_key(const Sampling& s) {
+    return describe(s) + "/" + std::to_string(s.border.r) + "," + std::to_string(s.border.g) +
+           "," + std::to_string(s.border.b) + "," + std::to_string(s.border.a);
+}
+
+bool same_storage(const ResourceDesc& a, const ResourceDesc& b) {
+    return a.format == b.format && a.shape == b.shape && a.size == b.size &&
+           a.levels == b.levels;
 }
 
 std::string program_key(const ShaderDesc& shader) {
@@ -57,13 +113,20 @@ void set_uniform(GLuint program, const Uniform& uniform) {
         uniform.value);
 }
 
+// Passes timed by wall clock: CPU work (a bake, producing and uploading data).
+bool cpu_pass(PassKind kind) {
+    return kind == PassKind::bake_ambient_occlusion || kind == PassKind::upload;
+}
+
 }  // namespace
 
 struct FrameExecutor::Impl {
-    struct Texture2d {
-        ResourceFormat format;
-        int width = 0, height = 0;
+    struct FrameTexture {
+        ResourceDesc desc;  // resolved by compile(): size and levels are final
         Texture texture;
+        std::string uploaded_hash;  // content hash of the last upload into it
+        int width() const { return desc.size.x; }
+        int height() const { return desc.size.y; }
     };
     // Mesh buffers, re-uploaded when the mesh changes (compared by content hash + size).
     std::string mesh_key;
@@ -73,7 +136,9 @@ struct FrameExecutor::Impl {
     VertexArray empty_vao;  // full-screen passes draw without attributes
     // AO streams by (mesh key, rays); the live one is attached at location 2.
     std::map<std::string, Buffer> ao_streams;
-    std::map<std::string, Texture2d> textures;
+    std::map<std::string, FrameTexture> textures;
+    std::map<std::string, Sampler> samplers;  // by sampler_key
+    std::size_t uploads = 0;
     std::map<std::string, Program> programs;
     std::vector<Query> queries;
     AmbientOcclusionSource ao_source = [](const Mesh& mesh, int rays) {
@@ -128,23 +193,97 @@ struct FrameExecutor::Impl {
         return it->second.id();
     }
 
-    // Allocates the plan's textures (reusing same-format, same-size ones) and frees the
+    // Allocates the plan's textures (reusing ones of the same storage) and frees the
     // ones it does not name.
     void allocate(const FramePlan& plan) {
-        std::map<std::string, Texture2d> kept;
+        std::map<std::string, FrameTexture> kept;
         for (const auto& r : plan.resources) {
             if (r.format == ResourceFormat::vertex_float) continue;
             auto it = textures.find(r.name);
-            if (it != textures.end() && it->second.format == r.format &&
-                it->second.width == plan.width && it->second.height == plan.height) {
+            if (it != textures.end() && same_storage(it->second.desc, r)) {
                 kept.emplace(r.name, std::move(it->second));
             } else {
-                kept.emplace(r.name, Texture2d{r.format, plan.width, plan.height,
-                                               make_texture_2d(internal_format(r.format),
-                                                               plan.width, plan.height)});
+                const bool three_d = r.shape == ResourceShape::fixed_3d;
+                kept.emplace(r.name,
+                             FrameTexture{r,
+                                          make_texture(internal_format(r.format), r.size.x,
+                                                       r.size.y, three_d ? r.size.z : 0,
+                                                       r.levels),
+                                          ""});
             }
         }
         textures = std::move(kept);
+    }
+
+    GLuint sampler_for(const Sampling& sampling) {
+        const std::string key = sampler_key(sampling);
+        auto it = samplers.find(key);
+        if (it == samplers.end()) {
+            const GLenum mag =
+                sampling.filter == TexelFilter::linear ? GL_LINEAR : GL_NEAREST;
+            it = samplers
+                     .emplace(key, make_sampler(min_filter(sampling), mag,
+                                                wrap_mode(sampling.wrap), &sampling.border[0]))
+                     .first;
+        }
+        return it->second.id();
+    }
+
+    // Calls the producer and uploads only when the content hash differs from the last
+    // upload into this texture (a reallocated texture has none).
+    void upload(const Pass& pass) {
+        FrameTexture& target = textures.at(pass.writes.at(0));
+        if (target.uploaded_hash == pass.data.content_hash) return;
+        const TextureData data = pass.data.produce();
+        const std::string problem = check_texture_data(target.desc, data);
+        if (!problem.empty())
+            throw std::runtime_error("pass '" + pass.name + "': data for '" +
+                                     target.desc.name + "': " + problem);
+        const bool three_d = target.desc.shape == ResourceShape::fixed_3d;
+        const GLenum format = pixel_format(target.desc.format);
+        for (std::size_t l = 0; l < data.levels.size(); ++l) {
+            const glm::ivec3 s = mip_size(target.desc.size, static_cast<int>(l), three_d);
+            if (three_d)
+                glTextureSubImage3D(target.texture.id(), static_cast<GLint>(l), 0, 0, 0, s.x,
+                                    s.y, s.z, format, GL_FLOAT, data.levels[l].data());
+            else
+                glTextureSubImage2D(target.texture.id(), static_cast<GLint>(l), 0, 0, s.x, s.y,
+                                    format, GL_FLOAT, data.levels[l].data());
+        }
+        target.uploaded_hash = pass.data.content_hash;
+        ++uploads;
+    }
+
+    // Levels 1.. of the written texture, each from the one above: that level alone is
+    // made visible (base = max level), so the draw reads no level it writes.
+    void build_mips(const Pass& pass) {
+        FrameTexture& target = textures.at(pass.writes.at(0));
+        const GLuint prog = program({"gl/shaders/fullscreen.vert", "gl/shaders/box_mip.frag", {}});
+        const GLuint id = target.texture.id();
+        glUseProgram(prog);
+        glProgramUniform1i(prog, glGetUniformLocation(prog, "source"), 0);
+        glDisable(GL_BLEND);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_CULL_FACE);
+        glBindVertexArray(empty_vao.id());
+        glBindTextureUnit(0, id);
+        glBindSampler(0, sampler_for(Sampling{}));
+        for (int level = 1; level < target.desc.levels; ++level) {
+            glTextureParameteri(id, GL_TEXTURE_BASE_LEVEL, level - 1);
+            glTextureParameteri(id, GL_TEXTURE_MAX_LEVEL, level - 1);
+            Framebuffer fbo = make_framebuffer({&target.texture}, nullptr, level);
+            glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+            const glm::ivec3 size = mip_size(target.desc.size, level, false);
+            glViewport(0, 0, size.x, size.y);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        }
+        glTextureParameteri(id, GL_TEXTURE_BASE_LEVEL, 0);
+        glTextureParameteri(id, GL_TEXTURE_MAX_LEVEL, target.desc.levels - 1);
+        glUseProgram(0);
+        glBindVertexArray(0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glBindTextureUnit(0, 0);
+        glBindSampler(0, 0);
     }
 
     void bake(const Scene& scene, const Pass& pass) {
@@ -165,32 +304,55 @@ struct FrameExecutor::Impl {
     }
 
     void draw(const Pass& pass, const FramePlan& plan) {
-        const GLuint prog = program(pass.shader);
         // Attachments: the depth-format write becomes the depth attachment, the others
         // colour attachments in order.
         std::vector<const Texture*> colour;
         const Texture* depth = nullptr;
         for (const auto& w : pass.writes) {
-            const Texture2d& t = textures.at(w);
-            if (is_depth_format(t.format))
+            const FrameTexture& t = textures.at(w);
+            if (is_depth_format(t.desc.format))
                 depth = &t.texture;
             else
                 colour.push_back(&t.texture);
         }
-        Framebuffer fbo = colour.size() == 0 ? make_framebuffer({}, depth)
-                          : colour.size() == 1
-                              ? make_framebuffer({colour[0]}, depth)
-                              : make_framebuffer({colour[0], colour[1]}, depth);
-        for (std::size_t i = 0; i < colour.size(); ++i)
-            glClearNamedFramebufferfv(fbo.id(), GL_COLOR, static_cast<GLint>(i),
-                                      &pass.clear_colour[0]);
-        if (depth) {
-            const float one = 1.0f;
-            glClearNamedFramebufferfv(fbo.id(), GL_DEPTH, 0, &one);
+        Framebuffer fbo = [&] {
+            try {
+                return make_framebuffer(colour, depth, pass.level);
+            } catch (const std::runtime_error& e) {
+                throw std::runtime_error("pass '" + pass.name + "': " + e.what());
+            }
+        }();
+        const GLuint prog = program(pass.shader);
+        if (pass.clear) {
+            for (std::size_t i = 0; i < colour.size(); ++i)
+                glClearNamedFramebufferfv(fbo.id(), GL_COLOR, static_cast<GLint>(i),
+                                          &pass.clear_colour[0]);
+            if (depth) {
+                const float one = 1.0f;
+                glClearNamedFramebufferfv(fbo.id(), GL_DEPTH, 0, &one);
+            }
         }
         glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
-        glViewport(0, 0, plan.width, plan.height);
-        glDisable(GL_BLEND);
+        const glm::ivec2 viewport = plan.viewport(pass);
+        glViewport(0, 0, viewport.x, viewport.y);
+        switch (pass.blend) {
+            case Blend::none:
+                glDisable(GL_BLEND);
+                break;
+            case Blend::additive:
+                glEnable(GL_BLEND);
+                glBlendFunc(GL_ONE, GL_ONE);
+                break;
+            case Blend::premultiplied_over:
+                glEnable(GL_BLEND);
+                glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+                break;
+            case Blend::premultiplied_under:
+                glEnable(GL_BLEND);
+                glBlendFunc(GL_ONE_MINUS_DST_ALPHA, GL_ONE);
+                break;
+        }
+        glBlendEquation(GL_FUNC_ADD);
         glDisable(GL_CULL_FACE);  // both facings count as layers, as ray hits do
         if (depth) {
             glEnable(GL_DEPTH_TEST);
@@ -208,6 +370,7 @@ struct FrameExecutor::Impl {
             const std::string& sampler =
                 read.sampler.empty() ? read.resource : read.sampler;
             glBindTextureUnit(static_cast<GLuint>(unit), it->second.texture.id());
+            glBindSampler(static_cast<GLuint>(unit), sampler_for(read.sampling));
             const GLint location = glGetUniformLocation(prog, sampler.c_str());
             if (location >= 0) glProgramUniform1i(prog, location, unit);
             ++unit;
@@ -224,7 +387,11 @@ struct FrameExecutor::Impl {
         glUseProgram(0);
         glBindVertexArray(0);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        for (GLint u = 0; u < unit; ++u) glBindTextureUnit(static_cast<GLuint>(u), 0);
+        glDisable(GL_BLEND);
+        for (GLint u = 0; u < unit; ++u) {
+            glBindTextureUnit(static_cast<GLuint>(u), 0);
+            glBindSampler(static_cast<GLuint>(u), 0);
+        }
     }
 };
 
@@ -261,14 +428,25 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
     for_each_pass(plan, [&](const Pass& pass) {
         const auto start = std::chrono::steady_clock::now();
         const bool gpu =
-            time_passes && gpu_timer && pass.kind != PassKind::bake_ambient_occlusion;
+            time_passes && gpu_timer && !cpu_pass(pass.kind);
         if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
-        if (pass.kind == PassKind::bake_ambient_occlusion)
-            impl_->bake(scene, pass);
-        else
-            impl_->draw(pass, plan);
+        switch (pass.kind) {
+            case PassKind::bake_ambient_occlusion:
+                impl_->bake(scene, pass);
+                break;
+            case PassKind::upload:
+                impl_->upload(pass);
+                break;
+            case PassKind::build_mips:
+                impl_->build_mips(pass);
+                break;
+            case PassKind::draw_mesh:
+            case PassKind::fullscreen:
+                impl_->draw(pass, plan);
+                break;
+        }
         if (gpu) glEndQuery(GL_TIME_ELAPSED);
-        if (time_passes && !gpu && pass.kind != PassKind::bake_ambient_occlusion)
+        if (time_passes && !gpu && !cpu_pass(pass.kind))
             glFinish();
         check_errors("pass '" + pass.name + "'");
         wall_ms.push_back(std::chrono::duration<double, std::milli>(
@@ -279,7 +457,7 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
     if (!time_passes) return;
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
         double ms = wall_ms[i];
-        if (gpu_timer && plan.passes[i].kind != PassKind::bake_ambient_occlusion) {
+        if (gpu_timer && !cpu_pass(plan.passes[i].kind)) {
             GLuint64 ns = 0;
             glGetQueryObjectui64v(impl_->queries[i].id(), GL_QUERY_RESULT, &ns);
             ms = static_cast<double>(ns) * 1e-6;
@@ -293,29 +471,53 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
 Image FrameExecutor::read_output(const FramePlan& plan) const {
     const auto& texture = impl_->textures.at(plan.output);
     const std::vector<float> pixels =
-        read_texture_rgba32f(texture.texture, texture.width, texture.height);
+        read_texture_rgba32f(texture.texture, texture.width(), texture.height());
     check_errors("read-back of '" + plan.output + "'");
-    Image image(texture.width, texture.height);
-    const std::size_t row = static_cast<std::size_t>(texture.width) * 4;
-    for (int y = 0; y < texture.height; ++y)  // GL rows are bottom first
-        std::copy_n(&pixels[static_cast<std::size_t>(texture.height - 1 - y) * row], row,
+    Image image(texture.width(), texture.height());
+    const std::size_t row = static_cast<std::size_t>(texture.width()) * 4;
+    for (int y = 0; y < texture.height(); ++y)  // GL rows are bottom first
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row], row,
                     &image.rgba[static_cast<std::size_t>(y) * row]);
     return image;
 }
 
 std::vector<float> FrameExecutor::read_channel(const std::string& resource) const {
     const auto& texture = impl_->textures.at(resource);
-    const GLenum format = is_depth_format(texture.format) ? GL_DEPTH_COMPONENT : GL_RED;
+    const GLenum format = is_depth_format(texture.desc.format) ? GL_DEPTH_COMPONENT : GL_RED;
     const std::vector<float> pixels =
-        read_texture_r32f(texture.texture, format, texture.width, texture.height);
+        read_texture_r32f(texture.texture, format, texture.width(), texture.height());
     check_errors("read-back of '" + resource + "'");
     std::vector<float> flipped(pixels.size());
-    const std::size_t row = static_cast<std::size_t>(texture.width);
-    for (int y = 0; y < texture.height; ++y)
-        std::copy_n(&pixels[static_cast<std::size_t>(texture.height - 1 - y) * row], row,
+    const std::size_t row = static_cast<std::size_t>(texture.width());
+    for (int y = 0; y < texture.height(); ++y)
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row], row,
                     &flipped[static_cast<std::size_t>(y) * row]);
     return flipped;
 }
+
+TextureData FrameExecutor::read_texture(const std::string& resource, int level) const {
+    auto it = impl_->textures.find(resource);
+    if (it == impl_->textures.end())
+        throw std::runtime_error("read-back: no texture '" + resource + "' in this frame");
+    const ResourceDesc& desc = it->second.desc;
+    if (level < 0 || level >= desc.levels)
+        throw std::runtime_error("read-back: '" + resource + "' has no level " +
+                                 std::to_string(level));
+    const glm::ivec3 size = mip_size(desc.size, level, desc.shape == ResourceShape::fixed_3d);
+    TextureData data;
+    data.size = size;
+    data.levels.emplace_back(static_cast<std::size_t>(size.x) * size.y * size.z *
+                             static_cast<std::size_t>(format_channels(desc.format)));
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glGetTextureImage(it->second.texture.id(), level, pixel_format(desc.format), GL_FLOAT,
+                      static_cast<GLsizei>(data.levels[0].size() * sizeof(float)),
+                      data.levels[0].data());
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    check_errors("read-back of '" + resource + "' level " + std::to_string(level));
+    return data;
+}
+
+std::size_t FrameExecutor::uploads_performed() const { return impl_->uploads; }
 
 void FrameExecutor::present(const FramePlan& plan, int x, int y, int width, int height) {
     const auto& texture = impl_->textures.at(plan.output);

@@ -1,6 +1,6 @@
 #pragma once
-// Runs a FramePlan with OpenGL: allocates exactly the resources the plan names (frame-
-// sized textures, the AO vertex stream), compiles each pass's shader variant once, binds
+// Runs a FramePlan with OpenGL: allocates exactly the resources the plan names (textures
+// of each resource's shape and levels, the AO vertex stream, CPU data), compiles each pass's shader variant once, binds
 // reads to samplers and writes to a framebuffer, and draws. Optional per-pass GPU timer
 // queries feed `lucent bench frame` and the explorer's status bar. Needs a current GL 4.5
 // context; every GL object is owned by an RAII wrapper held here.
@@ -20,6 +20,7 @@ namespace lucent::gl {
 struct PassTiming {
     std::string pass;
     double milliseconds = 0.0;
+    bool cached = false;  // not re-run: its inputs had not changed since the last frame
 };
 
 struct FrameTimings {
@@ -50,6 +51,9 @@ public:
     void execute(const Scene& scene, const FramePlan& plan, bool time_passes = false);
     // The plan's output after execute(), top row first.
     Image read_output(const FramePlan& plan) const;
+    // Every texel of `level` of a texture resource (any shape), in upload order: x
+    // fastest, row y = 0 (GL's bottom row) first, format_channels floats per texel.
+    TextureData read_texture(const std::string& resource, int level = 0) const;
     // A frame-sized single-channel resource (a depth layer, the smoothed layer), top row
     // first: for tests and the explorer's buffer view.
     std::vector<float> read_channel(const std::string& resource) const;
@@ -60,6 +64,9 @@ public:
     Image render(const Scene& scene, const FramePlan& plan);
 
     const FrameTimings& last_timings() const { return timings_; }
+    // How many times an upload pass called its producer and uploaded (a pass whose
+    // content hash equals the resource's last upload costs nothing).
+    std::size_t uploads_performed() const;
     // Names of the frame resources currently allocated (textures and vertex streams).
     std::vector<std::string> allocated_resources() const;
 

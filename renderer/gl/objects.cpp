@@ -1,5 +1,6 @@
 #include "gl/objects.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -37,20 +38,34 @@ Query make_query(GLenum target) {
 
 Framebuffer make_framebuffer(std::initializer_list<const Texture*> colour,
                              const Texture* depth) {
+    return make_framebuffer(std::vector<const Texture*>(colour), depth, 0);
+}
+
+Framebuffer make_framebuffer(const std::vector<const Texture*>& colour, const Texture* depth,
+                             int level) {
+    GLint max_attachments = 0, max_draw_buffers = 0;
+    glGetIntegerv(GL_MAX_COLOR_ATTACHMENTS, &max_attachments);
+    glGetIntegerv(GL_MAX_DRAW_BUFFERS, &max_draw_buffers);
+    const GLint limit = std::min(max_attachments, max_draw_buffers);
+    if (static_cast<GLint>(colour.size()) > limit)
+        throw std::runtime_error(
+            "framebuffer: " + std::to_string(colour.size()) +
+            " colour attachments, this GL allows " + std::to_string(limit) +
+            " (GL_MAX_COLOR_ATTACHMENTS " + std::to_string(max_attachments) +
+            ", GL_MAX_DRAW_BUFFERS " + std::to_string(max_draw_buffers) + ")");
     GLuint id = 0;
     glCreateFramebuffers(1, &id);
     Framebuffer fbo(id);
-    GLenum buffers[8];
-    GLsizei count = 0;
+    std::vector<GLenum> buffers;
     for (const Texture* texture : colour) {
-        if (count == 8) throw std::runtime_error("framebuffer: more than 8 colour attachments");
-        glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0 + count, texture->id(), 0);
-        buffers[count] = GL_COLOR_ATTACHMENT0 + count;
-        ++count;
+        const GLenum attachment = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(buffers.size());
+        glNamedFramebufferTexture(id, attachment, texture->id(), level);
+        buffers.push_back(attachment);
     }
-    if (depth) glNamedFramebufferTexture(id, GL_DEPTH_ATTACHMENT, depth->id(), 0);
-    if (count > 0)
-        glNamedFramebufferDrawBuffers(id, count, buffers);
+    if (depth) glNamedFramebufferTexture(id, GL_DEPTH_ATTACHMENT, depth->id(), level);
+    if (!buffers.empty())
+        glNamedFramebufferDrawBuffers(id, static_cast<GLsizei>(buffers.size()),
+                                      buffers.data());
     else
         glNamedFramebufferDrawBuffer(id, GL_NONE);
     const GLenum status = glCheckNamedFramebufferStatus(id, GL_FRAMEBUFFER);
@@ -58,6 +73,33 @@ Framebuffer make_framebuffer(std::initializer_list<const Texture*> colour,
         throw std::runtime_error("framebuffer incomplete: glCheckFramebufferStatus = " +
                                  std::to_string(status));
     return fbo;
+}
+
+Texture make_texture(GLenum internal_format, int width, int height, int depth, int levels) {
+    GLuint id = 0;
+    glCreateTextures(depth > 0 ? GL_TEXTURE_3D : GL_TEXTURE_2D, 1, &id);
+    if (depth > 0)
+        glTextureStorage3D(id, levels, internal_format, width, height, depth);
+    else
+        glTextureStorage2D(id, levels, internal_format, width, height);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    return Texture(id);
+}
+
+Sampler make_sampler(GLenum min_filter, GLenum mag_filter, GLenum wrap,
+                     const float border[4]) {
+    GLuint id = 0;
+    glCreateSamplers(1, &id);
+    glSamplerParameteri(id, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(min_filter));
+    glSamplerParameteri(id, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(mag_filter));
+    for (GLenum axis : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+        glSamplerParameteri(id, axis, static_cast<GLint>(wrap));
+    glSamplerParameterfv(id, GL_TEXTURE_BORDER_COLOR, border);
+    return Sampler(id);
 }
 
 }  // namespace lucent::gl

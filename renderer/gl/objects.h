@@ -4,6 +4,7 @@
 #include <epoxy/gl.h>
 
 #include <utility>
+#include <vector>
 
 namespace lucent::gl {
 
@@ -42,6 +43,7 @@ inline void delete_framebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
 inline void delete_vertex_array(GLuint id) { glDeleteVertexArrays(1, &id); }
 inline void delete_program(GLuint id) { glDeleteProgram(id); }
 inline void delete_query(GLuint id) { glDeleteQueries(1, &id); }
+inline void delete_sampler(GLuint id) { glDeleteSamplers(1, &id); }
 }  // namespace detail
 
 using Buffer = Object<detail::delete_buffer>;
@@ -50,11 +52,18 @@ using Framebuffer = Object<detail::delete_framebuffer>;
 using VertexArray = Object<detail::delete_vertex_array>;
 using Program = Object<detail::delete_program>;
 using Query = Object<detail::delete_query>;
+using Sampler = Object<detail::delete_sampler>;
 
 // Immutable-storage buffer holding `bytes` bytes copied from `data` (may be null).
 Buffer make_buffer(const void* data, GLsizeiptr bytes, GLbitfield flags = 0);
 // 2D texture with immutable storage, nearest filtering, clamped to edge.
 Texture make_texture_2d(GLenum internal_format, int width, int height);
+// Immutable 2D (depth 0) or 3D texture with `levels` mip levels; its filtering comes from
+// the sampler objects bound with it (the texture's own state is nearest, clamped).
+Texture make_texture(GLenum internal_format, int width, int height, int depth, int levels);
+// Sampler object with the given filters and one wrap mode on every axis.
+Sampler make_sampler(GLenum min_filter, GLenum mag_filter, GLenum wrap,
+                     const float border[4]);
 VertexArray make_vertex_array();
 Query make_query(GLenum target);
 
@@ -62,5 +71,9 @@ Query make_query(GLenum target);
 // optional depth texture; throws std::runtime_error naming the incompleteness status.
 Framebuffer make_framebuffer(std::initializer_list<const Texture*> colour,
                              const Texture* depth = nullptr);
+// Same, attaching mip `level` of every texture; any number of colour attachments up to
+// GL_MAX_COLOR_ATTACHMENTS and GL_MAX_DRAW_BUFFERS (std::runtime_error naming both above).
+Framebuffer make_framebuffer(const std::vector<const Texture*>& colour, const Texture* depth,
+                             int level);
 
 }  // namespace lucent::gl

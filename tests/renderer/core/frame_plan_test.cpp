@@ -186,5 +186,189 @@ TEST(PlanBuilder, RejectsReadsBeforeWritesAndUndeclaredResources) {
     EXPECT_THROW(undeclared.add(writer), std::logic_error);  // duplicate pass name
 }
 
+// [SECTION] Resource shapes, levels, data, attachments (the frame plan of issue 11)
+
+Pass pass_writing(std::string name, std::vector<std::string> writes,
+                  std::vector<Read> reads = {}) {
+    Pass pass{std::move(name)};
+    pass.kind = PassKind::fullscreen;
+    pass.writes = std::move(writes);
+    pass.reads = std::move(reads);
+    return pass;
+}
+
+DataSource constant_data(std::string hash, glm::ivec3 size, int channels) {
+    return {std::move(hash), [size, channels] {
+                return TextureData{size, {std::vector<float>(
+                                             std::size_t(size.x) * size.y * size.z * channels,
+                                             1.0f)}};
+            }};
+}
+
+TEST(PlanBuilder, ResolvesShapesSizesAndFullMipChains) {
+    PlanBuilder builder(PlanMode::pruned, 64, 48);
+    builder.create(frame_texture("colour", ResourceFormat::rgba32f));
+    builder.create(frame_texture("frame_mips", ResourceFormat::r32f, 0));
+    builder.create(texture_2d("atlas", ResourceFormat::r32f, 256, 64, 0));
+    builder.create(texture_3d("density", ResourceFormat::r8, 32, 16, 8));
+    Pass upload{"density_volume"};
+    upload.kind = PassKind::upload;
+    upload.writes = {"density"};
+    upload.data = constant_data("d1", {32, 16, 8}, 1);
+    builder.add(upload);
+    builder.add(pass_writing("atlas_pass", {"atlas"}, {{"density", ""}}));
+    builder.add(pass_writing("frame_pass", {"frame_mips"}));
+    builder.add(pass_writing("shade", {"colour"},
+                             {{"atlas", "", {TexelFilter::linear, MipFilter::linear}},
+                              {"frame_mips", ""}}));
+    builder.set_output("colour");
+    const FramePlan plan = builder.compile();
+    // Frame-sized resources take the plan's size; 0 levels is the full chain, counted by
+    // hand: 64x48 -> 32x24, 16x12, 8x6, 4x3, 2x1, 1x1 is 7 levels; 256x64 has 9.
+    EXPECT_EQ(plan.resource("colour")->size, glm::ivec3(64, 48, 1));
+    EXPECT_EQ(plan.resource("frame_mips")->levels, 7);
+    EXPECT_EQ(plan.resource("atlas")->levels, 9);
+    EXPECT_EQ(plan.resource("density")->size, glm::ivec3(32, 16, 8));
+    EXPECT_EQ(mip_size({256, 64, 1}, 7, false), glm::ivec3(2, 1, 1));
+    EXPECT_EQ(mip_size({5, 3, 7}, 1, true), glm::ivec3(2, 1, 3));
+    // Every resource's size and format is in --explain, and sampler state of a read.
+    const std::string text = plan.explain();
+    for (const char* line :
+         {"resource colour: 64x48 rgba32f (frame)", "resource frame_mips: 64x48 r32f, 7 levels",
+          "resource atlas: 256x64 r32f, 9 levels", "resource density: 32x16x8 r8",
+          "shade: atlas (linear/mip linear clamp), frame_mips -> colour (rgba32f)",
+          "density_volume: - -> density (r8)  <upload, data d1>"})
+        EXPECT_NE(text.find(line), std::string::npos) << line << "\n" << text;
+    EXPECT_EQ(plan.viewport(pass_named(plan, "atlas_pass")), glm::ivec2(256, 64));
+    EXPECT_EQ(plan.viewport(pass_named(plan, "shade")), glm::ivec2(64, 48));
+}
+
+TEST(PlanBuilder, ViewportIsTheAttachmentsLevelAndMixedSizesAreRejected) {
+    PlanBuilder builder(PlanMode::pruned, 64, 48);
+    builder.create(texture_2d("a", ResourceFormat::r32f, 32, 32, 0));
+    builder.create(texture_2d("b", ResourceFormat::r32f, 32, 16, 3));
+    builder.create(frame_texture("out", ResourceFormat::rgba32f));
+    builder.add(pass_writing("level_zero", {"a"}));
+    Pass level_two = pass_writing("level_two", {"a"});
+    level_two.level = 2;  // 32 / 4 = 8
+    level_two.clear = false;
+    builder.add(level_two);
+    Pass b_one = pass_writing("b_one", {"b"});
+    b_one.level = 1;
+    builder.add(b_one);
+    builder.add(pass_writing("final", {"out"}, {{"a", ""}, {"b", ""}}));
+    builder.set_output("out");
+    const FramePlan plan = builder.compile();
+    EXPECT_EQ(plan.viewport(pass_named(plan, "level_two")), glm::ivec2(8, 8));
+    EXPECT_EQ(plan.viewport(pass_named(plan, "b_one")), glm::ivec2(16, 8));
+    EXPECT_NE(plan.explain().find("level_two: - -> a (r32f)  <level 2>  <keeps contents>"),
+              std::string::npos)
+        << plan.explain();
+
+    PlanBuilder mixed(PlanMode::pruned, 64, 48);
+    mixed.create(texture_2d("a", ResourceFormat::r32f, 32, 32));
+    mixed.create(frame_texture("out", ResourceFormat::rgba32f));
+    mixed.add(pass_writing("both", {"a", "out"}));
+    mixed.set_output("out");
+    try {
+        mixed.compile();
+        ADD_FAILURE() << "mixed attachment sizes compiled";
+    } catch (const std::logic_error& e) {
+        EXPECT_STREQ(e.what(),
+                     "frame plan: pass 'both' writes 'a' (32x32x1) and 'out' (64x48x1): "
+                     "attachments differ in size");
+    }
+}
+
+TEST(PlanBuilder, RejectsMalformedUploadsMipsLevelsAndFeedback) {
+    const auto compile_with = [](std::vector<ResourceDesc> resources, std::vector<Pass> passes,
+                                 std::string output) {
+        PlanBuilder builder(PlanMode::pruned, 16, 16);
+        for (auto& r : resources) builder.create(r);
+        for (auto& p : passes) builder.add(p);
+        builder.set_output(output);
+        return builder.compile();
+    };
+    const ResourceDesc out = frame_texture("out", ResourceFormat::rgba32f);
+    Pass no_hash{"table"};
+    no_hash.kind = PassKind::upload;
+    no_hash.writes = {"out"};
+    no_hash.data.produce = [] { return TextureData{}; };
+    EXPECT_THROW(compile_with({out}, {no_hash}, "out"), std::logic_error);
+    Pass one_level_mips{"mips"};
+    one_level_mips.kind = PassKind::build_mips;
+    one_level_mips.writes = {"out"};
+    EXPECT_THROW(compile_with({out}, {pass_writing("w", {"out"}), one_level_mips}, "out"),
+                 std::logic_error);
+    // build_mips needs level 0 written first.
+    const ResourceDesc mipped = frame_texture("out", ResourceFormat::rgba32f, 0);
+    EXPECT_THROW(compile_with({mipped}, {one_level_mips}, "out"), std::logic_error);
+    EXPECT_NO_THROW(compile_with({mipped}, {pass_writing("w", {"out"}), one_level_mips}, "out"));
+    Pass too_deep = pass_writing("deep", {"out"});
+    too_deep.level = 5;  // 16x16 has levels 0..4
+    EXPECT_THROW(compile_with({mipped}, {too_deep}, "out"), std::logic_error);
+    EXPECT_THROW(compile_with({texture_2d("t", ResourceFormat::r32f, 0, 4)},
+                              {pass_writing("w", {"t"})}, "t"),
+                 std::logic_error);
+    EXPECT_THROW(compile_with({out, frame_texture("x", ResourceFormat::r32f)},
+                              {pass_writing("w", {"x"}), pass_writing("loop", {"x", "out"},
+                                                                      {{"x", ""}})},
+                              "out"),
+                 std::logic_error);
+    // A pass keeping its attachment's contents needs an earlier writer.
+    Pass keep = pass_writing("composite", {"out"});
+    keep.clear = false;
+    EXPECT_THROW(compile_with({out}, {keep}, "out"), std::logic_error);
+}
+
+// Compositing passes depend on what they draw over, and build_mips on the level it
+// reduces: culling keeps their producers.
+TEST(PlanBuilder, KeptContentsAndMipsKeepTheirProducers) {
+    PlanBuilder builder(PlanMode::pruned, 16, 16);
+    builder.create(frame_texture("layers", ResourceFormat::rgba32f));
+    builder.create(texture_2d("irradiance", ResourceFormat::r32f, 64, 64, 0));
+    builder.create(frame_texture("unread", ResourceFormat::r32f));
+    builder.add(pass_writing("irradiance", {"irradiance"}));
+    Pass mips{"irradiance_mips"};
+    mips.kind = PassKind::build_mips;
+    mips.writes = {"irradiance"};
+    builder.add(mips);
+    builder.add(pass_writing("dead", {"unread"}, {{"irradiance", ""}}));
+    builder.add(pass_writing("back_layer", {"layers"}, {{"irradiance", ""}}));
+    Pass front = pass_writing("front_layer", {"layers"});
+    front.clear = false;
+    front.blend = Blend::premultiplied_over;
+    builder.add(front);
+    builder.set_output("layers");
+    const FramePlan plan = builder.compile();
+    EXPECT_EQ(pass_names(plan), (std::vector<std::string>{"irradiance", "irradiance_mips",
+                                                          "back_layer", "front_layer"}));
+    EXPECT_EQ(plan.culled, (std::vector<std::string>{"dead"}));
+    const std::string text = plan.explain();
+    EXPECT_NE(text.find("irradiance_mips: - -> irradiance (r32f)  <2x2 box mips>"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("front_layer: - -> layers (rgba32f)  <keeps contents>  <blend over>"),
+              std::string::npos)
+        << text;
+}
+
+TEST(TextureData, ChecksSizeLevelsAndTexelCounts) {
+    const ResourceDesc volume{"v", ResourceFormat::rgba32f, ResourceShape::fixed_3d,
+                              {4, 2, 3}, 1};
+    EXPECT_EQ(check_texture_data(volume, {{4, 2, 3}, {std::vector<float>(4 * 2 * 3 * 4)}}), "");
+    EXPECT_EQ(check_texture_data(volume, {{4, 2, 3}, {std::vector<float>(4 * 2 * 3)}}),
+              "level 0 has 24 floats, expected 96");
+    EXPECT_EQ(check_texture_data(volume, {{4, 2, 2}, {std::vector<float>(64)}}),
+              "data is 4x2x2, the resource 4x2x3");
+    const ResourceDesc pyramid{"p", ResourceFormat::r32f, ResourceShape::fixed_2d,
+                               {4, 4, 1}, 3};
+    EXPECT_EQ(check_texture_data(pyramid, {{4, 4, 1},
+                                           {std::vector<float>(16), std::vector<float>(4),
+                                            std::vector<float>(1)}}),
+              "");
+    EXPECT_EQ(check_texture_data(pyramid, {{4, 4, 1}, {}}), "0 data levels for a resource of 3");
+}
+
 }  // namespace
 }  // namespace lucent

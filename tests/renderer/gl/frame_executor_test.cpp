@@ -1,0 +1,303 @@
+// The GL executor on the frame plan's resource model, each checked against values
+// computed independently on the CPU: exact box mips (double-precision block means),
+// uploads only on a content-hash change, sampler state per read (hand-derived filter
+// weights), any number of colour attachments with the viewport they imply, and blending.
+#include "gl/frame_executor.h"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gl_test_fixture.h"
+#include "test_paths.h"
+
+namespace lucent {
+namespace {
+
+class FrameExecutorGl : public test::HeadlessGlTest {
+protected:
+    // Test shaders live in tests/renderer/gl/test_shaders; renderer shaders still
+    // resolve from the embedded copies.
+    void SetUp() override {
+        test::HeadlessGlTest::SetUp();
+        const char* previous = std::getenv("LUCENT_SHADER_DIR");
+        previous_dir_ = previous ? previous : "";
+        const std::string dir = (test::source_dir() / "tests/renderer/gl").string();
+        setenv("LUCENT_SHADER_DIR", dir.c_str(), 1);
+        scene_.mesh = mesh();
+    }
+    void TearDown() override {
+        if (previous_dir_.empty())
+            unsetenv("LUCENT_SHADER_DIR");
+        else
+            setenv("LUCENT_SHADER_DIR", previous_dir_.c_str(), 1);
+    }
+    static std::shared_ptr<const Mesh> mesh() {
+        static const auto m = std::make_shared<const Mesh>(load_mesh("sphere:200"));
+        return m;
+    }
+    Scene scene_;
+
+private:
+    std::string previous_dir_;
+};
+
+Pass upload_pass(std::string name, std::string resource, std::string hash,
+                 TextureData data) {
+    Pass pass{std::move(name)};
+    pass.kind = PassKind::upload;
+    pass.writes = {std::move(resource)};
+    pass.data = {std::move(hash), [data = std::move(data)] { return data; }};
+    return pass;
+}
+
+Pass fullscreen(std::string name, std::string fragment, std::vector<std::string> writes) {
+    Pass pass{std::move(name)};
+    pass.kind = PassKind::fullscreen;
+    pass.shader = {"gl/shaders/fullscreen.vert", std::move(fragment), {}};
+    pass.writes = std::move(writes);
+    return pass;
+}
+
+std::vector<float> random_texels(std::size_t count, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<float> texels(count);
+    for (auto& t : texels) t = unit(rng);
+    return texels;
+}
+
+// Level l of a W x H texture whose levels are W/w x H/h blocks of level 0 (true for
+// power-of-two and 3 * 2^k sizes): each texel must be its block's mean, summed in double.
+TEST_F(FrameExecutorGl, MipChainIsTheExactBoxMeanOfLevelZero) {
+    struct Case {
+        int width, height;
+        ResourceFormat format;
+    };
+    for (const Case c : {Case{16, 8, ResourceFormat::rgba32f}, Case{12, 6, ResourceFormat::r32f},
+                         Case{1, 8, ResourceFormat::r32f}}) {
+        const int channels = format_channels(c.format);
+        const std::vector<float> base = random_texels(
+            std::size_t(c.width) * c.height * channels, unsigned(c.width * 100 + c.height));
+        PlanBuilder builder(PlanMode::pruned, 4, 4);
+        builder.create(texture_2d("pyramid", c.format, c.width, c.height, 0));
+        builder.add(upload_pass("base", "pyramid", "base", {{c.width, c.height, 1}, {base}}));
+        Pass mips{"mips"};
+        mips.kind = PassKind::build_mips;
+        mips.writes = {"pyramid"};
+        builder.add(mips);
+        builder.set_output("pyramid");
+        const FramePlan plan = builder.compile();
+        gl::FrameExecutor executor;
+        executor.execute(scene_, plan);
+        const int levels = plan.resource("pyramid")->levels;
+        ASSERT_EQ(levels, full_mip_levels({c.width, c.height, 1}, false));
+        for (int level = 0; level < levels; ++level) {
+            const TextureData got = executor.read_texture("pyramid", level);
+            const glm::ivec3 size = mip_size({c.width, c.height, 1}, level, false);
+            ASSERT_EQ(got.size, size);
+            const int bx = c.width / size.x, by = c.height / size.y;
+            double worst = 0.0;
+            for (int y = 0; y < size.y; ++y)
+                for (int x = 0; x < size.x; ++x)
+                    for (int k = 0; k < channels; ++k) {
+                        double sum = 0.0;
+                        for (int v = y * by; v < (y + 1) * by; ++v)
+                            for (int u = x * bx; u < (x + 1) * bx; ++u)
+                                sum += base[(std::size_t(v) * c.width + u) * channels + k];
+                        const double expected = sum / (bx * by);
+                        const float actual =
+                            got.levels[0][(std::size_t(y) * size.x + x) * channels + k];
+                        worst = std::max(worst, std::abs(actual - expected));
+                    }
+            EXPECT_LT(worst, 1e-6) << c.width << "x" << c.height << " level " << level;
+        }
+    }
+}
+
+TEST_F(FrameExecutorGl, UploadsOnlyWhenTheContentHashChanges) {
+    int produced = 0;
+    const auto plan_with = [&](std::string hash, int width, float value) {
+        PlanBuilder builder(PlanMode::pruned, 4, 4);
+        builder.create(texture_2d("table", ResourceFormat::r32f, width, 1));
+        Pass pass{"table"};
+        pass.kind = PassKind::upload;
+        pass.writes = {"table"};
+        pass.data = {hash, [&produced, width, value] {
+                         ++produced;
+                         return TextureData{{width, 1, 1},
+                                            {std::vector<float>(std::size_t(width), value)}};
+                     }};
+        builder.add(pass);
+        builder.set_output("table");
+        return builder.compile();
+    };
+    gl::FrameExecutor executor;
+    executor.execute(scene_, plan_with("h1", 4, 1.0f));
+    executor.execute(scene_, plan_with("h1", 4, 1.0f));
+    EXPECT_EQ(produced, 1);
+    EXPECT_EQ(executor.uploads_performed(), 1u);
+    executor.execute(scene_, plan_with("h2", 4, 2.0f));
+    EXPECT_EQ(produced, 2);
+    EXPECT_EQ(executor.read_texture("table").levels[0], std::vector<float>(4, 2.0f));
+    // A new size reallocates the texture, which then holds nothing: upload again.
+    executor.execute(scene_, plan_with("h2", 8, 2.0f));
+    EXPECT_EQ(produced, 3);
+    EXPECT_EQ(executor.uploads_performed(), 3u);
+
+    // Data of the wrong size is a one-line error naming the pass and the resource.
+    PlanBuilder bad(PlanMode::pruned, 4, 4);
+    bad.create(texture_2d("table", ResourceFormat::r32f, 4, 1));
+    bad.add(upload_pass("table_pass", "table", "short", {{4, 1, 1}, {std::vector<float>(3)}}));
+    bad.set_output("table");
+    try {
+        executor.execute(scene_, bad.compile());
+        ADD_FAILURE() << "short data uploaded";
+    } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(),
+                     "pass 'table_pass': data for 'table': level 0 has 3 floats, expected 4");
+    }
+}
+
+// Each case samples a tiny uploaded texture at one coordinate through one Read's sampler
+// state; the expected values follow from GL's filtering rules by hand.
+TEST_F(FrameExecutorGl, SamplerStateTravelsWithTheRead) {
+    gl::FrameExecutor executor;
+    const auto sample = [&](ResourceDesc desc, TextureData data, Sampling sampling,
+                            glm::vec3 at, float lod = 0.0f) {
+        PlanBuilder builder(PlanMode::pruned, 4, 4);
+        const bool volume = desc.shape == ResourceShape::fixed_3d;
+        builder.create(desc);
+        builder.create(texture_2d("out", ResourceFormat::rgba32f, 1, 1));
+        builder.add(upload_pass("data", desc.name, "fixed", std::move(data)));
+        Pass read = fullscreen("read", "test_shaders/sample.frag", {"out"});
+        if (volume) read.shader.defines = {"VOLUME"};
+        read.reads = {{desc.name, "source", sampling}};
+        read.uniforms = {{"origin", at}, {"step", glm::vec3(0.0f)}, {"lod", lod}};
+        builder.add(read);
+        builder.set_output("out");
+        executor.execute(scene_, builder.compile());
+        return executor.read_texture("out").levels[0][0];
+    };
+    // A 2x1 texture [0, 1]: texel centres at u = 0.25 and 0.75.
+    const ResourceDesc pair = texture_2d("pair", ResourceFormat::r32f, 2, 1);
+    const TextureData pair_data{{2, 1, 1}, {{0.0f, 1.0f}}};
+    const Sampling nearest{};
+    const Sampling linear{TexelFilter::linear};
+    Sampling border = nearest;
+    border.wrap = Wrap::clamp_to_border;
+    border.border = glm::vec4(7.0f);
+    Sampling repeat_nearest = nearest, repeat_linear = linear;
+    repeat_nearest.wrap = repeat_linear.wrap = Wrap::repeat;
+    const float v = 0.5f;  // the row's centre
+    EXPECT_FLOAT_EQ(sample(pair, pair_data, nearest, {0.375f, v, 0}), 0.0f);
+    EXPECT_FLOAT_EQ(sample(pair, pair_data, linear, {0.375f, v, 0}), 0.25f);
+    EXPECT_FLOAT_EQ(sample(pair, pair_data, border, {-0.5f, v, 0}), 7.0f);
+    EXPECT_FLOAT_EQ(sample(pair, pair_data, nearest, {-0.5f, v, 0}), 0.0f);
+    EXPECT_FLOAT_EQ(sample(pair, pair_data, repeat_nearest, {-0.375f, v, 0}), 1.0f);
+    // u = 1.125 wraps to 0.125, a quarter of the way from texel 1 (wrapped, at -0.25)
+    // to texel 0: 0.25 * 1 + 0.75 * 0; clamped, both taps are texel 0.
+    EXPECT_FLOAT_EQ(sample(pair, pair_data, repeat_linear, {1.125f, v, 0}), 0.25f);
+    EXPECT_FLOAT_EQ(sample(pair, pair_data, linear, {1.125f, v, 0}), 1.0f);
+
+    // Three levels holding 1, 3, 5: the mip filter picks or blends them.
+    const ResourceDesc levels = texture_2d("levels", ResourceFormat::r32f, 4, 4, 3);
+    const TextureData level_data{
+        {4, 4, 1}, {std::vector<float>(16, 1.0f), std::vector<float>(4, 3.0f), {5.0f}}};
+    Sampling mip_nearest = nearest, mip_linear = linear;
+    mip_nearest.mip = MipFilter::nearest;
+    mip_linear.mip = MipFilter::linear;
+    EXPECT_FLOAT_EQ(sample(levels, level_data, nearest, {0.5f, 0.5f, 0}, 1.0f), 1.0f);
+    EXPECT_FLOAT_EQ(sample(levels, level_data, mip_nearest, {0.5f, 0.5f, 0}, 1.0f), 3.0f);
+    EXPECT_FLOAT_EQ(sample(levels, level_data, mip_nearest, {0.5f, 0.5f, 0}, 2.0f), 5.0f);
+    EXPECT_NEAR(sample(levels, level_data, mip_linear, {0.5f, 0.5f, 0}, 0.5f), 2.0f, 1e-5f);
+
+    // A 2x2x2 volume holding x + 2y + 4z: trilinear at the centre is the mean 3.5.
+    const ResourceDesc volume = texture_3d("volume", ResourceFormat::r32f, 2, 2, 2);
+    const TextureData volume_data{{2, 2, 2}, {{0, 1, 2, 3, 4, 5, 6, 7}}};
+    EXPECT_NEAR(sample(volume, volume_data, linear, {0.5f, 0.5f, 0.5f}), 3.5f, 1e-5f);
+    EXPECT_FLOAT_EQ(sample(volume, volume_data, nearest, {0.75f, 0.25f, 0.75f}), 5.0f);
+}
+
+TEST_F(FrameExecutorGl, AnyNumberOfColourAttachmentsAtTheirOwnViewport) {
+    PlanBuilder builder(PlanMode::pruned, 64, 48);
+    const std::vector<std::string> names{"a0", "a1", "a2", "a3"};
+    for (const auto& name : names)
+        builder.create(texture_2d(name, ResourceFormat::rgba32f, 5, 3));
+    builder.add(fullscreen("four", "test_shaders/attachments.frag", names));
+    builder.set_output("a0");
+    const FramePlan plan = builder.compile();
+    gl::FrameExecutor executor;
+    executor.execute(scene_, plan);
+    for (int k = 0; k < 4; ++k) {
+        const TextureData got = executor.read_texture(names[k]);
+        ASSERT_EQ(got.size, glm::ivec3(5, 3, 1));
+        for (int y = 0; y < 3; ++y)
+            for (int x = 0; x < 5; ++x) {
+                const float* t = &got.levels[0][(std::size_t(y) * 5 + x) * 4];
+                EXPECT_EQ(t[0], float(k + 1)) << names[k];  // the attachment's own output
+                EXPECT_EQ(t[1], x + 0.5f);                  // every texel was drawn once:
+                EXPECT_EQ(t[2], y + 0.5f);                  // the viewport is 5x3
+            }
+    }
+
+    // One more attachment than GL allows: a one-line error naming the pass.
+    GLint limit = 0;
+    glGetIntegerv(GL_MAX_COLOR_ATTACHMENTS, &limit);
+    PlanBuilder over(PlanMode::pruned, 8, 8);
+    std::vector<std::string> many;
+    for (GLint i = 0; i <= limit; ++i) {
+        many.push_back("c" + std::to_string(i));
+        over.create(texture_2d(many.back(), ResourceFormat::r32f, 2, 2));
+    }
+    over.add(fullscreen("too_many", "test_shaders/attachments.frag", many));
+    over.set_output("c0");
+    try {
+        executor.execute(scene_, over.compile());
+        ADD_FAILURE() << limit + 1 << " colour attachments were accepted";
+    } catch (const std::runtime_error& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message.rfind("pass 'too_many': framebuffer: " + std::to_string(limit + 1) +
+                                    " colour attachments, this GL allows",
+                                0),
+                  0u)
+            << message;
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+}
+
+TEST_F(FrameExecutorGl, CompositingPassesBlendOntoKeptContents) {
+    const auto composite = [&](glm::vec4 dst, glm::vec4 src, Blend blend) {
+        PlanBuilder builder(PlanMode::pruned, 4, 4);
+        builder.create(texture_2d("layers", ResourceFormat::rgba32f, 2, 2));
+        Pass back = fullscreen("back", "test_shaders/constant.frag", {"layers"});
+        back.uniforms = {{"colour", dst}};
+        Pass front = fullscreen("front", "test_shaders/constant.frag", {"layers"});
+        front.uniforms = {{"colour", src}};
+        front.clear = false;
+        front.blend = blend;
+        builder.add(back);
+        builder.add(front);
+        builder.set_output("layers");
+        gl::FrameExecutor executor;
+        executor.execute(scene_, builder.compile());
+        const std::vector<float> t = executor.read_texture("layers").levels[0];
+        return glm::vec4(t[0], t[1], t[2], t[3]);
+    };
+    const auto expect_vec4 = [](glm::vec4 got, glm::vec4 want) {
+        for (int k = 0; k < 4; ++k) EXPECT_NEAR(got[k], want[k], 1e-6f) << k;
+    };
+    const glm::vec4 dst{0.2f, 0.4f, 0.6f, 1.0f}, src{0.5f, 0.25f, 0.0f, 0.5f};
+    expect_vec4(composite(dst, src, Blend::none), src);
+    expect_vec4(composite(dst, src, Blend::additive), dst + src);
+    expect_vec4(composite(dst, src, Blend::premultiplied_over), src + 0.5f * dst);
+    const glm::vec4 half_dst{0.1f, 0.2f, 0.3f, 0.5f}, near_src{0.4f, 0.4f, 0.4f, 0.8f};
+    expect_vec4(composite(half_dst, near_src, Blend::premultiplied_under),
+                0.5f * near_src + half_dst);
+}
+
+}  // namespace
+}  // namespace lucent
