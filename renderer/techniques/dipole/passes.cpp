@@ -222,7 +222,6 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
 
         Pass mips{"irradiance_mips", "mip pyramid of the texel masses (exact 2x2 box)",
                   PassKind::build_mips};
-        mips.reads = {{"irradiance", ""}};
         mips.writes = {"irradiance"};
         plan.add(mips);
 
