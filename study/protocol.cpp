@@ -224,12 +224,13 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
         if (s.technique.empty() == s.image.empty())
             r.fail(nullptr, "technique", "stimulus '" + s.id +
                    "' needs exactly one of technique (live) or image (pre-rendered)");
+        // The renderer's registry (lucent_study stays GL-free, so it is listed here).
         static const std::set<std::string> techniques = {"empirical", "ward",
-                                                         "contrast_reversed"};
+                                                         "contrast_reversed", "dipole"};
         if (!s.technique.empty() && !techniques.count(s.technique))
             r.fail(r.raw().get("technique"), "technique",
                    "unknown technique '" + s.technique +
-                       "' (valid: empirical, ward, contrast_reversed)");
+                       "' (valid: empirical, ward, contrast_reversed, dipole)");
         if (!s.image.empty() && !base_dir.empty() && std::filesystem::path(s.image).is_relative())
             s.image = (std::filesystem::path(base_dir) / s.image).string();
         if (const toml::table* params = r.table("params")) {

@@ -127,7 +127,14 @@ int ScatteringIntegrator::build(int first, int count, int depth) {
     for (int i = first; i < first + count; ++i) {
         const Cell& c = cells_[i];
         const glm::dvec3 o = c.centroid - node.centroid;
-        node.spread += c.irradiance * c.area * glm::outerProduct(o, o);
+        const glm::dvec3 ea = c.a - c.centroid, eb = c.b - c.centroid,
+                         ec = c.c - c.centroid;
+        // Each cell's offset plus its own spread (uniform triangle: (1/12) sum e e^T).
+        node.spread += c.irradiance * c.area *
+                       (glm::outerProduct(o, o) +
+                        (glm::outerProduct(ea, ea) + glm::outerProduct(eb, eb) +
+                         glm::outerProduct(ec, ec)) /
+                            12.0);
     }
     const glm::dvec3 extent = node.hi - node.lo;
     node.size = std::max({extent.x, extent.y, extent.z});
@@ -169,8 +176,14 @@ glm::dvec3 ScatteringIntegrator::refine(const glm::dvec3& a, const glm::dvec3& b
     const double d = glm::length(g - xo);
     if (depth >= 16 ||
         longest_edge(a, b, c) <= quality_.near_field_ratio * std::max(d, min_zr_)) {
-        const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
-        return irradiance * area * dipole_.rd(d);
+        // The cell's own second moment: a uniform triangle has covariance
+        // (1/12) sum (v_i - g)(v_i - g)^T.
+        const double flux = irradiance * 0.5 * glm::length(glm::cross(b - a, c - a));
+        const glm::dvec3 ea = a - g, eb = b - g, ec = c - g;
+        const glm::dmat3 spread = (flux / 12.0) * (glm::outerProduct(ea, ea) +
+                                                   glm::outerProduct(eb, eb) +
+                                                   glm::outerProduct(ec, ec));
+        return expansion(flux, g, spread, xo);
     }
     const glm::dvec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
     return refine(a, ab, ca, irradiance, xo, depth + 1) +
@@ -179,20 +192,23 @@ glm::dvec3 ScatteringIntegrator::refine(const glm::dvec3& a, const glm::dvec3& b
            refine(ab, bc, ca, irradiance, xo, depth + 1);
 }
 
-glm::dvec3 ScatteringIntegrator::far_field(const Node& node, const glm::dvec3& xo) const {
+glm::dvec3 ScatteringIntegrator::expansion(double flux, const glm::dvec3& centroid,
+                                           const glm::dmat3& spread,
+                                           const glm::dvec3& xo) const {
     // Taylor expansion of f(|x - xo|) about the centroid to second order: the first-order
     // term vanishes (flux-weighted centroid), the second is 1/2 tr(H S) with the Hessian
     // of a radial function H = f'' u u^T + f'/d (I - u u^T), S the spread.
-    const glm::dvec3 offset = node.centroid - xo;
+    const glm::dvec3 offset = centroid - xo;
     const double d = glm::length(offset);
+    const double h = 1e-3 * std::max(d, min_zr_);
+    const glm::dvec3 f0 = dipole_.rd(d);
+    if (d < 2.0 * h) return flux * f0;  // at the centroid: the monopole
     const glm::dvec3 u = offset / d;
-    const double radial = glm::dot(u, node.spread * u);
-    double trace = 0.0;
-    for (int i = 0; i < 3; ++i) trace += node.spread[i][i];
-    const double h = 1e-3 * d;
-    const glm::dvec3 f0 = dipole_.rd(d), fp = dipole_.rd(d + h), fm = dipole_.rd(d - h);
+    const double radial = glm::dot(u, spread * u);
+    const double trace = spread[0][0] + spread[1][1] + spread[2][2];
+    const glm::dvec3 fp = dipole_.rd(d + h), fm = dipole_.rd(d - h);
     const glm::dvec3 first = (fp - fm) / (2.0 * h), second = (fp - 2.0 * f0 + fm) / (h * h);
-    return node.flux * f0 + 0.5 * (second * radial + first / d * (trace - radial));
+    return flux * f0 + 0.5 * (second * radial + first / d * (trace - radial));
 }
 
 glm::dvec3 ScatteringIntegrator::radiosity(glm::dvec3 xo) const {
@@ -210,7 +226,7 @@ glm::dvec3 ScatteringIntegrator::radiosity(glm::dvec3 xo) const {
         // Far field: small against the distance and against the decay length 1/sigma_tr.
         if (outside && node.size < quality_.opening_angle * d &&
             node.size * max_sigma_tr_ < 4.0 * quality_.opening_angle) {
-            sum += far_field(node, xo);
+            sum += expansion(node.flux, node.centroid, node.spread, xo);
             continue;
         }
         if (node.leaf) {

@@ -7,7 +7,7 @@
 // flux-weighted centroid plus the second-order (quadrupole) term of its spread; JB02
 // uses the monopole with 0.3). Cells near xo are subdivided
 // further on the fly until they are small against max(distance, zr), so the r -> 0 peak
-// of Rd is integrated, not sampled.
+// of Rd is integrated, not sampled; cells and nodes alike count with their quadrupole.
 #include <glm/glm.hpp>
 #include <memory>
 #include <vector>
@@ -21,7 +21,7 @@ namespace lucent::dipole {
 struct IntegratorQuality {
     double cell_size_over_zr = 0.5;    // irradiance cell edge, in units of min zr
     double opening_angle = 0.1;        // Barnes-Hut acceptance size / distance
-    double near_field_ratio = 0.0625;  // near cells refined to edge < ratio*max(d, zr)
+    double near_field_ratio = 0.25;    // near cells refined to edge < ratio*max(d, zr)
     std::size_t max_cells = 4'000'000; // the cell edge grows beyond this many cells
     // The same integral with every step halved: the reference's own error estimate is
     // the difference between a quality and its halved().
@@ -71,7 +71,8 @@ private:
     glm::dvec3 refine(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
                       double irradiance, const glm::dvec3& xo, int depth) const;
 
-    glm::dvec3 far_field(const Node& node, const glm::dvec3& xo) const;
+    glm::dvec3 expansion(double flux, const glm::dvec3& centroid, const glm::dmat3& spread,
+                         const glm::dvec3& xo) const;
 
     DipoleRgb dipole_;
     double max_sigma_tr_ = 0.0;
