@@ -225,7 +225,7 @@ glm::dvec3 ScatteringIntegrator::radiosity(glm::dvec3 xo) const {
         const bool outside = glm::dot(gap, gap) > 0.0;
         // Far field: small against the distance and against the decay length 1/sigma_tr.
         if (outside && node.size < quality_.opening_angle * d &&
-            node.size * max_sigma_tr_ < 4.0 * quality_.opening_angle) {
+            node.size * max_sigma_tr_ < 2.0 * quality_.opening_angle) {
             sum += expansion(node.flux, node.centroid, node.spread, xo);
             continue;
         }

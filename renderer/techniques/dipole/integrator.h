@@ -20,7 +20,7 @@ namespace lucent::dipole {
 
 struct IntegratorQuality {
     double cell_size_over_zr = 0.5;    // irradiance cell edge, in units of min zr
-    double opening_angle = 0.1;        // Barnes-Hut acceptance size / distance
+    double opening_angle = 0.2;        // Barnes-Hut acceptance size / distance
     double near_field_ratio = 0.25;    // near cells refined to edge < ratio*max(d, zr)
     std::size_t max_cells = 4'000'000; // the cell edge grows beyond this many cells
     // The same integral with every step halved: the reference's own error estimate is

@@ -31,6 +31,8 @@ public:
             {"light_map_resolution",
              {std::string("256"), std::string("512"), std::string("1024")},
              std::string("1024")},
+            // Plain sampling against the hybrid (N global + L C + 1 local).
+            {"hybrid", {std::string("off"), std::string("on")}, std::string("off")},
         };
     }
 };
