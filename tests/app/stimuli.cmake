@@ -2,17 +2,17 @@
 set(LUCENT_STIMULI_CLI_DIR ${CMAKE_BINARY_DIR}/test-scratch/app_stimuli)
 set(LUCENT_RENDER_SET_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/render_set_check.cmake)
 
-# The built-in thesis set renders headless: 15 images and a manifest row for each; a
+# The built-in thesis set renders headless: 18 images and a manifest row for each; a
 # second run re-renders nothing; --force re-renders every image byte for byte.
 add_test(NAME app.render_preset_thesis
          COMMAND ${CMAKE_COMMAND} -DLUCENT=$<TARGET_FILE:lucent> -DMODE=preset
-                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/thesis -DEXPECT_IMAGES=15
+                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/thesis -DEXPECT_IMAGES=18
                  -P ${LUCENT_RENDER_SET_CHECK})
 # The committed example file is the same set.
 add_test(NAME app.render_config_example
          COMMAND ${CMAKE_COMMAND} -DLUCENT=$<TARGET_FILE:lucent> -DMODE=config
                  -DCONFIG=${CMAKE_SOURCE_DIR}/stimuli/presets/thesis.toml
-                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/example -DEXPECT_IMAGES=15
+                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/example -DEXPECT_IMAGES=18
                  -P ${LUCENT_RENDER_SET_CHECK})
 set_tests_properties(app.render_preset_thesis app.render_config_example PROPERTIES
                      ENVIRONMENT "LUCENT_CACHE_DIR=${CMAKE_BINARY_DIR}/test-cache"
