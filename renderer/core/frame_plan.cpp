@@ -134,8 +134,9 @@ std::string check_texture_data(const ResourceDesc& desc, const TextureData& data
                std::to_string(desc.levels);
     for (std::size_t l = 0; l < data.levels.size(); ++l) {
         const glm::ivec3 s = mip_size(desc.size, static_cast<int>(l), is_3d(desc));
-        const std::size_t expected = static_cast<std::size_t>(s.x) * s.y * s.z *
-                                     static_cast<std::size_t>(format_channels(desc.format));
+        const std::size_t expected =
+            static_cast<std::size_t>(s.x) * s.y * s.z *
+            static_cast<std::size_t>(format_channels(desc.format));
         if (data.levels[l].size() != expected)
             return "level " + std::to_string(l) + " has " +
                    std::to_string(data.levels[l].size()) + " floats, expected " +
@@ -185,11 +186,11 @@ std::string FramePlan::explain() const {
     std::string text;
     for (const auto& r : resources) {
         text += "resource " + r.name + ": ";
-        if (r.format == ResourceFormat::vertex_float)
-            text += "per vertex";
-        else
-            text += size_text(r.size, is_3d(r));
-        text += std::string(" ") + format_name(r.format);
+        if (r.format == ResourceFormat::vertex_float) {
+            text += "one float per vertex\n";
+            continue;
+        }
+        text += size_text(r.size, is_3d(r)) + " " + format_name(r.format);
         if (r.levels > 1) text += ", " + std::to_string(r.levels) + " levels";
         if (r.shape == ResourceShape::frame && r.format != ResourceFormat::vertex_float)
             text += " (frame)";
@@ -320,17 +321,18 @@ FramePlan PlanBuilder::compile() const {
                 attachment_size = size;
                 first_attachment = w;
             } else if (size != attachment_size) {
-                throw std::logic_error(
-                    where + " writes '" + first_attachment + "' (" +
-                    size_text(attachment_size, true) + ") and '" + w + "' (" +
-                    size_text(size, true) + "): attachments differ in size");
+                throw std::logic_error(where + " writes '" + first_attachment + "' (" +
+                                       size_text(attachment_size, true) + ") and '" + w +
+                                       "' (" + size_text(size, true) +
+                                       "): attachments differ in size");
             }
             if (is_3d(*desc) && pass.kind != PassKind::upload)
                 throw std::logic_error(where + " renders into the 3D resource '" + w +
                                        "'; volumes are uploaded");
         }
         if (depth_attachments > 1)
-            throw std::logic_error(where + " writes " + std::to_string(depth_attachments) +
+            throw std::logic_error(where + " writes " +
+                                   std::to_string(depth_attachments) +
                                    " depth attachments");
         if (pass.kind == PassKind::upload || pass.kind == PassKind::build_mips) {
             const ResourceDesc* desc =
@@ -344,8 +346,8 @@ FramePlan PlanBuilder::compile() const {
                                        ") reads nothing");
             if (pass.kind == PassKind::upload &&
                 (pass.data.content_hash.empty() || !pass.data.produce))
-                throw std::logic_error(where +
-                                       " uploads data without a content hash or producer");
+                throw std::logic_error(
+                    where + " uploads data without a content hash or producer");
             if (pass.kind == PassKind::build_mips &&
                 (desc->levels < 2 || is_3d(*desc) || pass.level != 0))
                 throw std::logic_error(where + " builds mips of '" + desc->name +

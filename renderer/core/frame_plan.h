@@ -128,7 +128,8 @@ struct Sampling {
     Wrap wrap = Wrap::clamp_to_edge;
     glm::vec4 border{0.0f};  // Wrap::clamp_to_border only
 };
-std::string describe(const Sampling& sampling);  // "nearest clamp", "linear/linear border"
+std::string describe(
+    const Sampling& sampling);  // "nearest clamp", "linear/linear border"
 
 // A resource a pass reads; textures are bound to the sampler uniform `sampler` (the
 // resource name when empty).
@@ -140,8 +141,8 @@ struct Read {
 
 // How a pass combines its fragments with its colour attachments.
 enum class Blend {
-    none,                // replace
-    additive,            // dst + src (accumulate samples or lights)
+    none,                 // replace
+    additive,             // dst + src (accumulate samples or lights)
     premultiplied_over,   // src + (1 - src.a) dst (layers drawn back to front)
     premultiplied_under,  // (1 - dst.a) src + dst (layers drawn front to back)
 };
@@ -194,8 +195,8 @@ public:
     void create(ResourceDesc desc);
     void add(Pass pass);
     void set_output(std::string resource);
-    // Checks the plan (std::logic_error naming the pass or resource otherwise): every read
-    // names a resource written earlier, every write a created resource, a pass's
+    // Checks the plan (std::logic_error naming the pass or resource otherwise): every
+    // read names a resource written earlier, every write a created resource, a pass's
     // attachments agree in size at its level, upload and build_mips passes write exactly
     // one fitting resource, sizes are positive. Then culls unread passes (pruned mode).
     FramePlan compile() const;

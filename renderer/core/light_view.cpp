@@ -15,11 +15,11 @@ LightView fit_light_view(const BoundingSphere& sphere, glm::vec3 to_light) {
     LightView view;
     view.direction = to_light / length;
     view.centre = sphere.centre;
-    view.radius = std::isfinite(sphere.radius) && sphere.radius > 0.0f ? sphere.radius
-                                                                        : 1e-6f;
+    view.radius =
+        std::isfinite(sphere.radius) && sphere.radius > 0.0f ? sphere.radius : 1e-6f;
     // Build the image axes: up is the hint minus its component along the light.
-    const glm::vec3 hint = std::abs(view.direction.y) < 0.999f ? glm::vec3(0, 1, 0)
-                                                                : glm::vec3(0, 0, 1);
+    const glm::vec3 hint =
+        std::abs(view.direction.y) < 0.999f ? glm::vec3(0, 1, 0) : glm::vec3(0, 0, 1);
     view.right = glm::normalize(glm::cross(hint, view.direction));
     view.up = glm::cross(view.direction, view.right);
     const float r = view.radius;

@@ -13,8 +13,8 @@ struct Scene;
 
 struct LightView {
     glm::vec3 direction{0.0f, 0.0f, 1.0f};  // unit, object space, towards the light
-    glm::vec3 centre{0.0f};                  // of the bounding sphere
-    float radius = 1.0f;                     // R_L, of the bounding sphere (> 0)
+    glm::vec3 centre{0.0f};                 // of the bounding sphere
+    float radius = 1.0f;                    // R_L, of the bounding sphere (> 0)
     // Object-space unit axes of the light image: u to the right, v up; (right, up,
     // direction) is a right-handed orthonormal frame.
     glm::vec3 right{1.0f, 0.0f, 0.0f};

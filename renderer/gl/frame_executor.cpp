@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/ambient_occlusion.h"
+#include "core/pass_reuse.h"
 #include "gl/errors.h"
 #include "gl/program.h"
 #include "gl/readback.h"
@@ -76,8 +77,9 @@ GLenum wrap_mode(Wrap wrap) {
 }
 
 std::string sampler_key(const Sampling& s) {
-    return describe(s) + "/" + std::to_string(s.border.r) + "," + std::to_string(s.border.g) +
-           "," + std::to_string(s.border.b) + "," + std::to_string(s.border.a);
+    return describe(s) + "/" + std::to_string(s.border.r) + "," +
+           std::to_string(s.border.g) + "," + std::to_string(s.border.b) + "," +
+           std::to_string(s.border.a);
 }
 
 bool same_storage(const ResourceDesc& a, const ResourceDesc& b) {
@@ -139,6 +141,8 @@ struct FrameExecutor::Impl {
     std::map<std::string, FrameTexture> textures;
     std::map<std::string, Sampler> samplers;  // by sampler_key
     std::size_t uploads = 0;
+    PassReuse reuse;
+    bool reuse_enabled = false;
     std::map<std::string, Program> programs;
     std::vector<Query> queries;
     AmbientOcclusionSource ao_source = [](const Mesh& mesh, int rays) {
@@ -204,12 +208,12 @@ struct FrameExecutor::Impl {
                 kept.emplace(r.name, std::move(it->second));
             } else {
                 const bool three_d = r.shape == ResourceShape::fixed_3d;
-                kept.emplace(r.name,
-                             FrameTexture{r,
-                                          make_texture(internal_format(r.format), r.size.x,
-                                                       r.size.y, three_d ? r.size.z : 0,
-                                                       r.levels),
-                                          ""});
+                kept.emplace(
+                    r.name,
+                    FrameTexture{r,
+                                 make_texture(internal_format(r.format), r.size.x,
+                                              r.size.y, three_d ? r.size.z : 0, r.levels),
+                                 ""});
             }
         }
         textures = std::move(kept);
@@ -222,8 +226,9 @@ struct FrameExecutor::Impl {
             const GLenum mag =
                 sampling.filter == TexelFilter::linear ? GL_LINEAR : GL_NEAREST;
             it = samplers
-                     .emplace(key, make_sampler(min_filter(sampling), mag,
-                                                wrap_mode(sampling.wrap), &sampling.border[0]))
+                     .emplace(key,
+                              make_sampler(min_filter(sampling), mag,
+                                           wrap_mode(sampling.wrap), &sampling.border[0]))
                      .first;
         }
         return it->second.id();
@@ -244,11 +249,12 @@ struct FrameExecutor::Impl {
         for (std::size_t l = 0; l < data.levels.size(); ++l) {
             const glm::ivec3 s = mip_size(target.desc.size, static_cast<int>(l), three_d);
             if (three_d)
-                glTextureSubImage3D(target.texture.id(), static_cast<GLint>(l), 0, 0, 0, s.x,
-                                    s.y, s.z, format, GL_FLOAT, data.levels[l].data());
+                glTextureSubImage3D(target.texture.id(), static_cast<GLint>(l), 0, 0, 0,
+                                    s.x, s.y, s.z, format, GL_FLOAT,
+                                    data.levels[l].data());
             else
-                glTextureSubImage2D(target.texture.id(), static_cast<GLint>(l), 0, 0, s.x, s.y,
-                                    format, GL_FLOAT, data.levels[l].data());
+                glTextureSubImage2D(target.texture.id(), static_cast<GLint>(l), 0, 0, s.x,
+                                    s.y, format, GL_FLOAT, data.levels[l].data());
         }
         target.uploaded_hash = pass.data.content_hash;
         ++uploads;
@@ -258,7 +264,8 @@ struct FrameExecutor::Impl {
     // made visible (base = max level), so the draw reads no level it writes.
     void build_mips(const Pass& pass) {
         FrameTexture& target = textures.at(pass.writes.at(0));
-        const GLuint prog = program({"gl/shaders/fullscreen.vert", "gl/shaders/box_mip.frag", {}});
+        const GLuint prog =
+            program({"gl/shaders/fullscreen.vert", "gl/shaders/box_mip.frag", {}});
         const GLuint id = target.texture.id();
         glUseProgram(prog);
         glProgramUniform1i(prog, glGetUniformLocation(prog, "source"), 0);
@@ -402,6 +409,12 @@ FrameExecutor::~FrameExecutor() = default;
 
 void FrameExecutor::set_ambient_occlusion_source(AmbientOcclusionSource source) {
     impl_->ao_source = std::move(source);
+    impl_->reuse.forget();  // the AO stream may differ now
+    impl_->ao_streams.clear();
+}
+
+void FrameExecutor::set_reuse_unchanged_passes(bool reuse) {
+    impl_->reuse_enabled = reuse;
 }
 
 void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time_passes) {
@@ -423,39 +436,50 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
     while (impl_->queries.size() < plan.passes.size())
         impl_->queries.push_back(make_query(GL_TIME_ELAPSED));
 
+    const std::vector<bool> run =
+        impl_->reuse.schedule(plan, impl_->mesh_key, impl_->reuse_enabled);
     std::vector<double> wall_ms;
     std::size_t index = 0;
-    for_each_pass(plan, [&](const Pass& pass) {
-        const auto start = std::chrono::steady_clock::now();
-        const bool gpu =
-            time_passes && gpu_timer && !cpu_pass(pass.kind);
-        if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
-        switch (pass.kind) {
-            case PassKind::bake_ambient_occlusion:
-                impl_->bake(scene, pass);
-                break;
-            case PassKind::upload:
-                impl_->upload(pass);
-                break;
-            case PassKind::build_mips:
-                impl_->build_mips(pass);
-                break;
-            case PassKind::draw_mesh:
-            case PassKind::fullscreen:
-                impl_->draw(pass, plan);
-                break;
-        }
-        if (gpu) glEndQuery(GL_TIME_ELAPSED);
-        if (time_passes && !gpu && !cpu_pass(pass.kind))
-            glFinish();
-        check_errors("pass '" + pass.name + "'");
-        wall_ms.push_back(std::chrono::duration<double, std::milli>(
-                              std::chrono::steady_clock::now() - start)
-                              .count());
-        ++index;
-    });
+    try {
+        for_each_pass(plan, [&](const Pass& pass) {
+            const auto start = std::chrono::steady_clock::now();
+            const bool runs = run[index];
+            const bool gpu = runs && time_passes && gpu_timer && !cpu_pass(pass.kind);
+            if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
+            switch (pass.kind) {
+                case PassKind::bake_ambient_occlusion:
+                    // The stream is cached; binding it is needed even when reused.
+                    impl_->bake(scene, pass);
+                    break;
+                case PassKind::upload:
+                    if (runs) impl_->upload(pass);
+                    break;
+                case PassKind::build_mips:
+                    if (runs) impl_->build_mips(pass);
+                    break;
+                case PassKind::draw_mesh:
+                case PassKind::fullscreen:
+                    if (runs) impl_->draw(pass, plan);
+                    break;
+            }
+            if (gpu) glEndQuery(GL_TIME_ELAPSED);
+            if (runs && time_passes && !gpu && !cpu_pass(pass.kind)) glFinish();
+            check_errors("pass '" + pass.name + "'");
+            wall_ms.push_back(std::chrono::duration<double, std::milli>(
+                                  std::chrono::steady_clock::now() - start)
+                                  .count());
+            ++index;
+        });
+    } catch (...) {
+        impl_->reuse.forget();  // what the failed pass left is unknown: rerun everything
+        throw;
+    }
     if (!time_passes) return;
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+        if (!run[i]) {
+            timings_.passes.push_back({plan.passes[i].name, 0.0, true});
+            continue;
+        }
         double ms = wall_ms[i];
         if (gpu_timer && !cpu_pass(plan.passes[i].kind)) {
             GLuint64 ns = 0;
@@ -476,34 +500,37 @@ Image FrameExecutor::read_output(const FramePlan& plan) const {
     Image image(texture.width(), texture.height());
     const std::size_t row = static_cast<std::size_t>(texture.width()) * 4;
     for (int y = 0; y < texture.height(); ++y)  // GL rows are bottom first
-        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row], row,
-                    &image.rgba[static_cast<std::size_t>(y) * row]);
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row],
+                    row, &image.rgba[static_cast<std::size_t>(y) * row]);
     return image;
 }
 
 std::vector<float> FrameExecutor::read_channel(const std::string& resource) const {
     const auto& texture = impl_->textures.at(resource);
-    const GLenum format = is_depth_format(texture.desc.format) ? GL_DEPTH_COMPONENT : GL_RED;
+    const GLenum format =
+        is_depth_format(texture.desc.format) ? GL_DEPTH_COMPONENT : GL_RED;
     const std::vector<float> pixels =
         read_texture_r32f(texture.texture, format, texture.width(), texture.height());
     check_errors("read-back of '" + resource + "'");
     std::vector<float> flipped(pixels.size());
     const std::size_t row = static_cast<std::size_t>(texture.width());
     for (int y = 0; y < texture.height(); ++y)
-        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row], row,
-                    &flipped[static_cast<std::size_t>(y) * row]);
+        std::copy_n(&pixels[static_cast<std::size_t>(texture.height() - 1 - y) * row],
+                    row, &flipped[static_cast<std::size_t>(y) * row]);
     return flipped;
 }
 
 TextureData FrameExecutor::read_texture(const std::string& resource, int level) const {
     auto it = impl_->textures.find(resource);
     if (it == impl_->textures.end())
-        throw std::runtime_error("read-back: no texture '" + resource + "' in this frame");
+        throw std::runtime_error("read-back: no texture '" + resource +
+                                 "' in this frame");
     const ResourceDesc& desc = it->second.desc;
     if (level < 0 || level >= desc.levels)
         throw std::runtime_error("read-back: '" + resource + "' has no level " +
                                  std::to_string(level));
-    const glm::ivec3 size = mip_size(desc.size, level, desc.shape == ResourceShape::fixed_3d);
+    const glm::ivec3 size =
+        mip_size(desc.size, level, desc.shape == ResourceShape::fixed_3d);
     TextureData data;
     data.size = size;
     data.levels.emplace_back(static_cast<std::size_t>(size.x) * size.y * size.z *

@@ -1,9 +1,10 @@
 #pragma once
 // Runs a FramePlan with OpenGL: allocates exactly the resources the plan names (textures
-// of each resource's shape and levels, the AO vertex stream, CPU data), compiles each pass's shader variant once, binds
-// reads to samplers and writes to a framebuffer, and draws. Optional per-pass GPU timer
-// queries feed `lucent bench frame` and the explorer's status bar. Needs a current GL 4.5
-// context; every GL object is owned by an RAII wrapper held here.
+// of each resource's shape and levels, the AO vertex stream, CPU data), compiles each
+// pass's shader variant once, binds reads to samplers and writes to a framebuffer, and
+// draws. Optional per-pass GPU timer queries feed `lucent bench frame` and the explorer's
+// status bar. Needs a current GL 4.5 context; every GL object is owned by an RAII wrapper
+// held here.
 #include <functional>
 #include <map>
 #include <memory>
@@ -43,6 +44,11 @@ public:
     FrameExecutor& operator=(const FrameExecutor&) = delete;
 
     void set_ambient_occlusion_source(AmbientOcclusionSource source);
+    // On: a pass whose inputs (description, uniforms, versions of what it reads, upload
+    // hash, mesh) are those of its last run, and whose outputs still hold that run's
+    // results, is not run again (core/pass_reuse.h); last_timings() marks it cached. For
+    // the explorer. Off (the default): every pass runs every frame, as benchmarks need.
+    void set_reuse_unchanged_passes(bool reuse);
 
     // Runs every pass of `plan` for `scene`. With `time_passes`, last_timings() holds
     // per-pass times afterwards (this waits for the GPU). Throws ShaderError, GlError

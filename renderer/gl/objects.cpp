@@ -41,8 +41,8 @@ Framebuffer make_framebuffer(std::initializer_list<const Texture*> colour,
     return make_framebuffer(std::vector<const Texture*>(colour), depth, 0);
 }
 
-Framebuffer make_framebuffer(const std::vector<const Texture*>& colour, const Texture* depth,
-                             int level) {
+Framebuffer make_framebuffer(const std::vector<const Texture*>& colour,
+                             const Texture* depth, int level) {
     GLint max_attachments = 0, max_draw_buffers = 0;
     glGetIntegerv(GL_MAX_COLOR_ATTACHMENTS, &max_attachments);
     glGetIntegerv(GL_MAX_DRAW_BUFFERS, &max_draw_buffers);
@@ -58,7 +58,8 @@ Framebuffer make_framebuffer(const std::vector<const Texture*>& colour, const Te
     Framebuffer fbo(id);
     std::vector<GLenum> buffers;
     for (const Texture* texture : colour) {
-        const GLenum attachment = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(buffers.size());
+        const GLenum attachment =
+            GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(buffers.size());
         glNamedFramebufferTexture(id, attachment, texture->id(), level);
         buffers.push_back(attachment);
     }
@@ -75,7 +76,8 @@ Framebuffer make_framebuffer(const std::vector<const Texture*>& colour, const Te
     return fbo;
 }
 
-Texture make_texture(GLenum internal_format, int width, int height, int depth, int levels) {
+Texture make_texture(GLenum internal_format, int width, int height, int depth,
+                     int levels) {
     GLuint id = 0;
     glCreateTextures(depth > 0 ? GL_TEXTURE_3D : GL_TEXTURE_2D, 1, &id);
     if (depth > 0)

@@ -60,7 +60,8 @@ Buffer make_buffer(const void* data, GLsizeiptr bytes, GLbitfield flags = 0);
 Texture make_texture_2d(GLenum internal_format, int width, int height);
 // Immutable 2D (depth 0) or 3D texture with `levels` mip levels; its filtering comes from
 // the sampler objects bound with it (the texture's own state is nearest, clamped).
-Texture make_texture(GLenum internal_format, int width, int height, int depth, int levels);
+Texture make_texture(GLenum internal_format, int width, int height, int depth,
+                     int levels);
 // Sampler object with the given filters and one wrap mode on every axis.
 Sampler make_sampler(GLenum min_filter, GLenum mag_filter, GLenum wrap,
                      const float border[4]);
@@ -72,8 +73,9 @@ Query make_query(GLenum target);
 Framebuffer make_framebuffer(std::initializer_list<const Texture*> colour,
                              const Texture* depth = nullptr);
 // Same, attaching mip `level` of every texture; any number of colour attachments up to
-// GL_MAX_COLOR_ATTACHMENTS and GL_MAX_DRAW_BUFFERS (std::runtime_error naming both above).
-Framebuffer make_framebuffer(const std::vector<const Texture*>& colour, const Texture* depth,
-                             int level);
+// GL_MAX_COLOR_ATTACHMENTS and GL_MAX_DRAW_BUFFERS (std::runtime_error naming both
+// above).
+Framebuffer make_framebuffer(const std::vector<const Texture*>& colour,
+                             const Texture* depth, int level);
 
 }  // namespace lucent::gl

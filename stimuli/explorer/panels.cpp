@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "explorer/pass_times.h"
 #include "techniques/registry.h"
 
 namespace lucent::explorer {
@@ -214,17 +215,8 @@ void status_bar(ExplorerSession& session, const PanelInfo& info) {
         t.min_ms, t.mean_ms, t.max_ms, info.faces, info.vertices);
     ImGui::TextWrapped("plan (%s): %s", session.current().technique().c_str(),
                        passes.c_str());
-    if (session.show_pass_times && info.timings) {
-        std::string line = info.timings->gpu_timer ? "GPU pass times (timer queries):"
-                                                   : "pass times (wall, glFinish):";
-        char text[96];
-        for (const auto& pass : info.timings->passes) {
-            std::snprintf(text, sizeof text, "  %s %.2f ms", pass.pass.c_str(),
-                          pass.milliseconds);
-            line += text;
-        }
-        ImGui::TextUnformatted(line.c_str());
-    }
+    if (session.show_pass_times && info.timings)
+        ImGui::TextWrapped("%s", pass_times_text(*info.timings).c_str());
     if (!session.message.empty()) ImGui::TextUnformatted(session.message.c_str());
     ImGui::End();
 }

@@ -99,6 +99,8 @@ gl::FrameExecutor& ViewRenderer::executor(const std::string& key,
     auto& slot = executors_[full];
     if (!slot) {
         slot = std::make_unique<gl::FrameExecutor>();
+        // A frame re-runs only the passes whose inputs a slider (or the view) changed.
+        slot->set_reuse_unchanged_passes(true);
         if (ambient_occlusion)
             // Only executed once find_or_start() returned the bake (see execute()).
             slot->set_ambient_occlusion_source([this](const Mesh& mesh, int rays) {

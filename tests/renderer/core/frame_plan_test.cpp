@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "core/recording_executor.h"
 #include "core/technique.h"
 #include "techniques/registry.h"
 
@@ -199,9 +200,10 @@ Pass pass_writing(std::string name, std::vector<std::string> writes,
 
 DataSource constant_data(std::string hash, glm::ivec3 size, int channels) {
     return {std::move(hash), [size, channels] {
-                return TextureData{size, {std::vector<float>(
-                                             std::size_t(size.x) * size.y * size.z * channels,
-                                             1.0f)}};
+                return TextureData{
+                    size,
+                    {std::vector<float>(std::size_t(size.x) * size.y * size.z * channels,
+                                        1.0f)}};
             }};
 }
 
@@ -218,9 +220,9 @@ TEST(PlanBuilder, ResolvesShapesSizesAndFullMipChains) {
     builder.add(upload);
     builder.add(pass_writing("atlas_pass", {"atlas"}, {{"density", ""}}));
     builder.add(pass_writing("frame_pass", {"frame_mips"}));
-    builder.add(pass_writing("shade", {"colour"},
-                             {{"atlas", "", {TexelFilter::linear, MipFilter::linear}},
-                              {"frame_mips", ""}}));
+    builder.add(pass_writing(
+        "shade", {"colour"},
+        {{"atlas", "", {TexelFilter::linear, MipFilter::linear}}, {"frame_mips", ""}}));
     builder.set_output("colour");
     const FramePlan plan = builder.compile();
     // Frame-sized resources take the plan's size; 0 levels is the full chain, counted by
@@ -234,7 +236,8 @@ TEST(PlanBuilder, ResolvesShapesSizesAndFullMipChains) {
     // Every resource's size and format is in --explain, and sampler state of a read.
     const std::string text = plan.explain();
     for (const char* line :
-         {"resource colour: 64x48 rgba32f (frame)", "resource frame_mips: 64x48 r32f, 7 levels",
+         {"resource colour: 64x48 rgba32f (frame)",
+          "resource frame_mips: 64x48 r32f, 7 levels",
           "resource atlas: 256x64 r32f, 9 levels", "resource density: 32x16x8 r8",
           "shade: atlas (linear/mip linear clamp), frame_mips -> colour (rgba32f)",
           "density_volume: - -> density (r8)  <upload, data d1>"})
@@ -261,8 +264,9 @@ TEST(PlanBuilder, ViewportIsTheAttachmentsLevelAndMixedSizesAreRejected) {
     const FramePlan plan = builder.compile();
     EXPECT_EQ(plan.viewport(pass_named(plan, "level_two")), glm::ivec2(8, 8));
     EXPECT_EQ(plan.viewport(pass_named(plan, "b_one")), glm::ivec2(16, 8));
-    EXPECT_NE(plan.explain().find("level_two: - -> a (r32f)  <level 2>  <keeps contents>"),
-              std::string::npos)
+    EXPECT_NE(
+        plan.explain().find("level_two: - -> a (r32f)  <level 2>  <keeps contents>"),
+        std::string::npos)
         << plan.explain();
 
     PlanBuilder mixed(PlanMode::pruned, 64, 48);
@@ -281,8 +285,8 @@ TEST(PlanBuilder, ViewportIsTheAttachmentsLevelAndMixedSizesAreRejected) {
 }
 
 TEST(PlanBuilder, RejectsMalformedUploadsMipsLevelsAndFeedback) {
-    const auto compile_with = [](std::vector<ResourceDesc> resources, std::vector<Pass> passes,
-                                 std::string output) {
+    const auto compile_with = [](std::vector<ResourceDesc> resources,
+                                 std::vector<Pass> passes, std::string output) {
         PlanBuilder builder(PlanMode::pruned, 16, 16);
         for (auto& r : resources) builder.create(r);
         for (auto& p : passes) builder.add(p);
@@ -303,7 +307,8 @@ TEST(PlanBuilder, RejectsMalformedUploadsMipsLevelsAndFeedback) {
     // build_mips needs level 0 written first.
     const ResourceDesc mipped = frame_texture("out", ResourceFormat::rgba32f, 0);
     EXPECT_THROW(compile_with({mipped}, {one_level_mips}, "out"), std::logic_error);
-    EXPECT_NO_THROW(compile_with({mipped}, {pass_writing("w", {"out"}), one_level_mips}, "out"));
+    EXPECT_NO_THROW(
+        compile_with({mipped}, {pass_writing("w", {"out"}), one_level_mips}, "out"));
     Pass too_deep = pass_writing("deep", {"out"});
     too_deep.level = 5;  // 16x16 has levels 0..4
     EXPECT_THROW(compile_with({mipped}, {too_deep}, "out"), std::logic_error);
@@ -311,8 +316,8 @@ TEST(PlanBuilder, RejectsMalformedUploadsMipsLevelsAndFeedback) {
                               {pass_writing("w", {"t"})}, "t"),
                  std::logic_error);
     EXPECT_THROW(compile_with({out, frame_texture("x", ResourceFormat::r32f)},
-                              {pass_writing("w", {"x"}), pass_writing("loop", {"x", "out"},
-                                                                      {{"x", ""}})},
+                              {pass_writing("w", {"x"}),
+                               pass_writing("loop", {"x", "out"}, {{"x", ""}})},
                               "out"),
                  std::logic_error);
     // A pass keeping its attachment's contents needs an earlier writer.
@@ -348,26 +353,73 @@ TEST(PlanBuilder, KeptContentsAndMipsKeepTheirProducers) {
     EXPECT_NE(text.find("irradiance_mips: - -> irradiance (r32f)  <2x2 box mips>"),
               std::string::npos)
         << text;
-    EXPECT_NE(text.find("front_layer: - -> layers (rgba32f)  <keeps contents>  <blend over>"),
-              std::string::npos)
+    EXPECT_NE(
+        text.find("front_layer: - -> layers (rgba32f)  <keeps contents>  <blend over>"),
+        std::string::npos)
         << text;
 }
 
+// The new pass kinds take part in culling like the others, --plan full keeps them, and
+// the recording executor runs them (calling a kept upload's producer once).
+TEST(PlanBuilder, NewPassKindsAreCulledWhenUnreadAndKeptInFullMode) {
+    int produced = 0;
+    const auto build = [&](PlanMode mode) {
+        PlanBuilder builder(mode, 8, 8);
+        builder.create(texture_2d("unused_table", ResourceFormat::r32f, 4, 1));
+        builder.create(texture_2d("unused_mips", ResourceFormat::r32f, 8, 8, 0));
+        builder.create(frame_texture("out", ResourceFormat::rgba32f));
+        Pass table{"unused_table", "", PassKind::upload};
+        table.writes = {"unused_table"};
+        table.data = {"h", [&produced] {
+                          ++produced;
+                          return TextureData{{4, 1, 1}, {std::vector<float>(4, 0.5f)}};
+                      }};
+        builder.add(table);
+        builder.add(pass_writing("level_zero", {"unused_mips"}, {{"unused_table", ""}}));
+        Pass mips{"mips", "", PassKind::build_mips};
+        mips.writes = {"unused_mips"};
+        builder.add(mips);
+        builder.add(pass_writing("final", {"out"}));
+        builder.set_output("out");
+        return builder.compile();
+    };
+    const FramePlan pruned = build(PlanMode::pruned);
+    EXPECT_EQ(pass_names(pruned), std::vector<std::string>{"final"});
+    EXPECT_EQ(pruned.culled,
+              (std::vector<std::string>{"unused_table", "level_zero", "mips"}));
+    EXPECT_EQ(pruned.resource("unused_mips"), nullptr);
+    RecordingExecutor recorder;
+    EXPECT_EQ(recorder.execute(pruned), std::vector<std::string>{"final"});
+    EXPECT_EQ(produced, 0);  // a culled upload never produces its data
+
+    const FramePlan full = build(PlanMode::full);
+    EXPECT_TRUE(full.culled.empty());
+    RecordingExecutor full_recorder;
+    EXPECT_EQ(full_recorder.execute(full),
+              (std::vector<std::string>{"unused_table", "level_zero", "mips", "final"}));
+    EXPECT_EQ(produced, 1);
+    EXPECT_NE(full.explain().find("resource unused_mips: 8x8 r32f, 4 levels"),
+              std::string::npos)
+        << full.explain();
+}
+
 TEST(TextureData, ChecksSizeLevelsAndTexelCounts) {
-    const ResourceDesc volume{"v", ResourceFormat::rgba32f, ResourceShape::fixed_3d,
-                              {4, 2, 3}, 1};
-    EXPECT_EQ(check_texture_data(volume, {{4, 2, 3}, {std::vector<float>(4 * 2 * 3 * 4)}}), "");
+    const ResourceDesc volume{
+        "v", ResourceFormat::rgba32f, ResourceShape::fixed_3d, {4, 2, 3}, 1};
+    EXPECT_EQ(
+        check_texture_data(volume, {{4, 2, 3}, {std::vector<float>(4 * 2 * 3 * 4)}}), "");
     EXPECT_EQ(check_texture_data(volume, {{4, 2, 3}, {std::vector<float>(4 * 2 * 3)}}),
               "level 0 has 24 floats, expected 96");
     EXPECT_EQ(check_texture_data(volume, {{4, 2, 2}, {std::vector<float>(64)}}),
               "data is 4x2x2, the resource 4x2x3");
-    const ResourceDesc pyramid{"p", ResourceFormat::r32f, ResourceShape::fixed_2d,
-                               {4, 4, 1}, 3};
+    const ResourceDesc pyramid{
+        "p", ResourceFormat::r32f, ResourceShape::fixed_2d, {4, 4, 1}, 3};
     EXPECT_EQ(check_texture_data(pyramid, {{4, 4, 1},
                                            {std::vector<float>(16), std::vector<float>(4),
                                             std::vector<float>(1)}}),
               "");
-    EXPECT_EQ(check_texture_data(pyramid, {{4, 4, 1}, {}}), "0 data levels for a resource of 3");
+    EXPECT_EQ(check_texture_data(pyramid, {{4, 4, 1}, {}}),
+              "0 data levels for a resource of 3");
 }
 
 }  // namespace

@@ -20,7 +20,8 @@ glm::vec3 to_ndc(const LightView& view, glm::vec3 p) {
     return glm::vec3(clip) / clip.w;
 }
 
-void expect_near(glm::vec3 actual, glm::vec3 expected, float tolerance, const char* what) {
+void expect_near(glm::vec3 actual, glm::vec3 expected, float tolerance,
+                 const char* what) {
     for (int k = 0; k < 3; ++k)
         EXPECT_NEAR(actual[k], expected[k], tolerance) << what << " axis " << k;
 }
@@ -62,13 +63,15 @@ TEST(LightView, FitsTheBoundingSphereForManyDirections) {
 }
 
 TEST(LightView, DegenerateInputsStayFiniteOrAreRejected) {
-    EXPECT_THROW(fit_light_view({{0, 0, 0}, 1.0f}, glm::vec3(0.0f)), std::invalid_argument);
+    EXPECT_THROW(fit_light_view({{0, 0, 0}, 1.0f}, glm::vec3(0.0f)),
+                 std::invalid_argument);
     EXPECT_THROW(fit_light_view({{0, 0, 0}, 1.0f}, glm::vec3(NAN, 0, 1)),
                  std::invalid_argument);
     const LightView point = fit_light_view({{1, 2, 3}, 0.0f}, {0, 0, 1});
     EXPECT_GT(point.radius, 0.0f);
     for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) EXPECT_TRUE(std::isfinite(point.view_projection[i][j]));
+        for (int j = 0; j < 4; ++j)
+            EXPECT_TRUE(std::isfinite(point.view_projection[i][j]));
 }
 
 // The scene's light is in eye space; the light view looks along it in object space.
@@ -77,8 +80,9 @@ TEST(LightView, SceneLightIsTakenFromEyeToObjectSpace) {
     const Technique& technique = find_technique("empirical");
     // Camera looking along -x (eye on +x): eye-space +z is object-space +x, eye +x is
     // object -z (right-handed, up +y).
-    Scene scene = make_scene(mesh, technique, resolve_knob_values(knobs_for(technique), {}),
-                             32, 32, {1, 0, 0});
+    Scene scene =
+        make_scene(mesh, technique, resolve_knob_values(knobs_for(technique), {}), 32, 32,
+                   {1, 0, 0});
     scene.light.direction = {0, 0, 1};
     expect_near(light_direction_object(scene), {1, 0, 0}, 1e-5f, "eye +z");
     scene.light.direction = {1, 0, 0};

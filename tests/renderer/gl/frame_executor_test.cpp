@@ -11,7 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "core/technique.h"
 #include "gl_test_fixture.h"
+#include "render.h"
+#include "techniques/registry.h"
 #include "test_paths.h"
 
 namespace lucent {
@@ -77,14 +80,17 @@ TEST_F(FrameExecutorGl, MipChainIsTheExactBoxMeanOfLevelZero) {
         int width, height;
         ResourceFormat format;
     };
-    for (const Case c : {Case{16, 8, ResourceFormat::rgba32f}, Case{12, 6, ResourceFormat::r32f},
-                         Case{1, 8, ResourceFormat::r32f}}) {
+    for (const Case c :
+         {Case{16, 8, ResourceFormat::rgba32f}, Case{12, 6, ResourceFormat::r32f},
+          Case{1, 8, ResourceFormat::r32f}}) {
         const int channels = format_channels(c.format);
-        const std::vector<float> base = random_texels(
-            std::size_t(c.width) * c.height * channels, unsigned(c.width * 100 + c.height));
+        const std::vector<float> base =
+            random_texels(std::size_t(c.width) * c.height * channels,
+                          unsigned(c.width * 100 + c.height));
         PlanBuilder builder(PlanMode::pruned, 4, 4);
         builder.create(texture_2d("pyramid", c.format, c.width, c.height, 0));
-        builder.add(upload_pass("base", "pyramid", "base", {{c.width, c.height, 1}, {base}}));
+        builder.add(
+            upload_pass("base", "pyramid", "base", {{c.width, c.height, 1}, {base}}));
         Pass mips{"mips"};
         mips.kind = PassKind::build_mips;
         mips.writes = {"pyramid"};
@@ -107,7 +113,8 @@ TEST_F(FrameExecutorGl, MipChainIsTheExactBoxMeanOfLevelZero) {
                         double sum = 0.0;
                         for (int v = y * by; v < (y + 1) * by; ++v)
                             for (int u = x * bx; u < (x + 1) * bx; ++u)
-                                sum += base[(std::size_t(v) * c.width + u) * channels + k];
+                                sum +=
+                                    base[(std::size_t(v) * c.width + u) * channels + k];
                         const double expected = sum / (bx * by);
                         const float actual =
                             got.levels[0][(std::size_t(y) * size.x + x) * channels + k];
@@ -128,8 +135,9 @@ TEST_F(FrameExecutorGl, UploadsOnlyWhenTheContentHashChanges) {
         pass.writes = {"table"};
         pass.data = {hash, [&produced, width, value] {
                          ++produced;
-                         return TextureData{{width, 1, 1},
-                                            {std::vector<float>(std::size_t(width), value)}};
+                         return TextureData{
+                             {width, 1, 1},
+                             {std::vector<float>(std::size_t(width), value)}};
                      }};
         builder.add(pass);
         builder.set_output("table");
@@ -151,14 +159,16 @@ TEST_F(FrameExecutorGl, UploadsOnlyWhenTheContentHashChanges) {
     // Data of the wrong size is a one-line error naming the pass and the resource.
     PlanBuilder bad(PlanMode::pruned, 4, 4);
     bad.create(texture_2d("table", ResourceFormat::r32f, 4, 1));
-    bad.add(upload_pass("table_pass", "table", "short", {{4, 1, 1}, {std::vector<float>(3)}}));
+    bad.add(upload_pass("table_pass", "table", "short",
+                        {{4, 1, 1}, {std::vector<float>(3)}}));
     bad.set_output("table");
     try {
         executor.execute(scene_, bad.compile());
         ADD_FAILURE() << "short data uploaded";
     } catch (const std::runtime_error& e) {
-        EXPECT_STREQ(e.what(),
-                     "pass 'table_pass': data for 'table': level 0 has 3 floats, expected 4");
+        EXPECT_STREQ(
+            e.what(),
+            "pass 'table_pass': data for 'table': level 0 has 3 floats, expected 4");
     }
 }
 
@@ -213,7 +223,8 @@ TEST_F(FrameExecutorGl, SamplerStateTravelsWithTheRead) {
     EXPECT_FLOAT_EQ(sample(levels, level_data, nearest, {0.5f, 0.5f, 0}, 1.0f), 1.0f);
     EXPECT_FLOAT_EQ(sample(levels, level_data, mip_nearest, {0.5f, 0.5f, 0}, 1.0f), 3.0f);
     EXPECT_FLOAT_EQ(sample(levels, level_data, mip_nearest, {0.5f, 0.5f, 0}, 2.0f), 5.0f);
-    EXPECT_NEAR(sample(levels, level_data, mip_linear, {0.5f, 0.5f, 0}, 0.5f), 2.0f, 1e-5f);
+    EXPECT_NEAR(sample(levels, level_data, mip_linear, {0.5f, 0.5f, 0}, 0.5f), 2.0f,
+                1e-5f);
 
     // A 2x2x2 volume holding x + 2y + 4z: trilinear at the centre is the mean 3.5.
     const ResourceDesc volume = texture_3d("volume", ResourceFormat::r32f, 2, 2, 2);
@@ -260,10 +271,11 @@ TEST_F(FrameExecutorGl, AnyNumberOfColourAttachmentsAtTheirOwnViewport) {
         ADD_FAILURE() << limit + 1 << " colour attachments were accepted";
     } catch (const std::runtime_error& e) {
         const std::string message = e.what();
-        EXPECT_EQ(message.rfind("pass 'too_many': framebuffer: " + std::to_string(limit + 1) +
-                                    " colour attachments, this GL allows",
-                                0),
-                  0u)
+        EXPECT_EQ(
+            message.rfind("pass 'too_many': framebuffer: " + std::to_string(limit + 1) +
+                              " colour attachments, this GL allows",
+                          0),
+            0u)
             << message;
         EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
@@ -297,6 +309,60 @@ TEST_F(FrameExecutorGl, CompositingPassesBlendOntoKeptContents) {
     const glm::vec4 half_dst{0.1f, 0.2f, 0.3f, 0.5f}, near_src{0.4f, 0.4f, 0.4f, 0.8f};
     expect_vec4(composite(half_dst, near_src, Blend::premultiplied_under),
                 0.5f * near_src + half_dst);
+}
+
+// Reuse on: a second identical frame runs no pass, a changed uniform re-runs its pass
+// only, and each image equals, bit for bit, one rendered from scratch by a new executor.
+TEST_F(FrameExecutorGl, ReusedPassesLeaveTheImageAFreshRenderWouldGive) {
+    const auto scene_with = [](std::vector<KnobAssignment> settings) {
+        RenderRequest request;
+        request.mesh = "sphere:2k";
+        request.settings = std::move(settings);
+        request.width = 48;
+        request.height = 40;
+        return build_scene(request);
+    };
+    const auto fresh = [](const Scene& scene) {
+        gl::FrameExecutor executor;
+        return executor.render(scene,
+                               make_frame_plan(scene, find_technique(scene.technique)));
+    };
+    const auto ran = [](const gl::FrameExecutor& executor) {
+        std::vector<std::string> names;
+        for (const auto& t : executor.last_timings().passes)
+            if (!t.cached) names.push_back(t.pass);
+        return names;
+    };
+    gl::FrameExecutor executor;
+    executor.set_reuse_unchanged_passes(true);
+    const Scene first = scene_with({});
+    const FramePlan first_plan = make_frame_plan(first, find_technique("empirical"));
+    executor.execute(first, first_plan, /*time_passes=*/true);
+    EXPECT_EQ(ran(executor).size(), first_plan.passes.size());
+    const Image reference = fresh(first);
+    EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba);
+
+    executor.execute(first, make_frame_plan(first, find_technique("empirical")), true);
+    EXPECT_EQ(ran(executor), std::vector<std::string>{});
+    EXPECT_EQ(executor.last_timings().passes.size(), first_plan.passes.size());
+    EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba);
+
+    for (const auto& [settings, expected] :
+         std::vector<std::pair<std::vector<KnobAssignment>, std::vector<std::string>>>{
+             {{{"shininess", "40"}}, {"shade"}},
+             {{{"shininess", "40"}, {"blur_kernel", "3"}},
+              {"smooth_back_layer", "shade"}},
+             {{{"shininess", "40"}, {"blur_kernel", "3"}, {"backlight", "0"}}, {"shade"}},
+             // Back on: the layers' textures were freed with the plan that lacked them.
+             {{{"shininess", "40"}, {"blur_kernel", "3"}},
+              {"front_depth", "second_layer", "smooth_back_layer", "shade"}}}) {
+        const Scene scene = scene_with(settings);
+        const FramePlan plan = make_frame_plan(scene, find_technique("empirical"));
+        executor.execute(scene, plan, true);
+        EXPECT_EQ(ran(executor), expected) << settings.back().key;
+        EXPECT_EQ(executor.read_output(plan).rgba, fresh(scene).rgba)
+            << settings.back().key;
+    }
 }
 
 }  // namespace

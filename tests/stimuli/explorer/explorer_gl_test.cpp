@@ -147,6 +147,30 @@ TEST_F(ExplorerTest, ScriptedSliderClickRaisesBacklightAndBrightensThinParts) {
     EXPECT_GT(gain_sum, 0.0);
 }
 
+// With pass times on, a frame with nothing changed re-runs no pass and a slider re-runs
+// only the passes it touches; the other passes show as cached.
+TEST_F(ExplorerTest, SlidersRerunOnlyThePassesTheyTouch) {
+    ExplorerSession session;
+    session.show_pass_times = true;
+    auto explorer = open(session);
+    const Image before = settle(*explorer);
+    explorer->step();
+    const auto ran = [&] {
+        std::vector<std::string> names;
+        for (const auto& t : explorer->shown().timings.passes)
+            if (!t.cached) names.push_back(t.pass);
+        return names;
+    };
+    EXPECT_FALSE(explorer->shown().timings.passes.empty());
+    EXPECT_EQ(ran(), std::vector<std::string>{});
+    explorer->session().current().set("shininess", 40.0);
+    explorer->step();
+    EXPECT_EQ(ran(), std::vector<std::string>{"shade"});
+    EXPECT_NE(explorer->shown().image.rgba, before.rgba);  // the highlight did change
+    explorer->step();
+    EXPECT_EQ(ran(), std::vector<std::string>{});
+}
+
 TEST_F(ExplorerTest, DragsOnTheViewOrbitAndMoveTheLight) {
     auto explorer = open(ExplorerSession{});
     settle(*explorer);
