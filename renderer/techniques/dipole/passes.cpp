@@ -270,11 +270,22 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
         }
     }
 
-    // Stage 3 (Eq. 11) and what follows it.
+    // Stage 3 (Eq. 11) and what follows it. The purpose names what was pruned and why,
+    // so --explain accounts for every culled pass.
+    std::string pruned;
+    const auto prune = [&](bool kept, const char* what) {
+        if (!kept) pruned += (pruned.empty() ? "; pruned: " : ", ") + std::string(what);
+    };
+    prune(subsurface, "subsurface passes (Id = 0 or nothing scatters)");
+    prune(!subsurface || local, p.hybrid ? "local part (no channel has an Rp at this c)"
+                                         : "local part (hybrid off)");
+    prune(fresnel, "Fresnel (eta = 1)");
+    prune(ambient, "ambient and AO (ka Ia = 0)");
+    prune(specular, "specular (ks Is = 0)");
     Pass shade{"translucency",
                "Eq. 11: Ft(eta, N.V) Id B / pi" + std::string(local ? " (global + local)" : "") +
                    (ambient ? " + ambient" : "") + (tone_map ? ", Reinhard" : "") +
-                   (specular ? " + Blinn-Phong" : ""),
+                   (specular ? " + Blinn-Phong" : "") + pruned,
                PassKind::draw_mesh,
                {mesh_vert, "techniques/dipole/shaders/translucency.frag", {}}};
     std::vector<Uniform> u = {{"u_light_direction", scene.light.direction},
