@@ -50,4 +50,4 @@ add_test(NAME app.render_mesh_and_config_exits_2
 # lucent bench render runs end to end (small images; the figures come from a full run).
 add_test(NAME app.bench_render_smoke COMMAND lucent bench render --size 64x64)
 set_tests_properties(app.bench_render_smoke PROPERTIES
-    PASS_REGULAR_EXPRESSION "15 stimuli at 64x64.*empty +[0-9.]+ .*filled +[0-9.]+ .*throughput")
+    PASS_REGULAR_EXPRESSION "18 stimuli at 64x64.*empty +[0-9.]+ .*filled +[0-9.]+ .*throughput")
