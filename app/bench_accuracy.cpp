@@ -30,6 +30,7 @@ struct AccuracyBenchOptions {
     std::vector<std::string> settings;
     int frames = 30;
     std::string svg = "bench-accuracy.svg";
+    std::string csv;  // the table, machine-readable (empty: none)
 };
 
 struct Row {
@@ -37,6 +38,7 @@ struct Row {
     ImageErrorStats error;
     double frame_ms = 0.0;
     double precompute_s = 0.0;
+    std::string pass_ms;  // "name=ms;..." median per pass, for the CSV
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -44,20 +46,38 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
         .count();
 }
 
+double median_of(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    return values[values.size() / 2];
+}
+
+// Median GPU frame time (the AO bake excluded) and the median of each pass, as
+// "name=ms;name=ms".
 double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene,
-                       const FramePlan& plan, int frames) {
+                       const FramePlan& plan, int frames, std::string* pass_ms = nullptr) {
     std::vector<double> times;
+    std::vector<std::vector<double>> per_pass(plan.passes.size());
     for (int i = 0; i < frames + 1; ++i) {  // the first frame warms caches
         executor.execute(scene, plan, true);
         double ms = 0.0;
         const auto& passes = executor.last_timings().passes;
         for (std::size_t p = 0; p < passes.size(); ++p)
-            if (plan.passes[p].kind != PassKind::bake_ambient_occlusion)
+            if (plan.passes[p].kind != PassKind::bake_ambient_occlusion) {
                 ms += passes[p].milliseconds;
+                if (i > 0 && p < per_pass.size()) per_pass[p].push_back(passes[p].milliseconds);
+            }
         if (i > 0) times.push_back(ms);
     }
-    std::sort(times.begin(), times.end());
-    return times[times.size() / 2];
+    if (pass_ms) {
+        pass_ms->clear();
+        for (std::size_t p = 0; p < per_pass.size(); ++p) {
+            if (per_pass[p].empty()) continue;
+            char text[64];
+            std::snprintf(text, sizeof text, "%.4g", median_of(per_pass[p]));
+            *pass_ms += (pass_ms->empty() ? "" : ";") + plan.passes[p].name + "=" + text;
+        }
+    }
+    return median_of(times);
 }
 
 std::string escape(const std::string& text) {
@@ -203,7 +223,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
                     resolve_knob_values(knobs_for(technique), row_request.settings);
                 const FramePlan plan = make_frame_plan(scene, technique);
                 Row row{sweep.knob, format_knob_value(value)};
-                row.frame_ms = median_frame_ms(executor, scene, plan, options.frames);
+                row.frame_ms =
+                    median_frame_ms(executor, scene, plan, options.frames, &row.pass_ms);
                 Image image = executor.read_output(plan);
                 replace_non_finite(image);
                 row.error = compare_images(image, reference, 1);
@@ -247,6 +268,24 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
         std::cout << line;
     }
     std::cout << "\nplot: " << options.svg << "\n";
+    if (!options.csv.empty()) {
+        // Columns named like the printed table, plus the median time of every pass.
+        std::ofstream csv(options.csv, std::ios::binary);
+        csv << "knob,value,rmse,p99,mean,max,frame_ms,bake_s,pass_ms\n";
+        for (const auto& r : rows) {
+            char text[256];
+            std::snprintf(text, sizeof text, "%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,",
+                          r.knob.c_str(), r.value.c_str(), r.error.rmse, r.error.p99,
+                          r.error.mean, r.error.max, r.frame_ms, r.precompute_s);
+            csv << text << '"' << r.pass_ms << "\"\n";
+        }
+        if (!csv) {
+            std::cerr << "lucent bench accuracy: --csv " << options.csv
+                      << ": cannot write\n";
+            return kExitFailure;
+        }
+        std::cout << "table: " << options.csv << "\n";
+    }
     return kExitOk;
 }
 
@@ -265,6 +304,8 @@ void register_bench_accuracy(CLI::App& bench, int& exit_code) {
                     "other parameters, key=value (repeatable)");
     cmd->add_option("--frames", options->frames, "timed frames per row (median)");
     cmd->add_option("--svg", options->svg, "where to write the error-vs-time plot");
+    cmd->add_option("--csv", options->csv,
+                    "also write the table as CSV (columns as printed, plus per-pass ms)");
     cmd->callback([options, &exit_code] { exit_code = run_accuracy_bench(*options); });
 }
 

@@ -22,6 +22,8 @@ struct RenderOptions {
     bool explain = false;
     std::string plan = "pruned";
     bool linear = false;
+    // The technique's CPU reference (Embree) instead of the GL frame plan.
+    bool reference = false;
     // Batch mode (stimuli/batch_render.h): a stimulus-set config or a built-in preset.
     std::string config;
     std::string preset;
@@ -58,6 +60,11 @@ int run_render(const RenderOptions& options) {
         else if (options.plan != "pruned")
             throw std::invalid_argument("--plan: '" + options.plan +
                                         "' (accepted: pruned, full)");
+        if (options.reference && mode == PlanMode::full)
+            throw std::invalid_argument(
+                "--plan: 'full' applies to GL renders, not to --reference");
+        if (options.reference && options.out.empty())
+            throw std::invalid_argument("--out: missing (--reference writes an image)");
         if (options.out.empty() && !options.explain)
             throw std::invalid_argument(
                 "--out: missing (give --out FILE, or --explain to print the plan)");
@@ -88,9 +95,18 @@ int run_render(const RenderOptions& options) {
     }
     std::size_t non_finite = 0;
     try {
-        auto context = gl::create_headless_context();
-        gl::FrameExecutor executor;
-        const RenderedImage rendered = render_image_counted(executor, scene, mode);
+        RenderedImage rendered;
+        if (options.reference) {
+            // The same scene, knobs and outputs; the ground truth a GL render is
+            // measured against (no GL context needed).
+            rendered.image = technique.render_reference(scene);
+            rendered.non_finite_pixels = count_non_finite_pixels(rendered.image);
+            replace_non_finite(rendered.image);
+        } else {
+            auto context = gl::create_headless_context();
+            gl::FrameExecutor executor;
+            rendered = render_image_counted(executor, scene, mode);
+        }
         ImageWriteOptions write;
         write.linear = options.linear;
         write_image(options.out, rendered.image, write);
@@ -99,7 +115,8 @@ int run_render(const RenderOptions& options) {
         std::cerr << "lucent render: " << e.what() << "\n";
         return kExitFailure;
     }
-    std::cout << "wrote " << options.out << "\n";
+    std::cout << "wrote " << options.out << (options.reference ? " (CPU reference)" : "")
+              << "\n";
     // The file is valid (values replaced), but NaN/Inf means a rendering bug: say so and
     // fail, so scripts notice.
     if (non_finite > 0) {
@@ -146,11 +163,18 @@ void register_render(CLI::App& app, int& exit_code) {
     cmd->add_option("--plan", options->plan,
                     "pruned (default) or full: run every pass, to check pruning");
     cmd->add_flag("--linear", options->linear, "write .png/.tif without sRGB encoding");
+    cmd->add_flag("--reference", options->reference,
+                  "render the technique's CPU reference (Embree) instead of the GL image: "
+                  "same scene, parameters and outputs");
     cmd->callback([options, &exit_code] {
         // One image (--mesh) or a stimulus set (CONFIG or --preset), never both.
         const bool batch = !options->config.empty() || !options->preset.empty();
         const bool both = !options->config.empty() && !options->preset.empty();
-        if (batch && (!options->mesh.empty() || both)) {
+        if (batch && options->reference) {
+            std::cerr << "lucent render: --reference renders one image (--mesh), not a "
+                         "stimulus set\n";
+            exit_code = kExitUsage;
+        } else if (batch && (!options->mesh.empty() || both)) {
             std::cerr << "lucent render: give one of --mesh, CONFIG or --preset\n";
             exit_code = kExitUsage;
         } else if (batch) {

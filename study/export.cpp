@@ -242,6 +242,8 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
         } else {
             for (const std::string& f : varies) {
                 if (f == "technique") factors.emplace_back(f, technique);
+                else if (f.rfind("series:", 0) == 0)  // a comparison series: one level per stimulus
+                    factors.emplace_back(f.substr(7), stimulus);
                 else if (pit != params.end() && pit->second.count(f))
                     factors.emplace_back(f, pit->second.at(f));
             }

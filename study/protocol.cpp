@@ -224,12 +224,13 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
         if (s.technique.empty() == s.image.empty())
             r.fail(nullptr, "technique", "stimulus '" + s.id +
                    "' needs exactly one of technique (live) or image (pre-rendered)");
+        // The renderer's registry (lucent_study stays GL-free, so it is listed here).
         static const std::set<std::string> techniques = {"empirical", "ward",
-                                                         "contrast_reversed"};
+                                                         "contrast_reversed", "dipole"};
         if (!s.technique.empty() && !techniques.count(s.technique))
             r.fail(r.raw().get("technique"), "technique",
                    "unknown technique '" + s.technique +
-                       "' (valid: empirical, ward, contrast_reversed)");
+                       "' (valid: empirical, ward, contrast_reversed, dipole)");
         if (!s.image.empty() && !base_dir.empty() && std::filesystem::path(s.image).is_relative())
             s.image = (std::filesystem::path(base_dir) / s.image).string();
         if (const toml::table* params = r.table("params")) {
@@ -239,10 +240,15 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
                     parameter_text(value, pr, std::string(key.str()));
         }
         s.varies = r.strings("varies");
+        // A factor is a parameter, "technique", or "series:NAME": a comparison series
+        // whose levels are the stimuli themselves (e.g. one empirical picture against
+        // three physically based ones).
         for (const std::string& factor : s.varies)
-            if (factor != "technique" && !s.parameters.count(factor))
+            if (factor != "technique" && !s.parameters.count(factor) &&
+                !(factor.rfind("series:", 0) == 0 && factor.size() > 7))
                 r.fail(r.raw().get("varies"), "varies",
-                       "'" + factor + "' is not a parameter of stimulus '" + s.id + "'");
+                       "'" + factor + "' is not a parameter of stimulus '" + s.id +
+                           "' (nor technique or series:NAME)");
         if (p.find_stimulus(s.id))
             r.fail(r.raw().get("id"), "id", "duplicate stimulus id '" + s.id + "'");
         r.reject_unknown();
@@ -373,6 +379,7 @@ std::string Protocol::level_of(const StimulusSpec& stimulus, std::string_view fa
         return it == levels.end() ? stimulus.id : it->second;
     }
     if (factor == "technique") return stimulus.technique.empty() ? "image" : stimulus.technique;
+    if (factor.rfind("series:", 0) == 0) return stimulus.id;
     auto it = stimulus.parameters.find(std::string(factor));
     return it == stimulus.parameters.end() ? std::string() : it->second;
 }

@@ -27,7 +27,8 @@ struct StimulusSpec {
     // "1.2", "0.8,0.6,0.5"), ordered by name. They become analysis factors.
     std::map<std::string, std::string> parameters;
     // Which parameters this stimulus was designed to vary (its factor series); empty
-    // means every parameter is a factor. "technique" may be listed too.
+    // means every parameter is a factor. "technique" may be listed too, and
+    // "series:NAME": a factor NAME whose levels are the stimuli listing it.
     std::vector<std::string> varies;
     bool live() const { return image.empty(); }
 };

@@ -75,9 +75,40 @@ std::string shader_source(std::string_view relative_path) {
     throw ShaderError("unknown shader '" + std::string(relative_path) + "'");
 }
 
+namespace {
+
+// Replaces each line `#include "path"` (path relative to renderer/, as shader_source
+// takes) by that file's text, recursively up to a small depth, with #line directives so
+// compiler errors keep pointing at the including file's own lines.
+std::string expand_includes(const std::string& source, std::string_view name, int depth) {
+    std::istringstream lines(source);
+    std::string out, line;
+    int number = 0;
+    while (std::getline(lines, line)) {
+        ++number;
+        const std::string directive = "#include \"";
+        if (line.rfind(directive, 0) == 0) {
+            const std::size_t end = line.find('"', directive.size());
+            if (end == std::string::npos || depth >= 8)
+                throw ShaderError(std::string(name) + ":" + std::to_string(number) +
+                                  ": bad #include");
+            const std::string path = line.substr(directive.size(), end - directive.size());
+            out += "#line 1\n" + expand_includes(shader_source(path), path, depth + 1);
+            out += "#line " + std::to_string(number + 1) + "\n";
+            continue;
+        }
+        out += line + "\n";
+    }
+    return out;
+}
+
+}  // namespace
+
 ShaderStage shader_stage(GLenum type, std::string_view relative_path,
                          const std::vector<std::string>& defines) {
     std::string source = shader_source(relative_path);
+    if (source.find("#include \"") != std::string::npos)
+        source = expand_includes(source, relative_path, 0);
     if (!defines.empty()) {
         std::string block;
         for (const auto& define : defines) block += "#define " + define + "\n";

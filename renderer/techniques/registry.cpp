@@ -9,12 +9,14 @@ namespace lucent {
 const Technique& empirical_technique();
 const Technique& ward_technique();
 const Technique& contrast_reversed_technique();
+const Technique& dipole_technique();
 
 const std::vector<const Technique*>& all_techniques() {
     static const std::vector<const Technique*> techniques = {
         &empirical_technique(),
         &ward_technique(),
         &contrast_reversed_technique(),
+        &dipole_technique(),
     };
     return techniques;
 }

@@ -137,6 +137,44 @@ TEST_F(ExportTest, AnalysisLongTableExcludesPracticeCatchAndFailedParticipants) 
               "participant,stimulus,factor,level,question,rating");
 }
 
+// A comparison series (`varies = ["series:NAME"]`): a factor NAME whose levels are the
+// stimuli that list it, next to their own parameter factors.
+TEST(ExportSeries, ComparisonSeriesLevelsAreTheStimuli) {
+    std::string text = lucent::test::kSmallProtocol;
+    for (const char* id : {"\"a\"", "\"c\""}) {
+        const size_t at = text.find("varies = [\"thickness_exponent\"]", text.find("id = " + std::string(id)));
+        ASSERT_NE(at, std::string::npos);
+        text.replace(at, 32, "varies = [\"thickness_exponent\", \"series:pair\"]");
+    }
+    const Protocol p = parse_protocol(text, "series.toml");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("a"), "series:pair"), "a");
+    const fs::path dir = lucent::test::scratch_dir("ExportSeriesComparison");
+    const std::string path = (dir / "study.db").string();
+    {
+        Store store(path);
+        lucent::test::run_full_session(store, p, "P1", 11);
+    }
+    const LongTable table = analysis_long_table(path);
+    std::map<std::string, int> levels;
+    int thickness = 0;
+    for (const LongRow& r : table.rows) {
+        if (r.factor == "pair") {
+            EXPECT_EQ(r.level, r.stimulus);
+            ++levels[r.level];
+        } else {
+            EXPECT_EQ(r.factor, "thickness_exponent");
+            ++thickness;
+        }
+    }
+    // a and c, 2 questions each; every rated stimulus keeps its thickness factor.
+    EXPECT_EQ(levels, (std::map<std::string, int>{{"a", 2}, {"c", 2}}));
+    EXPECT_EQ(thickness, 6);
+    // A misspelt series is still an error.
+    std::string bad = text;
+    bad.replace(bad.find("series:pair"), 11, "series:");
+    EXPECT_THROW(parse_protocol(bad, "bad.toml"), ProtocolError);
+}
+
 // Bytes of a file, to show it is untouched.
 std::string file_bytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "sha256.h"
@@ -33,8 +34,29 @@ TEST(ThesisPreset, HasTheNineStimuliOfTable43) {
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("thickness_exponent")), table[i][0]);
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("backlight")), table[i][1]);
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("diffuse_weight")), table[i][2]);
-        ASSERT_EQ(s->varies.size(), 1u);
+        // Row 1 also joins the physically based comparison series (section 8 of issue 11).
+        ASSERT_EQ(s->varies.size(), i == 0 ? 2u : 1u);
         EXPECT_EQ(s->varies[0], varies[i / 3]);
+        if (i == 0) EXPECT_EQ(s->varies[1], "series:physically_based");
+    }
+}
+
+TEST(ThesisPreset, PhysicallyBasedSeriesIsTheBestEmpiricalImageAndThreeDipoles) {
+    const Protocol p = builtin_protocol("thesis");
+    std::vector<std::string> series;
+    for (const StimulusSpec& s : p.stimuli)
+        if (std::find(s.varies.begin(), s.varies.end(), "series:physically_based") !=
+            s.varies.end())
+            series.push_back(s.id);
+    EXPECT_EQ(series, (std::vector<std::string>{"empirical_row_1", "dipole_skin1",
+                                                "dipole_marble", "dipole_skimmilk"}));
+    for (const char* material : {"skin1", "marble", "skimmilk"}) {
+        const StimulusSpec* s = p.find_stimulus(std::string("dipole_") + material);
+        ASSERT_NE(s, nullptr) << material;
+        EXPECT_EQ(s->technique, "dipole");
+        EXPECT_EQ(s->parameters.at("material"), material);
+        EXPECT_EQ(s->parameters.at("hybrid"), "on");
+        EXPECT_EQ(p.level_of(*s, "series:physically_based"), s->id);
     }
 }
 

@@ -1,0 +1,174 @@
+#include <algorithm>
+#include <cmath>
+
+#include "core/common_knobs.h"
+#include "techniques/dipole/dipole.h"
+
+namespace lucent::dipole {
+
+const std::vector<Knob>& knobs() {
+    static const std::vector<Knob> list = [] {
+        const Params d{};
+        std::vector<std::string> materials;
+        for (const auto& preset : material_presets()) materials.push_back(preset.name);
+        materials.push_back("custom");
+        Knob ambient = ambient_knob(), specular = specular_knob(),
+             shininess = shininess_knob(), rays = ao_rays_knob();
+        ambient.default_value = d.ambient;
+        specular.default_value = d.specular;
+        shininess.default_value = d.shininess;
+        rays.default_value = d.ao_rays;
+        const auto choice = [](std::string name, std::string description,
+                               std::string value, std::vector<std::string> choices) {
+            return Knob{std::move(name), std::move(description), KnobKind::choice, 0.0,
+                        0.0, std::move(value), std::move(choices)};
+        };
+        return std::vector<Knob>{
+            choice("material",
+                   "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta 1.3), or "
+                   "custom: sigma_a, sigma_s_prime and eta",
+                   d.material, materials),
+            {"sigma_a", "custom material: absorption coefficient, mm^-1 (rgb)",
+             KnobKind::rgb, 0.0, 100.0, d.sigma_a},
+            {"sigma_s_prime",
+             "custom material: reduced scattering coefficient, mm^-1 (rgb)",
+             KnobKind::rgb, 0.0, 1000.0, d.sigma_s_prime},
+            {"eta", "custom material: relative index of refraction", KnobKind::scalar,
+             1.0, 2.0, d.eta},
+            {"model_size", "the mesh's bounding-box diagonal in mm (the paper's '10 mm')",
+             KnobKind::scalar, 0.1, 1000.0, d.model_size},
+            {"samples", "N: texture-space importance samples shared by every pixel",
+             KnobKind::integer, 1.0, 65536.0, d.samples},
+            choice("atlas_resolution", "side of the surfel atlas of irradiance (texels)",
+                   std::to_string(d.atlas_resolution), {"256", "512", "1024", "2048"}),
+            choice("hybrid",
+                   "Sec. 4 hybrid: local part from the light view (L rings x C + 1), "
+                   "global part by texture-space sampling",
+                   d.hybrid ? "on" : "off", {"off", "on"}),
+            {"rings", "L: rings of the local pattern (hybrid)", KnobKind::integer, 1.0,
+             32.0, d.rings},
+            {"ring_samples", "C: samples per ring of the local pattern (hybrid)",
+             KnobKind::integer, 1.0, 32.0, d.ring_samples},
+            {"importance_bound",
+             "c: Rp is the largest r with 2 pi r Rd(r) = c, per channel (mm^-1; hybrid)",
+             KnobKind::scalar, 0.001, 10.0, d.importance_bound},
+            {"hybrid_k", "K: steepness of the local weight around Rp (mm^-1; hybrid)",
+             KnobKind::scalar, 0.01, 100.0, d.hybrid_k},
+            choice("light_map_resolution",
+                   "side of the light-view depth/flux maps (visibility, hybrid local part)",
+                   std::to_string(d.light_map_resolution), {"256", "512", "1024"}),
+            {"sample_seed", "stratification offset xi = frac(0.5 + seed * 0.618...)",
+             KnobKind::integer, 0.0, 1000000.0, d.sample_seed},
+            choice("tone_map", "none (linear radiance) or reinhard s/(1+s)", d.tone_map,
+                   {"none", "reinhard"}),
+            {"tone_key", "a: Reinhard key, s = a L / L_avg", KnobKind::scalar, 0.001,
+             100.0, d.tone_key},
+            specular,
+            shininess,
+            ambient,
+            rays,
+        };
+    }();
+    return list;
+}
+
+Params params(const Scene& scene) {
+    const KnobValues& v = scene.values;
+    Params p;
+    p.material = v.choice("material");
+    p.sigma_a = v.vec3("sigma_a");
+    p.sigma_s_prime = v.vec3("sigma_s_prime");
+    p.eta = v.scalar("eta");
+    p.model_size = v.scalar("model_size");
+    p.samples = v.integer("samples");
+    p.atlas_resolution = std::stoi(v.choice("atlas_resolution"));
+    p.hybrid = v.choice("hybrid") == "on";
+    p.rings = v.integer("rings");
+    p.ring_samples = v.integer("ring_samples");
+    p.importance_bound = v.scalar("importance_bound");
+    p.hybrid_k = v.scalar("hybrid_k");
+    p.light_map_resolution = std::stoi(v.choice("light_map_resolution"));
+    p.sample_seed = v.integer("sample_seed");
+    p.tone_map = v.choice("tone_map");
+    p.tone_key = v.scalar("tone_key");
+    p.specular = v.scalar("specular");
+    p.shininess = v.scalar("shininess");
+    p.ambient = v.scalar("ambient");
+    p.ao_rays = v.integer("ao_rays");
+    return p;
+}
+
+Material material_of(const Params& p) {
+    if (const Material* preset = find_material_preset(p.material)) return *preset;
+    return {p.sigma_a, p.sigma_s_prime, p.eta};
+}
+
+double model_scale(const Mesh& mesh, double model_size_mm) {
+    glm::dvec3 lo(1e300), hi(-1e300);
+    for (const glm::vec3& p : mesh.positions) {
+        lo = glm::min(lo, glm::dvec3(p));
+        hi = glm::max(hi, glm::dvec3(p));
+    }
+    const double diagonal = mesh.positions.empty() ? 0.0 : glm::length(hi - lo);
+    return diagonal > 0.0 && std::isfinite(diagonal) ? model_size_mm / diagonal : 1.0;
+}
+
+glm::dvec3 light_in_object_space(const Scene& scene) {
+    // The view is a rigid motion, so its inverse rotation is the transpose.
+    const glm::dmat3 rotation(glm::dmat4(scene.camera.view()));
+    return glm::normalize(glm::transpose(rotation) * glm::dvec3(scene.light.direction));
+}
+
+bool has_subsurface_term(const Params& p, const Scene& scene) {
+    const DipoleRgb d(material_of(p));
+    const glm::dvec3 id = scene.light.diffuse;
+    for (int c = 0; c < 3; ++c)
+        if (id[c] != 0.0 && d[c].scatters() && d[c].albedo() > 0.0) return true;
+    return false;
+}
+
+bool has_specular_term(const Params& p, const Scene& scene) {
+    return p.specular != 0.0 && scene.light.specular != glm::vec3(0.0f);
+}
+
+bool has_ambient_term(const Params& p, const Scene& scene) {
+    if (p.ambient == 0.0 || scene.light.ambient == glm::vec3(0.0f)) return false;
+    const glm::dvec3 rd = DipoleRgb(material_of(p)).total_reflectance();
+    return rd != glm::dvec3(0.0);
+}
+
+glm::dvec3 reinhard(glm::dvec3 radiance, double key, double average_luminance) {
+    if (!(average_luminance > 0.0)) return glm::dvec3(0.0);
+    const glm::dvec3 s = glm::max(radiance, glm::dvec3(0.0)) * (key / average_luminance);
+    return s / (glm::dvec3(1.0) + s);
+}
+
+double tone_map_average(const Params& p, const Scene& scene, double flux_per_id,
+                        double total_area_mm2) {
+    const glm::dvec3 rd = DipoleRgb(material_of(p)).total_reflectance();
+    const glm::dvec3 id = scene.light.diffuse;
+    const double y = 0.2126 * rd.r * id.r + 0.7152 * rd.g * id.g + 0.0722 * rd.b * id.b;
+    return total_area_mm2 > 0.0 ? y * flux_per_id / (kPi * total_area_mm2) : 0.0;
+}
+
+glm::dvec3 blinn_phong(const Params& p, const Light& light, glm::dvec3 n) {
+    const glm::dvec3 l = light.direction;
+    if (!(glm::dot(n, l) > 0.0)) return glm::dvec3(0.0);
+    const glm::dvec3 half_sum = l + glm::dvec3(0.0, 0.0, 1.0);
+    const double length2 = glm::dot(half_sum, half_sum);
+    const double n_dot_h =
+        length2 > 1e-30 ? std::max(glm::dot(n, half_sum / std::sqrt(length2)), 0.0) : 0.0;
+    // 0^0 = 1: shininess 0 is a constant lobe, as in the empirical technique.
+    const double lobe = p.shininess == 0.0 ? 1.0 : std::pow(n_dot_h, p.shininess);
+    return p.specular * glm::dvec3(light.specular) * lobe;
+}
+
+glm::dvec3 ambient_term(const Params& p, const Light& light, double n_dot_v, double ao) {
+    const Material m = material_of(p);
+    const glm::dvec3 kd = fresnel_transmittance(m.eta, n_dot_v) *
+                          mean_fresnel_transmittance(m.eta) *
+                          DipoleRgb(m).total_reflectance();
+    return p.ambient * glm::dvec3(light.ambient) * kd * ao;
+}
+
+}  // namespace lucent::dipole
