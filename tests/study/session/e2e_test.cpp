@@ -630,7 +630,8 @@ TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
     ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
     Database d(db, SQLITE_OPEN_READONLY);
     const int64_t trials = d.scalar_int("SELECT count(*) FROM trials");
-    EXPECT_EQ(trials, 2 + 15 + 2);  // practice + 9 empirical + 6 ward/contrast-reversed + catch
+    // practice + 9 empirical + 3 dipole + 6 ward/contrast-reversed + catch
+    EXPECT_EQ(trials, 2 + 18 + 2);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 3);
     EXPECT_EQ(d.scalar_int("SELECT count(DISTINCT question) FROM responses"), 3);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
