@@ -9,11 +9,22 @@ namespace lucent {
 PixelRays::PixelRays(const Camera& camera, int width, int height)
     : width_(width),
       height_(height),
+      near_(camera.near_plane),
+      far_(camera.far_plane),
       eye_(camera.eye),
       forward_(glm::normalize(glm::dvec3(camera.target) - glm::dvec3(camera.eye))),
       view_(camera.view()),
       inverse_view_projection_(glm::inverse(glm::dmat4(camera.projection()) * view_)),
       normal_matrix_(glm::inverseTranspose(glm::dmat3(view_))) {}
+
+std::optional<RayHit> PixelRays::front_hit(const RayCaster& caster, glm::dvec3 direction,
+                                           int max_hits) const {
+    for (const RayHit& hit : caster.hits(glm::vec3(eye_), glm::vec3(direction), max_hits)) {
+        const double z = eye_depth(hit.distance, direction);
+        if (z >= near_ && z < far_) return hit;
+    }
+    return std::nullopt;
+}
 
 glm::dvec3 PixelRays::direction(int x, int row) const {
     const int gl_y = height_ - 1 - row;  // image rows are top first, GL's bottom first

@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "core/camera.h"
@@ -29,9 +30,14 @@ public:
     double eye_depth(double distance, glm::dvec3 direction) const {
         return distance * glm::dot(direction, forward_);
     }
+    // The first hit the depth test keeps along the pixel ray `direction`: the nearest of
+    // the first `max_hits` whose eye depth lies in [camera near, camera far).
+    std::optional<RayHit> front_hit(const RayCaster& caster, glm::dvec3 direction,
+                                    int max_hits = 4) const;
 
 private:
     int width_, height_;
+    double near_, far_;
     glm::dvec3 eye_, forward_;
     glm::dmat4 view_, inverse_view_projection_;
     glm::dmat3 normal_matrix_;

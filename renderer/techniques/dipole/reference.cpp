@@ -41,22 +41,13 @@ Image render_reference(const Scene& scene, const IntegratorQuality& quality,
                  : 0.0;
     const glm::dvec3 id = scene.light.diffuse;
     const int w = scene.width, h = scene.height;
-    const double near = scene.camera.near_plane, far = scene.camera.far_plane;
     const PixelRays rays(scene.camera, w, h);
 
     Image image(w, h);
     for_each_row_parallel(h, [&](int row) {
         for (int x = 0; x < w; ++x) {
             const glm::dvec3 direction = rays.direction(x, row);
-            std::optional<RayHit> front;
-            for (const RayHit& hit :
-                 caster.hits(glm::vec3(rays.eye()), glm::vec3(direction), 4)) {
-                const double z = rays.eye_depth(hit.distance, direction);
-                if (z >= near && z < far) {
-                    front = hit;
-                    break;
-                }
-            }
+            const std::optional<RayHit> front = rays.front_hit(caster, direction);
             if (!front) {
                 image.set(x, row, glm::vec4(scene.background, 0.0f));
                 continue;

@@ -50,7 +50,6 @@ Image render_reference(const Scene& scene, Variant variant) {
         vertex_ao = load_or_bake_ambient_occlusion(mesh, options);
     }
     const int w = scene.width, h = scene.height;
-    const double near = scene.camera.near_plane, far = scene.camera.far_plane;
     const PixelRays rays(scene.camera, w, h);
     const RayCaster caster(mesh);
 
@@ -58,16 +57,7 @@ Image render_reference(const Scene& scene, Variant variant) {
     auto render_row = [&](int row) {
         for (int x = 0; x < w; ++x) {
             const glm::dvec3 direction = rays.direction(x, row);
-            // First hit the depth test keeps: between the near and far planes.
-            std::optional<RayHit> front;
-            for (const RayHit& hit :
-                 caster.hits(glm::vec3(rays.eye()), glm::vec3(direction), 4)) {
-                const double z = rays.eye_depth(hit.distance, direction);
-                if (z >= near && z < far) {
-                    front = hit;
-                    break;
-                }
-            }
+            const std::optional<RayHit> front = rays.front_hit(caster, direction);
             if (!front) {
                 image.set(x, row, glm::vec4(scene.background, 0.0f));
                 continue;
