@@ -80,6 +80,14 @@ double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene,
     return median_of(times);
 }
 
+// The knob's name, with the settings its sweep fixes: "rings (hybrid=on)".
+std::string sweep_label(const QualitySweep& sweep) {
+    std::string label = sweep.knob, fixed;
+    for (const auto& [knob, value] : sweep.with)
+        fixed += (fixed.empty() ? "" : " ") + knob + "=" + format_knob_value(value);
+    return fixed.empty() ? label : label + " (" + fixed + ")";
+}
+
 std::string escape(const std::string& text) {
     std::string out;
     for (char c : text) out += c == '<' ? "&lt;" : c == '&' ? "&amp;" : std::string(1, c);
@@ -217,12 +225,14 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
         for (const auto& sweep : sweeps)
             for (const auto& value : sweep.values) {
                 RenderRequest row_request = request;
+                for (const auto& [knob, fixed] : sweep.with)
+                    row_request.settings.push_back({knob, format_knob_value(fixed)});
                 row_request.settings.push_back({sweep.knob, format_knob_value(value)});
                 Scene scene = reference_scene;
                 scene.values =
                     resolve_knob_values(knobs_for(technique), row_request.settings);
                 const FramePlan plan = make_frame_plan(scene, technique);
-                Row row{sweep.knob, format_knob_value(value)};
+                Row row{sweep_label(sweep), format_knob_value(value)};
                 row.frame_ms =
                     median_frame_ms(executor, scene, plan, options.frames, &row.pass_ms);
                 Image image = executor.read_output(plan);
@@ -257,12 +267,12 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
     std::cout << "; error = GL image vs CPU reference outside a 1-pixel silhouette band, "
                  "linear rgb\n\n";
     char line[200];
-    std::snprintf(line, sizeof line, "%-16s %6s | %10s %10s %10s %10s | %9s %9s\n",
+    std::snprintf(line, sizeof line, "%-28s %6s | %10s %10s %10s %10s | %9s %9s\n",
                   "knob", "value", "RMSE", "p99", "mean", "max", "frame ms", "bake s");
-    std::cout << line << std::string(93, '-') << "\n";
+    std::cout << line << std::string(105, '-') << "\n";
     for (const auto& r : rows) {
         std::snprintf(line, sizeof line,
-                      "%-16s %6s | %10.2e %10.2e %10.2e %10.2e | %9.3f %9.3f\n",
+                      "%-28s %6s | %10.2e %10.2e %10.2e %10.2e | %9.3f %9.3f\n",
                       r.knob.c_str(), r.value.c_str(), r.error.rmse, r.error.p99,
                       r.error.mean, r.error.max, r.frame_ms, r.precompute_s);
         std::cout << line;

@@ -4,6 +4,7 @@
 // renderer/techniques/ plus one registry line. GL-free: a technique describes passes
 // (shaders, reads, writes, uniforms) and renderer/gl executes them.
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/frame_plan.h"
@@ -15,10 +16,13 @@ namespace lucent {
 
 // A knob whose value trades accuracy for time, for `lucent bench accuracy`: the values
 // to sweep (cheapest first) and the value the CPU reference image is rendered with.
+// `with`: other knobs set for this sweep only, for a knob that matters only in a mode
+// (the dipole's ring count L, say, only with hybrid=on).
 struct QualitySweep {
     std::string knob;
     std::vector<KnobValue> values;
     KnobValue reference;
+    std::vector<std::pair<std::string, KnobValue>> with = {};
 };
 
 class Technique {
