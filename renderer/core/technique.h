@@ -10,6 +10,7 @@
 #include "core/frame_plan.h"
 #include "core/image.h"
 #include "core/knobs.h"
+#include "core/progressive.h"
 #include "core/scene.h"
 
 namespace lucent {
@@ -41,6 +42,9 @@ public:
     virtual Image render_reference(const Scene& scene) const = 0;
     // Quality knobs for the accuracy bench; empty when the technique has none.
     virtual std::vector<QualitySweep> quality_sweeps() const { return {}; }
+    // How an interactive view refines this technique's image over frames (none by
+    // default): see core/progressive.h.
+    virtual ProgressiveRefinement progressive_refinement() const { return {}; }
 };
 
 // The plan of `scene` under its technique: technique.plan() then compile().

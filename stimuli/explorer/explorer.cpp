@@ -194,6 +194,7 @@ PanelInfo Explorer::panel_info() const {
         info.far_plane = side.scene.camera.far_plane;
         info.plan = &side.plan;
         info.timings = &side.timings;
+        info.refinement = side.refinement_status();
     }
     info.frame_times = stats_.summary();
     info.baking = view_->bakes().busy();

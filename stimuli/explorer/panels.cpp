@@ -217,6 +217,7 @@ void status_bar(ExplorerSession& session, const PanelInfo& info) {
                        passes.c_str());
     if (session.show_pass_times && info.timings)
         ImGui::TextWrapped("%s", pass_times_text(*info.timings).c_str());
+    if (!info.refinement.empty()) ImGui::TextUnformatted(info.refinement.c_str());
     if (!session.message.empty()) ImGui::TextUnformatted(session.message.c_str());
     ImGui::End();
 }

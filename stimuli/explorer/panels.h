@@ -31,6 +31,7 @@ struct PanelInfo {
     float bake_progress = 0;
     std::string bake_error;
     std::string buffer_message;
+    std::string refinement;  // "refining: 64 of 256 samples" while a view converges
 };
 
 struct PanelRequests {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "core/technique.h"
 #include "gl/upload.h"
@@ -138,8 +139,29 @@ void ViewRenderer::render_side(const ExplorerSession& session,
     RenderedSide& side = sides_[index];
     const ParameterSet& set = session.sets[index];
     const Technique& technique = find_technique(set.technique());
+    KnobValues values = set.values();
+    const ProgressiveRefinement refinement = technique.progressive_refinement();
+    const bool refine = refinement.enabled() && session.buffer_view == BufferView::shaded;
+    if (!refine) side.refinement.reset();
+    if (refine) {
+        if (!side.refinement || side.scene.technique != technique.name())
+            side.refinement.emplace(refinement);
+        const glm::vec3 direction = view_direction(session);
+        char view[160];
+        std::snprintf(view, sizeof view, "%s %dx%d %.9g,%.9g,%.9g ao=%d",
+                      mesh->content_hash.c_str(), width, height, direction.x,
+                      direction.y, direction.z, session.ambient_occlusion ? 1 : 0);
+        const auto knobs = knobs_for(technique);
+        const auto seed = std::find_if(knobs.begin(), knobs.end(), [&](const Knob& k) {
+            return k.name == refinement.seed_knob;
+        });
+        auto frame_values = side.refinement->next(
+            values, view, seed == knobs.end() ? 0 : static_cast<int>(seed->max));
+        if (!frame_values && side.valid) return;  // converged: nothing runs
+        if (frame_values) values = std::move(*frame_values);
+    }
     Scene scene =
-        make_scene(mesh, technique, set.values(), width, height, view_direction(session));
+        make_scene(mesh, technique, std::move(values), width, height, view_direction(session));
     FramePlan plan = make_frame_plan(scene, technique);
     // The scene is published first: the AO source looks the mesh up through it.
     const Scene previous = std::move(side.scene);
@@ -153,6 +175,10 @@ void ViewRenderer::render_side(const ExplorerSession& session,
     }
     side.image = shading.read_output(plan);
     replace_non_finite(side.image);
+    if (side.refinement && side.refinement->target() > 0 && !side.refinement->converged()) {
+        side.refinement->add(side.image);
+        side.image = side.refinement->mean();
+    }
     side.timings = shading.last_timings();
     side.plan = std::move(plan);
     side.valid = true;
@@ -188,6 +214,12 @@ void ViewRenderer::render_side(const ExplorerSession& session,
             }
         }
     }
+}
+
+std::string RenderedSide::refinement_status() const {
+    if (!refinement || refinement->converged() || refinement->frames() == 0) return "";
+    return "refining: " + std::to_string(refinement->samples()) + " of " +
+           std::to_string(refinement->target()) + " samples";
 }
 
 void ViewRenderer::render(const ExplorerSession& session,

@@ -4,11 +4,13 @@
 // `lucent render`, or a debug view of an intermediate buffer. Results are uploaded to
 // 8-bit sRGB textures for display. Needs the window's GL context to be current.
 #include <map>
+#include <optional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "core/frame_plan.h"
+#include "core/progressive.h"
 #include "core/image.h"
 #include "core/scene.h"
 #include "explorer/ao_bakes.h"
@@ -27,6 +29,11 @@ struct RenderedSide {
     gl::FrameTimings timings;  // per pass, when the session asks for them
     gl::Texture texture;  // what is displayed (shaded image or buffer view), sRGB 8-bit
     int texture_width = 0, texture_height = 0;
+    // A technique refined over frames (Technique::progressive_refinement()): the mean
+    // shown so far; `image` is then that mean.
+    std::optional<ProgressiveAccumulator> refinement;
+    // "refining: 64 of 256 samples", or "" when the image is complete.
+    std::string refinement_status() const;
 };
 
 class ViewRenderer {

@@ -171,6 +171,32 @@ TEST_F(ExplorerTest, SlidersRerunOnlyThePassesTheyTouch) {
     EXPECT_EQ(ran(), std::vector<std::string>{});
 }
 
+// The dipole refines progressively (4 samples a frame, core/progressive.h): the status
+// counts up to the set's N, then frames run no pass; a slider restarts the refinement.
+TEST_F(ExplorerTest, TheDipoleRefinesOverFramesToTheSetsSamples) {
+    ExplorerSession session;
+    session.show_pass_times = true;
+    session.sets[0].set_technique("dipole");
+    session.sets[0].set("samples", 12);
+    session.sets[0].set("atlas_resolution", std::string("256"));
+    session.sets[0].set("light_map_resolution", std::string("256"));
+    auto explorer = open(session, 320, 240);
+    settle(*explorer);
+    // settle() stepped until the first frame, then once more: 8 of 12 samples.
+    EXPECT_EQ(explorer->shown().refinement_status(), "refining: 8 of 12 samples");
+    explorer->step();
+    EXPECT_EQ(explorer->shown().refinement_status(), "");
+    ASSERT_TRUE(explorer->shown().refinement.has_value());
+    EXPECT_EQ(explorer->shown().refinement->samples(), 12);
+    const Image converged = explorer->shown().image;
+    explorer->step();  // nothing left to refine: the same image
+    EXPECT_EQ(explorer->shown().image.rgba, converged.rgba);
+    explorer->session().current().set("specular", 0.0);
+    explorer->step();
+    EXPECT_EQ(explorer->shown().refinement_status(), "refining: 4 of 12 samples");
+    EXPECT_NE(explorer->shown().image.rgba, converged.rgba);
+}
+
 TEST_F(ExplorerTest, DragsOnTheViewOrbitAndMoveTheLight) {
     auto explorer = open(ExplorerSession{});
     settle(*explorer);
