@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "data/decimal.h"
 
@@ -37,7 +38,8 @@ std::string format_exact(double value) {
 // allocation. `line_no` counts physical lines (a quoted field may span several).
 class LineCursor {
 public:
-    explicit LineCursor(std::string_view text) : text_(text) {}
+    explicit LineCursor(std::string_view text, std::size_t line_no = 0)
+        : text_(text), line_no_(line_no) {}
     // The next line without its LF (and CR), or nullopt at the end.
     std::optional<std::string_view> next() {
         if (position_ >= text_.size()) return std::nullopt;
@@ -52,6 +54,7 @@ public:
         return line;
     }
     std::size_t line_no() const { return line_no_; }
+    std::string_view rest() const { return text_.substr(std::min(position_, text_.size())); }
     // Lines after this one (at least as many as the records still to come): counted
     // once so that a million rows are placed without a reallocation.
     std::size_t lines_left() const {
@@ -209,39 +212,26 @@ private:
     bool has_previous_ = false;
 };
 
-LongTable parse_long_csv(std::string_view text, const std::string& source,
-                         const RatingScale& scale) {
-    LongTable table;
-    LineCursor lines(text);
-    std::array<int, kColumns.size()> column{};
-    column.fill(-1);
-    std::size_t header_fields = 0;
-    std::string origin_text;
+// The ratings' origin: the first rating's text (its value is what the rows store
+// differences from, exactly; see parse_rows).
+struct Origin {
+    std::string text;
+    double value = 0.0;
+};
+
+// The data records of a long CSV after its header, appended to `rows`. `column` gives
+// each required column's field; `origin` is set by the first rating when still empty.
+void parse_rows(LineCursor& lines, const std::string& source,
+                const std::array<int, kColumns.size()>& column, std::size_t header_fields,
+                Origin& origin, std::vector<RatingRow>& rows) {
     std::vector<std::string> decoded;
     std::vector<std::string_view> fields;
     std::array<ColumnLabels, 5> labels;
     while (const auto next = lines.next()) {
-        std::string_view line = *next;
+        const std::string_view line = *next;
         const std::size_t line_no = lines.line_no();
-        if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // BOM
         if (trimmed(line).empty()) continue;
         split_record(line, lines, source, decoded, fields);
-        if (header_fields == 0) {
-            // Header: find each required column by name.
-            header_fields = fields.size();
-            for (std::size_t f = 0; f < fields.size(); ++f)
-                for (std::size_t c = 0; c < kColumns.size(); ++c)
-                    if (trimmed(fields[f]) == kColumns[c])
-                        column[c] = static_cast<int>(f);
-            for (std::size_t c = 0; c < kColumns.size(); ++c)
-                if (column[c] < 0)
-                    throw InputError(location(source, line_no) +
-                                     ": header lacks column '" + kColumns[c] +
-                                     "' (expected participant,stimulus,factor,level,"
-                                     "question,rating)");
-            table.rows.reserve(lines.lines_left());
-            continue;
-        }
         if (fields.size() != header_fields)
             throw InputError(location(source, line_no) + ": expected " +
                              std::to_string(header_fields) + " fields, found " +
@@ -252,7 +242,7 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
         if (factor.empty() || level.empty() || question.empty())
             throw InputError(location(source, line_no) +
                              ": factor, level and question must not be empty");
-        RatingRow& row = table.rows.emplace_back();
+        RatingRow& row = rows.emplace_back();
         row.participant = labels[0](trimmed(fields[column[0]]));
         row.stimulus = labels[1](trimmed(fields[column[1]]));
         row.factor = labels[2](factor);
@@ -261,29 +251,120 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
         row.source_line = line_no;
         const std::string_view rating_text = trimmed(fields[column[5]]);
         if (rating_text.empty() || rating_text == "NA") continue;
-        if (origin_text.empty()) {
+        if (origin.text.empty()) {
             const auto value = parse_finite_number(rating_text);
             if (!value)
                 throw InputError(location(source, line_no) + ": rating '" +
                                  std::string(rating_text) + "' is not a finite number");
-            origin_text = rating_text;
-            table.origin = *value;
+            origin.text = rating_text;
+            origin.value = *value;
         }
-        if (rating_text.size() == 1 && is_digit(rating_text[0]) && origin_text.size() == 1) {
+        if (rating_text.size() == 1 && is_digit(rating_text[0]) && origin.text.size() == 1) {
             // Every Likert rating: one digit against a one-digit origin, exact.
-            row.rating = static_cast<double>(rating_text[0] - origin_text[0]);
+            row.rating = static_cast<double>(rating_text[0] - origin.text[0]);
             continue;
         }
         if (!parse_finite_number(rating_text))
             throw InputError(location(source, line_no) + ": rating '" +
                              std::string(rating_text) + "' is not a finite number");
-        row.rating = exact_difference(rating_text, origin_text);
+        row.rating = exact_difference(rating_text, origin.text);
+    }
+}
+
+// Files this large are parsed in two halves at once (when they have no quoted field,
+// so that every line is a record and the halves can be cut at a newline).
+constexpr std::size_t kParallelParseBytes = std::size_t{4} << 20;
+
+LongTable parse_long_csv(std::string_view text, const std::string& source,
+                         const RatingScale& scale) {
+    LongTable table;
+    LineCursor lines(text);
+    std::array<int, kColumns.size()> column{};
+    column.fill(-1);
+    std::size_t header_fields = 0;
+    std::vector<std::string> decoded;
+    std::vector<std::string_view> fields;
+    while (header_fields == 0) {
+        const auto next = lines.next();
+        if (!next) break;
+        std::string_view line = *next;
+        const std::size_t line_no = lines.line_no();
+        if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // BOM
+        if (trimmed(line).empty()) continue;
+        split_record(line, lines, source, decoded, fields);
+        // Header: find each required column by name.
+        header_fields = fields.size();
+        for (std::size_t f = 0; f < fields.size(); ++f)
+            for (std::size_t c = 0; c < kColumns.size(); ++c)
+                if (trimmed(fields[f]) == kColumns[c]) column[c] = static_cast<int>(f);
+        for (std::size_t c = 0; c < kColumns.size(); ++c)
+            if (column[c] < 0)
+                throw InputError(location(source, line_no) + ": header lacks column '" +
+                                 kColumns[c] +
+                                 "' (expected participant,stimulus,factor,level,"
+                                 "question,rating)");
     }
     if (header_fields == 0) throw InputError(source + ": empty file (no header)");
+    table.rows.reserve(lines.lines_left());
+    Origin origin;
+    const std::string_view body = lines.rest();
+    const std::size_t cut =
+        body.size() >= kParallelParseBytes && std::thread::hardware_concurrency() > 1 &&
+                std::memchr(body.data(), '"', body.size()) == nullptr
+            ? body.find('\n', body.size() / 2)
+            : std::string_view::npos;
+    if (cut == std::string_view::npos) {
+        parse_rows(lines, source, column, header_fields, origin, table.rows);
+    } else {
+        // The origin first (the first rating of the file), so that both halves store
+        // differences from the same text; then the second half on its own thread, its
+        // line numbers counted on from the first half's.
+        const std::string_view first = body.substr(0, cut + 1), second = body.substr(cut + 1);
+        {
+            LineCursor scout(first, lines.line_no());
+            std::vector<RatingRow> scratch;
+            while (origin.text.empty() && scout.rest().size() > 0) {
+                LineCursor one(scout.next().value(), scout.line_no() - 1);
+                parse_rows(one, source, column, header_fields, origin, scratch);
+            }
+        }
+        // The first half reads a copy: the worker may still set `origin` when the first
+        // half has no rating at all.
+        Origin first_origin = origin;
+        std::vector<RatingRow> second_rows;
+        std::exception_ptr second_error;
+        const std::size_t header_lines = lines.line_no();
+        std::thread worker([&] {
+            try {
+                const std::size_t first_lines = static_cast<std::size_t>(
+                    std::count(first.begin(), first.end(), '\n'));
+                second_rows.reserve(static_cast<std::size_t>(
+                    std::count(second.begin(), second.end(), '\n')) + 1);
+                LineCursor second_lines(second, header_lines + first_lines);
+                parse_rows(second_lines, source, column, header_fields, origin,
+                           second_rows);
+            } catch (...) {
+                second_error = std::current_exception();
+            }
+        });
+        std::exception_ptr first_error;
+        try {
+            LineCursor first_lines(first, header_lines);
+            parse_rows(first_lines, source, column, header_fields, first_origin, table.rows);
+        } catch (...) {
+            first_error = std::current_exception();
+        }
+        worker.join();
+        // The earlier line's error is the one reported, as a single pass would.
+        if (first_error) std::rethrow_exception(first_error);
+        if (second_error) std::rethrow_exception(second_error);
+        table.rows.insert(table.rows.end(), second_rows.begin(), second_rows.end());
+    }
+    if (!origin.text.empty()) table.origin = origin.value;
     // The origin is the first rating rounded to double; the stored differences are exact
     // relative to its text, so add back what that rounding dropped.
-    if (!origin_text.empty()) {
-        const double rounding = exact_difference(origin_text, format_exact(table.origin));
+    if (!origin.text.empty()) {
+        const double rounding = exact_difference(origin.text, format_exact(table.origin));
         if (rounding != 0.0)
             for (RatingRow& row : table.rows)
                 if (row.rating) *row.rating += rounding;

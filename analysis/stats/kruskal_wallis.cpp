@@ -1,6 +1,7 @@
 #include "stats/kruskal_wallis.h"
 
 #include <algorithm>
+#include <cmath>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <numeric>
 
@@ -16,43 +17,60 @@ KruskalWallisResult kruskal_wallis(const OneWayData& data) {
         return r;
     }
     // A value's mid-rank depends only on the value: find the distinct values and how
-    // often each occurs, then give every observation its value's mid-rank. A rating
-    // scale has a handful of distinct values (counted in a small sorted table, no sort
-    // of all n); otherwise the pooled values are sorted once.
+    // often each occurs in each group, then every group's rank sum is a sum over the
+    // distinct values. Ratings are whole numbers in a short range: counted straight into
+    // a histogram (no search, no sort of all n). Other data: the pooled values are
+    // sorted once and each group's values found by binary search.
     std::size_t total = 0;
     for (const Group* g : groups) total += g->values.size();
     std::vector<double> distinct;
     std::vector<std::size_t> counts;
-    constexpr std::size_t kFewDistinct = 64;
-    bool few = true;
-    for (std::size_t g = 0; g < groups.size() && few; ++g)
-        for (double x : groups[g]->values) {
-            const auto at = std::lower_bound(distinct.begin(), distinct.end(), x);
-            if (at != distinct.end() && *at == x) {
-                ++counts[at - distinct.begin()];
-                continue;
-            }
-            if (distinct.size() == kFewDistinct) {
-                few = false;
-                break;
-            }
-            counts.insert(counts.begin() + (at - distinct.begin()), 1);
-            distinct.insert(at, x);
+    std::vector<std::vector<std::size_t>> in_group(groups.size());
+    double lowest = groups[0]->values[0], highest = lowest;
+    bool whole = true;
+    for (const Group* g : groups)
+        for (double x : g->values) {
+            lowest = std::min(lowest, x);
+            highest = std::max(highest, x);
+            whole &= x == std::nearbyint(x);
         }
-    if (!few) {
+    constexpr double kHistogramSpan = 4096;
+    if (whole && std::isfinite(lowest) && std::isfinite(highest) &&
+        highest - lowest < kHistogramSpan &&
+        (highest - lowest + 1) * static_cast<double>(groups.size()) <= 1 << 20) {
+        const std::size_t span = static_cast<std::size_t>(highest - lowest) + 1;
+        std::vector<std::vector<std::size_t>> histogram(groups.size(),
+                                                        std::vector<std::size_t>(span, 0));
+        for (std::size_t g = 0; g < groups.size(); ++g)
+            for (double x : groups[g]->values)
+                ++histogram[g][static_cast<std::size_t>(x - lowest)];
+        for (std::size_t v = 0; v < span; ++v) {
+            std::size_t count = 0;
+            for (const auto& h : histogram) count += h[v];
+            if (count == 0) continue;
+            distinct.push_back(lowest + static_cast<double>(v));
+            counts.push_back(count);
+            for (std::size_t g = 0; g < groups.size(); ++g)
+                in_group[g].push_back(histogram[g][v]);
+        }
+    } else {
         std::vector<double> pooled;
         pooled.reserve(total);
         for (const Group* g : groups)
             pooled.insert(pooled.end(), g->values.begin(), g->values.end());
         std::sort(pooled.begin(), pooled.end());
-        distinct.clear();
-        counts.clear();
         for (std::size_t i = 0; i < pooled.size();) {
             std::size_t j = i;
             while (j < pooled.size() && pooled[j] == pooled[i]) ++j;
             distinct.push_back(pooled[i]);
             counts.push_back(j - i);
             i = j;
+        }
+        for (std::size_t g = 0; g < groups.size(); ++g) {
+            in_group[g].assign(distinct.size(), 0);
+            for (double x : groups[g]->values)
+                ++in_group[g][std::lower_bound(distinct.begin(), distinct.end(), x) -
+                              distinct.begin()];
         }
     }
     const double n = static_cast<double>(total);
@@ -68,16 +86,10 @@ KruskalWallisResult kruskal_wallis(const OneWayData& data) {
         below += counts[d];
     }
     std::vector<CompensatedSum> rank_sums(groups.size());
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-        // Within a group, add each distinct value's mid-rank times its count there.
-        std::vector<std::size_t> in_group(distinct.size(), 0);
-        for (double x : groups[g]->values)
-            ++in_group[std::lower_bound(distinct.begin(), distinct.end(), x) -
-                       distinct.begin()];
+    for (std::size_t g = 0; g < groups.size(); ++g)
         for (std::size_t d = 0; d < distinct.size(); ++d)
-            if (in_group[d] > 0)
-                rank_sums[g].add(mid_ranks[d] * static_cast<double>(in_group[d]));
-    }
+            if (in_group[g][d] > 0)
+                rank_sums[g].add(mid_ranks[d] * static_cast<double>(in_group[g][d]));
     const double tie_correction = 1.0 - tie_terms.value() / (n * n * n - n);
     r.df = static_cast<double>(groups.size() - 1);
     if (!(tie_correction > 0.0)) {

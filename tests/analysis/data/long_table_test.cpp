@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <random>
 #include <filesystem>
 #include <fstream>
@@ -217,6 +218,56 @@ TEST(LongTable, FileAndStreamReadersAgree) {
     EXPECT_FALSE(from_file.rows[0].rating.has_value());  // i = 0 is NA
     EXPECT_DOUBLE_EQ(from_file.origin + *from_file.rows.back().rating, 2.5);
     EXPECT_THROW(read_long_csv(path, RatingScale{}), InputError);  // gone: one line
+}
+
+// Over 4 MiB without quotes the reader parses two halves at once: every row, its
+// rating and its line number are those written (blank lines and a leading NA run
+// included), and of two bad lines the earlier is the one named.
+TEST(LongTable, LargeFilesParsedInTwoHalvesKeepEveryRowAndLine) {
+    struct Written {
+        std::string participant, level;
+        std::optional<int> rating;
+        std::size_t line;
+    };
+    std::vector<Written> written;
+    std::ostringstream csv;
+    csv << "participant,stimulus,factor,level,question,rating\n";
+    std::size_t line = 1;
+    std::mt19937 random(9);
+    for (int i = 0; i < 180000; ++i) {
+        if (i % 5000 == 17) {
+            csv << "\n";  // a blank line: skipped, but counted
+            ++line;
+        }
+        Written w{"participant" + std::to_string(i % 311), std::to_string(i % 7), {}, ++line};
+        if (i >= 3 && i % 1013 != 0) w.rating = 1 + static_cast<int>(random() % 7);
+        csv << w.participant << ",stimulus" << i % 97 << ",thickness," << w.level
+            << ",translucent," << (w.rating ? std::to_string(*w.rating) : "NA") << "\n";
+        written.push_back(w);
+    }
+    const std::string text = csv.str();
+    ASSERT_GT(text.size(), std::size_t{4} << 20);
+    const LongTable table = read(text);
+    ASSERT_EQ(table.rows.size(), written.size());
+    const double origin = *written[3].rating;  // the first rating (rows 0-2 are NA)
+    EXPECT_EQ(table.origin, origin);
+    for (std::size_t i = 0; i < written.size(); ++i) {
+        const RatingRow& row = table.rows[i];
+        ASSERT_EQ(row.participant, written[i].participant) << i;
+        ASSERT_EQ(row.level, written[i].level) << i;
+        ASSERT_EQ(row.source_line, written[i].line) << i;
+        ASSERT_EQ(row.rating.has_value(), written[i].rating.has_value()) << i;
+        if (row.rating) ASSERT_EQ(table.origin + *row.rating, *written[i].rating) << i;
+    }
+    // A bad rating near the end (second half), then another near the start as well.
+    std::string bad = text;
+    const std::size_t late = bad.rfind(",translucent,") + 13;
+    bad.replace(late, 1, "x");
+    const std::string late_line = std::to_string(written.back().line);
+    EXPECT_EQ(error_of(bad), "ratings.csv:" + late_line + ": rating 'x' is not a finite number");
+    const std::size_t early = bad.find(",translucent,", bad.find("participant10,")) + 13;
+    bad.replace(early, 1, "y");
+    EXPECT_EQ(error_of(bad).rfind("ratings.csv:12: rating 'y'", 0), 0u) << error_of(bad);
 }
 
 TEST(Label, EqualTextsAreOneLabelAndOrderByText) {

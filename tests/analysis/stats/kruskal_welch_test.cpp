@@ -68,7 +68,7 @@ TEST(KruskalWallis, LikertTiesMatchRankVarianceFormula) {
 }
 
 TEST(KruskalWallis, ManyDistinctValuesWithTiesMatchRankVarianceFormula) {
-    // Past 64 distinct values the ranks come from one sort of the pooled values.
+    // Values that are not whole numbers: the ranks come from one sort of the pooled values.
     std::mt19937 engine(5);
     std::normal_distribution<double> normal(0.0, 1.0);
     std::vector<std::vector<double>> values(4);
@@ -78,6 +78,21 @@ TEST(KruskalWallis, ManyDistinctValuesWithTiesMatchRankVarianceFormula) {
     const auto r = kruskal_wallis(groups(values));
     ASSERT_TRUE(r.h);
     EXPECT_NEAR(*r.h, h_by_rank_variance(values), 1e-10);
+}
+
+TEST(KruskalWallis, WholeNumbersNarrowOrWideMatchRankVarianceFormula) {
+    // Negative whole numbers with ties (counted in a histogram), and whole numbers spread
+    // wider than the histogram's span (sorted), against the brute-force ranks.
+    std::mt19937 engine(11);
+    for (const int spread : {9, 100000}) {
+        std::uniform_int_distribution<int> value(-spread, spread);
+        std::vector<std::vector<double>> values(3);
+        for (int g = 0; g < 3; ++g)
+            for (int i = 0; i < 40 + 5 * g; ++i) values[g].push_back(value(engine) + 2 * g);
+        const auto r = kruskal_wallis(groups(values));
+        ASSERT_TRUE(r.h) << spread;
+        EXPECT_NEAR(*r.h, h_by_rank_variance(values), 1e-10) << spread;
+    }
 }
 
 TEST(KruskalWallis, AllTiedIsUndefined) {
