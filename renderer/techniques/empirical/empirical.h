@@ -30,7 +30,12 @@ double peel_epsilon(const std::string& depth_precision);
 ResourceFormat depth_format(const std::string& depth_precision);
 
 // Adds the technique's passes to `plan` (passes.cpp).
-void add_passes(const Scene& scene, PlanBuilder& plan);
+// How `shade` lights the front layer when the backlight runs: once per pixel from the
+// surface the front pass stored (deferred, what the technique plans), or every rasterised
+// fragment (forward: always without the backlight; here for the test that the two agree).
+enum class Shading { deferred_when_exact, forward };
+void add_passes(const Scene& scene, PlanBuilder& plan,
+                Shading shading = Shading::deferred_when_exact);
 // CPU reference with Embree (reference.cpp).
 Image render_reference(const Scene& scene);
 

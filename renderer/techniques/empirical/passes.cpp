@@ -1,6 +1,7 @@
 // What the empirical technique adds to a frame plan (thesis ch. 3, apps. B-C):
 //   ambient_occlusion  per-vertex AO bake            -> vertex_ao        (ka*Ia != 0)
 //   front_depth        nearest surface depth         -> front_depth      (wb != 0)
+//                      (deferred: and its surface)   -> front_surface
 //   second_layer       depth peeling (App. B)        -> second_depth     (wb != 0)
 //   smooth_back_layer  depth-aware 5x5 / 3x3 blur    -> smoothed_depth   (wb != 0, kernel
 //   > 1) shade              Eq. 3.6                       -> colour
@@ -38,7 +39,7 @@ std::vector<Uniform> with(std::vector<Uniform> a, const std::vector<Uniform>& b)
 
 }  // namespace
 
-void add_passes(const Scene& scene, PlanBuilder& plan) {
+void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
     const Params p = params(scene);
     const glm::vec3 light_ambient = scene.light.ambient;
     // Which terms of Eq. 3.6 can change the image (all of them in full mode).
@@ -46,6 +47,14 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
         plan.full() || (p.ambient != 0.0 && light_ambient != glm::vec3(0.0f));
     const bool backlight_term = plan.full() || p.backlight != 0.0;
     const bool smoothing = backlight_term && (plan.full() || p.blur_kernel > 1);
+    // With the backlight the front layer is rasterised anyway (the peel reads it): it
+    // then also stores the surface, and `shade` lights it once per pixel instead of
+    // rasterising the mesh a third time and shading hidden fragments. The same floats
+    // in, the same colour out (tested bit for bit against Shading::forward); only with
+    // 32f depth, whose texels are the fragments' exact depths (at 16 or 24 bits the
+    // front layer's visibility would be resolved coarser than the shading's).
+    const bool deferred = backlight_term && shading == Shading::deferred_when_exact &&
+                          p.depth_precision == "32f";
     const ResourceFormat depth = depth_format(p.depth_precision);
     const auto camera = camera_uniforms(scene);
     const std::string mesh_vert = "techniques/empirical/shaders/mesh.vert";
@@ -64,13 +73,24 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     ao.ao_rays = p.ao_rays;
     plan.add(ao);
 
-    // Step 1 (Sec. 3.1): depth of the nearest surface; only the peel reads it.
+    // Step 1 (Sec. 3.1): depth of the nearest surface, read by the peel (and, deferred,
+    // the surface that `shade` lights).
     Pass front{"front_depth",
                "depth of the first layer",
                PassKind::draw_mesh,
                {mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}}};
     front.writes = {"front_depth"};
     front.uniforms = camera;
+    if (deferred) {
+        plan.create("front_surface", ResourceFormat::rgba32f);
+        front.purpose = "depth, interpolated normal and AO of the first layer";
+        front.shader.fragment = "techniques/empirical/shaders/front_surface.frag";
+        front.writes = {"front_surface", "front_depth"};
+        if (ambient_term) {
+            front.shader.defines.push_back("WITH_AMBIENT_OCCLUSION");
+            front.reads.push_back({"vertex_ao", ""});
+        }
+    }
     plan.add(front);
 
     std::string back_layer;
@@ -112,6 +132,14 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
                "Eq. 3.6: ambient*AO + diffuse + specular + backlight(thickness)",
                PassKind::draw_mesh,
                {mesh_vert, "techniques/empirical/shaders/shade.frag", {}}};
+    if (deferred) {
+        shade.purpose += ", once per pixel of the front layer";
+        shade.kind = PassKind::fullscreen;
+        shade.shader = {"gl/shaders/fullscreen.vert",
+                        "techniques/empirical/shaders/shade.frag",
+                        {"DEFERRED"}};
+        shade.reads = {{"front_depth", ""}, {"front_surface", ""}};
+    }
     std::vector<Uniform> u = {
         {"u_albedo", glm::vec3(p.albedo)},
         {"u_diffuse_contribution", static_cast<float>(p.diffuse_contribution)},
@@ -124,7 +152,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     };
     if (ambient_term) {
         shade.shader.defines.push_back("WITH_AMBIENT_OCCLUSION");
-        shade.reads.push_back({"vertex_ao", ""});
+        if (!deferred) shade.reads.push_back({"vertex_ao", ""});
         u.push_back({"u_ambient", static_cast<float>(p.ambient)});
         u.push_back({"u_light_ambient", light_ambient});
     }
@@ -138,8 +166,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
         u.push_back({"u_far", scene.camera.far_plane});
         u.push_back({"u_diameter", scene.bounds.diameter()});
     }
-    shade.uniforms = with(camera, u);
-    shade.writes = {"colour", "shade_depth"};
+    shade.uniforms = deferred ? u : with(camera, u);
+    shade.writes = deferred ? std::vector<std::string>{"colour"}
+                            : std::vector<std::string>{"colour", "shade_depth"};
     shade.clear_colour = glm::vec4(scene.background, 0.0f);
     plan.add(shade);
     plan.set_output("colour");

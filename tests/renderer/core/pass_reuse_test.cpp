@@ -166,11 +166,13 @@ TEST_F(TechniqueReuse, EmpiricalSlidersRerunOnlyThePassesTheyTouch) {
     EXPECT_EQ(
         executor.execute(plan("empirical", {{"shininess", "30"}, {"blur_kernel", "3"}})),
         (Names{"smooth_back_layer", "shade"}));
-    // AO rays: the bake and shading.
+    // AO rays: the bake, and the front layer that carries the AO to the (deferred)
+    // shading, so everything drawn after it.
     EXPECT_EQ(
         executor.execute(plan(
             "empirical", {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}})),
-        (Names{"ambient_occlusion", "shade"}));
+        (Names{"ambient_occlusion", "front_depth", "second_layer", "smooth_back_layer",
+               "shade"}));
     // Orbiting the camera: every drawing pass, never the AO bake.
     EXPECT_EQ(
         executor.execute(plan(
@@ -185,6 +187,10 @@ TEST_F(TechniqueReuse, EmpiricalSlidersRerunOnlyThePassesTheyTouch) {
                   "another mesh"),
               (Names{"ambient_occlusion", "front_depth", "second_layer",
                      "smooth_back_layer", "shade"}));
+    // Without the backlight the shading is forward: AO rays re-run the bake and it only.
+    executor.execute(plan("empirical", {{"backlight", "0"}, {"ao_rays", "64"}}));
+    EXPECT_EQ(executor.execute(plan("empirical", {{"backlight", "0"}, {"ao_rays", "32"}})),
+              (Names{"ambient_occlusion", "shade"}));
 }
 
 TEST_F(TechniqueReuse, EveryTechniqueRunsNothingOnAnIdenticalSecondFrame) {

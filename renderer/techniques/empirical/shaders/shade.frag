@@ -3,10 +3,19 @@
 //   colour = a*ka*Kd*Ia + wd*Kd*Id*max(N.L,0) + ws*ks*Is*max(N.H,0)^n   (only where N.L > 0)
 //          + wb*(1 - t)^r*(Kd + Kb)
 // Terms whose weight is zero are compiled out by the planner (WITH_AMBIENT_OCCLUSION,
-// WITH_BACKLIGHT), never branched on here.
+// WITH_BACKLIGHT), never branched on here. DEFERRED: a full-screen pass that lights the
+// front layer's stored surface once per pixel (front_surface.frag) instead of every
+// rasterised fragment; the inputs are the same floats, so is the colour.
+#ifdef DEFERRED
+uniform sampler2D front_depth;    // window depth of the front layer; 1 = no surface
+uniform sampler2D front_surface;  // interpolated eye-space normal, AO
+#else
 in vec3 v_normal_eye;
 #ifdef WITH_AMBIENT_OCCLUSION
 in float v_ambient_occlusion;
+#endif
+#endif
+#ifdef WITH_AMBIENT_OCCLUSION
 uniform float u_ambient;
 uniform vec3 u_light_ambient;
 #endif
@@ -45,24 +54,38 @@ float eye_depth(float window_depth) {
 
 // Thickness over the bounding-sphere diameter (Eq. 3.4), in [0, 1]. No second layer
 // (open mesh, clipped back) counts as the full diameter: t = 1.
-float thickness() {
+float thickness(float front) {
     float back = texelFetch(back_depth, ivec2(gl_FragCoord.xy), 0).r;
     if (back >= 1.0 || !(u_diameter > 0.0)) return 1.0;
-    float t = (eye_depth(back) - eye_depth(gl_FragCoord.z)) / u_diameter;
+    float t = (eye_depth(back) - eye_depth(front)) / u_diameter;
     return clamp(t, 0.0, 1.0);
 }
 #endif
 
 void main() {
+#ifdef DEFERRED
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    float front = texelFetch(front_depth, pixel, 0).r;
+    if (front >= 1.0) discard;  // no surface: the clear colour stays, as when rasterising
+    vec4 surface = texelFetch(front_surface, pixel, 0);
+    vec3 normal_eye = surface.xyz;
+    float ambient_occlusion = surface.w;
+#else
+    float front = gl_FragCoord.z;
+    vec3 normal_eye = v_normal_eye;
+#ifdef WITH_AMBIENT_OCCLUSION
+    float ambient_occlusion = v_ambient_occlusion;
+#endif
+#endif
     // Unit normal; a zero-length one (degenerate input) faces the viewer.
-    float length2 = dot(v_normal_eye, v_normal_eye);
-    vec3 n = length2 > 1e-30 ? v_normal_eye * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
+    float length2 = dot(normal_eye, normal_eye);
+    vec3 n = length2 > 1e-30 ? normal_eye * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
     vec3 l = u_light_direction;
     vec3 colour = vec3(0.0);
 
 #ifdef WITH_AMBIENT_OCCLUSION
     // Ambient term (Eq. 3.7): a * ka * Kd * Ia
-    colour += v_ambient_occlusion * u_ambient * u_albedo * u_light_ambient;
+    colour += ambient_occlusion * u_ambient * u_albedo * u_light_ambient;
 #endif
 
     // Diffuse and specular terms (Eqs. 3.8-3.9), only where N.L > 0. The half vector uses
@@ -79,7 +102,7 @@ void main() {
 
 #ifdef WITH_BACKLIGHT
     // Thickness term (Eq. 3.10): wb * (1 - t)^r * (Kd + Kb)
-    colour += u_backlight * power(1.0 - thickness(), u_thickness_exponent) *
+    colour += u_backlight * power(1.0 - thickness(front), u_thickness_exponent) *
               (u_albedo + vec3(u_diffuse_weight));
 #endif
     out_colour = vec4(colour, 1.0);

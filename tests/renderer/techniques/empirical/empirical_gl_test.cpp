@@ -11,6 +11,7 @@
 #include "gl/readback.h"
 #include "gl_test_fixture.h"
 #include "render.h"
+#include "techniques/empirical/empirical.h"
 #include "test_paths.h"
 
 namespace lucent {
@@ -54,6 +55,30 @@ TEST_F(EmpiricalGl, PrunedRenderEqualsFullRenderForEachPrunableTerm) {
     }
 }
 
+// Deferred shading (one full-screen pass lighting the front layer's stored normal and
+// AO) gives the image forward shading (the mesh rasterised again, every fragment
+// shaded) gives, bit for bit: the same floats go into the same arithmetic.
+TEST_F(EmpiricalGl, DeferredShadingEqualsForwardShadingBitForBit) {
+    gl::FrameExecutor executor;
+    const Technique& technique = find_technique("empirical");
+    for (const auto& settings : std::vector<std::vector<KnobAssignment>>{
+             {{"ao_rays", "32"}},
+             {{"ao_rays", "32"}, {"blur_kernel", "1"}, {"shininess", "80"}},
+             {{"ambient", "0"}, {"thickness_exponent", "3"}, {"backlight", "4"}}}) {
+        const Scene scene = empirical_scene(builtin_mesh("torus_knot:6k"), settings, 96, 80);
+        const FramePlan deferred = make_frame_plan(scene, technique);
+        PlanBuilder builder(PlanMode::pruned, scene.width, scene.height);
+        empirical::add_passes(scene, builder, empirical::Shading::forward);
+        const FramePlan forward = builder.compile();
+        ASSERT_EQ(deferred.passes.back().kind, PassKind::fullscreen);
+        ASSERT_EQ(forward.passes.back().kind, PassKind::draw_mesh);
+        const Image a = executor.render(scene, deferred);
+        const Image b = executor.render(scene, forward);
+        EXPECT_EQ(a.rgba, b.rgba) << settings.back().key;
+        EXPECT_GT(*std::max_element(a.rgba.begin(), a.rgba.end()), 0.05f);
+    }
+}
+
 TEST_F(EmpiricalGl, AllocatesOnlyTheTexturesThePlanNames) {
     gl::FrameExecutor executor;
     const auto mesh = builtin_mesh("sphere:2k");
@@ -64,7 +89,12 @@ TEST_F(EmpiricalGl, AllocatesOnlyTheTexturesThePlanNames) {
         std::sort(allocated.begin(), allocated.end());
         return allocated;
     };
+    // With the backlight, `shade` lights the front layer's stored surface (deferred):
+    // no depth buffer of its own.
     EXPECT_EQ(names({}),
+              (std::vector<std::string>{"colour", "front_depth", "front_surface",
+                                        "second_depth", "smoothed_depth", "vertex_ao"}));
+    EXPECT_EQ(names({{"depth_precision", "24"}}),
               (std::vector<std::string>{"colour", "front_depth", "second_depth",
                                         "shade_depth", "smoothed_depth", "vertex_ao"}));
     EXPECT_EQ(names({{"backlight", "0"}}),
