@@ -55,6 +55,95 @@ bool meets(const std::vector<int>& order, const std::vector<std::vector<bool>>& 
     return true;
 }
 
+// Over every order of a block's trials that meets `c` (as meets() judges a whole order),
+// how many there are and in how many the trial at each position is a catch trial. Exact,
+// by counting prefixes forwards and completions backwards over (trials used, the last
+// few trials): the constraints only look that far back, so this equals enumerating all
+// n! orders (checked against that on a small block below) in far fewer steps.
+std::pair<double, std::vector<double>> catch_position_counts(
+    const std::vector<std::vector<bool>>& same, const std::vector<bool>& is_catch,
+    const SequenceConstraints& c) {
+    const int n = static_cast<int>(same.size());
+    const int memory = std::max({c.min_distance - 1, c.max_repeat, 1});
+    struct State {
+        uint32_t used;
+        std::vector<int> last;  // the last `memory` trials, oldest first
+        bool operator<(const State& o) const {
+            return used != o.used ? used < o.used : last < o.last;
+        }
+    };
+    const auto allowed = [&](const State& s, int next) {
+        const int k = static_cast<int>(s.last.size());
+        for (int back = 1; back < c.min_distance && back <= k; ++back)
+            if (same[s.last[k - back]][next]) return false;
+        if (c.max_repeat > 0 && k >= c.max_repeat) {
+            const int first = s.last[k - c.max_repeat];
+            bool run = same[first][next];
+            for (int i = k - c.max_repeat + 1; i < k && run; ++i) run = same[first][s.last[i]];
+            if (run) return false;
+        }
+        return true;
+    };
+    const auto advance = [&](const State& s, int next) {
+        State t{s.used | (1u << next), s.last};
+        t.last.push_back(next);
+        if (static_cast<int>(t.last.size()) > memory) t.last.erase(t.last.begin());
+        return t;
+    };
+    std::vector<std::map<State, double>> prefixes(n + 1), completions(n + 1);
+    prefixes[0][State{0, {}}] = 1.0;
+    for (int length = 0; length < n; ++length)
+        for (const auto& [s, count] : prefixes[length])
+            for (int next = 0; next < n; ++next)
+                if (!(s.used >> next & 1u) && allowed(s, next))
+                    prefixes[length + 1][advance(s, next)] += count;
+    for (const auto& [s, count] : prefixes[n]) completions[n][s] = 1.0;
+    for (int length = n - 1; length >= 0; --length)
+        for (const auto& [s, count] : prefixes[length]) {
+            double ways = 0.0;
+            for (int next = 0; next < n; ++next)
+                if (!(s.used >> next & 1u) && allowed(s, next)) {
+                    const auto it = completions[length + 1].find(advance(s, next));
+                    if (it != completions[length + 1].end()) ways += it->second;
+                }
+            if (ways > 0.0) completions[length][s] = ways;
+        }
+    double valid = 0.0;
+    for (const auto& [s, count] : prefixes[n]) valid += count;
+    std::vector<double> at(n, 0.0);
+    for (int position = 0; position < n; ++position)
+        for (const auto& [s, count] : prefixes[position + 1]) {
+            const auto it = completions[position + 1].find(s);
+            if (it != completions[position + 1].end() && is_catch[s.last.back()])
+                at[position] += count * it->second;
+        }
+    return {valid, at};
+}
+
+TEST(PlanTrials, CatchPositionCountsEqualEnumeratingEveryOrder) {
+    // Seven trials: pictures A A B B C and catch trials showing A and C.
+    const std::vector<int> picture = {0, 0, 1, 1, 2, 0, 2};
+    const std::vector<bool> is_catch = {false, false, false, false, false, true, true};
+    std::vector<std::vector<bool>> same(7, std::vector<bool>(7));
+    for (int i = 0; i < 7; ++i)
+        for (int j = 0; j < 7; ++j) same[i][j] = picture[i] == picture[j];
+    for (const SequenceConstraints c : {SequenceConstraints{1, 3}, SequenceConstraints{1, 2},
+                                        SequenceConstraints{2, 0}}) {
+        std::vector<int> order = {0, 1, 2, 3, 4, 5, 6};
+        double valid = 0.0;
+        std::vector<double> at(7, 0.0);
+        do {
+            if (!meets(order, same, c)) continue;
+            ++valid;
+            for (int pos = 0; pos < 7; ++pos) at[pos] += is_catch[order[pos]];
+        } while (std::next_permutation(order.begin(), order.end()));
+        const auto [counted, counted_at] = catch_position_counts(same, is_catch, c);
+        EXPECT_GT(valid, 0.0);
+        EXPECT_EQ(counted, valid) << c.max_repeat << " " << c.min_distance;
+        EXPECT_EQ(counted_at, at) << c.max_repeat << " " << c.min_distance;
+    }
+}
+
 // Upper quantile of chi-square with `df` degrees of freedom at P = 0.001
 // (Wilson-Hilferty; within about 1% for df >= 3).
 double chi_square_999(double df) {
@@ -209,16 +298,7 @@ TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
         std::vector<std::vector<bool>> same(n, std::vector<bool>(n));
         for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j) same[i][j] = same_picture(*trials.stimuli[i], *trials.stimuli[j]);
-        std::vector<int> order(n);
-        for (int i = 0; i < n; ++i) order[i] = i;
-        std::vector<double> at(n, 0.0);
-        double valid = 0.0;
-        do {
-            if (!meets(order, same, c)) continue;
-            ++valid;
-            for (int pos = 0; pos < n; ++pos)
-                if (trials.is_catch[order[pos]]) ++at[pos];
-        } while (std::next_permutation(order.begin(), order.end()));
+        auto [valid, at] = catch_position_counts(same, trials.is_catch, c);
         ASSERT_GT(valid, 0.0) << block.id;
         for (double& a : at) a /= valid;
         catch_position_probability[block.id] = at;
