@@ -1,13 +1,15 @@
-// lucent bench frame: median GPU frame time per mesh size. For the empirical technique
-// (the default), the full shader against direct light only (ambient + diffuse +
-// specular: backlight = 0, so no peeling or smoothing), as the thesis's Table 4.2 with
-// the ratio per row. For any other technique, `--sweep KNOB=V1,V2,...` gives one row per
-// mesh and value with the total, the costliest pass and the cost per unit of the value
-// (the dipole's time per sample, as in Chang et al.'s Table 2). The AO bake is
-// precomputed (cached) and not part of the frame, as in the thesis.
+// lucent bench frame: median GPU frame time per mesh size. A technique that declares a
+// comparison (Technique::frame_comparison: the empirical shader's full vs direct light,
+// as the thesis's Table 4.2) gets its variants per mesh with the ratio to the baseline;
+// otherwise, or with `--sweep KNOB=V1,V2,...`, one row per mesh and value with the
+// total, the costliest pass and the cost per unit of the value (the dipole's time per
+// sample, as Chang et al.'s Table 2). The AO bake is precomputed (cached) and not part
+// of the frame, as in the thesis.
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "commands.h"
@@ -23,8 +25,8 @@ struct FrameBenchOptions {
     std::string technique = "empirical";
     std::string sweep;  // KNOB=V1,V2,...: one row per mesh and value
     std::vector<std::string> settings;  // key=value for every row
-    std::string mesh = "torus_knot";
-    std::vector<std::string> faces = {"4k", "30k", "60k", "120k", "240k"};
+    std::string mesh;                   // default: the technique's comparison, or sphere
+    std::vector<std::string> faces;
     std::string size = "512x512";
     int frames = 60;
     int warmup = 3;
@@ -235,8 +237,148 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
     return finish_csv(options, csv);
 }
 
-int run_frame_bench(const FrameBenchOptions& options) {
+// The technique's own comparison (Technique::frame_comparison): one row per mesh, each
+// variant's median frame time and its ratio to the last variant.
+int run_comparison_bench(const FrameBenchOptions& options, const FrameComparison& comparison,
+                         RenderRequest request, gl::Context& context) {
+    std::vector<KnobAssignment> fixed;
+    try {
+        for (const auto& setting : options.settings) fixed.push_back(parse_assignment(setting));
+    } catch (const std::exception& e) {
+        std::cerr << "lucent bench frame: --set: " << e.what() << "\n";
+        return kExitUsage;
+    }
+    const auto& variants = comparison.variants;
+    const std::string& baseline = variants.back().label;
+    std::ostringstream table, breakdowns;
+    std::vector<std::string> header = {"mesh", "faces", "vertices"};
+    char line[256];
+    std::snprintf(line, sizeof line, "%10s %10s |", "faces", "vertices");
+    std::string heading = line;
+    for (const auto& v : variants) {
+        std::snprintf(line, sizeof line, " %12s %8s |", (v.label + " (ms)").c_str(), "fps");
+        heading += line;
+        header.push_back(v.label + "_ms");
+    }
+    for (std::size_t v = 0; v + 1 < variants.size(); ++v) {
+        std::snprintf(line, sizeof line, " %*s", std::max<int>(6, static_cast<int>(
+                          variants[v].label.size() + baseline.size() + 3)),
+                      (variants[v].label + " / " + baseline).c_str());
+        heading += line;
+        header.push_back(variants[v].label + "_over_" + baseline);
+    }
+    table << heading << "\n" << std::string(heading.size(), '-') << "\n";
+    std::vector<std::vector<std::string>> csv = {header};
+    const Technique& technique = find_technique(options.technique);
+    bool gpu_timer = false;
+    for (const auto& faces : options.faces) {
+        request.mesh = options.mesh + ":" + faces;
+        std::vector<Scene> scenes;
+        try {
+            for (const auto& v : variants) {
+                request.settings = fixed;
+                request.settings.insert(request.settings.end(), v.settings.begin(),
+                                        v.settings.end());
+                scenes.push_back(build_scene(request));
+                scenes.back().mesh = scenes.front().mesh;  // same mesh object: uploaded once
+            }
+        } catch (const std::exception& e) {
+            std::cerr << "lucent bench frame: " << e.what() << "\n";
+            return kExitUsage;
+        }
+        const Mesh& mesh = *scenes.front().mesh;
+        std::cerr << "measuring " << request.mesh << " (" << mesh.face_count()
+                  << " faces)...\n";
+        // Frames alternate between the variants (one executor each, so none
+        // reallocates), so all see the same load on a shared machine.
+        std::vector<std::unique_ptr<Sampler>> samplers;
+        for (const Scene& scene : scenes) {
+            samplers.push_back(std::make_unique<Sampler>());
+            samplers.back()->plan = make_frame_plan(scene, technique);
+        }
+        try {
+            for (int i = 0; i < options.warmup + options.frames; ++i)
+                for (std::size_t v = 0; v < variants.size(); ++v)
+                    samplers[v]->run(scenes[v], i >= options.warmup);
+        } catch (const std::exception& e) {
+            std::cerr << "lucent bench frame: " << e.what() << "\n";
+            return kExitFailure;
+        }
+        gpu_timer = samplers.front()->executor.last_timings().gpu_timer;
+        std::vector<double> ms;
+        for (const auto& sampler : samplers) ms.push_back(median(sampler->frame_ms));
+        std::snprintf(line, sizeof line, "%10zu %10zu |", mesh.face_count(),
+                      mesh.vertex_count());
+        table << line;
+        std::vector<std::string> row = {request.mesh, std::to_string(mesh.face_count()),
+                                        std::to_string(mesh.vertex_count())};
+        breakdowns << "  " << mesh.face_count() << " faces:";
+        for (std::size_t v = 0; v < variants.size(); ++v) {
+            std::snprintf(line, sizeof line, " %12.3f %8.1f |", ms[v], 1000.0 / ms[v]);
+            table << line;
+            row.push_back(number(ms[v]));
+            breakdowns << (v ? " | " : " ") << variants[v].label << ": "
+                       << samplers[v]->breakdown();
+        }
+        for (std::size_t v = 0; v + 1 < variants.size(); ++v) {
+            const std::string label = variants[v].label + " / " + baseline;
+            std::snprintf(line, sizeof line, " %*.2f",
+                          std::max<int>(6, static_cast<int>(label.size())),
+                          ms[v] / ms.back());
+            table << line;
+            row.push_back(number(ms[v] / ms.back()));
+        }
+        table << "\n";
+        breakdowns << "\n";
+        csv.push_back(row);
+    }
+    std::string ratio_legend;
+    for (std::size_t v = 0; v + 1 < variants.size(); ++v)
+        ratio_legend += (v ? ", " : "ratio = ") + variants[v].label + " / " + baseline;
+    ratio_legend += " frame time";
+    const gl::GlInfo info = context.info();
+    std::cout << "lucent bench frame: " << options.technique << " on " << options.mesh
+              << " at " << request.width << "x" << request.height << ", median of "
+              << options.frames << " frames after " << options.warmup << " warm-up\n"
+              << "GL: " << info.renderer << " (" << info.version << ")\n"
+              << "timing: "
+              << (gpu_timer ? "GL timer queries (GL_TIME_ELAPSED), summed over passes"
+                            : "wall time around glFinish per pass (no timer queries)")
+              << "; AO bake precomputed, not in the frame\n"
+              << comparison.note << "\n\n"
+              << table.str() << ratio_legend << "\n\n"
+              << "median per pass (ms):\n"
+              << breakdowns.str();
+    return finish_csv(options, csv);
+}
+
+int run_frame_bench(FrameBenchOptions options, const std::vector<std::string>& given) {
+    const auto was_given = [&](const char* option) {
+        return std::find(given.begin(), given.end(), option) != given.end();
+    };
+    const Technique* technique = nullptr;
+    try {
+        technique = &find_technique(options.technique);
+    } catch (const std::exception& e) {
+        std::cerr << "lucent bench frame: --technique: " << e.what() << "\n";
+        return kExitUsage;
+    }
+    const std::optional<FrameComparison> comparison =
+        options.sweep.empty() ? technique->frame_comparison() : std::nullopt;
+    // Defaults: the technique's comparison table, else a sweep at a size llvmpipe can do
+    // in minutes (the dipole at N = 2500 costs seconds per 512x512 frame).
+    if (comparison) {
+        if (!was_given("--mesh")) options.mesh = comparison->mesh;
+        if (!was_given("--faces")) options.faces = comparison->faces;
+    } else {
+        if (!was_given("--size")) options.size = "128x128";
+        if (!was_given("--frames")) options.frames = 5;
+        if (!was_given("--warmup")) options.warmup = 1;
+        if (!was_given("--mesh")) options.mesh = "sphere";
+        if (!was_given("--faces")) options.faces = {"2k", "10k", "30k"};
+    }
     RenderRequest request;
+    request.technique = options.technique;
     if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) !=
             2 ||
         options.frames < 1) {
@@ -250,77 +392,8 @@ int run_frame_bench(const FrameBenchOptions& options) {
         std::cerr << "lucent bench frame: " << e.what() << "\n";
         return kExitFailure;
     }
-    request.technique = options.technique;
-    try {
-        find_technique(options.technique);
-    } catch (const std::exception& e) {
-        std::cerr << "lucent bench frame: --technique: " << e.what() << "\n";
-        return kExitUsage;
-    }
-    if (options.technique != "empirical" || !options.sweep.empty())
-        return run_sweep_bench(options, request, *context);
-    const gl::GlInfo info = context->info();
-    std::ostringstream table, breakdowns;
-    bool gpu_timer = false;
-    char line[200];
-    std::snprintf(line, sizeof line, "%10s %10s | %12s %8s | %12s %8s | %6s\n", "faces",
-                  "vertices", "full (ms)", "fps", "direct (ms)", "fps", "ratio");
-    table << line << std::string(80, '-') << "\n";
-    std::vector<std::vector<std::string>> csv = {
-        {"mesh", "faces", "vertices", "full_ms", "direct_ms", "ratio"}};
-    for (const auto& faces : options.faces) {
-        request.mesh = options.mesh + ":" + faces;
-        request.settings.clear();
-        Scene full, direct;
-        try {
-            full = build_scene(request);
-            request.settings = {{"backlight", "0"}};
-            direct = build_scene(request);
-            direct.mesh = full.mesh;  // same mesh object: uploaded once
-        } catch (const std::exception& e) {
-            std::cerr << "lucent bench frame: " << e.what() << "\n";
-            return kExitUsage;
-        }
-        std::cerr << "measuring " << request.mesh << " (" << full.mesh->face_count()
-                  << " faces)...\n";
-        // Frames alternate between the two variants (one executor each, so neither
-        // reallocates), so both see the same load on a shared machine.
-        Sampler full_sampler, direct_sampler;
-        full_sampler.plan = make_frame_plan(full, find_technique(full.technique));
-        direct_sampler.plan = make_frame_plan(direct, find_technique(direct.technique));
-        for (int i = 0; i < options.warmup + options.frames; ++i) {
-            full_sampler.run(full, i >= options.warmup);
-            direct_sampler.run(direct, i >= options.warmup);
-        }
-        gpu_timer = full_sampler.executor.last_timings().gpu_timer;
-        const double full_ms = median(full_sampler.frame_ms);
-        const double direct_ms = median(direct_sampler.frame_ms);
-        breakdowns << "  " << full.mesh->face_count()
-                   << " faces: full: " << full_sampler.breakdown()
-                   << " | direct: " << direct_sampler.breakdown() << "\n";
-        std::snprintf(
-            line, sizeof line, "%10zu %10zu | %12.3f %8.1f | %12.3f %8.1f | %6.2f\n",
-            full.mesh->face_count(), full.mesh->vertex_count(), full_ms, 1000.0 / full_ms,
-            direct_ms, 1000.0 / direct_ms, full_ms / direct_ms);
-        table << line;
-        csv.push_back({request.mesh, std::to_string(full.mesh->face_count()),
-                       std::to_string(full.mesh->vertex_count()), number(full_ms),
-                       number(direct_ms), number(full_ms / direct_ms)});
-    }
-    std::cout << "lucent bench frame: " << options.mesh << " at " << request.width << "x"
-              << request.height << ", median of " << options.frames << " frames after "
-              << options.warmup << " warm-up\n"
-              << "GL: " << info.renderer << " (" << info.version << ")\n"
-              << "timing: "
-              << (gpu_timer ? "GL timer queries (GL_TIME_ELAPSED), summed over passes"
-                            : "wall time around glFinish per pass (no timer queries)")
-              << "; AO bake precomputed, not in the frame\n"
-              << "full = empirical shader (AO, peel, 5x5 smoothing, Eq. 3.6); direct = "
-                 "ambient + diffuse + specular (backlight 0)\n\n"
-              << table.str() << "ratio = full / direct frame time\n\n"
-              << "median per pass (ms):\n"
-              << breakdowns.str();
-    return finish_csv(options, csv);
+    if (comparison) return run_comparison_bench(options, *comparison, request, *context);
+    return run_sweep_bench(options, request, *context);
 }
 
 }  // namespace
@@ -345,17 +418,10 @@ void register_bench_frame(CLI::App& bench, int& exit_code) {
     cmd->add_option("--warmup", options->warmup, "untimed frames first");
     cmd->add_option("--csv", options->csv, "also write the table as CSV (columns as printed)");
     cmd->callback([options, cmd, &exit_code] {
-        // A technique other than the empirical one defaults to a size llvmpipe can do in
-        // minutes (the dipole at N = 2500 costs seconds per 512x512 frame).
-        FrameBenchOptions effective = *options;
-        if (effective.technique != "empirical") {
-            if (cmd->count("--size") == 0) effective.size = "128x128";
-            if (cmd->count("--frames") == 0) effective.frames = 5;
-            if (cmd->count("--warmup") == 0) effective.warmup = 1;
-            if (cmd->count("--mesh") == 0) effective.mesh = "sphere";
-            if (cmd->count("--faces") == 0) effective.faces = {"2k", "10k", "30k"};
-        }
-        exit_code = run_frame_bench(effective);
+        std::vector<std::string> given;
+        for (const char* option : {"--size", "--frames", "--warmup", "--mesh", "--faces"})
+            if (cmd->count(option) > 0) given.push_back(option);
+        exit_code = run_frame_bench(*options, given);
     });
 }
 

@@ -3,6 +3,8 @@
 // time and listed once in renderer/techniques/registry.cpp; adding one is a folder under
 // renderer/techniques/ plus one registry line. GL-free: a technique describes passes
 // (shaders, reads, writes, uniforms) and renderer/gl executes them.
+#include <optional>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -26,6 +28,20 @@ struct QualitySweep {
     std::vector<std::pair<std::string, KnobValue>> with = {};
 };
 
+// What `lucent bench frame` compares for a technique, as its source paper's cost table
+// did: variants of one scene rendered on each mesh of a family, frames interleaved, each
+// variant's median frame time and its ratio to the last variant (the baseline).
+struct FrameComparison {
+    std::string mesh;                // built-in family, e.g. "torus_knot"
+    std::vector<std::string> faces;  // face budgets, one row each
+    struct Variant {
+        std::string label;  // column heading, e.g. "full"
+        std::vector<KnobAssignment> settings;
+    };
+    std::vector<Variant> variants;  // at least two; the last is the baseline
+    std::string note;               // one line under the table: what the ratios mean
+};
+
 class Technique {
 public:
     virtual ~Technique() = default;
@@ -45,6 +61,9 @@ public:
     // How an interactive view refines this technique's image over frames (none by
     // default): see core/progressive.h.
     virtual ProgressiveRefinement progressive_refinement() const { return {}; }
+    // The cost comparison of `lucent bench frame --technique NAME`; none: the bench
+    // sweeps the first quality knob instead.
+    virtual std::optional<FrameComparison> frame_comparison() const { return std::nullopt; }
 };
 
 // The plan of `scene` under its technique: technique.plan() then compile().

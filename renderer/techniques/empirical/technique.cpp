@@ -34,6 +34,15 @@ public:
             {"ao_rays", {16, 40, 80, 160, 320}, 1024},
         };
     }
+    // The thesis's Table 4.2: the full shader against direct light only (no peeling or
+    // smoothing), per mesh size.
+    std::optional<FrameComparison> frame_comparison() const override {
+        return FrameComparison{"torus_knot",
+                               {"4k", "30k", "60k", "120k", "240k"},
+                               {{"full", {}}, {"direct", {{"backlight", "0"}}}},
+                               "full = empirical shader (AO, peel, 5x5 smoothing, Eq. 3.6); "
+                               "direct = ambient + diffuse + specular (backlight 0)"};
+    }
 };
 
 }  // namespace
