@@ -3,6 +3,8 @@
 // per mesh size, as the thesis's Table 4.2 with the ratio per row. The AO bake is
 // precomputed (cached) and not part of the frame, as in the thesis.
 #include <algorithm>
+#include <fstream>
+#include <memory>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -10,12 +12,15 @@
 #include "commands.h"
 #include "gl/context.h"
 #include "render.h"
+#include "techniques/htsm/htsm.h"
 #include "techniques/registry.h"
 
 namespace lucent::app {
 namespace {
 
 struct FrameBenchOptions {
+    std::string technique = "empirical";  // empirical (Table 4.2) or htsm (Fig. 5.9)
+    std::string csv;                      // htsm: the table, machine-readable
     std::string mesh = "torus_knot";
     std::vector<std::string> faces = {"4k", "30k", "60k", "120k", "240k"};
     std::string size = "512x512";
@@ -62,6 +67,72 @@ struct Sampler {
     }
 };
 
+// Shopf's Fig. 5.9: frame time for n = 1, 5, 9, 13 rays at the default S, one mesh
+// (the first --faces budget), frames of the four variants interleaved; the ratio to
+// n = 1 (the thesis: 8.8-11.5x for n = 13 on three GPUs) and the fetches per pixel.
+int run_htsm_frame_bench(const FrameBenchOptions& options, RenderRequest request,
+                         const gl::GlInfo& info) {
+    request.technique = "htsm";
+    request.mesh = options.mesh + ":" + options.faces.front();
+    const std::vector<int> rays = {1, 5, 9, 13};
+    std::vector<Scene> scenes;
+    std::vector<std::unique_ptr<Sampler>> samplers;
+    try {
+        for (int n : rays) {
+            RenderRequest r = request;
+            r.settings.push_back({"rays", std::to_string(n)});
+            scenes.push_back(build_scene(r));
+            if (scenes.size() > 1) scenes.back().mesh = scenes.front().mesh;
+            samplers.push_back(std::make_unique<Sampler>());
+            samplers.back()->plan = make_frame_plan(scenes.back(), find_technique("htsm"));
+        }
+    } catch (const std::exception& e) {
+        std::cerr << "lucent bench frame: " << e.what() << "\n";
+        return kExitUsage;
+    }
+    std::cerr << "measuring htsm on " << request.mesh << "...\n";
+    for (int i = 0; i < options.warmup + options.frames; ++i)
+        for (std::size_t v = 0; v < rays.size(); ++v)
+            samplers[v]->run(scenes[v], i >= options.warmup);
+    const double base = median(samplers[0]->frame_ms);
+    std::ostringstream table, csv, breakdowns;
+    char line[200];
+    std::snprintf(line, sizeof line, "%6s | %12s %8s | %10s | %12s\n", "rays n", "frame (ms)",
+                  "fps", "ratio", "fetches/px");
+    table << line << std::string(60, '-') << "\n";
+    csv << "rays,frame_ms,fps,ratio_to_n1,fetches_per_pixel,steps,light_map_size\n";
+    const htsm::Params p = htsm::params(scenes[0]);
+    for (std::size_t v = 0; v < rays.size(); ++v) {
+        const double ms = median(samplers[v]->frame_ms);
+        const int fetches = htsm::fetches_per_pixel(scenes[v]);
+        std::snprintf(line, sizeof line, "%6d | %12.3f %8.1f | %10.2f | %12d\n", rays[v], ms,
+                      1000.0 / ms, ms / base, fetches);
+        table << line;
+        csv << rays[v] << "," << ms << "," << 1000.0 / ms << "," << ms / base << ","
+            << fetches << "," << p.steps << "," << p.light_map_size << "\n";
+        breakdowns << "  n = " << rays[v] << ": " << samplers[v]->breakdown() << "\n";
+    }
+    std::cout << "lucent bench frame --technique htsm: " << request.mesh << " at "
+              << request.width << "x" << request.height << ", S = " << p.steps
+              << ", W_L = " << p.light_map_size << ", median of " << options.frames
+              << " frames after " << options.warmup << " warm-up (variants interleaved)\n"
+              << "GL: " << info.renderer << " (" << info.version << ")\n\n"
+              << table.str()
+              << "ratio = frame time / frame time at n = 1 (Shopf Fig. 5.9: n = 13 costs "
+                 "8.8-11.5x n = 1 on three GPUs)\n\nmedian per pass (ms):\n"
+              << breakdowns.str();
+    if (!options.csv.empty()) {
+        std::ofstream out(options.csv);
+        out << csv.str();
+        if (!out) {
+            std::cerr << "lucent bench frame: --csv: cannot write " << options.csv << "\n";
+            return kExitFailure;
+        }
+        std::cout << "wrote " << options.csv << "\n";
+    }
+    return kExitOk;
+}
+
 int run_frame_bench(const FrameBenchOptions& options) {
     RenderRequest request;
     if (std::sscanf(options.size.c_str(), "%dx%d", &request.width, &request.height) !=
@@ -78,6 +149,12 @@ int run_frame_bench(const FrameBenchOptions& options) {
         return kExitFailure;
     }
     const gl::GlInfo info = context->info();
+    if (options.technique == "htsm") return run_htsm_frame_bench(options, request, info);
+    if (options.technique != "empirical") {
+        std::cerr << "lucent bench frame: --technique: '" << options.technique
+                  << "' (accepted: empirical, htsm)\n";
+        return kExitUsage;
+    }
     std::ostringstream table, breakdowns;
     bool gpu_timer = false;
     char line[200];
@@ -142,6 +219,10 @@ void register_bench_frame(CLI::App& bench, int& exit_code) {
     auto options = std::make_shared<FrameBenchOptions>();
     auto* cmd = bench.add_subcommand(
         "frame", "Median GPU frame time: full empirical shader vs direct light only");
+    cmd->add_option("--technique", options->technique,
+                    "empirical (full vs direct per mesh size) or htsm (n = 1, 5, 9, 13 "
+                    "rays on the first --faces budget)");
+    cmd->add_option("--csv", options->csv, "htsm: write the table as CSV");
     cmd->add_option("--mesh", options->mesh,
                     "built-in mesh family (face budgets from --faces)");
     cmd->add_option("--faces", options->faces, "face budgets, e.g. 4k 30k 60k 120k 240k")

@@ -21,6 +21,7 @@ struct Params {
     int samples = 5;                // knob `rays`: n = 1 + 4K rays: 1, 5, 9, 13 (Fig. 5.7/5.9)
     int steps = 5;                  // S midpoint steps per ray, [1, 64]
     int light_map_size = 256;       // W_L: 64 .. 1024, a power of two
+    bool light_mips = true;         // rings read their footprint's mip level (off: lod 0)
     int density_resolution = 64;    // R of generated volumes: 16, 32, 64, 128
     int phase_table_size = 256;     // N_f: 16, 64, 256, 1024
     double pattern_radius = 0.02;   // r1, first ring radius, fraction of Phi
@@ -89,5 +90,11 @@ Image render_reference_with_error(const Scene& scene, const ReferenceQuality& qu
                                   ReferenceError& error);
 
 void add_passes(const Scene& scene, PlanBuilder& plan);
+
+// Texture fetches per covered pixel of the shade pass as planned (pruned): per ray the
+// texcoord and irradiance, S density steps (a march), a phase lookup (g != 0); one
+// shadow-map read (surface terms). The thesis's "45 for n = 9" counts density only;
+// the full count at S = 5 is n (S + 3) + 1.
+int fetches_per_pixel(const Scene& scene);
 
 }  // namespace lucent::htsm

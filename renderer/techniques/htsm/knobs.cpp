@@ -44,6 +44,10 @@ const std::vector<Knob>& knobs() {
              1.0, 64.0, d.steps},
             choice("light_map_size", "W_L: side of the light-view images (texels)",
                    d.light_map_size, {"64", "128", "256", "512", "1024"}),
+            Knob{"light_mips",
+                 "on: each ring reads the mip level of its footprint (Sec. 4.3.1); off: "
+                 "every ray reads level 0 (point samples, no prefiltering)",
+                 KnobKind::choice, 0.0, 0.0, std::string("on"), {"off", "on"}},
             density,
             choice("density_resolution", "R: voxels per axis of a generated density volume",
                    d.density_resolution, {"16", "32", "64", "128"}),
@@ -80,6 +84,7 @@ Params params(const Scene& scene) {
     p.samples = std::stoi(v.choice("rays"));
     p.steps = v.integer("steps");
     p.light_map_size = std::stoi(v.choice("light_map_size"));
+    p.light_mips = v.choice("light_mips") == "on";
     p.density_resolution = std::stoi(v.choice("density_resolution"));
     p.phase_table_size = std::stoi(v.choice("phase_table_size"));
     p.pattern_radius = v.scalar("pattern_radius");
@@ -122,8 +127,9 @@ std::vector<PatternSample> pattern(const Params& p, const Geometry& g) {
     const int rings = (p.samples - 1) / 4;
     for (int k = 1; k <= rings; ++k) {
         const double radius = r1 * std::ldexp(1.0, k - 1);
-        const double lod =
-            radius > 0.0 ? std::clamp(std::log2(radius / g.texel), 0.0, top) : 0.0;
+        const double lod = radius > 0.0 && p.light_mips
+                               ? std::clamp(std::log2(radius / g.texel), 0.0, top)
+                               : 0.0;
         for (int j = 0; j < 4; ++j) {
             const double angle = j * 0.5 * M_PI + (k - 1) * 0.25 * M_PI;
             out.push_back({radius * glm::dvec2(std::cos(angle), std::sin(angle)), lod});
@@ -164,6 +170,17 @@ bool density_is_constant(const Params& p, const Scene& scene) {
 
 double constant_density(const Scene& scene) {
     return scene.density ? double(scene.density->mean) : 0.0;
+}
+
+int fetches_per_pixel(const Scene& scene) {
+    const Params p = params(scene);
+    int fetches = has_surface(p, scene) ? 1 : 0;
+    if (has_transport(p, scene)) {
+        const int per_ray = 2 + (density_is_constant(p, scene) ? 0 : p.steps) +
+                            (p.phase_g != 0.0 ? 1 : 0);
+        fetches += p.samples * per_ray;
+    }
+    return fetches;
 }
 
 }  // namespace lucent::htsm

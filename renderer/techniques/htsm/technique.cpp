@@ -31,6 +31,7 @@ public:
             {"density_resolution",
              {std::string("16"), std::string("32"), std::string("64"), std::string("128")},
              std::string("128")},
+            {"light_mips", {std::string("off"), std::string("on")}, std::string("on")},
             {"phase_table_size",
              {std::string("16"), std::string("64"), std::string("256"), std::string("1024")},
              std::string("1024")},
