@@ -28,7 +28,9 @@ const std::vector<Knob>& knobs() {
                      KnobKind::text, 0.0, 0.0, std::string("marble")};
         density.check = [](std::string_view text) -> std::string {
             try {
-                parse_density_spec(text);
+                // A file is read here too, so a bad one is refused where it is named
+                // (command line, config, explorer field), not later while rendering.
+                if (!parse_density_spec(text).file.empty()) make_density_volume(text, 1, 1.0);
                 return "";
             } catch (const DensityError& e) {
                 std::string why = e.what();
