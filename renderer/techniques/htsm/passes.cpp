@@ -30,7 +30,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     const bool full = plan.full();
     const bool transport = full || has_transport(p, scene);
     const bool surface = full || has_surface(p, scene);
-    const bool march = transport && (full || !density_is_constant(p, scene));
+    const bool march = transport && scene.density && (full || !density_is_constant(p, scene));
     const bool table = transport && (full || p.phase_g != 0.0);
     const std::vector<PatternSample> samples = pattern(p, g);
     bool coarse = full;
@@ -55,7 +55,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     plan.create("colour", ResourceFormat::rgba32f);
     plan.create("shade_depth", ResourceFormat::depth32f);
 
-    if (march && scene.density) {
+    if (march) {
         Pass volume{"density_volume",
                     "density volume " + scene.density->spec + " (" +
                         std::to_string(scene.density->size.x) + "^3 voxels)",
