@@ -231,6 +231,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
                 Scene scene = reference_scene;
                 scene.values =
                     resolve_knob_values(knobs_for(technique), row_request.settings);
+                // Scene inputs made from knobs follow them (htsm's density_resolution).
+                scene.density = density_from_knobs(scene.values);
                 const FramePlan plan = make_frame_plan(scene, technique);
                 Row row{sweep_label(sweep), format_knob_value(value)};
                 row.frame_ms =

@@ -319,6 +319,8 @@ int run_comparison_bench(const FrameBenchOptions& options, const FrameComparison
             row.push_back(number(ms[v]));
             breakdowns << (v ? " | " : " ") << variants[v].label << ": "
                        << samplers[v]->breakdown();
+            if (comparison.detail)
+                breakdowns << " (" << comparison.detail(scenes[v]) << ")";
         }
         for (std::size_t v = 0; v + 1 < variants.size(); ++v) {
             const std::string label = variants[v].label + " / " + baseline;

@@ -15,6 +15,7 @@ namespace {
 
 struct RenderOptions {
     std::string mesh;
+    std::string density;  // a density spec (htsm), the same as --set density=SPEC
     std::string technique = "empirical";
     std::vector<std::string> settings;
     std::string size = "512x512";
@@ -53,6 +54,7 @@ int run_render(const RenderOptions& options) {
         parse_size(options.size, request.width, request.height);
         request.mesh = options.mesh;
         request.technique = options.technique;
+        if (!options.density.empty()) request.settings.push_back({"density", options.density});
         for (const auto& s : options.settings)
             request.settings.push_back(parse_assignment(s));
         if (options.plan == "full")
@@ -150,6 +152,9 @@ void register_render(CLI::App& app, int& exit_code) {
     cmd->add_option("--preset", options->preset, "built-in stimulus set (thesis) into --out DIR");
     cmd->add_option("--jobs", options->jobs, "stimulus sets: parallel workers (default 1)");
     cmd->add_flag("--force", options->force, "stimulus sets: re-render unchanged stimuli too");
+    cmd->add_option("--density", options->density,
+                    "density volume over the mesh's box for techniques with one (htsm): "
+                    "constant, cube, spheres, marble, layers[:name=value,...] or FILE.nrrd");
     cmd->add_option("--technique", options->technique, "technique (" + techniques + ")");
     cmd->add_option(
         "--set", options->settings,

@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "core/ambient_occlusion.h"
+#include "core/density_volume.h"
 #include "core/mesh.h"
 #include "core/technique.h"
 #include "gl/context.h"
@@ -53,6 +54,10 @@ std::vector<ManifestField> parameter_fields(const Stimulus& stimulus) {
         const bool numeric =
             std::holds_alternative<double>(value) || std::holds_alternative<int>(value);
         fields.push_back({knob.name, format_knob_value(value), numeric});
+        // A density volume's content hash follows its spec, as mesh_hash follows mesh.
+        if (knob.name == "density")
+            fields.push_back({"density_hash",
+                              density_from_knobs(stimulus.parameters)->content_hash, false});
     }
     return fields;
 }
@@ -63,8 +68,10 @@ std::vector<std::string> parameter_columns(const StimulusSet& set) {
     std::vector<std::string> columns;
     for (const auto& s : set.stimuli)
         for (const Knob& knob : knobs_for(find_technique(s.technique)))
-            if (std::find(columns.begin(), columns.end(), knob.name) == columns.end())
+            if (std::find(columns.begin(), columns.end(), knob.name) == columns.end()) {
                 columns.push_back(knob.name);
+                if (knob.name == "density") columns.push_back("density_hash");
+            }
     return columns;
 }
 
@@ -208,6 +215,9 @@ std::string input_hash(const StimulusSet& set, const Stimulus& stimulus,
     for (const auto format : set.formats) hasher.add_field(extension(format));
     for (const auto& [name, value] : stimulus.parameters.all())
         hasher.add_field(name).add_field(format_knob_value(value));
+    // A density file can change under the same spec: its content decides.
+    if (const auto density = density_from_knobs(stimulus.parameters))
+        hasher.add_field("density_hash").add_field(density->content_hash);
     return hasher.hex();
 }
 

@@ -2,6 +2,7 @@
 // Knobs: every tunable parameter described once (name, meaning and unit, kind, range,
 // default). The CLI's `--set key=value`, TOML configs, the explorer's sliders, manifests
 // and `lucent bench accuracy` all read these descriptions; nothing else lists parameters.
+#include <functional>
 #include <glm/glm.hpp>
 #include <map>
 #include <span>
@@ -26,6 +27,7 @@ enum class KnobKind {
     integer,  // a whole number in [min, max]
     choice,   // one of `choices`, written as text ("5", "32f")
     vec3,     // "x,y,z"; each component in [min, max]; never the zero vector
+    text,     // free text (a density spec), checked by Knob::check; stored as a string
 };
 
 // double for scalar, glm::dvec3 for rgb and vec3, int for integer, std::string for
@@ -40,6 +42,9 @@ struct Knob {
     double max = 1.0;
     KnobValue default_value = 0.0;
     std::vector<std::string> choices;  // only for KnobKind::choice
+    // KnobKind::text only: why the text is not accepted, "" when it is (may be empty).
+    std::function<std::string(std::string_view)> check;
+    std::string accepted;  // KnobKind::text only: what is accepted, for messages
 };
 
 // Named, validated values; lookups of a missing name or the wrong type are logic errors
@@ -56,7 +61,7 @@ public:
     double scalar(std::string_view name) const;
     glm::dvec3 vec3(std::string_view name) const;  // rgb or vec3 knobs
     int integer(std::string_view name) const;
-    const std::string& choice(std::string_view name) const;
+    const std::string& choice(std::string_view name) const;  // choice or text knobs
     const std::map<std::string, KnobValue, std::less<>>& all() const { return values_; }
 
 private:

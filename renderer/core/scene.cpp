@@ -30,6 +30,7 @@ Scene make_scene(std::shared_ptr<const Mesh> mesh, const Technique& technique,
     scene.camera.near_plane =
         std::max(scene.camera.near_plane - margin, 0.5f * scene.camera.near_plane);
     scene.camera.far_plane += margin;
+    scene.density = density_from_knobs(values);
     scene.values = std::move(values);
     return scene;
 }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/camera.h"
+#include "core/density_volume.h"
 #include "core/knobs.h"
 #include "core/mesh.h"
 
@@ -24,6 +25,9 @@ struct Light {
 
 struct Scene {
     std::shared_ptr<const Mesh> mesh;
+    // Density over the mesh's bounding box, for techniques with a "density" knob (htsm);
+    // built from the knobs by make_scene, null otherwise.
+    std::shared_ptr<const DensityVolume> density;
     BoundingSphere bounds;  // of `mesh`; its diameter normalises thickness (Eq. 3.4)
     Camera camera;
     Light light;

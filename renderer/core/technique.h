@@ -3,6 +3,7 @@
 // time and listed once in renderer/techniques/registry.cpp; adding one is a folder under
 // renderer/techniques/ plus one registry line. GL-free: a technique describes passes
 // (shaders, reads, writes, uniforms) and renderer/gl executes them.
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -40,6 +41,8 @@ struct FrameComparison {
     };
     std::vector<Variant> variants;  // at least two; the last is the baseline
     std::string note;               // one line under the table: what the ratios mean
+    // Optional: what else to say of a variant's scene, e.g. "53 fetches per pixel".
+    std::function<std::string(const Scene&)> detail = {};
 };
 
 class Technique {

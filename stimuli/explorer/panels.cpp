@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/density_volume.h"
 #include "explorer/pass_times.h"
 #include "techniques/registry.h"
 
@@ -79,6 +80,15 @@ void knob_widget(ParameterSet& set, const Knob& knob, ExplorerSession& session,
             value = glm::dvec3(v[0], v[1], v[2]);
             break;
         }
+        case KnobKind::text: {
+            // Applied on Enter, so a half-typed spec is never built.
+            char text[512] = {};
+            std::snprintf(text, sizeof text, "%s", std::get<std::string>(value).c_str());
+            changed = ImGui::InputText(label, text, sizeof text,
+                                       ImGuiInputTextFlags_EnterReturnsTrue);
+            value = std::string(text);
+            break;
+        }
     }
     remember(knob.name, widgets, true);
     if (ImGui::IsItemHovered())
@@ -97,6 +107,39 @@ void group_widgets(ExplorerSession& session, KnobGroup group,
     ParameterSet& set = session.current();
     for (const Knob& knob : knobs_for(find_technique(set.technique())))
         if (knob_group(knob) == group) knob_widget(set, knob, session, widgets);
+}
+
+bool has_group(ExplorerSession& session, KnobGroup group) {
+    for (const Knob& knob : knobs_for(find_technique(session.current().technique())))
+        if (knob_group(knob) == group) return true;
+    return false;
+}
+
+// The density volume (htsm): one button per built-in generator, the spec field, then
+// resolution, contrast and scale; the volume's size and hash show what is rendered.
+void density_panel(ExplorerSession& session, std::map<std::string, WidgetRect>& widgets) {
+    ParameterSet& set = session.current();
+    for (const std::string& generator : density_generator_names()) {
+        if (button(generator.c_str(), widgets)) {
+            try {
+                set.set("density", generator);
+            } catch (const KnobError& e) {
+                session.message = e.what();
+            }
+        }
+        ImGui::SameLine();
+    }
+    ImGui::NewLine();
+    group_widgets(session, KnobGroup::density, widgets);
+    try {
+        if (const auto volume = density_from_knobs(set.values()))
+            ImGui::TextDisabled("%dx%dx%d voxels, mean %.3f, range [%.3f, %.3f], hash %s",
+                                volume->size.x, volume->size.y, volume->size.z,
+                                double(volume->mean), double(volume->min),
+                                double(volume->max), volume->content_hash.c_str());
+    } catch (const KnobError& e) {
+        ImGui::TextDisabled("%s", e.what());
+    }
 }
 
 void text_field(const char* label, std::string& text) {
@@ -240,6 +283,9 @@ PanelRequests draw_panels(ExplorerSession& session, const PanelInfo& info,
         actions_panel(session, requests, widgets);
     if (ImGui::CollapsingHeader("Technique", ImGuiTreeNodeFlags_DefaultOpen))
         group_widgets(session, KnobGroup::technique, widgets);
+    if (has_group(session, KnobGroup::density) &&
+        ImGui::CollapsingHeader("Density", ImGuiTreeNodeFlags_DefaultOpen))
+        density_panel(session, widgets);
     if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen))
         group_widgets(session, KnobGroup::material, widgets);
     if (ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) {

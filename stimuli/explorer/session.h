@@ -95,7 +95,7 @@ RenderRequest render_request(const ExplorerSession& session, int side, int width
 
 // The panel a knob belongs to: scene knobs by their group, shared material knobs,
 // ao_rays under AO, and everything else under the technique.
-enum class KnobGroup { light, camera, material, ambient_occlusion, technique };
+enum class KnobGroup { light, camera, material, ambient_occlusion, density, technique };
 KnobGroup knob_group(const Knob& knob);
 
 }  // namespace lucent::explorer

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 
+#include "core/density_volume.h"
 #include "core/mesh.h"
 #include "lucent/version.h"
 #include "manifest.h"
@@ -64,7 +65,7 @@ void check_against_manifest(StimulusProvenance& resolved, const std::vector<Knob
                 resolved.mesh_hash + " (mesh " + resolved.mesh + ")");
     for (const auto& [name, value] : resolved.values) {
         const Knob* knob = find_knob(knobs, name);
-        const std::string listed = canonical(*knob, field(row, name));
+        const std::string listed = knob ? canonical(*knob, field(row, name)) : field(row, name);
         if (listed != value) differs("parameter '" + name + "'", field(row, name), value);
     }
     // The content hash covers every format's file, as the batch renderer computed it.
@@ -134,9 +135,15 @@ std::vector<StimulusProvenance> resolve_stimuli(const Protocol& protocol,
             for (const auto& [name, value] : spec.parameters)
                 assignments.push_back({name, value});
             const KnobValues values = resolve_knob_values(*knobs, assignments);
-            for (const Knob& knob : *knobs)
+            for (const Knob& knob : *knobs) {
                 p.values.emplace_back(knob.name,
                                       format_knob_value(values.get(knob.name)));
+                // The density volume's content hash beside its spec, like mesh_hash
+                // beside the mesh: a changed file under the same spec is noticed.
+                if (knob.name == "density")
+                    p.values.emplace_back("density_hash",
+                                          density_from_knobs(values)->content_hash);
+            }
             auto [hash, is_new] = mesh_hashes.try_emplace(p.mesh);
             if (is_new) hash->second = load_mesh(p.mesh).content_hash;
             p.mesh_hash = hash->second;

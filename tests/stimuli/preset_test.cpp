@@ -118,7 +118,7 @@ TEST(ThesisPreset, RealCatalogRejectsUnknownTechniqueAndKeys) {
     } catch (const StimulusSetError& e) {
         EXPECT_NE(std::string(e.what()).find(
                       "x.toml:5:13: stimuli[0].technique: unknown technique "
-                      "'phong' (valid: empirical, ward, contrast_reversed, dipole)"),
+                      "'phong' (valid: empirical, ward, contrast_reversed, dipole, htsm)"),
                   std::string::npos)
             << e.what();
     }

@@ -1,0 +1,188 @@
+// The htsm knobs and the model functions the GL passes and the CPU reference share:
+// geometry (box, Phi, light view), the hierarchical pattern, Fresnel, phase, weight.
+#include <algorithm>
+#include <cmath>
+
+#include "core/common_knobs.h"
+#include "core/density_volume.h"
+#include "techniques/htsm/htsm.h"
+
+namespace lucent::htsm {
+
+const std::vector<Knob>& knobs() {
+    static const std::vector<Knob> list = [] {
+        const Params d{};
+        Knob albedo = albedo_knob(), specular = specular_knob(), shininess = shininess_knob();
+        albedo.default_value = d.albedo;
+        specular.default_value = d.specular;
+        shininess.default_value = d.shininess;
+        const auto choice = [](std::string name, std::string description, int value,
+                               std::vector<std::string> choices) {
+            return Knob{std::move(name), std::move(description), KnobKind::choice, 0.0,
+                        0.0, std::to_string(value), std::move(choices)};
+        };
+        Knob density{"density",
+                     "the density volume over the mesh's bounding box: a generator "
+                     "(constant, cube, spheres, marble, layers; e.g. marble:frequency=3) "
+                     "or an .nrrd file",
+                     KnobKind::text, 0.0, 0.0, std::string("marble")};
+        density.check = [](std::string_view text) -> std::string {
+            try {
+                // A file is read here too, so a bad one is refused where it is named
+                // (command line, config, explorer field), not later while rendering.
+                if (!parse_density_spec(text).file.empty()) make_density_volume(text, 1, 1.0);
+                return "";
+            } catch (const DensityError& e) {
+                std::string why = e.what();
+                return why.rfind("density: ", 0) == 0 ? why.substr(9) : why;
+            }
+        };
+        density.accepted =
+            "constant|cube|spheres|marble|layers[:name=value,...] or FILE.nrrd";
+        return std::vector<Knob>{
+            choice("rays", "n: rays per pixel in the hierarchical pattern (1 + 4 rings)",
+                   d.samples, {"1", "5", "9", "13"}),
+            {"steps", "S: midpoint steps through the density per ray", KnobKind::integer,
+             1.0, 64.0, d.steps},
+            choice("light_map_size", "W_L: side of the light-view images (texels)",
+                   d.light_map_size, {"64", "128", "256", "512", "1024"}),
+            Knob{"light_mips",
+                 "on: each ring reads the mip level of its footprint (Sec. 4.3.1); off: "
+                 "every ray reads level 0 (point samples, no prefiltering)",
+                 KnobKind::choice, 0.0, 0.0, std::string("on"), {"off", "on"}},
+            density,
+            choice("density_resolution", "R: voxels per axis of a generated density volume",
+                   d.density_resolution, {"16", "32", "64", "128"}),
+            {"density_contrast",
+             "c: rho = clamp(mean + c (rho - mean), 0, 1); 0 = homogeneous at the mean",
+             KnobKind::scalar, 0.0, 4.0, 1.0},
+            {"density_scale", "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
+             KnobKind::scalar, 0.0, 1000.0, d.density_scale},
+            choice("phase_table_size", "N_f: entries of the phase-function table",
+                   d.phase_table_size, {"16", "64", "256", "1024"}),
+            {"pattern_radius", "r1: radius of the first ring, fraction of Phi (ring k: r1 2^(k-1))",
+             KnobKind::scalar, 0.0, 0.5, d.pattern_radius},
+            {"transport_colour", "Tc: transport colour (linear rgb)", KnobKind::rgb, 0.0,
+             4.0, d.transport_colour},
+            {"transport_distance", "Td: transport distance, fraction of Phi",
+             KnobKind::scalar, 1e-3, 10.0, d.transport_distance},
+            {"phase_g", "g: Henyey-Greenstein asymmetry, normalised to f(1) = 1",
+             KnobKind::scalar, 0.0, 0.8, d.phase_g},
+            {"ior", "eta: index of refraction for Schlick's Fresnel on the lit side",
+             KnobKind::scalar, 1.0, 2.0, d.ior},
+            {"diffuse", "wd: weight of the shadowed Lambert term Kd Id N.L",
+             KnobKind::scalar, 0.0, 10.0, d.diffuse},
+            albedo,
+            specular,
+            shininess,
+        };
+    }();
+    return list;
+}
+
+Params params(const Scene& scene) {
+    const KnobValues& v = scene.values;
+    Params p;
+    p.samples = std::stoi(v.choice("rays"));
+    p.steps = v.integer("steps");
+    p.light_map_size = std::stoi(v.choice("light_map_size"));
+    p.light_mips = v.choice("light_mips") == "on";
+    p.density_resolution = std::stoi(v.choice("density_resolution"));
+    p.phase_table_size = std::stoi(v.choice("phase_table_size"));
+    p.pattern_radius = v.scalar("pattern_radius");
+    p.transport_colour = v.vec3("transport_colour");
+    p.transport_distance = v.scalar("transport_distance");
+    p.density_scale = v.scalar("density_scale");
+    p.phase_g = v.scalar("phase_g");
+    p.ior = v.scalar("ior");
+    p.albedo = v.vec3("albedo");
+    p.diffuse = v.scalar("diffuse");
+    p.specular = v.scalar("specular");
+    p.shininess = v.scalar("shininess");
+    return p;
+}
+
+Geometry geometry(const Scene& scene, const Params& p) {
+    Geometry g;
+    glm::dvec3 lo(1e300), hi(-1e300);
+    for (const glm::vec3& x : scene.mesh->positions) {
+        lo = glm::min(lo, glm::dvec3(x));
+        hi = glm::max(hi, glm::dvec3(x));
+    }
+    if (scene.mesh->positions.empty()) lo = hi = glm::dvec3(0.0);
+    g.phi = std::max(double(scene.bounds.diameter()), 1e-6);
+    // A flat mesh would make the box extent 0 (t = (p - min) / e divides by it): pad
+    // every extent to 1e-3 Phi around the centre.
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    g.box_extent = glm::max(hi - lo, glm::dvec3(1e-3 * g.phi));
+    g.box_min = centre - 0.5 * g.box_extent;
+    g.light = scene_light_view(scene);
+    g.to_light = glm::dvec3(g.light.direction);
+    g.texel = 2.0 * double(g.light.radius) / double(p.light_map_size);
+    return g;
+}
+
+std::vector<PatternSample> pattern(const Params& p, const Geometry& g) {
+    std::vector<PatternSample> out = {{{0.0, 0.0}, 0.0}};
+    const double top = std::log2(double(p.light_map_size));
+    const double r1 = p.pattern_radius * g.phi;
+    const int rings = (p.samples - 1) / 4;
+    for (int k = 1; k <= rings; ++k) {
+        const double radius = r1 * std::ldexp(1.0, k - 1);
+        const double lod = radius > 0.0 && p.light_mips
+                               ? std::clamp(std::log2(radius / g.texel), 0.0, top)
+                               : 0.0;
+        for (int j = 0; j < 4; ++j) {
+            const double angle = j * 0.5 * M_PI + (k - 1) * 0.25 * M_PI;
+            out.push_back({radius * glm::dvec2(std::cos(angle), std::sin(angle)), lod});
+        }
+    }
+    return out;
+}
+
+double schlick(double eta, double c) {
+    if (eta == 1.0) return 0.0;
+    const double f0 = ((eta - 1.0) / (eta + 1.0)) * ((eta - 1.0) / (eta + 1.0));
+    const double m = 1.0 - std::clamp(c, 0.0, 1.0);
+    return f0 + (1.0 - f0) * m * m * m * m * m;
+}
+
+double phase(double g, double mu) {
+    if (g == 0.0) return 1.0;
+    const double denominator = std::max(1.0 + g * g - 2.0 * g * std::clamp(mu, -1.0, 1.0), 1e-12);
+    return std::pow((1.0 - g) * (1.0 - g) / denominator, 1.5);
+}
+
+double transport_weight(double tau, double td) { return std::max(0.0, 2.0 - tau / td); }
+
+bool has_transport(const Params& p, const Scene& scene) {
+    return p.transport_colour != glm::dvec3(0.0) && scene.light.diffuse != glm::vec3(0.0f);
+}
+
+bool has_surface(const Params& p, const Scene& scene) {
+    const bool diffuse = p.diffuse != 0.0 && p.albedo != glm::dvec3(0.0) &&
+                         scene.light.diffuse != glm::vec3(0.0f);
+    const bool specular = p.specular != 0.0 && scene.light.specular != glm::vec3(0.0f);
+    return diffuse || specular;
+}
+
+bool density_is_constant(const Params& p, const Scene& scene) {
+    return !scene.density || scene.density->constant() || p.density_scale == 0.0;
+}
+
+double constant_density(const Scene& scene) {
+    return scene.density ? double(scene.density->mean) : 0.0;
+}
+
+int fetches_per_pixel(const Scene& scene) {
+    const Params p = params(scene);
+    int fetches = has_surface(p, scene) ? 1 : 0;
+    if (has_transport(p, scene)) {
+        const int per_ray = 2 + (density_is_constant(p, scene) ? 0 : p.steps) +
+                            (p.phase_g != 0.0 ? 1 : 0);
+        fetches += p.samples * per_ray;
+    }
+    return fetches;
+}
+
+}  // namespace lucent::htsm
