@@ -120,6 +120,10 @@ KnobValue knob_value(const Knob& knob, const toml::node& node, const std::string
                                                       : "[x, y, z] or \"x,y,z\"");
             }
             break;
+        case KnobKind::text:
+            if (!node.is_string()) wrong_type("a string");
+            text = node.as_string()->get();
+            break;
         case KnobKind::choice:
             if (node.is_string())
                 text = node.as_string()->get();

@@ -67,6 +67,8 @@ const char* kind_name(KnobKind kind) {
             return "a choice";
         case KnobKind::vec3:
             return "a 3-vector";
+        case KnobKind::text:
+            return "text";
     }
     return "?";
 }
@@ -133,6 +135,11 @@ std::string accepted_range(const Knob& knob) {
             for (const auto& c : knob.choices) list += (list.empty() ? "" : ", ") + c;
             return "one of " + list;
         }
+        case KnobKind::text: {
+            std::string list;
+            for (const auto& c : knob.choices) list += (list.empty() ? "" : ", ") + c;
+            return list.empty() ? "non-empty text" : "non-empty text such as " + list;
+        }
     }
     return "";
 }
@@ -179,6 +186,9 @@ KnobValue parse_knob_value(const Knob& knob, std::string_view text) {
             for (const auto& c : knob.choices)
                 if (text == c) return c;
             fail(knob, "'" + std::string(text) + "' is not a valid choice");
+        case KnobKind::text:
+            if (text.empty()) fail(knob, "empty");
+            return std::string(text);
     }
     fail(knob, "unknown kind");
 }
@@ -216,6 +226,12 @@ void validate_knob_value(const Knob& knob, const KnobValue& value) {
             for (const auto& c : knob.choices)
                 if (*v == c) return;
             fail(knob, "'" + *v + "' is not a valid choice");
+        }
+        case KnobKind::text: {
+            const auto* v = std::get_if<std::string>(&value);
+            if (!v) wrong_type();
+            if (v->empty()) fail(knob, "empty");
+            return;
         }
     }
 }

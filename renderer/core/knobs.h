@@ -26,10 +26,12 @@ enum class KnobKind {
     integer,  // a whole number in [min, max]
     choice,   // one of `choices`, written as text ("5", "32f")
     vec3,     // "x,y,z"; each component in [min, max]; never the zero vector
+    text,     // free text (a texture spec or file); the technique checks its meaning in
+              // Technique::check_scene, min and max unused; never empty
 };
 
 // double for scalar, glm::dvec3 for rgb and vec3, int for integer, std::string for
-// choice.
+// choice and text.
 using KnobValue = std::variant<double, glm::dvec3, int, std::string>;
 
 struct Knob {
@@ -39,7 +41,8 @@ struct Knob {
     double min = 0.0;  // range of a scalar / integer / each channel or component
     double max = 1.0;
     KnobValue default_value = 0.0;
-    std::vector<std::string> choices;  // only for KnobKind::choice
+    std::vector<std::string> choices;  // KnobKind::choice; for text: examples shown in
+                                       // the accepted range
 };
 
 // Named, validated values; lookups of a missing name or the wrong type are logic errors

@@ -10,6 +10,7 @@ const Technique& empirical_technique();
 const Technique& ward_technique();
 const Technique& contrast_reversed_technique();
 const Technique& dipole_technique();
+const Technique& thick_texture_technique();
 
 const std::vector<const Technique*>& all_techniques() {
     static const std::vector<const Technique*> techniques = {
@@ -17,6 +18,7 @@ const std::vector<const Technique*>& all_techniques() {
         &ward_technique(),
         &contrast_reversed_technique(),
         &dipole_technique(),
+        &thick_texture_technique(),
     };
     return techniques;
 }

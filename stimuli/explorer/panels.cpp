@@ -67,6 +67,17 @@ void knob_widget(ParameterSet& set, const Knob& knob, ExplorerSession& session,
             }
             break;
         }
+        case KnobKind::text: {
+            // Applied on Enter, so a half-typed spec is never rendered.
+            char buffer[512];
+            std::snprintf(buffer, sizeof buffer, "%s", std::get<std::string>(value).c_str());
+            if (ImGui::InputText(label, buffer, sizeof buffer,
+                                 ImGuiInputTextFlags_EnterReturnsTrue)) {
+                value = std::string(buffer);
+                changed = true;
+            }
+            break;
+        }
         case KnobKind::rgb:
         case KnobKind::vec3: {
             const glm::dvec3 d = std::get<glm::dvec3>(value);

@@ -1,0 +1,52 @@
+// Registers the thick_texture technique: David-Babin's semi-transparent textures of
+// opaque and transparent texels with a thickness.
+#include "core/technique.h"
+
+#include "techniques/thick_texture/thick_texture.h"
+
+namespace lucent {
+namespace {
+
+class ThickTextureTechnique final : public Technique {
+public:
+    std::string_view name() const override { return "thick_texture"; }
+    std::string_view description() const override {
+        return "see-through sheets: binary textures whose opaque texels have a thickness "
+               "(David-Babin 2022), over a backdrop; needs a mesh with UVs";
+    }
+    const std::vector<Knob>& knobs() const override { return thick_texture::knobs(); }
+    void check_scene(const Scene& scene) const override {
+        if (!scene.mesh->has_uvs())
+            throw MeshError(scene.mesh->name +
+                            ": has no texture coordinates, which thick_texture needs (use "
+                            "square, wave, drape or a mesh file with UVs)");
+        thick_texture::scene_texture(thick_texture::params(scene));  // parses the spec
+    }
+    void plan(const Scene& scene, PlanBuilder& plan) const override {
+        thick_texture::add_passes(scene, plan);
+    }
+    Image render_reference(const Scene& scene) const override {
+        return thick_texture::render_reference(scene);
+    }
+    std::vector<QualitySweep> quality_sweeps() const override {
+        return {
+            {"filter",
+             {std::string("nearest"), std::string("linear"), std::string("bilinear"),
+              std::string("trilinear")},
+             std::string("trilinear")},
+            {"fetch_path", {std::string("hardware"), std::string("thesis")},
+             std::string("hardware")},
+            {"wide_hole_bins", {std::string("1"), std::string("4"), std::string("8")},
+             std::string("1")},
+        };
+    }
+};
+
+}  // namespace
+
+const Technique& thick_texture_technique() {
+    static const ThickTextureTechnique technique;
+    return technique;
+}
+
+}  // namespace lucent
