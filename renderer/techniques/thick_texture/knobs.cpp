@@ -151,6 +151,13 @@ glm::dvec3 backdrop_colour(const Params& p, const Scene& scene, glm::dvec3 eye_d
     return cell == 0 ? a : b;
 }
 
+void require_uvs(const Mesh& mesh) {
+    if (!mesh.has_uvs() || mesh.tangents.size() != mesh.positions.size())
+        throw MeshError(mesh.name +
+                        ": has no texture coordinates, which thick_texture needs (use "
+                        "square, wave, drape or a mesh file with UVs)");
+}
+
 Variant variant_of(const Params& p, const TexelGrid& grid) {
     const double holes = grid.hole_fraction();
     if (holes == 0.0) return Variant::opaque;

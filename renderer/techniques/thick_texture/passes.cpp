@@ -66,12 +66,14 @@ std::string number(double value) {
 }  // namespace
 
 void add_passes(const Scene& scene, PlanBuilder& plan) {
+    require_uvs(*scene.mesh);  // the explorer plans without build_scene's check
     const Params p = params(scene);
     const TexelGrid& grid = scene_texture(p);
     const Variant variant = variant_of(p, grid);
     const bool full = plan.full();
     const bool thick = full || variant == Variant::thick;
-    const int bins = thick ? p.wide_hole_bins : 1;
+    // The wide-hole bins join the fast path only (the thesis path is the thesis's method).
+    const int bins = thick && p.fetch_path != "thesis" ? p.wide_hole_bins : 1;
     const bool flat = is_flat(*scene.mesh);
     const int layers = full ? p.layers
                             : (variant == Variant::opaque || flat ? 1 : p.layers);

@@ -54,6 +54,7 @@ double jitter(int x, int y, int k) {
 }  // namespace
 
 Image render_reference(const Scene& scene) {
+    require_uvs(*scene.mesh);
     const Params p = params(scene);
     const TexelGrid& grid = scene_texture(p);
     const Mesh& mesh = *scene.mesh;

@@ -16,10 +16,7 @@ public:
     }
     const std::vector<Knob>& knobs() const override { return thick_texture::knobs(); }
     void check_scene(const Scene& scene) const override {
-        if (!scene.mesh->has_uvs())
-            throw MeshError(scene.mesh->name +
-                            ": has no texture coordinates, which thick_texture needs (use "
-                            "square, wave, drape or a mesh file with UVs)");
+        thick_texture::require_uvs(*scene.mesh);
         thick_texture::scene_texture(thick_texture::params(scene));  // parses the spec
     }
     void plan(const Scene& scene, PlanBuilder& plan) const override {

@@ -134,6 +134,10 @@ double backdrop_distance(const Scene& scene);
 // Colour of the backdrop where an eye-space direction (z < 0) meets it.
 glm::dvec3 backdrop_colour(const Params& p, const Scene& scene, glm::dvec3 eye_direction);
 
+// Throws MeshError "NAME: has no texture coordinates, ..." for a mesh without UVs (the
+// planner, the reference and build_scene's check all call it).
+void require_uvs(const Mesh& mesh);
+
 // Which variant the planner picks (GL and --explain): thin alpha (h = 0), opaque (no
 // hole), empty (no opaque texel), or thick.
 enum class Variant { thin_alpha, opaque, empty, thick };
