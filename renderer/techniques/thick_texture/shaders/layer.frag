@@ -57,15 +57,19 @@ vec4 colour_of(Record t, vec2 r) {
 
 #ifdef THESIS_PATH
 ivec2 wrapped(ivec2 texel, ivec2 size) { return ((texel % size) + size) % size; }
+// Level sizes from level 0: llvmpipe's textureSize(sampler, lod) with a lod that differs
+// across the pixels shaded together returns one pixel's size for all of them (seen as
+// 2-pixel columns of wrong texels where the level changes).
+ivec2 level_size(int level) { return max(textureSize(albedo, 0) >> level, ivec2(1)); }
 Record fetch(ivec2 texel, int level) {
-    ivec2 size = textureSize(albedo, level);
+    ivec2 size = level_size(level);
     ivec2 q = wrapped(texel, size);
     return Record(texelFetch(albedo, q, level), texelFetch(walls, q, level),
                   texelFetch(triangles, q, level));
 }
 // One level: the nearest texel or the bilinear blend of four evaluated colours.
 vec4 level_colour(vec2 st, int level, vec2 r) {
-    vec2 size = vec2(textureSize(albedo, level));
+    vec2 size = vec2(level_size(level));
 #ifdef FILTER_TEXEL_LINEAR
     vec2 p = st * size - 0.5;
     ivec2 base = ivec2(floor(p));
