@@ -19,6 +19,9 @@ struct QualitySweep {
     std::string knob;
     std::vector<KnobValue> values;
     KnobValue reference;
+    // A scene knob swept for the table (thickness, viewing angle): the CPU reference is
+    // rendered again at each value instead of once at `reference`.
+    bool per_value_reference = false;
 };
 
 class Technique {

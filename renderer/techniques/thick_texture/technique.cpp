@@ -35,6 +35,10 @@ public:
              std::string("hardware")},
             {"wide_hole_bins", {std::string("1"), std::string("4"), std::string("8")},
              std::string("1")},
+            // Scene knobs, each row against its own reference: the model's error grows
+            // with h tan(theta) once holes wider than a texel lose their far walls.
+            {"thickness", {0.1, 0.5, 1.0, 2.0}, 1.0, true},
+            {"tilt", {0.0, 30.0, 60.0, 75.0, 85.0}, 0.0, true},
         };
     }
 };
