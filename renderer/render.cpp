@@ -18,8 +18,10 @@ Scene build_scene(const RenderRequest& request) {
     const std::vector<Knob> knobs = knobs_for(technique);
     KnobValues values = resolve_knob_values(knobs, request.settings);
     auto mesh = std::make_shared<const Mesh>(load_mesh(request.mesh));
-    return make_scene(std::move(mesh), technique, std::move(values), request.width,
-                      request.height);
+    Scene scene = make_scene(std::move(mesh), technique, std::move(values), request.width,
+                             request.height);
+    technique.check_scene(scene);
+    return scene;
 }
 
 RenderedImage render_image_counted(gl::FrameExecutor& executor, const Scene& scene,

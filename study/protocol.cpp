@@ -225,12 +225,13 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
             r.fail(nullptr, "technique", "stimulus '" + s.id +
                    "' needs exactly one of technique (live) or image (pre-rendered)");
         // The renderer's registry (lucent_study stays GL-free, so it is listed here).
-        static const std::set<std::string> techniques = {"empirical", "ward",
-                                                         "contrast_reversed", "dipole"};
+        static const std::set<std::string> techniques = {
+            "empirical", "ward", "contrast_reversed", "dipole", "htsm", "thick_texture"};
         if (!s.technique.empty() && !techniques.count(s.technique))
             r.fail(r.raw().get("technique"), "technique",
                    "unknown technique '" + s.technique +
-                       "' (valid: empirical, ward, contrast_reversed, dipole)");
+                       "' (valid: empirical, ward, contrast_reversed, dipole, htsm, "
+                       "thick_texture)");
         if (!s.image.empty() && !base_dir.empty() && std::filesystem::path(s.image).is_relative())
             s.image = (std::filesystem::path(base_dir) / s.image).string();
         if (const toml::table* params = r.table("params")) {
@@ -419,7 +420,7 @@ Protocol load_protocol_file(const std::string& path) {
                           std::filesystem::absolute(path).parent_path().string());
 }
 
-std::vector<std::string> builtin_protocol_names() { return {"thesis"}; }
+std::vector<std::string> builtin_protocol_names() { return {"thesis", "fabrics"}; }
 
 Protocol builtin_protocol(std::string_view name) {
     std::optional<std::string_view> text =

@@ -91,7 +91,8 @@ struct DataSource {
 enum class PassKind {
     bake_ambient_occlusion,  // CPU: per-vertex AO (cached bake) uploaded as a vertex
                              // stream
-    draw_mesh,               // rasterise the mesh: attributes 0 position, 1 normal, 2 AO
+    draw_mesh,               // rasterise the mesh: attributes 0 position, 1 normal, 2 AO,
+                             // 3 uv and 4 tangent (meshes with UVs)
     fullscreen,              // one full-screen triangle (gl/shaders/fullscreen.vert)
     upload,                  // CPU data (Pass::data) into the one written resource
     build_mips,              // levels 1.. of the one written 2D resource: exact 2x2 box

@@ -69,7 +69,8 @@ BoundingSphere Mesh::bounding_sphere() const {
 }
 
 std::string compute_content_hash(const std::vector<glm::vec3>& positions,
-                                 const std::vector<glm::uvec3>& triangles) {
+                                 const std::vector<glm::uvec3>& triangles,
+                                 const std::vector<glm::vec2>& uvs) {
     std::uint64_t hash = 0xcbf29ce484222325ull;
     auto mix = [&hash](std::uint32_t word) {
         for (int byte = 0; byte < 4; ++byte) {
@@ -89,6 +90,16 @@ std::string compute_content_hash(const std::vector<glm::vec3>& positions,
         }
     for (const glm::uvec3& t : triangles)
         for (int k = 0; k < 3; ++k) mix(t[k]);
+    if (!uvs.empty()) {
+        mix(static_cast<std::uint32_t>(uvs.size()));
+        for (const glm::vec2& uv : uvs)
+            for (int k = 0; k < 2; ++k) {
+                const float value = uv[k] == 0.0f ? 0.0f : uv[k];
+                std::uint32_t bits = 0;
+                std::memcpy(&bits, &value, sizeof bits);
+                mix(bits);
+            }
+    }
     char text[17];
     std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
     return text;
@@ -126,6 +137,44 @@ std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& posi
     return normals;
 }
 
+std::vector<glm::vec4> compute_tangents(const std::vector<glm::vec3>& positions,
+                                        const std::vector<glm::vec3>& normals,
+                                        const std::vector<glm::vec2>& uvs,
+                                        const std::vector<glm::uvec3>& triangles) {
+    std::vector<glm::dvec3> du(positions.size(), glm::dvec3(0.0));
+    std::vector<glm::dvec3> dv(positions.size(), glm::dvec3(0.0));
+    for (const glm::uvec3& t : triangles) {
+        const glm::dvec3 e1 = glm::dvec3(positions[t.y]) - glm::dvec3(positions[t.x]);
+        const glm::dvec3 e2 = glm::dvec3(positions[t.z]) - glm::dvec3(positions[t.x]);
+        const glm::dvec2 s1 = glm::dvec2(uvs[t.y]) - glm::dvec2(uvs[t.x]);
+        const glm::dvec2 s2 = glm::dvec2(uvs[t.z]) - glm::dvec2(uvs[t.x]);
+        // Solve [e1 e2] = [dp/du dp/dv] [s1 s2]; scaled by det so that large uv
+        // triangles weigh more and a zero-area one adds nothing.
+        const double det = s1.x * s2.y - s2.x * s1.y;
+        if (!std::isfinite(det) || det == 0.0) continue;
+        const double sign = det > 0.0 ? 1.0 : -1.0;
+        const glm::dvec3 tu = (e1 * s2.y - e2 * s1.y) * sign;
+        const glm::dvec3 tv = (e2 * s1.x - e1 * s2.x) * sign;
+        for (int k = 0; k < 3; ++k) du[t[k]] += tu, dv[t[k]] += tv;
+    }
+    std::vector<glm::vec4> tangents(positions.size());
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+        const glm::dvec3 n = glm::dvec3(normals[i]);
+        glm::dvec3 t = du[i] - n * glm::dot(n, du[i]);
+        double length = glm::length(t);
+        if (!(length > 1e-12 * (glm::length(du[i]) + 1e-300))) {
+            // Any unit vector perpendicular to n.
+            t = std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0))
+                                    : glm::cross(n, glm::dvec3(0, 1, 0));
+            length = glm::length(t);
+        }
+        t /= length;
+        const double w = glm::dot(glm::cross(n, t), dv[i]) < 0.0 ? -1.0 : 1.0;
+        tangents[i] = glm::vec4(glm::vec3(t), static_cast<float>(w));
+    }
+    return tangents;
+}
+
 void finalize_mesh(Mesh& mesh) {
     if (mesh.normals.size() != mesh.positions.size())
         mesh.normals = compute_smooth_normals(mesh.positions, mesh.triangles);
@@ -141,14 +190,20 @@ void finalize_mesh(Mesh& mesh) {
             smooth = compute_smooth_normals(mesh.positions, mesh.triangles);
         n = smooth[i];
     }
-    mesh.content_hash = compute_content_hash(mesh.positions, mesh.triangles);
+    if (mesh.uvs.size() != mesh.positions.size()) mesh.uvs.clear();
+    if (mesh.uvs.empty())
+        mesh.tangents.clear();
+    else if (mesh.tangents.size() != mesh.positions.size())
+        mesh.tangents =
+            compute_tangents(mesh.positions, mesh.normals, mesh.uvs, mesh.triangles);
+    mesh.content_hash = compute_content_hash(mesh.positions, mesh.triangles, mesh.uvs);
 }
 
 Mesh load_mesh(const std::string& spec) {
     if (spec.empty())
         throw MeshError(
             "(empty mesh spec): give a built-in name (sphere, torus, torus_knot, "
-            "hand) or a mesh file path");
+            "hand, square, wave, drape) or a mesh file path");
     // A built-in name wins unless a regular file of that exact name exists.
     std::error_code error;
     if (is_builtin_mesh_spec(spec) && !std::filesystem::is_regular_file(spec, error))

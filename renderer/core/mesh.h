@@ -28,8 +28,15 @@ struct Mesh {
     std::vector<glm::vec3> positions;   // object space
     std::vector<glm::vec3> normals;     // unit length, one per position
     std::vector<glm::uvec3> triangles;  // indices into positions; no degenerate ones
-    std::string content_hash;           // hex digest of positions + triangles
+    // Texture coordinates, empty or one per position (files keep theirs; the sheets
+    // `square`, `wave`, `drape` have them). Tangents come with them: xyz unit, along
+    // dp/du made orthogonal to the normal, w = +-1 so that B = w * cross(N, T) points
+    // along dp/dv.
+    std::vector<glm::vec2> uvs;
+    std::vector<glm::vec4> tangents;
+    std::string content_hash;  // hex digest of positions + triangles (+ uvs when present)
 
+    bool has_uvs() const { return !uvs.empty() && uvs.size() == positions.size(); }
     std::size_t face_count() const { return triangles.size(); }
     std::size_t vertex_count() const { return positions.size(); }
     // Contains every position; the smaller of the AABB-centred and Ritter spheres.
@@ -47,9 +54,20 @@ std::vector<std::string> builtin_mesh_names();
 // Face budget of a built-in mesh when the spec gives none.
 inline constexpr std::size_t kDefaultFaceBudget = 30000;
 
-// 64-bit FNV-1a over the position bits and triangle indices, as 16 hex digits.
+// 64-bit FNV-1a over the position bits and triangle indices (and the uv bits when `uvs`
+// is not empty, so meshes without UVs keep their old hashes), as 16 hex digits.
 std::string compute_content_hash(const std::vector<glm::vec3>& positions,
-                                 const std::vector<glm::uvec3>& triangles);
+                                 const std::vector<glm::uvec3>& triangles,
+                                 const std::vector<glm::vec2>& uvs = {});
+
+// Per-vertex tangent frames from UVs: dp/du of each incident triangle summed (weighted by
+// the triangle's area in uv space, i.e. solved per triangle), then Gram-Schmidt against
+// the normal; w = sign of dot(cross(N, T), dp/dv). A vertex whose sum vanishes (zero-area
+// uv triangles) gets any unit vector perpendicular to its normal, w = +1.
+std::vector<glm::vec4> compute_tangents(const std::vector<glm::vec3>& positions,
+                                        const std::vector<glm::vec3>& normals,
+                                        const std::vector<glm::vec2>& uvs,
+                                        const std::vector<glm::uvec3>& triangles);
 
 // Unit per-vertex normals: incident face normals weighted by the corner angle (so the
 // result does not depend on how a flat region is triangulated). A vertex whose weighted
@@ -58,7 +76,8 @@ std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& posi
                                               const std::vector<glm::uvec3>& triangles);
 
 // Replaces non-finite or zero-length normals (computing smooth ones when `normals` is
-// empty or the wrong size), normalises the rest and sets content_hash.
+// empty or the wrong size), normalises the rest, computes tangents when there are UVs
+// (dropping UVs of the wrong count) and sets content_hash.
 void finalize_mesh(Mesh& mesh);
 
 }  // namespace lucent

@@ -7,6 +7,13 @@
 //   hand        palm, four fingers, a thumb and a wrist smoothly merged (non-convex, thin
 //               protrusions; stand-in for the thesis's hand and Fertility models);
 //               polygonised, so budgets under ~1000 faces are met only roughly
+// Open sheets with texture coordinates whose texels are square in world space (for the
+// thick_texture technique), 2 x 2 units, facing +Z, uv = world distance / 2:
+//   square      flat grid at z = 0 (default 2 triangles, the thesis's Square)
+//   wave        a curtain z = 0.12 sin(2 pi x), u = arc length along x / 2 (default 800
+//               triangles, the thesis's Wave1; wave:12800 is Wave2)
+//   drape       doubly curved z = 0.2 sin(pi x) sin(pi y), uv = ((x, y) + 1) / 2: not
+//               developable, so its texels are not square (a robustness case)
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -259,14 +266,81 @@ Mesh make_hand(std::size_t budget) {
     return best;
 }
 
+// A sheet of (columns x rows) cells over x, y in [-1, 1]: z = height(x, y) and the uv
+// of each vertex from `uv(x, y)`, two triangles per cell, counter-clockwise from +Z.
+Mesh make_sheet(unsigned columns, unsigned rows, const std::function<double(double, double)>& height,
+                const std::function<glm::dvec2(double, double)>& uv) {
+    Mesh mesh;
+    for (unsigned i = 0; i <= rows; ++i)
+        for (unsigned j = 0; j <= columns; ++j) {
+            const double x = -1.0 + 2.0 * j / columns, y = -1.0 + 2.0 * i / rows;
+            mesh.positions.emplace_back(x, y, height(x, y));
+            mesh.uvs.push_back(glm::vec2(uv(x, y)));
+        }
+    for (unsigned i = 0; i < rows; ++i)
+        for (unsigned j = 0; j < columns; ++j) {
+            const unsigned a = i * (columns + 1) + j, b = a + 1;
+            const unsigned c = b + columns + 1, d = a + columns + 1;
+            mesh.triangles.push_back({a, b, c});
+            mesh.triangles.push_back({a, c, d});
+        }
+    return mesh;
+}
+
+unsigned sheet_side(std::size_t budget) {
+    return std::max(1u, static_cast<unsigned>(std::lround(std::sqrt(budget / 2.0))));
+}
+
+Mesh make_square(std::size_t budget) {
+    const unsigned n = sheet_side(budget);
+    return make_sheet(
+        n, n, [](double, double) { return 0.0; },
+        [](double x, double y) { return glm::dvec2(x + 1.0, y + 1.0) * 0.5; });
+}
+
+constexpr double kWaveAmplitude = 0.12;
+double wave_height(double x) { return kWaveAmplitude * std::sin(2.0 * kPi * x); }
+// Arc length of the wave from x = -1 to x (Simpson's rule, fine enough for float uvs).
+double wave_arc_length(double x) {
+    const int steps = 2048;
+    const double h = (x + 1.0) / steps;
+    const auto speed = [](double t) {
+        const double slope = kWaveAmplitude * 2.0 * kPi * std::cos(2.0 * kPi * t);
+        return std::sqrt(1.0 + slope * slope);
+    };
+    double sum = speed(-1.0) + speed(x);
+    for (int k = 1; k < steps; ++k) sum += (k % 2 ? 4.0 : 2.0) * speed(-1.0 + k * h);
+    return sum * h / 3.0;
+}
+
+Mesh make_wave(std::size_t budget) {
+    const unsigned n = sheet_side(budget);
+    return make_sheet(
+        n, n, [](double x, double) { return wave_height(x); },
+        [](double x, double y) { return glm::dvec2(wave_arc_length(x), y + 1.0) * 0.5; });
+}
+
+Mesh make_drape(std::size_t budget) {
+    const unsigned n = sheet_side(budget);
+    return make_sheet(
+        n, n,
+        [](double x, double y) { return 0.2 * std::sin(kPi * x) * std::sin(kPi * y); },
+        [](double x, double y) { return glm::dvec2(x + 1.0, y + 1.0) * 0.5; });
+}
+
 struct Builtin {
     const char* name;
     Mesh (*make)(std::size_t);
+    std::size_t default_budget = kDefaultFaceBudget;
+    std::size_t min_budget = kMinFaceBudget;
 };
-constexpr Builtin kBuiltins[] = {{"sphere", make_sphere},
-                                 {"torus", make_torus},
-                                 {"torus_knot", make_torus_knot},
-                                 {"hand", make_hand}};
+const Builtin kBuiltins[] = {{"sphere", make_sphere},
+                             {"torus", make_torus},
+                             {"torus_knot", make_torus_knot},
+                             {"hand", make_hand},
+                             {"square", make_square, 2, 2},
+                             {"wave", make_wave, 800, 2},
+                             {"drape", make_drape, 12800, 2}};
 
 const Builtin* find_builtin(const std::string& name) {
     for (const Builtin& b : kBuiltins)
@@ -274,10 +348,11 @@ const Builtin* find_builtin(const std::string& name) {
     return nullptr;
 }
 
-std::size_t parse_face_budget(const std::string& spec, const std::string& text) {
+std::size_t parse_face_budget(const std::string& spec, const std::string& text,
+                              std::size_t min_budget) {
     const std::string usage = spec +
                               ": face budget must be a whole number like 30000 or 240k, "
-                              "between 100 and 20m";
+                              "between " + std::to_string(min_budget) + " and 20m";
     std::size_t value = 0;
     const char* end = text.data() + text.size();
     const auto [rest, error] = std::from_chars(text.data(), end, value);
@@ -292,7 +367,7 @@ std::size_t parse_face_budget(const std::string& spec, const std::string& text) 
         throw MeshError(usage);
     if (value > kMaxFaceBudget / scale) throw MeshError(usage);
     value *= scale;
-    if (value < kMinFaceBudget || value > kMaxFaceBudget) throw MeshError(usage);
+    if (value < min_budget || value > kMaxFaceBudget) throw MeshError(usage);
     return value;
 }
 
@@ -317,9 +392,10 @@ Mesh build_builtin_mesh(const std::string& spec) {
             names += (names.empty() ? "" : ", ") + std::string(b.name);
         throw MeshError(spec + ": not a built-in mesh (" + names + ")");
     }
-    const std::size_t budget = colon == std::string::npos
-                                   ? kDefaultFaceBudget
-                                   : parse_face_budget(spec, spec.substr(colon + 1));
+    const std::size_t budget =
+        colon == std::string::npos
+            ? builtin->default_budget
+            : parse_face_budget(spec, spec.substr(colon + 1), builtin->min_budget);
     Mesh mesh = builtin->make(budget);
     mesh.name = spec;
     finalize_mesh(mesh);

@@ -48,9 +48,11 @@ RawMesh read_with_assimp(const std::string& path) {
     if (scene == nullptr)
         throw MeshError(path + ": Assimp: " + importer.GetErrorString());
     RawMesh raw;
-    bool all_have_normals = scene->mNumMeshes > 0;
-    for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+    bool all_have_normals = scene->mNumMeshes > 0, all_have_uvs = scene->mNumMeshes > 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         all_have_normals = all_have_normals && scene->mMeshes[m]->HasNormals();
+        all_have_uvs = all_have_uvs && scene->mMeshes[m]->HasTextureCoords(0);
+    }
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh* source = scene->mMeshes[m];
         const auto base = static_cast<unsigned>(raw.positions.size());
@@ -60,6 +62,10 @@ RawMesh read_with_assimp(const std::string& path) {
             if (all_have_normals) {
                 const aiVector3D& n = source->mNormals[v];
                 raw.normals.emplace_back(n.x, n.y, n.z);
+            }
+            if (all_have_uvs) {
+                const aiVector3D& uv = source->mTextureCoords[0][v];
+                raw.uvs.emplace_back(uv.x, uv.y);
             }
         }
         raw.faces_in_file += source->mNumFaces;
@@ -75,7 +81,7 @@ RawMesh read_with_assimp(const std::string& path) {
 }
 
 struct PositionKey {
-    std::uint32_t bits[3];
+    std::uint32_t bits[5];  // position, then uv (0 when the file has none)
     bool operator==(const PositionKey& other) const {
         return std::memcmp(bits, other.bits, sizeof bits) == 0;
     }
@@ -88,23 +94,29 @@ struct PositionKeyHash {
     }
 };
 
-PositionKey key_of(glm::vec3 p) {
+PositionKey key_of(glm::vec3 p, glm::vec2 uv) {
     PositionKey key;
-    for (int k = 0; k < 3; ++k) {
-        const float v = p[k] == 0.0f ? 0.0f : p[k];  // weld -0 with +0
+    const float values[5] = {p.x, p.y, p.z, uv.x, uv.y};
+    for (int k = 0; k < 5; ++k) {
+        const float v = values[k] == 0.0f ? 0.0f : values[k];  // weld -0 with +0
         std::memcpy(&key.bits[k], &v, sizeof v);
     }
     return key;
 }
 
-// Welds equal positions, drops unusable triangles and unused vertices.
+// Welds equal (position, uv) pairs, drops unusable triangles and unused vertices.
 Mesh clean(const std::string& path, RawMesh raw) {
     std::unordered_map<PositionKey, unsigned, PositionKeyHash> welded;
     std::vector<unsigned> representative(raw.positions.size());
     bool normals_agree = !raw.normals.empty();
+    // A file with any non-finite uv keeps none (tangents from NaN uvs would be NaN).
+    bool with_uvs = raw.uvs.size() == raw.positions.size() && !raw.uvs.empty();
+    for (std::size_t i = 0; with_uvs && i < raw.uvs.size(); ++i)
+        with_uvs = std::isfinite(raw.uvs[i].x) && std::isfinite(raw.uvs[i].y);
     for (std::size_t i = 0; i < raw.positions.size(); ++i) {
-        const auto [it, inserted] =
-            welded.try_emplace(key_of(raw.positions[i]), static_cast<unsigned>(i));
+        const glm::vec2 uv = with_uvs ? raw.uvs[i] : glm::vec2(0.0f);
+        const auto [it, inserted] = welded.try_emplace(key_of(raw.positions[i], uv),
+                                                       static_cast<unsigned>(i));
         representative[i] = it->second;
         if (!inserted && normals_agree &&
             glm::dot(raw.normals[i], raw.normals[it->second]) <
@@ -131,6 +143,7 @@ Mesh clean(const std::string& path, RawMesh raw) {
                 target = static_cast<unsigned>(mesh.positions.size());
                 mesh.positions.push_back(raw.positions[t[k]]);
                 if (normals_agree) mesh.normals.push_back(raw.normals[t[k]]);
+                if (with_uvs) mesh.uvs.push_back(raw.uvs[t[k]]);
             }
             t[k] = target;
         }

@@ -20,6 +20,7 @@ Mesh load_mesh_file(const std::string& path);
 struct RawMesh {
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals;  // empty, or one per position
+    std::vector<glm::vec2> uvs;      // empty, or one per position (texture channel 0)
     std::vector<glm::uvec3> triangles;
     std::size_t faces_in_file = 0;
 };

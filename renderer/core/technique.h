@@ -26,6 +26,9 @@ struct QualitySweep {
     std::string knob;
     std::vector<KnobValue> values;
     KnobValue reference;
+    // A scene knob swept for the table (thickness, viewing angle): the CPU reference is
+    // rendered again at each value instead of once at `reference`.
+    bool per_value_reference = false;
     std::vector<std::pair<std::string, KnobValue>> with = {};
 };
 
@@ -59,6 +62,10 @@ public:
     // The same image computed on the CPU (Embree ray casting), independent of the GL
     // path.
     virtual Image render_reference(const Scene& scene) const = 0;
+    // Refuses a scene the technique cannot render, in one line: MeshError naming the mesh
+    // (e.g. no UVs where the technique needs them) or KnobError naming the knob (e.g. a
+    // texture spec or file that does not parse). build_scene() calls it.
+    virtual void check_scene(const Scene& /*scene*/) const {}
     // Quality knobs for the accuracy bench; empty when the technique has none.
     virtual std::vector<QualitySweep> quality_sweeps() const { return {}; }
     // How an interactive view refines this technique's image over frames (none by

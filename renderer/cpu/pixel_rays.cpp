@@ -27,9 +27,15 @@ std::optional<RayHit> PixelRays::front_hit(const RayCaster& caster, glm::dvec3 d
 }
 
 glm::dvec3 PixelRays::direction(int x, int row) const {
+    return direction_at(x, row, 0.5, 0.5);
+}
+
+glm::dvec3 PixelRays::direction_at(int x, int row, double offset_x, double offset_y) const {
     const int gl_y = height_ - 1 - row;  // image rows are top first, GL's bottom first
-    // Un-project the pixel centre's far-plane point and aim at it from the eye.
-    const glm::dvec2 ndc((x + 0.5) / width_ * 2.0 - 1.0, (gl_y + 0.5) / height_ * 2.0 - 1.0);
+    // Un-project the point's far-plane point and aim at it from the eye (GL y: offset_y
+    // counts from the bottom edge of the pixel).
+    const glm::dvec2 ndc((x + offset_x) / width_ * 2.0 - 1.0,
+                         (gl_y + offset_y) / height_ * 2.0 - 1.0);
     const glm::dvec4 far_point = inverse_view_projection_ * glm::dvec4(ndc, 1.0, 1.0);
     return glm::normalize(glm::dvec3(far_point) / far_point.w - eye_);
 }

@@ -25,6 +25,10 @@ public:
     const glm::dmat3& normal_matrix() const { return normal_matrix_; }
     // Unit direction from the eye through the centre of pixel (x, row); row 0 is the top.
     glm::dvec3 direction(int x, int row) const;
+    // Through the point (offset_x, offset_y) in [0, 1]^2 of that pixel, offsets from its
+    // left and bottom edges (sub-pixel rays of supersampled references); (0.5, 0.5) is
+    // direction(x, row).
+    glm::dvec3 direction_at(int x, int row, double offset_x, double offset_y) const;
     // Eye-space depth (distance along the viewing axis) of a point `distance` along a
     // ray with unit `direction`: what the near/far planes and the depth buffer compare.
     double eye_depth(double distance, glm::dvec3 direction) const {

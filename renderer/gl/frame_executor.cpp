@@ -133,6 +133,7 @@ struct FrameExecutor::Impl {
     // Mesh buffers, re-uploaded when the mesh changes (compared by content hash + size).
     std::string mesh_key;
     Buffer positions, normals, indices;
+    Buffer uvs, tangents;  // attributes 3 and 4, only for meshes with UVs
     GLsizei index_count = 0;
     VertexArray mesh_vao;
     VertexArray empty_vao;  // full-screen passes draw without attributes
@@ -180,6 +181,22 @@ struct FrameExecutor::Impl {
         }
         glVertexArrayAttribFormat(vao, 2, 1, GL_FLOAT, GL_FALSE, 0);
         glVertexArrayAttribBinding(vao, 2, 2);
+        if (mesh.has_uvs() && mesh.tangents.size() == mesh.positions.size()) {
+            // Texture coordinates (3) and tangents with handedness (4).
+            uvs = make_buffer(mesh.uvs.data(),
+                              static_cast<GLsizeiptr>(mesh.uvs.size() * sizeof(glm::vec2)));
+            tangents = make_buffer(
+                mesh.tangents.data(),
+                static_cast<GLsizeiptr>(mesh.tangents.size() * sizeof(glm::vec4)));
+            glVertexArrayVertexBuffer(vao, 3, uvs.id(), 0, sizeof(glm::vec2));
+            glVertexArrayVertexBuffer(vao, 4, tangents.id(), 0, sizeof(glm::vec4));
+            glEnableVertexArrayAttrib(vao, 3);
+            glVertexArrayAttribFormat(vao, 3, 2, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(vao, 3, 3);
+            glEnableVertexArrayAttrib(vao, 4);
+            glVertexArrayAttribFormat(vao, 4, 4, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(vao, 4, 4);
+        }
         glVertexArrayElementBuffer(vao, indices.id());
         mesh_key = key;
         ao_streams.clear();

@@ -11,6 +11,7 @@ const Technique& ward_technique();
 const Technique& contrast_reversed_technique();
 const Technique& dipole_technique();
 const Technique& htsm_technique();
+const Technique& thick_texture_technique();
 
 const std::vector<const Technique*>& all_techniques() {
     static const std::vector<const Technique*> techniques = {
@@ -19,6 +20,7 @@ const std::vector<const Technique*>& all_techniques() {
         &contrast_reversed_technique(),
         &dipole_technique(),
         &htsm_technique(),
+        &thick_texture_technique(),
     };
     return techniques;
 }

@@ -68,6 +68,17 @@ void knob_widget(ParameterSet& set, const Knob& knob, ExplorerSession& session,
             }
             break;
         }
+        case KnobKind::text: {
+            // Applied on Enter, so a half-typed spec is never rendered.
+            char buffer[512];
+            std::snprintf(buffer, sizeof buffer, "%s", std::get<std::string>(value).c_str());
+            if (ImGui::InputText(label, buffer, sizeof buffer,
+                                 ImGuiInputTextFlags_EnterReturnsTrue)) {
+                value = std::string(buffer);
+                changed = true;
+            }
+            break;
+        }
         case KnobKind::rgb:
         case KnobKind::vec3: {
             const glm::dvec3 d = std::get<glm::dvec3>(value);
@@ -78,15 +89,6 @@ void knob_widget(ParameterSet& set, const Knob& knob, ExplorerSession& session,
                 changed = ImGui::DragFloat3(label, v, 0.01f, lo, hi, "%.3f",
                                             ImGuiSliderFlags_AlwaysClamp);
             value = glm::dvec3(v[0], v[1], v[2]);
-            break;
-        }
-        case KnobKind::text: {
-            // Applied on Enter, so a half-typed spec is never built.
-            char text[512] = {};
-            std::snprintf(text, sizeof text, "%s", std::get<std::string>(value).c_str());
-            changed = ImGui::InputText(label, text, sizeof text,
-                                       ImGuiInputTextFlags_EnterReturnsTrue);
-            value = std::string(text);
             break;
         }
     }

@@ -53,6 +53,9 @@ TEST_F(RenderFraming, PortraitAndLandscapeShowTheWholeSphereAtItsAnalyticRadius)
     gl::FrameExecutor executor;
     const double fov = 64.0;  // a little wider than the fit: 2 px of margin at 64 px
     for (const Technique* technique : all_techniques()) {
+        // thick_texture draws sheets with UVs, not spheres (its framing is the same
+        // camera; its tests check GL against the reference at the image centre).
+        if (technique->name() == "thick_texture") continue;
         for (const auto& [width, height] : {std::pair{64, 128}, std::pair{128, 64}}) {
             RenderRequest request;
             request.mesh = "sphere:20k";  // the unit sphere

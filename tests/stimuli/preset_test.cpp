@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "stimulus_set.h"
@@ -118,7 +119,8 @@ TEST(ThesisPreset, RealCatalogRejectsUnknownTechniqueAndKeys) {
     } catch (const StimulusSetError& e) {
         EXPECT_NE(std::string(e.what()).find(
                       "x.toml:5:13: stimuli[0].technique: unknown technique "
-                      "'phong' (valid: empirical, ward, contrast_reversed, dipole, htsm)"),
+                      "'phong' (valid: empirical, ward, contrast_reversed, dipole, htsm, "
+                      "thick_texture)"),
                   std::string::npos)
             << e.what();
     }
@@ -130,6 +132,39 @@ TEST(ThesisPreset, RealCatalogRejectsUnknownTechniqueAndKeys) {
     EXPECT_NO_THROW(parse_stimulus_set(
         head + "technique = \"contrast_reversed\"\nreversed_diffuse = 0.5\n", "x.toml",
         ".", catalog));
+}
+
+}  // namespace
+}  // namespace lucent::stimuli
+
+namespace lucent::stimuli {
+namespace {
+
+// The built-in `fabrics` set (issue 14 section 6): a net and a weave, two thicknesses,
+// three tilts, on the wavy curtain; four factor series whose levels are the tilts.
+TEST(FabricsPreset, TwoFabricsTwoThicknessesThreeAnglesInFourSeries) {
+    std::ifstream in(test::source_dir() / "stimuli/presets/fabrics.toml", std::ios::binary);
+    std::ostringstream file;
+    file << in.rdbuf();
+    ASSERT_TRUE(preset_text("fabrics").has_value());
+    EXPECT_EQ(std::string(*preset_text("fabrics")), file.str());
+    const auto set = load_preset("fabrics", default_catalog());
+    ASSERT_EQ(set.stimuli.size(), 12u);
+    std::map<std::string, std::vector<double>> tilts;
+    for (const auto& s : set.stimuli) {
+        EXPECT_EQ(s.technique, "thick_texture");
+        EXPECT_EQ(s.mesh_spec, "wave:12800");
+        const std::string texture = s.parameters.choice("texture");
+        EXPECT_TRUE(texture == "net:5,1" || texture == "weave:2,2") << texture;
+        const double h = s.parameters.scalar("thickness");
+        EXPECT_TRUE(h == 0.5 || h == 1.5);
+        EXPECT_EQ(s.series, (texture[0] == 'n' ? "net_h" : "weave_h") +
+                                std::string(h == 0.5 ? "0.5" : "1.5"));
+        tilts[s.series].push_back(s.parameters.scalar("tilt"));
+    }
+    ASSERT_EQ(tilts.size(), 4u);
+    for (const auto& [series, values] : tilts)
+        EXPECT_EQ(values, (std::vector<double>{0.0, 45.0, 70.0})) << series;
 }
 
 }  // namespace

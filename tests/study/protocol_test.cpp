@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <algorithm>
 #include <fstream>
 
@@ -96,6 +98,29 @@ TEST(ThesisPreset, AsksTheThreeStatementsOnSevenPoints) {
     EXPECT_GT(p.break_every, 0);
     EXPECT_FALSE(p.screens.consent.empty());
     EXPECT_FALSE(p.screens.debrief.empty());
+}
+
+// The built-in `fabrics` protocol (issue 14 section 6): the 12 pictures of the `fabrics`
+// stimulus set, with tilt, thickness and texture as factors of 3, 2 and 2 levels.
+TEST(FabricsPreset, TwelveThickTextureStimuliWithThreeFactors) {
+    const Protocol p = builtin_protocol("fabrics");
+    EXPECT_EQ(p.stimuli.size(), 14u);  // 12 rated + 2 practice
+    std::set<std::string> tilts, thicknesses, textures;
+    int rated = 0;
+    for (const StimulusSpec& s : p.stimuli) {
+        EXPECT_EQ(s.technique, "thick_texture");
+        if (s.varies.empty()) continue;  // practice
+        ++rated;
+        EXPECT_EQ(s.varies, (std::vector<std::string>{"tilt", "thickness", "texture"}));
+        tilts.insert(p.level_of(s, "tilt"));
+        thicknesses.insert(p.level_of(s, "thickness"));
+        textures.insert(p.level_of(s, "texture"));
+    }
+    EXPECT_EQ(rated, 12);
+    EXPECT_EQ(tilts.size(), 3u);
+    EXPECT_EQ(thicknesses.size(), 2u);
+    EXPECT_EQ(textures, (std::set<std::string>{"net:5,1", "weave:2,2"}));
+    EXPECT_EQ(p.questions.size(), 3u);
 }
 
 TEST(BuiltinProtocol, UnknownNameListsValidOnes) {
