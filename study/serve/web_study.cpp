@@ -57,8 +57,13 @@ std::string one_line(std::string text) {
     return text;
 }
 
+// As text; bytes that are not UTF-8 (echoed from a malformed request) become U+FFFD.
+std::string to_text(const json& value) {
+    return value.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 WebReply error_reply(int status, const std::string& why) {
-    return {status, json{{"error", one_line(why)}}.dump()};
+    return {status, to_text(json{{"error", one_line(why)}})};
 }
 
 const json* field(const json& body, const char* key) {
@@ -372,12 +377,12 @@ WebReply WebStudy::start(const json& body) {
                           store_.has_consent(unfinished->id), ms_to_ns(t_ms));
         json reply = state(live);
         reply["token"] = live.token;
-        return {200, reply.dump()};
+        return {200, to_text(reply)};
     }
     if (store_.has_completed_session(code)) {
         json reply = done_state();
         reply["already_completed"] = true;
-        return {200, reply.dump()};
+        return {200, to_text(reply)};
     }
     // A new participant: number and cell as on a lab station, the whole plan stored
     // before trial 1.
@@ -396,7 +401,7 @@ WebReply WebStudy::start(const json& body) {
     live.flow.emplace(protocol_, store_, session.id, live.trials, false, ms_to_ns(t_ms));
     json reply = state(live);
     reply["token"] = live.token;
-    return {200, reply.dump()};
+    return {200, to_text(reply)};
 }
 
 // ---- [SECTION] actions -------------------------------------------------------------------
@@ -416,11 +421,11 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
     Live& live = *it->second;
     SessionFlow& flow = *live.flow;
 
-    if (endpoint == "state") return {200, state(live).dump()};
+    if (endpoint == "state") return {200, to_text(state(live))};
     if (endpoint == "environment") {
         live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);
         store_.update_environment(live.session.id, environment_for(live));
-        return {200, state(live).dump()};
+        return {200, to_text(state(live))};
     }
     if (endpoint == "answer") return answer(live, body);
 
@@ -446,17 +451,16 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
         throw RequestError(400, "the key came before the screen was shown (t_ms < shown_ms)");
     if (decline) {
         live_.erase(code);
-        return {200, json{{"screen", "declined"},
+        return {200, to_text(json{{"screen", "declined"},
                           {"text", "You did not agree to take part; nothing of yours is kept "
-                                   "but that choice. You may close this window."}}
-                         .dump()};
+                                   "but that choice. You may close this window."}})};
     }
     live.flow.emplace(next);
     if (next.screen() == Screen::Done) {
         live_.erase(code);
-        return {200, done_state().dump()};
+        return {200, to_text(done_state())};
     }
-    return {200, state(live).dump()};
+    return {200, to_text(state(live))};
 }
 
 WebReply WebStudy::answer(Live& live, const json& body) {
@@ -573,7 +577,7 @@ WebReply WebStudy::answer(Live& live, const json& body) {
     for (TrialRow& t : live.trials)
         if (t.uuid == trial_uuid) t.answered = true;
     live.flow.emplace(next);
-    return {200, state(live).dump()};
+    return {200, to_text(state(live))};
 }
 
 // ---- [SECTION] the state a page shows ---------------------------------------------------

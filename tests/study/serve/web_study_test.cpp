@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "../study_fixtures.h"
+#include "web_page.h"
 #include "../postgres/server_environment.h"
 #include "store.h"
 #include "study_store.h"
@@ -23,6 +24,9 @@ namespace lucent::study {
 namespace {
 
 using nlohmann::json;
+using lucent::test::Page;
+using lucent::test::direct;
+using lucent::test::page_rating;
 
 std::string web_protocol_text() {
     return std::string(lucent::test::kSmallProtocol) +
@@ -38,8 +42,6 @@ size_t planned_trials(const Protocol& p) {
     return n;
 }
 
-// The rating a test page gives question q of the k-th trial it was shown.
-int page_rating(int k, int q, bool is_catch) { return is_catch ? 7 : 1 + (k * 3 + q * 2) % 7; }
 
 class Serve : public ::testing::TestWithParam<std::string> {
 protected:
@@ -85,79 +87,8 @@ protected:
 
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
 
-// One browser page: its clock (ms since load), the token and the screen it shows.
-struct Page {
-    WebStudy& web;
-    double now = 50;
-    std::string token;
-    json state;
-    std::vector<std::string> shown;  // trial ids in the order the page was given them
-
-    WebReply raw(const std::string& endpoint, const json& body) {
-        return web.handle(endpoint, body.dump());
-    }
-    json call(const std::string& endpoint, json body, int expected = 200) {
-        if (!token.empty() && !body.contains("token")) body["token"] = token;
-        const WebReply r = web.handle(endpoint, body.dump());
-        EXPECT_EQ(r.status, expected) << endpoint << ": " << r.body;
-        return json::parse(r.body);
-    }
-    void open(const json& who, int expected = 200) {
-        json body = who;
-        body["t_ms"] = now;
-        body["client"] = {{"user_agent", "TestBrowser/1.0"}, {"window_width", 1280},
-                          {"window_height", 900},         {"device_pixel_ratio", 2},
-                          {"screen_width", 2560},           {"screen_height", 1440}};
-        const json reply = call("session", body, expected);
-        if (expected != 200) return;
-        if (reply.contains("token")) token = reply["token"];
-        state = reply;
-    }
-    void enter() {
-        const double shown_at = now;
-        now += 300;
-        state = call("continue", {{"view", state["view"]}, {"shown_ms", shown_at}, {"t_ms", now}});
-    }
-    // The page's answer to the trial on screen: each question clicked 100 ms apart after
-    // the onset, then Next. Returns the onset.
-    json answer_body(int k) {
-        const json& trial = state["trial"];
-        const double onset = now + trial["blank_ms"].get<double>() + 20;
-        json events = json::array();
-        const int n = static_cast<int>(state["questions"].size());
-        const bool is_catch = !trial["prompt"].get<std::string>().empty();
-        for (int q = 0; q < n; ++q)
-            events.push_back({{"t_ms", onset + 100.0 * (q + 1)}, {"type", "point"},
-                              {"question", q}, {"value", page_rating(k, q, is_catch)}});
-        events.push_back({{"t_ms", onset + 100.0 * (n + 1)}, {"type", "next"}});
-        return {{"trial", trial["id"]}, {"view", state["view"]}, {"onset_ms", onset},
-                {"events", events}};
-    }
-    void answer(int k) {
-        json body = answer_body(k);
-        shown.push_back(state["trial"]["id"]);
-        now = body["onset_ms"].get<double>() + 1000;
-        state = call("answer", body);
-    }
-    // Continues text screens and answers trials until `stop` screens were answered or
-    // the study is done.
-    void run(size_t trials = 1000) {
-        for (int guard = 0; guard < 200; ++guard) {
-            const std::string screen = state["screen"];
-            if (screen == "done") return;
-            if (screen == "trial") {
-                if (shown.size() >= trials) return;
-                answer(static_cast<int>(shown.size()));
-            } else {
-                enter();
-            }
-        }
-        ADD_FAILURE() << "the session never ended";
-    }
-};
-
 TEST_P(Serve, APageCompletesTheWholeProtocolAndEveryAnswerIsStoredAsSent) {
-    Page page{*web_};
+    Page page{direct(*web_)};
     page.open({{"participant", "P1"}});
     ASSERT_EQ(page.state["screen"], "consent");
     EXPECT_EQ(page.state["text"], "Do you agree?");
@@ -225,7 +156,7 @@ TEST_P(Serve, APageCompletesTheWholeProtocolAndEveryAnswerIsStoredAsSent) {
               1);
     EXPECT_EQ(web_->live_sessions(), 0u);
     // A return after completion shows the completion page and starts nothing.
-    Page again{*web_};
+    Page again{direct(*web_)};
     again.open({{"participant", "P1"}});
     EXPECT_EQ(again.state["screen"], "done");
     EXPECT_EQ(again.state["already_completed"], true);
@@ -233,7 +164,7 @@ TEST_P(Serve, APageCompletesTheWholeProtocolAndEveryAnswerIsStoredAsSent) {
 }
 
 TEST_P(Serve, TheRefreshEstimateIsStoredWithTheSegment) {
-    Page page{*web_};
+    Page page{direct(*web_)};
     page.open({{"participant", "P2"}});
     page.call("environment", {{"refresh_hz", 59.94}});
     EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE abs(measured_refresh_hz - "
@@ -244,7 +175,7 @@ TEST_P(Serve, TheRefreshEstimateIsStoredWithTheSegment) {
 }
 
 TEST_P(Serve, ProlificIdsNameTheParticipantAndAreStored) {
-    Page page{*web_};
+    Page page{direct(*web_)};
     page.open({{"prolific",
                 {{"PROLIFIC_PID", "5f1a2b3c4d5e6f7a8b9c0d1e"},
                  {"STUDY_ID", "60aabbccddeeff0011223344"},
@@ -255,7 +186,7 @@ TEST_P(Serve, ProlificIdsNameTheParticipantAndAreStored) {
     EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE display_mode LIKE "
                     "'%; Prolific STUDY_ID=60aabbccddeeff0011223344 SESSION_ID=abc123XYZ'"),
               1);
-    Page other{*web_};
+    Page other{direct(*web_)};
     other.open({{"participant", "someone"}, {"prolific", {{"PROLIFIC_PID", "else"}}}}, 400);
     other.open({{"prolific", {{"PROLIFIC_PID", "x"}, {"STUDY_ID", "a/b"}}}}, 400);
 }
@@ -264,7 +195,7 @@ TEST_P(Serve, AReloadOrARestartResumesAtTheFirstUnansweredTrialOnlyWithTheToken)
     std::string token;
     std::vector<std::string> shown;
     {
-        Page page{*web_};
+        Page page{direct(*web_)};
         page.open({{"participant", "P3"}});
         page.run(3);
         ASSERT_EQ(page.shown.size(), 3u);
@@ -274,13 +205,13 @@ TEST_P(Serve, AReloadOrARestartResumesAtTheFirstUnansweredTrialOnlyWithTheToken)
     const int64_t session = count("SELECT id FROM sessions");
     const std::vector<TrialRow> trials = store_->trials(session);
     // Someone else with the code but not the key: refused, nothing changes.
-    Page stranger{*web_};
+    Page stranger{direct(*web_)};
     stranger.open({{"participant", "P3"}}, 403);
     stranger.open({{"participant", "P3"}, {"token", token.substr(0, token.size() - 1) + "0"}}, 403);
     EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 1);
 
     auto resume = [&](int segments) {
-        Page page{*web_};
+        Page page{direct(*web_)};
         page.token = token;
         page.open({{"participant", "P3"}, {"token", token}});
         // Consent is on record: straight to the first unanswered trial (the 4th).
@@ -301,10 +232,10 @@ TEST_P(Serve, AReloadOrARestartResumesAtTheFirstUnansweredTrialOnlyWithTheToken)
 
 // The hostile requests of issue 16: each a 4xx with one line, and nothing stored.
 TEST_P(Serve, HostileRequestsAreRefusedWithOneLineAndStoreNothing) {
-    Page page{*web_};
+    Page page{direct(*web_)};
     page.open({{"participant", "P4"}});
     page.run(1);  // consent, instructions, the practice trial
-    Page other{*web_};
+    Page other{direct(*web_)};
     other.open({{"participant", "P5"}});
     other.run(1);
     while (page.state["screen"] != "trial") page.enter();
@@ -355,6 +286,8 @@ TEST_P(Serve, HostileRequestsAreRefusedWithOneLineAndStoreNothing) {
     refused("answer", with([&](json& b) { b["token"] = "../../etc.x"; }), 403, "unknown session token");
     refused("answer", "{\"token\": ", 400, "malformed JSON");
     refused("answer", "[1, 2]", 400, "must be a JSON object");
+    refused("answer", "{\"token\": \"\xff\xfe\"}", 400, "malformed JSON");  // not UTF-8
+    refused("answer", "{\"token\": 5}", 400, "'token' must be a string");
     refused("answer", std::string(70 * 1024, ' '), 413, "over the limit");
     refused("answer", with([](json& b) { b["trial"] = std::string(5000, 'a'); }), 400, "longer than");
     refused("wipe", "{}", 404, "no API endpoint");
@@ -373,7 +306,7 @@ TEST_P(Serve, HostileRequestsAreRefusedWithOneLineAndStoreNothing) {
 }
 
 TEST_P(Serve, TheConsentScreenCanBeDeclinedAndADoubleEnterActsOnce) {
-    Page page{*web_};
+    Page page{direct(*web_)};
     page.open({{"participant", "P6"}});
     const json consent = page.state;
     page.enter();  // agreed; on the instructions now
@@ -387,7 +320,7 @@ TEST_P(Serve, TheConsentScreenCanBeDeclinedAndADoubleEnterActsOnce) {
         "continue", json{{"token", page.token}, {"view", page.state["view"]}, {"shown_ms", 5000}, {"t_ms", 4000}}.dump());
     EXPECT_EQ(early.status, 400) << early.body;
 
-    Page no{*web_};
+    Page no{direct(*web_)};
     no.open({{"participant", "P7"}});
     const json declined = no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
     EXPECT_EQ(declined["screen"], "declined");
@@ -406,7 +339,7 @@ TEST_P(Serve, FiftyParticipantsAtOnceLoseAndDuplicateNothing) {
     std::vector<std::vector<std::string>> shown(kPages);
     for (int i = 0; i < kPages; ++i)
         threads.emplace_back([&, i] {
-            Page page{*web_};
+            Page page{direct(*web_)};
             page.open({{"participant", "W" + std::to_string(i + 1)}});
             page.run();
             if (page.state["screen"] == "done") ++finished;
