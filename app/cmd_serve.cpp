@@ -1,9 +1,7 @@
 // lucent serve: the study for online participants in a browser. The HTTP layer only:
 // every decision is in study/serve/web_study.h; the page is embedded (serve/web/).
 #include <fcntl.h>
-#include <sys/socket.h>
 #include <httplib.h>
-#include <nlohmann/json.hpp>
 #include <signal.h>
 #include <unistd.h>
 
@@ -20,7 +18,7 @@
 #include "lucent/version.h"
 #include "postgres/trial_journal.h"
 #include "protocol.h"
-#include "serve/web_files.h"
+#include "serve_http.h"
 #include "serve/web_study.h"
 #include "session/stimulus_source.h"
 #include "store.h"
@@ -40,11 +38,6 @@ struct ServeArgs {
     int threads = 64;
 };
 
-struct Picture {
-    std::string png;  // the bytes served
-    study::WebImage size;
-};
-
 std::string read_file(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
     std::ostringstream bytes;
@@ -55,9 +48,9 @@ std::string read_file(const std::filesystem::path& path) {
 // Every stimulus's picture as the lab shows it (load_image_rgba8: 8-bit sRGB, EXR
 // encoded on the way), written once as PNG and kept in memory: nothing else on disk is
 // ever served.
-std::map<std::string, Picture> load_pictures(const study::Protocol& protocol,
+std::map<std::string, ServedPicture> load_pictures(const study::Protocol& protocol,
                                              const study::PrerenderedStimuli& stimuli) {
-    std::map<std::string, Picture> out;
+    std::map<std::string, ServedPicture> out;
     char scratch_template[] = "/tmp/lucent-serve-XXXXXX";
     const char* scratch = mkdtemp(scratch_template);
     if (!scratch) throw std::runtime_error("cannot create a scratch folder in /tmp");
@@ -100,14 +93,6 @@ std::string load_or_create_secret(const std::string& path) {
     return secret;
 }
 
-std::string one_line_json_error(const std::string& why) {
-    std::string line = why;
-    for (char& c : line)
-        if (static_cast<unsigned char>(c) < 0x20) c = ' ';
-    return nlohmann::json{{"error", line}}.dump(-1, ' ', false,
-                                                nlohmann::json::error_handler_t::replace);
-}
-
 bool parse_listen(const std::string& listen, std::string& host, int& port) {
     const size_t colon = listen.rfind(':');
     if (colon == std::string::npos || colon == 0) return false;
@@ -138,7 +123,7 @@ int serve_command(const ServeArgs& args) {
     study::Protocol protocol;
     std::unique_ptr<study::StudyStore> store;
     std::unique_ptr<study::WebStudy> web;
-    std::map<std::string, Picture> pictures;
+    std::map<std::string, ServedPicture> pictures;
     try {
         protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                        : study::builtin_protocol(args.preset);
@@ -177,75 +162,12 @@ int serve_command(const ServeArgs& args) {
     }
 
     httplib::Server http;
-    const int threads = args.threads;
-    http.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
-    http.set_payload_max_length(64 * 1024);  // larger bodies: 413 before they are read
-    http.set_read_timeout(10);
-    http.set_write_timeout(10);
-    http.set_keep_alive_timeout(2);
-    http.set_default_headers({{"X-Content-Type-Options", "nosniff"},
-                              {"Referrer-Policy", "no-referrer"},
-                              {"X-Frame-Options", "DENY"},
-                              {"Content-Security-Policy",
-                               "default-src 'self'; img-src 'self'; frame-ancestors 'none'"},
-                              {"Cache-Control", "no-store"}});
-    auto page_file = [](const char* name, const char* type) {
-        return [name, type](const httplib::Request&, httplib::Response& res) {
-            res.set_content(std::string(*embedded::serve_file(name)), type);
-        };
-    };
-    http.Get("/", page_file("index.html", "text/html; charset=utf-8"));
-    http.Get("/lucent.js", page_file("lucent.js", "text/javascript; charset=utf-8"));
-    http.Get("/lucent.css", page_file("lucent.css", "text/css; charset=utf-8"));
-    std::map<std::string, study::WebImage> sizes;
-    for (const auto& [id, picture] : pictures) sizes[id] = picture.size;
-    http.Get(R"(/images/.*)", [&](const httplib::Request& req, httplib::Response& res) {
-        // Matched on the raw target, so no decoding here can turn a name into a path.
-        const std::optional<std::string> id = study::image_of_target(req.target, sizes);
-        if (!id) {
-            res.status = 404;
-            res.set_content(one_line_json_error("no such picture: " + req.target), "application/json");
-            return;
-        }
-        res.set_header("Cache-Control", "private, max-age=3600");
-        res.set_content(pictures.at(*id).png, "image/png");
-    });
-    http.Post(R"(/api/([a-z_]+))", [&](const httplib::Request& req, httplib::Response& res) {
-        const study::WebReply reply = web->handle(req.matches[1].str(), req.body);
-        res.status = reply.status;
-        res.set_content(reply.body, "application/json");
-    });
-    http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
-        if (!res.body.empty()) return;
-        const std::string why = res.status == 413 ? "request body over 65536 bytes"
-                                : res.status == 404 ? "not found: " + req.method + " " + req.target
-                                                    : "HTTP " + std::to_string(res.status);
-        res.set_content(one_line_json_error(why), "application/json");
-    });
-    http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
-        res.status = 500;
-        res.set_content(one_line_json_error("internal error"), "application/json");
-    });
-
-    // The library listens with a backlog of 5 (compiled in), which drops connections
-    // when many participants arrive at once: the socket is kept and listened on again
-    // with a deeper queue (Linux takes a second listen() as a new backlog).
-    int listen_fd = -1;
-    http.set_socket_options([&listen_fd](socket_t fd) {
-        int yes = 1;
-        ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-        listen_fd = fd;
-    });
-    if (port == 0) {
-        port = http.bind_to_any_port(host);
-    } else if (!http.bind_to_port(host, port)) {
-        port = -1;
-    }
+    configure_serve_http(http, *web, pictures, args.threads);
+    port = bind_serve_port(http, host, port);
     if (port < 0) {
         std::cerr << "lucent serve: cannot listen on " << args.listen << ": " << std::strerror(errno) << "\n";
         return kExitFailure;
     }
-    if (listen_fd >= 0) ::listen(listen_fd, 1024);
     // SIGINT/SIGTERM stop the server from a thread of their own (never in a handler).
     sigset_t stop_signals;
     sigemptyset(&stop_signals);
