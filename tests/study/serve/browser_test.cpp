@@ -164,8 +164,9 @@ TEST_F(ServeBrowser, AReloadInTheMiddleResumesAtTheFirstUnansweredTrial) {
         const int64_t session = store.query_int("SELECT id FROM sessions");
         for (const TrialRow& t : store.trials(session))
             if (!t.answered) {
-                if (screen() == "trial")
+                if (screen() == "trial") {
                     EXPECT_EQ(browser_->evaluate("document.body.dataset.trial"), t.uuid);
+                }
                 break;
             }
     }
