@@ -13,7 +13,11 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "commands.h"
+#include "serve/web_study.h"
+#include "serve_http.h"
 #include "postgres/local_server.h"
 #include "protocol.h"
 #include "sqlite.h"
@@ -114,13 +118,116 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
     return row;
 }
 
+// `writers` browsers at once through `lucent serve`'s HTTP server on loopback (the same
+// routes), each a participant answering `trials` trials; a commit's latency is the whole
+// /api/answer round trip (request, checks, replay, the store's commit, the reply).
+BenchRow run_serve_writers(const std::string& backend, const std::string& db, int writers,
+                           int trials, const std::string& journal_dir) {
+    using nlohmann::json;
+    const study::Protocol protocol = study::builtin_protocol("thesis");
+    study::StoreOptions store_options;
+    store_options.journal_path = journal_dir + "/serve-journal-" + std::to_string(writers) + ".db";
+    auto store = study::open_study_store(db, store_options);
+    study::WebStudyOptions options;
+    options.secret = "bench";
+    std::map<std::string, ServedPicture> pictures;
+    for (const study::StimulusSpec& s : protocol.stimuli) {
+        options.images[s.id] = {protocol.stimulus_width, protocol.stimulus_height};
+        pictures[s.id] = {"", options.images[s.id]};
+    }
+    study::WebStudy web(protocol, *store, options);
+    httplib::Server http;
+    configure_serve_http(http, web, pictures, std::max(8, writers + 4));
+    const int port = bind_serve_port(http, "127.0.0.1", 0);
+    if (port < 0) throw study::StoreError("cannot listen on 127.0.0.1 for the serve rows");
+    std::thread server([&] { http.listen_after_bind(); });
+
+    using Clock = std::chrono::steady_clock;
+    std::vector<std::vector<double>> latencies(writers);
+    std::vector<Clock::time_point> first_start(writers, Clock::time_point::max()),
+        last_end(writers, Clock::time_point::min());
+    std::vector<std::string> errors(writers);
+    std::vector<std::thread> threads;
+    for (int w = 0; w < writers; ++w) {
+        threads.emplace_back([&, w] {
+            httplib::Client client("127.0.0.1", port);
+            client.set_keep_alive(true);
+            client.set_tcp_nodelay(true);  // as browsers do
+            client.set_read_timeout(60);
+            double now = 10;  // the simulated page's performance.now()
+            auto post = [&](const std::string& endpoint, const json& body) {
+                const auto r = client.Post(("/api/" + endpoint).c_str(), body.dump(), "application/json");
+                if (!r) throw std::runtime_error(endpoint + ": " + httplib::to_string(r.error()));
+                if (r->status != 200) throw std::runtime_error(endpoint + ": " + r->body);
+                return json::parse(r->body);
+            };
+            try {
+                json state = post("session", {{"participant", "web" + std::to_string(writers) + "w" +
+                                                                  std::to_string(w)},
+                                              {"t_ms", now}});
+                const std::string token = state["token"];
+                int answered = 0;
+                while (state["screen"] != "done" && answered < trials) {
+                    if (state["screen"] != "trial") {
+                        now += 100;
+                        state = post("continue", {{"token", token}, {"view", state["view"]},
+                                                  {"shown_ms", now - 50}, {"t_ms", now}});
+                        continue;
+                    }
+                    const double onset = now + state["trial"]["blank_ms"].get<double>() + 10;
+                    json events = json::array();
+                    const bool is_catch = !state["trial"]["prompt"].get<std::string>().empty();
+                    for (size_t q = 0; q < protocol.questions.size(); ++q)
+                        events.push_back({{"t_ms", onset + 100.0 * (q + 1)}, {"type", "point"},
+                                          {"question", q},
+                                          {"value", is_catch ? protocol.catch_trials[0].expected
+                                                             : 1 + (answered + int(q)) % 7}});
+                    events.push_back({{"t_ms", onset + 400}, {"type", "next"}});
+                    now = onset + 1000;
+                    const auto t0 = Clock::now();
+                    state = post("answer", {{"token", token}, {"trial", state["trial"]["id"]},
+                                            {"view", state["view"]}, {"onset_ms", onset},
+                                            {"events", events}});
+                    const auto t1 = Clock::now();
+                    ++answered;
+                    first_start[w] = std::min(first_start[w], t0);
+                    last_end[w] = std::max(last_end[w], t1);
+                    latencies[w].push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+                }
+            } catch (const std::exception& e) {
+                errors[w] = e.what();
+            }
+        });
+    }
+    for (std::thread& t : threads) t.join();
+    http.stop();
+    server.join();
+    if (store->pending_trials() > 0) store->sync();
+
+    BenchRow row;
+    row.backend = backend;
+    row.writers = writers;
+    const auto begin = *std::min_element(first_start.begin(), first_start.end());
+    const auto end = *std::max_element(last_end.begin(), last_end.end());
+    row.seconds = end > begin ? std::chrono::duration<double>(end - begin).count() : 0.0;
+    std::vector<double> all;
+    for (int w = 0; w < writers; ++w) {
+        if (!errors[w].empty() && row.failed_writers++ == 0) row.first_error = errors[w];
+        all.insert(all.end(), latencies[w].begin(), latencies[w].end());
+    }
+    row.commits = static_cast<int>(all.size());
+    row.p50_ms = percentile(all, 0.50);
+    row.p99_ms = percentile(all, 0.99);
+    return row;
+}
+
 int run_bench_store(const std::vector<int>& writer_counts, int trials, const std::string& server,
                     const std::string& csv) {
     namespace fs = std::filesystem;
     std::string pattern = (fs::temp_directory_path() / "lucent-bench-store-XXXXXX").string();
     if (!mkdtemp(pattern.data())) throw study::StoreError("cannot create a scratch folder");
     const std::string scratch = pattern;
-    std::vector<BenchRow> rows;
+    std::vector<BenchRow> rows, serve_rows;
     {
         std::unique_ptr<study::LocalPostgres> local;
         if (server.empty()) local = std::make_unique<study::LocalPostgres>();
@@ -134,17 +241,31 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials, const std
             rows.push_back(run_writers(local ? "postgresql (unix socket)" : "postgresql " + server,
                                        uri, writers, trials, scratch));
         }
+        // lucent serve's round trips over loopback HTTP, into each backend.
+        for (int writers : writer_counts) {
+            const std::string file = scratch + "/serve-w" + std::to_string(writers) + ".db";
+            serve_rows.push_back(run_serve_writers("serve + sqlite (HTTP round trip)", file,
+                                                   writers, trials, scratch));
+            std::string uri = server;
+            if (local) uri = local->create_database("bench_serve_" + std::to_string(k++));
+            study::init_study_store(uri);
+            serve_rows.push_back(run_serve_writers(
+                local ? "serve + postgresql (HTTP round trip)" : "serve + postgresql " + server,
+                uri, writers, trials, scratch));
+        }
     }
     std::error_code ec;
     fs::remove_all(scratch, ec);
 
+    std::vector<BenchRow> all_rows = rows;
+    all_rows.insert(all_rows.end(), serve_rows.begin(), serve_rows.end());
     std::printf("%-34s %7s %8s %9s %10s %8s %8s %7s\n", "backend", "writers", "commits",
                 "seconds", "commits/s", "p50 ms", "p99 ms", "failed");
-    for (const BenchRow& r : rows)
+    for (const BenchRow& r : all_rows)
         std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d\n", r.backend.c_str(), r.writers,
                     r.commits, r.seconds, rate(r), r.p50_ms, r.p99_ms,
                     r.failed_writers);
-    for (const BenchRow& r : rows)
+    for (const BenchRow& r : all_rows)
         if (r.failed_writers)
             std::printf("%s, %d writers: %d stopped, first: %s\n", r.backend.c_str(), r.writers,
                         r.failed_writers, r.first_error.c_str());
@@ -153,10 +274,19 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials, const std
         if (rate(rows[i]) > 0)
             std::printf("writers %d: postgresql/sqlite throughput ratio %.2f\n", rows[i].writers,
                         rate(rows[i + 1]) / rate(rows[i]));
+    // The serve rows: the same table, and each row against the store it writes into.
+    for (size_t i = 0; i + 1 < serve_rows.size(); i += 2)
+        for (size_t j = 0; j + 1 < rows.size(); j += 2)
+            if (rows[j].writers == serve_rows[i].writers && rate(rows[j]) > 0 &&
+                rate(rows[j + 1]) > 0)
+                std::printf("writers %d: serve/sqlite throughput ratio %.2f, "
+                            "serve/postgresql %.2f\n",
+                            serve_rows[i].writers, rate(serve_rows[i]) / rate(rows[j]),
+                            rate(serve_rows[i + 1]) / rate(rows[j + 1]));
     if (!csv.empty()) {
         std::ofstream out(csv);
         out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,failed_writers\n";
-        for (const BenchRow& r : rows)
+        for (const BenchRow& r : all_rows)
             out << '"' << r.backend << "\"," << r.writers << ',' << r.commits << ',' << r.seconds
                 << ',' << rate(r) << ',' << r.p50_ms << ',' << r.p99_ms << ','
                 << r.failed_writers << "\n";

@@ -20,6 +20,7 @@ void register_simulate(CLI::App& app, int& exit_code);
 void register_power(CLI::App& app, int& exit_code);
 void register_render(CLI::App& app, int& exit_code);
 void register_run(CLI::App& app, int& exit_code);
+void register_serve(CLI::App& app, int& exit_code);
 void register_participants(CLI::App& app, int& exit_code);
 void register_export(CLI::App& app, int& exit_code);
 void register_merge(CLI::App& app, int& exit_code);

@@ -340,6 +340,25 @@ void read_analysis_plan(Protocol& p, TableReader& root) {
     r.reject_unknown();
 }
 
+void read_online(Protocol& p, TableReader& root) {
+    const toml::table* table = root.table("online");
+    if (!table) return;
+    TableReader r(*table, "online", p.source);
+    p.online.completion_code = r.string("completion_code", "");
+    p.online.completion_url = r.string("completion_url", "");
+    const std::string& url = p.online.completion_url;
+    if (!url.empty() && url.rfind("https://", 0) != 0 && url.rfind("http://", 0) != 0)
+        r.fail(r.raw().get("completion_url"), "completion_url",
+               "must start with https:// or http://, got '" + url + "'");
+    for (const std::string* text : {&p.online.completion_code, &p.online.completion_url})
+        for (char c : *text)
+            if (static_cast<unsigned char>(c) < 0x20 || c == '"' || c == '<' || c == '>')
+                r.fail(r.raw().get(text == &url ? "completion_url" : "completion_code"),
+                       text == &url ? "completion_url" : "completion_code",
+                       "must not hold control characters, quotes or angle brackets");
+    r.reject_unknown();
+}
+
 }  // namespace
 
 const StimulusSpec* Protocol::find_stimulus(std::string_view id) const {
@@ -407,6 +426,7 @@ Protocol parse_protocol(std::string_view text, const std::string& source,
     read_trials(p, root);
     read_randomisation(p, root);
     read_analysis_plan(p, root);
+    read_online(p, root);
     root.reject_unknown();
     return p;
 }

@@ -72,6 +72,12 @@ struct AnalysisPlan {
     std::string primary_design = "within";
 };
 
+// [online]: how `lucent serve` ends a participant's session in the browser.
+struct OnlineSettings {
+    std::string completion_code;  // shown on the completion page (e.g. Prolific's code)
+    std::string completion_url;   // http(s) URL the page redirects to when the study ends
+};
+
 struct Screens {
     std::string consent;
     std::string instructions;
@@ -99,6 +105,7 @@ struct Protocol {
     std::vector<CatchTrial> catch_trials;
     Randomisation randomisation;
     AnalysisPlan analysis;
+    OnlineSettings online;
 
     const StimulusSpec* find_stimulus(std::string_view id) const;
     // Level of `factor` for a stimulus ("stimulus", "technique" or a parameter); empty

@@ -270,5 +270,31 @@ TEST(Protocol, LevelsAreCanonicalNumbers) {
     EXPECT_EQ(p.level_of(*p.find_stimulus("contrast_reversed_jade"), "technique"), "contrast_reversed");
 }
 
+
+TEST(OnlineSettings, CompletionCodeAndUrlAreReadAndCheckedInOneLine) {
+    const std::string base = lucent::test::kSmallProtocol;
+    const Protocol none = parse_protocol(base, "web.toml");
+    EXPECT_EQ(none.online.completion_code, "");
+    EXPECT_EQ(none.online.completion_url, "");
+    const Protocol p = parse_protocol(
+        base + "\n[online]\ncompletion_code = \"C0DE42\"\n"
+               "completion_url = \"https://app.prolific.com/submissions/complete?cc=C0DE42\"\n",
+        "web.toml");
+    EXPECT_EQ(p.online.completion_code, "C0DE42");
+    EXPECT_EQ(p.online.completion_url, "https://app.prolific.com/submissions/complete?cc=C0DE42");
+    for (const char* bad : {"completion_url = \"javascript:alert(1)\"",
+                            "completion_code = \"<b>\"", "completion_link = \"x\""}) {
+        try {
+            parse_protocol(base + "\n[online]\n" + bad + "\n", "web.toml");
+            ADD_FAILURE() << bad;
+        } catch (const ProtocolError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.rfind("web.toml:", 0), 0u) << what;
+            EXPECT_NE(what.find("key 'online."), std::string::npos) << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lucent::study

@@ -1,0 +1,235 @@
+// lucent serve: the study for online participants in a browser. The HTTP layer only:
+// every decision is in study/serve/web_study.h; the page is embedded (serve/web/).
+#include <fcntl.h>
+#include <httplib.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "commands.h"
+#include "lucent/version.h"
+#include "postgres/trial_journal.h"
+#include "protocol.h"
+#include "serve_http.h"
+#include "serve/web_study.h"
+#include "session/stimulus_source.h"
+#include "store.h"
+#include "study_store.h"
+#include "trial_plan.h"
+
+namespace lucent::app {
+namespace {
+
+struct ServeArgs {
+    std::string protocol_file;
+    std::string preset;
+    std::string images_dir;
+    std::string db;
+    std::string listen = "127.0.0.1:8080";
+    std::string secret_file;
+    int threads = 64;
+};
+
+std::string read_file(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
+
+// Every stimulus's picture as the lab shows it (load_image_rgba8: 8-bit sRGB, EXR
+// encoded on the way), written once as PNG and kept in memory: nothing else on disk is
+// ever served.
+std::map<std::string, ServedPicture> load_pictures(const study::Protocol& protocol,
+                                             const study::PrerenderedStimuli& stimuli) {
+    std::map<std::string, ServedPicture> out;
+    char scratch_template[] = "/tmp/lucent-serve-XXXXXX";
+    const char* scratch = mkdtemp(scratch_template);
+    if (!scratch) throw std::runtime_error("cannot create a scratch folder in /tmp");
+    struct Cleanup {
+        std::filesystem::path dir;
+        ~Cleanup() {
+            std::error_code ignored;
+            std::filesystem::remove_all(dir, ignored);
+        }
+    } cleanup{scratch};
+    for (const study::StimulusSpec& s : protocol.stimuli) {
+        const study::CpuImage image = study::load_image_rgba8(stimuli.path_for(s));
+        const auto png = cleanup.dir / "picture.png";
+        study::save_image_rgba8(png.string(), image);
+        out[s.id] = {read_file(png), {image.width, image.height}};
+    }
+    return out;
+}
+
+// The key of the session tokens: 32 random bytes kept in a file (mode 0600) so tokens
+// survive a restart. Default: beside an SQLite database, else in the journal folder.
+std::string load_or_create_secret(const std::string& path) {
+    if (std::filesystem::exists(path)) {
+        const std::string secret = read_file(path);
+        if (secret.size() < 32)
+            throw std::runtime_error(path + ": session key file is shorter than 32 bytes");
+        return secret;
+    }
+    std::filesystem::create_directories(std::filesystem::absolute(path).parent_path());
+    std::string secret(32, '\0');
+    std::ifstream random("/dev/urandom", std::ios::binary);
+    random.read(secret.data(), static_cast<std::streamsize>(secret.size()));
+    if (random.gcount() != 32) throw std::runtime_error("cannot read /dev/urandom");
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0) throw std::runtime_error(path + ": cannot create the session key file: " + std::strerror(errno));
+    const bool written = ::write(fd, secret.data(), secret.size()) == static_cast<ssize_t>(secret.size()) &&
+                         ::fsync(fd) == 0;
+    ::close(fd);
+    if (!written) throw std::runtime_error(path + ": cannot write the session key file");
+    return secret;
+}
+
+bool parse_listen(const std::string& listen, std::string& host, int& port) {
+    const size_t colon = listen.rfind(':');
+    if (colon == std::string::npos || colon == 0) return false;
+    host = listen.substr(0, colon);
+    if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+    const std::string digits = listen.substr(colon + 1);
+    if (digits.empty() || digits.size() > 5 || digits.find_first_not_of("0123456789") != std::string::npos)
+        return false;
+    port = std::stoi(digits);
+    return port <= 65535;
+}
+
+bool is_loopback(const std::string& host) {
+    return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+int serve_command(const ServeArgs& args) {
+    if (args.protocol_file.empty() == args.preset.empty()) {
+        std::cerr << "lucent serve: give a PROTOCOL.toml or --preset NAME (exactly one)\n";
+        return kExitUsage;
+    }
+    std::string host;
+    int port = 0;
+    if (!parse_listen(args.listen, host, port)) {
+        std::cerr << "lucent serve: --listen '" << args.listen << "': expected HOST:PORT, e.g. 127.0.0.1:8080\n";
+        return kExitUsage;
+    }
+    study::Protocol protocol;
+    std::unique_ptr<study::StudyStore> store;
+    std::unique_ptr<study::WebStudy> web;
+    std::map<std::string, ServedPicture> pictures;
+    try {
+        protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
+                                       : study::builtin_protocol(args.preset);
+        study::plan_trials(protocol, 0, 0);  // impossible randomisation fails here, early
+        const study::PrerenderedStimuli stimuli(args.images_dir);
+        stimuli.check(protocol);
+        study::WebStudyOptions options;
+        options.environment.machine_id = study::machine_id();
+        options.environment.software_version = version_string();
+        options.environment.build_hash = build_hash();
+        options.environment.stimuli = stimuli.provenance(protocol);
+        pictures = load_pictures(protocol, stimuli);
+        for (const auto& [id, picture] : pictures) options.images[id] = picture.size;
+        const std::string secret_file =
+            !args.secret_file.empty() ? args.secret_file
+            : study::is_server_uri(args.db) ? study::default_journal_path(args.db) + ".serve-key"
+                                            : args.db + "-serve-key";
+        options.secret = load_or_create_secret(secret_file);
+        store = study::open_study_store(args.db);
+        web = std::make_unique<study::WebStudy>(protocol, *store, options);
+    } catch (const study::ProtocolError& e) {
+        std::cerr << "lucent serve: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const study::PlanError& e) {
+        std::cerr << "lucent serve: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const study::StimulusError& e) {
+        std::cerr << "lucent serve: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const study::StoreError& e) {
+        std::cerr << "lucent serve: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const std::exception& e) {
+        std::cerr << "lucent serve: " << e.what() << "\n";
+        return kExitFailure;
+    }
+
+    httplib::Server http;
+    configure_serve_http(http, *web, pictures, args.threads);
+    port = bind_serve_port(http, host, port);
+    if (port < 0) {
+        std::cerr << "lucent serve: cannot listen on " << args.listen << ": " << std::strerror(errno) << "\n";
+        return kExitFailure;
+    }
+    // SIGINT/SIGTERM stop the server from a thread of their own (never in a handler).
+    sigset_t stop_signals;
+    sigemptyset(&stop_signals);
+    sigaddset(&stop_signals, SIGINT);
+    sigaddset(&stop_signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+    std::thread stopper([&] {
+        int signal = 0;
+        sigwait(&stop_signals, &signal);
+        http.stop();
+    });
+    std::cout << "lucent serve: study '" << protocol.name << "' (" << pictures.size()
+              << " pictures) from " << store->name() << " on http://"
+              << (host.find(':') != std::string::npos ? "[" + host + "]" : host) << ":" << port
+              << "/?participant=ID" << std::endl;
+    if (!is_loopback(host))
+        std::cout << "lucent serve: note: listening beyond this machine (" << host
+                  << "); serve participants through an HTTPS reverse proxy (README)" << std::endl;
+    http.listen_after_bind();
+    if (stopper.joinable()) {
+        pthread_kill(stopper.native_handle(), SIGTERM);  // wakes sigwait when stopped otherwise
+        stopper.join();
+    }
+    std::cout << "lucent serve: stopped; " << web->live_sessions()
+              << " sessions were open (they resume from their links)" << std::endl;
+    if (store->pending_trials() > 0) {
+        try {
+            store->sync();
+        } catch (const study::StoreError& e) {
+            std::cerr << "lucent serve: " << e.what() << "\n";
+        }
+        if (const int left = store->pending_trials(); left > 0)
+            std::cerr << "lucent serve: " << left << " trials are kept in the local journal until "
+                      << store->name() << " confirms them; send them with 'lucent store sync --db "
+                      << store->name() << "'\n";
+    }
+    return kExitOk;
+}
+
+}  // namespace
+
+void register_serve(CLI::App& app, int& exit_code) {
+    auto args = std::make_shared<ServeArgs>();
+    auto* cmd = app.add_subcommand(
+        "serve", "Serve the study to online participants in a browser (same protocol as 'run')");
+    cmd->add_option("protocol", args->protocol_file, "Study protocol file (TOML)");
+    cmd->add_option("--preset", args->preset, "Built-in protocol instead of a file")
+        ->check(CLI::IsMember(study::builtin_protocol_names()));
+    cmd->add_option("--images", args->images_dir,
+                    "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr (e.g. from "
+                    "'lucent render --preset thesis --out DIR')");
+    cmd->add_option("--db", args->db,
+                    "Study database: FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
+        ->required();
+    cmd->add_option("--listen", args->listen,
+                    "HOST:PORT to listen on (default 127.0.0.1:8080, loopback only; port 0 picks one)");
+    cmd->add_option("--secret-file", args->secret_file,
+                    "Key of the participants' session tokens (created when absent; default "
+                    "DB-serve-key beside an SQLite file)");
+    cmd->add_option("--threads", args->threads, "HTTP worker threads (connections served at once)")
+        ->check(CLI::Range(2, 1024));
+    cmd->callback([args, &exit_code] { exit_code = serve_command(*args); });
+}
+
+}  // namespace lucent::app

@@ -1,0 +1,300 @@
+// lucent serve's page: a thin view of the screen the server says is current (the
+// server owns the plan and the state; a reload asks it again). Keys 1-7, arrows and
+// Enter, and clicks follow the lab's rules (study/session/rating_input.h); each answer
+// sends its input events with performance.now() times, and the server replays them.
+// The picture is drawn pixel for pixel; its onset is the first requestAnimationFrame
+// after it decoded and entered the page.
+'use strict';
+(() => {
+  const el = (id) => document.getElementById(id);
+  const params = new URLSearchParams(location.search);
+  const who = {};
+  if (params.get('participant')) who.participant = params.get('participant');
+  if (params.get('PROLIFIC_PID')) {
+    who.prolific = { PROLIFIC_PID: params.get('PROLIFIC_PID') };
+    if (params.get('STUDY_ID')) who.prolific.STUDY_ID = params.get('STUDY_ID');
+    if (params.get('SESSION_ID')) who.prolific.SESSION_ID = params.get('SESSION_ID');
+  }
+  const code = who.participant || (who.prolific && who.prolific.PROLIFIC_PID) || '';
+  const tokenKey = 'lucent-token:' + code;
+
+  let state = null;     // the server's last reply
+  let token = null;
+  let shownAt = null;   // performance.now() of the current screen's first frame
+  let busy = false;     // a request is on its way: input waits
+  let trial = null;     // the rating screen: onset, events, ratings, focus
+
+  function mark(screen) {
+    document.body.dataset.screen = screen;
+    document.body.dataset.view = state && state.view !== undefined ? String(state.view) : '';
+  }
+  function only(id) {
+    for (const m of ['text-screen', 'trial-screen', 'message'])
+      el(m).hidden = m !== id;
+  }
+  function message(text, screen) {
+    only('message');
+    el('progress').hidden = true;
+    el('message-text').textContent = text;
+    mark(screen || 'error');
+  }
+  function firstFrame() {
+    return new Promise((resolve) => requestAnimationFrame(() => resolve(performance.now())));
+  }
+  function client() {
+    return {
+      user_agent: navigator.userAgent, window_width: innerWidth, window_height: innerHeight,
+      device_pixel_ratio: devicePixelRatio, screen_width: screen.width,
+      screen_height: screen.height,
+    };
+  }
+
+  async function api(endpoint, body) {
+    if (token && !body.token) body.token = token;
+    try {
+      const r = await fetch('/api/' + endpoint, {
+        method: 'POST', headers: { 'Content-Type': 'application/json' },
+        body: JSON.stringify(body), cache: 'no-store',
+      });
+      let reply;
+      try { reply = await r.json(); } catch (e) { reply = { error: 'no reply (' + r.status + ')' }; }
+      return { status: r.status, reply };
+    } catch (e) {
+      return { status: 0, reply: { error: 'the study server cannot be reached: ' + e.message } };
+    }
+  }
+  // 200: the next screen; 409: the page is behind the server (another tab, a restart),
+  // so it asks again; anything else is shown.
+  function settle(status, reply) {
+    busy = false;
+    if (status === 200) return show(reply);
+    if (status === 409 || status === 0) return setTimeout(start, status ? 0 : 2000);
+    message(reply.error || 'error ' + status);
+  }
+
+  async function start() {
+    if (!code) return message('This link has no participant code (?participant=ID).');
+    const body = Object.assign({ t_ms: performance.now(), client: client() }, who);
+    const saved = localStorage.getItem(tokenKey);
+    if (saved) body.token = saved;
+    busy = true;
+    const { status, reply } = await api('session', body);
+    busy = false;
+    if (status !== 200) return message(reply.error || 'error ' + status);
+    if (reply.token) {
+      token = reply.token;
+      localStorage.setItem(tokenKey, token);
+    }
+    show(reply);
+    if (reply.token) measureRefresh();
+  }
+
+  // The display's refresh from 60 frame intervals (median), stored with the session.
+  async function measureRefresh() {
+    const times = [];
+    for (let i = 0; i < 61; ++i) times.push(await firstFrame());
+    const gaps = times.slice(1).map((t, i) => t - times[i]).sort((a, b) => a - b);
+    const median = gaps[Math.floor(gaps.length / 2)];
+    if (median > 0) await api('environment', { refresh_hz: 1000 / median });
+  }
+
+  function show(s) {
+    state = s;
+    shownAt = null;
+    trial = null;
+    document.body.style.background = s.background || '#000';
+    const progress = s.progress;
+    el('progress').hidden = !progress || s.screen === 'consent';
+    if (progress) el('progress').textContent = progress.done + ' of ' + progress.total;
+    if (s.screen === 'done') return finish(s);
+    if (s.screen === 'declined') return message(s.text, 'declined');
+    if (s.screen === 'trial') return beginTrial(s);
+    only('text-screen');
+    el('text').textContent = s.text;
+    const consent = s.screen === 'consent';
+    el('decline').hidden = !consent;
+    el('continue').textContent = consent ? 'I agree (Enter)' : 'Continue (Enter)';
+    // Shown with its first frame: keys before it were meant for the screen before.
+    firstFrame().then((t) => {
+      if (state !== s) return;
+      shownAt = t;
+      mark(s.screen);
+    });
+  }
+
+  function finish(s) {
+    localStorage.removeItem(tokenKey);
+    const c = s.completion || {};
+    let text = s.text;
+    if (c.code) text += '\n\nYour completion code: ' + c.code;
+    if (c.url) text += '\n\nTaking you back now...';
+    message(text, 'done');
+    if (c.code) document.body.dataset.completionCode = c.code;
+    if (c.url) setTimeout(() => location.assign(c.url), 1500);
+  }
+
+  function act(endpoint, t) {
+    if (busy || shownAt === null || t < shownAt) return;  // a key meant for the screen before
+    busy = true;
+    api(endpoint, { view: state.view, shown_ms: shownAt, t_ms: t })
+      .then(({ status, reply }) => settle(status, reply));
+  }
+
+  // ---- the rating screen ------------------------------------------------------------
+  const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+  function buildQuestions(s) {
+    const box = el('questions');
+    box.textContent = '';
+    s.questions.forEach((q, qi) => {
+      const div = document.createElement('div');
+      div.className = 'question';
+      const text = document.createElement('div');
+      text.textContent = q.text;
+      div.appendChild(text);
+      const scale = document.createElement('div');
+      scale.className = 'scale';
+      const left = document.createElement('span');
+      left.className = 'label left';
+      left.textContent = q.labels[0] || '';
+      scale.appendChild(left);
+      for (let v = 1; v <= q.labels.length; ++v) {
+        const b = document.createElement('button');
+        b.type = 'button';
+        b.textContent = String(v);
+        b.dataset.question = String(qi);
+        b.dataset.value = String(v);
+        b.addEventListener('click', (ev) => {
+          ev.currentTarget.blur();  // Enter stays the study's key, not the button's
+          input({ type: 'point', question: qi, value: v }, ev.timeStamp);
+        });
+        scale.appendChild(b);
+      }
+      const right = document.createElement('span');
+      right.className = 'label right';
+      right.textContent = q.labels[q.labels.length - 1] || '';
+      scale.appendChild(right);
+      div.appendChild(scale);
+      box.appendChild(div);
+    });
+  }
+
+  // True when the page shows the picture at its size and the scales without scrolling.
+  function fits() {
+    const root = document.documentElement;
+    return root.scrollWidth <= innerWidth && root.scrollHeight <= innerHeight;
+  }
+
+  async function beginTrial(s) {
+    const t = s.trial;
+    only('trial-screen');
+    const screenBox = el('trial-screen');
+    screenBox.style.visibility = 'hidden';  // the blank between trials
+    mark('blank');
+    const img = new Image();
+    img.alt = '';
+    img.src = t.image;
+    const decoded = img.decode();
+    await sleep(t.blank_ms);
+    try { await decoded; } catch (e) { return message('The picture ' + t.image + ' cannot be shown.'); }
+    if (state !== s) return;
+    // One image pixel per device pixel: the CSS size divides by devicePixelRatio.
+    const size = () => {
+      img.style.width = t.width / devicePixelRatio + 'px';
+      img.style.height = t.height / devicePixelRatio + 'px';
+    };
+    el('picture').textContent = '';
+    el('picture').appendChild(img);
+    el('prompt').textContent = t.prompt || (t.practice ? 'Practice' : '');
+    buildQuestions(s);
+    for (;;) {  // laid out invisibly and measured; too small: say so and wait
+      only('trial-screen');
+      size();
+      if (fits()) break;
+      message('Your browser window is too small to show the picture at its true size (' +
+              t.width + ' x ' + t.height + ' pixels) with the rating scales. Please enlarge ' +
+              'the window or zoom out; the study continues by itself.', 'too-small');
+      await new Promise((resolve) => addEventListener('resize', resolve, { once: true }));
+      if (state !== s) return;
+    }
+    only('trial-screen');
+    el('progress').hidden = !s.progress;
+    screenBox.style.visibility = 'visible';
+    const onset = await firstFrame();
+    if (state !== s) return;
+    trial = {
+      onset, events: [], focus: 0, ratings: s.questions.map(() => null),
+      points: s.questions.map((q) => q.labels.length),
+    };
+    render();
+    document.body.dataset.trial = t.id;
+    mark('trial');
+  }
+
+  function render() {
+    document.querySelectorAll('.question').forEach((div, qi) => {
+      div.classList.toggle('focused', qi === trial.focus);
+      div.querySelectorAll('button').forEach((b) =>
+        b.classList.toggle('chosen', Number(b.dataset.value) === trial.ratings[qi]));
+    });
+    el('next').disabled = !trial.ratings.every((r) => r !== null);
+  }
+
+  // One input on the rating screen, by the lab's rules; recorded for the server's replay.
+  function input(ev, t) {
+    if (!trial || busy || t < trial.onset) return;
+    const rec = Object.assign({ t_ms: t }, ev);
+    const n = trial.ratings.length;
+    const set = (q, v) => { if (v >= 1 && v <= trial.points[q]) trial.ratings[q] = v; };
+    const all = () => trial.ratings.every((r) => r !== null);
+    let confirm = false;
+    if (ev.type === 'point') {
+      trial.focus = ev.question;
+      set(ev.question, ev.value);
+    } else if (ev.type === 'next') {
+      if (!all()) return;
+      confirm = true;
+    } else {
+      const k = ev.key, f = trial.focus, r = trial.ratings[f], p = trial.points[f];
+      const middle = Math.floor((p + 1) / 2);
+      if (k >= '1' && k <= '9' && k.length === 1) {
+        if (Number(k) > Math.max(...trial.points)) return;
+        set(f, Number(k));
+      } else if (k === 'ArrowLeft') set(f, r ? Math.max(1, r - 1) : middle);
+      else if (k === 'ArrowRight') set(f, r ? Math.min(p, r + 1) : middle);
+      else if (k === 'ArrowUp') trial.focus = Math.max(0, f - 1);
+      else if (k === 'ArrowDown') trial.focus = Math.min(n - 1, f + 1);
+      else if (k === 'Enter') {
+        if (!r) return;
+        if (all()) confirm = true;
+        else {
+          for (let step = 1; step <= n; ++step)
+            if (trial.ratings[(f + step) % n] === null) { trial.focus = (f + step) % n; break; }
+        }
+      } else return;
+    }
+    trial.events.push(rec);
+    render();
+    if (!confirm) return;
+    busy = true;
+    const body = { trial: state.trial.id, view: state.view, onset_ms: trial.onset, events: trial.events };
+    trial = null;
+    api('answer', body).then(({ status, reply }) => settle(status, reply));
+  }
+
+  // ---- keys and buttons -------------------------------------------------------------
+  document.addEventListener('keydown', (ev) => {
+    if (!state || ev.repeat) return;
+    const t = ev.timeStamp;  // when the key went down (performance.now()'s clock)
+    const k = ev.key;
+    if (['ArrowLeft', 'ArrowRight', 'ArrowUp', 'ArrowDown', 'Enter', ' '].includes(k))
+      ev.preventDefault();
+    if (state.screen === 'trial') return input({ type: 'key', key: k }, t);
+    if (k === 'Enter') act('continue', t);
+    else if ((k === 'n' || k === 'N') && state.screen === 'consent') act('decline', t);
+  });
+  el('continue').addEventListener('click', (ev) => act('continue', ev.timeStamp));
+  el('decline').addEventListener('click', (ev) => act('decline', ev.timeStamp));
+  el('next').addEventListener('click', (ev) => input({ type: 'next' }, ev.timeStamp));
+  start();
+})();

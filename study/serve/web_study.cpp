@@ -1,0 +1,624 @@
+// `lucent serve`'s core (web_study.h). [SECTIONS] tokens and names | request fields |
+// sessions (start, resume, reload) | actions (continue, decline, answer, environment) |
+// the state a page shows.
+#include "serve/web_study.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <stdexcept>
+
+#include "session/session_flow.h"
+#include "sha256.h"
+#include "store.h"
+
+namespace lucent::study {
+
+using nlohmann::json;
+
+namespace {
+
+// ---- [SECTION] tokens and names ----------------------------------------------------------
+std::string bytes_of_hex(const std::string& hex) {
+    std::string out;
+    for (size_t i = 0; i + 1 < hex.size(); i += 2)
+        out += static_cast<char>(std::stoi(hex.substr(i, 2), nullptr, 16));
+    return out;
+}
+
+// Compares without an early exit, so the time taken tells nothing about the token.
+bool same_secret_text(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    unsigned char diff = 0;
+    for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+    return diff == 0;
+}
+
+int hex_digit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+// ---- [SECTION] request fields ------------------------------------------------------------
+// A refused request: HTTP status and one line.
+struct RequestError : std::runtime_error {
+    RequestError(int status, const std::string& what) : std::runtime_error(what), status(status) {}
+    int status;
+};
+
+std::string one_line(std::string text) {
+    for (char& c : text)
+        if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+    return text;
+}
+
+// As text; bytes that are not UTF-8 (echoed from a malformed request) become U+FFFD.
+std::string to_text(const json& value) {
+    return value.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+WebReply error_reply(int status, const std::string& why) {
+    return {status, to_text(json{{"error", one_line(why)}})};
+}
+
+const json* field(const json& body, const char* key) {
+    const auto it = body.find(key);
+    return it == body.end() || it->is_null() ? nullptr : &*it;
+}
+
+std::string text_field(const json& body, const char* key, size_t max_length, bool required) {
+    const json* value = field(body, key);
+    if (!value) {
+        if (required) throw RequestError(400, std::string("field '") + key + "' is required");
+        return "";
+    }
+    if (!value->is_string())
+        throw RequestError(400, std::string("field '") + key + "' must be a string");
+    const std::string& text = value->get_ref<const std::string&>();
+    if (text.size() > max_length)
+        throw RequestError(400, std::string("field '") + key + "' is longer than " +
+                                    std::to_string(max_length) + " bytes");
+    return text;
+}
+
+// A finite number in [lo, hi].
+std::optional<double> number_field(const json& body, const char* key, double lo, double hi,
+                                   bool required) {
+    const json* value = field(body, key);
+    if (!value) {
+        if (required) throw RequestError(400, std::string("field '") + key + "' is required");
+        return std::nullopt;
+    }
+    if (!value->is_number())
+        throw RequestError(400, std::string("field '") + key + "' must be a number");
+    const double v = value->get<double>();
+    if (!std::isfinite(v) || v < lo || v > hi) {
+        char range[96];
+        std::snprintf(range, sizeof range, "' must lie in [%g, %g]", lo, hi);
+        throw RequestError(400, std::string("field '") + key + range);
+    }
+    return v;
+}
+
+// Browser times: performance.now() milliseconds since the page loaded.
+constexpr double kMaxPageMs = 7 * 24 * 3600e3;
+int64_t ms_to_ns(double ms) { return static_cast<int64_t>(std::llround(ms * 1e6)); }
+
+void check_code(const std::string& code, const char* what) {
+    if (const std::string why = participant_code_problem(code); !why.empty())
+        throw RequestError(400, std::string(what) + " " + why);
+}
+
+int64_t random_seed() {
+    std::random_device device;
+    return static_cast<int64_t>((uint64_t(device()) << 32 | device()) & 0x7FFFFFFFFFFFFFFFull);
+}
+
+std::string css_colour(const float rgb[3]) {
+    // The protocol's background is linear; the page takes sRGB.
+    auto encode = [](float c) {
+        const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+        return static_cast<int>(std::lround(std::clamp(s, 0.0, 1.0) * 255));
+    };
+    char out[8];
+    std::snprintf(out, sizeof out, "#%02x%02x%02x", encode(rgb[0]), encode(rgb[1]),
+                  encode(rgb[2]));
+    return out;
+}
+
+const char* screen_name(Screen screen) {
+    switch (screen) {
+    case Screen::Consent: return "consent";
+    case Screen::Instructions: return "instructions";
+    case Screen::PracticeDone: return "practice_done";
+    case Screen::Blank:
+    case Screen::Trial: return "trial";
+    case Screen::Break: return "break";
+    case Screen::Debrief: return "debrief";
+    case Screen::Done: return "done";
+    }
+    return "done";
+}
+
+}  // namespace
+
+std::string hmac_sha256_hex(std::string_view key, std::string_view message) {
+    constexpr size_t kBlock = 64;
+    std::string k = key.size() > kBlock ? bytes_of_hex(sha256_hex(key)) : std::string(key);
+    k.resize(kBlock, '\0');
+    std::string inner(kBlock, '\0'), outer(kBlock, '\0');
+    for (size_t i = 0; i < kBlock; ++i) {
+        inner[i] = static_cast<char>(k[i] ^ 0x36);
+        outer[i] = static_cast<char>(k[i] ^ 0x5c);
+    }
+    return sha256_hex(outer + bytes_of_hex(sha256_hex(inner + std::string(message))));
+}
+
+std::string participant_code_problem(std::string_view code) {
+    if (code.empty()) return "is empty";
+    if (code.size() > kMaxCodeLength)
+        return "is longer than " + std::to_string(kMaxCodeLength) + " characters";
+    for (char c : code)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
+            return "may hold only letters, digits, '_' and '-'";
+    return "";
+}
+
+std::string session_token(std::string_view secret, std::string_view code,
+                          std::string_view session_uuid) {
+    return std::string(code) + "." + hmac_sha256_hex(secret, session_uuid);
+}
+
+std::optional<std::string> image_of_target(std::string_view target,
+                                           const std::map<std::string, WebImage>& images) {
+    target = target.substr(0, target.find('?'));
+    std::string path;
+    for (size_t i = 0; i < target.size(); ++i) {
+        if (target[i] != '%') {
+            path += target[i];
+            continue;
+        }
+        if (i + 2 >= target.size() || hex_digit(target[i + 1]) < 0 || hex_digit(target[i + 2]) < 0)
+            return std::nullopt;
+        path += static_cast<char>(hex_digit(target[i + 1]) * 16 + hex_digit(target[i + 2]));
+        i += 2;
+    }
+    const std::string_view prefix = "/images/", suffix = ".png";
+    if (path.size() <= prefix.size() + suffix.size() || path.compare(0, prefix.size(), prefix) != 0 ||
+        path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
+        return std::nullopt;
+    const std::string id = path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
+    // A name, never a path: no separator, no parent, nothing a file system would resolve.
+    if (id.find_first_of("/\\%") != std::string::npos || id.find("..") != std::string::npos ||
+        id.find('\0') != std::string::npos || !images.count(id))
+        return std::nullopt;
+    return id;
+}
+
+// ---- [SECTION] sessions -----------------------------------------------------------------
+struct WebStudy::Live {
+    std::string code;
+    SessionRow session;
+    std::string token;
+    std::vector<TrialRow> trials;  // as stored when loaded; `answered` kept up to date
+    std::optional<SessionFlow> flow;
+    // What the browser said about itself (the segment's environment).
+    std::string user_agent;
+    int window_width = 0, window_height = 0, screen_width = 0, screen_height = 0;
+    double device_pixel_ratio = 0;
+    std::optional<double> refresh_hz;
+    std::string prolific_study, prolific_session;
+};
+
+WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions options)
+    : protocol_(protocol), store_(store), options_(std::move(options)) {
+    for (const StimulusSpec& s : protocol_.stimuli)
+        if (!options_.images.count(s.id))
+            throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id + "'");
+    study_id_ = store_.ensure_study(protocol_);
+    store_.check_stimulus_values(options_.environment.stimuli);
+}
+
+WebStudy::~WebStudy() = default;
+
+size_t WebStudy::live_sessions() const {
+    std::lock_guard lock(mutex_);
+    return live_.size();
+}
+
+WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
+    if (body.size() > options_.max_body_bytes)
+        return error_reply(413, "request body of " + std::to_string(body.size()) +
+                                    " bytes is over the limit of " +
+                                    std::to_string(options_.max_body_bytes));
+    json request;
+    try {
+        request = json::parse(body);
+    } catch (const json::parse_error& e) {
+        return error_reply(400, std::string("malformed JSON: ") + e.what());
+    }
+    if (!request.is_object()) return error_reply(400, "the request body must be a JSON object");
+    std::lock_guard lock(mutex_);
+    try {
+        if (endpoint == "session") return start(request);
+        if (endpoint == "state" || endpoint == "continue" || endpoint == "decline" ||
+            endpoint == "answer" || endpoint == "environment")
+            return act(endpoint, request);
+        return error_reply(404, "no API endpoint '" + std::string(endpoint) + "'");
+    } catch (const RequestError& e) {
+        return error_reply(e.status, e.what());
+    } catch (const json::exception& e) {
+        return error_reply(400, std::string("bad request: ") + e.what());
+    } catch (const StoreError& e) {
+        // Refused by the store (a participant run on a lab station now, a rating it
+        // does not accept): nothing was written.
+        return error_reply(409, e.what());
+    } catch (const std::exception& e) {
+        return error_reply(500, e.what());
+    }
+}
+
+SessionEnvironment WebStudy::environment_for(const Live& live) const {
+    SessionEnvironment env = options_.environment;
+    env.gl_vendor = "web browser";
+    env.gl_renderer = live.user_agent;  // the browser draws: its user agent
+    std::string mode = "browser window " + std::to_string(live.window_width) + "x" +
+                       std::to_string(live.window_height) + " CSS px, devicePixelRatio ";
+    char dpr[32];
+    std::snprintf(dpr, sizeof dpr, "%g", live.device_pixel_ratio);
+    mode += dpr;
+    if (live.screen_width > 0)
+        mode += ", screen " + std::to_string(live.screen_width) + "x" +
+                std::to_string(live.screen_height);
+    if (!live.prolific_study.empty() || !live.prolific_session.empty())
+        mode += "; Prolific STUDY_ID=" + live.prolific_study +
+                " SESSION_ID=" + live.prolific_session;
+    env.display_mode = mode;
+    env.display_refresh_hz.reset();
+    env.measured_refresh_hz = live.refresh_hz;
+    env.refresh_note = live.refresh_hz
+                           ? "browser estimate: median requestAnimationFrame interval"
+                           : "refresh not measured by the browser (yet)";
+    return env;
+}
+
+WebStudy::Live& WebStudy::load(const std::string& code, const SessionRow& session,
+                               const std::string& token) {
+    auto live = std::make_unique<Live>();
+    live->code = code;
+    live->session = session;
+    live->token = token;
+    Live& out = *live;
+    live_[code] = std::move(live);
+    return out;
+}
+
+WebReply WebStudy::start(const json& body) {
+    // Who: ?participant=ID, or Prolific's PROLIFIC_PID (with STUDY_ID and SESSION_ID).
+    std::string code = text_field(body, "participant", kMaxCodeLength + 1, false);
+    std::string prolific_study, prolific_session;
+    if (const json* prolific = field(body, "prolific")) {
+        if (!prolific->is_object()) throw RequestError(400, "field 'prolific' must be an object");
+        const std::string pid = text_field(*prolific, "PROLIFIC_PID", kMaxCodeLength + 1, true);
+        check_code(pid, "PROLIFIC_PID");
+        if (!code.empty() && code != pid)
+            throw RequestError(400, "participant '" + code + "' and PROLIFIC_PID '" + pid +
+                                        "' differ");
+        code = pid;
+        prolific_study = text_field(*prolific, "STUDY_ID", kMaxCodeLength + 1, false);
+        prolific_session = text_field(*prolific, "SESSION_ID", kMaxCodeLength + 1, false);
+        if (!prolific_study.empty()) check_code(prolific_study, "STUDY_ID");
+        if (!prolific_session.empty()) check_code(prolific_session, "SESSION_ID");
+    }
+    if (code.empty())
+        throw RequestError(400, "no participant code (the link needs ?participant=ID or "
+                                "Prolific's PROLIFIC_PID)");
+    check_code(code, "participant code");
+    const std::string token = text_field(body, "token", kMaxTokenLength, false);
+    const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+
+    Live browser;  // what this page says about itself
+    if (const json* client = field(body, "client")) {
+        if (!client->is_object()) throw RequestError(400, "field 'client' must be an object");
+        browser.user_agent = text_field(*client, "user_agent", kMaxUserAgentLength, false);
+        browser.window_width = static_cast<int>(number_field(*client, "window_width", 0, 1e5, false).value_or(0));
+        browser.window_height = static_cast<int>(number_field(*client, "window_height", 0, 1e5, false).value_or(0));
+        browser.screen_width = static_cast<int>(number_field(*client, "screen_width", 0, 1e5, false).value_or(0));
+        browser.screen_height = static_cast<int>(number_field(*client, "screen_height", 0, 1e5, false).value_or(0));
+        browser.device_pixel_ratio = number_field(*client, "device_pixel_ratio", 0.05, 16, false).value_or(0);
+        browser.refresh_hz = number_field(*client, "refresh_hz", 1, 1000, false);
+    }
+    browser.prolific_study = prolific_study;
+    browser.prolific_session = prolific_session;
+    auto take_browser = [&](Live& live) {
+        live.user_agent = browser.user_agent;
+        live.window_width = browser.window_width;
+        live.window_height = browser.window_height;
+        live.screen_width = browser.screen_width;
+        live.screen_height = browser.screen_height;
+        live.device_pixel_ratio = browser.device_pixel_ratio;
+        live.refresh_hz = browser.refresh_hz;
+        live.prolific_study = browser.prolific_study;
+        live.prolific_session = browser.prolific_session;
+    };
+    const std::string in_progress =
+        "participant '" + code + "' has a session in progress in another browser; continue "
+        "it there (the study link in that browser holds its key)";
+
+    // A page (re)loaded for a session in progress: a new segment, from the first
+    // unanswered trial, as `lucent run --resume` does.
+    std::optional<SessionRow> unfinished;
+    if (const auto it = live_.find(code); it != live_.end())
+        unfinished = it->second->session;
+    else
+        unfinished = store_.unfinished_session(code);
+    if (unfinished && store_.complete_session_if_answered(unfinished->id)) {
+        live_.erase(code);
+        unfinished.reset();
+    }
+    if (unfinished) {
+        const std::string expected = session_token(options_.secret, code, unfinished->uuid);
+        if (!same_secret_text(token, expected)) throw RequestError(403, in_progress);
+        store_.claim_participant(code);
+        Live probe;
+        take_browser(probe);
+        const SessionEnvironment env = environment_for(probe);
+        store_.set_status(unfinished->id, "running", false);
+        store_.begin_segment(unfinished->id, env);
+        Live& live = load(code, *unfinished, expected);
+        take_browser(live);
+        live.trials = store_.trials(unfinished->id);
+        live.flow.emplace(protocol_, store_, unfinished->id, live.trials,
+                          store_.has_consent(unfinished->id), ms_to_ns(t_ms));
+        json reply = state(live);
+        reply["token"] = live.token;
+        return {200, to_text(reply)};
+    }
+    if (store_.has_completed_session(code)) {
+        json reply = done_state();
+        reply["already_completed"] = true;
+        return {200, to_text(reply)};
+    }
+    // A new participant: number and cell as on a lab station, the whole plan stored
+    // before trial 1.
+    store_.claim_participant(code);
+    int number = 0;
+    const int64_t participant_id = store_.ensure_participant(study_id_, code, &number);
+    const uint64_t seed = static_cast<uint64_t>(random_seed());
+    Live probe;
+    take_browser(probe);
+    const SessionRow session = store_.create_session(
+        study_id_, participant_id, plan_trials(protocol_, seed, number), seed,
+        environment_for(probe));
+    Live& live = load(code, session, session_token(options_.secret, code, session.uuid));
+    take_browser(live);
+    live.trials = store_.trials(session.id);
+    live.flow.emplace(protocol_, store_, session.id, live.trials, false, ms_to_ns(t_ms));
+    json reply = state(live);
+    reply["token"] = live.token;
+    return {200, to_text(reply)};
+}
+
+// ---- [SECTION] actions -------------------------------------------------------------------
+WebReply WebStudy::act(std::string_view endpoint, const json& body) {
+    const std::string token = text_field(body, "token", kMaxTokenLength, true);
+    const size_t dot = token.rfind('.');
+    const std::string code = token.substr(0, dot == std::string::npos ? 0 : dot);
+    const auto it = live_.find(code);
+    if (participant_code_problem(code).empty() && it == live_.end()) {
+        // Not loaded here (the server restarted, or the session ended): the page starts
+        // again through /api/session, which checks the token against the store.
+        throw RequestError(409, "session of '" + code + "' is not loaded; start it again "
+                                "(POST /api/session with its token)");
+    }
+    if (it == live_.end() || !same_secret_text(token, it->second->token))
+        throw RequestError(403, "unknown session token");
+    Live& live = *it->second;
+    SessionFlow& flow = *live.flow;
+
+    if (endpoint == "state") return {200, to_text(state(live))};
+    if (endpoint == "environment") {
+        live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);
+        store_.update_environment(live.session.id, environment_for(live));
+        return {200, to_text(state(live))};
+    }
+    if (endpoint == "answer") return answer(live, body);
+
+    // continue / decline: Enter (or N on the consent screen) on the view shown.
+    const double view = *number_field(body, "view", 0, 1e9, true);
+    const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
+    const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+    if (static_cast<int>(view) != flow.serial())
+        throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
+                                    " is no longer shown (now view " +
+                                    std::to_string(flow.serial()) + ")");
+    const Screen screen = flow.screen();
+    const bool decline = endpoint == "decline";
+    if (decline && screen != Screen::Consent)
+        throw RequestError(409, "declining is possible only on the consent screen");
+    if (screen == Screen::Blank || screen == Screen::Trial || screen == Screen::Done)
+        throw RequestError(409, std::string("the ") + screen_name(screen) +
+                                    " screen is not continued with Enter");
+    SessionFlow next = flow;  // changes kept only when the key was taken
+    next.presented(next.serial(), ms_to_ns(shown_ms));
+    next.key({decline ? Key::Decline : Key::Enter, 0, ms_to_ns(t_ms)});
+    if (next.serial() == flow.serial() && !next.finished())
+        throw RequestError(400, "the key came before the screen was shown (t_ms < shown_ms)");
+    if (decline) {
+        live_.erase(code);
+        return {200, to_text(json{{"screen", "declined"},
+                          {"text", "You did not agree to take part; nothing of yours is kept "
+                                   "but that choice. You may close this window."}})};
+    }
+    live.flow.emplace(next);
+    if (next.screen() == Screen::Done) {
+        live_.erase(code);
+        return {200, to_text(done_state())};
+    }
+    return {200, to_text(state(live))};
+}
+
+WebReply WebStudy::answer(Live& live, const json& body) {
+    SessionFlow& flow = *live.flow;
+    const std::string trial_uuid = text_field(body, "trial", 64, true);
+    const TrialRow* current = flow.trial();
+    if (!current || current->uuid != trial_uuid) {
+        const auto it = std::find_if(live.trials.begin(), live.trials.end(),
+                                     [&](const TrialRow& t) { return t.uuid == trial_uuid; });
+        if (it == live.trials.end())
+            throw RequestError(404, "trial '" + trial_uuid + "' is not one of this session's trials");
+        if (it->answered)
+            throw RequestError(409, "trial " + std::to_string(it->position + 1) +
+                                        " is already answered");
+        throw RequestError(409, "trial " + std::to_string(it->position + 1) +
+                                    " is not the one on screen");
+    }
+    const double view = *number_field(body, "view", 0, 1e9, true);
+    if (static_cast<int>(view) != flow.serial())
+        throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
+                                    " is no longer shown (now view " +
+                                    std::to_string(flow.serial()) + ")");
+    const double onset_ms = *number_field(body, "onset_ms", 0, kMaxPageMs, true);
+    const json* events = field(body, "events");
+    if (!events || !events->is_array())
+        throw RequestError(400, "field 'events' must be an array");
+    if (events->size() > kMaxEventsPerAnswer)
+        throw RequestError(400, "more than " + std::to_string(kMaxEventsPerAnswer) + " events");
+
+    // Every event checked before any is replayed.
+    int max_points = 0;
+    for (const Question& q : protocol_.questions) max_points = std::max(max_points, q.points());
+    struct Event {
+        enum class Kind { Key, Point, Next } kind;
+        Key key = Key::Enter;
+        int digit = 0, question = 0, value = 0;
+        int64_t t_ns = 0;
+    };
+    std::vector<Event> replay;
+    for (const json& e : *events) {
+        if (!e.is_object()) throw RequestError(400, "each event must be an object");
+        Event ev{Event::Kind::Key};
+        ev.t_ns = ms_to_ns(*number_field(e, "t_ms", 0, kMaxPageMs, true));
+        const std::string type = text_field(e, "type", 16, true);
+        if (type == "key") {
+            const std::string key = text_field(e, "key", 16, true);
+            if (key.size() == 1 && key[0] >= '1' && key[0] <= '9') {
+                ev.key = Key::Digit;
+                ev.digit = key[0] - '0';
+                if (ev.digit > max_points)
+                    throw RequestError(400, "key '" + key + "' is outside every scale (1.." +
+                                                std::to_string(max_points) + ")");
+            } else if (key == "Enter") {
+                ev.key = Key::Enter;
+            } else if (key == "ArrowLeft") {
+                ev.key = Key::Left;
+            } else if (key == "ArrowRight") {
+                ev.key = Key::Right;
+            } else if (key == "ArrowUp") {
+                ev.key = Key::Up;
+            } else if (key == "ArrowDown") {
+                ev.key = Key::Down;
+            } else {
+                throw RequestError(400, "unknown key '" + one_line(key) + "'");
+            }
+        } else if (type == "point") {
+            ev.kind = Event::Kind::Point;
+            const double q = *number_field(e, "question", 0, 1e6, true);
+            if (q != std::floor(q) || q >= static_cast<double>(protocol_.questions.size()))
+                throw RequestError(400, "question index " + json(q).dump() +
+                                            " is not one of the " +
+                                            std::to_string(protocol_.questions.size()) +
+                                            " questions");
+            ev.question = static_cast<int>(q);
+            const Question& question = protocol_.questions[ev.question];
+            const json* v = field(e, "value");
+            if (!v || !v->is_number_integer() || v->get<int64_t>() < 1 ||
+                v->get<int64_t>() > question.points())
+                throw RequestError(400, "rating " + (v ? v->dump() : std::string("(none)")) +
+                                            " is outside 1.." +
+                                            std::to_string(question.points()) +
+                                            " of question '" + question.id + "'");
+            ev.value = static_cast<int>(v->get<int64_t>());
+        } else if (type == "next") {
+            ev.kind = Event::Kind::Next;
+        } else {
+            throw RequestError(400, "unknown event type '" + one_line(type) + "'");
+        }
+        replay.push_back(ev);
+    }
+
+    // Replayed on a copy: the blank gives way to the picture at its onset, then the keys
+    // and clicks as the lab's RatingInput takes them; the copy commits the trial.
+    SessionFlow next = flow;
+    const int64_t onset_ns = ms_to_ns(onset_ms);
+    next.tick(onset_ns);
+    if (next.screen() != Screen::Trial)
+        throw RequestError(400, "the picture was shown before the " +
+                                    std::to_string(protocol_.inter_trial_ms) +
+                                    " ms blank ended");
+    next.presented(next.serial(), onset_ns);
+    const size_t answered_before = next.answered_trials();
+    for (const Event& ev : replay) {
+        if (next.answered_trials() != answered_before) break;  // confirmed: the rest is late
+        switch (ev.kind) {
+        case Event::Kind::Key: next.key({ev.key, ev.digit, ev.t_ns}); break;
+        case Event::Kind::Point: next.click_point(ev.question, ev.value, ev.t_ns); break;
+        case Event::Kind::Next: next.click_next(ev.t_ns); break;
+        }
+    }
+    if (next.answered_trials() == answered_before)
+        throw RequestError(400, "the events do not rate every question and confirm it "
+                                "(Enter or Next) after the picture's onset");
+    for (TrialRow& t : live.trials)
+        if (t.uuid == trial_uuid) t.answered = true;
+    live.flow.emplace(next);
+    return {200, to_text(state(live))};
+}
+
+// ---- [SECTION] the state a page shows ---------------------------------------------------
+json WebStudy::done_state() const {
+    json out{{"screen", "done"},
+             {"text", "Thank you: the study is complete and your answers are saved."}};
+    json completion = json::object();
+    if (!protocol_.online.completion_code.empty())
+        completion["code"] = protocol_.online.completion_code;
+    if (!protocol_.online.completion_url.empty())
+        completion["url"] = protocol_.online.completion_url;
+    out["completion"] = completion;
+    return out;
+}
+
+json WebStudy::state(const Live& live) const {
+    const SessionFlow& flow = *live.flow;
+    json out;
+    out["screen"] = screen_name(flow.screen());
+    out["view"] = flow.serial();
+    out["title"] = protocol_.title;
+    out["background"] = css_colour(protocol_.background);
+    out["progress"] = {{"done", flow.main_trials_done()}, {"total", flow.main_trials_total()}};
+    json questions = json::array();
+    for (const Question& q : protocol_.questions)
+        questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
+    out["questions"] = questions;
+    if (const TrialRow* t = flow.trial()) {
+        const WebImage& image = options_.images.at(t->stimulus);
+        out["trial"] = {{"id", t->uuid},
+                        {"image", "/images/" + t->stimulus + ".png"},
+                        {"width", image.width},
+                        {"height", image.height},
+                        {"practice", t->practice},
+                        {"prompt", t->is_catch ? t->prompt : std::string()},
+                        {"blank_ms", protocol_.inter_trial_ms}};
+    } else {
+        const std::string& text = flow.text();
+        out["text"] = text.empty() ? std::string("Press Enter.") : text;
+    }
+    return out;
+}
+
+}  // namespace lucent::study

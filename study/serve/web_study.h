@@ -1,0 +1,102 @@
+#pragma once
+// The server side of `lucent serve`, GL-free and without HTTP: online participants run
+// the same protocol as `lucent run` (consent, instructions, practice, blocks, breaks,
+// catch trials, debrief) through the same SessionFlow, trial plan and StudyStore. The
+// HTTP layer (app/cmd_serve.cpp) only hands each API request's name and body here and
+// sends back the reply; README.md documents the endpoints.
+//
+// The server owns the plan and the state; the page is a view of one screen at a time.
+// Every action names the view it answers (the flow's serial), so an action meant for a
+// screen already left (a double Enter, a second tab) is refused, never applied twice.
+// An answer carries the participant's input events (keys, clicks, performance.now()
+// times), which the server replays through the session's RatingInput: the same rules as
+// in the lab, and the trial is committed to the store before the reply names the next
+// screen. A refused request (4xx, one-line reason) changes nothing: each action runs on
+// a copy of the participant's flow, kept only when it succeeded.
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "protocol.h"
+#include "study_store.h"
+
+namespace lucent::study {
+
+struct WebReply {
+    int status = 200;
+    std::string body;  // JSON: the state, or {"error": "one line"} for a 4xx/5xx
+};
+
+// A picture the page shows, served at /images/<stimulus id>.png.
+struct WebImage {
+    int width = 0;
+    int height = 0;
+};
+
+struct WebStudyOptions {
+    std::string secret;  // HMAC key of the session tokens (kept: tokens outlive restarts)
+    // What every segment records besides the browser: machine, software, stimuli.
+    SessionEnvironment environment;
+    std::map<std::string, WebImage> images;  // by stimulus id, every protocol stimulus
+    size_t max_body_bytes = 64 * 1024;       // larger API bodies: 413
+};
+
+// Field limits of API requests (beyond them: 400).
+inline constexpr size_t kMaxCodeLength = 64;  // participant code, Prolific ids
+inline constexpr size_t kMaxUserAgentLength = 512;
+inline constexpr size_t kMaxTokenLength = 160;
+inline constexpr size_t kMaxEventsPerAnswer = 500;
+
+// A participant code or Prolific id: 1..64 of [A-Za-z0-9_-]. "" when valid, else why.
+std::string participant_code_problem(std::string_view code);
+// The token of a session: "<code>.<hex HMAC-SHA256(secret, session uuid)>".
+std::string session_token(std::string_view secret, std::string_view code,
+                          std::string_view session_uuid);
+// HMAC-SHA256 (RFC 2104) in lower-case hex.
+std::string hmac_sha256_hex(std::string_view key, std::string_view message);
+// The stimulus id an /images/ request names, from the raw request target (percent-
+// encoded or not): exactly "/images/<id>.png" for a stimulus in `images`, else nullopt
+// (traversal, other folders, encoded separators, unknown names).
+std::optional<std::string> image_of_target(std::string_view target,
+                                           const std::map<std::string, WebImage>& images);
+
+class WebStudy {
+public:
+    // `protocol` and `store` must outlive this; ensure_study runs here (StoreError when
+    // the store holds another protocol).
+    WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions options);
+    ~WebStudy();
+
+    // One API request: `endpoint` is the name after /api/ (session, state, continue,
+    // decline, answer, environment), `body` its JSON. Thread-safe (one at a time).
+    WebReply handle(std::string_view endpoint, std::string_view body);
+
+    // Participants whose session is loaded now (a page opened and not yet done).
+    size_t live_sessions() const;
+
+private:
+    struct Live;
+    WebReply start(const nlohmann::json& body);
+    WebReply act(std::string_view endpoint, const nlohmann::json& body);
+    WebReply answer(Live& live, const nlohmann::json& body);
+    nlohmann::json state(const Live& live) const;
+    nlohmann::json done_state() const;
+    SessionEnvironment environment_for(const Live& live) const;
+    Live& load(const std::string& code, const SessionRow& session, const std::string& token);
+
+    const Protocol& protocol_;
+    StudyStore& store_;
+    WebStudyOptions options_;
+    int64_t study_id_ = 0;
+    mutable std::mutex mutex_;  // one store connection: requests in turn
+    std::map<std::string, std::unique_ptr<Live>> live_;  // by participant code
+};
+
+}  // namespace lucent::study

@@ -1,0 +1,187 @@
+// The real `lucent serve` over loopback, on every store backend: hostile HTTP requests,
+// and 50 simulated participants at once. Expected values come from the study folder the
+// test wrote (pictures of known bytes, the protocol's trial count and scales).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "../postgres/server_environment.h"
+#include "serve_process.h"
+#include "study_store.h"
+#include "test_paths.h"
+
+namespace lucent::study {
+namespace {
+
+using lucent::test::json;
+using lucent::test::Page;
+
+class ServeHttp : public ::testing::TestWithParam<std::string> {
+protected:
+    void SetUp() override {
+        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        std::string slug;
+        for (char c : test)
+            slug += std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
+        dir_ = lucent::test::scratch_dir("serve_http_" + slug);
+        protocol_ = lucent::test::write_serve_study(dir_);
+        if (GetParam() == "sqlite") {
+            db_ = (dir_ / "study.db").string();
+        } else {
+            db_ = lucent::test::new_postgres_database("serve_http_" + slug);
+            init_study_store(db_);
+        }
+        server_ = std::make_unique<lucent::test::ServeProcess>(protocol_, db_, dir_.string());
+        ASSERT_GT(server_->port(), 0) << "lucent serve did not start: " << server_->first_line();
+    }
+    // Counts read through a store of its own (the server holds its own connection).
+    int64_t count(const std::string& sql) {
+        StoreOptions options;
+        options.journal_path = (dir_ / "reader-journal.db").string();
+        return open_study_store(db_, options)->query_int(sql);
+    }
+
+    std::filesystem::path dir_;
+    std::string protocol_, db_;
+    std::unique_ptr<lucent::test::ServeProcess> server_;
+};
+
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
+
+TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
+    httplib::Client http("127.0.0.1", server_->port());
+    // The page and a picture, as the browser asks for them.
+    auto page = http.Get("/?participant=P1");
+    ASSERT_TRUE(page);
+    EXPECT_EQ(page->status, 200);
+    EXPECT_NE(page->body.find("<script src=\"/lucent.js\">"), std::string::npos);
+    EXPECT_EQ(page->get_header_value("X-Content-Type-Options"), "nosniff");
+    auto picture = http.Get("/images/a.png");
+    ASSERT_TRUE(picture);
+    EXPECT_EQ(picture->status, 200);
+    EXPECT_EQ(picture->get_header_value("Content-Type"), "image/png");
+    EXPECT_EQ(picture->body.substr(1, 3), "PNG");
+
+    // Paths out of the pictures, plain and encoded: never a file, always a 404.
+    std::ofstream(dir_ / "secret.txt") << "not for participants";
+    const std::string db_name = std::filesystem::path(db_).filename().string();
+    for (const std::string& target : std::vector<std::string>{"/images/../study.toml", "/images/..%2fstudy.toml", "/images/%2e%2e%2fstudy.toml",
+          "/images/%2E%2E/secret.txt", "/images/%252e%252e%252fsecret.txt",
+          "/images/a.png%00.txt", "/../secret.txt", "/%2e%2e/secret.txt",
+          "/images/..%5csecret.txt", "/images/" + db_name, "/images/../" + db_name,
+          "/etc/passwd", "/../../../../etc/passwd", "/images/a.png/../../secret.txt",
+          "/secret.txt", "/study.toml", "/a.png"}) {
+        auto r = http.Get(target.c_str());
+        ASSERT_TRUE(r) << target;
+        EXPECT_EQ(r->status, 404) << target;
+        EXPECT_EQ(r->body.find("not for participants"), std::string::npos) << target;
+        EXPECT_EQ(r->body.find("SQLite"), std::string::npos) << target;
+        EXPECT_EQ(r->body.find("root:"), std::string::npos) << target;
+        EXPECT_EQ(r->body.find('\n'), std::string::npos) << target;
+    }
+    // No endpoint reads data out: unknown API names, other methods.
+    for (const char* name : {"export", "responses", "participants", "sessions", "dump"}) {
+        auto r = http.Post((std::string("/api/") + name).c_str(), "{}", "application/json");
+        ASSERT_TRUE(r);
+        EXPECT_EQ(r->status, 404) << name;
+    }
+    auto get_api = http.Get("/api/session");
+    ASSERT_TRUE(get_api);
+    EXPECT_EQ(get_api->status, 404);
+    auto put = http.Put("/api/session", "{}", "application/json");
+    ASSERT_TRUE(put);
+    EXPECT_GE(put->status, 400);
+    EXPECT_LT(put->status, 500);
+
+    // Bodies and fields out of bounds, malformed JSON, bad codes: 4xx, one line.
+    auto post = [&](const std::string& endpoint, const std::string& body, int status) {
+        auto r = http.Post(("/api/" + endpoint).c_str(), body, "application/json");
+        ASSERT_TRUE(r) << body.substr(0, 80);
+        EXPECT_EQ(r->status, status) << body.substr(0, 80) << " -> " << r->body;
+        const json reply = json::parse(r->body, nullptr, false);
+        EXPECT_TRUE(reply.is_object() && reply.contains("error")) << r->body;
+        EXPECT_EQ(r->body.find('\n'), std::string::npos);
+    };
+    post("session", std::string(100 * 1024, '{'), 413);
+    post("session", "{\"participant\": ", 400);
+    post("session", "{\"participant\": \"\xff\"}", 400);
+    post("session", json{{"participant", "../../P1"}, {"t_ms", 1}}.dump(), 400);
+    post("session", json{{"participant", std::string(1000, 'x')}, {"t_ms", 1}}.dump(), 400);
+    // A participant with a session, then someone else's requests against it.
+    Page p1{lucent::test::over_http(http)};
+    p1.catch_rating = 5;  // the catch trial asks for 5 (the 5-point scale's top)
+    p1.open({{"participant", "P1"}});
+    ASSERT_EQ(p1.state["screen"], "consent");
+    p1.run(1);  // consent, instructions, the practice trial, the practice-done screen
+    ASSERT_EQ(p1.state["screen"], "trial");
+    json bad = p1.answer_body(1);
+    bad["token"] = p1.token;
+    bad["events"][0]["value"] = 8;
+    post("answer", bad.dump(), 400);
+    bad["events"][0]["value"] = 0;
+    post("answer", bad.dump(), 400);
+    bad = p1.answer_body(1);
+    bad["token"] = "P1." + std::string(64, 'f');
+    post("answer", bad.dump(), 403);
+    bad["token"] = p1.token;
+    bad["trial"] = p1.shown[0];
+    post("answer", bad.dump(), 409);
+    post("session", json{{"participant", "P1"}, {"t_ms", 1}}.dump(), 403);  // no key
+    // A URI too long for the server: refused before routing.
+    auto long_uri = http.Get(("/images/" + std::string(20000, 'a') + ".png").c_str());
+    ASSERT_TRUE(long_uri);
+    EXPECT_EQ(long_uri->status, 414);
+
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), 2);  // the practice trial only
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 1);
+    p1.answer(1);
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), 4);
+    EXPECT_EQ(server_->stop(), 0);
+}
+
+// 50 pages at once over loopback, each on its own connection; every answer stored once.
+TEST_P(ServeHttp, FiftyParticipantsAtOnceOverHttpLoseAndDuplicateNothing) {
+    constexpr int kPages = 50;
+    std::atomic<int> done{0};
+    std::vector<std::thread> threads;
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < kPages; ++i)
+        threads.emplace_back([&, i] {
+            httplib::Client http("127.0.0.1", server_->port());
+            http.set_keep_alive(true);
+            http.set_read_timeout(60);
+            Page page{lucent::test::over_http(http)};
+            page.catch_rating = 5;
+            page.open({{"participant", "W" + std::to_string(i + 1)}});
+            page.run();
+            if (page.state["screen"] == "done" && page.state["completion"]["code"] == "C0DE42" &&
+                page.shown.size() == size_t(lucent::test::kServeStudyTrials))
+                ++done;
+        });
+    for (std::thread& t : threads) t.join();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(done, kPages);
+    EXPECT_LT(seconds, 60.0);
+    std::printf("[ measured ] %d participants x %d trials over HTTP (%s): %.2f s, %.0f trials/s\n",
+                kPages, lucent::test::kServeStudyTrials, GetParam().c_str(), seconds,
+                kPages * lucent::test::kServeStudyTrials / seconds);
+    EXPECT_EQ(server_->stop(), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), kPages * lucent::test::kServeStudyTrials * 2);
+    EXPECT_EQ(count("SELECT count(*) FROM (SELECT trial_id, question FROM responses GROUP BY "
+                    "trial_id, question HAVING count(*) > 1) d"),
+              0);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), kPages);
+    // Catch trials answered as asked (5 on both scales), so nobody is excluded.
+    EXPECT_EQ(count("SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
+                    "WHERE t.catch = 1 AND r.rating = 5"),
+              kPages * 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Stores, ServeHttp, ::testing::Values("sqlite", "postgresql"), param_name);
+
+}  // namespace
+}  // namespace lucent::study

@@ -1,0 +1,152 @@
+#pragma once
+// The real `lucent serve` for tests: a study folder (protocol + pictures of known
+// colours), the server started on a free loopback port (--listen 127.0.0.1:0, the port
+// read from its first line) and stopped with SIGTERM.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "web_page.h"
+
+namespace lucent::test {
+
+// Four pictures of one colour each (64 x 48), a practice trial, a catch trial and a
+// 5-point second question; breaks after every 2 main trials.
+inline std::string write_serve_study(const std::filesystem::path& dir) {
+    const struct { const char* id; unsigned char rgb[3]; } pictures[] = {
+        {"a", {200, 30, 30}}, {"b", {30, 200, 30}}, {"c", {30, 30, 200}}, {"p", {200, 200, 30}}};
+    for (const auto& pic : pictures) {
+        std::vector<unsigned char> pixels(64 * 48 * 3);
+        for (size_t i = 0; i < pixels.size(); ++i) pixels[i] = pic.rgb[i % 3];
+        const std::string path = (dir / (std::string(pic.id) + ".png")).string();
+        auto out = OIIO::ImageOutput::create(path);
+        out->open(path, OIIO::ImageSpec(64, 48, 3, OIIO::TypeDesc::UINT8));
+        out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
+        out->close();
+    }
+    const std::string protocol = (dir / "study.toml").string();
+    std::ofstream(protocol) << R"toml(
+[study]
+name = "web"
+break_every = 2
+inter_trial_ms = 100
+
+[screens]
+consent = "Do you agree to take part?"
+instructions = "Rate each picture."
+debrief = "Thank you."
+
+[online]
+completion_code = "C0DE42"
+
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+
+[[questions]]
+id = "realistic"
+text = "The object looks realistic."
+labels = ["no", "", "", "", "yes"]
+
+[[stimuli]]
+id = "a"
+image = "a.png"
+[[stimuli]]
+id = "b"
+image = "b.png"
+[[stimuli]]
+id = "c"
+image = "c.png"
+[[stimuli]]
+id = "p"
+image = "p.png"
+
+[practice]
+stimuli = ["p"]
+
+[[blocks]]
+id = "main"
+stimuli = ["a", "b", "c"]
+
+[[catch_trials]]
+id = "attention"
+stimulus = "a"
+block = "main"
+prompt = "Attention: choose 5 on both"
+expected = 5
+)toml";
+    return protocol;
+}
+inline constexpr int kServeStudyTrials = 5;  // 1 practice + 3 rated + 1 catch
+
+class ServeProcess {
+public:
+    // `state_dir`: the server's journal and key folder (LUCENT_JOURNAL_DIR).
+    ServeProcess(const std::string& protocol, const std::string& db, const std::string& state_dir) {
+        int out[2];
+        if (pipe(out) != 0) return;
+        pid_ = fork();
+        if (pid_ == 0) {
+            dup2(out[1], 1);
+            close(out[0]);
+            close(out[1]);
+            setenv("LUCENT_JOURNAL_DIR", state_dir.c_str(), 1);
+            execl(LUCENT_EXECUTABLE, LUCENT_EXECUTABLE, "serve", protocol.c_str(), "--db",
+                  db.c_str(), "--listen", "127.0.0.1:0", static_cast<char*>(nullptr));
+            _exit(127);
+        }
+        close(out[1]);
+        // The first line names the address: "... on http://127.0.0.1:PORT/?participant=ID".
+        std::string line;
+        char c = 0;
+        while (read(out[0], &c, 1) == 1 && c != '\n') line += c;
+        stdout_ = out[0];
+        const size_t at = line.find("http://127.0.0.1:");
+        if (at != std::string::npos) port_ = std::stoi(line.substr(at + 17));
+        first_line_ = line;
+    }
+    ~ServeProcess() { stop(); }
+    // SIGTERM; the exit status (0 when it stopped cleanly).
+    int stop() {
+        if (pid_ <= 0) return exit_status_;
+        kill(pid_, SIGTERM);
+        int status = 0;
+        waitpid(pid_, &status, 0);
+        pid_ = -1;
+        if (stdout_ >= 0) close(stdout_);
+        stdout_ = -1;
+        exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        return exit_status_;
+    }
+    int port() const { return port_; }
+    const std::string& first_line() const { return first_line_; }
+    std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
+
+private:
+    int pid_ = -1;
+    int stdout_ = -1;
+    int port_ = 0;
+    int exit_status_ = -1;
+    std::string first_line_;
+};
+
+// The API over HTTP, one keep-alive connection per page.
+inline Transport over_http(httplib::Client& client) {
+    return [&client](const std::string& endpoint, const std::string& body) {
+        const auto r = client.Post(("/api/" + endpoint).c_str(), body, "application/json");
+        if (!r)
+            return study::WebReply{0, json{{"error", "no reply: " + httplib::to_string(r.error())}}.dump()};
+        return study::WebReply{r->status, r->body};
+    };
+}
+
+}  // namespace lucent::test

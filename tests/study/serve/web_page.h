@@ -1,0 +1,106 @@
+#pragma once
+// A simulated browser page for lucent serve's tests: it speaks the API as lucent.js does
+// (JSON bodies, performance.now() times, the input events of each answer) over any
+// transport: WebStudy::handle directly, or HTTP to a running `lucent serve`.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "serve/web_study.h"
+
+namespace lucent::test {
+
+using nlohmann::json;
+using Transport = std::function<study::WebReply(const std::string& endpoint, const std::string& body)>;
+
+inline Transport direct(study::WebStudy& web) {
+    return [&web](const std::string& endpoint, const std::string& body) {
+        return web.handle(endpoint, body);
+    };
+}
+
+// The rating a test page gives question q of the k-th trial it was shown.
+inline int page_rating(int k, int q, bool is_catch, int catch_rating = 7) {
+    return is_catch ? catch_rating : 1 + (k * 3 + q * 2) % 5;
+}
+
+// One browser page: its clock (ms since load), the token and the screen it shows.
+struct Page {
+    Transport send;
+    int catch_rating = 7;
+    double now = 50;
+    std::string token;
+    json state;
+    std::vector<std::string> shown;  // trial ids in the order the page was given them
+
+    study::WebReply raw(const std::string& endpoint, const json& body) {
+        return send(endpoint, body.dump());
+    }
+    json call(const std::string& endpoint, json body, int expected = 200) {
+        if (!token.empty() && !body.contains("token")) body["token"] = token;
+        const study::WebReply r = send(endpoint, body.dump());
+        EXPECT_EQ(r.status, expected) << endpoint << ": " << r.body;
+        return json::parse(r.body);
+    }
+    void open(const json& who, int expected = 200) {
+        json body = who;
+        body["t_ms"] = now;
+        body["client"] = {{"user_agent", "TestBrowser/1.0"}, {"window_width", 1280},
+                          {"window_height", 900},         {"device_pixel_ratio", 2},
+                          {"screen_width", 2560},           {"screen_height", 1440}};
+        const json reply = call("session", body, expected);
+        if (expected != 200 || !reply.is_object()) return;
+        if (reply.contains("token")) token = reply["token"];
+        state = reply;
+    }
+    void enter() {
+        const double shown_at = now;
+        now += 300;
+        state = call("continue", {{"view", state["view"]}, {"shown_ms", shown_at}, {"t_ms", now}});
+    }
+    // The page's answer to the trial on screen: each question clicked 100 ms apart after
+    // the onset, then Next. Returns the onset.
+    json answer_body(int k) {
+        const json& trial = state["trial"];
+        const double onset = now + trial["blank_ms"].get<double>() + 20;
+        json events = json::array();
+        const int n = static_cast<int>(state["questions"].size());
+        const bool is_catch = !trial["prompt"].get<std::string>().empty();
+        for (int q = 0; q < n; ++q)
+            events.push_back({{"t_ms", onset + 100.0 * (q + 1)}, {"type", "point"},
+                              {"question", q}, {"value", page_rating(k, q, is_catch, catch_rating)}});
+        events.push_back({{"t_ms", onset + 100.0 * (n + 1)}, {"type", "next"}});
+        return {{"trial", trial["id"]}, {"view", state["view"]}, {"onset_ms", onset},
+                {"events", events}};
+    }
+    void answer(int k) {
+        json body = answer_body(k);
+        shown.push_back(state["trial"]["id"]);
+        now = body["onset_ms"].get<double>() + 1000;
+        state = call("answer", body);
+    }
+    // Continues text screens and answers trials until `stop` screens were answered or
+    // the study is done.
+    void run(size_t trials = 1000) {
+        for (int guard = 0; guard < 200; ++guard) {
+            if (!state.contains("screen") || !state["screen"].is_string()) {
+                ADD_FAILURE() << "no screen in " << state.dump();
+                return;
+            }
+            const std::string screen = state["screen"];
+            if (screen == "done") return;
+            if (screen == "trial") {
+                if (shown.size() >= trials) return;
+                answer(static_cast<int>(shown.size()));
+            } else {
+                enter();
+            }
+        }
+        ADD_FAILURE() << "the session never ended";
+    }
+};
+
+}  // namespace lucent::test
