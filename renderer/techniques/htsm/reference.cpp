@@ -115,20 +115,12 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
     const glm::dvec3 l_eye = scene.light.direction;
     const glm::dvec3 half = glm::normalize(l_eye + glm::dvec3(0, 0, 1));
     const int w = scene.width, h = scene.height;
-    const double near = scene.camera.near_plane, far = scene.camera.far_plane;
     const PixelRays rays(scene.camera, w, h);
     Image image(w, h);
     for_each_row_parallel(h, [&](int row) {
         for (int x = 0; x < w; ++x) {
             const glm::dvec3 direction = rays.direction(x, row);
-            std::optional<RayHit> front;
-            for (const RayHit& hit : caster.hits(glm::vec3(rays.eye()), glm::vec3(direction), 4)) {
-                const double z = rays.eye_depth(hit.distance, direction);
-                if (z >= near && z < far) {
-                    front = hit;
-                    break;
-                }
-            }
+            const std::optional<RayHit> front = rays.front_hit(caster, direction);
             if (!front) {
                 image.set(x, row, glm::vec4(scene.background, 0.0f));
                 continue;
