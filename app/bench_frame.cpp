@@ -106,6 +106,20 @@ struct Sampler {
     }
 };
 
+// The lines above every table: what was measured, on which GL, timed how.
+void print_heading(const FrameBenchOptions& options, const RenderRequest& request,
+                   gl::Context& context, bool gpu_timer) {
+    const gl::GlInfo info = context.info();
+    std::cout << "lucent bench frame: " << options.technique << " on " << options.mesh
+              << " at " << request.width << "x" << request.height << ", median of "
+              << options.frames << " frames after " << options.warmup << " warm-up\n"
+              << "GL: " << info.renderer << " (" << info.version << ")\n"
+              << "timing: "
+              << (gpu_timer ? "GL timer queries (GL_TIME_ELAPSED), summed over passes"
+                            : "wall time around glFinish per pass (no timer queries)")
+              << "; AO bake precomputed, not in the frame\n";
+}
+
 int finish_csv(const FrameBenchOptions& options,
                const std::vector<std::vector<std::string>>& csv) {
     if (options.csv.empty()) return kExitOk;
@@ -220,16 +234,8 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
                            number(pass_ms), per_unit ? number(ms_per_unit) : ""});
         }
     }
-    const gl::GlInfo info = context.info();
-    std::cout << "lucent bench frame: " << options.technique << " on " << options.mesh
-              << " at " << request.width << "x" << request.height << ", median of "
-              << options.frames << " frames after " << options.warmup << " warm-up\n"
-              << "GL: " << info.renderer << " (" << info.version << ")\n"
-              << "timing: "
-              << (gpu_timer ? "GL timer queries (GL_TIME_ELAPSED), summed over passes"
-                            : "wall time around glFinish per pass (no timer queries)")
-              << "; AO bake precomputed, not in the frame\n"
-              << "every pass runs every frame (as when the light or material changes)\n\n"
+    print_heading(options, request, context, gpu_timer);
+    std::cout << "every pass runs every frame (as when the light or material changes)\n\n"
               << table.str();
     if (per_unit)
         std::cout << "ms per unit = the costliest pass's median / " << knob_name << "\n";
@@ -338,16 +344,8 @@ int run_comparison_bench(const FrameBenchOptions& options, const FrameComparison
     for (std::size_t v = 0; v + 1 < variants.size(); ++v)
         ratio_legend += (v ? ", " : "ratio = ") + variants[v].label + " / " + baseline;
     ratio_legend += " frame time";
-    const gl::GlInfo info = context.info();
-    std::cout << "lucent bench frame: " << options.technique << " on " << options.mesh
-              << " at " << request.width << "x" << request.height << ", median of "
-              << options.frames << " frames after " << options.warmup << " warm-up\n"
-              << "GL: " << info.renderer << " (" << info.version << ")\n"
-              << "timing: "
-              << (gpu_timer ? "GL timer queries (GL_TIME_ELAPSED), summed over passes"
-                            : "wall time around glFinish per pass (no timer queries)")
-              << "; AO bake precomputed, not in the frame\n"
-              << comparison.note << "\n\n"
+    print_heading(options, request, context, gpu_timer);
+    std::cout << comparison.note << "\n\n"
               << table.str() << ratio_legend << "\n\n"
               << "median per pass (ms):\n"
               << breakdowns.str();
