@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -103,6 +104,18 @@ CommandTime time_command(const std::string& command) {
     return status == 0 ? t : CommandTime{-1.0, -1.0};
 }
 
+// The median of each of wall and CPU time over runs (one run: itself).
+CommandTime median_time(std::vector<CommandTime> runs) {
+    const auto median_of = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        const std::size_t n = v.size();
+        return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    };
+    std::vector<double> wall, cpu;
+    for (const CommandTime& t : runs) wall.push_back(t.wall), cpu.push_back(t.cpu);
+    return {median_of(wall), median_of(cpu)};
+}
+
 std::string quoted(const std::filesystem::path& path) {
     return "'" + path.string() + "'";
 }
@@ -110,7 +123,7 @@ std::string quoted(const std::filesystem::path& path) {
 // `lucent analyze` as a whole process on a simulated long CSV (one question, one factor,
 // `groups` levels), and R's read.csv + aov + TukeyHSD + kruskal.test + oneway.test on the
 // same file when Rscript is on the PATH (nothing is installed).
-int bench_whole_process(long ratings, int groups, Results& results) {
+int bench_whole_process(long ratings, int groups, int repeat, Results& results) {
     namespace fs = std::filesystem;
     const fs::path dir =
         fs::temp_directory_path() / ("lucent-bench-stats-" + std::to_string(getpid()));
@@ -135,16 +148,40 @@ int bench_whole_process(long ratings, int groups, Results& results) {
                 groups, csv.c_str());
     // The `lucent` users run (it runs analyze itself), not this lucent-full process.
     const fs::path self = fs::read_symlink("/proc/self/exe").parent_path() / "lucent";
-    const CommandTime t_lucent =
-        time_command(quoted(self) + " analyze " + quoted(csv) + " --out " +
-                     quoted(dir / "report") + " --format csv >/dev/null 2>&1");
-    if (t_lucent.wall < 0) {
-        std::fprintf(stderr, "lucent bench stats: lucent analyze failed on %s\n",
-                     csv.c_str());
-        return kExitFailure;
+    // The runs alternate between lucent and R, so that both see the same load on a
+    // shared machine; each column is the median of `repeat` runs.
+    const std::string lucent_command = quoted(self) + " analyze " + quoted(csv) + " --out " +
+                                       quoted(dir / "report") + " --format csv >/dev/null 2>&1";
+    const bool have_r = std::system("command -v Rscript >/dev/null 2>&1") == 0;
+    const fs::path script = dir / "analysis.R";
+    if (have_r)
+        std::ofstream(script) << "d <- read.csv(commandArgs(trailingOnly = TRUE)[1])\n"
+                                 "d$level <- factor(d$level)\n"
+                                 "fit <- aov(rating ~ level, data = d)\n"
+                                 "print(summary(fit))\n"
+                                 "print(TukeyHSD(fit))\n"
+                                 "print(kruskal.test(rating ~ level, data = d))\n"
+                                 "print(oneway.test(rating ~ level, data = d))\n";
+    const std::string r_command =
+        "Rscript " + quoted(script) + " " + quoted(csv) + " >/dev/null 2>&1";
+    std::vector<CommandTime> lucent_runs, r_runs;
+    bool r_failed = false;
+    for (int run = 0; run < repeat; ++run) {
+        lucent_runs.push_back(time_command(lucent_command));
+        if (lucent_runs.back().wall < 0) {
+            std::fprintf(stderr, "lucent bench stats: lucent analyze failed on %s\n",
+                         csv.c_str());
+            return kExitFailure;
+        }
+        if (have_r && !r_failed) {
+            r_runs.push_back(time_command(r_command));
+            r_failed = r_runs.back().wall < 0;
+        }
     }
+    const CommandTime t_lucent = median_time(lucent_runs);
     const CommandTime t_start = time_command(quoted(self) + " analyze --help >/dev/null 2>&1");
-    std::printf("  %-40s %10s %10s\n", "process", "wall s", "CPU s");
+    std::printf("  %-40s %10s %10s   (median of %d runs, alternating)\n", "process",
+                "wall s", "CPU s", repeat);
     std::printf("  %-40s %10.3f %10.3f\n", "lucent analyze --format csv", t_lucent.wall,
                 t_lucent.cpu);
     std::printf("  %-40s %10.3f %10.3f\n", "  of which starting lucent (analyze --help)",
@@ -153,35 +190,22 @@ int bench_whole_process(long ratings, int groups, Results& results) {
                 "s");
     results.add("whole_process", "lucent analyze --format csv (cpu)", t_lucent.cpu, "s");
     results.add("whole_process", "lucent analyze --help (cpu)", t_start.cpu, "s");
-    if (std::system("command -v Rscript >/dev/null 2>&1") != 0) {
+    if (!have_r) {
         std::printf(
             "  R comparison skipped: Rscript is not on the PATH (the bench installs "
             "nothing)\n");
+    } else if (r_failed) {
+        std::printf("  R comparison failed: Rscript exited with an error\n");
     } else {
-        const fs::path script = dir / "analysis.R";
-        std::ofstream(script) << "d <- read.csv(commandArgs(trailingOnly = TRUE)[1])\n"
-                                 "d$level <- factor(d$level)\n"
-                                 "fit <- aov(rating ~ level, data = d)\n"
-                                 "print(summary(fit))\n"
-                                 "print(TukeyHSD(fit))\n"
-                                 "print(kruskal.test(rating ~ level, data = d))\n"
-                                 "print(oneway.test(rating ~ level, data = d))\n";
-        const CommandTime t_r = time_command("Rscript " + quoted(script) + " " +
-                                             quoted(csv) + " >/dev/null 2>&1");
-        if (t_r.wall < 0) {
-            std::printf("  R comparison failed: Rscript exited with an error\n");
-        } else {
-            std::printf("  %-40s %10.3f %10.3f\n",
-                        "R read.csv+aov+TukeyHSD+kruskal+oneway", t_r.wall, t_r.cpu);
-            std::printf("  %-40s %9.1fx %9.1fx\n", "R / lucent", t_r.wall / t_lucent.wall,
-                        t_r.cpu / t_lucent.cpu);
-            results.add("whole_process", "R (wall)", t_r.wall, "s");
-            results.add("whole_process", "R (cpu)", t_r.cpu, "s");
-            results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall,
-                        "ratio");
-            results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu,
-                        "ratio");
-        }
+        const CommandTime t_r = median_time(r_runs);
+        std::printf("  %-40s %10.3f %10.3f\n", "R read.csv+aov+TukeyHSD+kruskal+oneway",
+                    t_r.wall, t_r.cpu);
+        std::printf("  %-40s %9.1fx %9.1fx\n", "R / lucent", t_r.wall / t_lucent.wall,
+                    t_r.cpu / t_lucent.cpu);
+        results.add("whole_process", "R (wall)", t_r.wall, "s");
+        results.add("whole_process", "R (cpu)", t_r.cpu, "s");
+        results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall, "ratio");
+        results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu, "ratio");
     }
     std::error_code ignored;
     fs::remove_all(dir, ignored);
@@ -261,8 +285,12 @@ void bench_distribution(double seconds, Results& results) {
 }
 
 int run_bench_stats(long ratings, int groups, double cdf_seconds, bool whole_process,
-                    const std::string& csv_path) {
+                    int repeat, const std::string& csv_path) {
     using namespace lucent::analysis;
+    if (repeat < 1) {
+        std::fprintf(stderr, "lucent bench stats: --repeat: must be at least 1\n");
+        return kExitUsage;
+    }
     if (ratings < 2L * groups || groups < 2 || groups > kMaxRangeGroups) {
         std::fprintf(stderr,
                      "lucent bench stats: need 2..200 groups and 2+ ratings each\n");
@@ -271,7 +299,7 @@ int run_bench_stats(long ratings, int groups, double cdf_seconds, bool whole_pro
     Results results;
     bench_in_process(ratings, groups, results);
     if (whole_process) {
-        const int status = bench_whole_process(ratings, groups, results);
+        const int status = bench_whole_process(ratings, groups, repeat, results);
         if (status != kExitOk) return status;
     }
     bench_distribution(cdf_seconds, results);
@@ -290,6 +318,7 @@ void register_bench_stats(CLI::App& bench, int& exit_code) {
         int groups = 10;
         double cdf_seconds = 1.0;
         bool no_process = false;
+        int repeat = 3;
         std::string csv;
     };
     auto args = std::make_shared<Args>();
@@ -303,6 +332,10 @@ void register_bench_stats(CLI::App& bench, int& exit_code) {
     cmd->add_option("--cdf-seconds", args->cdf_seconds,
                     "Seconds per distribution timing row")
         ->capture_default_str();
+    cmd->add_option("--repeat", args->repeat,
+                    "Whole-process runs of lucent and of R, alternating; the median is "
+                    "reported")
+        ->capture_default_str();
     cmd->add_flag("--no-process", args->no_process,
                   "Skip the whole-process 'lucent analyze' (and R) timing");
     cmd->add_option(
@@ -310,7 +343,7 @@ void register_bench_stats(CLI::App& bench, int& exit_code) {
         "Also write every timing as CSV (section,name,value,unit) to this file");
     cmd->callback([args, &exit_code] {
         exit_code = run_bench_stats(args->ratings, args->groups, args->cdf_seconds,
-                                    !args->no_process, args->csv);
+                                    !args->no_process, args->repeat, args->csv);
     });
 }
 
