@@ -226,11 +226,12 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
                    "' needs exactly one of technique (live) or image (pre-rendered)");
         // The renderer's registry (lucent_study stays GL-free, so it is listed here).
         static const std::set<std::string> techniques = {"empirical", "ward",
-                                                         "contrast_reversed", "dipole"};
+                                                         "contrast_reversed", "dipole",
+                                                         "htsm"};
         if (!s.technique.empty() && !techniques.count(s.technique))
             r.fail(r.raw().get("technique"), "technique",
                    "unknown technique '" + s.technique +
-                       "' (valid: empirical, ward, contrast_reversed, dipole)");
+                       "' (valid: empirical, ward, contrast_reversed, dipole, htsm)");
         if (!s.image.empty() && !base_dir.empty() && std::filesystem::path(s.image).is_relative())
             s.image = (std::filesystem::path(base_dir) / s.image).string();
         if (const toml::table* params = r.table("params")) {
