@@ -2,11 +2,15 @@
 // transport distances, each Td one factor series.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
+#include <thread>
 #include <set>
 #include <sstream>
 
+#include "batch_render.h"
 #include "core/density_volume.h"
+#include "manifest.h"
 #include "stimulus_set.h"
 #include "test_paths.h"
 
@@ -38,6 +42,37 @@ TEST(HeterogeneousPreset, ThreeStructuresAtTwoTransportDistances) {
         hashes.insert(volume->content_hash);
     }
     EXPECT_EQ(hashes.size(), 3u);  // one volume per structure, shared across Td
+}
+
+// The volume's content hash travels like the mesh hash: a manifest column beside the
+// spec, and part of the input hash, so a density file changed under the same path is
+// rendered again.
+TEST(HeterogeneousPreset, ManifestCarriesTheDensityHashAndAChangedFileRerenders) {
+    const auto dir = test::scratch_dir("htsm_density_manifest");
+    const std::string volume_path = (dir / "volume.nrrd").string();
+    const std::filesystem::path out = dir / "out";
+    write_density_nrrd(*make_density_volume("cube", 8, 1.0), volume_path);
+    const std::string config = "name = \"d\"\nresolution = [24, 24]\n[meshes]\nball = "
+                               "\"sphere:1k\"\n[[stimuli]]\nid = \"h\"\ntechnique = "
+                               "\"htsm\"\ndensity = \"" + volume_path + "\"\n";
+    const auto set = parse_stimulus_set(config, "d.toml", dir, default_catalog());
+    BatchOptions options;
+    options.out_dir = out;
+    options.progress = false;
+    EXPECT_EQ(render_stimulus_set(set, options).rendered, 1u);
+    auto rows = read_manifest_csv(out);
+    const std::string first = rows.at("h").at("density_hash");
+    EXPECT_EQ(first, make_density_volume("cube", 8, 1.0)->content_hash);
+    EXPECT_EQ(rows.at("h").at("density"), volume_path);
+    // Unchanged: reused. Changed file, same spec: rendered again with the new hash.
+    EXPECT_EQ(render_stimulus_set(set, options).rendered, 0u);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    write_density_nrrd(*make_density_volume("spheres", 8, 1.0), volume_path);
+    EXPECT_EQ(render_stimulus_set(set, options).rendered, 1u);
+    rows = read_manifest_csv(out);
+    EXPECT_EQ(rows.at("h").at("density_hash"),
+              make_density_volume("spheres", 8, 1.0)->content_hash);
+    EXPECT_NE(rows.at("h").at("density_hash"), first);
 }
 
 }  // namespace

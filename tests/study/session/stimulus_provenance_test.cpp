@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "batch_render.h"
+#include "core/density_volume.h"
 #include "core/mesh.h"
 #include "export.h"
 #include "session/stimulus_source.h"
@@ -273,6 +274,50 @@ TEST(ThesisPresets, TheStudyShowsTheStimulusSetsPicturesValueForValue) {
         EXPECT_NE(std::find(study.practice.begin(), study.practice.end(), id),
                   study.practice.end())
             << id << " is rated but not in stimuli/presets/thesis.toml";
+}
+
+// An htsm stimulus: the density volume's content hash is recorded beside its spec, and a
+// later session whose volume differs (a changed file, a new generator) is refused like a
+// changed mesh.
+TEST(ResolveStimuli, ADensityVolumesHashIsRecordedAndCheckedLikeTheMeshHash) {
+    const std::string text = R"toml(
+[study]
+name = "dense"
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+[[stimuli]]
+id = "e"
+technique = "htsm"
+mesh = "sphere:1k"
+params = { density = "cube" }
+[[blocks]]
+id = "main"
+stimuli = ["e"]
+)toml";
+    const Protocol p = parse_protocol(text, "htsm.toml");
+    std::vector<StimulusProvenance> resolved = resolve_stimuli(p, "");
+    ASSERT_EQ(resolved.size(), 1u);
+    const auto values = values_of(resolved[0]);
+    EXPECT_EQ(values.at("density"), "cube");
+    EXPECT_EQ(values.at("density_hash"), make_density_volume("cube", 64, 1.0)->content_hash);
+    const auto dir = lucent::test::scratch_dir("provenance_density_hash");
+    const std::string db = (dir / "study.db").string();
+    store_session(db, p, resolved);
+    {
+        Database database(db, SQLITE_OPEN_READONLY);
+        EXPECT_EQ(read_resolved_stimuli(database).at("e").values.at("density_hash"),
+                  values.at("density_hash"));
+    }
+    for (auto& [name, value] : resolved[0].values)
+        if (name == "density_hash") value = "0123456789abcdef";
+    Store store(db);
+    try {
+        store.check_stimulus_values(resolved);
+        FAIL() << "a different density volume was accepted";
+    } catch (const StoreError& e) {
+        EXPECT_NE(std::string(e.what()).find("density_hash"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
