@@ -48,6 +48,40 @@ double percentile(std::vector<double> v, double q) {
     return v[i];
 }
 
+// What each writer measured: commit latencies, its first and last commit, and why it
+// stopped early ("" when it did not).
+struct WriterTimes {
+    using Clock = std::chrono::steady_clock;
+    explicit WriterTimes(int writers)
+        : latencies(writers),
+          first_start(writers, Clock::time_point::max()),
+          last_end(writers, Clock::time_point::min()),
+          errors(writers) {}
+    std::vector<std::vector<double>> latencies;
+    std::vector<Clock::time_point> first_start, last_end;
+    std::vector<std::string> errors;
+};
+
+// One row of the table: commits per second over the span of all writers, p50/p99.
+BenchRow summarise(const std::string& backend, const WriterTimes& times) {
+    BenchRow row;
+    row.backend = backend;
+    row.writers = static_cast<int>(times.errors.size());
+    const auto begin = *std::min_element(times.first_start.begin(), times.first_start.end());
+    const auto end = *std::max_element(times.last_end.begin(), times.last_end.end());
+    row.seconds = end > begin ? std::chrono::duration<double>(end - begin).count() : 0.0;
+    std::vector<double> all;
+    for (std::size_t w = 0; w < times.errors.size(); ++w) {
+        if (!times.errors[w].empty() && row.failed_writers++ == 0)
+            row.first_error = times.errors[w];
+        all.insert(all.end(), times.latencies[w].begin(), times.latencies[w].end());
+    }
+    row.commits = static_cast<int>(all.size());
+    row.p50_ms = percentile(all, 0.50);
+    row.p99_ms = percentile(all, 0.99);
+    return row;
+}
+
 // `writers` stations at once, each answering `trials` trials of its own session.
 BenchRow run_writers(const std::string& backend, const std::string& db, int writers, int trials,
                      const std::string& journal_dir) {
@@ -56,11 +90,9 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
         auto store = study::open_study_store(db);  // the study row, before the clock starts
         store->ensure_study(protocol);
     }
-    std::vector<std::vector<double>> latencies(writers);
-    using Clock = std::chrono::steady_clock;
-    std::vector<Clock::time_point> first_start(writers, Clock::time_point::max()),
-        last_end(writers, Clock::time_point::min());
-    std::vector<std::string> errors(writers);
+    using Clock = WriterTimes::Clock;
+    WriterTimes times(writers);
+    auto& [latencies, first_start, last_end, errors] = times;
     std::vector<std::thread> threads;
     for (int w = 0; w < writers; ++w) {
         threads.emplace_back([&, w] {
@@ -99,23 +131,7 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
         });
     }
     for (std::thread& t : threads) t.join();
-    BenchRow row;
-    row.backend = backend;
-    row.writers = writers;
-    const auto begin = *std::min_element(first_start.begin(), first_start.end());
-    const auto end = *std::max_element(last_end.begin(), last_end.end());
-    row.seconds = end > begin ? std::chrono::duration<double>(end - begin).count() : 0.0;
-    std::vector<double> all;
-    for (int w = 0; w < writers; ++w) {
-        if (!errors[w].empty()) {
-            if (row.failed_writers++ == 0) row.first_error = errors[w];
-        }
-        all.insert(all.end(), latencies[w].begin(), latencies[w].end());
-    }
-    row.commits = static_cast<int>(all.size());
-    row.p50_ms = percentile(all, 0.50);
-    row.p99_ms = percentile(all, 0.99);
-    return row;
+    return summarise(backend, times);
 }
 
 // `writers` browsers at once through `lucent serve`'s HTTP server on loopback (the same
@@ -142,11 +158,9 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
     if (port < 0) throw study::StoreError("cannot listen on 127.0.0.1 for the serve rows");
     std::thread server([&] { http.listen_after_bind(); });
 
-    using Clock = std::chrono::steady_clock;
-    std::vector<std::vector<double>> latencies(writers);
-    std::vector<Clock::time_point> first_start(writers, Clock::time_point::max()),
-        last_end(writers, Clock::time_point::min());
-    std::vector<std::string> errors(writers);
+    using Clock = WriterTimes::Clock;
+    WriterTimes times(writers);
+    auto& [latencies, first_start, last_end, errors] = times;
     std::vector<std::thread> threads;
     for (int w = 0; w < writers; ++w) {
         threads.emplace_back([&, w] {
@@ -204,21 +218,7 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
     server.join();
     if (store->pending_trials() > 0) store->sync();
 
-    BenchRow row;
-    row.backend = backend;
-    row.writers = writers;
-    const auto begin = *std::min_element(first_start.begin(), first_start.end());
-    const auto end = *std::max_element(last_end.begin(), last_end.end());
-    row.seconds = end > begin ? std::chrono::duration<double>(end - begin).count() : 0.0;
-    std::vector<double> all;
-    for (int w = 0; w < writers; ++w) {
-        if (!errors[w].empty() && row.failed_writers++ == 0) row.first_error = errors[w];
-        all.insert(all.end(), latencies[w].begin(), latencies[w].end());
-    }
-    row.commits = static_cast<int>(all.size());
-    row.p50_ms = percentile(all, 0.50);
-    row.p99_ms = percentile(all, 0.99);
-    return row;
+    return summarise(backend, times);
 }
 
 int run_bench_store(const std::vector<int>& writer_counts, int trials, const std::string& server,
