@@ -25,15 +25,8 @@ Scene scene_for(std::vector<KnobAssignment> settings, const std::string& mesh = 
     return test::scene_for("dipole", std::move(settings), mesh, size);
 }
 
-const Pass* find_pass(const FramePlan& plan, const std::string& name) {
-    for (const auto& pass : plan.passes)
-        if (pass.name == name) return &pass;
-    return nullptr;
-}
-bool has_define(const Pass* pass, const std::string& define) {
-    return pass && std::find(pass->shader.defines.begin(), pass->shader.defines.end(),
-                             define) != pass->shader.defines.end();
-}
+using test::find_pass;
+using test::has_define;
 
 TEST(DipolePlan, IsRegisteredWithItsKnobs) {
     const Technique& t = find_technique("dipole");

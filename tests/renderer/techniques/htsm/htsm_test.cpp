@@ -18,15 +18,8 @@
 namespace lucent::htsm {
 namespace {
 
-const Pass* find_pass(const FramePlan& plan, const std::string& name) {
-    for (const auto& pass : plan.passes)
-        if (pass.name == name) return &pass;
-    return nullptr;
-}
-bool has_define(const Pass* pass, const std::string& define) {
-    return pass && std::find(pass->shader.defines.begin(), pass->shader.defines.end(),
-                             define) != pass->shader.defines.end();
-}
+using test::find_pass;
+using test::has_define;
 
 Scene sphere_scene(std::vector<KnobAssignment> settings, int size = 32) {
     return test::scene_for("htsm", std::move(settings), "sphere:2k", size);

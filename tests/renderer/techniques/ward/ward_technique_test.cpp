@@ -28,11 +28,7 @@ bool has_define(const Pass& pass, const std::string& define) {
            pass.shader.defines.end();
 }
 
-const Pass* find_pass(const FramePlan& plan, const std::string& name) {
-    for (const auto& pass : plan.passes)
-        if (pass.name == name) return &pass;
-    return nullptr;
-}
+using test::find_pass;
 
 TEST(WardPlan, BothTechniquesAreRegistered) {
     EXPECT_EQ(find_technique("ward").name(), "ward");
