@@ -221,6 +221,8 @@ std::string FramePlan::explain() const {
         if (pass.blend == Blend::additive) text += "  <blend additive>";
         if (pass.blend == Blend::premultiplied_over) text += "  <blend over>";
         if (pass.blend == Blend::premultiplied_under) text += "  <blend under>";
+        if (pass.cull == FaceCulling::back) text += "  <culls back faces>";
+        if (pass.cull == FaceCulling::front) text += "  <culls front faces>";
         if (!pass.shader.defines.empty()) {
             std::string defines;
             for (const auto& d : pass.shader.defines)
@@ -256,6 +258,8 @@ void PlanBuilder::add(Pass pass) {
 }
 
 void PlanBuilder::set_output(std::string resource) { output_ = std::move(resource); }
+
+void PlanBuilder::also_keep(std::string resource) { also_keep_.push_back(std::move(resource)); }
 
 FramePlan PlanBuilder::compile() const {
     // Resolve every resource's size and level count.
@@ -361,6 +365,7 @@ FramePlan PlanBuilder::compile() const {
     // Cull: walk backwards from the output, keeping a pass only when something needed
     // later reads one of its writes; a kept pass makes its reads needed.
     std::set<std::string> needed{output_};
+    needed.insert(also_keep_.begin(), also_keep_.end());
     std::vector<bool> keep(passes_.size(), false);
     for (std::size_t i = passes_.size(); i-- > 0;) {
         const Pass& pass = passes_[i];

@@ -148,6 +148,16 @@ enum class Blend {
     premultiplied_under,  // (1 - dst.a) src + dst (layers drawn front to back)
 };
 
+// Which rasterised triangles a mesh pass drops by their facing (counter-clockwise as seen
+// = front). Only valid where the mesh bounds a solid facing out (Mesh::closed_facing_out)
+// and the camera is outside it: then the nearest surface faces the viewer and the one
+// behind it faces away, so a pass that wants either needs only that facing.
+enum class FaceCulling {
+    none,   // both facings count as layers, as ray hits do
+    back,   // keep front faces: the nearest surface
+    front,  // keep back faces: the surface behind the nearest (a closed mesh's exit)
+};
+
 struct Pass {
     std::string name;     // unique in the plan, e.g. "second_layer"
     std::string purpose;  // one line for --explain
@@ -163,6 +173,7 @@ struct Pass {
     // the attachments then count as read too).
     bool clear = true;
     Blend blend = Blend::none;
+    FaceCulling cull = FaceCulling::none;  // draw_mesh only
     DataSource data;  // upload only
 };
 
@@ -196,6 +207,10 @@ public:
     void create(ResourceDesc desc);
     void add(Pass pass);
     void set_output(std::string resource);
+    // Keeps the passes that produce `resource` as if it were the output too, for a view
+    // of an intermediate layer (the explorer's depth views). A resource that no pass
+    // writes keeps nothing.
+    void also_keep(std::string resource);
     // Checks the plan (std::logic_error naming the pass or resource otherwise): every
     // read names a resource written earlier, every write a created resource, a pass's
     // attachments agree in size at its level, upload and build_mips passes write exactly
@@ -208,6 +223,7 @@ private:
     std::vector<ResourceDesc> resources_;
     std::vector<Pass> passes_;
     std::string output_;
+    std::vector<std::string> also_keep_;
 };
 
 // Visits the passes of a plan in order: the one loop every executor (GL, recording test

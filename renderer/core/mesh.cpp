@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <unordered_map>
 
 #include "core/mesh_sources.h"
 
@@ -175,6 +176,54 @@ std::vector<glm::vec4> compute_tangents(const std::vector<glm::vec3>& positions,
     return tangents;
 }
 
+bool bounds_solid_facing_out(const std::vector<glm::vec3>& positions,
+                             const std::vector<glm::uvec3>& triangles) {
+    if (triangles.empty()) return false;
+    // Merge vertices at bit-identical positions, so a seam (vertices split for their
+    // normals or UVs) does not count as a boundary: the rasteriser sees one edge there.
+    struct PositionBits {
+        std::size_t operator()(const glm::vec3& p) const {
+            std::uint32_t bits[3];
+            std::memcpy(bits, &p[0], sizeof bits);
+            return (std::size_t(bits[0]) * 0x9e3779b1u) ^ (std::size_t(bits[1]) << 21) ^
+                   (std::size_t(bits[2]) * 0x85ebca6bu);
+        }
+    };
+    struct SameBits {
+        bool operator()(const glm::vec3& a, const glm::vec3& b) const {
+            return std::memcmp(&a[0], &b[0], sizeof(glm::vec3)) == 0;
+        }
+    };
+    std::unordered_map<glm::vec3, std::uint32_t, PositionBits, SameBits> first_at;
+    first_at.reserve(positions.size());
+    std::vector<std::uint32_t> merged(positions.size());
+    for (std::size_t i = 0; i < positions.size(); ++i)
+        merged[i] = first_at.emplace(positions[i], std::uint32_t(i)).first->second;
+
+    // Every directed edge exactly once, and its reverse present too.
+    std::vector<std::uint64_t> edges;
+    edges.reserve(3 * triangles.size());
+    double six_volume = 0.0;
+    for (const glm::uvec3& t : triangles) {
+        if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size())
+            return false;
+        const std::uint32_t v[3] = {merged[t.x], merged[t.y], merged[t.z]};
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) return false;  // collapsed
+        for (int k = 0; k < 3; ++k)
+            edges.push_back(std::uint64_t(v[k]) << 32 | v[(k + 1) % 3]);
+        // Divergence theorem: 6 V = sum over faces of p0 . (p1 x p2).
+        const glm::dvec3 p0(positions[t.x]), p1(positions[t.y]), p2(positions[t.z]);
+        six_volume += glm::dot(p0, glm::cross(p1, p2));
+    }
+    std::sort(edges.begin(), edges.end());
+    if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) return false;
+    for (const std::uint64_t e : edges) {
+        const std::uint64_t reverse = (e << 32) | (e >> 32);
+        if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
+    }
+    return six_volume > 0.0 && std::isfinite(six_volume);
+}
+
 void finalize_mesh(Mesh& mesh) {
     if (mesh.normals.size() != mesh.positions.size())
         mesh.normals = compute_smooth_normals(mesh.positions, mesh.triangles);
@@ -197,6 +246,7 @@ void finalize_mesh(Mesh& mesh) {
         mesh.tangents =
             compute_tangents(mesh.positions, mesh.normals, mesh.uvs, mesh.triangles);
     mesh.content_hash = compute_content_hash(mesh.positions, mesh.triangles, mesh.uvs);
+    mesh.closed_facing_out = bounds_solid_facing_out(mesh.positions, mesh.triangles);
 }
 
 Mesh load_mesh(const std::string& spec) {

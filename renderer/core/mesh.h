@@ -35,6 +35,11 @@ struct Mesh {
     std::vector<glm::vec2> uvs;
     std::vector<glm::vec4> tangents;
     std::string content_hash;  // hex digest of positions + triangles (+ uvs when present)
+    // True when the triangles bound a solid and face out of it (bounds_solid_facing_out;
+    // set by finalize_mesh). Then from outside the nearest surface along any ray faces
+    // the viewer and the next one faces away, so renderers may cull by facing instead of
+    // peeling layers. False (the safe answer) for meshes never finalised.
+    bool closed_facing_out = false;
 
     bool has_uvs() const { return !uvs.empty() && uvs.size() == positions.size(); }
     std::size_t face_count() const { return triangles.size(); }
@@ -75,9 +80,19 @@ std::vector<glm::vec4> compute_tangents(const std::vector<glm::vec3>& positions,
 std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& positions,
                                               const std::vector<glm::uvec3>& triangles);
 
+// Whether `triangles` bound a solid and face out of it: with vertices at bit-identical
+// positions merged (seams), every edge is shared by exactly two triangles that run along
+// it in opposite directions (a closed, consistently wound surface), and the volume they
+// enclose, counter-clockwise being the front, is positive. Along a ray from outside,
+// crossings of such a surface then alternate entering (a front face) and leaving (a back
+// face). Self-intersection is not checked (it costs far more and no mesh Lucent builds
+// has it). O(F log F).
+bool bounds_solid_facing_out(const std::vector<glm::vec3>& positions,
+                             const std::vector<glm::uvec3>& triangles);
+
 // Replaces non-finite or zero-length normals (computing smooth ones when `normals` is
 // empty or the wrong size), normalises the rest, computes tangents when there are UVs
-// (dropping UVs of the wrong count) and sets content_hash.
+// (dropping UVs of the wrong count) and sets content_hash and closed_facing_out.
 void finalize_mesh(Mesh& mesh);
 
 }  // namespace lucent

@@ -70,6 +70,7 @@ std::uint64_t pass_description_hash(const Pass& pass) {
     h.value(pass.level);
     h.value(pass.clear);
     h.value(pass.blend);
+    h.value(pass.cull);
     h.text(pass.data.content_hash);
     return h.result();
 }

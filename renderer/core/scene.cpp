@@ -1,6 +1,7 @@
 #include "core/scene.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/technique.h"
 
@@ -33,6 +34,15 @@ Scene make_scene(std::shared_ptr<const Mesh> mesh, const Technique& technique,
     scene.density = density_from_knobs(values);
     scene.values = std::move(values);
     return scene;
+}
+
+bool facing_separates_layers(const Scene& scene) {
+    if (!scene.mesh || !scene.mesh->closed_facing_out) return false;
+    const float distance = glm::distance(scene.camera.eye, scene.bounds.centre);
+    // The view ray first meets the sphere at distance - radius: the near plane must lie
+    // before it, or a clipped solid shows its inside (back faces) first.
+    return std::isfinite(distance) && distance > scene.bounds.radius &&
+           scene.camera.near_plane <= distance - scene.bounds.radius;
 }
 
 }  // namespace lucent

@@ -44,4 +44,11 @@ Scene make_scene(std::shared_ptr<const Mesh> mesh, const Technique& technique,
                  KnobValues values, int width, int height,
                  glm::vec3 view_direction = {0.0f, 0.0f, 1.0f});
 
+// True when a mesh pass may drop triangles by facing and keep the same layers: the mesh
+// bounds a solid facing out (Mesh::closed_facing_out) and the camera sees all of it from
+// outside (the eye outside the bounding sphere, the near plane in front of it). Then
+// the nearest surface of every pixel faces the viewer and the one right behind it faces
+// away (FaceCulling).
+bool facing_separates_layers(const Scene& scene);
+
 }  // namespace lucent

@@ -76,8 +76,10 @@ public:
     virtual std::optional<FrameComparison> frame_comparison() const { return std::nullopt; }
 };
 
-// The plan of `scene` under its technique: technique.plan() then compile().
+// The plan of `scene` under its technique: technique.plan() then compile(), keeping also
+// the passes that produce the resources named in `also_keep` (PlanBuilder::also_keep).
 FramePlan make_frame_plan(const Scene& scene, const Technique& technique,
-                          PlanMode mode = PlanMode::pruned);
+                          PlanMode mode = PlanMode::pruned,
+                          const std::vector<std::string>& also_keep = {});
 
 }  // namespace lucent

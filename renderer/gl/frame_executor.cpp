@@ -377,7 +377,17 @@ struct FrameExecutor::Impl {
                 break;
         }
         glBlendEquation(GL_FUNC_ADD);
-        glDisable(GL_CULL_FACE);  // both facings count as layers, as ray hits do
+        switch (pass.cull) {
+            case FaceCulling::none:
+                glDisable(GL_CULL_FACE);  // both facings count as layers, as ray hits do
+                break;
+            case FaceCulling::back:
+            case FaceCulling::front:
+                glEnable(GL_CULL_FACE);
+                glFrontFace(GL_CCW);
+                glCullFace(pass.cull == FaceCulling::back ? GL_BACK : GL_FRONT);
+                break;
+        }
         if (depth) {
             glEnable(GL_DEPTH_TEST);
             glDepthFunc(GL_LESS);
@@ -412,6 +422,7 @@ struct FrameExecutor::Impl {
         glBindVertexArray(0);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         glDisable(GL_BLEND);
+        glDisable(GL_CULL_FACE);
         for (GLint u = 0; u < unit; ++u) {
             glBindTextureUnit(static_cast<GLuint>(u), 0);
             glBindSampler(static_cast<GLuint>(u), 0);

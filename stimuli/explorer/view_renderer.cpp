@@ -162,7 +162,12 @@ void ViewRenderer::render_side(const ExplorerSession& session,
     }
     Scene scene =
         make_scene(mesh, technique, std::move(values), width, height, view_direction(session));
-    FramePlan plan = make_frame_plan(scene, technique);
+    // A depth view keeps the pass that makes its layer even where the image does not
+    // need it (a closed mesh's smoothing happens inside `shade`).
+    const std::string viewed = buffer_resource(session.buffer_view);
+    FramePlan plan = make_frame_plan(scene, technique, PlanMode::pruned,
+                                     viewed.empty() ? std::vector<std::string>{}
+                                                    : std::vector<std::string>{viewed});
     // The scene is published first: the AO source looks the mesh up through it.
     const Scene previous = std::move(side.scene);
     side.scene = scene;

@@ -46,6 +46,14 @@ const std::vector<Knob>& knobs() {
              0.0,
              d.depth_precision,
              {"16", "24", "32f"}},
+            {"layer_method",
+             "how the two depth layers are found: auto (a closed mesh: nearest front and "
+             "back faces by culling; otherwise peeling) or peel (always depth peeling)",
+             KnobKind::choice,
+             0.0,
+             0.0,
+             d.layer_method,
+             {"auto", "peel"}},
         };
     }();
     return list;
@@ -66,6 +74,7 @@ Params params(const Scene& scene) {
     p.ao_rays = v.integer("ao_rays");
     p.blur_kernel = std::stoi(v.choice("blur_kernel"));
     p.depth_precision = v.choice("depth_precision");
+    p.layer_method = v.choice("layer_method");
     return p;
 }
 

@@ -24,6 +24,9 @@ struct Params {
     int blur_kernel = 5;                 // 1 (none), 3 or 5: back-layer smoothing kernel
     std::string depth_precision =
         "32f";  // "16", "24" or "32f": depth-layer texture format
+    // "auto": on a closed mesh facing out the layers are the nearest front and back faces
+    // (culling, no peel); otherwise, and always with "peel", the thesis's depth peeling.
+    std::string layer_method = "auto";
 };
 
 // The technique's knobs (material + technique), defaults taken from Params{}.

@@ -37,16 +37,27 @@ bool has_define(const Pass& pass, const std::string& define) {
     return std::find(d.begin(), d.end(), define) != d.end();
 }
 
+// The thesis's layers by depth peeling (layer_method = peel; what every open mesh gets).
 class EmpiricalPlan : public ::testing::Test {
 protected:
     FramePlan plan(std::vector<KnobAssignment> settings,
                    PlanMode mode = PlanMode::pruned) {
+        settings.push_back({"layer_method", "peel"});
+        return plan_for(closed_sphere(), std::move(settings), mode);
+    }
+    static std::shared_ptr<const Mesh> closed_sphere() {
         static const auto mesh = std::make_shared<const Mesh>(load_mesh("sphere:200"));
+        return mesh;
+    }
+    static FramePlan plan_for(const std::shared_ptr<const Mesh>& mesh,
+                              const std::vector<KnobAssignment>& settings,
+                              PlanMode mode = PlanMode::pruned,
+                              const std::vector<std::string>& also_keep = {}) {
         const Technique& technique = find_technique("empirical");
         const auto knobs = knobs_for(technique);
         const Scene scene =
             make_scene(mesh, technique, resolve_knob_values(knobs, settings), 64, 48);
-        return make_frame_plan(scene, technique, mode);
+        return make_frame_plan(scene, technique, mode, also_keep);
     }
 };
 
@@ -133,6 +144,94 @@ TEST_F(EmpiricalPlan, DepthPrecisionPicksTheLayerFormatAndPlansArePure) {
               std::string::npos)
         << text;
     EXPECT_NE(text.find("culled: front_depth"), std::string::npos) << text;
+}
+
+// layer_method = auto on a closed mesh facing out: the layers come from culling by facing.
+TEST_F(EmpiricalPlan, AClosedMeshTakesItsLayersByFacingWithoutPeeling) {
+    ASSERT_TRUE(closed_sphere()->closed_facing_out);
+    const FramePlan p = plan_for(closed_sphere(), {});
+    EXPECT_EQ(pass_names(p),
+              (std::vector<std::string>{"ambient_occlusion", "second_layer", "shade"}));
+    // The separate smoothing pass is planned but nothing reads it: `shade` smooths.
+    EXPECT_EQ(p.culled, (std::vector<std::string>{"smooth_back_layer"}));
+    const Pass& back = pass_named(p, "second_layer");
+    EXPECT_EQ(back.cull, FaceCulling::front);
+    EXPECT_TRUE(back.reads.empty());  // no peel: the first layer is not read
+    EXPECT_EQ(back.writes, (std::vector<std::string>{"second_depth"}));
+    const Pass& shade = pass_named(p, "shade");
+    EXPECT_EQ(shade.kind, PassKind::draw_mesh);
+    EXPECT_EQ(shade.cull, FaceCulling::back);
+    EXPECT_TRUE(has_define(shade, "WITH_BACKLIGHT"));
+    EXPECT_TRUE(has_define(shade, "SMOOTH_IN_SHADE"));
+    EXPECT_TRUE(has_define(shade, "KERNEL_SIZE 5"));
+    EXPECT_EQ(shade.writes, (std::vector<std::string>{"colour", "front_depth"}));
+    EXPECT_TRUE(std::any_of(shade.reads.begin(), shade.reads.end(), [](const Read& r) {
+        return r.resource == "second_depth" && r.sampler == "back_depth";
+    }));
+    EXPECT_EQ(p.resource("front_depth")->format, ResourceFormat::depth32f);
+    EXPECT_EQ(p.resource("front_surface"), nullptr);
+    EXPECT_EQ(p.resource("smoothed_depth"), nullptr);
+    const std::string text = p.explain();
+    EXPECT_NE(text.find("<culls front faces>"), std::string::npos) << text;
+    EXPECT_NE(text.find("<culls back faces>"), std::string::npos) << text;
+}
+
+TEST_F(EmpiricalPlan, ByFacingKernelOneAndZeroBacklightKeepTheirPrunes) {
+    const FramePlan raw = plan_for(closed_sphere(), {{"blur_kernel", "1"}});
+    EXPECT_EQ(pass_names(raw),
+              (std::vector<std::string>{"ambient_occlusion", "second_layer", "shade"}));
+    EXPECT_FALSE(has_define(pass_named(raw, "shade"), "SMOOTH_IN_SHADE"));
+    const FramePlan direct = plan_for(closed_sphere(), {{"backlight", "0"}});
+    EXPECT_EQ(pass_names(direct),
+              (std::vector<std::string>{"ambient_occlusion", "shade"}));
+    EXPECT_EQ(pass_named(direct, "shade").cull, FaceCulling::back);
+    EXPECT_FALSE(has_define(pass_named(direct, "shade"), "WITH_BACKLIGHT"));
+    EXPECT_EQ(resource_names(direct),
+              (std::vector<std::string>{"colour", "front_depth", "vertex_ao"}));
+    // Full mode keeps every pass, the separate smoothing included.
+    const FramePlan full = plan_for(closed_sphere(), {{"backlight", "0"}}, PlanMode::full);
+    EXPECT_EQ(pass_names(full),
+              (std::vector<std::string>{"ambient_occlusion", "second_layer",
+                                        "smooth_back_layer", "shade"}));
+}
+
+TEST_F(EmpiricalPlan, AViewOfTheSmoothedLayerKeepsItsPass) {
+    const FramePlan p = plan_for(closed_sphere(), {}, PlanMode::pruned, {"smoothed_depth"});
+    EXPECT_EQ(pass_names(p),
+              (std::vector<std::string>{"ambient_occlusion", "second_layer",
+                                        "smooth_back_layer", "shade"}));
+    ASSERT_NE(p.resource("smoothed_depth"), nullptr);
+    // A resource the plan does not have keeps nothing more.
+    EXPECT_EQ(pass_names(plan_for(closed_sphere(), {}, PlanMode::pruned, {"no_such"})),
+              (std::vector<std::string>{"ambient_occlusion", "second_layer", "shade"}));
+}
+
+TEST_F(EmpiricalPlan, AnOpenMeshOrACameraInsideIsPeeled) {
+    Mesh open = load_mesh("sphere:200");
+    open.triangles.pop_back();  // a hole
+    finalize_mesh(open);
+    ASSERT_FALSE(open.closed_facing_out);
+    const FramePlan p = plan_for(std::make_shared<const Mesh>(std::move(open)), {});
+    EXPECT_EQ(pass_names(p),
+              (std::vector<std::string>{"ambient_occlusion", "front_depth",
+                                        "second_layer", "smooth_back_layer", "shade"}));
+    EXPECT_EQ(pass_named(p, "second_layer").cull, FaceCulling::none);
+    EXPECT_EQ(pass_named(p, "shade").cull, FaceCulling::none);
+
+    // The same closed sphere seen from inside its bounding sphere, or with the near plane
+    // cutting into it: culling by facing would show its inside, so it is peeled.
+    const Technique& technique = find_technique("empirical");
+    Scene scene = make_scene(closed_sphere(), technique,
+                             resolve_knob_values(knobs_for(technique), {}), 64, 48);
+    EXPECT_TRUE(facing_separates_layers(scene));
+    Scene inside = scene;
+    inside.camera.eye = inside.bounds.centre + glm::vec3(0.0f, 0.0f, 0.5f * inside.bounds.radius);
+    EXPECT_FALSE(facing_separates_layers(inside));
+    EXPECT_EQ(pass_named(make_frame_plan(inside, technique), "second_layer").cull,
+              FaceCulling::none);
+    Scene clipped = scene;
+    clipped.camera.near_plane = glm::distance(clipped.camera.eye, clipped.bounds.centre);
+    EXPECT_FALSE(facing_separates_layers(clipped));
 }
 
 // The compiler on a synthetic graph (Filament's SimplePassCulling): a pass whose output

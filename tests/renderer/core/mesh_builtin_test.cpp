@@ -44,6 +44,12 @@ TEST_P(BuiltinMeshTest, IsClosedOrientableWithTheRightGenus) {
     EXPECT_EQ(long(mesh.vertex_count()), expected_vertices);
 }
 
+TEST_P(BuiltinMeshTest, IsMarkedAsBoundingASolidFacingOut) {
+    const Mesh mesh = load_mesh(std::string(GetParam().name) + ":8000");
+    EXPECT_TRUE(mesh.closed_facing_out);
+    EXPECT_TRUE(bounds_solid_facing_out(mesh.positions, mesh.triangles));
+}
+
 TEST_P(BuiltinMeshTest, WindsOutwardWithUnitNormalsAndNoDegenerateFaces) {
     const Mesh mesh = load_mesh(std::string(GetParam().name) + ":8000");
     EXPECT_GT(signed_volume(mesh), 0.0);
@@ -201,6 +207,61 @@ TEST(BuiltinMesh, NamesAreListed) {
     const std::vector<std::string> names = builtin_mesh_names();
     for (const char* name : {"sphere", "torus", "torus_knot", "hand"})
         EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+}
+
+// What culling by facing relies on (Mesh::closed_facing_out), on meshes whose answer is
+// known by construction: a tetrahedron wound outward, and ways of breaking it.
+TEST(BoundsSolidFacingOut, AcceptsOnlyClosedSurfacesWoundOutward) {
+    const std::vector<glm::vec3> p = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    // Counter-clockwise seen from outside: the normal (p1-p0)x(p2-p0) points away from
+    // the opposite vertex.
+    const std::vector<glm::uvec3> tetra = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    EXPECT_TRUE(bounds_solid_facing_out(p, tetra));
+
+    std::vector<glm::uvec3> inward = tetra;
+    for (auto& t : inward) std::swap(t.y, t.z);
+    EXPECT_FALSE(bounds_solid_facing_out(p, inward)) << "closed but facing in";
+
+    std::vector<glm::uvec3> hole(tetra.begin(), tetra.end() - 1);
+    EXPECT_FALSE(bounds_solid_facing_out(p, hole)) << "a missing face";
+
+    std::vector<glm::uvec3> flipped = tetra;
+    std::swap(flipped[3].y, flipped[3].z);
+    EXPECT_FALSE(bounds_solid_facing_out(p, flipped)) << "one face wound the other way";
+
+    std::vector<glm::uvec3> doubled = tetra;
+    doubled.push_back(tetra[3]);
+    EXPECT_FALSE(bounds_solid_facing_out(p, doubled)) << "an edge shared three times";
+
+    EXPECT_FALSE(bounds_solid_facing_out(p, {})) << "no triangles";
+    EXPECT_FALSE(bounds_solid_facing_out(p, {{0, 1, 7}})) << "an index past the end";
+
+    // Split vertices at bit-identical positions (a seam for normals or UVs) are one
+    // vertex to the rasteriser: still closed.
+    std::vector<glm::vec3> seam = p;
+    seam.push_back(p[3]);  // index 4 sits on vertex 3
+    std::vector<glm::uvec3> split = tetra;
+    split[3] = {1, 2, 4};
+    EXPECT_TRUE(bounds_solid_facing_out(seam, split));
+    // ...but a vertex moved by one ulp is a crack.
+    seam[4].z = std::nextafter(seam[4].z, 2.0f);
+    EXPECT_FALSE(bounds_solid_facing_out(seam, split));
+
+    // Two disjoint closed parts are closed.
+    std::vector<glm::vec3> two = p;
+    for (const glm::vec3& q : p) two.push_back(q + glm::vec3(5.0f, 0.0f, 0.0f));
+    std::vector<glm::uvec3> both = tetra;
+    for (const glm::uvec3& t : tetra) both.push_back(t + glm::uvec3(4u));
+    EXPECT_TRUE(bounds_solid_facing_out(two, both));
+
+    // The open sheets are not, and the flag travels with finalize_mesh.
+    EXPECT_FALSE(load_mesh("square").closed_facing_out);
+    EXPECT_FALSE(load_mesh("wave").closed_facing_out);
+    Mesh tetrahedron;
+    tetrahedron.positions = p;
+    tetrahedron.triangles = tetra;
+    finalize_mesh(tetrahedron);
+    EXPECT_TRUE(tetrahedron.closed_facing_out);
 }
 
 }  // namespace

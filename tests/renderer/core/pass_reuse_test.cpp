@@ -155,42 +155,68 @@ protected:
 };
 
 TEST_F(TechniqueReuse, EmpiricalSlidersRerunOnlyThePassesTheyTouch) {
+    // A closed mesh: back faces for the second layer, then front faces shaded with the
+    // smoothing done per fragment.
     RecordingExecutor executor;
     EXPECT_EQ(executor.execute(plan("empirical", {})),
-              (Names{"ambient_occlusion", "front_depth", "second_layer",
-                     "smooth_back_layer", "shade"}));
+              (Names{"ambient_occlusion", "second_layer", "shade"}));
     EXPECT_EQ(executor.execute(plan("empirical", {})), Names{});
-    // A shading uniform: the shade pass only.
+    // A shading uniform, or the smoothing kernel (a define of `shade`): shade only.
     EXPECT_EQ(executor.execute(plan("empirical", {{"shininess", "30"}})), Names{"shade"});
-    // The smoothing kernel (a define): smoothing and shading, not the layers or the AO.
     EXPECT_EQ(
         executor.execute(plan("empirical", {{"shininess", "30"}, {"blur_kernel", "3"}})),
-        (Names{"smooth_back_layer", "shade"}));
-    // AO rays: the bake, and the front layer that carries the AO to the (deferred)
-    // shading, so everything drawn after it.
+        Names{"shade"});
+    // AO rays: the bake and the shading that reads it; the back layer stays.
     EXPECT_EQ(
         executor.execute(plan(
             "empirical", {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}})),
-        (Names{"ambient_occlusion", "front_depth", "second_layer", "smooth_back_layer",
-               "shade"}));
+        (Names{"ambient_occlusion", "shade"}));
     // Orbiting the camera: every drawing pass, never the AO bake.
     EXPECT_EQ(
         executor.execute(plan(
             "empirical", {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}},
             {1.0f, 0.0f, 0.0f})),
-        (Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}));
+        (Names{"second_layer", "shade"}));
     // Another mesh: everything that depends on it.
     EXPECT_EQ(executor.execute(
                   plan("empirical",
                        {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}},
                        {1.0f, 0.0f, 0.0f}),
                   "another mesh"),
-              (Names{"ambient_occlusion", "front_depth", "second_layer",
-                     "smooth_back_layer", "shade"}));
-    // Without the backlight the shading is forward: AO rays re-run the bake and it only.
+              (Names{"ambient_occlusion", "second_layer", "shade"}));
+    // Without the backlight: AO rays re-run the bake and the shading only.
     executor.execute(plan("empirical", {{"backlight", "0"}, {"ao_rays", "64"}}));
     EXPECT_EQ(executor.execute(plan("empirical", {{"backlight", "0"}, {"ao_rays", "32"}})),
               (Names{"ambient_occlusion", "shade"}));
+}
+
+TEST_F(TechniqueReuse, EmpiricalPeelingSlidersRerunOnlyThePassesTheyTouch) {
+    // The thesis's depth peeling (every open mesh; layer_method = peel).
+    const auto peel = [](std::vector<KnobAssignment> settings, glm::vec3 view = {0, 0, 1}) {
+        settings.push_back({"layer_method", "peel"});
+        return plan("empirical", settings, view);
+    };
+    RecordingExecutor executor;
+    EXPECT_EQ(executor.execute(peel({})),
+              (Names{"ambient_occlusion", "front_depth", "second_layer",
+                     "smooth_back_layer", "shade"}));
+    EXPECT_EQ(executor.execute(peel({})), Names{});
+    // A shading uniform: the shade pass only.
+    EXPECT_EQ(executor.execute(peel({{"shininess", "30"}})), Names{"shade"});
+    // The smoothing kernel (a define): smoothing and shading, not the layers or the AO.
+    EXPECT_EQ(executor.execute(peel({{"shininess", "30"}, {"blur_kernel", "3"}})),
+              (Names{"smooth_back_layer", "shade"}));
+    // AO rays: the bake, and the front layer that carries the AO to the (deferred)
+    // shading, so everything drawn after it.
+    EXPECT_EQ(executor.execute(
+                  peel({{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}})),
+              (Names{"ambient_occlusion", "front_depth", "second_layer",
+                     "smooth_back_layer", "shade"}));
+    // Orbiting the camera: every drawing pass, never the AO bake.
+    EXPECT_EQ(executor.execute(peel(
+                  {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}},
+                  {1.0f, 0.0f, 0.0f})),
+              (Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}));
 }
 
 TEST_F(TechniqueReuse, EveryTechniqueRunsNothingOnAnIdenticalSecondFrame) {

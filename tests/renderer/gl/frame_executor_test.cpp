@@ -314,54 +314,65 @@ TEST_F(FrameExecutorGl, CompositingPassesBlendOntoKeptContents) {
 // Reuse on: a second identical frame runs no pass, a changed uniform re-runs its pass
 // only, and each image equals, bit for bit, one rendered from scratch by a new executor.
 TEST_F(FrameExecutorGl, ReusedPassesLeaveTheImageAFreshRenderWouldGive) {
-    const auto scene_with = [](std::vector<KnobAssignment> settings) {
-        RenderRequest request;
-        request.mesh = "sphere:2k";
-        request.settings = std::move(settings);
-        request.width = 48;
-        request.height = 40;
-        return build_scene(request);
-    };
-    const auto fresh = [](const Scene& scene) {
+    using Names = std::vector<std::string>;
+    // The closed sphere by facing (auto) and by peeling: each reuse must leave the image
+    // a fresh executor renders.
+    for (const std::string method : {"auto", "peel"}) {
+        const bool peel = method == "peel";
+        const auto scene_with = [&](std::vector<KnobAssignment> settings) {
+            RenderRequest request;
+            request.mesh = "sphere:2k";
+            request.settings = std::move(settings);
+            request.settings.push_back({"layer_method", method});
+            request.width = 48;
+            request.height = 40;
+            return build_scene(request);
+        };
+        const auto fresh = [](const Scene& scene) {
+            gl::FrameExecutor executor;
+            return executor.render(scene,
+                                   make_frame_plan(scene, find_technique(scene.technique)));
+        };
+        const auto ran = [](const gl::FrameExecutor& executor) {
+            Names names;
+            for (const auto& t : executor.last_timings().passes)
+                if (!t.cached) names.push_back(t.pass);
+            return names;
+        };
         gl::FrameExecutor executor;
-        return executor.render(scene,
-                               make_frame_plan(scene, find_technique(scene.technique)));
-    };
-    const auto ran = [](const gl::FrameExecutor& executor) {
-        std::vector<std::string> names;
-        for (const auto& t : executor.last_timings().passes)
-            if (!t.cached) names.push_back(t.pass);
-        return names;
-    };
-    gl::FrameExecutor executor;
-    executor.set_reuse_unchanged_passes(true);
-    const Scene first = scene_with({});
-    const FramePlan first_plan = make_frame_plan(first, find_technique("empirical"));
-    executor.execute(first, first_plan, /*time_passes=*/true);
-    EXPECT_EQ(ran(executor).size(), first_plan.passes.size());
-    const Image reference = fresh(first);
-    EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba);
+        executor.set_reuse_unchanged_passes(true);
+        const Scene first = scene_with({});
+        const FramePlan first_plan = make_frame_plan(first, find_technique("empirical"));
+        executor.execute(first, first_plan, /*time_passes=*/true);
+        EXPECT_EQ(ran(executor).size(), first_plan.passes.size()) << method;
+        const Image reference = fresh(first);
+        EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba) << method;
 
-    executor.execute(first, make_frame_plan(first, find_technique("empirical")), true);
-    EXPECT_EQ(ran(executor), std::vector<std::string>{});
-    EXPECT_EQ(executor.last_timings().passes.size(), first_plan.passes.size());
-    EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba);
+        executor.execute(first, make_frame_plan(first, find_technique("empirical")), true);
+        EXPECT_EQ(ran(executor), Names{}) << method;
+        EXPECT_EQ(executor.last_timings().passes.size(), first_plan.passes.size());
+        EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba) << method;
 
-    for (const auto& [settings, expected] :
-         std::vector<std::pair<std::vector<KnobAssignment>, std::vector<std::string>>>{
-             {{{"shininess", "40"}}, {"shade"}},
-             {{{"shininess", "40"}, {"blur_kernel", "3"}},
-              {"smooth_back_layer", "shade"}},
-             {{{"shininess", "40"}, {"blur_kernel", "3"}, {"backlight", "0"}}, {"shade"}},
-             // Back on: the layers' textures were freed with the plan that lacked them.
-             {{{"shininess", "40"}, {"blur_kernel", "3"}},
-              {"front_depth", "second_layer", "smooth_back_layer", "shade"}}}) {
-        const Scene scene = scene_with(settings);
-        const FramePlan plan = make_frame_plan(scene, find_technique("empirical"));
-        executor.execute(scene, plan, true);
-        EXPECT_EQ(ran(executor), expected) << settings.back().key;
-        EXPECT_EQ(executor.read_output(plan).rgba, fresh(scene).rgba)
-            << settings.back().key;
+        for (const auto& [settings, expected] :
+             std::vector<std::pair<std::vector<KnobAssignment>, Names>>{
+                 {{{"shininess", "40"}}, {"shade"}},
+                 // By facing, `shade` smooths: the kernel re-runs it alone.
+                 {{{"shininess", "40"}, {"blur_kernel", "3"}},
+                  peel ? Names{"smooth_back_layer", "shade"} : Names{"shade"}},
+                 {{{"shininess", "40"}, {"blur_kernel", "3"}, {"backlight", "0"}},
+                  {"shade"}},
+                 // Back on: the layers' textures were freed with the plan that lacked
+                 // them.
+                 {{{"shininess", "40"}, {"blur_kernel", "3"}},
+                  peel ? Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}
+                       : Names{"second_layer", "shade"}}}) {
+            const Scene scene = scene_with(settings);
+            const FramePlan plan = make_frame_plan(scene, find_technique("empirical"));
+            executor.execute(scene, plan, true);
+            EXPECT_EQ(ran(executor), expected) << method << " " << settings.back().key;
+            EXPECT_EQ(executor.read_output(plan).rgba, fresh(scene).rgba)
+                << method << " " << settings.back().key;
+        }
     }
 }
 

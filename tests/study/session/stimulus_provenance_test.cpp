@@ -99,7 +99,8 @@ TEST(ResolveStimuli, AProtocolSettingOneParameterStoresEveryParameterOfTheTechni
                                                          {"diffuse_weight", "0.2"},
                                                          {"ao_rays", "320"},
                                                          {"blur_kernel", "5"},
-                                                         {"depth_precision", "32f"}};
+                                                         {"depth_precision", "32f"},
+                                                         {"layer_method", "auto"}};
     EXPECT_EQ(values_of(resolved[0]), expected);
     EXPECT_EQ(resolved[0].source, "live");
     EXPECT_EQ(resolved[0].mesh_hash, load_mesh("sphere:1k").content_hash);

@@ -19,14 +19,17 @@ in float v_ambient_occlusion;
 uniform float u_ambient;
 uniform vec3 u_light_ambient;
 #endif
+#include "techniques/empirical/shaders/power.glsl"
 #ifdef WITH_BACKLIGHT
-uniform sampler2D back_depth;  // window depth of the (smoothed) second layer; 1 = none
-uniform float u_near;
-uniform float u_far;
-uniform float u_diameter;
-uniform float u_backlight;
-uniform float u_thickness_exponent;
-uniform float u_diffuse_weight;
+#include "techniques/empirical/shaders/backlight.glsl"
+// The second layer's window depth (1 = none): smoothed by an earlier pass, or, with
+// SMOOTH_IN_SHADE, unsmoothed and smoothed here per fragment (the same operations, so the
+// same floats, without a full-screen pass).
+uniform sampler2D back_depth;
+#ifdef SMOOTH_IN_SHADE
+#include "techniques/empirical/shaders/smoothing.glsl"
+uniform float u_falloff;
+#endif
 #endif
 uniform vec3 u_albedo;
 uniform float u_diffuse_contribution;
@@ -37,30 +40,6 @@ uniform vec3 u_light_diffuse;
 uniform vec3 u_light_specular;
 uniform vec3 u_light_direction;  // unit, towards the light, eye space
 layout(location = 0) out vec4 out_colour;
-
-// x^e with x^0 = 1 (also for x = 0) and negative bases treated as 0: GLSL's pow is
-// undefined there.
-float power(float x, float e) {
-    if (e == 0.0) return 1.0;
-    return x <= 0.0 ? 0.0 : pow(x, e);
-}
-
-#ifdef WITH_BACKLIGHT
-// Eq. 3.3: window depth -> positive eye-space distance.
-float eye_depth(float window_depth) {
-    float ndc = 2.0 * window_depth - 1.0;
-    return 2.0 * u_near * u_far / (u_far + u_near - ndc * (u_far - u_near));
-}
-
-// Thickness over the bounding-sphere diameter (Eq. 3.4), in [0, 1]. No second layer
-// (open mesh, clipped back) counts as the full diameter: t = 1.
-float thickness(float front) {
-    float back = texelFetch(back_depth, ivec2(gl_FragCoord.xy), 0).r;
-    if (back >= 1.0 || !(u_diameter > 0.0)) return 1.0;
-    float t = (eye_depth(back) - eye_depth(front)) / u_diameter;
-    return clamp(t, 0.0, 1.0);
-}
-#endif
 
 void main() {
 #ifdef DEFERRED
@@ -102,8 +81,12 @@ void main() {
 
 #ifdef WITH_BACKLIGHT
     // Thickness term (Eq. 3.10): wb * (1 - t)^r * (Kd + Kb)
-    colour += u_backlight * power(1.0 - thickness(front), u_thickness_exponent) *
-              (u_albedo + vec3(u_diffuse_weight));
+#ifdef SMOOTH_IN_SHADE
+    float back = smoothed_depth(back_depth, ivec2(gl_FragCoord.xy), u_falloff);
+#else
+    float back = texelFetch(back_depth, ivec2(gl_FragCoord.xy), 0).r;
+#endif
+    colour += backlight_term(front, back, u_albedo);
 #endif
     out_colour = vec4(colour, 1.0);
 }
