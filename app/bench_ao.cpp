@@ -18,7 +18,7 @@
 #include "core/ambient_occlusion.h"
 #include "core/progress.h"
 #include "cpu/ambient_occlusion_directions.h"
-#include "cpu/ray_caster.h"
+#include "cpu/occlusion_counter.h"
 
 namespace lucent::app {
 namespace {
@@ -44,20 +44,29 @@ double thread_cpu_seconds() {
 }
 
 // Rays per CPU-second of each query type on the bake's own rays for every `sample`th
-// vertex, on this thread; the escape counts must agree (same rays, same answers).
+// vertex, on this thread, in both scene layouts; the escape counts must agree (same rays,
+// same answers).
 void time_query_types(const Mesh& mesh, int rays, unsigned sample, BenchResults& results) {
-    const RayCaster caster(mesh);
     const AoDirections lattice(rays);
     const float offset = 1e-4f * std::max(mesh.bounding_sphere().radius, 1e-6f);
     struct Query {
-        const char* name;
+        std::string name;
+        OcclusionScene layout;
         OcclusionQuery query;
         double seconds = 0.0;
         std::size_t escaped = 0;
     };
-    Query queries[] = {{"rtcOccluded1", OcclusionQuery::single},
-                       {"rtcOccluded8", OcclusionQuery::packet8},
-                       {"rtcOccluded1M", OcclusionQuery::stream}};
+    std::vector<Query> queries;
+    for (const auto& [layout, layout_name] :
+         {std::pair{OcclusionScene::triangles, "triangles"},
+          std::pair{OcclusionScene::paired_quads, "quads"}})
+        for (const auto& [query, query_name] :
+             {std::pair{OcclusionQuery::single, "rtcOccluded1"},
+              std::pair{OcclusionQuery::packet8, "rtcOccluded8"},
+              std::pair{OcclusionQuery::stream, "rtcOccluded1M"}})
+            queries.push_back({std::string(query_name) + " " + layout_name, layout, query});
+    const OcclusionCounter triangles(mesh, OcclusionScene::triangles);
+    const OcclusionCounter quads(mesh, OcclusionScene::paired_quads);
     double setup = 0.0, traced = 0.0;
     std::vector<glm::vec3> directions;
     for (std::size_t v = 0; v < mesh.vertex_count(); v += sample) {
@@ -66,26 +75,28 @@ void time_query_types(const Mesh& mesh, int rays, unsigned sample, BenchResults&
         const glm::vec3 origin = mesh.positions[v] + offset * mesh.normals[v];
         setup += thread_cpu_seconds() - t0;
         for (Query& q : queries) {
+            const OcclusionCounter& counter =
+                q.layout == OcclusionScene::triangles ? triangles : quads;
             const double start = thread_cpu_seconds();
-            q.escaped += caster.count_escaping(origin, directions, 0.0f, q.query);
+            q.escaped += counter.count_escaping(origin, directions, 0.0f, q.query);
             q.seconds += thread_cpu_seconds() - start;
         }
         traced += rays;
     }
     const std::string section = "query " + mesh.name;
-    std::printf("  %-16s %11.2f %9s  (ray directions + origins)\n", "set-up",
+    std::printf("  %-24s %11.2f %9s  (ray directions + origins)\n", "set-up",
                 traced / setup / 1e6, "");
     results.add(section, "set-up rate", traced / setup / 1e6, "Mrays/CPUs");
     for (const Query& q : queries) {
         const double rate = traced / q.seconds / 1e6;
-        std::printf("  %-16s %11.2f %9.2f  escaped %.5f%s\n", q.name, rate,
+        std::printf("  %-24s %11.2f %9.2f  escaped %.5f%s\n", q.name.c_str(), rate,
                     queries[0].seconds / q.seconds, double(q.escaped) / traced,
-                    q.escaped == queries[0].escaped ? "" : "  (differs from rtcOccluded1)");
-        results.add(section, std::string(q.name) + " rate", rate, "Mrays/CPUs");
-        results.add(section, std::string(q.name) + " speed-up over rtcOccluded1",
+                    q.escaped == queries[0].escaped ? "" : "  (differs from the first row)");
+        results.add(section, q.name + " rate", rate, "Mrays/CPUs");
+        results.add(section, q.name + " speed-up over the first row",
                     queries[0].seconds / q.seconds, "ratio");
-        results.add(section, std::string(q.name) + " escaped fraction",
-                    double(q.escaped) / traced, "fraction");
+        results.add(section, q.name + " escaped fraction", double(q.escaped) / traced,
+                    "fraction");
     }
 }
 
@@ -117,7 +128,7 @@ int run_bench_ao(const BenchAoOptions& options) {
                 "", "", "", "", "CPU", "CPU", "Mrays/CPUs", "Embree");
     for (const Mesh& mesh : meshes) {
         const auto build_start = std::chrono::steady_clock::now();
-        { const RayCaster caster(mesh); }
+        { const OcclusionCounter counter(mesh); }
         const double build = seconds_since(build_start);
 
         AoBakeOptions bake;
@@ -160,10 +171,11 @@ int run_bench_ao(const BenchAoOptions& options) {
         results.add("bake " + m, "bake / ceiling", rate / ceiling, "ratio");
     }
     std::printf(
-        "\nEmbree query types on the bake's rays of every %u%s vertex, one thread "
-        "(thread CPU time)\n  %-16s %11s %9s\n",
+        "\nEmbree query types and scene layouts (the mesh's triangles; paired into quads, "
+        "the bake's) on the bake's rays of every %u%s vertex, one thread (thread CPU "
+        "time)\n  %-24s %11s %9s\n",
         options.sample, options.sample == 1 ? "st" : "th", "query", "Mrays/CPUs",
-        "vs single");
+        "vs first");
     for (const Mesh& mesh : meshes) {
         std::printf(" %s\n", mesh.name.c_str());
         time_query_types(mesh, options.rays, options.sample, results);

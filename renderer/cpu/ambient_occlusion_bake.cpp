@@ -1,8 +1,8 @@
 // Per-vertex AO bake (thesis Eq. 3.5): AO = (1/N) sum_i V(p, w_i), V = 1 when the ray
 // escapes. Directions: AoDirections (stratified, uniform over the hemisphere, shifted per
-// vertex). Each vertex's rays go to Embree as one stream (measured fastest by `lucent
-// bench ao`). Each vertex's result depends only on its index, never on which thread
-// bakes it.
+// vertex). Each vertex's rays go to Embree as one stream, on paired quads with denormals
+// flushed (OcclusionCounter; each measured fastest by `lucent bench ao`). Each vertex's
+// result depends only on its index, never on which thread bakes it.
 #include <time.h>
 
 #include <algorithm>
@@ -18,7 +18,7 @@
 
 #include "core/ambient_occlusion.h"
 #include "cpu/ambient_occlusion_directions.h"
-#include "cpu/ray_caster.h"
+#include "cpu/occlusion_counter.h"
 
 namespace lucent {
 
@@ -104,7 +104,7 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh,
         if (options.progress) options.progress(total, total);
         return result;  // nothing to occlude
     }
-    const RayCaster caster(mesh);
+    const OcclusionCounter counter(mesh);
     // Meshes from load_mesh() have unit normals; one assembled by hand may not.
     std::vector<glm::vec3> repaired;
     bool usable = mesh.normals.size() == total;
@@ -134,7 +134,7 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh,
             // Start just above the surface so the vertex's own triangles are not hit.
             const glm::vec3 origin = mesh.positions[v] + offset * normals[v];
             const double t1 = timed ? thread_cpu_seconds() : 0.0;
-            result[v] = float(caster.count_escaping(origin, directions)) /
+            result[v] = float(counter.count_escaping(origin, directions)) /
                         float(options.rays);
             if (timed) {
                 const double t2 = thread_cpu_seconds();

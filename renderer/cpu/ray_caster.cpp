@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "cpu/embree_support.h"
+
 namespace lucent {
 
 struct RayCaster::Impl {
@@ -25,21 +27,11 @@ struct RayCaster::Impl {
 
 namespace {
 
-bool finite(glm::vec3 v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+using embree::finite;
 
 RTCRayHit make_ray(glm::vec3 origin, glm::vec3 unit_direction, float t_min, float t_max) {
     RTCRayHit query{};
-    query.ray.org_x = origin.x;
-    query.ray.org_y = origin.y;
-    query.ray.org_z = origin.z;
-    query.ray.dir_x = unit_direction.x;
-    query.ray.dir_y = unit_direction.y;
-    query.ray.dir_z = unit_direction.z;
-    query.ray.tnear = t_min;
-    query.ray.tfar = t_max;
-    query.ray.mask = ~0u;
+    query.ray = embree::make_ray(origin, unit_direction, t_min, t_max);
     query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     query.hit.primID = RTC_INVALID_GEOMETRY_ID;
     return query;
@@ -61,44 +53,12 @@ std::optional<glm::vec3> unit(glm::vec3 origin, glm::vec3 direction) {
 }  // namespace
 
 RayCaster::RayCaster(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
-    for (const glm::uvec3& t : mesh.triangles)
-        if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() ||
-            t.z >= mesh.positions.size())
-            throw std::invalid_argument(mesh.name +
-                                        ": a triangle refers to a vertex past the "
-                                        "last of " +
-                                        std::to_string(mesh.positions.size()));
+    embree::check_indices(mesh);
     impl_->positions = mesh.positions;
     impl_->triangles = mesh.triangles;
     impl_->epsilon = 1e-5f * std::max(mesh.bounding_sphere().radius, 1e-6f);
-    impl_->device = rtcNewDevice(nullptr);
-    if (!impl_->device)
-        throw std::runtime_error("Embree: cannot create a device (error " +
-                                 std::to_string(rtcGetDeviceError(nullptr)) + ")");
-    impl_->scene = rtcNewScene(impl_->device);
-    rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
-    if (!mesh.triangles.empty()) {
-        RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        // Embree copies into its own (padded) buffers, so the Mesh may go away.
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-            mesh.positions.size()));
-        for (std::size_t i = 0; i < mesh.positions.size(); ++i)
-            for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.positions[i][k];
-        auto* indices = static_cast<unsigned*>(
-            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                    3 * sizeof(unsigned), mesh.triangles.size()));
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
-            for (int k = 0; k < 3; ++k) indices[3 * i + k] = mesh.triangles[i][k];
-        rtcCommitGeometry(geometry);
-        rtcAttachGeometry(impl_->scene, geometry);
-        rtcReleaseGeometry(geometry);
-    }
-    rtcCommitScene(impl_->scene);
-    if (const RTCError error = rtcGetDeviceError(impl_->device); error != RTC_ERROR_NONE)
-        throw std::runtime_error("Embree: scene build failed (error " +
-                                 std::to_string(static_cast<int>(error)) + ")");
+    impl_->device = embree::new_device();
+    impl_->scene = embree::build_scene(impl_->device, mesh);
 }
 
 RayCaster::~RayCaster() = default;
@@ -151,63 +111,6 @@ bool RayCaster::occluded(glm::vec3 origin, glm::vec3 direction, float t_min,
     RTCRay ray = make_ray(origin, *dir, exclusive_near(t_min), t_max).ray;
     rtcOccluded1(impl_->scene, &context, &ray);
     return ray.tfar == -std::numeric_limits<float>::infinity();
-}
-
-std::size_t RayCaster::count_escaping(glm::vec3 origin,
-                                      const std::vector<glm::vec3>& directions,
-                                      float t_min, OcclusionQuery query) const {
-    if (!finite(origin)) return directions.size();  // an unusable ray hits nothing
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);  // incoherent: the rays fan out over a hemisphere
-    const float near = exclusive_near(t_min);
-    constexpr float kFar = std::numeric_limits<float>::infinity();
-    constexpr float kBlocked = -std::numeric_limits<float>::infinity();  // Embree's mark
-    std::size_t escaped = 0;
-    switch (query) {
-        case OcclusionQuery::single:
-            for (const glm::vec3& direction : directions) {
-                RTCRay ray = make_ray(origin, direction, near, kFar).ray;
-                rtcOccluded1(impl_->scene, &context, &ray);
-                if (ray.tfar != kBlocked) ++escaped;
-            }
-            break;
-        case OcclusionQuery::packet8:
-            for (std::size_t first = 0; first < directions.size(); first += 8) {
-                alignas(32) int valid[8];
-                RTCRay8 packet{};
-                for (std::size_t k = 0; k < 8; ++k) {
-                    const bool used = first + k < directions.size();
-                    valid[k] = used ? -1 : 0;
-                    const glm::vec3 d = used ? directions[first + k] : glm::vec3(0, 0, 1);
-                    packet.org_x[k] = origin.x;
-                    packet.org_y[k] = origin.y;
-                    packet.org_z[k] = origin.z;
-                    packet.dir_x[k] = d.x;
-                    packet.dir_y[k] = d.y;
-                    packet.dir_z[k] = d.z;
-                    packet.tnear[k] = near;
-                    packet.tfar[k] = kFar;
-                    packet.mask[k] = ~0u;
-                }
-                rtcOccluded8(valid, impl_->scene, &context, &packet);
-                for (std::size_t k = 0; k < 8 && first + k < directions.size(); ++k)
-                    if (packet.tfar[k] != kBlocked) ++escaped;
-            }
-            break;
-        case OcclusionQuery::stream: {
-            // Reused per thread: the bake calls this once per vertex.
-            thread_local std::vector<RTCRay> rays;
-            rays.resize(directions.size());
-            for (std::size_t i = 0; i < directions.size(); ++i)
-                rays[i] = make_ray(origin, directions[i], near, kFar).ray;
-            rtcOccluded1M(impl_->scene, &context, rays.data(),
-                          static_cast<unsigned>(rays.size()), sizeof(RTCRay));
-            for (const RTCRay& ray : rays)
-                if (ray.tfar != kBlocked) ++escaped;
-            break;
-        }
-    }
-    return escaped;
 }
 
 }  // namespace lucent

@@ -1,5 +1,6 @@
 #pragma once
-// Embree ray casting over a Mesh, shared by the AO bake and the CPU reference renderers.
+// Embree ray casting over a Mesh for the CPU reference renderers (the AO bake counts
+// escaping rays with cpu/occlusion_counter.h).
 #include <glm/glm.hpp>
 #include <memory>
 #include <optional>
@@ -8,14 +9,6 @@
 #include "core/mesh.h"
 
 namespace lucent {
-
-// How count_escaping() hands its rays to Embree. All give the same counts (the rays are
-// the same); they differ in speed only (`lucent bench ao` times each).
-enum class OcclusionQuery {
-    single,   // rtcOccluded1 per ray
-    packet8,  // rtcOccluded8 on consecutive groups of 8 rays
-    stream,   // one rtcOccluded1M call for all the rays (Embree regroups them)
-};
 
 struct RayHit {
     float distance = 0.0f;             // along the (normalised) ray direction
@@ -44,13 +37,6 @@ public:
     std::vector<RayHit> hits(glm::vec3 origin, glm::vec3 direction, int max_hits) const;
     // True when anything is hit with distance in (t_min, t_max).
     bool occluded(glm::vec3 origin, glm::vec3 direction, float t_min, float t_max) const;
-
-    // How many rays from one origin along `directions` (unit) hit nothing with distance
-    // in (t_min, inf): the AO estimator's count. The stream query is the fastest on
-    // hemisphere fans (measured by `lucent bench ao`).
-    std::size_t count_escaping(glm::vec3 origin, const std::vector<glm::vec3>& directions,
-                               float t_min = 0.0f,
-                               OcclusionQuery query = OcclusionQuery::stream) const;
 
     // 1e-5 of the mesh's bounding-sphere radius: the gap between successive layers.
     float layer_epsilon() const;
