@@ -84,6 +84,10 @@ struct ReferenceError {
 Image render_reference_with_error(const Scene& scene, const IntegratorQuality& quality,
                                   ReferenceError& error);
 
-void add_passes(const Scene& scene, PlanBuilder& plan);
+// How `translucency` shades: once per covered pixel from the surface a `surface` pass
+// stored (deferred, what the technique plans), or every rasterised fragment (forward:
+// here for the test that the two agree bit for bit).
+enum class Shading { deferred, forward };
+void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading = Shading::deferred);
 
 }  // namespace lucent::dipole

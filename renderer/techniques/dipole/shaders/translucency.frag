@@ -7,11 +7,23 @@
 //   then the optional Reinhard tone map, then Blinn-Phong specular (WITH_SPECULAR).
 // Rd_g = Rd (1 - Wl), Rd_l = Rd Wl; without the hybrid Wl = 0. The same equations as
 // renderer/techniques/dipole/reference.cpp, which integrates B directly instead.
+// DEFERRED: a full-screen pass over the surface the `surface` pass stored (surface.frag)
+// instead of the mesh, so each covered pixel sums the samples once rather than every
+// rasterised fragment (llvmpipe shades whole 4x4 blocks of small triangles); the inputs
+// are the same floats, so is the colour.
 #include "techniques/dipole/shaders/dipole.glsl"
+#ifdef DEFERRED
+uniform sampler2D surface_position;  // xyz object space; w = 1 where a surface is
+uniform sampler2D surface_normal;    // xyz object space (interpolated); w = AO
+#ifdef WITH_SPECULAR
+uniform sampler2D surface_normal_eye;
+#endif
+#else
 in vec3 v_position_object;
 in vec3 v_normal_object;
 in vec3 v_normal_eye;
 in vec3 v_position_eye;
+#endif
 uniform vec3 u_light_direction;  // eye space, towards the light
 uniform vec3 u_eye_object;       // camera position, object space
 uniform vec3 u_background;
@@ -41,7 +53,9 @@ uniform vec3 u_light_up;
 uniform float u_light_plane_mm;    // width of the light view in mm
 #endif
 #ifdef WITH_AMBIENT
+#ifndef DEFERRED
 in float v_ambient_occlusion;
+#endif
 uniform vec3 u_ambient_colour;  // ka Ia mean(Ft) Rd_tot
 #endif
 #ifdef TONE_MAP
@@ -55,14 +69,36 @@ uniform vec3 u_light_specular;
 #endif
 
 void main() {
-    vec3 n = normalize(v_normal_object);
-    float n_dot_v = max(dot(n, normalize(u_eye_object - v_position_object)), 0.0);
+#ifdef DEFERRED
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    vec4 position = texelFetch(surface_position, pixel, 0);
+    if (position.w == 0.0) {
+        o_colour = vec4(u_background, 0.0);  // no surface: the clear colour
+        return;
+    }
+    vec3 position_object = position.xyz;
+    vec4 normal = texelFetch(surface_normal, pixel, 0);
+    vec3 normal_object = normal.xyz;
+    float ambient_occlusion = normal.w;
+#ifdef WITH_SPECULAR
+    vec3 normal_eye = texelFetch(surface_normal_eye, pixel, 0).xyz;
+#endif
+#else
+    vec3 position_object = v_position_object;
+    vec3 normal_object = v_normal_object;
+    vec3 normal_eye = v_normal_eye;
+#ifdef WITH_AMBIENT
+    float ambient_occlusion = v_ambient_occlusion;
+#endif
+#endif
+    vec3 n = normalize(normal_object);
+    float n_dot_v = max(dot(n, normalize(u_eye_object - position_object)), 0.0);
     vec3 colour = vec3(0.0);
     float flux = 0.0;
 #ifdef WITH_SUBSURFACE
     // Eq. 10 over the shared samples; Phi = the mean mass times the texel count.
     flux = texelFetch(irradiance, ivec2(0), u_top_level).r * u_texel_count;
-    vec3 xo = v_position_object * u_scale;
+    vec3 xo = position_object * u_scale;
     vec3 radiosity = vec3(0.0);
     if (flux > 0.0) {
         vec3 sum = vec3(0.0);
@@ -77,7 +113,7 @@ void main() {
 #ifdef WITH_LOCAL
     // Sec. 4.2: the equal-mass ring pattern on the light plane around xo's projection.
     {
-        vec4 clip = u_light_view_projection * vec4(v_position_object, 1.0);
+        vec4 clip = u_light_view_projection * vec4(position_object, 1.0);
         vec2 uv_o = clip.xy / clip.w * 0.5 + 0.5;
         vec3 sum = vec3(0.0);
         for (int j = 0; j < u_ring_count; ++j) {
@@ -97,7 +133,7 @@ void main() {
               3.14159265358979;
 #endif
 #ifdef WITH_AMBIENT
-    colour += u_ambient_colour * fresnel_transmittance(u_eta, n_dot_v) * v_ambient_occlusion;
+    colour += u_ambient_colour * fresnel_transmittance(u_eta, n_dot_v) * ambient_occlusion;
 #endif
 #ifdef TONE_MAP
     // Reinhard (the DirectX HDRLighting operator the paper cites): s = a L / L_avg.
@@ -107,7 +143,7 @@ void main() {
     colour = colour / (1.0 + colour);
 #endif
 #ifdef WITH_SPECULAR
-    vec3 ne = normalize(v_normal_eye);
+    vec3 ne = normalize(normal_eye);
     if (dot(ne, u_light_direction) > 0.0) {
         vec3 h = u_light_direction + vec3(0.0, 0.0, 1.0);
         float n_dot_h = dot(h, h) > 1e-30 ? max(dot(ne, normalize(h)), 0.0) : 0.0;
