@@ -507,7 +507,11 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
         impl_->reuse.forget();  // what the failed pass left is unknown: rerun everything
         throw;
     }
-    if (!time_passes) return;
+    if (!time_passes) {  // which passes ran, untimed
+        for (std::size_t i = 0; i < plan.passes.size(); ++i)
+            timings_.passes.push_back({plan.passes[i].name, 0.0, !run[i]});
+        return;
+    }
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
         if (!run[i]) {
             timings_.passes.push_back({plan.passes[i].name, 0.0, true});

@@ -25,6 +25,8 @@ struct PassTiming {
 };
 
 struct FrameTimings {
+    // One per pass of the last frame; without time_passes the times are 0 but `cached`
+    // still says which passes ran.
     std::vector<PassTiming> passes;
     double total_milliseconds = 0.0;
     // True: GL_TIME_ELAPSED queries; false: wall time around glFinish (no timer queries).

@@ -29,6 +29,10 @@ struct RenderedSide {
     gl::FrameTimings timings;  // per pass, when the session asks for them
     gl::Texture texture;  // what is displayed (shaded image or buffer view), sRGB 8-bit
     int texture_width = 0, texture_height = 0;
+    BufferView shown_view = BufferView::shaded;  // what `texture` shows
+    // Read-backs of the output so far: a frame in which no pass re-ran reads none (it
+    // keeps showing `texture`).
+    std::size_t read_backs = 0;
     // A technique refined over frames (Technique::progressive_refinement()): the mean
     // shown so far; `image` is then that mean.
     std::optional<ProgressiveAccumulator> refinement;

@@ -171,6 +171,27 @@ TEST_F(ExplorerTest, SlidersRerunOnlyThePassesTheyTouch) {
     EXPECT_EQ(ran(), std::vector<std::string>{});
 }
 
+// A frame in which no pass re-ran (pass reuse) shows the image it already has: no
+// read-back, encoding or upload (most of an idle frame at 1280x720); a slider reads the
+// new image back once.
+TEST_F(ExplorerTest, IdleFramesReadNothingBack) {
+    ExplorerSession session;  // pass times off: reuse is reported all the same
+    auto explorer = open(session);
+    const Image before = settle(*explorer);
+    const std::size_t reads = explorer->shown().read_backs;
+    ASSERT_GT(reads, 0u);
+    explorer->step();
+    explorer->step();
+    EXPECT_EQ(explorer->shown().read_backs, reads);
+    EXPECT_EQ(explorer->shown().image.rgba, before.rgba);
+    explorer->session().current().set("shininess", 40.0);
+    explorer->step();
+    EXPECT_EQ(explorer->shown().read_backs, reads + 1);
+    EXPECT_NE(explorer->shown().image.rgba, before.rgba);
+    explorer->step();
+    EXPECT_EQ(explorer->shown().read_backs, reads + 1);
+}
+
 // The dipole refines progressively (4 samples a frame, core/progressive.h): the status
 // counts up to the set's N, then frames run no pass; a slider restarts the refinement.
 TEST_F(ExplorerTest, TheDipoleRefinesOverFramesToTheSetsSamples) {
