@@ -10,6 +10,7 @@
 #include "core/image.h"
 #include "core/knobs.h"
 #include "core/scene.h"
+#include "techniques/deferred_surface.h"
 #include "techniques/dipole/integrator.h"
 #include "techniques/dipole/scattering.h"
 
@@ -84,10 +85,10 @@ struct ReferenceError {
 Image render_reference_with_error(const Scene& scene, const IntegratorQuality& quality,
                                   ReferenceError& error);
 
-// How `translucency` shades: once per covered pixel from the surface a `surface` pass
-// stored (deferred, what the technique plans), or every rasterised fragment (forward:
-// here for the test that the two agree bit for bit).
-enum class Shading { deferred, forward };
-void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading = Shading::deferred);
+// `translucency` lights each covered pixel once from the stored surface (deferred, what
+// the technique plans; techniques/deferred_surface.h), or every rasterised fragment
+// (forward: for the test that the two agree bit for bit).
+void add_passes(const Scene& scene, PlanBuilder& plan,
+                SurfaceShading shading = SurfaceShading::deferred);
 
 }  // namespace lucent::dipole

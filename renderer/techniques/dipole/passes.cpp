@@ -21,6 +21,7 @@
 
 #include "core/light_view.h"
 #include "techniques/dipole/atlas.h"
+#include "techniques/deferred_surface.h"
 #include "techniques/dipole/dipole.h"
 
 namespace lucent::dipole {
@@ -68,7 +69,7 @@ std::string number(double value) {
 
 }  // namespace
 
-void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
+void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const Params p = params(scene);
     const Material material = material_of(p);
     const DipoleRgb dipole(material);
@@ -337,45 +338,10 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
         u.push_back({"u_shininess", float(p.shininess)});
         u.push_back({"u_light_specular", scene.light.specular});
     }
-    if (shading == Shading::deferred) {
-        // The surface once, then the sums once per covered pixel: on llvmpipe a
-        // fragment of a small triangle costs a whole 4x4 block of lanes, and the
-        // translucency shader is the frame (hundreds of samples per fragment).
-        plan.create("surface_position", ResourceFormat::rgba32f);
-        plan.create("surface_normal", ResourceFormat::rgba32f);
-        plan.create("surface_normal_eye", ResourceFormat::rgba32f);
-        Pass surface{"surface",
-                     "nearest surface for translucency: object position, normal, AO" +
-                         std::string(specular ? ", eye normal" : ""),
-                     PassKind::draw_mesh,
-                     {mesh_vert, "techniques/dipole/shaders/surface.frag", {}}};
-        surface.writes = {"surface_position", "surface_normal"};
-        if (ambient) {
-            surface.shader.defines.push_back("WITH_AMBIENT");
-            surface.reads.push_back({"vertex_ao", ""});
-        }
-        if (specular) {
-            surface.shader.defines.push_back("WITH_SPECULAR");
-            surface.writes.push_back("surface_normal_eye");
-        }
-        surface.writes.push_back("shade_depth");
-        surface.uniforms = camera;
-        plan.add(surface);
-
-        shade.kind = PassKind::fullscreen;
-        shade.purpose += ", once per covered pixel";
-        shade.shader.vertex = "gl/shaders/fullscreen.vert";
-        shade.shader.defines.push_back("DEFERRED");
-        std::erase_if(shade.reads, [](const Read& r) { return r.resource == "vertex_ao"; });
-        shade.reads.push_back({"surface_position", ""});
-        shade.reads.push_back({"surface_normal", ""});
-        if (specular) shade.reads.push_back({"surface_normal_eye", ""});
-        shade.uniforms = u;
-        shade.writes = {"colour"};
-    } else {
-        shade.uniforms = with(camera, u);
-        shade.writes = {"colour", "shade_depth"};
-    }
+    shade.uniforms = with(camera, u);
+    shade.writes = {"colour", "shade_depth"};
+    if (shading == SurfaceShading::deferred)
+        shade_deferred(plan, shade, camera, /*eye_normal=*/specular, ambient);
     shade.clear_colour = glm::vec4(scene.background, 0.0f);
     plan.add(shade);
     plan.set_output("colour");

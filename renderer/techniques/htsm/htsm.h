@@ -14,6 +14,7 @@
 #include "core/knobs.h"
 #include "core/light_view.h"
 #include "core/scene.h"
+#include "techniques/deferred_surface.h"
 
 namespace lucent::htsm {
 
@@ -89,7 +90,11 @@ struct ReferenceError {
 Image render_reference_with_error(const Scene& scene, const ReferenceQuality& quality,
                                   ReferenceError& error);
 
-void add_passes(const Scene& scene, PlanBuilder& plan);
+// `shade` lights each covered pixel once from the stored surface (deferred, what the
+// technique plans; techniques/deferred_surface.h), or every rasterised fragment
+// (forward: for the test that the two agree bit for bit).
+void add_passes(const Scene& scene, PlanBuilder& plan,
+                SurfaceShading shading = SurfaceShading::deferred);
 
 // Texture fetches per covered pixel of the shade pass as planned (pruned): per ray the
 // texcoord and irradiance, S density steps (a march), a phase lookup (g != 0); one

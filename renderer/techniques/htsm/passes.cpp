@@ -24,7 +24,7 @@ std::string number(double value) {
 
 }  // namespace
 
-void add_passes(const Scene& scene, PlanBuilder& plan) {
+void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const Params p = params(scene);
     const Geometry g = geometry(scene, p);
     const bool full = plan.full();
@@ -141,10 +141,13 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
                    std::to_string(p.samples) + ", S = " + std::to_string(p.steps) + pruned,
                PassKind::draw_mesh,
                {mesh_vert, "techniques/htsm/shaders/shade.frag", {}}};
-    std::vector<Uniform> u = {{"u_model_view", view},
-                              {"u_projection", scene.camera.projection()},
-                              {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))},
-                              {"u_light_direction", scene.light.direction}};
+    const std::vector<Uniform> camera = {
+        {"u_model_view", view},
+        {"u_projection", scene.camera.projection()},
+        {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))}};
+    std::vector<Uniform> u = camera;
+    u.push_back({"u_light_direction", scene.light.direction});
+    u.push_back({"u_background", scene.background});
     const Sampling clamp_linear{TexelFilter::linear, MipFilter::none, Wrap::clamp_to_edge};
     if (transport) {
         shade.shader.defines.push_back("WITH_TRANSPORT");
@@ -195,6 +198,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     }
     shade.uniforms = u;
     shade.writes = {"colour", "shade_depth"};
+    if (shading == SurfaceShading::deferred)
+        shade_deferred(plan, shade, camera, /*eye_normal=*/surface,
+                       /*ambient_occlusion=*/false);
     shade.clear_colour = glm::vec4(scene.background, 0.0f);
     plan.add(shade);
     plan.set_output("colour");

@@ -12,18 +12,7 @@
 // rasterised fragment (llvmpipe shades whole 4x4 blocks of small triangles); the inputs
 // are the same floats, so is the colour.
 #include "techniques/dipole/shaders/dipole.glsl"
-#ifdef DEFERRED
-uniform sampler2D surface_position;  // xyz object space; w = 1 where a surface is
-uniform sampler2D surface_normal;    // xyz object space (interpolated); w = AO
-#ifdef WITH_SPECULAR
-uniform sampler2D surface_normal_eye;
-#endif
-#else
-in vec3 v_position_object;
-in vec3 v_normal_object;
-in vec3 v_normal_eye;
-in vec3 v_position_eye;
-#endif
+#include "techniques/dipole/shaders/surface_inputs.glsl"
 uniform vec3 u_light_direction;  // eye space, towards the light
 uniform vec3 u_eye_object;       // camera position, object space
 uniform vec3 u_background;
@@ -53,9 +42,6 @@ uniform vec3 u_light_up;
 uniform float u_light_plane_mm;    // width of the light view in mm
 #endif
 #ifdef WITH_AMBIENT
-#ifndef DEFERRED
-in float v_ambient_occlusion;
-#endif
 uniform vec3 u_ambient_colour;  // ka Ia mean(Ft) Rd_tot
 #endif
 #ifdef TONE_MAP
@@ -69,28 +55,15 @@ uniform vec3 u_light_specular;
 #endif
 
 void main() {
-#ifdef DEFERRED
-    ivec2 pixel = ivec2(gl_FragCoord.xy);
-    vec4 position = texelFetch(surface_position, pixel, 0);
-    if (position.w == 0.0) {
+    Surface surface;
+    if (!read_surface(surface)) {
         o_colour = vec4(u_background, 0.0);  // no surface: the clear colour
         return;
     }
-    vec3 position_object = position.xyz;
-    vec4 normal = texelFetch(surface_normal, pixel, 0);
-    vec3 normal_object = normal.xyz;
-    float ambient_occlusion = normal.w;
-#ifdef WITH_SPECULAR
-    vec3 normal_eye = texelFetch(surface_normal_eye, pixel, 0).xyz;
-#endif
-#else
-    vec3 position_object = v_position_object;
-    vec3 normal_object = v_normal_object;
-    vec3 normal_eye = v_normal_eye;
-#ifdef WITH_AMBIENT
-    float ambient_occlusion = v_ambient_occlusion;
-#endif
-#endif
+    vec3 position_object = surface.position_object;
+    vec3 normal_object = surface.normal_object;
+    vec3 normal_eye = surface.normal_eye;
+    float ambient_occlusion = surface.ambient_occlusion;
     vec3 n = normalize(normal_object);
     float n_dot_v = max(dot(n, normalize(u_eye_object - position_object)), 0.0);
     vec3 colour = vec3(0.0);

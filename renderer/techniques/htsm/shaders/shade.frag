@@ -6,11 +6,11 @@
 //   w = max(0, 2 - tau / Td), f = Henyey-Greenstein with f(1) = 1 (table),
 //   mu_i = dir_i . -N, dir_i = normalize(d_i + max(0, eps_d - |d_i|) l).
 // The same equations as renderer/techniques/htsm/reference.cpp (exact footprints there).
-in vec3 v_position_object;
-in vec3 v_normal_object;
-in vec3 v_normal_eye;
-in vec3 v_position_eye;
+// DEFERRED: a full-screen pass over the surface a `surface` pass stored, each covered
+// pixel lit once instead of every rasterised fragment (the same floats, the same colour).
+#include "techniques/dipole/shaders/surface_inputs.glsl"
 uniform vec3 u_light_direction;  // eye space, towards the light
+uniform vec3 u_background;
 layout(location = 0) out vec4 o_colour;
 
 #ifdef WITH_TRANSPORT
@@ -50,13 +50,18 @@ uniform float u_depth_bias;
 #endif
 
 void main() {
-    vec3 n = normalize(v_normal_object);
+    Surface surface;
+    if (!read_surface(surface)) {
+        o_colour = vec4(u_background, 0.0);  // no surface: the clear colour
+        return;
+    }
+    vec3 n = normalize(surface.normal_object);
     vec3 colour = vec3(0.0);
 #ifdef WITH_TRANSPORT
     // The visible point's light-image coordinate and 3-D texture coordinate (START).
-    vec3 rel = v_position_object - u_light_centre;
+    vec3 rel = surface.position_object - u_light_centre;
     vec2 uv = vec2(dot(rel, u_light_right), dot(rel, u_light_up)) / u_plane_size + 0.5;
-    vec3 start = (v_position_object - u_box_min) / u_box_extent;
+    vec3 start = (surface.position_object - u_box_min) / u_box_extent;
     vec3 sum = vec3(0.0);
     for (int i = 0; i < HTSM_SAMPLES; ++i) {
         // Sec. 4.3.1: the sample's footprint, read at its ring's mip level.
@@ -95,10 +100,10 @@ void main() {
 #endif
 #ifdef WITH_SURFACE
     // Diffuse and specular where N.L > 0 and the light view sees the point.
-    vec3 n_eye = normalize(v_normal_eye);
+    vec3 n_eye = normalize(surface.normal_eye);
     float n_dot_l = dot(n_eye, u_light_direction);
     if (n_dot_l > 0.0) {
-        vec3 lifted = v_position_object + u_shadow_offset * n;
+        vec3 lifted = surface.position_object + u_shadow_offset * n;
         vec4 clip = u_light_view_projection * vec4(lifted, 1.0);
         vec3 w = clip.xyz / clip.w * 0.5 + 0.5;
         float stored = texture(light_depth, w.xy).r;

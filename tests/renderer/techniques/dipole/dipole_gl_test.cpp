@@ -131,7 +131,7 @@ TEST_F(DipoleGl, DeferredTranslucencyEqualsForwardBitForBit) {
         const Scene scene = scene_for(settings, "torus_knot:6k", 72);
         const FramePlan deferred = make_frame_plan(scene, technique);
         PlanBuilder builder(PlanMode::pruned, scene.width, scene.height);
-        dipole::add_passes(scene, builder, dipole::Shading::forward);
+        dipole::add_passes(scene, builder, SurfaceShading::forward);
         const FramePlan forward = builder.compile();
         ASSERT_EQ(deferred.passes.back().kind, PassKind::fullscreen);
         ASSERT_EQ(forward.passes.back().kind, PassKind::draw_mesh);
