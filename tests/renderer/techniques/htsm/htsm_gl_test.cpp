@@ -10,6 +10,7 @@
 #include "../dipole/test_meshes.h"
 #include "core/image_compare.h"
 #include "core/technique.h"
+#include "deferred_check.h"
 #include "gl_test_fixture.h"
 #include "render.h"
 #include "scene_for_test.h"
@@ -64,26 +65,20 @@ TEST_F(HtsmGl, PrunedEqualsFull) {
 // shadowed surface terms, and with each pruned.
 TEST_F(HtsmGl, DeferredShadingEqualsForwardBitForBit) {
     gl::FrameExecutor executor;
-    const Technique& technique = find_technique("htsm");
     for (const auto& settings : std::vector<std::vector<KnobAssignment>>{
              {},
              {{"rays", "5"}, {"density", "constant:value=0.4"}},
              {{"diffuse", "0"}, {"specular", "0"}},
              {{"transport_colour", "0"}}}) {
         const Scene scene = test::scene_for("htsm", settings, "torus_knot:6k", 64);
-        const FramePlan deferred = make_frame_plan(scene, technique);
-        PlanBuilder builder(PlanMode::pruned, scene.width, scene.height);
-        add_passes(scene, builder, SurfaceShading::forward);
-        const FramePlan forward = builder.compile();
-        ASSERT_EQ(deferred.passes.back().kind, PassKind::fullscreen);
-        ASSERT_EQ(forward.passes.back().kind, PassKind::draw_mesh);
-        ASSERT_NE(find_pass(deferred, "surface"), nullptr);
-        const Image a = executor.render(scene, deferred);
-        const Image b = executor.render(scene, forward);
         std::string label;
         for (const auto& s : settings) label += s.key + "=" + s.text + " ";
-        EXPECT_EQ(a.rgba, b.rgba) << label;
-        EXPECT_GT(*std::max_element(a.rgba.begin(), a.rgba.end()), 0.02f) << label;
+        test::expect_deferred_equals_forward(
+            executor, scene,
+            [&](PlanBuilder& builder) {
+                add_passes(scene, builder, SurfaceShading::forward);
+            },
+            label);
     }
 }
 
