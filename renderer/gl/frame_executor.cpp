@@ -507,14 +507,10 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
         impl_->reuse.forget();  // what the failed pass left is unknown: rerun everything
         throw;
     }
-    if (!time_passes) {  // which passes ran, untimed
-        for (std::size_t i = 0; i < plan.passes.size(); ++i)
-            timings_.passes.push_back({plan.passes[i].name, 0.0, !run[i]});
-        return;
-    }
+    // Which passes ran is reported always; their times only when asked for.
     for (std::size_t i = 0; i < plan.passes.size(); ++i) {
-        if (!run[i]) {
-            timings_.passes.push_back({plan.passes[i].name, 0.0, true});
+        if (!run[i] || !time_passes) {
+            timings_.passes.push_back({plan.passes[i].name, 0.0, !run[i]});
             continue;
         }
         double ms = wall_ms[i];
@@ -526,7 +522,7 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
         timings_.passes.push_back({plan.passes[i].name, ms});
         timings_.total_milliseconds += ms;
     }
-    check_errors("reading the pass timer queries");
+    if (time_passes) check_errors("reading the pass timer queries");
 }
 
 Image FrameExecutor::read_output(const FramePlan& plan) const {
