@@ -200,7 +200,9 @@ bool bounds_solid_facing_out(const std::vector<glm::vec3>& positions,
     for (std::size_t i = 0; i < positions.size(); ++i)
         merged[i] = first_at.emplace(positions[i], std::uint32_t(i)).first->second;
 
-    // Every directed edge exactly once, and its reverse present too.
+    // Each edge as its undirected key with the direction in the lowest bit, sorted once:
+    // a closed, consistently wound surface lists every key exactly twice, once each way.
+    if (positions.size() >= (std::size_t(1) << 31)) return false;  // keys need 62 bits
     std::vector<std::uint64_t> edges;
     edges.reserve(3 * triangles.size());
     double six_volume = 0.0;
@@ -209,18 +211,21 @@ bool bounds_solid_facing_out(const std::vector<glm::vec3>& positions,
             return false;
         const std::uint32_t v[3] = {merged[t.x], merged[t.y], merged[t.z]};
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) return false;  // collapsed
-        for (int k = 0; k < 3; ++k)
-            edges.push_back(std::uint64_t(v[k]) << 32 | v[(k + 1) % 3]);
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t from = v[k], to = v[(k + 1) % 3];
+            const std::uint64_t key =
+                std::uint64_t(std::min(from, to)) << 31 | std::max(from, to);
+            edges.push_back(key << 1 | (from < to ? 0u : 1u));
+        }
         // Divergence theorem: 6 V = sum over faces of p0 . (p1 x p2).
         const glm::dvec3 p0(positions[t.x]), p1(positions[t.y]), p2(positions[t.z]);
         six_volume += glm::dot(p0, glm::cross(p1, p2));
     }
     std::sort(edges.begin(), edges.end());
-    if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) return false;
-    for (const std::uint64_t e : edges) {
-        const std::uint64_t reverse = (e << 32) | (e >> 32);
-        if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
-    }
+    for (std::size_t i = 0; i < edges.size(); i += 2)
+        if (i + 1 == edges.size() || (edges[i] & 1u) != 0 || edges[i + 1] != (edges[i] | 1u) ||
+            (i + 2 < edges.size() && edges[i + 2] >> 1 == edges[i] >> 1))
+            return false;
     return six_volume > 0.0 && std::isfinite(six_volume);
 }
 
