@@ -2,7 +2,7 @@
 // series differs by at least the report's threshold (mean Delta E00 3), no two stimuli
 // are the same picture, each series has its colour, and the report opens in a browser
 // with every picture drawn. The screenshot stays in the build tree for people to look at
-// (test-scratch/thesis_report/report-screenshot.png).
+// (test-scratch/thesis_report/ThesisSetReport.*/report-screenshot.png).
 #include <gtest/gtest.h>
 
 #include <cstdio>
