@@ -1,10 +1,23 @@
 #include "core/frame_plan.h"
 
 #include <algorithm>
+#include <glm/gtc/matrix_inverse.hpp>
 #include <set>
 #include <stdexcept>
 
 namespace lucent {
+
+std::vector<Uniform> mesh_transform_uniforms(const glm::mat4& view,
+                                             const glm::mat4& projection) {
+    return {{"u_model_view", view},
+            {"u_projection", projection},
+            {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))}};
+}
+
+std::vector<Uniform> with_uniforms(std::vector<Uniform> a, const std::vector<Uniform>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
 
 bool is_depth_format(ResourceFormat format) {
     return format == ResourceFormat::depth16 || format == ResourceFormat::depth24 ||

@@ -114,6 +114,14 @@ struct Uniform {
     UniformValue value;
 };
 
+// The transforms a mesh vertex stage reads, for a camera or light with this view and
+// projection: u_model_view, u_projection and u_normal_matrix (the inverse transpose of
+// the view's 3x3, so normals stay perpendicular under non-uniform scale).
+std::vector<Uniform> mesh_transform_uniforms(const glm::mat4& view,
+                                             const glm::mat4& projection);
+// `a` followed by `b`.
+std::vector<Uniform> with_uniforms(std::vector<Uniform> a, const std::vector<Uniform>& b);
+
 // Sampler state of one read (GL sampler objects, so two passes may read one texture
 // differently). The defaults are the first techniques' texelFetch-like reads.
 enum class TexelFilter { nearest, linear };

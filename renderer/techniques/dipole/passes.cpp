@@ -15,7 +15,6 @@
 // Exact prunes: Id = 0 or nothing scatters (no subsurface passes), ks = 0 or Is = 0 (no
 // specular), eta = 1 (no Fresnel), hybrid off or no channel with an Rp (no local part),
 // ka Ia = 0 (no AO). In full mode every pass runs with the pruned terms at weight 0.
-#include <glm/gtc/matrix_inverse.hpp>
 #include <memory>
 #include <mutex>
 
@@ -89,10 +88,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const bool tone_map = p.tone_map == "reinhard";
 
     const glm::mat4 view = scene.camera.view();
-    const std::vector<Uniform> camera = {
-        {"u_model_view", view},
-        {"u_projection", scene.camera.projection()},
-        {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))}};
+    const std::vector<Uniform> camera =
+        mesh_transform_uniforms(view, scene.camera.projection());
     const std::string mesh_vert = "techniques/dipole/shaders/mesh.vert";
     const glm::vec3 light_object = glm::vec3(light_in_object_space(scene));
 
@@ -115,10 +112,6 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                                           {"u_hybrid_k", float(p.hybrid_k)},
                                           {"u_eta", float(material.eta)},
                                           {"u_scale", float(scale)}};
-    const auto with = [](std::vector<Uniform> a, const std::vector<Uniform>& b) {
-        a.insert(a.end(), b.begin(), b.end());
-        return a;
-    };
     const auto fresnel_define = [&](ShaderDesc& shader) {
         if (fresnel) shader.defines.push_back("WITH_FRESNEL");
     };
@@ -189,16 +182,14 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                         PassKind::draw_mesh,
                         {mesh_vert, "techniques/dipole/shaders/light_view.frag", {}}};
         light_pass.writes = {"light_depth"};
-        std::vector<Uniform> light_uniforms = {
-            {"u_model_view", light.view},
-            {"u_projection", light.projection},
-            {"u_normal_matrix", glm::inverseTranspose(glm::mat3(light.view))}};
+        std::vector<Uniform> light_uniforms =
+            mesh_transform_uniforms(light.view, light.projection);
         if (local) {
             light_pass.shader.defines.push_back("WITH_LOCAL");
             fresnel_define(light_pass.shader);
             light_pass.writes = {"light_flux", "light_position", "light_depth"};
             light_uniforms.push_back({"u_light_object", light_object});
-            light_uniforms = with(light_uniforms, profile);
+            light_uniforms = with_uniforms(light_uniforms, profile);
         }
         light_pass.uniforms = light_uniforms;
         plan.add(light_pass);
@@ -216,7 +207,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                             {"atlas_normal", ""},
                             {"light_depth", "", {TexelFilter::nearest}}};
         irradiance.writes = {"irradiance"};
-        irradiance.uniforms = with(
+        irradiance.uniforms = with_uniforms(
             {{"u_light_view_projection", light.view_projection},
              {"u_light_object", light_object},
              {"u_normal_offset", 1.5f * texel_object},
@@ -304,7 +295,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
         u.push_back({"u_sample_side", side});
         u.push_back({"u_top_level", top_level});
         u.push_back({"u_texel_count", float(atlas) * float(atlas)});
-        u = with(u, profile);
+        u = with_uniforms(u, profile);
         if (local) {
             const LightView light = scene_light_view(scene);
             shade.shader.defines.push_back("WITH_LOCAL");
@@ -338,7 +329,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
         u.push_back({"u_shininess", float(p.shininess)});
         u.push_back({"u_light_specular", scene.light.specular});
     }
-    shade.uniforms = with(camera, u);
+    shade.uniforms = with_uniforms(camera, u);
     shade.writes = {"colour", "shade_depth"};
     if (shading == SurfaceShading::deferred)
         shade_deferred(plan, shade, camera, /*eye_normal=*/specular, ambient);

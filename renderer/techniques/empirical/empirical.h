@@ -6,6 +6,7 @@
 #include "core/frame_plan.h"
 #include "core/image.h"
 #include "core/scene.h"
+#include "techniques/deferred_surface.h"
 #include "techniques/empirical/knobs.h"
 
 namespace lucent::empirical {
@@ -30,12 +31,13 @@ double peel_epsilon(const std::string& depth_precision);
 ResourceFormat depth_format(const std::string& depth_precision);
 
 // Adds the technique's passes to `plan` (passes.cpp).
-// How `shade` lights the front layer when the backlight runs: once per pixel from the
-// surface the front pass stored (deferred, what the technique plans), or every rasterised
-// fragment (forward: always without the backlight; here for the test that the two agree).
-enum class Shading { deferred_when_exact, forward };
+// `shading`: deferred (what the technique plans) lights the front layer once per pixel
+// from the surface its front pass stored, where that gives the same image: peeled
+// layers, the backlight on, 32f depth; elsewhere, and always with forward (for the test
+// that the two agree), `shade` lights every rasterised fragment. The empirical technique
+// stores its surface in the front-depth pass it needs anyway, not with shade_deferred().
 void add_passes(const Scene& scene, PlanBuilder& plan,
-                Shading shading = Shading::deferred_when_exact);
+                SurfaceShading shading = SurfaceShading::deferred);
 // CPU reference with Embree (reference.cpp).
 Image render_reference(const Scene& scene);
 

@@ -8,7 +8,6 @@
 //   shade              Eq. 3.6                       -> colour
 // Terms that cannot change the image select a shader variant without them, and the
 // passes that only fed them are culled by PlanBuilder::compile().
-#include <glm/gtc/matrix_inverse.hpp>
 
 #include "techniques/empirical/empirical.h"
 
@@ -26,21 +25,9 @@ double peel_epsilon(const std::string& depth_precision) {
 
 namespace {
 
-std::vector<Uniform> camera_uniforms(const Scene& scene) {
-    const glm::mat4 view = scene.camera.view();
-    return {{"u_model_view", view},
-            {"u_projection", scene.camera.projection()},
-            {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))}};
-}
-
-std::vector<Uniform> with(std::vector<Uniform> a, const std::vector<Uniform>& b) {
-    a.insert(a.end(), b.begin(), b.end());
-    return a;
-}
-
 }  // namespace
 
-void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
+void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const Params p = params(scene);
     const glm::vec3 light_ambient = scene.light.ambient;
     // Which terms of Eq. 3.6 can change the image (all of them in full mode).
@@ -49,8 +36,10 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
     const bool backlight_term = plan.full() || p.backlight != 0.0;
     const bool smoothing = backlight_term && (plan.full() || p.blur_kernel > 1);
     const ResourceFormat depth = depth_format(p.depth_precision);
-    const auto camera = camera_uniforms(scene);
+    const auto camera =
+        mesh_transform_uniforms(scene.camera.view(), scene.camera.projection());
     const std::string mesh_vert = "techniques/empirical/shaders/mesh.vert";
+    const ShaderDesc depth_only{mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}};
     // A closed mesh facing out, seen from outside: the nearest surface of every pixel is
     // a front face and the one behind it a back face (the first exit). The second layer
     // is then the nearest back face, rasterised with front faces culled and without
@@ -61,11 +50,11 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
     // Peeling rasterises the front layer anyway: it then also stores the surface, and
     // `shade` lights it once per pixel instead of rasterising the mesh a third time and
     // shading hidden fragments. The same floats in, the same colour out (tested bit for
-    // bit against Shading::forward); only with 32f depth, whose texels are the
+    // bit against SurfaceShading::forward); only with 32f depth, whose texels are the
     // fragments' exact depths (at 16 or 24 bits the front layer's visibility would be
     // resolved coarser than the shading's).
     const bool deferred = !by_facing && backlight_term &&
-                          shading == Shading::deferred_when_exact &&
+                          shading == SurfaceShading::deferred &&
                           p.depth_precision == "32f";
 
     plan.create("vertex_ao", ResourceFormat::vertex_float);
@@ -86,10 +75,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
     if (!by_facing) {
         // Step 1 (Sec. 3.1): depth of the nearest surface, read by the peel (and,
         // deferred, the surface that `shade` lights).
-        Pass front{"front_depth",
-                   "depth of the first layer",
-                   PassKind::draw_mesh,
-                   {mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}}};
+        Pass front{"front_depth", "depth of the first layer", PassKind::draw_mesh,
+                   depth_only};
         front.writes = {"front_depth"};
         front.uniforms = camera;
         if (deferred) {
@@ -111,8 +98,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
         if (by_facing) {
             Pass back{"second_layer",
                       "the surface behind the first: nearest back face of the closed mesh",
-                      PassKind::draw_mesh,
-                      {mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}}};
+                      PassKind::draw_mesh, depth_only};
             back.writes = {"second_depth"};
             back.uniforms = camera;
             back.cull = FaceCulling::front;
@@ -125,7 +111,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
                       {mesh_vert, "techniques/empirical/shaders/peel.frag", {}}};
             peel.reads = {{"front_depth", ""}};
             peel.writes = {"second_depth"};
-            peel.uniforms = with(camera, {{"u_epsilon", static_cast<float>(peel_epsilon(
+            peel.uniforms = with_uniforms(camera, {{"u_epsilon", static_cast<float>(peel_epsilon(
                                                            p.depth_precision))}});
             plan.add(peel);
         }
@@ -200,7 +186,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Shading shading) {
             u.push_back({"u_falloff", static_cast<float>(kSmoothingFalloff)});
         }
     }
-    shade.uniforms = deferred ? u : with(camera, u);
+    shade.uniforms = deferred ? u : with_uniforms(camera, u);
     // By facing, the shading pass's depth buffer is the first layer (the explorer shows
     // it under that name).
     shade.writes = deferred    ? std::vector<std::string>{"colour"}

@@ -9,7 +9,6 @@
 // constant density (or kappa = 0) drops the volume and the march; g = 0 the table; no
 // ring with a lod above 0 the mips; no diffuse or specular the shadow read.
 #include <cstdio>
-#include <glm/gtc/matrix_inverse.hpp>
 
 #include "techniques/htsm/htsm.h"
 
@@ -98,9 +97,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                           : "mesh from the key light: depth for the surface shadow",
                 PassKind::draw_mesh,
                 {mesh_vert, "techniques/htsm/shaders/light_view.frag", {}}};
-        lv.uniforms = {{"u_model_view", light.view},
-                       {"u_projection", light.projection},
-                       {"u_normal_matrix", glm::inverseTranspose(glm::mat3(light.view))}};
+        lv.uniforms = mesh_transform_uniforms(light.view, light.projection);
         if (transport) {
             lv.shader.defines.push_back("WITH_TRANSPORT");
             lv.writes = {"htsm_irradiance", "htsm_texcoord"};
@@ -141,10 +138,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                    std::to_string(p.samples) + ", S = " + std::to_string(p.steps) + pruned,
                PassKind::draw_mesh,
                {mesh_vert, "techniques/htsm/shaders/shade.frag", {}}};
-    const std::vector<Uniform> camera = {
-        {"u_model_view", view},
-        {"u_projection", scene.camera.projection()},
-        {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))}};
+    const std::vector<Uniform> camera =
+        mesh_transform_uniforms(view, scene.camera.projection());
     std::vector<Uniform> u = camera;
     u.push_back({"u_light_direction", scene.light.direction});
     u.push_back({"u_background", scene.background});

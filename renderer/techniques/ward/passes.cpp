@@ -3,7 +3,6 @@
 //   shade              Eq. 14 or Eq. 15            -> colour
 // A zero diffuse weight or zero specular reflectance compiles that term out of the
 // shader; no AO term culls the bake.
-#include <glm/gtc/matrix_inverse.hpp>
 
 #include "techniques/ward/ward.h"
 
@@ -36,12 +35,10 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
                                    "Y(Kd)*N.L) + Ward specular",
         PassKind::draw_mesh,
         {"techniques/ward/shaders/mesh.vert", "techniques/ward/shaders/shade.frag", {}}};
-    shade.uniforms = {{"u_model_view", view},
-                      {"u_projection", scene.camera.projection()},
-                      {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))},
-                      {"u_albedo", glm::vec3(p.albedo)},
-                      {"u_light_diffuse", scene.light.diffuse},
-                      {"u_light_direction", scene.light.direction}};
+    shade.uniforms = with_uniforms(mesh_transform_uniforms(view, scene.camera.projection()),
+                                   {{"u_albedo", glm::vec3(p.albedo)},
+                                    {"u_light_diffuse", scene.light.diffuse},
+                                    {"u_light_direction", scene.light.direction}});
     if (ambient_term) {
         shade.shader.defines.push_back("WITH_AMBIENT_OCCLUSION");
         shade.reads.push_back({"vertex_ao", ""});

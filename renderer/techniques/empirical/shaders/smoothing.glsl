@@ -1,7 +1,7 @@
 // Depth-aware smoothing of the second layer (App. C.2.2, Eq. C.1), shared by
-// smooth_depth.frag (its own pass) and shade.frag (SMOOTH_IN_SHADE). Weights are the thesis's 5x5 kernel (or a
-// binomial 3x3, or 1x1 = copy), times a falloff that ignores samples whose window depth
-// differs from the centre by `falloff` or more. Background samples (depth 1: no second
+// smooth_depth.frag (its own pass) and shade.frag (SMOOTH_IN_SHADE). Weights are the
+// thesis's 5x5 kernel (or a binomial 3x3, or 1x1 = copy), times a falloff that ignores
+// samples whose window depth differs from the centre by `falloff` or more. Background samples (depth 1: no second
 // layer) are skipped; a centre without a second layer stays 1. Edge texels repeat, as with
 // clamp-to-edge sampling.
 #ifndef KERNEL_SIZE
