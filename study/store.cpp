@@ -162,6 +162,24 @@ CREATE TABLE retired_participant_numbers (number INTEGER PRIMARY KEY);
 ALTER TABLE trials ADD COLUMN uuid TEXT;
 CREATE UNIQUE INDEX trials_by_uuid ON trials(uuid);
 )sql",
+    // 5: withdrawals that survive merges, imports and syncs (tombstones: the withdrawn
+    // sessions' UUIDs, and each (code, machine) as a salted SHA-256 so the code itself is
+    // gone); how a session's counterbalancing cell was allocated; declined consents as
+    // an anonymous count per study (nothing else of a decline is kept).
+    R"sql(
+CREATE TABLE withdrawn_sessions (
+    uuid TEXT PRIMARY KEY,
+    withdrawn_utc TEXT NOT NULL);
+CREATE TABLE withdrawn_codes (
+    salt TEXT NOT NULL,
+    code_hash TEXT NOT NULL,
+    withdrawn_utc TEXT NOT NULL,
+    PRIMARY KEY (salt, code_hash));
+ALTER TABLE sessions ADD COLUMN allocation TEXT;
+CREATE TABLE consent_declines (
+    study_id INTEGER NOT NULL PRIMARY KEY REFERENCES studies(id) ON DELETE CASCADE,
+    declined INTEGER NOT NULL CHECK (declined >= 0));
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 

@@ -27,7 +27,7 @@
 namespace lucent::study {
 
 inline constexpr int32_t kApplicationId = 0x4C55434E;  // "LUCN"
-inline constexpr int kSchemaVersion = 4;
+inline constexpr int kSchemaVersion = 5;
 
 // Checks, without writing a byte, that `path` is a Lucent study database this build can
 // use (or absent/empty). Throws StoreError with one line: not SQLite, corrupt, another
