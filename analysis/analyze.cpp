@@ -27,10 +27,63 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
         analyses.back().within = analyze_within_subject(
             matrix.complete, std::move(matrix.incomplete_participants));
     }
+    if (request.primary) {
+        result.primary = *request.primary;
+        result.primary_reason =
+            std::string("as ") +
+            (request.primary_source.empty() ? "requested" : request.primary_source) +
+            " states";
+        return result;
+    }
+    // Within only when the design is within: in every pair, (the stated share of) every
+    // participant rated every level. The pair furthest from that decides and is named.
+    if (!(request.within_share > 0.0 && request.within_share <= 1.0))
+        throw InputError("within share must lie in (0, 1], got " +
+                         std::to_string(request.within_share));
+    const OneWayAnalysis* weakest = nullptr;
+    double weakest_share = 2.0;
     bool all_within = true;
-    for (const OneWayAnalysis& a : analyses) all_within = all_within && a.within.computed;
-    result.primary = request.primary.value_or(all_within ? Design::Within : Design::Between);
+    for (const OneWayAnalysis& a : analyses) {
+        const int total = pair_participants(a);
+        const double share =
+            total > 0 ? static_cast<double>(a.within.participants) / total : 0.0;
+        // A share of 10 of 12 against 0.8333...: compare counts, not rounded ratios.
+        const bool within = a.within.computed &&
+                            static_cast<double>(a.within.participants) >=
+                                request.within_share * total - 1e-9;
+        all_within = all_within && within;
+        if (!weakest || share < weakest_share) {
+            weakest = &a;
+            weakest_share = share;
+        }
+    }
+    result.primary = all_within ? Design::Within : Design::Between;
+    const std::string wanted =
+        request.within_share >= 1.0
+            ? std::string("every participant")
+            : "at least " + std::to_string(static_cast<int>(request.within_share * 100.0 + 0.5)) +
+                  "% of participants";
+    const std::string counts =
+        std::to_string(weakest->within.participants) + " of " +
+        std::to_string(pair_participants(*weakest)) + " participants rated every level of " +
+        weakest->question + " ~ " + weakest->factor;
+    if (all_within)
+        result.primary_reason = "from the data: in every (question, factor) " + wanted +
+                                " rated every level (fewest: " + counts + ")";
+    else
+        result.primary_reason = "from the data: only " + counts + ", and within needs " +
+                                wanted + " (and at least 2) to have rated every level";
     return result;
+}
+
+int pair_participants(const OneWayAnalysis& pair) {
+    return pair.within.participants + static_cast<int>(pair.within.excluded_participants.size());
+}
+
+std::size_t pair_ratings(const OneWayAnalysis& pair) {
+    std::size_t n = 0;
+    for (const Descriptives& d : pair.descriptives) n += d.n;
+    return n;
 }
 
 }  // namespace lucent::analysis

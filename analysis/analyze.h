@@ -19,14 +19,26 @@ struct AnalysisRequest {
     std::function<void(const std::string& question, const std::string& factor,
                        std::size_t levels)>
         on_pair;
-    // The primary design; empty: within when every pair has a within-subject layout.
+    // The primary design; empty: chosen from the data (within_share below).
     std::optional<Design> primary;
+    // Who set `primary`, for the report ("--design", "the protocol's [analysis] plan").
+    std::string primary_source;
+    // With no `primary`: within only when, in every (question, factor) pair, at least
+    // this share of the pair's participants rated every level (1: every participant, a
+    // truly within-subject design) and at least two did; otherwise between.
+    double within_share = 1.0;
 };
 
 struct AnalysisResult {
     std::vector<OneWayAnalysis> pairs;
     Design primary = Design::Between;  // the request's, or the one the data allow
+    std::string primary_reason;        // one sentence: why this design leads the report
 };
+
+// The participants of a pair: those with a rating at some level (complete or not).
+int pair_participants(const OneWayAnalysis& pair);
+// The ratings the pair's between-subject tests use.
+std::size_t pair_ratings(const OneWayAnalysis& pair);
 
 // Throws InputError when no rating matches the filters.
 AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& request);

@@ -19,6 +19,7 @@ struct AnalyzeArgs {
     std::string design;  // "", "between" or "within"
     std::string images;  // folder of rendered stimuli for thumbnails
     double alpha = 0.10;
+    double within_share = 1.0;
 };
 
 int run_analyze(const AnalyzeArgs& args) {
@@ -31,8 +32,11 @@ int run_analyze(const AnalyzeArgs& args) {
         options.alpha = args.alpha;
         options.source = args.input;
         options.inputs = {args.input};  // a report file never replaces the input
+        if (!(args.within_share > 0.0 && args.within_share <= 1.0))
+            throw InputError("--within-share must lie in (0, 1]");
         std::optional<Design> plan_design;
-        const LongTable table = read_ratings(args.input, parse_scale(args.scale), &plan_design);
+        const LongTable table = read_ratings(args.input, parse_scale(args.scale), &plan_design,
+                                             &options.input_notes);
         if (!args.images.empty()) {
             options.level_images = level_images_from_directory(table, args.images);
             if (thumbnail_maker) options.thumbnail_png = thumbnail_maker;
@@ -43,11 +47,19 @@ int run_analyze(const AnalyzeArgs& args) {
                                     std::cerr << "analyzing " << question << " ~ "
                                               << factor << " (" << levels << " levels)\n";
                                 }};
+        request.within_share = args.within_share;
         if (args.design == "within") request.primary = Design::Within;
         if (args.design == "between") request.primary = Design::Between;
-        if (!request.primary) request.primary = plan_design;
+        if (request.primary) request.primary_source = "--design " + args.design;
+        if (!request.primary && plan_design) {
+            request.primary = plan_design;
+            request.primary_source = "the protocol's [analysis] primary_design";
+        }
         const AnalysisResult result = analyze_table(table, request);
         options.primary = result.primary;
+        options.primary_reason = result.primary_reason;
+        std::cerr << "lucent analyze: primary design " << design_name(result.primary) << ", "
+                  << result.primary_reason << "\n";
         for (const auto& path : write_report(result.pairs, args.out_dir, options))
             std::cout << path.string() << "\n";
         return kExitOk;
@@ -81,6 +93,10 @@ void register_analyze(CLI::App& app, int& exit_code) {
                     "Primary design: between or within (default: the protocol's analysis "
                     "plan; for a CSV, within when every participant rated every level)")
         ->check(CLI::IsMember({"between", "within"}));
+    cmd->add_option("--within-share", args->within_share,
+                    "Without --design or a plan: within only when at least this share of "
+                    "each (question, factor)'s participants rated every level")
+        ->capture_default_str();
     cmd->add_option("--images", args->images,
                     "Folder of rendered stimuli (lucent render's output): each level's "
                     "picture is shown beside its descriptives, embedded in report.html");

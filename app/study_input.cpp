@@ -19,12 +19,15 @@ bool is_sqlite_file(const std::string& path) {
 }
 
 analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale,
-                                 std::optional<analysis::Design>* plan_design) {
+                                 std::optional<analysis::Design>* plan_design,
+                                 std::vector<std::string>* notes) {
     const bool server = study::is_server_uri(path);
     if (!server && !is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
     study::LongTable rows;
+    std::string read_path;
     try {
         const study::ReadableStudyFile source(path);  // a server: one snapshot of it
+        read_path = source.path();
         study::check_stored_ratings(source.path());  // each rating on its own question's scale
         rows = study::analysis_long_table(source.path());
     } catch (const study::StoreError& e) {
@@ -35,6 +38,11 @@ analysis::LongTable read_ratings(const std::string& path, const analysis::Rating
                                                        : analysis::Design::Between;
     for (const std::string& p : rows.excluded_participants)
         std::cerr << "lucent analyze: excluded participant " << p << "\n";
+    // The snapshot of a server has a temporary name: the note names what was given.
+    std::string note = rows.sessions_note;
+    if (note.rfind(read_path, 0) == 0) note = path + note.substr(read_path.size());
+    std::cerr << "lucent analyze: note: " << note << "\n";
+    if (notes) notes->push_back("Sessions: " + note + ".");
     analysis::LongTable table;
     for (size_t i = 0; i < rows.rows.size(); ++i) {
         const study::LongRow& r = rows.rows[i];

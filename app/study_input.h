@@ -4,6 +4,7 @@
 #include <string>
 
 #include <optional>
+#include <vector>
 
 #include "data/long_table.h"
 #include "stats/one_way_analysis.h"
@@ -13,8 +14,10 @@ namespace lucent::app {
 // True when `path` starts with the SQLite header.
 bool is_sqlite_file(const std::string& path);
 // Reads either kind; throws analysis::InputError (one line) on bad input. For a study
-// database, `plan_design` receives the stored protocol's primary design.
+// database, `plan_design` receives the stored protocol's primary design, and `notes` the
+// line saying how many sessions were analysed and left out, by reason (also on stderr).
 analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale,
-                                 std::optional<analysis::Design>* plan_design = nullptr);
+                                 std::optional<analysis::Design>* plan_design = nullptr,
+                                 std::vector<std::string>* notes = nullptr);
 
 }  // namespace lucent::app

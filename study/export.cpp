@@ -1,6 +1,7 @@
 // CSV export and the analysis long table.
 #include "export.h"
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <set>
@@ -211,27 +212,98 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
         }
     }
     LongTable table;
-    if (const std::optional<Protocol> protocol = stored_protocol(db))
+    const std::optional<Protocol> protocol = stored_protocol(db);
+    if (protocol) {
         table.primary_design = protocol->analysis.primary_design;
+        table.sessions = protocol->analysis.sessions;
+    }
+    if (!options.sessions.empty()) table.sessions = options.sessions;
+    if (table.sessions != "completed" && table.sessions != "all")
+        throw StoreError("analysis sessions: expected \"completed\" or \"all\", got '" +
+                         table.sessions + "'");
+
+    // Which sessions are read: never a withdrawn one (a tombstone's UUID; its rows are
+    // normally gone already), and with "completed" only completed ones.
+    std::set<std::string> withdrawn;
+    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'withdrawn_sessions'") > 0) {
+        Statement w = db.prepare("SELECT uuid FROM withdrawn_sessions");
+        while (w.step()) withdrawn.insert(w.text(0));
+    }
+    table.left_out.withdrawn = static_cast<int>(withdrawn.size());
+    table.sessions_total = table.left_out.withdrawn;
+    std::map<std::int64_t, std::string> taken;  // session id -> participant code
+    {
+        Statement q = db.prepare(
+            "SELECT se.id, se.uuid, se.status, p.code FROM sessions se "
+            "JOIN participants p ON p.id = se.participant_id ORDER BY se.id");
+        while (q.step()) {
+            if (withdrawn.count(q.text(1))) continue;  // counted with the tombstones
+            ++table.sessions_total;
+            const std::string status = q.text(2);
+            if (table.sessions == "completed" && status != "completed") {
+                ++table.left_out.incomplete;
+                ++table.left_out.incomplete_by_status[status];
+                continue;
+            }
+            taken[q.integer(0)] = q.text(3);
+        }
+    }
+
+    // Catch trials failed in the sessions taken, per participant.
     std::set<std::string> excluded;
     if (options.exclude_failed_catch) {
         const int allowed = max_failed_catch(db);
-        for (const auto& [participant, n] : catch_failures(db))
+        std::map<std::string, int> failed;
+        Statement f = db.prepare(
+            "SELECT r.session_id, count(DISTINCT t.id) FROM responses r "
+            "JOIN trials t ON t.id = r.trial_id "
+            "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > coalesce(t.tolerance, 0) "
+            "GROUP BY r.session_id");
+        while (f.step()) {
+            const auto it = taken.find(f.integer(0));
+            if (it != taken.end()) failed[it->second] += static_cast<int>(f.integer(1));
+        }
+        for (const auto& [participant, n] : failed)
             if (n > allowed) {
                 excluded.insert(participant);
                 table.excluded_participants.push_back(participant + " (" + std::to_string(n) +
                                                       " catch trials failed)");
             }
+        for (const auto& [id, participant] : taken)
+            if (excluded.count(participant)) ++table.left_out.failed_catch;
     }
+    table.sessions_analysed = static_cast<int>(taken.size()) - table.left_out.failed_catch;
+    {
+        const SessionsLeftOut& l = table.left_out;
+        std::string note = db_path + ": " + std::to_string(table.sessions_analysed) + " of " +
+                           std::to_string(table.sessions_total) + " sessions analysed (" +
+                           (table.sessions == "completed"
+                                ? "completed sessions only, the analysis plan's default"
+                                : "sessions of every status, as the analysis plan says") +
+                           "); left out: " + std::to_string(l.incomplete) + " incomplete";
+        if (!l.incomplete_by_status.empty()) {
+            note += " (";
+            bool first = true;
+            for (const auto& [status, n] : l.incomplete_by_status) {
+                note += (first ? "" : ", ") + std::to_string(n) + " " + status;
+                first = false;
+            }
+            note += ")";
+        }
+        note += ", " + std::to_string(l.failed_catch) + " failed catch trials, " +
+                std::to_string(l.withdrawn) + " withdrawn";
+        table.sessions_note = note;
+    }
+
     Statement s = db.prepare(
-        "SELECT p.code, st.stimulus_key, r.question, r.rating FROM responses r "
+        "SELECT p.code, st.stimulus_key, r.question, r.rating, se.id FROM responses r "
         "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
         "JOIN participants p ON p.id = se.participant_id "
         "JOIN stimuli st ON st.id = t.stimulus_id "
         "WHERE t.practice = 0 AND t.catch = 0 ORDER BY p.code, se.id, t.position, r.id");
     while (s.step()) {
         const std::string participant = s.text(0);
-        if (excluded.count(participant)) continue;
+        if (!taken.count(s.integer(4)) || excluded.count(participant)) continue;
         const std::string stimulus = s.text(1);
         const auto& [technique, varies] = stimuli[stimulus];
         const auto pit = params.find(stimulus);
@@ -267,6 +339,7 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                 write_long_table_csv(table, out);
                 result.rows = static_cast<int>(table.rows.size());
                 result.excluded_participants = table.excluded_participants;
+                result.notes.push_back(table.sessions_note);
             } else if (format == "long" || format == "wide") {
                 result.rows = export_csv(
                     db_path, format == "long" ? ExportFormat::Long : ExportFormat::Wide, out,

@@ -1,6 +1,7 @@
 #pragma once
 // Data out of a study database: CSV exports (long: one row per rating; wide: one row per
 // participant), the analysis long table, and merging databases from several machines.
+#include <map>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -21,7 +22,9 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
 struct ExportFileResult {
     int rows = 0;
     std::vector<std::string> excluded_participants;  // format "analysis" only
-    std::vector<std::string> notes;  // long, wide: values older databases did not record
+    // long, wide: values older databases did not record; analysis: the sessions left out
+    // by reason (LongTable::sessions_note)
+    std::vector<std::string> notes;
 };
 
 // Writes format "long", "wide" or "analysis" of `db_path` to the CSV file `out_path`:
@@ -45,16 +48,39 @@ struct LongRow {
 struct LongTableOptions {
     // Drop participants who failed more catch trials than the protocol allows.
     bool exclude_failed_catch = true;
+    // "completed" or "all"; empty: the stored protocol's [analysis] sessions, and
+    // "completed" when there is none (or it cannot be read).
+    std::string sessions;
+};
+
+// The sessions a long table leaves out, by reason (each session counted once, in this
+// order: withdrawn, incomplete, failed catch trials).
+struct SessionsLeftOut {
+    int withdrawn = 0;   // withdrawn_sessions tombstones (their ratings already deleted)
+    int incomplete = 0;  // status running, paused or aborted (sessions = "completed")
+    std::map<std::string, int> incomplete_by_status;  // "running" -> 1, ...
+    int failed_catch = 0;  // sessions of participants excluded for failed catch trials
+    int total() const { return withdrawn + incomplete + failed_catch; }
 };
 
 struct LongTable {
     std::vector<LongRow> rows;
     std::vector<std::string> excluded_participants;  // with the reason, "P3 (2 catch failed)"
     std::string primary_design;  // the stored protocol's [analysis] plan; "" if unreadable
+    std::string sessions = "completed";  // which sessions were taken
+    int sessions_total = 0;              // in the database, withdrawn ones included
+    int sessions_analysed = 0;
+    SessionsLeftOut left_out;
+    // One line: how many sessions were analysed and left out, by reason ("study.db: 2 of
+    // 5 sessions analysed (completed sessions only); left out: 2 incomplete (1 running,
+    // 1 paused), 1 failed catch trials, 0 withdrawn").
+    std::string sessions_note;
 };
 
 // Factors of a stimulus: the parameters it `varies` (or all its parameters when it
-// declares none); "technique" is a factor only when listed in `varies`.
+// declares none); "technique" is a factor only when listed in `varies`. Only the
+// sessions the plan (or `options.sessions`) names are read: by default completed ones.
+// A session whose UUID is a withdrawal tombstone is never read.
 LongTable analysis_long_table(const std::string& db_path, const LongTableOptions& options = {});
 void write_long_table_csv(const LongTable& table, std::ostream& out);
 

@@ -337,6 +337,10 @@ void read_analysis_plan(Protocol& p, TableReader& root) {
     if (p.analysis.primary_design != "within" && p.analysis.primary_design != "between")
         r.fail(r.raw().get("primary_design"), "primary_design",
                "must be \"within\" or \"between\", got '" + p.analysis.primary_design + "'");
+    p.analysis.sessions = r.string("sessions", "completed");
+    if (p.analysis.sessions != "completed" && p.analysis.sessions != "all")
+        r.fail(r.raw().get("sessions"), "sessions",
+               "must be \"completed\" or \"all\", got '" + p.analysis.sessions + "'");
     r.reject_unknown();
 }
 

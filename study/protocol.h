@@ -70,6 +70,10 @@ struct AnalysisPlan {
     // "within": every participant rates every level (the thesis's survey), so the
     // repeated-measures tests lead the report; "between": independent groups lead.
     std::string primary_design = "within";
+    // Which sessions enter the analysis (`lucent analyze`, `export --format analysis`):
+    // "completed" (the default: a participant who gave up, or quit before the catch
+    // trials, is left out as incomplete) or "all" (running, paused and aborted too).
+    std::string sessions = "completed";
 };
 
 // [online]: how `lucent serve` ends a participant's session in the browser.

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 namespace lucent::analysis {
@@ -102,8 +103,20 @@ double exact_difference(std::string_view value, std::string_view origin) {
     };
     const Decimal difference = to_decimal(value) - to_decimal(origin);
     // Round once: through the shortest exact decimal text, parsed correctly rounded.
+    // A difference beyond the double range (ratings of 1e308 and -1e308) is returned as
+    // an infinity of its sign, for the caller to refuse naming the row (never an
+    // exception without a location, as std::stod's "stod" was).
     const std::string text = difference.str(40, std::ios_base::scientific);
-    return std::stod(text);
+    double rounded = 0.0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), rounded);
+    if (error == std::errc::result_out_of_range) {
+        if (abs(difference) < 1) return 0.0;  // below the smallest subnormal
+        return difference < 0 ? -std::numeric_limits<double>::infinity()
+                              : std::numeric_limits<double>::infinity();
+    }
+    if (error != std::errc() || end != text.data() + text.size())
+        return std::numeric_limits<double>::quiet_NaN();  // not reached: the text is ours
+    return rounded;
 }
 
 }  // namespace lucent::analysis

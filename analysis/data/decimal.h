@@ -12,7 +12,9 @@ namespace lucent::analysis {
 std::optional<double> parse_finite_number(std::string_view text);
 
 // (value - origin) computed exactly in 100-digit decimal, then rounded once to double.
-// Both texts must be valid numbers (parse_finite_number).
+// Both texts must be valid numbers (parse_finite_number). A difference beyond the double
+// range (1e308 - -1e308) is an infinity of its sign, never an exception: the caller
+// refuses it naming the row.
 double exact_difference(std::string_view value, std::string_view origin);
 
 }  // namespace lucent::analysis

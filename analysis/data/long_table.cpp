@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -217,7 +218,32 @@ private:
 struct Origin {
     std::string text;
     double value = 0.0;
+    std::size_t line = 0;  // where it was read, for messages
 };
+
+// "FILE:LINE: column N (rating): " for a message about one rating cell.
+std::string rating_cell(const std::string& source, std::size_t line, int column) {
+    return location(source, line) + ": column " + std::to_string(column + 1) + " (rating): ";
+}
+
+// Why a rating text is not a number the analysis takes: beyond the double range
+// (1e400), or not a finite number at all ("abc", "inf").
+[[noreturn]] void refuse_rating(const std::string& source, std::size_t line, int column,
+                                std::string_view text) {
+    std::string_view digits = text;
+    if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
+    double value = 0.0;
+    const auto [end, error] =
+        std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    const bool out_of_range = error == std::errc::result_out_of_range &&
+                              end == digits.data() + digits.size() &&
+                              digits.find_first_not_of("0123456789.eE+-") ==
+                                  std::string_view::npos;
+    throw InputError(rating_cell(source, line, column) + "rating '" + std::string(text) +
+                     (out_of_range ? "' is beyond the range of a double (magnitudes up to "
+                                     "about 1.8e308): rescale the ratings"
+                                   : "' is not a finite number"));
+}
 
 // The data records of a long CSV after its header, appended to `rows`. `column` gives
 // each required column's field; `origin` is set by the first rating when still empty.
@@ -253,11 +279,10 @@ void parse_rows(LineCursor& lines, const std::string& source,
         if (rating_text.empty() || rating_text == "NA") continue;
         if (origin.text.empty()) {
             const auto value = parse_finite_number(rating_text);
-            if (!value)
-                throw InputError(location(source, line_no) + ": rating '" +
-                                 std::string(rating_text) + "' is not a finite number");
+            if (!value) refuse_rating(source, line_no, column[5], rating_text);
             origin.text = rating_text;
             origin.value = *value;
+            origin.line = line_no;
         }
         if (rating_text.size() == 1 && is_digit(rating_text[0]) && origin.text.size() == 1) {
             // Every Likert rating: one digit against a one-digit origin, exact.
@@ -265,10 +290,47 @@ void parse_rows(LineCursor& lines, const std::string& source,
             continue;
         }
         if (!parse_finite_number(rating_text))
-            throw InputError(location(source, line_no) + ": rating '" +
-                             std::string(rating_text) + "' is not a finite number");
+            refuse_rating(source, line_no, column[5], rating_text);
         row.rating = exact_difference(rating_text, origin.text);
+        if (!std::isfinite(*row.rating))  // 1e308 after -1e308: no double holds the gap
+            throw InputError(rating_cell(source, line_no, column[5]) + "rating '" +
+                             std::string(rating_text) + "' lies further from the rating '" +
+                             origin.text + "' (line " + std::to_string(origin.line) +
+                             ") than a double can hold: ratings this far apart cannot be "
+                             "analysed; rescale them");
     }
+}
+
+// The analysis sums squared deviations of the ratings (one-way and repeated-measures
+// sums of squares, variances, their weights): with n ratings spanning S each such sum is
+// at most n * S^2, finite while S <= sqrt(DBL_MAX / n) / 4 (headroom for the terms the
+// sums combine). Ratings spread wider (1e200 next to 0) are refused naming the row, so
+// that no table holds an infinity or NaN that the data did not call for.
+void check_spread(const LongTable& table, const std::string& source, int column) {
+    const RatingRow *low = nullptr, *high = nullptr;
+    std::size_t n = 0;
+    for (const RatingRow& row : table.rows) {
+        if (!row.rating) continue;
+        ++n;
+        if (!low || *row.rating < *low->rating) low = &row;
+        if (!high || *row.rating > *high->rating) high = &row;
+    }
+    if (n < 2) return;
+    const double span = *high->rating - *low->rating;  // infinite when beyond a double
+    const double limit =
+        std::sqrt(std::numeric_limits<double>::max() / static_cast<double>(n)) / 4.0;
+    if (span <= limit) return;
+    const RatingRow& later = high->source_line > low->source_line ? *high : *low;
+    const RatingRow& earlier = &later == high ? *low : *high;
+    char span_text[32], limit_text[32];
+    std::snprintf(span_text, sizeof span_text, "%.3g", span);
+    std::snprintf(limit_text, sizeof limit_text, "%.3g", limit);
+    throw InputError(rating_cell(source, later.source_line, column) + "the ratings span " +
+                     (std::isfinite(span) ? std::string(span_text) : "more than 1.8e308") +
+                     " (this rating and line " + std::to_string(earlier.source_line) +
+                     "); the sums of squares of " + std::to_string(n) +
+                     " ratings stay finite only up to a span of " + limit_text +
+                     ": rescale the ratings");
 }
 
 // Files this large are parsed in two halves at once (when they have no quoted field,
@@ -370,6 +432,7 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
                 if (row.rating) *row.rating += rounding;
     }
     check_scale(table, scale, source);
+    check_spread(table, source, column[5]);
     return table;
 }
 

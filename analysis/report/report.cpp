@@ -79,15 +79,31 @@ Statistic within_summary_p(const WithinSubjectAnalysis& w) {
     return w.anova.p_gg ? w.anova.p_gg : w.anova.p;
 }
 
+// Who a test used: the between-subject tests every rating of the pair; the
+// within-subject tests the participants who rated every level.
+std::string used_cell(const OneWayAnalysis& a, Design design) {
+    std::size_t ratings = 0;
+    for (const Descriptives& d : a.descriptives) ratings += d.n;
+    const int total =
+        a.within.participants + static_cast<int>(a.within.excluded_participants.size());
+    if (design == Design::Between)
+        return std::to_string(total) + (total == 1 ? " participant, " : " participants, ") +
+               std::to_string(ratings) + (ratings == 1 ? " rating" : " ratings");
+    return std::to_string(a.within.participants) + " of " + std::to_string(total) +
+           " participants complete";
+}
+
 std::vector<std::string> summary_cells(const OneWayAnalysis& a, Design design,
                                        double alpha) {
     if (design == Design::Between)
         return {"one-way ANOVA", format_p_short(a.anova.p), format_short(a.anova.f),
-                significant_at(a.anova.p, alpha)};
-    if (!a.within.computed) return {"repeated measures", "undefined", "undefined", "undefined"};
+                significant_at(a.anova.p, alpha), used_cell(a, design)};
+    if (!a.within.computed)
+        return {"repeated measures", "undefined", "undefined", "undefined",
+                used_cell(a, design)};
     const Statistic p = within_summary_p(a.within);
     return {"repeated measures (G-G)", format_p_short(p), format_short(a.within.anova.f),
-            significant_at(p, alpha)};
+            significant_at(p, alpha), used_cell(a, design)};
 }
 
 std::string participants_note(const WithinSubjectAnalysis& w) {
@@ -161,10 +177,13 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                                           ", Tukey HSD intervals at " +
                                           format_short(1.0 - options.alpha) +
                                           " confidence, descriptive intervals at 95%."});
+    for (const std::string& note : options.input_notes)
+        doc.push_back({Block::kParagraph, note});
     // Summary in the layout of the thesis's Table 4.4, both designs, the primary first.
     const Design primary = options.primary;
     const Design secondary = primary == Design::Within ? Design::Between : Design::Within;
-    Table summary{{"configuration", "design", "test", "p", "F", "significant at alpha"}, {}};
+    Table summary{
+        {"configuration", "design", "test", "p", "F", "significant at alpha", "used"}, {}};
     for (const OneWayAnalysis& a : analyses)
         for (Design design : {primary, secondary}) {
             std::vector<std::string> row{configuration(a),
@@ -178,9 +197,11 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
     doc.push_back({Block::kParagraph,
                    std::string("Primary design: ") + design_name(primary) +
                        (primary == Design::Within
-                            ? " (every participant rated every level; repeated-measures "
-                              "tests on participants' means)."
-                            : " (levels compared as independent groups of ratings).")});
+                            ? " (repeated-measures tests on the means of the participants "
+                              "who rated every level)"
+                            : " (levels compared as independent groups of ratings)") +
+                       (options.primary_reason.empty() ? "" : ", " + options.primary_reason) +
+                       ". Column \"used\": the participants and ratings each test used."});
     doc.push_back({Block::kTable, "", summary});
 
     // One figure per factor, its questions side by side on one scale (thesis Fig. 4.5).

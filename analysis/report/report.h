@@ -24,6 +24,10 @@ struct ReportOptions {
     // them, or any SQLite database, is refused before anything is written.
     std::vector<std::filesystem::path> inputs;
     Design primary = Design::Between;  // shown first in the summary and in each section
+    std::string primary_reason;  // why it leads (AnalysisResult::primary_reason); may be empty
+    // Paragraphs after the input line: what the input reader left out and why (sessions
+    // not completed, failed catch trials, withdrawn).
+    std::vector<std::string> input_notes;
     // A picture of each level's stimulus, shown beside its descriptives (HTML embeds the
     // PNG, so the report stays one file): (factor, level) -> (stimulus id, PNG path).
     std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>

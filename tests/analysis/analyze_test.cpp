@@ -4,7 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <regex>
 #include <sstream>
+
+#include "report/report.h"
+#include "test_paths.h"
 
 namespace lucent::analysis {
 namespace {
@@ -59,11 +64,99 @@ TEST(AnalyzeTable, WithinSubjectLayoutUsesParticipantMeansAndLeavesOutIncomplete
     ASSERT_EQ(w.paired.size(), 1u);
     EXPECT_DOUBLE_EQ(*w.paired[0].diff, 3.25);
     EXPECT_EQ(w.paired[0].level_a, "18");
-    // Every pair is within-subject, so that is the primary design unless asked.
-    EXPECT_EQ(result.primary, Design::Within);
+    // p3 rated one level only: 2 of 3 participants complete is not a within design
+    // (issue 26 item 4), unless a share of two thirds is stated.
+    EXPECT_EQ(result.primary, Design::Between);
+    AnalysisRequest two_thirds;
+    two_thirds.within_share = 2.0 / 3.0;
+    EXPECT_EQ(analyze_table(t, two_thirds).primary, Design::Within);
     AnalysisRequest between;
     between.primary = Design::Between;
     EXPECT_EQ(analyze_table(t, between).primary, Design::Between);
+}
+
+TEST(AnalyzeTable, EveryParticipantRatingEveryLevelIsWithin) {
+    const LongTable t = table_of(
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,a,f,1,q,2\np1,b,f,2,q,5\np2,a,f,1,q,3\np2,b,f,2,q,7\n"
+        "p3,a,f,1,q,1\np3,b,f,2,q,4\n");
+    const AnalysisResult result = analyze_table(t, AnalysisRequest{});
+    EXPECT_EQ(result.primary, Design::Within);
+    EXPECT_NE(result.primary_reason.find("3 of 3 participants"), std::string::npos)
+        << result.primary_reason;
+}
+
+// Issue 26 item 4: 12 participants of whom 10 rated one level each. The old rule ("every
+// pair has at least two complete participants") called this within and ran the
+// repeated-measures ANOVA on 2 participants; it is between, and the summary says how
+// many participants and ratings each test used.
+TEST(AnalyzeTable, TwelveParticipantsOfWhomTenRatedOneLevelEachAreNotWithin) {
+    std::string csv = "participant,stimulus,factor,level,question,rating\n";
+    // p1, p2: both levels; p3..p7 level 1 only; p8..p12 level 2 only: 4 + 10 = 14 ratings.
+    csv += "p1,a,f,1,q,2\np1,b,f,2,q,5\np2,a,f,1,q,3\np2,b,f,2,q,6\n";
+    for (int i = 3; i <= 12; ++i)
+        csv += "p" + std::to_string(i) + (i <= 7 ? ",a,f,1,q," : ",b,f,2,q,") +
+               std::to_string(1 + i % 7) + "\n";
+    const LongTable t = table_of(csv);
+    const AnalysisResult result = analyze_table(t, AnalysisRequest{});
+    ASSERT_EQ(result.pairs.size(), 1u);
+    const OneWayAnalysis& a = result.pairs[0];
+    EXPECT_EQ(a.within.participants, 2);
+    EXPECT_EQ(pair_participants(a), 12);
+    EXPECT_EQ(pair_ratings(a), 14u);
+    EXPECT_EQ(result.primary, Design::Between);
+    EXPECT_NE(result.primary_reason.find("only 2 of 12 participants rated every level of q ~ f"),
+              std::string::npos)
+        << result.primary_reason;
+
+    const auto dir = test::scratch_dir("analyze_twelve_participants");
+    ReportOptions options;
+    options.csv = options.html = false;
+    options.primary = result.primary;
+    options.primary_reason = result.primary_reason;
+    write_report(result.pairs, dir, options);
+    std::ifstream in(dir / "report.md");
+    const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("Primary design: between"), std::string::npos) << md;
+    EXPECT_EQ(md.find("every participant rated every level"), std::string::npos) << md;
+    EXPECT_NE(md.find("| q ~ f | between (primary) | one-way ANOVA |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| 12 participants, 14 ratings |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| 2 of 12 participants complete |"), std::string::npos) << md;
+
+    // A stated share decides: 2 of 12 meets one sixth, not one fifth.
+    AnalysisRequest sixth;
+    sixth.within_share = 1.0 / 6.0;
+    EXPECT_EQ(analyze_table(t, sixth).primary, Design::Within);
+    AnalysisRequest fifth;
+    fifth.within_share = 0.2;
+    EXPECT_EQ(analyze_table(t, fifth).primary, Design::Between);
+}
+
+// Issue 26 item 10: ratings near 1e150 (--scale any) are analysed, every number finite.
+// Levels {1, 3} x 1e150 and {5, 7} x 1e150: means 2e150 and 6e150; in units of 1e300,
+// SSB = 2 (2^2) + 2 (2^2) = 16 on 1 df, SSW = 4 on 2 df, F = 16 / 2 = 8.
+TEST(AnalyzeTable, HugeFiniteRatingsOnScaleAnyGiveFiniteResults) {
+    std::istringstream in(
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,a,f,1,q,1e150\np2,a,f,1,q,3e150\np3,b,f,2,q,5e150\np4,b,f,2,q,7e150\n");
+    const LongTable t = read_long_csv(in, "huge.csv", RatingScale{true});
+    const AnalysisResult result = analyze_table(t, AnalysisRequest{});
+    const OneWayAnalysis& a = result.pairs.at(0);
+    ASSERT_EQ(a.descriptives.size(), 2u);
+    EXPECT_NEAR(*a.descriptives[0].mean / 2e150, 1.0, 1e-12);
+    EXPECT_NEAR(*a.descriptives[1].mean / 6e150, 1.0, 1e-12);
+    ASSERT_TRUE(a.anova.f.has_value());
+    EXPECT_NEAR(*a.anova.f, 8.0, 1e-9);
+    const auto dir = test::scratch_dir("analyze_huge_finite");
+    ReportOptions options;
+    options.primary = result.primary;
+    for (const auto& file : write_report(result.pairs, dir, options)) {
+        std::ifstream f(file);
+        const std::string text((std::istreambuf_iterator<char>(f)),
+                               std::istreambuf_iterator<char>());
+        EXPECT_FALSE(std::regex_search(text, std::regex("nan|inf", std::regex::icase)))
+            << file;
+    }
 }
 
 TEST(AnalyzeTable, BetweenSubjectLayoutIsNotAnalysedWithinAndNamesWhy) {

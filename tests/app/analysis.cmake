@@ -33,6 +33,18 @@ add_test(NAME app.analyze_rejects_out_of_scale
                  "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/out_of_scale.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/out_of_scale"
                  -DEXPECT_CODE=2 "-DEXPECT_STDERR=out_of_scale.csv:3: rating 9 is outside the scale 1..7"
                  -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+# Issue 26 item 10: ratings of +-1e308 (--scale any) ended with "lucent: stod"; they, and
+# a rating beyond the double range, are refused in one line naming file, line and column.
+add_test(NAME app.analyze_ratings_of_plus_minus_1e308_name_line_and_column
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/ratings_plus_minus_1e308.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/plus_minus_1e308;--scale;any"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=^lucent analyze: [^ ]*ratings_plus_minus_1e308.csv:3: column 6 .rating.: rating '-1e308' lies further"
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.analyze_rating_overflowing_1e400_names_line_and_column
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/ratings_overflowing_1e400.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/overflowing_1e400;--scale;any"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=^lucent analyze: [^ ]*ratings_overflowing_1e400.csv:3: column 6 .rating.: rating '1e400' is beyond the range of a double"
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
 add_test(NAME app.analyze_bad_format_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/out_of_scale.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/bad_format;--format;pdf"

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <random>
 #include <filesystem>
@@ -264,10 +266,12 @@ TEST(LongTable, LargeFilesParsedInTwoHalvesKeepEveryRowAndLine) {
     const std::size_t late = bad.rfind(",translucent,") + 13;
     bad.replace(late, 1, "x");
     const std::string late_line = std::to_string(written.back().line);
-    EXPECT_EQ(error_of(bad), "ratings.csv:" + late_line + ": rating 'x' is not a finite number");
+    EXPECT_EQ(error_of(bad), "ratings.csv:" + late_line +
+                                 ": column 6 (rating): rating 'x' is not a finite number");
     const std::size_t early = bad.find(",translucent,", bad.find("participant10,")) + 13;
     bad.replace(early, 1, "y");
-    EXPECT_EQ(error_of(bad).rfind("ratings.csv:12: rating 'y'", 0), 0u) << error_of(bad);
+    EXPECT_EQ(error_of(bad).rfind("ratings.csv:12: column 6 (rating): rating 'y'", 0), 0u)
+        << error_of(bad);
 }
 
 TEST(Label, EqualTextsAreOneLabelAndOrderByText) {
@@ -283,6 +287,75 @@ TEST(Label, EqualTextsAreOneLabelAndOrderByText) {
     EXPECT_EQ(a.str().size(), 9u);
     EXPECT_EQ(std::hash<Label>{}(a), std::hash<Label>{}(b));
     EXPECT_EQ("level " + a, "level thickness");
+}
+
+
+// Issue 26 item 10: ratings of +-1e308 with --scale any ended `analyze` with "lucent:
+// stod" (the exact difference of 1e308 and -1e308 is 2e308, beyond a double, and
+// std::stod threw an out_of_range that named nothing). Now one line names the file, the
+// line and the column.
+TEST(LongTable, RatingsOfPlusAndMinus1e308AreRefusedNamingFileLineAndColumnNotStod) {
+    const std::string csv =
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,a,f,1,q,1e308\n"
+        "p2,b,f,2,q,-1e308\n";
+    std::string message;
+    try {
+        read(csv, RatingScale{true});
+        ADD_FAILURE() << "not refused";
+    } catch (const InputError& e) {
+        message = e.what();
+    }  // any other exception (std::out_of_range "stod") fails the test
+    EXPECT_EQ(message.rfind("ratings.csv:3: column 6 (rating): rating '-1e308'", 0), 0u)
+        << message;
+    EXPECT_NE(message.find("(line 2)"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.find("stod"), std::string::npos) << message;
+    // The column is the rating's wherever the header puts it.
+    const std::string first =
+        error_of("rating,participant,stimulus,factor,level,question\n"
+                 "-1e308,p1,a,f,1,q\n1e308,p2,b,f,2,q\n",
+                 RatingScale{true});
+    EXPECT_EQ(first.rfind("ratings.csv:3: column 1 (rating):", 0), 0u) << first;
+}
+
+// The overflow case: a rating text beyond the double range (1e400) is not a number the
+// analysis takes; the line says so, where, and why.
+TEST(LongTable, RatingsBeyondTheDoubleRangeAreRefusedNamingFileLineAndColumn) {
+    const std::string first = error_of(
+        "participant,stimulus,factor,level,question,rating\np1,a,f,1,q,1e400\n",
+        RatingScale{true});
+    EXPECT_EQ(first, "ratings.csv:2: column 6 (rating): rating '1e400' is beyond the range of "
+                     "a double (magnitudes up to about 1.8e308): rescale the ratings");
+    const std::string later = error_of(
+        "participant,stimulus,factor,level,question,rating\np1,a,f,1,q,3\np1,b,f,2,q,-1e400\n",
+        RatingScale{true});
+    EXPECT_EQ(later.rfind("ratings.csv:3: column 6 (rating): rating '-1e400' is beyond", 0), 0u)
+        << later;
+    // A word stays "not a finite number".
+    EXPECT_NE(error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,abc\n")
+                  .find("ratings.csv:2: column 6 (rating): rating 'abc' is not a finite number"),
+              std::string::npos);
+}
+
+// Finite ratings whose spread would overflow the sums of squares (0 and 1e200: one
+// squared deviation is already 1e400) are refused too, naming the later of the two rows.
+TEST(LongTable, RatingsSpreadBeyondFiniteSumsOfSquaresAreRefusedNamingTheRow) {
+    const std::string message = error_of(
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,a,f,1,q,0\np2,a,f,1,q,1\np3,b,f,2,q,1e200\n",
+        RatingScale{true});
+    EXPECT_EQ(message.rfind("ratings.csv:4: column 6 (rating): the ratings span 1e+200 "
+                            "(this rating and line 2)",
+                            0),
+              0u)
+        << message;
+    // sqrt(DBL_MAX / 3) / 4 for three ratings.
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%.3g",
+                  std::sqrt(std::numeric_limits<double>::max() / 3.0) / 4.0);
+    EXPECT_NE(message.find(std::string("up to a span of ") + limit), std::string::npos)
+        << message;
 }
 
 }  // namespace
