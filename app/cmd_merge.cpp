@@ -11,14 +11,30 @@
 #include <memory>
 
 namespace lucent::app {
+namespace {
+
+// ", 1 session extended by a later copy, 2 sessions of withdrawn participants not
+// merged" (each part only when it happened).
+std::string reconciled(const study::MergeReport& r) {
+    auto sessions = [](int n) { return std::to_string(n) + (n == 1 ? " session" : " sessions"); };
+    std::string out;
+    if (r.sessions_extended > 0)
+        out += ", " + sessions(r.sessions_extended) +
+               " extended by a later copy (the copy with every answer kept)";
+    if (r.sessions_withdrawn > 0)
+        out += ", " + sessions(r.sessions_withdrawn) + " of withdrawn participants not merged";
+    return out;
+}
+
+}  // namespace
 
 void register_merge(CLI::App& app, int& exit_code) {
     auto inputs = std::make_shared<std::vector<std::string>>();
     auto out = std::make_shared<std::string>();
     auto* cmd = app.add_subcommand(
         "merge",
-        "Combine study databases (sessions de-duplicated by UUID, a participant is a code on "
-        "one machine; one protocol only)");
+        "Combine study databases (copies of a session reconciled by UUID, withdrawn "
+        "participants left out, a participant is a code on one machine; one protocol only)");
     cmd->add_option("inputs", *inputs, "Databases to merge: FILE.db or postgresql://... URIs")
         ->required()
         ->check(study_db_validator());
@@ -36,19 +52,19 @@ void register_merge(CLI::App& app, int& exit_code) {
                 files.push_back(sources.back()->path());
             }
             if (study::is_server_uri(*out)) {
-                const study::MergeReport r = study::merge_into_server(files, *out);
+                const study::MergeReport r = study::merge_into_server(files, *out, *inputs);
                 for (const std::string& note : r.notes) std::cout << "lucent merge: " << note << "\n";
                 std::cout << "merged " << inputs->size() << " databases into " << *out << ": "
                           << r.sessions_added << " sessions added, " << r.sessions_already_present
-                          << " already there\n";
+                          << " already there" << reconciled(r) << "\n";
                 exit_code = kExitOk;
                 return;
             }
-            const study::MergeReport r = study::merge_databases(files, *out);
+            const study::MergeReport r = study::merge_databases(files, *out, *inputs);
             for (const std::string& note : r.notes) std::cout << "lucent merge: " << note << "\n";
             std::cout << "merged " << inputs->size() << " databases into " << *out << ": "
                       << r.sessions_added << " sessions, " << r.sessions_already_present
-                      << " duplicates skipped\n";
+                      << " duplicates skipped" << reconciled(r) << "\n";
             exit_code = kExitOk;
         } catch (const study::StoreError& e) {
             std::cerr << "lucent merge: " << e.what() << "\n";

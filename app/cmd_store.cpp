@@ -52,24 +52,33 @@ void register_store(CLI::App& app, int& exit_code) {
             options.journal_path = journal->empty() ? study::default_journal_path(*db) : *journal;
             // Counted from the journal itself, so an unreachable server still gets a count.
             const int before = study::TrialJournal(options.journal_path, *db).count();
-            int left = before;
+            int left = before, withdrawn = 0;
+            // Trials of a session withdrawn on the server leave the journal unsent.
+            auto dropped = [&withdrawn] {
+                return withdrawn ? "; " + std::to_string(withdrawn) +
+                                       " dropped unsent (their participant was withdrawn)"
+                                 : std::string();
+            };
             try {
                 const std::unique_ptr<study::StudyStore> store = study::open_study_store(*db, options);
                 try {
                     store->sync();
                 } catch (const study::StoreError&) {
                     left = store->pending_trials();
+                    withdrawn = store->withdrawn_trials_dropped();
                     throw;
                 }
                 left = store->pending_trials();
+                withdrawn = store->withdrawn_trials_dropped();
             } catch (const study::StoreError& e) {
                 std::cerr << "lucent store sync: " << e.what() << "\n";
-                std::cout << "sent " << before - left << " of " << before << " trials; " << left
-                          << " still held in " << options.journal_path << "\n";
+                std::cout << "sent " << before - left - withdrawn << " of " << before
+                          << " trials" << dropped() << "; " << left << " still held in "
+                          << options.journal_path << "\n";
                 return kExitFailure;
             }
-            std::cout << "sent " << before - left << " of " << before << " trials to " << *db
-                      << "; 0 still held\n";
+            std::cout << "sent " << before - left - withdrawn << " of " << before << " trials to "
+                      << *db << dropped() << "; 0 still held\n";
             return kExitOk;
         });
         (void)exit_code;

@@ -86,23 +86,44 @@ void write_long_table_csv(const LongTable& table, std::ostream& out);
 
 struct MergeReport {
     int sessions_added = 0;
-    int sessions_already_present = 0;  // same UUID seen in an earlier input
+    // Copies of a session beyond the one kept that hold nothing more (identical).
+    int sessions_already_present = 0;
+    // Sessions of which one input held a copy that another extends (more answers, or
+    // the same answers and a later status): the extending copy was kept.
+    int sessions_extended = 0;
+    // Sessions not merged because a withdrawal in some input covers them (withdrawal.h).
+    int sessions_withdrawn = 0;
     // One line each: a code from several machines kept apart as several participants
     // ("P01: sessions from 2 machines are different people, kept apart as P01@3f2a9c1e
-    // P01@77b0d2aa"), an older input read through an upgraded copy.
+    // P01@77b0d2aa"), people of one code on one machine kept apart, an older input read
+    // through an upgraded copy.
     std::vector<std::string> notes;
 };
 
 // Combines databases into `out_path`, a new file (never an input or any database),
-// written under a temporary name and renamed when complete. Sessions are de-duplicated
-// by UUID. A participant is a code on one machine (sessions.machine_id): a code whose
-// sessions come from several machines becomes one participant per machine, coded
-// CODE@MACHINE (the shortest machine-id prefix of at least 8 characters that tells them
-// apart), so two people are never fused. Inputs of an older schema are read through a
-// migrated temporary copy; inputs holding different protocols (hashes), newer schemas
-// or foreign files are refused before anything is written. Inputs are opened read-only
-// and never modified.
-MergeReport merge_databases(const std::vector<std::string>& inputs, const std::string& out_path);
+// written under a temporary name and renamed when complete. `names` (one per input, or
+// none) name the inputs in messages, e.g. a server's URI for its snapshot file.
+//
+// Sessions are matched by UUID. Copies of one session in several inputs are reconciled
+// (merge_reconcile.h): the copy that extends every other (its answers a superset with
+// equal ratings) is kept with its status, trials, ratings and segments, whatever the
+// order of the inputs; copies that disagree on a rating, or each hold answers the other
+// lacks, or name other participants or plans, are refused in one line naming the
+// session, participant and trial. Withdrawals recorded in any input (withdrawal.h) drop
+// the sessions they cover from every input, and the output keeps every tombstone.
+//
+// A participant is a code on one machine (sessions.machine_id): a code whose sessions
+// come from several machines becomes one participant per machine, coded CODE@MACHINE
+// (the shortest machine-id prefix of at least 8 characters that tells them apart). On
+// one machine, sessions of one code from different inputs that one file could not have
+// held together (two completed sessions: a station runs a code to completion once) are
+// one person per group of inputs sharing sessions, coded CODE@MACHINE#1, #2, ... in the
+// order of their first session's start. So two people are never fused. Inputs of an
+// older schema are read through a migrated temporary copy; inputs holding different
+// protocols (hashes), newer schemas or foreign files are refused before anything is
+// written. Inputs are opened read-only and never modified.
+MergeReport merge_databases(const std::vector<std::string>& inputs, const std::string& out_path,
+                            const std::vector<std::string>& names = {});
 
 // One CSV cell, quoted when it holds a comma, quote or line break.
 std::string csv_cell(const std::string& value);

@@ -17,6 +17,8 @@
 #include <set>
 #include <sstream>
 
+#include "withdrawal.h"
+
 namespace lucent::study {
 namespace {
 
@@ -702,6 +704,22 @@ void Store::set_status(int64_t session_id, const std::string& status, bool ended
 
 bool Store::withdraw_participant(const std::string& code) {
     Transaction tx(db_);
+    // Tombstones first (withdrawal.h), in the same transaction as the delete: the
+    // sessions' UUIDs and the (code, machine) hashes, so no merge brings them back.
+    const std::string now = utc_now_iso8601();
+    std::vector<std::pair<std::string, std::string>> sessions;  // uuid, machine
+    {
+        Statement s = db_.prepare("SELECT se.uuid, se.machine_id FROM sessions se JOIN "
+                                  "participants p ON p.id = se.participant_id WHERE p.code = ?");
+        s.bind(1, code);
+        while (s.step()) sessions.emplace_back(s.text(0), s.text(1));
+    }
+    if (first_int(db_.prepare("SELECT count(*) FROM participants WHERE code = ?").bind(1, code)) > 0) {
+        Tombstones tombstones;
+        for (const auto& [uuid, machine] : sessions) tombstones.add_session(uuid, now);
+        for (const WithdrawnCode& c : code_tombstones(code, sessions, now)) tombstones.add_code(c);
+        tombstones.write(db_);
+    }
     db_.prepare("INSERT OR IGNORE INTO retired_participant_numbers (number) "
                 "SELECT number FROM participants WHERE code = ?")
         .bind(1, code).run();

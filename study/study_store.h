@@ -84,6 +84,9 @@ public:
     virtual int pending_trials() { return 0; }
     // Sends what is pending; returns how many trials the server confirmed now.
     virtual int sync() { return 0; }
+    // Journaled trials dropped unsent because the server holds their session as
+    // withdrawn (a withdrawal's tombstone); they never count as confirmed.
+    virtual int withdrawn_trials_dropped() const { return 0; }
 };
 
 struct StoreOptions {

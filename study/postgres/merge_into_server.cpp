@@ -3,6 +3,7 @@
 
 #include <pqxx/pqxx>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -69,9 +70,103 @@ IdMap copy_rows(pqxx::work& tx, Database& m, const std::string& table, const std
     return ids;
 }
 
+// The server's sessions that a file's copy extends (temp.extended): the status, end
+// and consent the kept copy holds (never undoing a completion), its segments the
+// server lacks (temp.ext_segments) with what they showed, and each trial answered there
+// but not on the server (temp.ext_trials) with its ratings. The server's session keeps
+// its id and every row it had.
+void extend_server_sessions(pqxx::work& tx, Database& m, const IdMap& stimuli) {
+    IdMap sessions, segments, trials;
+    Statement e = m.prepare("SELECT e.id, e.uuid, s.status, s.ended_utc, s.consent_utc "
+                            "FROM temp.extended e JOIN main.sessions s ON s.id = e.id");
+    while (e.step()) {
+        const pqxx::result held = tx.exec_params(
+            "SELECT id FROM sessions WHERE uuid = $1 FOR UPDATE", e.text(1));
+        if (held.empty())
+            throw StoreError("merge: session " + e.text(1) +
+                             " left the server meanwhile (withdrawn?); nothing changed");
+        const int64_t id = held[0][0].as<int64_t>();
+        sessions[e.integer(0)] = id;
+        tx.exec_params("UPDATE sessions SET status = $1, ended_utc = $2, "
+                       "consent_utc = coalesce(consent_utc, $3) WHERE id = $4 "
+                       "AND status <> 'completed'",
+                       e.text(2), e.is_null(3) ? std::optional<std::string>() : e.text(3),
+                       e.is_null(4) ? std::optional<std::string>() : e.text(4), id);
+    }
+    if (sessions.empty()) return;
+    segments = copy_rows(tx, m, "session_segments", "id IN (SELECT id FROM temp.ext_segments)",
+                         {{"session_id", &sessions}}, true);
+    copy_rows(tx, m, "segment_stimuli", "segment_id IN (SELECT id FROM temp.ext_segments)",
+              {{"segment_id", &segments}, {"stimulus_id", &stimuli}}, false);
+    // The segments both hold, by number.
+    Statement g = m.prepare("SELECT g.id, g.session_id, g.segment FROM main.session_segments g "
+                            "JOIN temp.extended e ON e.id = g.session_id "
+                            "WHERE g.id NOT IN (SELECT id FROM temp.ext_segments)");
+    while (g.step())
+        segments[g.integer(0)] =
+            tx.exec_params1("SELECT id FROM session_segments WHERE session_id = $1 AND segment = $2",
+                            sessions.at(g.integer(1)), g.integer(2))[0]
+                .as<int64_t>();
+    Statement t = m.prepare("SELECT t.id, t.session_id, t.position, t.onset_ns, t.confirm_ns, "
+                            "t.dropped_frames, t.answered_utc, t.segment_id FROM main.trials t "
+                            "WHERE t.id IN (SELECT id FROM temp.ext_trials)");
+    auto optional_int = [&t](int col) {
+        return t.is_null(col) ? std::optional<int64_t>() : std::optional<int64_t>(t.integer(col));
+    };
+    while (t.step()) {
+        const int64_t server_session = sessions.at(t.integer(1));
+        const int64_t id = tx.exec_params1("SELECT id FROM trials WHERE session_id = $1 AND "
+                                           "position = $2 FOR UPDATE",
+                                           server_session, t.integer(2))[0]
+                               .as<int64_t>();
+        trials[t.integer(0)] = id;
+        std::optional<int64_t> segment;
+        if (!t.is_null(7)) segment = segments.at(t.integer(7));
+        tx.exec_params("UPDATE trials SET onset_ns = $1, confirm_ns = $2, dropped_frames = $3, "
+                       "answered_utc = $4, segment_id = $5 WHERE id = $6",
+                       optional_int(3), optional_int(4), optional_int(5),
+                       t.is_null(6) ? std::optional<std::string>() : t.text(6), segment, id);
+    }
+    // A station answering the same trial meanwhile makes the insert fail (one rating per
+    // trial and question): the whole merge is then not stored.
+    copy_rows(tx, m, "responses", "trial_id IN (SELECT id FROM temp.ext_trials)",
+              {{"session_id", &sessions}, {"trial_id", &trials}}, false);
+}
+
+// The tombstones the inputs hold, onto the server; then the server's sessions they
+// cover are deleted, and participants left without a session with them (their
+// numbers retired), as `participants withdraw` does.
+void withdraw_on_server(pqxx::work& tx, Database& m, const std::vector<std::string>& uuids) {
+    Statement s = m.prepare("SELECT uuid, withdrawn_utc FROM main.withdrawn_sessions");
+    while (s.step())
+        tx.exec_params("INSERT INTO withdrawn_sessions (uuid, withdrawn_utc) VALUES ($1, $2) "
+                       "ON CONFLICT DO NOTHING",
+                       s.text(0), s.text(1));
+    Statement c = m.prepare("SELECT salt, code_hash, withdrawn_utc FROM main.withdrawn_codes");
+    while (c.step())
+        tx.exec_params("INSERT INTO withdrawn_codes (salt, code_hash, withdrawn_utc) VALUES "
+                       "($1, $2, $3) ON CONFLICT DO NOTHING",
+                       c.text(0), c.text(1), c.text(2));
+    for (const std::string& uuid : uuids) {
+        const pqxx::result gone =
+            tx.exec_params("DELETE FROM sessions WHERE uuid = $1 RETURNING participant_id", uuid);
+        for (const pqxx::row& r : gone) {
+            const int64_t participant = r[0].as<int64_t>();
+            if (!tx.exec_params("SELECT 1 FROM sessions WHERE participant_id = $1", participant)
+                     .empty())
+                continue;
+            tx.exec_params("INSERT INTO retired_participant_numbers (number) SELECT number FROM "
+                           "participants WHERE id = $1 ON CONFLICT DO NOTHING",
+                           participant);
+            tx.exec_params("DELETE FROM participants WHERE id = $1", participant);
+        }
+    }
+}
+
 }  // namespace
 
-MergeReport merge_into_server(const std::vector<std::string>& files, const std::string& uri) {
+MergeReport merge_into_server(const std::vector<std::string>& files, const std::string& uri,
+                              const std::vector<std::string>& names) {
     namespace fs = std::filesystem;
     if (files.empty()) throw StoreError("merge: no input databases given");
     const ReadableStudyFile server_snapshot(uri);  // refuses an uninitialised/newer server
@@ -87,32 +182,79 @@ MergeReport merge_into_server(const std::vector<std::string>& files, const std::
     const std::string merged_path = pattern + "/merged.db";
     std::vector<std::string> inputs = {server_snapshot.path()};
     inputs.insert(inputs.end(), files.begin(), files.end());
-    MergeReport merged = merge_databases(inputs, merged_path);
+    std::vector<std::string> input_names = {uri};
+    input_names.insert(input_names.end(), names.empty() ? files.begin() : names.begin(),
+                       names.empty() ? files.end() : names.end());
+    // The server's copy of a session and the files' are reconciled there: the kept copy
+    // extends the server's or equals it (a disagreement is refused before anything).
+    MergeReport merged = merge_databases(inputs, merged_path, input_names);
 
     Database m(merged_path, SQLITE_OPEN_READWRITE);
     m.prepare("ATTACH DATABASE ? AS srv").bind(1, file_uri(server_snapshot.path(), "mode=ro")).run();
     // A code the server holds must keep its name: a rename would split a server participant.
     {
         Statement renamed = m.prepare(
-            "SELECT code FROM srv.participants WHERE code NOT IN (SELECT code FROM main.participants)");
+            "SELECT p.code FROM srv.participants p WHERE p.code NOT IN "
+            "(SELECT code FROM main.participants) AND EXISTS (SELECT 1 FROM srv.sessions s "
+            "WHERE s.participant_id = p.id AND s.uuid IN (SELECT uuid FROM main.sessions))");
         if (renamed.step())
             throw StoreError("refusing to merge into " + uri + ": participant code " +
                              renamed.text(0) +
-                             " on the server also comes from another machine in the inputs; "
-                             "merge into a file instead");
+                             " on the server is several people once the inputs are added "
+                             "(another machine, or another file's completed session); merge "
+                             "into a file instead");
     }
     m.exec("CREATE TEMP TABLE new_sessions AS SELECT id FROM main.sessions "
            "WHERE uuid NOT IN (SELECT uuid FROM srv.sessions)");
+    // Sessions the server holds that a file's copy extends (more answers, a later status).
+    m.exec("CREATE TEMP TABLE extended AS SELECT m.id, m.uuid FROM main.sessions m "
+           "JOIN srv.sessions s ON s.uuid = m.uuid WHERE m.status <> s.status "
+           "OR (SELECT count(*) FROM main.responses WHERE session_id = m.id) <> "
+           "(SELECT count(*) FROM srv.responses WHERE session_id = s.id) "
+           "OR (SELECT count(*) FROM main.session_segments WHERE session_id = m.id) <> "
+           "(SELECT count(*) FROM srv.session_segments WHERE session_id = s.id)");
+    m.exec("CREATE TEMP TABLE ext_segments AS SELECT g.id FROM main.session_segments g "
+           "JOIN temp.extended e ON e.id = g.session_id WHERE NOT EXISTS (SELECT 1 FROM "
+           "srv.session_segments sg JOIN srv.sessions ss ON ss.id = sg.session_id "
+           "WHERE ss.uuid = e.uuid AND sg.segment = g.segment)");
+    m.exec("CREATE TEMP TABLE ext_trials AS SELECT t.id FROM main.trials t "
+           "JOIN temp.extended e ON e.id = t.session_id "
+           "WHERE EXISTS (SELECT 1 FROM main.responses r WHERE r.trial_id = t.id) "
+           "AND NOT EXISTS (SELECT 1 FROM srv.responses r JOIN srv.trials st ON st.id = r.trial_id "
+           "JOIN srv.sessions ss ON ss.id = st.session_id WHERE ss.uuid = e.uuid "
+           "AND st.position = t.position)");
+    // Sessions the server holds that a withdrawal in an input covers: the merge left
+    // them out, and the server drops them too.
+    std::vector<std::string> withdrawn_on_server;
+    {
+        Statement w = m.prepare("SELECT uuid FROM srv.sessions WHERE uuid NOT IN "
+                                "(SELECT uuid FROM main.sessions) ORDER BY id");
+        while (w.step()) withdrawn_on_server.push_back(w.text(0));
+    }
     MergeReport report;
     report.notes = merged.notes;
     report.sessions_added = static_cast<int>(m.scalar_int("SELECT count(*) FROM temp.new_sessions"));
-    int offered = 0;
+    report.sessions_extended = static_cast<int>(m.scalar_int("SELECT count(*) FROM temp.extended"));
+    report.sessions_withdrawn = merged.sessions_withdrawn;
+    int offered = 0;  // the files' copies of sessions the merge kept
     for (const std::string& f : files) {
         Database in(f, SQLITE_OPEN_READONLY);
-        if (in.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'sessions'"))
-            offered += static_cast<int>(in.scalar_int("SELECT count(*) FROM sessions"));
+        if (!in.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'sessions'")) continue;
+        Statement uuids = in.prepare("SELECT uuid FROM sessions");
+        Statement kept = m.prepare("SELECT count(*) FROM main.sessions WHERE uuid = ?");
+        while (uuids.step()) {
+            kept.reset();
+            kept.bind(1, uuids.text(0));
+            if (kept.step() && kept.integer(0) > 0) ++offered;
+        }
     }
-    report.sessions_already_present = offered - report.sessions_added;
+    report.sessions_already_present =
+        std::max(0, offered - report.sessions_added - report.sessions_extended);
+    if (!withdrawn_on_server.empty())
+        report.notes.push_back(
+            std::to_string(withdrawn_on_server.size()) + " session" +
+            (withdrawn_on_server.size() == 1 ? "" : "s") +
+            " of withdrawn participants removed from the server (withdrawn in an input)");
 
     try {
         pqxx::connection c(checked_server_uri(uri));
@@ -185,6 +327,8 @@ MergeReport merge_into_server(const std::vector<std::string>& files, const std::
                            true);
         copy_rows(tx, m, "responses", "session_id IN (SELECT id FROM temp.new_sessions)",
                   {{"session_id", &sessions}, {"trial_id", &trials}}, false);
+        extend_server_sessions(tx, m, stimuli);
+        withdraw_on_server(tx, m, withdrawn_on_server);
         tx.commit();
     } catch (const StoreError&) {
         throw;

@@ -10,6 +10,7 @@
 #include <chrono>
 
 #include "store.h"
+#include "withdrawal.h"
 
 namespace lucent::study {
 namespace {
@@ -608,6 +609,10 @@ bool complete_if_answered(pqxx::work& tx, int64_t session_id) {
 PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict, bool* completed) {
     return guarded("sending a trial", [&] {
         pqxx::work tx(connection());
+        // A withdrawn participant's trial is never sent back (withdrawal.h).
+        if (!tx.exec_params("SELECT 1 FROM withdrawn_sessions WHERE uuid = $1", j.session_uuid)
+                 .empty())
+            return Sent::Withdrawn;
         const pqxx::result t = tx.exec_params(
             "SELECT id, session_id FROM trials WHERE uuid = $1 FOR UPDATE", j.trial_uuid);
         if (t.empty())
@@ -680,7 +685,12 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
     if (steady_ns() < next_attempt_ns_) return local_completed;
     bool completed = local_completed;
     try {
-        send(journaled, true, &completed);
+        if (send(journaled, true, &completed) == Sent::Withdrawn) {
+            journal_.remove(journaled.trial_uuid);
+            cache.answered.erase(trial_id);
+            throw StoreError(where + ": session " + cache.uuid +
+                             " was withdrawn on the server; the trial is not kept");
+        }
         journal_.remove(journaled.trial_uuid);
     } catch (const Unreachable&) {
         next_attempt_ns_ = steady_ns() + int64_t(options_.retry_interval_ms) * 1'000'000;
@@ -700,8 +710,12 @@ int PostgresStore::flush(const std::string& skip_uuid) {
     for (const JournaledTrial& j : journal_.pending()) {
         if (j.trial_uuid == skip_uuid) continue;
         try {
-            send(j, false, nullptr);
+            const Sent sent = send(j, false, nullptr);
             journal_.remove(j.trial_uuid);
+            if (sent == Sent::Withdrawn) {
+                ++withdrawn_dropped_;
+                continue;
+            }
             ++confirmed;
         } catch (const Unreachable&) {
             next_attempt_ns_ = steady_ns() + int64_t(options_.retry_interval_ms) * 1'000'000;
@@ -716,9 +730,14 @@ int PostgresStore::flush(const std::string& skip_uuid) {
 int PostgresStore::sync() {
     int confirmed = 0;
     for (const JournaledTrial& j : journal_.pending()) {
-        send(j, false, nullptr);  // unreachable or refused: one line, the rest stays
+        // Unreachable or refused: one line, the rest stays. A withdrawn session's trial
+        // leaves the journal unsent.
+        const Sent sent = send(j, false, nullptr);
         journal_.remove(j.trial_uuid);
-        ++confirmed;
+        if (sent == Sent::Withdrawn)
+            ++withdrawn_dropped_;
+        else
+            ++confirmed;
     }
     next_attempt_ns_ = 0;
     return confirmed;
@@ -764,6 +783,24 @@ bool PostgresStore::withdraw_participant(const std::string& code) {
     return guarded("withdrawing the participant", [&] {
         pqxx::work tx(connection());
         tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kNumberLock);
+        // Tombstones (withdrawal.h) in the same transaction as the delete.
+        if (!tx.exec_params("SELECT 1 FROM participants WHERE code = $1", code).empty()) {
+            const std::string now = utc_now_iso8601();
+            std::vector<std::pair<std::string, std::string>> sessions;  // uuid, machine
+            for (const pqxx::row& r :
+                 tx.exec_params("SELECT se.uuid, se.machine_id FROM sessions se JOIN "
+                                "participants p ON p.id = se.participant_id WHERE p.code = $1",
+                                code))
+                sessions.emplace_back(r[0].as<std::string>(), r[1].as<std::string>());
+            for (const auto& [uuid, machine] : sessions)
+                tx.exec_params("INSERT INTO withdrawn_sessions (uuid, withdrawn_utc) VALUES "
+                               "($1, $2) ON CONFLICT DO NOTHING",
+                               uuid, now);
+            for (const WithdrawnCode& c : code_tombstones(code, sessions, now))
+                tx.exec_params("INSERT INTO withdrawn_codes (salt, code_hash, withdrawn_utc) "
+                               "VALUES ($1, $2, $3) ON CONFLICT DO NOTHING",
+                               c.salt, c.code_hash, c.withdrawn_utc);
+        }
         tx.exec_params("INSERT INTO retired_participant_numbers (number) SELECT number FROM "
                        "participants WHERE code = $1 ON CONFLICT DO NOTHING",
                        code);

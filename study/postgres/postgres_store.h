@@ -62,6 +62,7 @@ public:
     void snapshot_to_sqlite(const std::string& sqlite_path) override;
     int pending_trials() override { return journal_.count(); }
     int sync() override;
+    int withdrawn_trials_dropped() const override { return withdrawn_dropped_; }
 
     const std::string& journal_path() const { return journal_.path(); }
 
@@ -74,7 +75,7 @@ private:
         std::map<int64_t, std::string> trial_uuid;  // trial id -> uuid
         std::set<int64_t> answered;
     };
-    enum class Sent { Stored, AlreadyThere };
+    enum class Sent { Stored, AlreadyThere, Withdrawn };
 
     struct Connection;  // the libpqxx connection, kept out of this header
     Connection& connection();  // (re)connects; throws StoreError when unreachable
@@ -84,6 +85,8 @@ private:
     SessionCache& session_cache(int64_t session_id);
     // One journaled trial to the server, in one transaction. `strict`: a trial already
     // holding ratings is refused (a fresh record); otherwise identical ratings confirm.
+    // A trial of a session the server holds as withdrawn (withdrawn_sessions) is not
+    // sent: Withdrawn, and the caller drops it from the journal.
     Sent send(const JournaledTrial& trial, bool strict, bool* completed);
     // Sends what the journal holds (oldest first); stops at the first unreachable server.
     int flush(const std::string& skip_uuid);
@@ -95,6 +98,7 @@ private:
     TrialJournal journal_;
     std::set<std::string> claimed_;
     std::map<int64_t, SessionCache> sessions_;
+    int withdrawn_dropped_ = 0;  // journaled trials dropped: their session was withdrawn
     int64_t next_attempt_ns_ = 0;  // steady clock; no server attempt before it after a failure
 };
 
