@@ -12,12 +12,14 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <set>
 #include <sstream>
 
 #include "core/image.h"
+#include "core/progress.h"
 #include "manifest.h"
 #include "output_file.h"
 #include "set_report/contact_sheet.h"
@@ -297,6 +299,53 @@ void build_series(SetReport& report, const std::vector<std::string>& header) {
     }
 }
 
+// Every pair (a, b), a < b, of n levels in order.
+std::vector<std::pair<std::size_t, std::size_t>> all_pairs(std::size_t n) {
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b = a + 1; b < n; ++b) pairs.emplace_back(a, b);
+    return pairs;
+}
+
+// The neighbouring levels of a large series, as positions in level order (a < b, sorted):
+// each level and the next; and where several parameters vary (a grid), for each of them
+// the levels that share every other varying value, ordered by that parameter (by value
+// when all are numbers, else in level order), each with the next. O(n log n) pairs.
+std::vector<std::pair<std::size_t, std::size_t>> neighbour_pairs(const SetReport& report,
+                                                                 const ReportSeries& series) {
+    const std::size_t n = series.members.size();
+    std::set<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t a = 0; a + 1 < n; ++a) pairs.emplace(a, a + 1);
+    if (series.varying.size() >= 2) {
+        for (std::size_t along = 0; along < series.varying.size(); ++along) {
+            const std::string& column = series.varying[along];
+            std::map<std::string, std::vector<std::size_t>> lines;  // the others' values
+            for (std::size_t position = 0; position < n; ++position) {
+                const auto& cells = report.stimuli[series.members[position]].cells;
+                std::string key;
+                for (std::size_t v = 0; v < series.varying.size(); ++v)
+                    if (v != along) key += cell(cells, series.varying[v]) + '\x1f';
+                lines[key].push_back(position);
+            }
+            for (auto& [key, line] : lines) {
+                bool numeric = true;
+                for (std::size_t position : line)
+                    numeric &= number(cell(report.stimuli[series.members[position]].cells,
+                                           column))
+                                   .has_value();
+                if (numeric)
+                    std::stable_sort(line.begin(), line.end(), [&](std::size_t a, std::size_t b) {
+                        return *number(cell(report.stimuli[series.members[a]].cells, column)) <
+                               *number(cell(report.stimuli[series.members[b]].cells, column));
+                    });
+                for (std::size_t k = 0; k + 1 < line.size(); ++k)
+                    pairs.emplace(std::min(line[k], line[k + 1]), std::max(line[k], line[k + 1]));
+            }
+        }
+    }
+    return {pairs.begin(), pairs.end()};
+}
+
 std::string set_name_of(const fs::path& directory) {
     // manifest.json's "set" value; the folder's name when it has none.
     std::ifstream in(directory / "manifest.json", std::ios::binary);
@@ -346,46 +395,85 @@ SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions
         stimulus.thumbnail = make_thumbnail(d.rgb, d.width, d.height, kThumbnailSide);
         pixel_hashes[i] = d.pixel_hash;
     }
-    for (const auto& series : report.series) {
-        std::vector<Measured> measured;
-        for (std::size_t m : series.members) {
-            auto& stimulus = report.stimuli[m];
+    // The pairs each series compares (positions in level order, (a, b) with a < b), all
+    // counted first for the progress callback.
+    std::vector<std::vector<std::pair<std::size_t, std::size_t>>> compared;
+    std::size_t total_pairs = 0;
+    for (auto& series : report.series) {
+        const std::size_t n = series.members.size();
+        series.pairs_possible = n * (n - 1) / 2;
+        series.all_pairs = n <= options.all_pairs_up_to;
+        compared.push_back(series.all_pairs ? all_pairs(n) : neighbour_pairs(report, series));
+        total_pairs += compared.back().size();
+    }
+    std::size_t pairs_done = 0;
+    for (std::size_t s = 0; s < report.series.size(); ++s) {
+        const ReportSeries& series = report.series[s];
+        const auto& pairs = compared[s];
+        const std::size_t n = series.members.size();
+        // Each member is measured when the first pair needing it comes up (in order of
+        // its later member) and released after its last pair: a grid compared on
+        // neighbours holds about one row of measurements, not the whole series.
+        std::vector<std::size_t> last_use(n, 0);
+        std::vector<std::vector<std::size_t>> ending_at(n);  // pairs by their later member
+        for (std::size_t k = 0; k < pairs.size(); ++k) {
+            last_use[pairs[k].first] = std::max(last_use[pairs[k].first], pairs[k].second);
+            last_use[pairs[k].second] = std::max(last_use[pairs[k].second], pairs[k].second);
+            ending_at[pairs[k].second].push_back(k);
+        }
+        std::vector<std::optional<Measured>> measured(n);
+        struct Outcome {
+            std::optional<PairDifference> pair;
+            std::string warning;
+        };
+        std::vector<Outcome> outcomes(pairs.size());
+        for (std::size_t position = 0; position < n; ++position) {
+            auto& stimulus = report.stimuli[series.members[position]];
             Displayed d = decode(stimulus.image, cell(stimulus.cells, "background"));
             stimulus.thumbnail = make_thumbnail(d.rgb, d.width, d.height, kThumbnailSide);
-            pixel_hashes[m] = d.pixel_hash;
-            measured.push_back(measure(std::move(d), to_lab));
-        }
-        for (std::size_t a = 0; a < measured.size(); ++a)
-            for (std::size_t b = a + 1; b < measured.size(); ++b) {
-                const Measured &x = measured[a], &y = measured[b];
+            pixel_hashes[series.members[position]] = d.pixel_hash;
+            measured[position] = measure(std::move(d), to_lab);
+            for (std::size_t k : ending_at[position]) {
+                const auto [a, b] = pairs[k];
+                const Measured &x = *measured[a], &y = *measured[b];
                 PairDifference pair;
                 pair.series = series.name;
                 pair.first = series.members[a];
                 pair.second = series.members[b];
-                pair.adjacent = b == a + 1;
+                pair.adjacent = !series.all_pairs || b == a + 1;
                 const std::string names = "series '" + series.name + "': " +
                                           report.stimuli[pair.first].id + " vs " +
                                           report.stimuli[pair.second].id;
                 if (x.displayed.width != y.displayed.width ||
                     x.displayed.height != y.displayed.height) {
-                    report.warnings.push_back(names + ": images of different sizes, not compared");
-                    continue;
-                }
-                // Object pixels of either image: a level that grows the object counts.
-                std::vector<std::uint8_t> mask(x.displayed.mask.size());
-                for (std::size_t i = 0; i < mask.size(); ++i)
-                    mask[i] = x.displayed.mask[i] || y.displayed.mask[i];
-                pair.delta_e = delta_e_statistics(x.lab, y.lab, mask);
-                pair.ssim = ssim({x.displayed.width, x.displayed.height, x.luminance},
-                                 {y.displayed.width, y.displayed.height, y.luminance}, mask);
-                pair.identical = x.displayed.pixel_hash == y.displayed.pixel_hash;
-                if (pair.delta_e.mean < options.min_delta_e)
-                    report.warnings.push_back(names + ": mean Delta E00 " +
+                    outcomes[k].warning = names + ": images of different sizes, not compared";
+                } else {
+                    // Object pixels of either image: a level that grows the object counts.
+                    std::vector<std::uint8_t> mask(x.displayed.mask.size());
+                    for (std::size_t i = 0; i < mask.size(); ++i)
+                        mask[i] = x.displayed.mask[i] || y.displayed.mask[i];
+                    pair.delta_e = delta_e_statistics(x.lab, y.lab, mask);
+                    pair.ssim =
+                        ssim({x.displayed.width, x.displayed.height, x.luminance},
+                             {y.displayed.width, y.displayed.height, y.luminance}, mask);
+                    pair.identical = x.displayed.pixel_hash == y.displayed.pixel_hash;
+                    if (pair.delta_e.mean < options.min_delta_e)
+                        outcomes[k].warning = names + ": mean Delta E00 " +
                                               fixed(pair.delta_e.mean, 2) + " is below " +
                                               fixed(options.min_delta_e, 2) +
-                                              (pair.adjacent ? " (adjacent levels)" : ""));
-                report.pairs.push_back(pair);
+                                              (pair.adjacent ? " (adjacent levels)" : "");
+                    outcomes[k].pair = pair;
+                }
+                if (options.on_pair) options.on_pair(++pairs_done, total_pairs);
             }
+            for (std::size_t m = 0; m <= position; ++m)
+                if (measured[m] && last_use[m] <= position) measured[m].reset();
+        }
+        // In (a, b) order, as the page lists them.
+        for (const Outcome& o : outcomes) {
+            if (!o.warning.empty()) report.warnings.push_back(o.warning);
+            if (o.pair) report.pairs.push_back(*o.pair);
+        }
     }
 
     // Identical pictures anywhere in the set: each stimulus is meant to be its own image.
@@ -515,6 +603,14 @@ void write_html(std::ostream& out, const SetReport& r) {
         out << "<p>The manifest names no factor series (column <code>series</code>).</p>\n";
     for (const auto& series : r.series) {
         out << "<h3>Series " << markup_escape(series.name) << "</h3>\n";
+        if (!series.all_pairs) {
+            std::size_t compared = 0;
+            for (const auto& p : r.pairs) compared += p.series == series.name;
+            out << "<p>" << series.members.size() << " levels: neighbouring levels compared ("
+                << compared << " of " << series.pairs_possible
+                << " pairs): each level and the next, and where several parameters vary, "
+                << "the next value of each with the others equal.</p>\n";
+        }
         out << "<table><tr><th>pair</th><th>levels</th><th>mean &Delta;E00</th>"
             << "<th>95th percentile</th><th>share &gt; 1</th><th>SSIM</th><th>pixels</th>"
             << "<th></th></tr>\n";
@@ -611,7 +707,23 @@ int run_stimuli_report(const fs::path& directory, const SetReportOptions& option
                        const std::string& command) {
     SetReport report;
     try {
-        report = measure_stimulus_set(directory, options);
+        // Progress: one line first when the comparisons are many (logs see it too), then
+        // the shared bar on a terminal once the work has run half a second.
+        std::unique_ptr<ProgressBar> bar;
+        SetReportOptions with_progress = options;
+        with_progress.on_pair = [&](std::size_t done, std::size_t total) {
+            if (options.on_pair) options.on_pair(done, total);
+            if (!bar) {
+                if (total > 100)
+                    std::cerr << command << ": report: comparing " << total
+                              << " pairs of levels\n";
+                bar = std::make_unique<ProgressBar>(command + ": report", total);
+            }
+            bar->update(done);
+            if (done == total) bar->finish();
+        };
+        report = measure_stimulus_set(directory, with_progress);
+        bar.reset();
     } catch (const SetReportError& e) {
         std::cerr << command << ": " << e.what() << "\n";
         return 2;

@@ -8,6 +8,7 @@
 // and DIR/contact-sheet.png.
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -29,6 +30,14 @@ struct SetReportOptions {
     // A pair of levels whose mean Delta E00 is below this gets a warning (about what is
     // noticed when images are shown one at a time, not side by side).
     double min_delta_e = 3.0;
+    // A series of at most this many levels has every pair compared (a factor's levels,
+    // as the thesis's Table 4.3); a larger one (a grid) only its neighbouring levels: the
+    // next in level order and, where several parameters vary, the next value of one
+    // parameter with the others equal. Every pair of a 400-stimulus grid would be 79,800
+    // comparisons; its neighbours are 760.
+    std::size_t all_pairs_up_to = 12;
+    // Called after each pair is measured with (pairs done, pairs in all); may be empty.
+    std::function<void(std::size_t done, std::size_t total)> on_pair;
 };
 
 // One manifest row as the report reads it.
@@ -45,12 +54,16 @@ struct ReportSeries {
     std::string name;
     std::vector<std::string> varying;        // the columns whose values differ
     std::vector<std::size_t> members;        // indices into SetReport::stimuli
+    bool all_pairs = true;        // false: neighbouring levels only (all_pairs_up_to)
+    std::size_t pairs_possible = 0;  // every pair of its levels: n (n - 1) / 2
 };
 
 struct PairDifference {
     std::string series;
     std::size_t first = 0, second = 0;  // indices into SetReport::stimuli
-    bool adjacent = false;              // neighbours in level order
+    // Neighbours in level order; in a series compared on neighbours only, every pair is
+    // one of neighbouring levels (next in level order, or next value of one parameter).
+    bool adjacent = false;
     DeltaEStatistics delta_e;
     double ssim = 1.0;
     bool identical = false;  // the decoded pixels are equal
@@ -74,7 +87,8 @@ SetReport measure_stimulus_set(const std::filesystem::path& directory,
 // paths. Throws SetReportError or std::runtime_error naming the file.
 std::vector<std::filesystem::path> write_set_report(const SetReport& report);
 
-// The command: measures, prints each warning on stderr
+// The command: measures (a progress bar on a terminal, and one line first when there
+// are more than 100 pairs to compare), prints each warning on stderr
 // ("lucent stimuli report: warning: ..."), writes, prints the files. Returns 0, 2 for a
 // directory that is not a valid set (one line, nothing written) or 1 on a write failure.
 // `command` prefixes messages ("lucent stimuli report", "lucent render").

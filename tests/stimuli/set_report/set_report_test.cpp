@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <iostream>
+#include <set>
 
 #include "browser.h"
 #include "core/image.h"
@@ -266,6 +268,131 @@ TEST_F(SmallSet, AFileNameOutsideTheDirectoryIsRefused) {
     std::ofstream(dir_ / "manifest.csv") << text;
     const std::string why = refusal();
     EXPECT_NE(why.find("'../white.png' is not a file name inside"), std::string::npos) << why;
+}
+
+
+// A grid as `lucent render` writes one: an entry varying two parameters expands into
+// one series of a x b stimuli, listed row by row (id g_I_J, albedo = I, roughness = J),
+// each a disc of its own colour (red by I, green by J) on `side` pixels.
+void write_grid(const fs::path& dir, int side, int rows, int columns) {
+    std::vector<ManifestRow> manifest;
+    for (int i = 0; i < rows; ++i)
+        for (int j = 0; j < columns; ++j) {
+            const std::string id = "g_" + std::to_string(i) + "_" + std::to_string(j);
+            Image image(side, side);
+            const float r = float(i + 1) / float(rows), g = float(j + 1) / float(columns);
+            for (int y = 0; y < side; ++y)
+                for (int x = 0; x < side; ++x) {
+                    const double dx = x + 0.5 - side / 2.0, dy = y + 0.5 - side / 2.0;
+                    if (dx * dx + dy * dy < side * side / 9.0) image.set(x, y, {r, g, 0.2f, 1.0f});
+                }
+            write_image(dir / (id + ".png"), image);
+            ManifestRow row = {{"id", id, false},          {"file", id + ".png", false},
+                               {"files", id + ".png", false}, {"technique", "ward", false},
+                               {"series", "grid", false},     {"mesh", "sphere", false},
+                               {"mesh_faces", "100", true},   {"mesh_hash", "0", false},
+                               {"width", std::to_string(side), true},
+                               {"height", std::to_string(side), true},
+                               {"background", "0,0,0", false},
+                               {"albedo", std::to_string(i), true},
+                               {"roughness", std::to_string(j), true}};
+            const auto stats = compute_image_statistics(
+                FloatImageView{image.width, image.height, 4, image.rgba});
+            for (const auto& field : statistics_fields(stats)) row.push_back(field);
+            row.push_back({"non_finite_pixels", "0", true});
+            row.push_back({"software_version", "test", false});
+            row.push_back({"build_hash", "test", false});
+            row.push_back({"input_hash", "0", false});
+            row.push_back({"content_hash",
+                           Hasher().add_field(hash_file(dir / (id + ".png"))).hex(), false});
+            manifest.push_back(std::move(row));
+        }
+    write_manifest(dir, "grid", manifest);
+}
+
+std::pair<int, int> grid_cell(const std::string& id) {
+    const auto second = id.find('_', 2);
+    return {std::stoi(id.substr(2, second - 2)), std::stoi(id.substr(second + 1))};
+}
+
+// Issue 26 item 10: the report after a 400-stimulus grid render compared all 79,800
+// pairs of its one series, silently (over 300 s). A series that large is compared on
+// neighbouring levels only, with progress: 2 x 20 x 19 = 760 grid neighbours (one step
+// of one parameter, the other equal) and the 19 row ends next to the next row's first
+// stimulus in level (set) order: 779 pairs.
+TEST(SetReportGrid, A400StimulusGridComparesNeighbouringLevelsWithProgress) {
+    const fs::path dir = test::scratch_dir("set_report_grid_400");
+    write_grid(dir, 16, 20, 20);
+    std::size_t calls = 0, last_done = 0, last_total = 0;
+    SetReportOptions options;
+    options.on_pair = [&](std::size_t done, std::size_t total) {
+        ++calls;
+        last_done = done;
+        last_total = total;
+    };
+    const SetReport r = measure_stimulus_set(dir, options);
+    ASSERT_EQ(r.series.size(), 1u);
+    EXPECT_EQ(r.series[0].members.size(), 400u);
+    EXPECT_FALSE(r.series[0].all_pairs);
+    EXPECT_EQ(r.series[0].pairs_possible, 400u * 399u / 2u);
+    EXPECT_EQ(r.series[0].varying, (std::vector<std::string>{"albedo", "roughness"}));
+    ASSERT_EQ(r.pairs.size(), 779u);
+    EXPECT_EQ(calls, 779u);
+    EXPECT_EQ(last_done, 779u);
+    EXPECT_EQ(last_total, 779u);
+    std::set<std::pair<std::size_t, std::size_t>> seen;
+    std::size_t steps = 0, wraps = 0;
+    for (const PairDifference& p : r.pairs) {
+        EXPECT_TRUE(seen.emplace(p.first, p.second).second) << "listed twice";
+        const auto [i1, j1] = grid_cell(r.stimuli[p.first].id);
+        const auto [i2, j2] = grid_cell(r.stimuli[p.second].id);
+        const bool step = (i1 == i2 && std::abs(j1 - j2) == 1) ||
+                          (j1 == j2 && std::abs(i1 - i2) == 1);
+        const bool wrap = i2 == i1 + 1 && j1 == 19 && j2 == 0;
+        EXPECT_TRUE(step || wrap) << r.stimuli[p.first].id << " vs " << r.stimuli[p.second].id;
+        steps += step;
+        wraps += wrap;
+        EXPECT_TRUE(p.adjacent);
+        EXPECT_GT(p.delta_e.pixels, 0u);
+    }
+    EXPECT_EQ(steps, 760u);
+    EXPECT_EQ(wraps, 19u);
+
+    // The command says what it is doing before the long part, and the page says which
+    // pairs it compared.
+    ::testing::internal::CaptureStderr();
+    ::testing::internal::CaptureStdout();
+    EXPECT_EQ(run_stimuli_report(dir, {}), 0);
+    (void)::testing::internal::GetCapturedStdout();
+    const std::string err = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(err.rfind("lucent stimuli report: report: comparing 779 pairs of levels\n", 0), 0u)
+        << err;
+    std::ifstream in(dir / "report.html");
+    const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(html.find("400 levels: neighbouring levels compared (779 of 79800 pairs)"),
+              std::string::npos);
+}
+
+// A factor's few levels keep every pair (the thesis's Table 4.3): a 3 x 4 grid of 12 is
+// compared on all 66 pairs; lowering all_pairs_up_to below 12 gives its neighbours,
+// 3 x 3 + 2 x 4 = 17 grid steps and 2 row ends.
+TEST(SetReportGrid, SeriesUpToTwelveLevelsCompareEveryPair) {
+    const fs::path dir = test::scratch_dir("set_report_grid_12");
+    write_grid(dir, 16, 3, 4);
+    const SetReport all = measure_stimulus_set(dir);
+    EXPECT_TRUE(all.series.at(0).all_pairs);
+    EXPECT_EQ(all.pairs.size(), 66u);
+    SetReportOptions neighbours;
+    neighbours.all_pairs_up_to = 11;
+    EXPECT_EQ(measure_stimulus_set(dir, neighbours).pairs.size(), 19u);
+}
+
+// Not a test: writes a 20 x 20 grid of 64-pixel stimuli for timing `lucent stimuli
+// report` (run with --gtest_also_run_disabled_tests; the folder is printed).
+TEST(SetReportGrid, DISABLED_WriteA400StimulusGridForTiming) {
+    const fs::path dir = test::scratch_dir("set_report_grid_timing");
+    write_grid(dir, 64, 20, 20);
+    std::cout << "grid: " << dir.string() << "\n";
 }
 
 }  // namespace
