@@ -55,7 +55,9 @@ int withdraw(const std::string& db_path, const std::string& code, bool yes) {
         }
     }
     store->withdraw_participant(code);
-    std::cout << "withdrew participant '" << code << "': their sessions and ratings are deleted\n";
+    std::cout << "withdrew participant '" << code << "': their sessions and ratings are deleted\n"
+              << "Other copies (station files, backups) still hold them until merged: a merge "
+                 "with this database leaves them out (its withdrawal tombstones)\n";
     return kExitOk;
 }
 
