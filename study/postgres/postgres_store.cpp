@@ -683,6 +683,15 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
     cache.answered.insert(trial_id);
     const bool local_completed = cache.answered.size() == cache.trial_uuid.size();
     if (steady_ns() < next_attempt_ns_) return local_completed;
+    // One sender at a time per journal (every station of this server on this machine
+    // shares it), older trials first: each session's trials reach the server in the order
+    // they were recorded, and no two stations send one trial at once.
+    const TrialJournal::SendLock sending(journal_);
+    const int64_t attempt = next_attempt_ns_;
+    flush(journaled.trial_uuid);
+    if (next_attempt_ns_ != attempt) return local_completed;  // unreachable: all stay journaled
+    // Another station sent it from the shared journal while this one waited: confirmed.
+    if (!journal_.contains(journaled.trial_uuid)) return local_completed;
     bool completed = local_completed;
     try {
         if (send(journaled, true, &completed) == Sent::Withdrawn) {
@@ -701,7 +710,6 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
         cache.answered.erase(trial_id);
         throw;
     }
-    flush(journaled.trial_uuid);  // and any older ones, now the server answers
     return completed;
 }
 
@@ -728,6 +736,7 @@ int PostgresStore::flush(const std::string& skip_uuid) {
 }
 
 int PostgresStore::sync() {
+    const TrialJournal::SendLock sending(journal_);
     int confirmed = 0;
     for (const JournaledTrial& j : journal_.pending()) {
         // Unreachable or refused: one line, the rest stays. A withdrawn session's trial

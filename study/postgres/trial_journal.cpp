@@ -1,7 +1,13 @@
 // The station's journal of unconfirmed trials (trial_journal.h).
 #include "postgres/trial_journal.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 
 #include "sha256.h"
@@ -66,6 +72,24 @@ TrialJournal::TrialJournal(const std::string& path, const std::string& server)
     } else if (app != kJournalApplicationId) {
         throw StoreError(path + ": not a Lucent trial journal; left unchanged");
     }
+}
+
+TrialJournal::SendLock::SendLock(const TrialJournal& journal) {
+    const std::string path = journal.path() + ".send-lock";
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    if (fd_ < 0)
+        throw StoreError(path + ": cannot open the journal's send lock: " + std::strerror(errno));
+    while (::flock(fd_, LOCK_EX) != 0) {
+        if (errno == EINTR) continue;
+        const int error = errno;
+        ::close(fd_);
+        fd_ = -1;
+        throw StoreError(path + ": cannot lock the journal for sending: " + std::strerror(error));
+    }
+}
+
+TrialJournal::SendLock::~SendLock() {
+    if (fd_ >= 0) ::close(fd_);  // closing the only descriptor releases the flock
 }
 
 bool TrialJournal::contains(const std::string& trial_uuid) {

@@ -23,6 +23,25 @@ struct JournaledTrial {
 
 class TrialJournal {
 public:
+    // Held while trials of a journal are sent to the server (a new trial, the older ones
+    // flushed before it, `store sync`): an exclusive flock on PATH.send-lock. Every
+    // station and process on this machine that uses the journal (two stations of one
+    // server on one machine share it) takes turns, so each session's trials reach the
+    // server in the order they were recorded, oldest first, and no trial is sent by two
+    // stations at once. Each lock opens the file anew, so two stores or threads of one
+    // process take turns too; released by the destructor, or by the kernel when the
+    // process dies. Throws StoreError naming the file when it cannot be opened.
+    class SendLock {
+    public:
+        explicit SendLock(const TrialJournal& journal);
+        ~SendLock();
+        SendLock(const SendLock&) = delete;
+        SendLock& operator=(const SendLock&) = delete;
+
+    private:
+        int fd_ = -1;
+    };
+
     // Opens or creates the journal for `server` (the URI without password). Throws
     // StoreError naming the file when it is another kind of file.
     TrialJournal(const std::string& path, const std::string& server);
@@ -41,7 +60,10 @@ private:
 };
 
 // $LUCENT_JOURNAL_DIR, else $XDG_STATE_HOME/lucent, else ~/.local/state/lucent, then
-// journal-<first 16 hex digits of sha256(server)>.db: one journal per server and machine.
+// journal-<first 16 hex digits of sha256(server)>.db: one journal per server and machine
+// (and user), shared by every station of that server on the machine, so that `lucent
+// store sync` and any later session find what a stopped station left; sending from it is
+// serialised by TrialJournal::SendLock.
 std::string default_journal_path(const std::string& server);
 
 }  // namespace lucent::study
