@@ -59,7 +59,7 @@ StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int w
             out.rgba[i * 4 + c] = static_cast<uint8_t>(std::lround(srgb_encode(image.rgba[i * 4 + c]) * 255.f));
         out.rgba[i * 4 + 3] = 255;  // opaque, like the RGB PNG of the same stimulus
     }
-    return upload_texture(out);
+    return upload_texture(out, "stimulus '" + spec.id + "'");
 }
 
 }  // namespace lucent::study

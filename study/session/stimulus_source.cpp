@@ -3,6 +3,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/image.h"
+#include "gl/errors.h"
+#include "gl/upload.h"
 #include "session/stimulus_provenance.h"
 
 #include <cmath>
@@ -56,13 +58,45 @@ void save_image_rgba8(const std::string& path, const CpuImage& image) {
         throw StimulusError(path + ": cannot write image: " + OIIO::geterror());
 }
 
-StimulusTexture upload_texture(const CpuImage& image) {
+StimulusTexture upload_texture(const CpuImage& image, const std::string& what) {
+    const std::string size = std::to_string(image.width) + "x" + std::to_string(image.height);
+    const auto fail = [&](const std::string& why) {
+        throw StimulusError(what + ": the " + size + " picture cannot be shown: " + why);
+    };
+    if (image.width <= 0 || image.height <= 0 ||
+        image.rgba.size() != size_t(image.width) * size_t(image.height) * 4)
+        fail("its pixels do not match its size");
+    GLint max_size = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+    if (image.width > max_size || image.height > max_size)
+        fail("larger than this GPU's largest texture (" + std::to_string(max_size) +
+             " pixels a side)");
     StimulusTexture t;
     t.width = image.width;
     t.height = image.height;
-    t.texture = gl::make_texture_2d(GL_RGBA8, image.width, image.height);
-    glTextureSubImage2D(t.texture.id(), 0, 0, 0, image.width, image.height, GL_RGBA,
-                        GL_UNSIGNED_BYTE, image.rgba.data());
+    try {
+        // An error left by an earlier call is reported now, not blamed on this upload
+        // later; then the rows are read as they are stored (no unpack buffer, no row
+        // length or skips that other code, Dear ImGui's backend, may have left set).
+        gl::check_errors("the session window before uploading a picture");
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+        glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+        t.texture = gl::make_texture_2d(GL_RGBA8, image.width, image.height);
+        gl::check_errors("the texture storage of a " + size + " picture");
+        gl::upload_texture_rgba8(t.texture, image.width, image.height, image.rgba);
+    } catch (const gl::GlError& e) {
+        fail(e.what());
+    }
+    // Complete: level 0 holds the whole picture (a texture without storage samples black).
+    GLint width = 0, height = 0;
+    glGetTextureLevelParameteriv(t.texture.id(), 0, GL_TEXTURE_WIDTH, &width);
+    glGetTextureLevelParameteriv(t.texture.id(), 0, GL_TEXTURE_HEIGHT, &height);
+    if (width != image.width || height != image.height)
+        fail("the texture has level 0 of " + std::to_string(width) + "x" +
+             std::to_string(height) + " after the upload");
     return t;
 }
 
@@ -76,15 +110,33 @@ std::string PrerenderedStimuli::path_for(const StimulusSpec& spec) const {
     return "";
 }
 
+namespace {
+
+// What to run so that `dir` holds the picture: the protocol's own stimulus set when it is
+// a built-in study (its `render --preset` writes every picture the study shows, practice
+// included), else a stimulus set that lists the stimulus.
+std::string how_to_render(const Protocol& protocol, const std::string& dir) {
+    const std::string out = dir.empty() ? "DIR" : dir;
+    const std::string preset = "preset:";
+    if (protocol.source.rfind(preset, 0) == 0)
+        return "'lucent render --preset " + protocol.source.substr(preset.size()) + " --out " +
+               out + "' writes every picture of the built-in study, practice included";
+    return "render a stimulus set that lists it ('lucent render CONFIG.toml --out " + out +
+           "') and pass that folder";
+}
+
+}  // namespace
+
 void PrerenderedStimuli::check(const Protocol& protocol) const {
     for (const StimulusSpec& s : protocol.stimuli) {
         const std::string path = path_for(s);
         if (path.empty())
             throw StimulusError(
-                protocol.source + ": stimulus '" + s.id + "' (technique " + s.technique +
-                "): live rendering is not wired into 'lucent run' yet; pre-render the set "
-                "(e.g. 'lucent render --preset thesis --out DIR') and pass --images DIR" +
-                (images_dir_.empty() ? "" : " (no " + s.id + ".png/.tif/.exr in " + images_dir_ + ")"));
+                protocol.source + ": stimulus '" + s.id + "' (technique " + s.technique + "): " +
+                (images_dir_.empty()
+                     ? "no pre-rendered picture: pass --images DIR; "
+                     : "no " + s.id + ".png, .tif or .exr in " + images_dir_ + "; ") +
+                how_to_render(protocol, images_dir_));
         if (!std::filesystem::exists(path))
             throw StimulusError(protocol.source + ": stimulus '" + s.id + "': image " + path +
                                 " does not exist");
@@ -98,7 +150,7 @@ std::vector<StimulusProvenance> PrerenderedStimuli::provenance(const Protocol& p
 StimulusTexture PrerenderedStimuli::render(const StimulusSpec& spec, int, int) {
     const std::string path = path_for(spec);
     if (path.empty()) throw StimulusError("stimulus '" + spec.id + "': no image");
-    return upload_texture(load_image_rgba8(path));
+    return upload_texture(load_image_rgba8(path), path);
 }
 
 }  // namespace lucent::study

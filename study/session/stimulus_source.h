@@ -51,8 +51,10 @@ public:
 };
 
 // Image stimuli from their `image` path; live stimuli from `images_dir/<id>.png|.tif|.exr`
-// (e.g. the output of `lucent render --preset thesis --out DIR`). Live stimuli without
-// such a file are an error naming what to do: the live renderer is not wired in yet.
+// (e.g. the output of `lucent render --preset thesis --out DIR`, which holds every picture
+// of the built-in study, practice included). check() refuses a live stimulus without such
+// a file in one line naming what to render (`lucent serve` shows files only;
+// LiveOrPrerenderedStimuli renders the others).
 class PrerenderedStimuli : public StimulusRenderer {
 public:
     explicit PrerenderedStimuli(std::string images_dir) : images_dir_(std::move(images_dir)) {}
@@ -66,6 +68,11 @@ private:
     std::string images_dir_;
 };
 
-StimulusTexture upload_texture(const CpuImage& image);
+// The picture into an RGBA8 texture of the current context (row 0 = top). Checked, never
+// shown black: a picture larger than GL_MAX_TEXTURE_SIZE, a GL error (an error left
+// earlier included) or a texture whose level 0 is not the picture's size throws
+// StimulusError "WHAT: the WxH picture cannot be shown: ..." (WHAT names the file or
+// stimulus).
+StimulusTexture upload_texture(const CpuImage& image, const std::string& what);
 
 }  // namespace lucent::study

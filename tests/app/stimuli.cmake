@@ -2,18 +2,18 @@
 set(LUCENT_STIMULI_CLI_DIR ${CMAKE_BINARY_DIR}/test-scratch/app_stimuli)
 set(LUCENT_RENDER_SET_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/render_set_check.cmake)
 
-# The built-in thesis set renders headless: 18 images and a manifest row for each, and
-# its report without warnings; a second run re-renders nothing; --force re-renders every
-# image byte for byte.
+# The built-in thesis set renders headless: 20 images (18 rated, 2 practice) and a
+# manifest row for each, and its report without warnings; a second run re-renders
+# nothing; --force re-renders every image byte for byte.
 add_test(NAME app.render_preset_thesis
          COMMAND ${CMAKE_COMMAND} -DLUCENT=$<TARGET_FILE:lucent> -DMODE=preset
-                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/thesis -DEXPECT_IMAGES=18
+                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/thesis -DEXPECT_IMAGES=20
                  -P ${LUCENT_RENDER_SET_CHECK})
 # The committed example file is the same set.
 add_test(NAME app.render_config_example
          COMMAND ${CMAKE_COMMAND} -DLUCENT=$<TARGET_FILE:lucent> -DMODE=config
                  -DCONFIG=${CMAKE_SOURCE_DIR}/stimuli/presets/thesis.toml
-                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/example -DEXPECT_IMAGES=18
+                 -DOUT=${LUCENT_STIMULI_CLI_DIR}/example -DEXPECT_IMAGES=20
                  -P ${LUCENT_RENDER_SET_CHECK})
 set_tests_properties(app.render_preset_thesis app.render_config_example PROPERTIES
                      ENVIRONMENT "LUCENT_CACHE_DIR=${CMAKE_BINARY_DIR}/test-cache"
@@ -65,7 +65,7 @@ add_test(NAME app.stimuli_report_bad_threshold_exits_2
 # lucent bench render runs end to end (small images; the figures come from a full run).
 add_test(NAME app.bench_render_smoke COMMAND lucent bench render --size 64x64)
 set_tests_properties(app.bench_render_smoke PROPERTIES
-    PASS_REGULAR_EXPRESSION "18 stimuli at 64x64.*empty +[0-9.]+ .*filled, before +[0-9.]+ .*filled +[0-9.]+ .*throughput.*now / before: [0-9.]+x")
+    PASS_REGULAR_EXPRESSION "20 stimuli at 64x64.*empty +[0-9.]+ .*filled, before +[0-9.]+ .*filled +[0-9.]+ .*throughput.*now / before: [0-9.]+x")
 add_test(NAME app.bench_render_csv
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=bench;render;--size;32x32"

@@ -33,6 +33,10 @@ TEST(ThesisPreset, NineEmpiricalRendersOfTable43) {
     const auto set = load_preset("thesis", default_catalog());
     EXPECT_EQ(set.width, 512);
     EXPECT_EQ(set.height, 512);
+    // 18 rated pictures and the study's two practice pictures, outside every series.
+    ASSERT_EQ(set.stimuli.size(), 20u);
+    EXPECT_EQ(find(set, "practice_a").series, "");
+    EXPECT_EQ(find(set, "practice_b").series, "");
     // Table 4.3 (seeds.md, section A): r / wb / Kb per row.
     const double table[9][3] = {{25, 1.2, 0.2}, {18, 1.2, 0.2}, {30, 1.2, 0.2},
                                 {25, 1.2, 0.2}, {25, 0.8, 0.2}, {25, 1.6, 0.2},
@@ -149,9 +153,13 @@ TEST(FabricsPreset, TwoFabricsTwoThicknessesThreeAnglesInFourSeries) {
     ASSERT_TRUE(preset_text("fabrics").has_value());
     EXPECT_EQ(std::string(*preset_text("fabrics")), file.str());
     const auto set = load_preset("fabrics", default_catalog());
-    ASSERT_EQ(set.stimuli.size(), 12u);
+    ASSERT_EQ(set.stimuli.size(), 12u + 2u);  // and the study's two practice pictures
     std::map<std::string, std::vector<double>> tilts;
     for (const auto& s : set.stimuli) {
+        if (s.id == "practice_a" || s.id == "practice_b") {
+            EXPECT_EQ(s.series, "");  // outside every factor series
+            continue;
+        }
         EXPECT_EQ(s.technique, "thick_texture");
         EXPECT_EQ(s.mesh_spec, "wave:12800");
         const std::string texture = s.parameters.choice("texture");

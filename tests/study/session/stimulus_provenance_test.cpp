@@ -1,10 +1,11 @@
 // What a session shows, resolved before it starts: every knob value of a stimulus's
 // technique (defaults from the knob registry), pre-rendered files checked against their
-// stimulus set's manifest, and the thesis protocol agreeing with the thesis stimulus set.
+// stimulus set's manifest, and each built-in protocol agreeing with its stimulus set.
 #include "session/stimulus_provenance.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -253,28 +254,38 @@ TEST_F(ImagesAgainstManifest, AFileWithoutAManifestRowIsRefused) {
     EXPECT_NE(why.find("manifest.csv"), std::string::npos) << why;
 }
 
-TEST(ThesisPresets, TheStudyShowsTheStimulusSetsPicturesValueForValue) {
-    const auto set = stimuli::load_preset("thesis", stimuli::default_catalog());
-    const Protocol study = builtin_protocol("thesis");
-    std::map<std::string, StimulusProvenance> by_id;
-    for (StimulusProvenance& p : resolve_stimuli(study, "")) by_id[p.stimulus] = p;
-    for (const stimuli::Stimulus& s : set.stimuli) {
-        SCOPED_TRACE(s.id);
-        ASSERT_TRUE(by_id.count(s.id)) << "not in study/presets/thesis.toml";
-        const StimulusProvenance& p = by_id.at(s.id);
-        EXPECT_EQ(p.technique, s.technique);
-        EXPECT_EQ(p.mesh, s.mesh_spec);
-        std::map<std::string, std::string> set_values;
-        for (const auto& [name, value] : s.parameters.all())
-            set_values[name] = format_knob_value(value);
-        EXPECT_EQ(values_of(p), set_values);
-        by_id.erase(s.id);
+// Every built-in study runs from the folder its own `lucent render --preset NAME` writes
+// (issue 26 item 9): the set holds every stimulus the protocol shows, practice included,
+// with the same technique, mesh and resolved values, and nothing else.
+TEST(BuiltinPresets, EachStudyShowsExactlyItsStimulusSetsPicturesValueForValue) {
+    for (const std::string& name : builtin_protocol_names()) {
+        SCOPED_TRACE(name);
+        const auto set = stimuli::load_preset(name, stimuli::default_catalog());
+        const Protocol study = builtin_protocol(name);
+        std::map<std::string, StimulusProvenance> by_id;
+        for (StimulusProvenance& p : resolve_stimuli(study, "")) by_id[p.stimulus] = p;
+        for (const stimuli::Stimulus& s : set.stimuli) {
+            SCOPED_TRACE(s.id);
+            ASSERT_TRUE(by_id.count(s.id)) << "not in study/presets/" << name << ".toml";
+            const StimulusProvenance& p = by_id.at(s.id);
+            EXPECT_EQ(p.technique, s.technique);
+            EXPECT_EQ(p.mesh, s.mesh_spec);
+            EXPECT_EQ(p.mesh_hash, load_mesh(s.mesh_spec).content_hash);
+            std::map<std::string, std::string> set_values;
+            for (const auto& [key, value] : s.parameters.all())
+                set_values[key] = format_knob_value(value);
+            EXPECT_EQ(values_of(p), set_values);
+            by_id.erase(s.id);
+        }
+        for (const auto& [id, p] : by_id)
+            ADD_FAILURE() << id << " is shown by the study but not in stimuli/presets/" << name
+                          << ".toml";
+        for (const std::string& id : study.practice)
+            EXPECT_NE(std::find_if(set.stimuli.begin(), set.stimuli.end(),
+                                   [&](const stimuli::Stimulus& s) { return s.id == id; }),
+                      set.stimuli.end())
+                << "practice stimulus " << id;
     }
-    // What only the study has: its practice pictures.
-    for (const auto& [id, p] : by_id)
-        EXPECT_NE(std::find(study.practice.begin(), study.practice.end(), id),
-                  study.practice.end())
-            << id << " is rated but not in stimuli/presets/thesis.toml";
 }
 
 // An htsm stimulus: the density volume's content hash is recorded beside its spec, and a

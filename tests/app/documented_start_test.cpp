@@ -1,0 +1,214 @@
+// The README's start of a built-in study from its pictures, command for command (issue 26
+// item 9): `lucent render --preset NAME --out DIR`, then `lucent serve --preset NAME
+// --images DIR ...` and `lucent run --preset NAME --images DIR ...` from the folder that
+// render wrote. The three command lines are read from README.md as written (they must be
+// there, in that order) and run in a scratch folder; the test adds only what a test needs:
+// `--listen 127.0.0.1:0` to serve (a free port) and the autopilot participant to run. For
+// `fabrics` the same lines run with the study's name in place of `thesis`.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "display.h"
+#include "protocol.h"
+#include "sqlite.h"
+#include "test_paths.h"
+#include "trial_plan.h"
+
+namespace lucent {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_file(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::vector<std::string> words(const std::string& line) {
+    std::istringstream in(line);
+    std::vector<std::string> out;
+    for (std::string w; in >> w;) out.push_back(w);
+    return out;
+}
+
+// The README's three command lines of the online start, in order ("    lucent render
+// --preset thesis ...", "    lucent serve ...", "    lucent run ..."): the indented block
+// whose first line renders the preset. Empty when the README lacks them.
+std::vector<std::string> readme_start_commands() {
+    std::istringstream readme(read_file(test::source_dir() / "README.md"));
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(readme, line);) lines.push_back(line);
+    for (size_t i = 0; i + 2 < lines.size(); ++i) {
+        if (lines[i].rfind("    lucent render --preset thesis --out ", 0) != 0) continue;
+        if (lines[i + 1].rfind("    lucent serve --preset thesis --images ", 0) != 0) continue;
+        if (lines[i + 2].rfind("    lucent run --preset thesis --images ", 0) != 0) continue;
+        return {lines[i], lines[i + 1], lines[i + 2]};
+    }
+    return {};
+}
+
+// `line` for study `name` (the README writes thesis), as argv after "lucent".
+std::vector<std::string> args_of(std::string line, const std::string& name) {
+    for (size_t at = 0; (at = line.find("thesis", at)) != std::string::npos; at += name.size())
+        line.replace(at, 6, name);
+    std::vector<std::string> w = words(line);
+    w.erase(w.begin());  // "lucent"
+    return w;
+}
+
+struct Child {
+    pid_t pid = -1;
+    int stdout_fd = -1;
+    fs::path stderr_path;
+};
+
+// Starts lucent with `args` in `cwd`; stdout to a pipe (read by the caller) or a file.
+Child start(const std::vector<std::string>& args, const fs::path& cwd, const std::string& tag,
+            bool pipe_stdout) {
+    Child c;
+    c.stderr_path = cwd / (tag + ".stderr");
+    const fs::path out_path = cwd / (tag + ".stdout");
+    int out[2] = {-1, -1};
+    if (pipe_stdout && pipe(out) != 0) return c;
+    c.pid = fork();
+    if (c.pid == 0) {
+        if (chdir(cwd.c_str()) != 0) _exit(126);
+        const int err = open(c.stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(err, 2);
+        if (pipe_stdout) {
+            dup2(out[1], 1);
+            close(out[0]);
+            close(out[1]);
+        } else {
+            const int fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            dup2(fd, 1);
+        }
+        std::vector<char*> argv{const_cast<char*>(LUCENT_EXECUTABLE)};
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(LUCENT_EXECUTABLE, argv.data());
+        _exit(127);
+    }
+    if (pipe_stdout) {
+        close(out[1]);
+        c.stdout_fd = out[0];
+    }
+    return c;
+}
+
+int wait_exit(Child& c, bool terminate = false) {
+    if (c.pid <= 0) return -1;
+    if (terminate) kill(c.pid, SIGTERM);
+    int status = 0;
+    waitpid(c.pid, &status, 0);
+    c.pid = -1;
+    if (c.stdout_fd >= 0) close(c.stdout_fd);
+    c.stdout_fd = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string first_line(int fd) {
+    std::string line;
+    char ch = 0;
+    while (read(fd, &ch, 1) == 1 && ch != '\n') line += ch;
+    return line;
+}
+
+void documented_start(const std::string& name) {
+    LUCENT_REQUIRE_DISPLAY();
+    const std::vector<std::string> readme = readme_start_commands();
+    ASSERT_EQ(readme.size(), 3u)
+        << "README.md has no block of the three lines 'lucent render --preset thesis --out "
+           "DIR', 'lucent serve --preset thesis --images DIR ...', 'lucent run --preset "
+           "thesis --images DIR ...'";
+    const fs::path dir = test::scratch_dir("documented_start");
+    const study::Protocol protocol = study::builtin_protocol(name);
+
+    // 1. lucent render --preset NAME --out DIR: every picture the study shows.
+    const std::vector<std::string> render = args_of(readme[0], name);
+    Child r = start(render, dir, "render", false);
+    ASSERT_EQ(wait_exit(r), 0) << read_file(r.stderr_path);
+    const fs::path pictures = dir / render.back();
+    for (const study::StimulusSpec& s : protocol.stimuli)
+        EXPECT_TRUE(fs::exists(pictures / (s.id + ".png"))) << s.id;
+    for (const std::string& id : protocol.practice) {
+        const std::string manifest = read_file(pictures / "manifest.csv");
+        EXPECT_NE(manifest.find("\n" + id + ","), std::string::npos) << id << " has no manifest row";
+    }
+
+    // 2. lucent serve --preset NAME --images DIR --db study.db: starts, and a participant
+    // gets the consent screen; the practice pictures are served.
+    std::vector<std::string> serve = args_of(readme[1], name);
+    serve.insert(serve.end(), {"--listen", "127.0.0.1:0"});
+    Child s = start(serve, dir, "serve", true);
+    const std::string line = first_line(s.stdout_fd);
+    const size_t at = line.find("http://127.0.0.1:");
+    if (at == std::string::npos) {
+        const int code = wait_exit(s, true);
+        FAIL() << "serve did not start (exit " << code << "): " << line
+               << read_file(s.stderr_path);
+    }
+    {
+        httplib::Client client("127.0.0.1", std::stoi(line.substr(at + 17)));
+        const auto session = client.Post("/api/session", R"({"participant": "WEB1", "t_ms": 0})",
+                                         "application/json");
+        ASSERT_TRUE(session) << httplib::to_string(session.error());
+        EXPECT_EQ(session->status, 200) << session->body;
+        EXPECT_NE(session->body.find("\"screen\":\"consent\""), std::string::npos) << session->body;
+        for (const std::string& id : protocol.practice) {
+            const auto png = client.Get(("/images/" + id + ".png").c_str());
+            ASSERT_TRUE(png) << id;
+            EXPECT_EQ(png->status, 200) << id;
+            EXPECT_EQ(png->body.substr(1, 3), "PNG") << id;
+        }
+    }
+    EXPECT_EQ(wait_exit(s, true), 0) << read_file(s.stderr_path);
+
+    // 3. lucent run --preset NAME --images DIR --db study.db --participant P01: the
+    // whole session, every picture from the folder.
+    std::vector<std::string> run = args_of(readme[2], name);
+    run.insert(run.end(), {"--autopilot", "3", "--autopilot-speed", "25"});
+    Child l = start(run, dir, "run", false);
+    ASSERT_EQ(wait_exit(l), 0) << read_file(l.stderr_path);
+    std::string db, participant;
+    for (size_t i = 0; i + 1 < run.size(); ++i) {
+        if (run[i] == "--db") db = run[i + 1];
+        if (run[i] == "--participant") participant = run[i + 1];
+    }
+    study::Database d((dir / db).string(), SQLITE_OPEN_READONLY);
+    const std::string session =
+        "(SELECT s.id FROM sessions s JOIN participants p ON p.id = s.participant_id WHERE "
+        "p.code = '" + participant + "' AND s.status = 'completed')";
+    const int64_t trials = d.scalar_int("SELECT count(*) FROM trials WHERE session_id = " + session);
+    EXPECT_EQ(trials, static_cast<int64_t>(study::plan_trials(protocol, 1, 1).trials.size()));
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE practice = 1 AND session_id = " + session),
+              static_cast<int64_t>(protocol.practice.size()));
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses WHERE session_id = " + session),
+              trials * static_cast<int64_t>(protocol.questions.size()));
+    // Every picture came from the folder (none rendered live), practice included.
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM segment_stimuli ss JOIN session_segments g ON "
+                           "g.id = ss.segment_id WHERE ss.source = 'images' AND g.session_id = " +
+                           session),
+              static_cast<int64_t>(protocol.stimuli.size()));
+}
+
+TEST(DocumentedStart, ThesisRunsAndServesFromTheSetItsRenderPresetWrites) {
+    documented_start("thesis");
+}
+
+TEST(DocumentedStart, FabricsRunsAndServesFromTheSetItsRenderPresetWrites) {
+    documented_start("fabrics");
+}
+
+}  // namespace
+}  // namespace lucent
