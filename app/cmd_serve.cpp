@@ -5,12 +5,18 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <cmath>
+#include <chrono>
+#include <condition_variable>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -36,6 +42,8 @@ struct ServeArgs {
     std::string listen = "127.0.0.1:8080";
     std::string secret_file;
     int threads = 64;
+    double idle_minutes = 30;
+    double request_timeout_s = 5;
 };
 
 std::string read_file(const std::filesystem::path& path) {
@@ -142,6 +150,8 @@ int serve_command(const ServeArgs& args) {
             : study::is_server_uri(args.db) ? study::default_journal_path(args.db) + ".serve-key"
                                             : args.db + "-serve-key";
         options.secret = load_or_create_secret(secret_file);
+        options.idle_timeout = std::chrono::milliseconds(
+            static_cast<int64_t>(std::llround(args.idle_minutes * 60'000)));
         store = study::open_study_store(args.db);
         web = std::make_unique<study::WebStudy>(protocol, *store, options);
     } catch (const study::ProtocolError& e) {
@@ -162,7 +172,12 @@ int serve_command(const ServeArgs& args) {
     }
 
     httplib::Server http;
-    configure_serve_http(http, *web, pictures, args.threads);
+    ServeHttpLimits limits;
+    limits.threads = args.threads;
+    limits.request_deadline = std::chrono::milliseconds(
+        static_cast<int64_t>(std::llround(args.request_timeout_s * 1000)));
+    limits.read_timeout = limits.request_deadline;
+    configure_serve_http(http, *web, pictures, limits);
     port = bind_serve_port(http, host, port);
     if (port < 0) {
         std::cerr << "lucent serve: cannot listen on " << args.listen << ": " << std::strerror(errno) << "\n";
@@ -174,9 +189,14 @@ int serve_command(const ServeArgs& args) {
     sigaddset(&stop_signals, SIGINT);
     sigaddset(&stop_signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+    std::atomic<bool> listen_over{false};
     std::thread stopper([&] {
         int signal = 0;
         sigwait(&stop_signals, &signal);
+        // A signal right after the first line may come before the server runs, when
+        // stop() does nothing: wait until it runs (or never will).
+        while (!http.is_running() && !listen_over)
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
         http.stop();
     });
     std::cout << "lucent serve: study '" << protocol.name << "' (" << pictures.size()
@@ -186,7 +206,26 @@ int serve_command(const ServeArgs& args) {
     if (!is_loopback(host))
         std::cout << "lucent serve: note: listening beyond this machine (" << host
                   << "); serve participants through an HTTPS reverse proxy (README)" << std::endl;
+    // Pages idle past --idle-minutes are put aside (their claims end) even when no
+    // request comes to do it.
+    std::mutex sweep_mutex;
+    std::condition_variable sweep_wake;
+    bool sweep_stop = false;
+    std::thread sweeper([&] {
+        const auto every = std::clamp(std::chrono::duration_cast<std::chrono::milliseconds>(
+                                          std::chrono::duration<double>(args.idle_minutes * 15)),
+                                      std::chrono::milliseconds(50), std::chrono::milliseconds(30'000));
+        std::unique_lock lock(sweep_mutex);
+        while (!sweep_wake.wait_for(lock, every, [&] { return sweep_stop; })) web->release_idle();
+    });
     http.listen_after_bind();
+    listen_over = true;
+    {
+        std::lock_guard lock(sweep_mutex);
+        sweep_stop = true;
+    }
+    sweep_wake.notify_all();
+    sweeper.join();
     if (stopper.joinable()) {
         pthread_kill(stopper.native_handle(), SIGTERM);  // wakes sigwait when stopped otherwise
         stopper.join();
@@ -229,6 +268,15 @@ void register_serve(CLI::App& app, int& exit_code) {
                     "DB-serve-key beside an SQLite file)");
     cmd->add_option("--threads", args->threads, "HTTP worker threads (connections served at once)")
         ->check(CLI::Range(2, 1024));
+    cmd->add_option("--idle-minutes", args->idle_minutes,
+                    "A page silent this long is put aside: its claim on the participant ends "
+                    "(a lab station may run them) and its cell is free for the next arrival "
+                    "(default 30)")
+        ->check(CLI::Range(0.001, 1e6));
+    cmd->add_option("--request-timeout", args->request_timeout_s,
+                    "Seconds a request may take to arrive; slower connections are cut "
+                    "(default 5)")
+        ->check(CLI::Range(0.05, 600.0));
     cmd->callback([args, &exit_code] { exit_code = serve_command(*args); });
 }
 

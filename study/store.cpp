@@ -416,8 +416,18 @@ int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int
 SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
                                  const TrialPlan& plan, uint64_t seed,
                                  const SessionEnvironment& env) {
+    Transaction tx(db_);
+    SessionRow row = insert_session(study_id, participant_id, plan, seed, env, new_uuid_v4(), "");
+    tx.commit();
+    return row;
+}
+
+SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
+                                 const TrialPlan& plan, uint64_t seed,
+                                 const SessionEnvironment& env, const std::string& uuid,
+                                 const std::string& allocation) {
     SessionRow row;
-    row.uuid = new_uuid_v4();
+    row.uuid = uuid;
     row.participant_id = participant_id;
     row.seed = seed;
     row.cell = plan.cell;
@@ -425,20 +435,22 @@ SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
     std::string order;
     for (const std::string& b : plan.block_order) order += (order.empty() ? "" : ",") + b;
 
-    Transaction tx(db_);
     db_.prepare(
            "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, cell, "
            "block_order, status, started_utc, software_version, build_hash, gl_vendor, "
-           "gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, refresh_note) "
-           "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+           "gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, refresh_note, "
+           "allocation) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
         .bind(1, row.uuid).bind(2, study_id).bind(3, participant_id).bind(4, env.machine_id)
         .bind(5, std::to_string(seed)).bind(6, plan.cell).bind(7, order)
         .bind(8, utc_now_iso8601()).bind(9, env.software_version).bind(10, env.build_hash)
         .bind(11, env.gl_vendor).bind(12, env.gl_renderer).bind(13, env.display_mode)
         .bind(14, env.display_refresh_hz).bind(15, env.measured_refresh_hz)
         .bind(16, env.refresh_note)
+        .bind(17, allocation.empty() ? std::nullopt : std::optional<std::string>(allocation))
         .run();
     row.id = db_.last_insert_id();
+    Statement code = db_.prepare("SELECT code FROM participants WHERE id = ?");
+    if (code.bind(1, participant_id).step()) row.participant = code.text(0);
     insert_segment(row.id, 1, env);
     Statement insert = db_.prepare(
         "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, "
@@ -455,8 +467,78 @@ SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
         }
         insert.bind(12, t.break_before ? 1 : 0).bind(13, new_uuid_v4()).run();
     }
-    tx.commit();
     return row;
+}
+
+std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int number,
+                                        const std::string& active_since_utc) {
+    const int cells = static_cast<int>(counts.size());
+    const int first = ((number % cells) + cells) % cells;
+    int best = first;
+    for (int k = 0; k < cells; ++k) {
+        const int c = (first + k) % cells;
+        if (counts[c] < counts[best]) best = c;
+    }
+    std::string per_cell;
+    for (int64_t n : counts) per_cell += (per_cell.empty() ? "" : ",") + std::to_string(n);
+    return {best, "online arrival " + std::to_string(number) + ": cell " + std::to_string(best) +
+                      " of " + std::to_string(cells) +
+                      ", the fewest completed + active sessions (per cell " + per_cell +
+                      "; active = activity since " + active_since_utc + ")"};
+}
+
+std::string online_cell_counts_sql(bool postgres) {
+    const std::string latest = postgres ? "greatest" : "max";
+    const std::string study = postgres ? "$1" : "?1", since = postgres ? "$2" : "?2";
+    return "SELECT s.cell, count(*) FROM sessions s WHERE s.study_id = " + study +
+           " AND (s.status = 'completed' OR (s.status IN ('running', 'paused') AND " + latest +
+           "(s.started_utc, coalesce((SELECT max(g.started_utc) FROM session_segments g WHERE "
+           "g.session_id = s.id), ''), coalesce((SELECT max(t.answered_utc) FROM trials t "
+           "WHERE t.session_id = s.id), '')) >= " + since + ")) GROUP BY s.cell";
+}
+
+OnlineSession Store::enrol_online(int64_t study_id, const std::string& code,
+                                  const OnlineEnrolment& how, const SessionEnvironment& env) {
+    if (how.cells < 1 || !how.plan)
+        throw StoreError(db_.path() + ": an online enrolment needs at least one cell and a plan");
+    check_stimulus_values(env.stimuli);
+    // BEGIN IMMEDIATE: numbers and cell counts read and taken under one write lock.
+    Transaction tx(db_);
+    OnlineSession out;
+    int64_t participant_id = 0;
+    Statement find = db_.prepare("SELECT id, number FROM participants WHERE code = ?");
+    find.bind(1, code);
+    if (find.step()) {
+        participant_id = find.integer(0);
+        out.number = static_cast<int>(find.integer(1));
+    } else {
+        out.number = static_cast<int>(db_.scalar_int(
+                         "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
+                         "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) +
+                     1;
+        db_.prepare("INSERT INTO participants (study_id, code, number, created_utc) "
+                    "VALUES (?, ?, ?, ?)")
+            .bind(1, study_id).bind(2, code).bind(3, out.number).bind(4, utc_now_iso8601()).run();
+        participant_id = db_.last_insert_id();
+    }
+    std::vector<int64_t> counts(static_cast<size_t>(how.cells), 0);
+    Statement per_cell = db_.prepare(online_cell_counts_sql(false));
+    per_cell.bind(1, study_id).bind(2, how.active_since_utc);
+    while (per_cell.step()) {
+        const int64_t cell = per_cell.integer(0);
+        if (cell >= 0 && cell < how.cells) counts[static_cast<size_t>(cell)] = per_cell.integer(1);
+    }
+    const auto [cell, allocation] = online_cell(counts, out.number, how.active_since_utc);
+    const TrialPlan plan = how.plan(cell);
+    if (plan.cell != cell)
+        throw StoreError(db_.path() + ": the plan of cell " + std::to_string(cell) +
+                         " is cell " + std::to_string(plan.cell));
+    out.session = insert_session(study_id, participant_id, plan, how.seed, env,
+                                 how.session_uuid.empty() ? new_uuid_v4() : how.session_uuid,
+                                 allocation);
+    out.allocation = allocation;
+    tx.commit();
+    return out;
 }
 
 std::optional<SessionRow> Store::unfinished_session(const std::string& participant_code) {
@@ -581,6 +663,37 @@ int Store::begin_segment(int64_t session_id, const SessionEnvironment& env) {
     return segment;
 }
 
+int Store::resume_segment(int64_t session_id, const SessionEnvironment& env) {
+    Transaction tx(db_);
+    Statement newest = db_.prepare(
+        "SELECT g.id, g.segment, EXISTS (SELECT 1 FROM trials t WHERE t.segment_id = g.id) "
+        "FROM session_segments g WHERE g.session_id = ? ORDER BY g.segment DESC LIMIT 1");
+    newest.bind(1, session_id);
+    const bool found = newest.step();
+    const bool answered_in_it = found && newest.integer(2) != 0;
+    const int64_t id = found ? newest.integer(0) : 0;
+    const int segment = found ? static_cast<int>(newest.integer(1)) : 0;
+    newest.reset();
+    if (!found || answered_in_it) {
+        tx.commit();  // nothing written yet: the new segment has its own transaction
+        return begin_segment(session_id, env);
+    }
+    // Nothing was answered under the newest segment: it is replaced, not added to.
+    db_.prepare("DELETE FROM session_segments WHERE id = ?").bind(1, id).run();
+    insert_segment(session_id, segment, env);
+    if (segment == 1)
+        db_.prepare("UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
+                    "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
+                    "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
+            .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
+            .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
+            .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
+            .bind(9, env.refresh_note).bind(10, session_id)
+            .run();
+    tx.commit();
+    return segment;
+}
+
 void Store::update_environment(int64_t session_id, const SessionEnvironment& env) {
     Transaction tx(db_);
     db_.prepare("UPDATE session_segments SET machine_id = ?, software_version = ?, "
@@ -606,6 +719,13 @@ void Store::update_environment(int64_t session_id, const SessionEnvironment& env
         .bind(9, env.refresh_note).bind(10, session_id)
         .run();
     tx.commit();
+}
+
+void Store::count_declined_consent(int64_t study_id) {
+    db_.prepare("INSERT INTO consent_declines (study_id, declined) VALUES (?, 1) "
+                "ON CONFLICT (study_id) DO UPDATE SET declined = declined + 1")
+        .bind(1, study_id)
+        .run();
 }
 
 void Store::set_consent(int64_t session_id) {
@@ -753,6 +873,7 @@ void Store::claim_participant(const std::string& code) {
     }
     // One byte per code (a 62-bit hash of it) locked for this open file description:
     // a second store, in this process or another, cannot take it while this one lives.
+    if (claimed_.count(code)) return;
     struct flock lock {};
     lock.l_type = F_WRLCK;
     lock.l_whence = SEEK_SET;
@@ -762,6 +883,23 @@ void Store::claim_participant(const std::string& code) {
         throw StoreError(db_.path() + ": participant '" + code +
                          "' is in a session on this machine now; refusing to run it twice "
                          "at once");
+    claimed_[code] = lock.l_start;
+}
+
+void Store::release_participant(const std::string& code) {
+    const auto it = claimed_.find(code);
+    if (it == claimed_.end()) return;
+    const int64_t byte = it->second;
+    claimed_.erase(it);
+    // Two codes of one byte (a hash collision) share the lock: it ends with the last.
+    for (const auto& [other, other_byte] : claimed_)
+        if (other_byte == byte) return;
+    struct flock lock {};
+    lock.l_type = F_UNLCK;
+    lock.l_whence = SEEK_SET;
+    lock.l_start = static_cast<off_t>(byte);
+    lock.l_len = 1;
+    fcntl(claim_fd_, F_OFD_SETLK, &lock);
 }
 
 Store::~Store() {

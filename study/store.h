@@ -67,6 +67,11 @@ public:
     // Within one machine: an open-file-description lock on `<db>-participants.lock`,
     // released when this store closes or the process dies.
     void claim_participant(const std::string& code) override;
+    // Unlocks the code's byte (unless another code claimed here shares it).
+    void release_participant(const std::string& code) override;
+    OnlineSession enrol_online(int64_t study_id, const std::string& code,
+                               const OnlineEnrolment& how,
+                               const SessionEnvironment& env) override;
     void check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) override;
     SessionRow create_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
                               uint64_t seed, const SessionEnvironment& env) override;
@@ -74,8 +79,10 @@ public:
     bool has_completed_session(const std::string& participant_code) override;
     std::vector<TrialRow> trials(int64_t session_id) override;
     int begin_segment(int64_t session_id, const SessionEnvironment& env) override;
+    int resume_segment(int64_t session_id, const SessionEnvironment& env) override;
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
+    void count_declined_consent(int64_t study_id) override;
     bool has_consent(int64_t session_id) override;
     bool record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) override;
     // Also repairs sessions written before completion was atomic.
@@ -91,12 +98,17 @@ public:
 private:
     // Stores (first time) or checks env.stimuli's resolved values, then the segment's rows.
     void insert_segment(int64_t session_id, int segment, const SessionEnvironment& env);
+    // The session row, its first segment and its trials, inside the caller's transaction.
+    SessionRow insert_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
+                              uint64_t seed, const SessionEnvironment& env,
+                              const std::string& uuid, const std::string& allocation);
 
     const QuestionPoints& question_points_of_session(int64_t session_id);
 
     Database db_;
     std::map<int64_t, QuestionPoints> question_points_by_session_;  // parsed once
     int claim_fd_ = -1;  // the participant lock file, once something is claimed
+    std::map<std::string, int64_t> claimed_;  // code -> its locked byte
 };
 
 // Migration steps 1..kSchemaVersion in SQLite's dialect (the server backend translates
@@ -106,6 +118,12 @@ const std::vector<std::string>& schema_migrations();
 // Shared by the backends: a code's trailing digits as its number (-1 when none or over
 // 9 digits); a provenance row as stored; one word for a segment's picture source.
 int participant_number_from_code(const std::string& code);
+// Online allocation (enrol_online): the SQL giving (cell, completed + active sessions) of
+// study ?1/$1 with activity since ?2/$2, in SQLite's or PostgreSQL's dialect; the cell
+// with the fewest (ties: the first from number mod cells) and the allocation text.
+std::string online_cell_counts_sql(bool postgres);
+std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int number,
+                                        const std::string& active_since_utc);
 ResolvedStimulus resolved_of(const StimulusProvenance& p);
 std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli);
 

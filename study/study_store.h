@@ -9,6 +9,7 @@
 // guarantees: the planned trial order written before trial 1, each trial's ratings
 // committed in one transaction before the next trial starts, nothing recorded twice.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -19,6 +20,23 @@
 #include "trial_plan.h"
 
 namespace lucent::study {
+
+// How `lucent serve` enrols a participant who has just consented (enrol_online).
+struct OnlineEnrolment {
+    std::string session_uuid;  // chosen before consent: the page's token is derived from it
+    uint64_t seed = 0;
+    int cells = 1;  // counterbalancing cells (Latin-square rows; 1 without counterbalancing)
+    // A session that is neither completed nor active since this time (ISO 8601 UTC, as
+    // stored) is abandoned: its cell counts as free again.
+    std::string active_since_utc;
+    std::function<TrialPlan(int cell)> plan;  // the plan of the cell chosen (plan.cell == cell)
+};
+
+struct OnlineSession {
+    SessionRow session;
+    int number = 0;          // the participant's number (arrival order)
+    std::string allocation;  // as stored in sessions.allocation
+};
 
 class StudyStore {
 public:
@@ -38,6 +56,20 @@ public:
     // Marks `code` as being run by this process until the store is closed. Throws
     // StoreError (one line) when another station or process runs that participant now.
     virtual void claim_participant(const std::string& code) = 0;
+    // Ends this process's claim on `code` (a session completed, declined or left idle),
+    // so another station or process may run the participant; a no-op when not claimed.
+    virtual void release_participant(const std::string& code) = 0;
+    // Online (`lucent serve`), once the participant consents, in one transaction under
+    // the lock that hands out participant numbers: the participant (created when new,
+    // numbered in arrival order: one past the highest number held or retired, whatever
+    // the code's digits), the cell with the fewest completed + active sessions of the
+    // study (active: not completed, not aborted, activity since how.active_since_utc;
+    // ties go to the first such cell from number mod cells), the session with how.plan
+    // of that cell, its first segment and its trials, and sessions.allocation saying
+    // how the cell was chosen. Writes nothing when it throws.
+    virtual OnlineSession enrol_online(int64_t study_id, const std::string& code,
+                                       const OnlineEnrolment& how,
+                                       const SessionEnvironment& env) = 0;
 
     // Throws StoreError naming the stimulus and parameter when `stimuli` resolve to other
     // values than the earlier sessions recorded (new values are not stored).
@@ -53,10 +85,16 @@ public:
     virtual std::vector<TrialRow> trials(int64_t session_id) = 0;
     // A resume: adds segment n+1 with `env` and what it shows. Returns its number.
     virtual int begin_segment(int64_t session_id, const SessionEnvironment& env) = 0;
+    // A page reload (`lucent serve`): when no trial has been answered in the newest
+    // segment, that segment is replaced by one with `env` (same number, started now),
+    // else begin_segment. So reloads add at most one segment per answered trial.
+    virtual int resume_segment(int64_t session_id, const SessionEnvironment& env) = 0;
     // Updates the newest segment's environment (e.g. the measured refresh); the session
     // row's copy (the first segment's) only while the session has one segment.
     virtual void update_environment(int64_t session_id, const SessionEnvironment& env) = 0;
     virtual void set_consent(int64_t session_id) = 0;
+    // One more declined consent of the study (consent_declines: a count, nothing else).
+    virtual void count_declined_consent(int64_t study_id) = 0;
     virtual bool has_consent(int64_t session_id) = 0;
     // Commits one trial's ratings atomically; refuses a trial that already has ratings,
     // lacks a question, names one the study does not ask, or has a rating outside

@@ -302,6 +302,18 @@ void PostgresStore::claim_participant(const std::string& code) {
     claimed_.insert(code);
 }
 
+void PostgresStore::release_participant(const std::string& code) {
+    if (!claimed_.erase(code)) return;
+    if (!conn_ || !conn_->is_open()) return;  // the server ended the session's locks with it
+    try {
+        pqxx::nontransaction n(*conn_);
+        n.exec_params("SELECT pg_advisory_unlock(hashtextextended($1, 0))",
+                      "lucent participant " + code);
+    } catch (const std::exception&) {
+        drop_connection();  // a connection in doubt holds nothing once closed
+    }
+}
+
 void PostgresStore::check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) {
     guarded("checking stimulus values", [&] {
         pqxx::work tx(connection());
@@ -385,29 +397,31 @@ SessionRow session_row(const pqxx::row& r) {
 
 }  // namespace
 
-SessionRow PostgresStore::create_session(int64_t study_id, int64_t participant_id,
-                                         const TrialPlan& plan, uint64_t seed,
-                                         const SessionEnvironment& env) {
-    check_stimulus_values(env.stimuli);
+namespace {
+
+// The session row, its first segment and its trials, inside `tx`.
+SessionRow insert_session(pqxx::work& tx, int64_t study_id, int64_t participant_id,
+                          const TrialPlan& plan, uint64_t seed, const SessionEnvironment& env,
+                          const std::string& uuid, const std::optional<std::string>& allocation) {
     SessionRow row;
-    row.uuid = new_uuid_v4();
+    row.uuid = uuid;
     row.participant_id = participant_id;
     row.seed = seed;
     row.cell = plan.cell;
     row.status = "running";
-    guarded("creating the session", [&] {
-        pqxx::work tx(connection());
+    {
         row.id = tx.exec_params1(
                        "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, "
                        "cell, block_order, status, started_utc, software_version, build_hash, "
                        "gl_vendor, gl_renderer, display_mode, display_refresh_hz, "
-                       "measured_refresh_hz, refresh_note) VALUES ($1, $2, $3, $4, $5, $6, $7, "
-                       "'running', $8, $9, $10, $11, $12, $13, $14, $15, $16) RETURNING id",
+                       "measured_refresh_hz, refresh_note, allocation) VALUES ($1, $2, $3, $4, "
+                       "$5, $6, $7, 'running', $8, $9, $10, $11, $12, $13, $14, $15, $16, $17) "
+                       "RETURNING id",
                        row.uuid, study_id, participant_id, env.machine_id, std::to_string(seed),
                        plan.cell, flag_list(plan.block_order), utc_now_iso8601(),
                        env.software_version, env.build_hash, env.gl_vendor, env.gl_renderer,
                        env.display_mode, env.display_refresh_hz, env.measured_refresh_hz,
-                       env.refresh_note)[0]
+                       env.refresh_note, allocation)[0]
                      .as<int64_t>();
         row.participant = tx.exec_params1("SELECT code FROM participants WHERE id = $1",
                                           participant_id)[0]
@@ -431,10 +445,75 @@ SessionRow PostgresStore::create_session(int64_t study_id, int64_t participant_i
                            t.is_catch ? 1 : 0, catch_id, prompt, expected, tolerance,
                            t.break_before ? 1 : 0, new_uuid_v4());
         }
-        tx.commit();
-        return 0;
-    });
+    }
     return row;
+}
+
+}  // namespace
+
+SessionRow PostgresStore::create_session(int64_t study_id, int64_t participant_id,
+                                         const TrialPlan& plan, uint64_t seed,
+                                         const SessionEnvironment& env) {
+    check_stimulus_values(env.stimuli);
+    const std::string uuid = new_uuid_v4();
+    return guarded("creating the session", [&] {
+        pqxx::work tx(connection());
+        SessionRow row = insert_session(tx, study_id, participant_id, plan, seed, env, uuid,
+                                        std::nullopt);
+        tx.commit();
+        return row;
+    });
+}
+
+OnlineSession PostgresStore::enrol_online(int64_t study_id, const std::string& code,
+                                          const OnlineEnrolment& how,
+                                          const SessionEnvironment& env) {
+    if (how.cells < 1 || !how.plan)
+        throw StoreError(name_ + ": an online enrolment needs at least one cell and a plan");
+    check_stimulus_values(env.stimuli);
+    const std::string uuid = how.session_uuid.empty() ? new_uuid_v4() : how.session_uuid;
+    return guarded("enrolling the participant", [&] {
+        pqxx::work tx(connection());
+        // The number lock: stations and serve processes on this server take numbers and
+        // count cells one at a time, so arrivals never share a number and cells stay
+        // balanced across processes.
+        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kNumberLock);
+        OnlineSession out;
+        int64_t participant_id = 0;
+        const pqxx::result found =
+            tx.exec_params("SELECT id, number FROM participants WHERE code = $1", code);
+        if (!found.empty()) {
+            participant_id = found[0][0].as<int64_t>();
+            out.number = found[0][1].as<int>();
+        } else {
+            out.number = tx.exec_params1(
+                               "SELECT greatest(coalesce((SELECT max(number) FROM participants), "
+                               "0), coalesce((SELECT max(number) FROM "
+                               "retired_participant_numbers), 0))")[0]
+                             .as<int>() +
+                         1;
+            participant_id = tx.exec_params1("INSERT INTO participants (study_id, code, number, "
+                                             "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
+                                             study_id, code, out.number, utc_now_iso8601())[0]
+                                 .as<int64_t>();
+        }
+        std::vector<int64_t> counts(static_cast<size_t>(how.cells), 0);
+        for (const pqxx::row& r :
+             tx.exec_params(online_cell_counts_sql(true), study_id, how.active_since_utc)) {
+            const int64_t cell = r[0].as<int64_t>();
+            if (cell >= 0 && cell < how.cells) counts[static_cast<size_t>(cell)] = r[1].as<int64_t>();
+        }
+        const auto [cell, allocation] = online_cell(counts, out.number, how.active_since_utc);
+        const TrialPlan plan = how.plan(cell);
+        if (plan.cell != cell)
+            throw StoreError(name_ + ": the plan of cell " + std::to_string(cell) + " is cell " +
+                             std::to_string(plan.cell));
+        out.session = insert_session(tx, study_id, participant_id, plan, how.seed, env, uuid,
+                                     allocation);
+        out.allocation = allocation;
+        tx.commit();
+        return out;
+    });
 }
 
 std::optional<SessionRow> PostgresStore::unfinished_session(const std::string& code) {
@@ -544,6 +623,38 @@ int PostgresStore::begin_segment(int64_t session_id, const SessionEnvironment& e
     });
 }
 
+int PostgresStore::resume_segment(int64_t session_id, const SessionEnvironment& env) {
+    check_stimulus_values(env.stimuli);
+    return guarded("starting a segment", [&] {
+        pqxx::work tx(connection());
+        const pqxx::result newest = tx.exec_params(
+            "SELECT g.id, g.segment, EXISTS (SELECT 1 FROM trials t WHERE t.segment_id = g.id) "
+            "FROM session_segments g WHERE g.session_id = $1 ORDER BY g.segment DESC LIMIT 1 "
+            "FOR UPDATE OF g",
+            session_id);
+        int segment = 1;
+        if (!newest.empty() && !newest[0][2].as<bool>()) {
+            // Nothing was answered under the newest segment: replaced, not added to.
+            segment = newest[0][1].as<int>();
+            tx.exec_params("DELETE FROM session_segments WHERE id = $1", newest[0][0].as<int64_t>());
+            if (segment == 1)
+                tx.exec_params("UPDATE sessions SET machine_id = $1, software_version = $2, "
+                               "build_hash = $3, gl_vendor = $4, gl_renderer = $5, "
+                               "display_mode = $6, display_refresh_hz = $7, "
+                               "measured_refresh_hz = $8, refresh_note = $9 WHERE id = $10",
+                               env.machine_id, env.software_version, env.build_hash,
+                               env.gl_vendor, env.gl_renderer, env.display_mode,
+                               env.display_refresh_hz, env.measured_refresh_hz,
+                               env.refresh_note, session_id);
+        } else if (!newest.empty()) {
+            segment = newest[0][1].as<int>() + 1;
+        }
+        insert_segment(tx, session_id, segment, env);
+        tx.commit();
+        return segment;
+    });
+}
+
 void PostgresStore::update_environment(int64_t session_id, const SessionEnvironment& env) {
     guarded("updating the environment", [&] {
         pqxx::work tx(connection());
@@ -564,6 +675,18 @@ void PostgresStore::update_environment(int64_t session_id, const SessionEnvironm
                            env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
                            env.gl_renderer, env.display_mode, env.display_refresh_hz,
                            env.measured_refresh_hz, env.refresh_note, session_id);
+        tx.commit();
+        return 0;
+    });
+}
+
+void PostgresStore::count_declined_consent(int64_t study_id) {
+    guarded("counting a declined consent", [&] {
+        pqxx::work tx(connection());
+        tx.exec_params("INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
+                       "ON CONFLICT (study_id) DO UPDATE SET declined = "
+                       "consent_declines.declined + 1",
+                       study_id);
         tx.commit();
         return 0;
     });

@@ -40,6 +40,11 @@ public:
     int64_t ensure_study(const Protocol& protocol) override;
     int64_t ensure_participant(int64_t study_id, const std::string& code, int* number) override;
     void claim_participant(const std::string& code) override;
+    // pg_advisory_unlock on this connection (a lost connection released it already).
+    void release_participant(const std::string& code) override;
+    OnlineSession enrol_online(int64_t study_id, const std::string& code,
+                               const OnlineEnrolment& how,
+                               const SessionEnvironment& env) override;
     void check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) override;
     SessionRow create_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
                               uint64_t seed, const SessionEnvironment& env) override;
@@ -47,8 +52,10 @@ public:
     bool has_completed_session(const std::string& code) override;
     std::vector<TrialRow> trials(int64_t session_id) override;
     int begin_segment(int64_t session_id, const SessionEnvironment& env) override;
+    int resume_segment(int64_t session_id, const SessionEnvironment& env) override;
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
+    void count_declined_consent(int64_t study_id) override;
     bool has_consent(int64_t session_id) override;
     // Journal first, then the server (see the file comment); the return value is the
     // server's when it answered, else whether every trial is now recorded here.

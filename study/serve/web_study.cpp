@@ -1,5 +1,6 @@
 // `lucent serve`'s core (web_study.h). [SECTIONS] tokens and names | request fields |
-// sessions (start, resume, reload) | actions (continue, decline, answer, environment) |
+// sessions (pending until consent, enrol, resume, reload, idle) | actions (continue,
+// decline, answer, environment) |
 // the state a page shows.
 #include "serve/web_study.h"
 
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <random>
 #include <stdexcept>
 
@@ -201,12 +203,19 @@ std::optional<std::string> image_of_target(std::string_view target,
 }
 
 // ---- [SECTION] sessions -----------------------------------------------------------------
+// A page is `pending` from its first request until the participant agrees on the consent
+// screen: held in memory only (the session UUID and so its token, the seed, what the
+// browser said), nothing stored. Agreeing enrols it (StudyStore::enrol_online), and from
+// then on it is a session like a lab station's.
 struct WebStudy::Live {
     std::string code;
-    SessionRow session;
+    bool pending = false;
+    uint64_t seed = 0;  // pending: the seed its plan will have
+    SessionRow session;  // pending: only the UUID
     std::string token;
     std::vector<TrialRow> trials;  // as stored when loaded; `answered` kept up to date
     std::optional<SessionFlow> flow;
+    std::chrono::system_clock::time_point seen;  // the page's last request
     // What the browser said about itself (the segment's environment).
     std::string user_agent;
     int window_width = 0, window_height = 0, screen_width = 0, screen_height = 0;
@@ -215,20 +224,98 @@ struct WebStudy::Live {
     std::string prolific_study, prolific_session;
 };
 
+namespace {
+
+// The view a pending page's consent screen has: a new SessionFlow's first screen.
+constexpr int kConsentView = 1;
+
+const char* const kWithdrawn =
+    "this session was withdrawn: nothing more of it is recorded. You may close this window.";
+
+std::string iso8601(std::chrono::system_clock::time_point t) {
+    const std::time_t secs = std::chrono::system_clock::to_time_t(t);
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                        t.time_since_epoch()).count() % 1000;
+    std::tm tm{};
+    gmtime_r(&secs, &tm);
+    char out[64];
+    std::snprintf(out, sizeof out, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
+                  tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
+                  static_cast<int>(ms < 0 ? ms + 1000 : ms));
+    return out;
+}
+
+}  // namespace
+
 WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions options)
     : protocol_(protocol), store_(store), options_(std::move(options)) {
     for (const StimulusSpec& s : protocol_.stimuli)
         if (!options_.images.count(s.id))
             throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id + "'");
+    if (!options_.clock) options_.clock = [] { return std::chrono::system_clock::now(); };
     study_id_ = store_.ensure_study(protocol_);
     store_.check_stimulus_values(options_.environment.stimuli);
 }
 
 WebStudy::~WebStudy() = default;
 
+std::chrono::system_clock::time_point WebStudy::now() const { return options_.clock(); }
+
+std::string WebStudy::active_since_utc() const {
+    return iso8601(now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                               options_.idle_timeout));
+}
+
 size_t WebStudy::live_sessions() const {
     std::lock_guard lock(mutex_);
-    return live_.size();
+    size_t n = 0;
+    for (const auto& [code, live] : live_) n += live->pending ? 0 : 1;
+    return n;
+}
+
+size_t WebStudy::pending_sessions() const {
+    std::lock_guard lock(mutex_);
+    size_t n = 0;
+    for (const auto& [code, live] : live_) n += live->pending ? 1 : 0;
+    return n;
+}
+
+size_t WebStudy::release_idle() {
+    std::lock_guard lock(mutex_);
+    return release_idle_locked();
+}
+
+size_t WebStudy::release_idle_locked() {
+    const auto cutoff = now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                                    options_.idle_timeout);
+    std::vector<std::string> idle;
+    for (const auto& [code, live] : live_)
+        if (live->seen < cutoff) idle.push_back(code);
+    for (const std::string& code : idle) {
+        Live& live = *live_.at(code);
+        if (!live.pending && live.flow && live.flow->answered_trials() < live.flow->total_trials()) {
+            try {
+                store_.set_status(live.session.id, "paused", false);  // as a lab quit leaves it
+            } catch (const std::exception&) {
+                // Withdrawn, completed meanwhile, or the server away: the claim ends anyway.
+            }
+        }
+        drop(code);
+    }
+    return idle.size();
+}
+
+void WebStudy::drop(const std::string& code) {
+    const auto it = live_.find(code);
+    if (it == live_.end()) return;
+    const bool loaded = !it->second->pending;
+    live_.erase(it);
+    if (!loaded) return;
+    try {
+        store_.release_participant(code);
+    } catch (const std::exception&) {
+        // A release that fails leaves the lock to the connection's end (its next loss).
+    }
 }
 
 WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
@@ -237,14 +324,25 @@ WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
                                     " bytes is over the limit of " +
                                     std::to_string(options_.max_body_bytes));
     json request;
+    std::string last_key;  // the field being parsed, for a number the parser cannot hold
     try {
-        request = json::parse(body);
-    } catch (const json::parse_error& e) {
+        request = json::parse(body, [&](int, json::parse_event_t event, json& parsed) {
+            if (event == json::parse_event_t::key && parsed.is_string())
+                last_key = parsed.get<std::string>();
+            return true;
+        });
+    } catch (const json::out_of_range&) {
+        // A number beyond a double (e.g. 1e999): the parser stops at it.
+        return error_reply(400, last_key.empty()
+                                    ? std::string("a number in the request is beyond a double's range")
+                                    : "field '" + last_key + "' holds a number beyond a double's range");
+    } catch (const json::exception& e) {
         return error_reply(400, std::string("malformed JSON: ") + e.what());
     }
     if (!request.is_object()) return error_reply(400, "the request body must be a JSON object");
     std::lock_guard lock(mutex_);
     try {
+        release_idle_locked();
         if (endpoint == "session") return start(request);
         if (endpoint == "state" || endpoint == "continue" || endpoint == "decline" ||
             endpoint == "answer" || endpoint == "environment")
@@ -293,6 +391,7 @@ WebStudy::Live& WebStudy::load(const std::string& code, const SessionRow& sessio
     live->code = code;
     live->session = session;
     live->token = token;
+    live->seen = now();
     Live& out = *live;
     live_[code] = std::move(live);
     return out;
@@ -350,17 +449,22 @@ WebReply WebStudy::start(const json& body) {
         "participant '" + code + "' has a session in progress in another browser; continue "
         "it there (the study link in that browser holds its key)";
 
-    // A page (re)loaded for a session in progress: a new segment, from the first
-    // unanswered trial, as `lucent run --resume` does.
-    std::optional<SessionRow> unfinished;
-    if (const auto it = live_.find(code); it != live_.end())
-        unfinished = it->second->session;
-    else
-        unfinished = store_.unfinished_session(code);
+    std::optional<SessionRow> unfinished = store_.unfinished_session(code);
+    if (const auto it = live_.find(code); it != live_.end() && !it->second->pending &&
+                                          (!unfinished || unfinished->id != it->second->session.id)) {
+        // The loaded session is no longer an unfinished one of the store: completed, or
+        // withdrawn (`participants withdraw`) while its page was open.
+        const bool same_page = same_secret_text(token, it->second->token);
+        drop(code);
+        if (same_page && !store_.has_completed_session(code) && !store_.participant_counts(code))
+            throw RequestError(410, kWithdrawn);
+    }
     if (unfinished && store_.complete_session_if_answered(unfinished->id)) {
-        live_.erase(code);
+        drop(code);
         unfinished.reset();
     }
+    // A page (re)loaded for a session in progress: from the first unanswered trial, as
+    // `lucent run --resume` does; a new segment only once the last one has an answer.
     if (unfinished) {
         const std::string expected = session_token(options_.secret, code, unfinished->uuid);
         if (!same_secret_text(token, expected)) throw RequestError(403, in_progress);
@@ -369,7 +473,7 @@ WebReply WebStudy::start(const json& body) {
         take_browser(probe);
         const SessionEnvironment env = environment_for(probe);
         store_.set_status(unfinished->id, "running", false);
-        store_.begin_segment(unfinished->id, env);
+        store_.resume_segment(unfinished->id, env);
         Live& live = load(code, *unfinished, expected);
         take_browser(live);
         live.trials = store_.trials(unfinished->id);
@@ -380,28 +484,107 @@ WebReply WebStudy::start(const json& body) {
         return {200, to_text(reply)};
     }
     if (store_.has_completed_session(code)) {
+        drop(code);
         json reply = done_state();
         reply["already_completed"] = true;
         return {200, to_text(reply)};
     }
-    // A new participant: number and cell as on a lab station, the whole plan stored
-    // before trial 1.
-    store_.claim_participant(code);
-    int number = 0;
-    const int64_t participant_id = store_.ensure_participant(study_id_, code, &number);
-    const uint64_t seed = static_cast<uint64_t>(random_seed());
-    Live probe;
-    take_browser(probe);
-    const SessionRow session = store_.create_session(
-        study_id_, participant_id, plan_trials(protocol_, seed, number), seed,
-        environment_for(probe));
-    Live& live = load(code, session, session_token(options_.secret, code, session.uuid));
+    // A new participant: the consent screen, nothing stored (the same page reloaded
+    // keeps its pending session; another page without its token starts a new one).
+    const auto it = live_.find(code);
+    if (it == live_.end() || !it->second->pending || !same_secret_text(token, it->second->token)) {
+        drop(code);
+        if (live_.size() >= options_.max_pending) {
+            // Forget the pending page idle longest (it holds nothing but memory).
+            auto oldest = live_.end();
+            for (auto i = live_.begin(); i != live_.end(); ++i)
+                if (i->second->pending && (oldest == live_.end() || i->second->seen < oldest->second->seen))
+                    oldest = i;
+            if (oldest != live_.end()) live_.erase(oldest);
+        }
+        SessionRow planned;
+        planned.uuid = new_uuid_v4();
+        Live& live = load(code, planned, session_token(options_.secret, code, planned.uuid));
+        live.pending = true;
+        live.seed = static_cast<uint64_t>(random_seed());
+    }
+    Live& live = *live_.at(code);
     take_browser(live);
-    live.trials = store_.trials(session.id);
-    live.flow.emplace(protocol_, store_, session.id, live.trials, false, ms_to_ns(t_ms));
-    json reply = state(live);
+    live.seen = now();
+    if (protocol_.screens.consent.empty()) {
+        // No consent screen in the protocol: the session starts at once.
+        WebReply reply = consent(live, false, t_ms, t_ms);
+        if (reply.status == 200) {
+            json out = json::parse(reply.body);
+            out["token"] = live_.at(code)->token;
+            reply.body = to_text(out);
+        }
+        return reply;
+    }
+    json reply = pending_state(live);
     reply["token"] = live.token;
     return {200, to_text(reply)};
+}
+
+// The answer on a pending page's consent screen. Declined: one more in the study's count,
+// the page forgotten. Agreed: enrolled (number, cell, session, plan) and consent recorded
+// through the same SessionFlow as in the lab.
+WebReply WebStudy::consent(Live& live, bool decline, double shown_ms, double t_ms) {
+    const std::string code = live.code;
+    if (decline) {
+        store_.count_declined_consent(study_id_);
+        drop(code);
+        return {200, to_text(json{{"screen", "declined"},
+                          {"text", "You did not agree to take part. Nothing of yours was "
+                                   "stored; the study counts only that one person declined. "
+                                   "You may close this window."}})};
+    }
+    store_.claim_participant(code);
+    OnlineSession enrolled;
+    try {
+        OnlineEnrolment how;
+        how.session_uuid = live.session.uuid;
+        how.seed = live.seed;
+        how.cells = protocol_.randomisation.counterbalance_blocks
+                        ? latin_square_rows(static_cast<int>(protocol_.blocks.size()))
+                        : 1;
+        how.active_since_utc = active_since_utc();
+        how.plan = [&](int cell) { return plan_trials(protocol_, live.seed, cell); };
+        enrolled = store_.enrol_online(study_id_, code, how, environment_for(live));
+    } catch (...) {
+        store_.release_participant(code);
+        throw;
+    }
+    live.pending = false;
+    live.session = enrolled.session;
+    live.trials = store_.trials(enrolled.session.id);
+    SessionFlow flow(protocol_, store_, enrolled.session.id, live.trials, false,
+                     ms_to_ns(shown_ms));
+    if (flow.screen() == Screen::Consent) {
+        flow.presented(flow.serial(), ms_to_ns(shown_ms));
+        flow.key({Key::Enter, 0, ms_to_ns(t_ms)});  // records consent
+    }
+    live.flow.emplace(flow);
+    return {200, to_text(state(live))};
+}
+
+json WebStudy::pending_state(const Live& live) const {
+    (void)live;
+    json out;
+    out["screen"] = "consent";
+    out["view"] = kConsentView;
+    out["title"] = protocol_.title;
+    out["background"] = css_colour(protocol_.background);
+    int main = static_cast<int>(protocol_.catch_trials.size());
+    for (const Block& b : protocol_.blocks)
+        main += static_cast<int>(b.stimuli.size()) * b.repeats;
+    out["progress"] = {{"done", 0}, {"total", main}};
+    json questions = json::array();
+    for (const Question& q : protocol_.questions)
+        questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
+    out["questions"] = questions;
+    out["text"] = protocol_.screens.consent;
+    return out;
 }
 
 // ---- [SECTION] actions -------------------------------------------------------------------
@@ -411,56 +594,95 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
     const std::string code = token.substr(0, dot == std::string::npos ? 0 : dot);
     const auto it = live_.find(code);
     if (participant_code_problem(code).empty() && it == live_.end()) {
-        // Not loaded here (the server restarted, or the session ended): the page starts
-        // again through /api/session, which checks the token against the store.
+        // Not loaded here (the server restarted, the page was idle, or the session
+        // ended): the page starts again through /api/session, which checks the token
+        // against the store.
         throw RequestError(409, "session of '" + code + "' is not loaded; start it again "
                                 "(POST /api/session with its token)");
     }
     if (it == live_.end() || !same_secret_text(token, it->second->token))
         throw RequestError(403, "unknown session token");
     Live& live = *it->second;
-    SessionFlow& flow = *live.flow;
+    live.seen = now();
 
-    if (endpoint == "state") return {200, to_text(state(live))};
-    if (endpoint == "environment") {
-        live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);
-        store_.update_environment(live.session.id, environment_for(live));
+    if (live.pending) {
+        if (endpoint == "state") return {200, to_text(pending_state(live))};
+        if (endpoint == "environment") {
+            live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);  // kept in memory
+            return {200, to_text(pending_state(live))};
+        }
+        if (endpoint == "answer")
+            throw RequestError(409, "the consent screen is shown; no trial yet");
+        const double view = *number_field(body, "view", 0, 1e9, true);
+        const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
+        const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+        if (static_cast<int>(view) != kConsentView)
+            throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
+                                        " is no longer shown (now view " +
+                                        std::to_string(kConsentView) + ")");
+        if (t_ms < shown_ms)
+            throw RequestError(400, "the key came before the screen was shown (t_ms < shown_ms)");
+        return consent(live, endpoint == "decline", shown_ms, t_ms);
+    }
+
+    try {
+        SessionFlow& flow = *live.flow;
+        if (endpoint == "state") return {200, to_text(state(live))};
+        if (endpoint == "environment") {
+            live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);
+            store_.update_environment(live.session.id, environment_for(live));
+            return {200, to_text(state(live))};
+        }
+        if (endpoint == "answer") {
+            WebReply reply = answer(live, body);
+            if (live.flow->answered_trials() == live.flow->total_trials())
+                store_.release_participant(code);  // completed: the debrief writes nothing
+            return reply;
+        }
+
+        // continue / decline: Enter (or N on the consent screen) on the view shown.
+        const double view = *number_field(body, "view", 0, 1e9, true);
+        const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
+        const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+        if (static_cast<int>(view) != flow.serial())
+            throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
+                                        " is no longer shown (now view " +
+                                        std::to_string(flow.serial()) + ")");
+        const Screen screen = flow.screen();
+        const bool decline = endpoint == "decline";
+        if (decline && screen != Screen::Consent)
+            throw RequestError(409, "declining is possible only on the consent screen");
+        if (screen == Screen::Blank || screen == Screen::Trial || screen == Screen::Done)
+            throw RequestError(409, std::string("the ") + screen_name(screen) +
+                                        " screen is not continued with Enter");
+        SessionFlow next = flow;  // changes kept only when the key was taken
+        next.presented(next.serial(), ms_to_ns(shown_ms));
+        next.key({decline ? Key::Decline : Key::Enter, 0, ms_to_ns(t_ms)});
+        if (next.serial() == flow.serial() && !next.finished())
+            throw RequestError(400, "the key came before the screen was shown (t_ms < shown_ms)");
+        if (decline) {
+            // A session stored before consent (by a lab station, or an older lucent
+            // serve) is left 'aborted', as a lab decline leaves it.
+            drop(code);
+            return {200, to_text(json{{"screen", "declined"},
+                              {"text", "You did not agree to take part. You may close this "
+                                       "window."}})};
+        }
+        live.flow.emplace(next);
+        if (next.screen() == Screen::Done) {
+            drop(code);
+            return {200, to_text(done_state())};
+        }
         return {200, to_text(state(live))};
+    } catch (const StoreError&) {
+        // Refused by the store: when because the participant was withdrawn while the page
+        // was open, the page is told so (and forgotten) instead of the store's words.
+        if (!store_.participant_counts(code)) {
+            drop(code);
+            throw RequestError(410, kWithdrawn);
+        }
+        throw;
     }
-    if (endpoint == "answer") return answer(live, body);
-
-    // continue / decline: Enter (or N on the consent screen) on the view shown.
-    const double view = *number_field(body, "view", 0, 1e9, true);
-    const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
-    const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
-    if (static_cast<int>(view) != flow.serial())
-        throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
-                                    " is no longer shown (now view " +
-                                    std::to_string(flow.serial()) + ")");
-    const Screen screen = flow.screen();
-    const bool decline = endpoint == "decline";
-    if (decline && screen != Screen::Consent)
-        throw RequestError(409, "declining is possible only on the consent screen");
-    if (screen == Screen::Blank || screen == Screen::Trial || screen == Screen::Done)
-        throw RequestError(409, std::string("the ") + screen_name(screen) +
-                                    " screen is not continued with Enter");
-    SessionFlow next = flow;  // changes kept only when the key was taken
-    next.presented(next.serial(), ms_to_ns(shown_ms));
-    next.key({decline ? Key::Decline : Key::Enter, 0, ms_to_ns(t_ms)});
-    if (next.serial() == flow.serial() && !next.finished())
-        throw RequestError(400, "the key came before the screen was shown (t_ms < shown_ms)");
-    if (decline) {
-        live_.erase(code);
-        return {200, to_text(json{{"screen", "declined"},
-                          {"text", "You did not agree to take part; nothing of yours is kept "
-                                   "but that choice. You may close this window."}})};
-    }
-    live.flow.emplace(next);
-    if (next.screen() == Screen::Done) {
-        live_.erase(code);
-        return {200, to_text(done_state())};
-    }
-    return {200, to_text(state(live))};
 }
 
 WebReply WebStudy::answer(Live& live, const json& body) {

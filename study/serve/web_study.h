@@ -15,8 +15,10 @@
 // a copy of the participant's flow, kept only when it succeeded.
 #include <nlohmann/json_fwd.hpp>
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -46,6 +48,15 @@ struct WebStudyOptions {
     SessionEnvironment environment;
     std::map<std::string, WebImage> images;  // by stimulus id, every protocol stimulus
     size_t max_body_bytes = 64 * 1024;       // larger API bodies: 413
+    // A page that sent nothing for this long is put aside (release_idle): its claim on
+    // the participant ends, and its session no longer holds a cell (abandoned) once the
+    // store has seen no activity of it for as long. A later request re-loads it.
+    std::chrono::milliseconds idle_timeout = std::chrono::minutes(30);
+    // Wall time (tests pass a fake one).
+    std::function<std::chrono::system_clock::time_point()> clock;
+    // Pages shown the consent screen and not yet answered (held in memory only); beyond
+    // this many, the one idle longest is forgotten.
+    size_t max_pending = 10000;
 };
 
 // Field limits of API requests (beyond them: 400).
@@ -78,8 +89,14 @@ public:
     // decline, answer, environment), `body` its JSON. Thread-safe (one at a time).
     WebReply handle(std::string_view endpoint, std::string_view body);
 
-    // Participants whose session is loaded now (a page opened and not yet done).
+    // Participants whose session is loaded now (consented, a page open and not yet done).
     size_t live_sessions() const;
+    // Pages on the consent screen (nothing of them stored).
+    size_t pending_sessions() const;
+    // Puts aside every page idle for longer than idle_timeout: a loaded session's claim
+    // ends (its status becomes paused), a pending one is forgotten. Also runs at the
+    // start of every request. Returns how many were put aside.
+    size_t release_idle();
 
 private:
     struct Live;
@@ -90,6 +107,13 @@ private:
     nlohmann::json done_state() const;
     SessionEnvironment environment_for(const Live& live) const;
     Live& load(const std::string& code, const SessionRow& session, const std::string& token);
+    // Forgets a page; ends the claim when its session was loaded.
+    void drop(const std::string& code);
+    size_t release_idle_locked();
+    WebReply consent(Live& live, bool decline, double shown_ms, double t_ms);
+    nlohmann::json pending_state(const Live& live) const;
+    std::chrono::system_clock::time_point now() const;
+    std::string active_since_utc() const;
 
     const Protocol& protocol_;
     StudyStore& store_;

@@ -69,6 +69,7 @@
     busy = false;
     if (status === 200) return show(reply);
     if (status === 409 || status === 0) return setTimeout(start, status ? 0 : 2000);
+    if (status === 410) localStorage.removeItem(tokenKey);  // withdrawn: the key is spent
     message(reply.error || 'error ' + status);
   }
 
@@ -107,7 +108,10 @@
     el('progress').hidden = !progress || s.screen === 'consent';
     if (progress) el('progress').textContent = progress.done + ' of ' + progress.total;
     if (s.screen === 'done') return finish(s);
-    if (s.screen === 'declined') return message(s.text, 'declined');
+    if (s.screen === 'declined') {
+      localStorage.removeItem(tokenKey);
+      return message(s.text, 'declined');
+    }
     if (s.screen === 'trial') return beginTrial(s);
     only('text-screen');
     el('text').textContent = s.text;

@@ -481,6 +481,122 @@ TEST_P(Backend, EightStationsAtOnceLoseNothingAndBalanceTheCells) {
     EXPECT_EQ(store->query_int("SELECT count(DISTINCT number) FROM participants"), kStations);
 }
 
+// Issue 26 item 7: a claim ends when released, so another station may run the code; on
+// PostgreSQL the connection holds no advisory lock afterwards.
+TEST_P(Backend, AReleasedClaimCanBeTakenByAnotherStationAtOnce) {
+    auto serve = open("serve");
+    auto lab = open("lab");
+    for (int i = 0; i < 20; ++i) serve->claim_participant("web" + std::to_string(i));
+    EXPECT_THROW(lab->claim_participant("web3"), StoreError);
+    for (int i = 0; i < 20; ++i) serve->release_participant("web" + std::to_string(i));
+    serve->release_participant("never-claimed");  // a no-op
+    if (is_server())
+        EXPECT_EQ(serve->query_int("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' "
+                                   "AND pid = pg_backend_pid()"),
+                  0);
+    EXPECT_NO_THROW(lab->claim_participant("web3"));
+    // Now the lab holds it: the serve store is refused, and may claim again once released.
+    EXPECT_THROW(serve->claim_participant("web3"), StoreError);
+    lab->release_participant("web3");
+    EXPECT_NO_THROW(serve->claim_participant("web3"));
+}
+
+std::string four_block_protocol_text() {
+    std::string text = lucent::test::kSmallProtocol;
+    const std::string main = "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
+    text.replace(text.find(main), main.size(),
+                 "[[blocks]]\nid = \"main\"\nstimuli = [\"a\"]\n\n"
+                 "[[blocks]]\nid = \"second\"\nstimuli = [\"b\"]\n\n"
+                 "[[blocks]]\nid = \"third\"\nstimuli = [\"c\"]\n\n"
+                 "[[blocks]]\nid = \"fourth\"\nstimuli = [\"b\", \"c\"]\n");
+    return text;
+}
+
+// Issue 26 item 8: serve processes and lab stations enrolling at once on one store never
+// share a number, and the online arrivals fill the cells evenly (counted under the lock
+// that hands out numbers).
+TEST_P(Backend, OnlineEnrolmentsFromManyConnectionsAtOnceStayUniqueAndBalanced) {
+    const Protocol p = parse_protocol(four_block_protocol_text(), "four_blocks.toml");
+    ASSERT_EQ(latin_square_rows(4), 4);
+    open()->ensure_study(p);
+    constexpr int kServers = 8, kEach = 2;
+    std::vector<std::string> errors(kServers);
+    std::vector<std::thread> threads;
+    for (int k = 0; k < kServers; ++k)
+        threads.emplace_back([&, k] {
+            try {
+                auto store = open("serve" + std::to_string(k));
+                const int64_t study = store->ensure_study(p);
+                for (int i = 0; i < kEach; ++i) {
+                    OnlineEnrolment how;
+                    how.seed = static_cast<uint64_t>(k * 10 + i);
+                    how.cells = 4;
+                    how.active_since_utc = "2000-01-01T00:00:00.000Z";
+                    how.plan = [&](int cell) { return plan_trials(p, how.seed, cell); };
+                    // Codes whose digits would all pick one cell, and digitless ones.
+                    const std::string code = i == 0 ? "P0" + std::to_string(k * 4)
+                                                    : "web-" + std::string(1, char('a' + k));
+                    store->enrol_online(study, code, how, {});
+                }
+                // A lab station among them keeps the code's digits.
+                if (k == 0) {
+                    int n = 0;
+                    store->ensure_participant(study, "LAB90", &n);
+                    if (n != 90) errors[k] = "lab number " + std::to_string(n);
+                }
+            } catch (const std::exception& e) {
+                errors[k] = e.what();
+            }
+        });
+    for (std::thread& t : threads) t.join();
+    for (const std::string& e : errors) EXPECT_EQ(e, "");
+    auto store = open();
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions"), kServers * kEach);
+    EXPECT_EQ(store->query_int("SELECT count(DISTINCT number) FROM participants"),
+              kServers * kEach + 1);
+    // The online numbers: 1..16 (the lab's 90 may come before some: then 91..).
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM participants WHERE code <> 'LAB90' AND "
+                               "(number BETWEEN 1 AND 16 OR number BETWEEN 91 AND 106)"),
+              kServers * kEach);
+    for (int cell = 0; cell < 4; ++cell)
+        EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE cell = " +
+                                   std::to_string(cell)),
+                  kServers * kEach / 4)
+            << "cell " << cell;
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE allocation LIKE "
+                               "'online arrival %: cell % of 4, the fewest completed + active %'"),
+              kServers * kEach);
+    // Each session's plan is its cell's Latin-square row.
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE block_order NOT LIKE '%,%,%,%'"), 0);
+}
+
+// Issue 26 item 10: a reload replaces a segment nothing was answered in.
+TEST_P(Backend, AResumeSegmentReplacesASegmentWithoutAnswersAndAddsOneAfterAnAnswer) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    int number = 0;
+    const int64_t pid = store->ensure_participant(study, "P1", &number);
+    SessionEnvironment env;
+    env.machine_id = "first";
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 1, number), 1, env);
+    for (int i = 0; i < 10; ++i) {
+        env.machine_id = "reload" + std::to_string(i);
+        EXPECT_EQ(store->resume_segment(s.id, env), 1);
+    }
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments"), 1);
+    // The replaced first segment's environment is the session row's too.
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE machine_id = 'reload9'"), 1);
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
+    EXPECT_EQ(store->resume_segment(s.id, env), 2);
+    EXPECT_EQ(store->resume_segment(s.id, env), 2);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments"), 2);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM trials t JOIN session_segments g ON "
+                               "g.id = t.segment_id AND g.segment = 1"),
+              1);
+}
+
 INSTANTIATE_TEST_SUITE_P(Stores, Backend, ::testing::Values("sqlite", "postgresql"), param_name);
 
 // ---- the server alone: schema, URI, outages ----------------------------------------------

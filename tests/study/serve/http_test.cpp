@@ -1,7 +1,11 @@
 // The real `lucent serve` over loopback, on every store backend: hostile HTTP requests,
 // and 50 simulated participants at once. Expected values come from the study folder the
 // test wrote (pictures of known bytes, the protocol's trial count and scales).
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -110,6 +114,14 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     post("session", "{\"participant\": \"\xff\"}", 400);
     post("session", json{{"participant", "../../P1"}, {"t_ms", 1}}.dump(), 400);
     post("session", json{{"participant", std::string(1000, 'x')}, {"t_ms", 1}}.dump(), 400);
+    // A number beyond a double: 400 naming the field, not a 500 (issue 26 item 10).
+    post("session", "{\"participant\": \"P1\", \"t_ms\": 1e999}", 400);
+    {
+        auto r = http.Post("/api/session", "{\"participant\": \"P1\", \"t_ms\": -1e999}",
+                           "application/json");
+        ASSERT_TRUE(r);
+        EXPECT_NE(r->body.find("'t_ms'"), std::string::npos) << r->body;
+    }
     // A participant with a session, then someone else's requests against it.
     Page p1{lucent::test::over_http(http)};
     p1.catch_rating = 5;  // the catch trial asks for 5 (the 5-point scale's top)
@@ -179,6 +191,71 @@ TEST_P(ServeHttp, FiftyParticipantsAtOnceOverHttpLoseAndDuplicateNothing) {
     EXPECT_EQ(count("SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
                     "WHERE t.catch = 1 AND r.rating = 5"),
               kPages * 2);
+}
+
+// Issue 26 item 10: slow clients trickling header lines are cut at the request deadline,
+// so two of them cannot hold a 2-worker server; a normal request is answered promptly.
+TEST_P(ServeHttp, SlowClientsTricklingHeadersAreCutAndANormalRequestIsAnswered) {
+    if (GetParam() != "sqlite") GTEST_SKIP() << "the HTTP layer is the same for every store";
+    server_.reset();
+    server_ = std::make_unique<lucent::test::ServeProcess>(
+        protocol_, db_, dir_.string(),
+        std::vector<std::string>{"--threads", "2", "--request-timeout", "0.5"});
+    ASSERT_GT(server_->port(), 0) << server_->first_line();
+    auto connect_slow = [&] {
+        const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_port = htons(static_cast<uint16_t>(server_->port()));
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        EXPECT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+        const std::string line = "POST /api/session HTTP/1.1\r\nHost: x\r\n";
+        ::send(fd, line.data(), line.size(), MSG_NOSIGNAL);
+        return fd;
+    };
+    const int slow[2] = {connect_slow(), connect_slow()};
+    std::atomic<bool> stop{false};
+    std::atomic<int> cut{0};
+    std::atomic<double> cut_after{0};
+    const auto start = std::chrono::steady_clock::now();
+    // Each slow client sends one more header line every 200 ms (well within the read
+    // timeout) until the server closes its connection, for at most 4 s.
+    std::vector<std::thread> trickle;
+    for (int fd : slow)
+        trickle.emplace_back([&, fd] {
+            while (!stop && std::chrono::steady_clock::now() - start < std::chrono::seconds(4)) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(200));
+                const std::string header = "X-Slow: 1\r\n";
+                char byte = 0;
+                const bool closed = ::send(fd, header.data(), header.size(), MSG_NOSIGNAL) < 0 ||
+                                    ::recv(fd, &byte, 1, MSG_DONTWAIT) == 0;
+                if (closed) {
+                    cut_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                    ++cut;
+                    return;
+                }
+            }
+        });
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // both workers taken
+    httplib::Client http("127.0.0.1", server_->port());
+    http.set_read_timeout(10);
+    const auto asked = std::chrono::steady_clock::now();
+    auto page = http.Get("/");
+    const double answered_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+    stop = true;
+    for (std::thread& t : trickle) t.join();
+    for (int fd : slow) ::close(fd);
+    ASSERT_TRUE(page);
+    EXPECT_EQ(page->status, 200);
+    // Within the 0.5 s deadline plus the watchdog's tick and scheduling, far below the 4 s
+    // the slow clients would otherwise hold both workers.
+    EXPECT_LT(answered_s, 2.0);
+    EXPECT_EQ(cut, 2);
+    EXPECT_LT(cut_after.load(), 2.5);
+    std::printf("[ measured ] a normal request answered after %.2f s beside 2 slow clients\n",
+                answered_s);
+    EXPECT_EQ(server_->stop(), 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Stores, ServeHttp, ::testing::Values("sqlite", "postgresql"), param_name);

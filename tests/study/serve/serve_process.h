@@ -91,7 +91,8 @@ inline constexpr int kServeStudyTrials = 5;  // 1 practice + 3 rated + 1 catch
 class ServeProcess {
 public:
     // `state_dir`: the server's journal and key folder (LUCENT_JOURNAL_DIR).
-    ServeProcess(const std::string& protocol, const std::string& db, const std::string& state_dir) {
+    ServeProcess(const std::string& protocol, const std::string& db, const std::string& state_dir,
+                 const std::vector<std::string>& extra_args = {}) {
         int out[2];
         if (pipe(out) != 0) return;
         pid_ = fork();
@@ -100,8 +101,13 @@ public:
             close(out[0]);
             close(out[1]);
             setenv("LUCENT_JOURNAL_DIR", state_dir.c_str(), 1);
-            execl(LUCENT_EXECUTABLE, LUCENT_EXECUTABLE, "serve", protocol.c_str(), "--db",
-                  db.c_str(), "--listen", "127.0.0.1:0", static_cast<char*>(nullptr));
+            std::vector<std::string> args = {LUCENT_EXECUTABLE, "serve", protocol, "--db", db,
+                                             "--listen", "127.0.0.1:0"};
+            args.insert(args.end(), extra_args.begin(), extra_args.end());
+            std::vector<char*> argv;
+            for (std::string& a : args) argv.push_back(a.data());
+            argv.push_back(nullptr);
+            execv(LUCENT_EXECUTABLE, argv.data());
             _exit(127);
         }
         close(out[1]);

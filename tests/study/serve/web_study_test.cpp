@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <set>
 #include <thread>
@@ -60,20 +61,54 @@ protected:
         protocol_ = parse_protocol(web_protocol_text(), "web.toml");
         start_server();
     }
+    // A new, empty store with another protocol (the fixture's store holds one protocol).
+    void use_protocol(const std::string& text, const std::string& name) {
+        web_.reset();
+        store_.reset();
+        if (GetParam() == "sqlite") {
+            db_ = (dir_ / (name + ".db")).string();
+        } else {
+            db_ = lucent::test::new_postgres_database(name);
+            init_study_store(db_);
+        }
+        protocol_ = parse_protocol(text, name + ".toml");
+        start_server();
+    }
     void start_server() {
         web_.reset();
         store_.reset();
-        StoreOptions options;
-        options.journal_path = (dir_ / "journal.db").string();
-        options.retry_interval_ms = 0;
-        store_ = open_study_store(db_, options);
+        store_ = open_store("journal");
         WebStudyOptions o;
         o.secret = "test secret";
         o.environment.machine_id = "server-machine";
         o.environment.software_version = "test";
         o.environment.build_hash = "test";
+        // What each segment shows: one segment_stimuli row per stimulus.
+        for (const StimulusSpec& s : protocol_.stimuli) {
+            StimulusProvenance p;
+            p.stimulus = s.id;
+            p.source = "images";
+            p.technique = s.technique;
+            p.mesh = "sphere";
+            p.mesh_hash = "mesh-hash";
+            p.values = {{"knob", "1"}};
+            p.software_version = "test";
+            p.build_hash = "test";
+            p.file = s.id + ".png";
+            p.content_hash = "content-" + s.id;
+            o.environment.stimuli.push_back(p);
+        }
         for (const StimulusSpec& s : protocol_.stimuli) o.images[s.id] = {64, 48};
+        o.idle_timeout = std::chrono::minutes(30);
+        o.clock = [this] { return now_; };
         web_ = std::make_unique<WebStudy>(protocol_, *store_, o);
+    }
+    // Another connection to the same store (a lab station, a second serve process).
+    std::unique_ptr<StudyStore> open_store(const std::string& journal) {
+        StoreOptions options;
+        options.journal_path = (dir_ / (journal + ".db")).string();
+        options.retry_interval_ms = 0;
+        return open_study_store(db_, options);
     }
     int64_t count(const std::string& sql) { return store_->query_int(sql); }
     int64_t responses() { return count("SELECT count(*) FROM responses"); }
@@ -83,6 +118,8 @@ protected:
     Protocol protocol_;
     std::unique_ptr<StudyStore> store_;
     std::unique_ptr<WebStudy> web_;
+    // The server's wall clock: the real time until a test moves it on.
+    std::chrono::system_clock::time_point now_ = std::chrono::system_clock::now();
 };
 
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
@@ -167,8 +204,15 @@ TEST_P(Serve, TheRefreshEstimateIsStoredWithTheSegment) {
     Page page{direct(*web_)};
     page.open({{"participant", "P2"}});
     page.call("environment", {{"refresh_hz", 59.94}});
+    // Kept in memory on the consent screen; stored with the segment once they agree.
+    EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 0);
+    page.enter();
     EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE abs(measured_refresh_hz - "
                     "59.94) < 1e-9"),
+              1);
+    page.call("environment", {{"refresh_hz", 120}});
+    EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE abs(measured_refresh_hz - "
+                    "120) < 1e-9"),
               1);
     page.call("environment", {{"refresh_hz", 0}}, 400);
     page.call("environment", {{"refresh_hz", "fast"}}, 400);
@@ -182,6 +226,9 @@ TEST_P(Serve, ProlificIdsNameTheParticipantAndAreStored) {
                  {"SESSION_ID", "abc123XYZ"}}}});
     EXPECT_EQ(page.state["screen"], "consent");
     EXPECT_EQ(page.token.rfind("5f1a2b3c4d5e6f7a8b9c0d1e.", 0), 0u);
+    // Nothing of them is stored before they agree (issue 26 item 5).
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 0);
+    page.enter();
     EXPECT_EQ(count("SELECT count(*) FROM participants WHERE code = '5f1a2b3c4d5e6f7a8b9c0d1e'"), 1);
     EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE display_mode LIKE "
                     "'%; Prolific STUDY_ID=60aabbccddeeff0011223344 SESSION_ID=abc123XYZ'"),
@@ -224,9 +271,10 @@ TEST_P(Serve, AReloadOrARestartResumesAtTheFirstUnansweredTrialOnlyWithTheToken)
         EXPECT_EQ(count("SELECT count(*) FROM session_segments"), segments);
         return page;
     };
-    resume(2);                  // a reload
+    resume(2);                  // a reload: segment 1 holds answers, so segment 2 begins
     start_server();             // the server restarted: the token still holds
-    Page page = resume(3);
+    // Nothing was answered in segment 2: the reload replaces it rather than adding one.
+    Page page = resume(2);
     page.shown = shown;
     page.run();
     EXPECT_EQ(page.state["screen"], "done");
@@ -328,10 +376,11 @@ TEST_P(Serve, TheConsentScreenCanBeDeclinedAndADoubleEnterActsOnce) {
     no.open({{"participant", "P7"}});
     const json declined = no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
     EXPECT_EQ(declined["screen"], "declined");
-    EXPECT_EQ(count("SELECT count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
-                    "WHERE p.code = 'P7' AND s.status = 'aborted' AND s.consent_utc IS NULL"),
-              1);
+    // Declined: no participant, no session; only the count (issue 26 item 5).
+    EXPECT_EQ(count("SELECT count(*) FROM participants WHERE code = 'P7'"), 0);
+    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
     EXPECT_EQ(web_->live_sessions(), 1u);
+    EXPECT_EQ(web_->pending_sessions(), 0u);
 }
 
 // Fifty pages at once through one server (threads calling handle as the HTTP server's
@@ -359,6 +408,328 @@ TEST_P(Serve, FiftyParticipantsAtOnceLoseAndDuplicateNothing) {
     EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), kPages);
     EXPECT_EQ(count("SELECT count(DISTINCT number) FROM participants"), kPages);
     for (int i = 0; i < kPages; ++i) EXPECT_EQ(static_cast<int64_t>(shown[i].size()), n);
+}
+
+// ---- issue 26: consent first, claims that end, arrival-order cells, bounded rows --------
+
+// Item 5: before consent nothing of the person is stored; a decline leaves only a count.
+TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
+    const std::string pid = "5f3a9c1b2d4e6f708192a3b4";
+    auto nothing_of_them = [&](const std::string& when) {
+        EXPECT_EQ(count("SELECT count(*) FROM participants"), 0) << when;
+        EXPECT_EQ(count("SELECT count(*) FROM sessions"), 0) << when;
+        EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 0) << when;
+        EXPECT_EQ(count("SELECT count(*) FROM segment_stimuli"), 0) << when;
+        EXPECT_EQ(count("SELECT count(*) FROM trials"), 0) << when;
+        EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE gl_renderer LIKE "
+                        "'%TestBrowser%' OR display_mode LIKE '%" + pid + "%' OR display_mode "
+                        "LIKE '%60aabbcc%'"),
+                  0)
+            << when;
+    };
+    const json prolific = {{"prolific",
+                            {{"PROLIFIC_PID", pid},
+                             {"STUDY_ID", "60aabbccddeeff0011223344"},
+                             {"SESSION_ID", "abc123XYZ"}}}};
+    Page page{direct(*web_)};
+    page.open(prolific);
+    ASSERT_EQ(page.state["screen"], "consent");
+    EXPECT_EQ(page.state["text"], "Do you agree?");
+    nothing_of_them("on the consent screen");
+    page.call("environment", {{"refresh_hz", 60}});  // the page measures its refresh
+    page.open(prolific);                             // and is reloaded
+    ASSERT_EQ(page.state["screen"], "consent");
+    nothing_of_them("after a reload and the refresh estimate");
+    EXPECT_EQ(web_->pending_sessions(), 1u);
+
+    const json declined = page.call("decline", {{"view", page.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
+    EXPECT_EQ(declined["screen"], "declined");
+    EXPECT_NE(declined["text"].get<std::string>().find("Nothing of yours was stored"), std::string::npos);
+    nothing_of_them("after the decline");
+    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(web_->pending_sessions(), 0u);
+    // The declined page's token is spent: it acts on nothing.
+    page.call("continue", {{"view", 1}, {"shown_ms", 60}, {"t_ms", 900}}, 409);
+    nothing_of_them("after the spent token was used");
+
+    // A second person declines: the count only grows.
+    Page second{direct(*web_)};
+    second.open({{"participant", "P2"}});
+    second.call("decline", {{"view", second.state["view"]}, {"shown_ms", 10}, {"t_ms", 20}});
+    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 2);
+    nothing_of_them("after the second decline");
+
+    // Agreeing stores them, with the browser's details, and the consent time.
+    Page yes{direct(*web_)};
+    yes.open(prolific);
+    yes.enter();
+    EXPECT_EQ(yes.state["screen"], "instructions");
+    EXPECT_EQ(count("SELECT count(*) FROM participants WHERE code = '" + pid + "'"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE consent_utc IS NOT NULL AND "
+                    "gl_renderer = 'TestBrowser/1.0'"),
+              1);
+    EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE display_mode LIKE "
+                    "'%Prolific STUDY_ID=60aabbccddeeff0011223344 SESSION_ID=abc123XYZ'"),
+              1);
+    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 2);
+    // The token handed out before consent is the stored session's: a reload with it
+    // resumes that session (403 without it).
+    const std::string token = yes.token;
+    yes.open(prolific);
+    EXPECT_EQ(yes.state["token"], token);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions"), 1);
+    Page stranger{direct(*web_)};
+    stranger.open(prolific, 403);
+}
+
+// Item 7: a session's claim ends with the session, so a lab station (another store
+// connection) may take the participant; on PostgreSQL no advisory lock stays behind.
+TEST_P(Serve, CompletedSessionsLeaveNoClaimBehind) {
+    constexpr int kSessions = 6;
+    for (int i = 1; i <= kSessions; ++i) {
+        Page page{direct(*web_)};
+        page.open({{"participant", "C" + std::to_string(i)}});
+        page.run();
+        ASSERT_EQ(page.state["screen"], "done");
+    }
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), kSessions);
+    if (GetParam() == "postgresql")
+        EXPECT_EQ(count("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' AND "
+                        "pid = pg_backend_pid()"),
+                  0);
+    auto station = open_store("station");
+    for (int i = 1; i <= kSessions; ++i)
+        EXPECT_NO_THROW(station->claim_participant("C" + std::to_string(i))) << i;
+    // A declined page held nothing either.
+    Page no{direct(*web_)};
+    no.open({{"participant", "D1"}});
+    no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 10}, {"t_ms", 20}});
+    EXPECT_NO_THROW(station->claim_participant("D1"));
+}
+
+// Item 7: a participant who gave up online is released after the idle timeout (a lab
+// station can run them); the page coming back later re-loads and re-claims.
+TEST_P(Serve, AParticipantWhoGaveUpOnlineCanBeRunOnALabStationAfterTheIdleTimeout) {
+    Page page{direct(*web_)};
+    page.open({{"participant", "G1"}});
+    page.run(2);
+    ASSERT_EQ(page.state["screen"], "trial");
+    {
+        auto station = open_store("station");
+        EXPECT_THROW(station->claim_participant("G1"), StoreError);  // the page is open
+    }
+    now_ += std::chrono::minutes(29);
+    EXPECT_EQ(web_->release_idle(), 0u);
+    now_ += std::chrono::minutes(2);  // 31 minutes without a request
+    EXPECT_EQ(web_->release_idle(), 1u);
+    EXPECT_EQ(web_->live_sessions(), 0u);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'paused'"), 1);
+    if (GetParam() == "postgresql")
+        EXPECT_EQ(count("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' AND "
+                        "pid = pg_backend_pid()"),
+                  0);
+    {
+        auto station = open_store("station");
+        EXPECT_NO_THROW(station->claim_participant("G1"));
+        // While the station runs them, the page's return is refused and changes nothing.
+        const WebReply busy = web_->handle(
+            "session", json{{"participant", "G1"}, {"token", page.token}, {"t_ms", 5}}.dump());
+        EXPECT_EQ(busy.status, 409) << busy.body;
+    }
+    // The station is done with them: the page re-loads at its first unanswered trial.
+    const json back = page.call("state", json::object(), 409);  // not loaded any more
+    EXPECT_NE(back["error"].get<std::string>().find("not loaded"), std::string::npos);
+    page.now = 40;
+    page.open({{"participant", "G1"}, {"token", page.token}});
+    EXPECT_EQ(page.state["screen"], "trial");
+    page.run();
+    EXPECT_EQ(page.state["screen"], "done");
+    auto station = open_store("station");
+    EXPECT_NO_THROW(station->claim_participant("G1"));
+}
+
+std::string four_block_protocol_text() {
+    std::string text = web_protocol_text();
+    const std::string main = "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
+    text.replace(text.find(main), main.size(),
+                 "[[blocks]]\nid = \"main\"\nstimuli = [\"a\"]\n\n"
+                 "[[blocks]]\nid = \"second\"\nstimuli = [\"b\"]\n\n"
+                 "[[blocks]]\nid = \"third\"\nstimuli = [\"c\"]\n\n"
+                 "[[blocks]]\nid = \"fourth\"\nstimuli = [\"b\", \"c\"]\n");
+    return text;
+}
+
+// Item 8: online numbers follow arrival and cells are balanced, whatever the codes'
+// digits; an abandoned slot's cell goes to the next arrival; each allocation is stored.
+TEST_P(Serve, OnlineArrivalsAreBalancedAcrossCellsWhateverTheirCodes) {
+    use_protocol(four_block_protocol_text(), "four_blocks");
+    ASSERT_EQ(latin_square_rows(4), 4);
+    // A Prolific id, two codes with the same trailing digit, digitless codes, one whose
+    // digits would name a later participant.
+    const std::vector<std::string> codes = {"5f3a9c1b2d4e6f708192a3b4", "-A1", "P01", "abc",
+                                            "P06", "xyz", "Q7", "a-b_c"};
+    std::vector<Page> pages;
+    for (const std::string& code : codes) {
+        pages.push_back(Page{direct(*web_)});
+        pages.back().open({{"participant", code}});
+        pages.back().enter();  // consents: enrolled now
+        ASSERT_EQ(pages.back().state["screen"], "instructions") << code;
+    }
+    // Numbers 1..8 in arrival order, never from the codes.
+    for (size_t i = 0; i < codes.size(); ++i)
+        EXPECT_EQ(count("SELECT number FROM participants WHERE code = '" + codes[i] + "'"),
+                  static_cast<int64_t>(i + 1))
+            << codes[i];
+    // Each of the 4 cells twice; -A1 and P01 apart.
+    for (int cell = 0; cell < 4; ++cell)
+        EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE cell = " + std::to_string(cell)), 2)
+            << "cell " << cell;
+    auto cell_of = [&](const std::string& code) {
+        return count("SELECT s.cell FROM sessions s JOIN participants p ON p.id = "
+                     "s.participant_id WHERE p.code = '" + code + "'");
+    };
+    EXPECT_NE(cell_of("-A1"), cell_of("P01"));
+    // Every allocation is recorded: arrival, cell, the counts it saw.
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE allocation LIKE 'online arrival %: "
+                    "cell % of 4, the fewest completed + active sessions (per cell %'"),
+              8);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions s JOIN participants p ON p.id = "
+                    "s.participant_id WHERE p.code = 'P01' AND s.allocation LIKE "
+                    "'online arrival 3: cell % of 4, % (per cell %'"),
+              1);
+
+    // All finish but P01 (arrival 3), who stops after consenting.
+    const int64_t abandoned_cell = cell_of("P01");
+    for (size_t i = 0; i < pages.size(); ++i)
+        if (codes[i] != "P01") {
+            pages[i].run();
+            ASSERT_EQ(pages[i].state["screen"], "done") << codes[i];
+        }
+    // Arrival 9 while P01's page is still active: P01's cell is taken (its slot is held).
+    Page ninth{direct(*web_)};
+    ninth.open({{"participant", "N9"}});
+    ninth.enter();
+    ninth.run();
+    const int64_t ninth_cell = cell_of("N9");
+    EXPECT_NE(ninth_cell, abandoned_cell);
+    // 31 minutes later P01 has abandoned: arrival 10 takes the freed cell, the only
+    // one with fewer than 2 completed + active sessions.
+    now_ += std::chrono::minutes(31);
+    Page tenth{direct(*web_)};
+    tenth.open({{"participant", "N10"}});
+    tenth.enter();
+    EXPECT_EQ(cell_of("N10"), abandoned_cell);
+    std::vector<int64_t> expected_counts(4, 2);
+    expected_counts[static_cast<size_t>(ninth_cell)] = 3;
+    expected_counts[static_cast<size_t>(abandoned_cell)] = 1;
+    std::string per_cell;
+    for (int64_t n : expected_counts) per_cell += (per_cell.empty() ? "" : ",") + std::to_string(n);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions s JOIN participants p ON p.id = "
+                    "s.participant_id WHERE p.code = 'N10' AND s.allocation LIKE "
+                    "'online arrival 10: cell " + std::to_string(abandoned_cell) +
+                    " of 4, the fewest completed + active sessions (per cell " + per_cell + ";%'"),
+              1);
+    EXPECT_EQ(count("SELECT number FROM participants WHERE code = 'N10'"), 10);
+}
+
+// Item 10: reloads and declines do not add rows without bound.
+TEST_P(Serve, FiftyReloadsAndDeclinesAddBoundedRows) {
+    const int64_t stimuli = static_cast<int64_t>(protocol_.stimuli.size());
+    Page page{direct(*web_)};
+    page.open({{"participant", "R1"}});
+    page.enter();
+    for (int i = 0; i < 50; ++i) page.open({{"participant", "R1"}, {"token", page.token}});
+    // No trial answered yet: still one segment showing each stimulus once.
+    EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM segment_stimuli"), stimuli);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions"), 1);
+    // Reloads between answers: at most one segment per answered trial, plus the first.
+    page.run(1);
+    for (int i = 0; i < 50; ++i) page.open({{"participant", "R1"}, {"token", page.token}});
+    page.run(2);
+    for (int i = 0; i < 50; ++i) page.open({{"participant", "R1"}, {"token", page.token}});
+    const int64_t answered = count("SELECT count(*) FROM trials WHERE answered_utc IS NOT NULL");
+    ASSERT_EQ(answered, 2);
+    EXPECT_LE(count("SELECT count(*) FROM session_segments"), answered + 1);
+    EXPECT_LE(count("SELECT count(*) FROM segment_stimuli"), (answered + 1) * stimuli);
+    // Every answered trial names a segment that is still there.
+    EXPECT_EQ(count("SELECT count(*) FROM trials t JOIN session_segments g ON g.id = t.segment_id"),
+              answered);
+    // Fifty pages opened and declined: no rows at all, one count.
+    for (int i = 0; i < 50; ++i) {
+        Page no{direct(*web_)};
+        no.open({{"participant", "N" + std::to_string(i)}});
+        no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 10}, {"t_ms", 20}});
+    }
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions"), 1);
+    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 50);
+}
+
+// Item 10: a participant withdrawn while their page is open: the page is told so (410),
+// never the store's own words ("FOREIGN KEY constraint failed").
+TEST_P(Serve, AWithdrawnParticipantsOpenPageIsToldTheSessionWasWithdrawn) {
+    Page page{direct(*web_)};
+    page.open({{"participant", "W1"}});
+    page.run(1);
+    ASSERT_EQ(page.state["screen"], "trial");
+    auto admin = open_store("admin");
+    ASSERT_TRUE(admin->withdraw_participant("W1"));
+    const json body = [&] {
+        json b = page.answer_body(1);
+        b["token"] = page.token;
+        return b;
+    }();
+    const WebReply answered = web_->handle("answer", body.dump());
+    EXPECT_EQ(answered.status, 410) << answered.body;
+    EXPECT_NE(answered.body.find("withdrawn"), std::string::npos) << answered.body;
+    EXPECT_EQ(answered.body.find("FOREIGN KEY"), std::string::npos) << answered.body;
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
+    EXPECT_EQ(web_->live_sessions(), 0u);
+
+    // The same on a reload of a page whose participant was withdrawn.
+    Page other{direct(*web_)};
+    other.open({{"participant", "W2"}});
+    other.run(1);
+    ASSERT_TRUE(admin->withdraw_participant("W2"));
+    const WebReply reload = web_->handle(
+        "session", json{{"participant", "W2"}, {"token", other.token}, {"t_ms", 5}}.dump());
+    EXPECT_EQ(reload.status, 410) << reload.body;
+    EXPECT_NE(reload.body.find("withdrawn"), std::string::npos) << reload.body;
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 0);
+    if (GetParam() == "postgresql")
+        EXPECT_EQ(count("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' AND "
+                        "pid = pg_backend_pid()"),
+                  0);
+}
+
+// Item 10: a number beyond a double is a 400 naming its field (it was a 500).
+TEST_P(Serve, ANumberBeyondADoubleIsA400NamingTheField) {
+    for (const char* t : {"1e999", "-1e999", "1e400"}) {
+        const WebReply r = web_->handle(
+            "session", std::string("{\"participant\": \"P1\", \"t_ms\": ") + t + "}");
+        EXPECT_EQ(r.status, 400) << t << " -> " << r.body;
+        EXPECT_NE(r.body.find("'t_ms'"), std::string::npos) << r.body;
+    }
+    const std::string huge_integer = std::string(400, '9');
+    const WebReply r = web_->handle("session", "{\"participant\": \"P1\", \"client\": "
+                                               "{\"window_width\": " + huge_integer + "}, \"t_ms\": 1}");
+    EXPECT_EQ(r.status, 400) << r.body;
+    EXPECT_NE(r.body.find("'window_width'"), std::string::npos) << r.body;
+    // Inside an answer's events.
+    Page page{direct(*web_)};
+    page.open({{"participant", "P2"}});
+    page.run(0);
+    ASSERT_EQ(page.state["screen"], "trial");
+    json body = page.answer_body(0);
+    body["token"] = page.token;
+    std::string text = body.dump();
+    const std::string onset = "\"onset_ms\":" + body["onset_ms"].dump();
+    text.replace(text.find(onset), onset.size(), "\"onset_ms\":1e309");
+    const WebReply a = web_->handle("answer", text);
+    EXPECT_EQ(a.status, 400) << a.body;
+    EXPECT_NE(a.body.find("'onset_ms'"), std::string::npos) << a.body;
+    EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Stores, Serve, ::testing::Values("sqlite", "postgresql"), param_name);
