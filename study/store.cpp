@@ -681,17 +681,21 @@ int Store::resume_segment(int64_t session_id, const SessionEnvironment& env) {
     // Nothing was answered under the newest segment: it is replaced, not added to.
     db_.prepare("DELETE FROM session_segments WHERE id = ?").bind(1, id).run();
     insert_segment(session_id, segment, env);
-    if (segment == 1)
-        db_.prepare("UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
-                    "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
-                    "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
-            .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
-            .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
-            .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
-            .bind(9, env.refresh_note).bind(10, session_id)
-            .run();
+    if (segment == 1) copy_environment_to_session_row(session_id, env);
     tx.commit();
     return segment;
+}
+
+// The session row keeps the first segment's environment (what older readers show).
+void Store::copy_environment_to_session_row(int64_t session_id, const SessionEnvironment& env) {
+    db_.prepare("UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
+                "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
+                "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
+        .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
+        .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
+        .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
+        .bind(9, env.refresh_note).bind(10, session_id)
+        .run();
 }
 
 void Store::update_environment(int64_t session_id, const SessionEnvironment& env) {
@@ -710,14 +714,7 @@ void Store::update_environment(int64_t session_id, const SessionEnvironment& env
         tx.commit();
         return;
     }
-    db_.prepare("UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
-                "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
-                "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
-        .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
-        .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
-        .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
-        .bind(9, env.refresh_note).bind(10, session_id)
-        .run();
+    copy_environment_to_session_row(session_id, env);
     tx.commit();
 }
 
@@ -906,19 +903,21 @@ Store::~Store() {
     if (claim_fd_ >= 0) ::close(claim_fd_);  // releases the claims
 }
 
-std::string utc_now_iso8601() {
-    const auto now = std::chrono::system_clock::now();
-    const std::time_t t = std::chrono::system_clock::to_time_t(now);
-    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
-                        now.time_since_epoch()).count() % 1000;
+std::string utc_iso8601(std::chrono::system_clock::time_point t) {
+    // Floor, not truncation: a time before 1970 keeps its milliseconds in [0, 1000).
+    const auto secs = std::chrono::floor<std::chrono::seconds>(t);
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t - secs).count();
+    const std::time_t whole = std::chrono::system_clock::to_time_t(secs);
     std::tm tm{};
-    gmtime_r(&t, &tm);
+    gmtime_r(&whole, &tm);
     char out[64];
     std::snprintf(out, sizeof out, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
                   tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
                   static_cast<int>(ms));
     return out;
 }
+
+std::string utc_now_iso8601() { return utc_iso8601(std::chrono::system_clock::now()); }
 
 std::string new_uuid_v4() {
     std::random_device device;

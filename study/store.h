@@ -11,6 +11,7 @@
 // Durability contract: a session's full trial order is written before trial 1, and each
 // trial's ratings are committed in one transaction (record_trial) before the next trial
 // starts, so a crash loses at most the trial on screen and never duplicates a rating.
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -98,6 +99,7 @@ public:
 private:
     // Stores (first time) or checks env.stimuli's resolved values, then the segment's rows.
     void insert_segment(int64_t session_id, int segment, const SessionEnvironment& env);
+    void copy_environment_to_session_row(int64_t session_id, const SessionEnvironment& env);
     // The session row, its first segment and its trials, inside the caller's transaction.
     SessionRow insert_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
                               uint64_t seed, const SessionEnvironment& env,
@@ -127,6 +129,8 @@ std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int 
 ResolvedStimulus resolved_of(const StimulusProvenance& p);
 std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli);
 
+// UTC as 2026-12-02T16:56:02.123Z (milliseconds), the form every stored time uses.
+std::string utc_iso8601(std::chrono::system_clock::time_point t);
 std::string utc_now_iso8601();
 std::string new_uuid_v4();
 std::string machine_id();

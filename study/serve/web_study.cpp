@@ -232,19 +232,6 @@ constexpr int kConsentView = 1;
 const char* const kWithdrawn =
     "this session was withdrawn: nothing more of it is recorded. You may close this window.";
 
-std::string iso8601(std::chrono::system_clock::time_point t) {
-    const std::time_t secs = std::chrono::system_clock::to_time_t(t);
-    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(
-                        t.time_since_epoch()).count() % 1000;
-    std::tm tm{};
-    gmtime_r(&secs, &tm);
-    char out[64];
-    std::snprintf(out, sizeof out, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
-                  tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
-                  static_cast<int>(ms < 0 ? ms + 1000 : ms));
-    return out;
-}
-
 }  // namespace
 
 WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions options)
@@ -262,7 +249,7 @@ WebStudy::~WebStudy() = default;
 std::chrono::system_clock::time_point WebStudy::now() const { return options_.clock(); }
 
 std::string WebStudy::active_since_utc() const {
-    return iso8601(now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
+    return utc_iso8601(now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
                                options_.idle_timeout));
 }
 

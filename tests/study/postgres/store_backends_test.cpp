@@ -643,7 +643,8 @@ TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
                 << t.text(0) << "." << c.text(0);
         }
     }
-    EXPECT_EQ(tables, 11);
+    // Schema 5 added withdrawn_sessions, withdrawn_codes and consent_declines to the 11.
+    EXPECT_EQ(tables, 14);
     // The server has the same tables plus lucent_schema, nothing else.
     EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.tables WHERE "
                                 "table_schema = 'public'"),
@@ -765,13 +766,25 @@ TEST_F(Server, SnapshotHoldsEveryRowTheServerHolds) {
         for (const TrialRow& t : store->trials(s.id))
             store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
     }
+    // Schema 5's tables: a withdrawal's tombstones and an anonymous decline.
+    {
+        int number = 0;
+        const int64_t pid = store->ensure_participant(study, "P3", &number);
+        store->create_session(study, pid, plan_trials(p, number, number), number, {});
+        ASSERT_TRUE(store->withdraw_participant("P3"));
+        store->count_declined_consent(study);
+    }
     const ReadableStudyFile snapshot(uri_);
     Database copy(snapshot.path(), SQLITE_OPEN_READONLY);
-    for (const char* table : {"studies", "stimuli", "stimulus_parameters", "participants",
-                              "sessions", "session_segments", "trials", "responses"})
+    for (const char* table :
+         {"studies", "stimuli", "stimulus_parameters", "participants", "sessions",
+          "session_segments", "trials", "responses", "retired_participant_numbers",
+          "withdrawn_sessions", "withdrawn_codes", "consent_declines"})
         EXPECT_EQ(copy.scalar_int(std::string("SELECT count(*) FROM ") + table),
                   store->query_int(std::string("SELECT count(*) FROM ") + table))
             << table;
+    EXPECT_EQ(copy.scalar_int("SELECT count(*) FROM withdrawn_sessions"), 1);
+    EXPECT_EQ(copy.scalar_int("SELECT declined FROM consent_declines"), 1);
     // The ratings themselves, against the deterministic answers given.
     Statement s = copy.prepare(
         "SELECT t.position, r.question, r.rating, t.catch FROM responses r JOIN trials t ON "
