@@ -725,6 +725,24 @@ void Store::count_declined_consent(int64_t study_id) {
         .run();
 }
 
+bool Store::forget_declined_session(int64_t session_id) {
+    Transaction tx(db_);
+    Statement s = db_.prepare(
+        "SELECT study_id, participant_id FROM sessions WHERE id = ? AND consent_utc IS NULL "
+        "AND NOT EXISTS (SELECT 1 FROM responses r WHERE r.session_id = sessions.id)");
+    s.bind(1, session_id);
+    if (!s.step()) return false;
+    const int64_t study_id = s.integer(0), participant_id = s.integer(1);
+    s.reset();
+    db_.prepare("DELETE FROM sessions WHERE id = ?").bind(1, session_id).run();
+    db_.prepare("DELETE FROM participants WHERE id = ? AND NOT EXISTS "
+                "(SELECT 1 FROM sessions WHERE participant_id = ?)")
+        .bind(1, participant_id).bind(2, participant_id).run();
+    count_declined_consent(study_id);
+    tx.commit();
+    return true;
+}
+
 void Store::set_consent(int64_t session_id) {
     db_.prepare("UPDATE sessions SET consent_utc = ? WHERE id = ?")
         .bind(1, utc_now_iso8601()).bind(2, session_id).run();

@@ -84,6 +84,7 @@ public:
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
     void count_declined_consent(int64_t study_id) override;
+    bool forget_declined_session(int64_t session_id) override;
     bool has_consent(int64_t session_id) override;
     bool record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) override;
     // Also repairs sessions written before completion was atomic.

@@ -95,6 +95,11 @@ public:
     virtual void set_consent(int64_t session_id) = 0;
     // One more declined consent of the study (consent_declines: a count, nothing else).
     virtual void count_declined_consent(int64_t study_id) = 0;
+    // A lab station's declined consent: when the session has no consent and no answered
+    // trial, deletes it (segments, planned trials), and its participant when they have no
+    // other session, and counts the decline, in one transaction; true then. Otherwise
+    // (a resumed session that had consent or answers) changes nothing and returns false.
+    virtual bool forget_declined_session(int64_t session_id) = 0;
     virtual bool has_consent(int64_t session_id) = 0;
     // Commits one trial's ratings atomically; refuses a trial that already has ratings,
     // lacks a question, names one the study does not ask, or has a rating outside

@@ -692,6 +692,30 @@ void PostgresStore::count_declined_consent(int64_t study_id) {
     });
 }
 
+bool PostgresStore::forget_declined_session(int64_t session_id) {
+    return guarded("forgetting a declined session", [&] {
+        pqxx::work tx(connection());
+        const pqxx::result found = tx.exec_params(
+            "SELECT study_id, participant_id FROM sessions WHERE id = $1 AND consent_utc IS NULL "
+            "AND NOT EXISTS (SELECT 1 FROM responses r WHERE r.session_id = sessions.id) "
+            "FOR UPDATE",
+            session_id);
+        if (found.empty()) return false;
+        const int64_t study_id = found[0][0].as<int64_t>();
+        const int64_t participant_id = found[0][1].as<int64_t>();
+        tx.exec_params("DELETE FROM sessions WHERE id = $1", session_id);
+        tx.exec_params("DELETE FROM participants WHERE id = $1 AND NOT EXISTS "
+                       "(SELECT 1 FROM sessions WHERE participant_id = $1)",
+                       participant_id);
+        tx.exec_params("INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
+                       "ON CONFLICT (study_id) DO UPDATE SET declined = "
+                       "consent_declines.declined + 1",
+                       study_id);
+        tx.commit();
+        return true;
+    });
+}
+
 void PostgresStore::set_consent(int64_t session_id) {
     guarded("recording consent", [&] {
         pqxx::work tx(connection());

@@ -56,6 +56,7 @@ public:
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
     void count_declined_consent(int64_t study_id) override;
+    bool forget_declined_session(int64_t session_id) override;
     bool has_consent(int64_t session_id) override;
     // Journal first, then the server (see the file comment); the return value is the
     // server's when it answered, else whether every trial is now recorded here.

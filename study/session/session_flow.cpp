@@ -159,7 +159,10 @@ void SessionFlow::key(const TimedKey& press) {
                 else
                     enter(Screen::Instructions, press.t_ns);
             } else if (press.key == Key::Decline) {
-                store_.set_status(session_id_, "aborted", true);
+                // Nothing of a person who declined is kept, only the count (as online);
+                // a resumed session they had consented to or answered in is aborted.
+                if (!store_.forget_declined_session(session_id_))
+                    store_.set_status(session_id_, "aborted", true);
                 result_ = RunResult::Declined;
                 finished_ = true;
             }

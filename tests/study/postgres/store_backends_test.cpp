@@ -189,6 +189,33 @@ TEST_P(Backend, WithdrawalDeletesEverythingAndRetiresTheNumber) {
     EXPECT_EQ(third, 3);  // 2 is retired, never handed out again
 }
 
+TEST_P(Backend, ALabDeclineBeforeConsentKeepsOnlyTheCount) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    int number = 0;
+    const int64_t dora = store->ensure_participant(study, "dora", &number);
+    SessionEnvironment env;
+    env.machine_id = "lab-station-7";
+    env.gl_renderer = "a renderer string";
+    const SessionRow s = store->create_session(study, dora, plan_trials(p, number, number), 3, env);
+    EXPECT_TRUE(store->forget_declined_session(s.id));
+    for (const char* table : {"participants", "sessions", "session_segments", "trials"})
+        EXPECT_EQ(store->query_int(std::string("SELECT count(*) FROM ") + table), 0) << table;
+    EXPECT_EQ(store->query_int("SELECT declined FROM consent_declines"), 1);
+
+    // A session with consent and an answer is not forgotten (it is aborted instead).
+    const int64_t emil = store->ensure_participant(study, "emil", &number);
+    const SessionRow e = store->create_session(study, emil, plan_trials(p, number, number), 4, env);
+    store->set_consent(e.id);
+    const TrialRow t = store->trials(e.id)[0];
+    store->record_trial(e.id, t.id, lucent::test::outcome_for(p, t));
+    EXPECT_FALSE(store->forget_declined_session(e.id));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"),
+              static_cast<int64_t>(p.questions.size()));
+    EXPECT_EQ(store->query_int("SELECT declined FROM consent_declines"), 1);
+}
+
 TEST_P(Backend, AParticipantRunningOnOneStationIsRefusedOnAnother) {
     auto a = open("a");
     auto b = open("b");

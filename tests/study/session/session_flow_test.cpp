@@ -308,7 +308,7 @@ TEST_F(Flow, PauseRestartsTheTrialAndQuitSavesItPaused) {
     EXPECT_EQ(stored_status(), "paused");
 }
 
-TEST_F(Flow, WindowCloseMidSessionSavesAndDeclineAborts) {
+TEST_F(Flow, WindowCloseMidSessionSavesAndADeclineBeforeConsentKeepsOnlyTheCount) {
     open(small_with_screens());
     frame();
     press(Key::Enter);
@@ -322,7 +322,27 @@ TEST_F(Flow, WindowCloseMidSessionSavesAndDeclineAborts) {
     frame();
     press(Key::Decline);
     EXPECT_EQ(flow_->result(), RunResult::Declined);
+    // Nothing of the person is kept: no session, trial, segment or participant; a count.
+    EXPECT_EQ(stored_status(), "");
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM trials"), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 0);
+    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
+}
+
+TEST_F(Flow, DecliningAResumedSessionThatHadConsentAbortsItAndKeepsItsAnswers) {
+    open(small_with_screens(), true);
+    const std::vector<TrialRow> trials = store_->trials(session_.id);
+    store_->record_trial(session_.id, trials[0].id,
+                         lucent::test::outcome_for(protocol_, trials[0]));
+    restart(false);  // a flow that shows the consent screen again
+    frame();
+    press(Key::Decline);
+    EXPECT_EQ(flow_->result(), RunResult::Declined);
     EXPECT_EQ(stored_status(), "aborted+ended");
+    EXPECT_EQ(count("SELECT count(*) FROM responses"),
+              static_cast<int64_t>(protocol_.questions.size()));
+    EXPECT_EQ(count("SELECT count(*) FROM consent_declines"), 0);
 }
 
 TEST_F(Flow, AResumedSessionStartsAtItsFirstOpenTrial) {
