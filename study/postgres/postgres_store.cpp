@@ -680,13 +680,20 @@ void PostgresStore::update_environment(int64_t session_id, const SessionEnvironm
     });
 }
 
+namespace {
+// One more declined consent of `study_id`, inside the caller's transaction.
+void add_declined_consent(pqxx::work& tx, int64_t study_id) {
+    tx.exec_params("INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
+                   "ON CONFLICT (study_id) DO UPDATE SET declined = "
+                   "consent_declines.declined + 1",
+                   study_id);
+}
+}  // namespace
+
 void PostgresStore::count_declined_consent(int64_t study_id) {
     guarded("counting a declined consent", [&] {
         pqxx::work tx(connection());
-        tx.exec_params("INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
-                       "ON CONFLICT (study_id) DO UPDATE SET declined = "
-                       "consent_declines.declined + 1",
-                       study_id);
+        add_declined_consent(tx, study_id);
         tx.commit();
         return 0;
     });
@@ -707,10 +714,7 @@ bool PostgresStore::forget_declined_session(int64_t session_id) {
         tx.exec_params("DELETE FROM participants WHERE id = $1 AND NOT EXISTS "
                        "(SELECT 1 FROM sessions WHERE participant_id = $1)",
                        participant_id);
-        tx.exec_params("INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
-                       "ON CONFLICT (study_id) DO UPDATE SET declined = "
-                       "consent_declines.declined + 1",
-                       study_id);
+        add_declined_consent(tx, study_id);
         tx.commit();
         return true;
     });
