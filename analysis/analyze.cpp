@@ -23,7 +23,8 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
         analyses.back().missing_ratings = pair.missing_ratings;
         std::vector<std::string> levels;
         for (const Group& g : pair.data.groups) levels.push_back(g.level);
-        SubjectMatrix matrix = subject_by_level(table, pair.question, pair.factor, levels);
+        SubjectMatrix matrix =
+            subject_by_level(table, pair.question, pair.factor, levels);
         analyses.back().within = analyze_within_subject(
             matrix.complete, std::move(matrix.incomplete_participants));
     }
@@ -48,9 +49,9 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
         const double share =
             total > 0 ? static_cast<double>(a.within.participants) / total : 0.0;
         // A share of 10 of 12 against 0.8333...: compare counts, not rounded ratios.
-        const bool within = a.within.computed &&
-                            static_cast<double>(a.within.participants) >=
-                                request.within_share * total - 1e-9;
+        const bool within =
+            a.within.computed && static_cast<double>(a.within.participants) >=
+                                     request.within_share * total - 1e-9;
         all_within = all_within && within;
         if (!weakest || share < weakest_share) {
             weakest = &a;
@@ -61,12 +62,13 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
     const std::string wanted =
         request.within_share >= 1.0
             ? std::string("every participant")
-            : "at least " + std::to_string(static_cast<int>(request.within_share * 100.0 + 0.5)) +
+            : "at least " +
+                  std::to_string(static_cast<int>(request.within_share * 100.0 + 0.5)) +
                   "% of participants";
-    const std::string counts =
-        std::to_string(weakest->within.participants) + " of " +
-        std::to_string(pair_participants(*weakest)) + " participants rated every level of " +
-        weakest->question + " ~ " + weakest->factor;
+    const std::string counts = std::to_string(weakest->within.participants) + " of " +
+                               std::to_string(pair_participants(*weakest)) +
+                               " participants rated every level of " + weakest->question +
+                               " ~ " + weakest->factor;
     if (all_within)
         result.primary_reason = "from the data: in every (question, factor) " + wanted +
                                 " rated every level (fewest: " + counts + ")";
@@ -77,7 +79,8 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
 }
 
 int pair_participants(const OneWayAnalysis& pair) {
-    return pair.within.participants + static_cast<int>(pair.within.excluded_participants.size());
+    return pair.within.participants +
+           static_cast<int>(pair.within.excluded_participants.size());
 }
 
 std::size_t pair_ratings(const OneWayAnalysis& pair) {

@@ -81,7 +81,8 @@ double median_of(std::vector<double> values) {
 // Median GPU frame time (the AO bake excluded) and the median of each pass, as
 // "name=ms;name=ms".
 double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene,
-                       const FramePlan& plan, int frames, std::string* pass_ms = nullptr) {
+                       const FramePlan& plan, int frames,
+                       std::string* pass_ms = nullptr) {
     std::vector<double> times;
     std::vector<std::vector<double>> per_pass(plan.passes.size());
     for (int i = 0; i < frames + 1; ++i) {  // the first frame warms caches
@@ -91,7 +92,8 @@ double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene,
         for (std::size_t p = 0; p < passes.size(); ++p)
             if (plan.passes[p].kind != PassKind::bake_ambient_occlusion) {
                 ms += passes[p].milliseconds;
-                if (i > 0 && p < per_pass.size()) per_pass[p].push_back(passes[p].milliseconds);
+                if (i > 0 && p < per_pass.size())
+                    per_pass[p].push_back(passes[p].milliseconds);
             }
         if (i > 0) times.push_back(ms);
     }
@@ -207,7 +209,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
             request.settings.push_back(parse_assignment(s));
         for (const auto& sweep : sweeps)  // scene knobs keep --set or their default
             if (!sweep.per_value_reference)
-                request.settings.push_back({sweep.knob, format_knob_value(sweep.reference)});
+                request.settings.push_back(
+                    {sweep.knob, format_knob_value(sweep.reference)});
         reference_scene = build_scene(request);
     } catch (const std::exception& e) {
         std::cerr << "lucent bench accuracy: " << e.what() << "\n";
@@ -271,7 +274,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
                               << format_knob_value(value) << "...\n";
                     row_reference = technique.render_reference(scene);
                 }
-                const Image& truth = sweep.per_value_reference ? row_reference : reference;
+                const Image& truth =
+                    sweep.per_value_reference ? row_reference : reference;
                 row.frame_ms =
                     median_frame_ms(executor, scene, plan, options.frames, &row.pass_ms);
                 Image image = executor.read_output(plan);
@@ -318,7 +322,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
         std::snprintf(line, sizeof line,
                       "%-28s %9s | %10.2e %10.2e %10.2e %10.2e %10.2e | %9.3f %9.3f\n",
                       r.knob.c_str(), r.value.c_str(), r.error.rmse, r.error.p99,
-                      r.error.mean, r.error.max, r.block_rmse, r.frame_ms, r.precompute_s);
+                      r.error.mean, r.error.max, r.block_rmse, r.frame_ms,
+                      r.precompute_s);
         std::cout << line;
     }
     std::cout << "\nplot: " << options.svg << "\n";

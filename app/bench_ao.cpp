@@ -46,7 +46,8 @@ double thread_cpu_seconds() {
 // Rays per CPU-second of each query type on the bake's own rays for every `sample`th
 // vertex, on this thread, in both scene layouts; the escape counts must agree (same rays,
 // same answers).
-void time_query_types(const Mesh& mesh, int rays, unsigned sample, BenchResults& results) {
+void time_query_types(const Mesh& mesh, int rays, unsigned sample,
+                      BenchResults& results) {
     const AoDirections lattice(rays);
     const float offset = 1e-4f * std::max(mesh.bounding_sphere().radius, 1e-6f);
     struct Query {
@@ -64,7 +65,8 @@ void time_query_types(const Mesh& mesh, int rays, unsigned sample, BenchResults&
              {std::pair{OcclusionQuery::single, "rtcOccluded1"},
               std::pair{OcclusionQuery::packet8, "rtcOccluded8"},
               std::pair{OcclusionQuery::stream, "rtcOccluded1M"}})
-            queries.push_back({std::string(query_name) + " " + layout_name, layout, query});
+            queries.push_back(
+                {std::string(query_name) + " " + layout_name, layout, query});
     const OcclusionCounter triangles(mesh, OcclusionScene::triangles);
     const OcclusionCounter quads(mesh, OcclusionScene::paired_quads);
     double setup = 0.0, traced = 0.0;
@@ -89,9 +91,10 @@ void time_query_types(const Mesh& mesh, int rays, unsigned sample, BenchResults&
     results.add(section, "set-up rate", traced / setup / 1e6, "Mrays/CPUs");
     for (const Query& q : queries) {
         const double rate = traced / q.seconds / 1e6;
-        std::printf("  %-24s %11.2f %9.2f  escaped %.5f%s\n", q.name.c_str(), rate,
-                    queries[0].seconds / q.seconds, double(q.escaped) / traced,
-                    q.escaped == queries[0].escaped ? "" : "  (differs from the first row)");
+        std::printf(
+            "  %-24s %11.2f %9.2f  escaped %.5f%s\n", q.name.c_str(), rate,
+            queries[0].seconds / q.seconds, double(q.escaped) / traced,
+            q.escaped == queries[0].escaped ? "" : "  (differs from the first row)");
         results.add(section, q.name + " rate", rate, "Mrays/CPUs");
         results.add(section, q.name + " speed-up over the first row",
                     queries[0].seconds / q.seconds, "ratio");
@@ -117,7 +120,8 @@ int run_bench_ao(const BenchAoOptions& options) {
     std::printf(
         "AO bake: %d rays per vertex (uniform, stratified hemisphere), %u threads, "
         "Embree %s\nbake s: wall time, BVH build included; CPU s: process CPU time, so "
-        "Mrays/CPUs is the per-core rate (less affected by other load)\nEmbree: thread CPU "
+        "Mrays/CPUs is the per-core rate (less affected by other load)\nEmbree: thread "
+        "CPU "
         "time inside the occlusion queries only, on the same rays: the ceiling; set-up: "
         "directions and origins\n",
         options.rays, threads, RTC_VERSION_STRING);
@@ -152,10 +156,11 @@ int run_bench_ao(const BenchAoOptions& options) {
         const double rays = double(mesh.vertex_count()) * options.rays;
         const double rate = rays / cpu / 1e6;
         const double ceiling = timings.rays / timings.trace_cpu_seconds / 1e6;
-        std::printf("%-18s %7zu %8zu %7.3f %8.3f %8.3f %8.2f %10.2f %8.3f %10.3f %8.2f %7.2f\n",
-                    mesh.name.c_str(), mesh.face_count(), mesh.vertex_count(), build,
-                    seconds, cpu, rays / seconds / 1e6, rate, timings.setup_cpu_seconds,
-                    timings.trace_cpu_seconds, ceiling, rate / ceiling);
+        std::printf(
+            "%-18s %7zu %8zu %7.3f %8.3f %8.3f %8.2f %10.2f %8.3f %10.3f %8.2f %7.2f\n",
+            mesh.name.c_str(), mesh.face_count(), mesh.vertex_count(), build, seconds,
+            cpu, rays / seconds / 1e6, rate, timings.setup_cpu_seconds,
+            timings.trace_cpu_seconds, ceiling, rate / ceiling);
         std::fflush(stdout);
         const std::string& m = mesh.name;
         results.add("bake " + m, "faces", double(mesh.face_count()), "count");
@@ -171,7 +176,8 @@ int run_bench_ao(const BenchAoOptions& options) {
         results.add("bake " + m, "bake / ceiling", rate / ceiling, "ratio");
     }
     std::printf(
-        "\nEmbree query types and scene layouts (the mesh's triangles; paired into quads, "
+        "\nEmbree query types and scene layouts (the mesh's triangles; paired into "
+        "quads, "
         "the bake's) on the bake's rays of every %u%s vertex, one thread (thread CPU "
         "time)\n  %-24s %11s %9s\n",
         options.sample, options.sample == 1 ? "st" : "th", "query", "Mrays/CPUs",
@@ -205,13 +211,13 @@ void register_bench_ao(CLI::App& bench, int& exit_code) {
                    "Worker threads; 0 = all hardware threads")
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
-    ao->add_option("--sample", options->sample,
-                   "Query-type table: time every Nth vertex")
+    ao->add_option("--sample", options->sample, "Query-type table: time every Nth vertex")
         ->check(CLI::Range(1, 1 << 20))
         ->capture_default_str();
     ao->add_flag("--progress", options->progress, "Draw a progress bar on stderr");
-    ao->add_option("--csv", options->csv,
-                   "Also write every number as CSV (section,name,value,unit) to this file");
+    ao->add_option(
+        "--csv", options->csv,
+        "Also write every number as CSV (section,name,value,unit) to this file");
     ao->callback([options, &exit_code] { exit_code = run_bench_ao(*options); });
 }
 

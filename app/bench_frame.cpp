@@ -13,8 +13,8 @@
 #include <sstream>
 
 #include "commands.h"
-#include "output_file.h"
 #include "gl/context.h"
+#include "output_file.h"
 #include "render.h"
 #include "techniques/registry.h"
 
@@ -23,7 +23,7 @@ namespace {
 
 struct FrameBenchOptions {
     std::string technique = "empirical";
-    std::string sweep;  // KNOB=V1,V2,...: one row per mesh and value
+    std::string sweep;                  // KNOB=V1,V2,...: one row per mesh and value
     std::vector<std::string> settings;  // key=value for every row
     std::string mesh;                   // default: the technique's comparison, or sphere
     std::vector<std::string> faces;
@@ -172,18 +172,20 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
                   << "\n";
         return kExitUsage;
     }
-    const bool per_unit = knob->kind == KnobKind::integer || knob->kind == KnobKind::scalar;
+    const bool per_unit =
+        knob->kind == KnobKind::integer || knob->kind == KnobKind::scalar;
     std::vector<KnobAssignment> fixed;
     try {
-        for (const auto& setting : options.settings) fixed.push_back(parse_assignment(setting));
+        for (const auto& setting : options.settings)
+            fixed.push_back(parse_assignment(setting));
     } catch (const std::exception& e) {
         std::cerr << "lucent bench frame: --set: " << e.what() << "\n";
         return kExitUsage;
     }
     std::ostringstream table, breakdowns;
-    std::vector<std::vector<std::string>> csv = {
-        {"mesh", "faces", knob_name, "total_ms", "fps", "costliest_pass", "pass_ms",
-         per_unit ? "ms_per_unit" : "-"}};
+    std::vector<std::vector<std::string>> csv = {{"mesh", "faces", knob_name, "total_ms",
+                                                  "fps", "costliest_pass", "pass_ms",
+                                                  per_unit ? "ms_per_unit" : "-"}};
     char line[240];
     std::snprintf(line, sizeof line, "%10s %10s | %12s %8s | %-16s %10s | %12s\n",
                   "faces", knob_name.c_str(), "total (ms)", "fps", "costliest pass", "ms",
@@ -221,14 +223,13 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
             const auto [pass, pass_ms] = sampler.costliest_pass();
             const double unit = per_unit ? std::stod(value) : 0.0;
             const double ms_per_unit = unit > 0.0 ? pass_ms / unit : 0.0;
-            std::snprintf(line, sizeof line,
-                          "%10zu %10s | %12.3f %8.2f | %-16s %10.3f | %12s\n",
-                          scene.mesh->face_count(), value.c_str(), total_ms,
-                          1000.0 / total_ms, pass.c_str(), pass_ms,
-                          per_unit ? number(ms_per_unit).c_str() : "");
+            std::snprintf(
+                line, sizeof line, "%10zu %10s | %12.3f %8.2f | %-16s %10.3f | %12s\n",
+                scene.mesh->face_count(), value.c_str(), total_ms, 1000.0 / total_ms,
+                pass.c_str(), pass_ms, per_unit ? number(ms_per_unit).c_str() : "");
             table << line;
-            breakdowns << "  " << scene.mesh->face_count() << " faces, " << knob_name << "="
-                       << value << ": " << sampler.breakdown() << "\n";
+            breakdowns << "  " << scene.mesh->face_count() << " faces, " << knob_name
+                       << "=" << value << ": " << sampler.breakdown() << "\n";
             csv.push_back({request.mesh, std::to_string(scene.mesh->face_count()), value,
                            number(total_ms), number(1000.0 / total_ms), pass,
                            number(pass_ms), per_unit ? number(ms_per_unit) : ""});
@@ -245,11 +246,13 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
 
 // The technique's own comparison (Technique::frame_comparison): one row per mesh, each
 // variant's median frame time and its ratio to the last variant.
-int run_comparison_bench(const FrameBenchOptions& options, const FrameComparison& comparison,
-                         RenderRequest request, gl::Context& context) {
+int run_comparison_bench(const FrameBenchOptions& options,
+                         const FrameComparison& comparison, RenderRequest request,
+                         gl::Context& context) {
     std::vector<KnobAssignment> fixed;
     try {
-        for (const auto& setting : options.settings) fixed.push_back(parse_assignment(setting));
+        for (const auto& setting : options.settings)
+            fixed.push_back(parse_assignment(setting));
     } catch (const std::exception& e) {
         std::cerr << "lucent bench frame: --set: " << e.what() << "\n";
         return kExitUsage;
@@ -262,13 +265,15 @@ int run_comparison_bench(const FrameBenchOptions& options, const FrameComparison
     std::snprintf(line, sizeof line, "%10s %10s |", "faces", "vertices");
     std::string heading = line;
     for (const auto& v : variants) {
-        std::snprintf(line, sizeof line, " %12s %8s |", (v.label + " (ms)").c_str(), "fps");
+        std::snprintf(line, sizeof line, " %12s %8s |", (v.label + " (ms)").c_str(),
+                      "fps");
         heading += line;
         header.push_back(v.label + "_ms");
     }
     for (std::size_t v = 0; v + 1 < variants.size(); ++v) {
-        std::snprintf(line, sizeof line, " %*s", std::max<int>(6, static_cast<int>(
-                          variants[v].label.size() + baseline.size() + 3)),
+        std::snprintf(line, sizeof line, " %*s",
+                      std::max<int>(6, static_cast<int>(variants[v].label.size() +
+                                                        baseline.size() + 3)),
                       (variants[v].label + " / " + baseline).c_str());
         heading += line;
         header.push_back(variants[v].label + "_over_" + baseline);
@@ -286,7 +291,8 @@ int run_comparison_bench(const FrameBenchOptions& options, const FrameComparison
                 request.settings.insert(request.settings.end(), v.settings.begin(),
                                         v.settings.end());
                 scenes.push_back(build_scene(request));
-                scenes.back().mesh = scenes.front().mesh;  // same mesh object: uploaded once
+                scenes.back().mesh =
+                    scenes.front().mesh;  // same mesh object: uploaded once
             }
         } catch (const std::exception& e) {
             std::cerr << "lucent bench frame: " << e.what() << "\n";
@@ -400,15 +406,18 @@ int run_frame_bench(FrameBenchOptions options, const std::vector<std::string>& g
 
 void register_bench_frame(CLI::App& bench, int& exit_code) {
     auto options = std::make_shared<FrameBenchOptions>();
-    auto* cmd = bench.add_subcommand(
-        "frame", "Median GPU frame time per mesh: full empirical shader vs direct light, or a technique's knob swept");
+    auto* cmd =
+        bench.add_subcommand("frame",
+                             "Median GPU frame time per mesh: full empirical shader vs "
+                             "direct light, or a technique's knob swept");
     cmd->add_option("--technique", options->technique,
                     "empirical: full vs direct light; another: rows of mesh x --sweep");
     cmd->add_option("--sweep", options->sweep,
                     "KNOB=V1,V2,...: one row per mesh and value (default for a technique "
                     "other than empirical: its first quality knob)");
-    cmd->add_option("--set", options->settings,
-                    "other parameters for every row of a --sweep, key=value (repeatable)");
+    cmd->add_option(
+        "--set", options->settings,
+        "other parameters for every row of a --sweep, key=value (repeatable)");
     cmd->add_option("--mesh", options->mesh,
                     "built-in mesh family (face budgets from --faces)");
     cmd->add_option("--faces", options->faces, "face budgets, e.g. 4k 30k 60k 120k 240k")
@@ -416,7 +425,8 @@ void register_bench_frame(CLI::App& bench, int& exit_code) {
     cmd->add_option("--size", options->size, "frame size WxH");
     cmd->add_option("--frames", options->frames, "timed frames per row (median)");
     cmd->add_option("--warmup", options->warmup, "untimed frames first");
-    cmd->add_option("--csv", options->csv, "also write the table as CSV (columns as printed)");
+    cmd->add_option("--csv", options->csv,
+                    "also write the table as CSV (columns as printed)");
     cmd->callback([options, cmd, &exit_code] {
         std::vector<std::string> given;
         for (const char* option : {"--size", "--frames", "--warmup", "--mesh", "--faces"})

@@ -1,7 +1,8 @@
 // lucent bench render: stimuli per second for the built-in `thesis` set (512x512 unless
 // --size), and where the time goes: AO baking, GL rendering (plan, passes, read-back),
-// image encoding, statistics + content hashes (rendering and encoding overlap). Run twice in one process: with an empty
-// AO cache (a fresh machine) and with the cache the first run filled.
+// image encoding, statistics + content hashes (rendering and encoding overlap). Run twice
+// in one process: with an empty AO cache (a fresh machine) and with the cache the first
+// run filled.
 #include <unistd.h>
 
 #include <cstdio>
@@ -33,8 +34,8 @@ void print_row(const char* label, std::size_t stimuli, const stimuli::BatchTimin
                double cpu, BenchResults& results) {
     const double rate = t.wall_seconds > 0 ? double(stimuli) / t.wall_seconds : 0.0;
     const double cpu_rate = cpu > 0 ? double(stimuli) / cpu : 0.0;
-    const double busy = t.ao_seconds + t.gl_seconds + t.encode_seconds +
-                        t.statistics_seconds;
+    const double busy =
+        t.ao_seconds + t.gl_seconds + t.encode_seconds + t.statistics_seconds;
     std::printf("%-14s %9.2f %8.2f %7.2f %10.2f %7.2f %7.2f %9.2f %8.2f %7.2f\n", label,
                 rate, t.wall_seconds, cpu, cpu_rate, t.ao_seconds, t.gl_seconds,
                 t.encode_seconds, t.statistics_seconds,
@@ -84,12 +85,13 @@ int run_render_bench(const RenderBenchOptions& options) {
             std::printf(" %s", std::string(stimuli::extension(format)).c_str());
         std::printf(
             "\nstage seconds are summed over workers: %d render (AO, GL) and %d encode "
-            "(encode, stats+hash) workers run at once; busy = stages / wall;\nCPU s: process "
+            "(encode, stats+hash) workers run at once; busy = stages / wall;\nCPU s: "
+            "process "
             "CPU time, llvmpipe's threads included (less affected by other load)\n\n",
             options.jobs, options.jobs);
         std::printf("%-14s %9s %8s %7s %10s %7s %7s %9s %8s %7s\n", "AO cache",
-                    "stimuli/s", "wall s", "CPU s", "stimuli/", "AO s", "GL s", "encode s",
-                    "stats s", "busy");
+                    "stimuli/s", "wall s", "CPU s", "stimuli/", "AO s", "GL s",
+                    "encode s", "stats s", "busy");
         std::printf("%-14s %9s %8s %7s %10s\n", "", "", "", "", "CPU s");
         stimuli::BatchOptions batch;
         batch.out_dir = scratch / "out";
@@ -116,16 +118,18 @@ int run_render_bench(const RenderBenchOptions& options) {
             const auto [nw, nc] = run("filled", batch);
             before_wall += bw, before_cpu += bc, now_wall += nw, now_cpu += nc;
         }
-        std::printf("%-14s: serial encode, libpng default PNG compression (the previous "
-                    "way; same pixels)\n",
-                    "filled, before");
+        std::printf(
+            "%-14s: serial encode, libpng default PNG compression (the previous "
+            "way; same pixels)\n",
+            "filled, before");
         const double speedup = cold.first / std::max(now_wall / 2, 1e-9);
         const double wall_gain = before_wall / std::max(now_wall, 1e-9);
         const double cpu_gain = before_cpu / std::max(now_cpu, 1e-9);
         std::printf("\nfilled / empty cache throughput: %.2fx\n", speedup);
-        std::printf("filled, now / before: %.2fx stimuli per second, %.2fx stimuli per "
-                    "CPU-second\n",
-                    wall_gain, cpu_gain);
+        std::printf(
+            "filled, now / before: %.2fx stimuli per second, %.2fx stimuli per "
+            "CPU-second\n",
+            wall_gain, cpu_gain);
         results.add("summary", "filled / empty cache throughput", speedup, "ratio");
         results.add("summary", "filled now / before, stimuli per second", wall_gain,
                     "ratio");
@@ -158,8 +162,9 @@ void register_bench_render(CLI::App& bench, int& exit_code) {
                     "image size WxH (default 512x512, the set's own)");
     cmd->add_option("--jobs", options->jobs,
                     "render workers, and as many encode workers (default 1)");
-    cmd->add_option("--csv", options->csv,
-                    "Also write every number as CSV (section,name,value,unit) to this file");
+    cmd->add_option(
+        "--csv", options->csv,
+        "Also write every number as CSV (section,name,value,unit) to this file");
     cmd->callback([options, &exit_code] { exit_code = run_render_bench(*options); });
 }
 

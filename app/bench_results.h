@@ -1,7 +1,7 @@
 #pragma once
 // Every number a bench prints, also written to its --csv FILE as
-// section,name,value,unit (one header line; sections and names quoted), so runs can be compared by
-// script. Shared by the `lucent bench` subcommands.
+// section,name,value,unit (one header line; sections and names quoted), so runs can be
+// compared by script. Shared by the `lucent bench` subcommands.
 #include <string>
 #include <utility>
 #include <vector>

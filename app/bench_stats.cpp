@@ -150,8 +150,9 @@ int bench_whole_process(long ratings, int groups, int repeat, Results& results) 
     const fs::path self = fs::read_symlink("/proc/self/exe").parent_path() / "lucent";
     // The runs alternate between lucent and R, so that both see the same load on a
     // shared machine; each column is the median of `repeat` runs.
-    const std::string lucent_command = quoted(self) + " analyze " + quoted(csv) + " --out " +
-                                       quoted(dir / "report") + " --format csv >/dev/null 2>&1";
+    const std::string lucent_command = quoted(self) + " analyze " + quoted(csv) +
+                                       " --out " + quoted(dir / "report") +
+                                       " --format csv >/dev/null 2>&1";
     const bool have_r = std::system("command -v Rscript >/dev/null 2>&1") == 0;
     const fs::path script = dir / "analysis.R";
     if (have_r)
@@ -179,7 +180,8 @@ int bench_whole_process(long ratings, int groups, int repeat, Results& results) 
         }
     }
     const CommandTime t_lucent = median_time(lucent_runs);
-    const CommandTime t_start = time_command(quoted(self) + " analyze --help >/dev/null 2>&1");
+    const CommandTime t_start =
+        time_command(quoted(self) + " analyze --help >/dev/null 2>&1");
     std::printf("  %-40s %10s %10s   (median of %d runs, alternating)\n", "process",
                 "wall s", "CPU s", repeat);
     std::printf("  %-40s %10.3f %10.3f\n", "lucent analyze --format csv", t_lucent.wall,
@@ -204,7 +206,8 @@ int bench_whole_process(long ratings, int groups, int repeat, Results& results) 
                     t_r.cpu / t_lucent.cpu);
         results.add("whole_process", "R (wall)", t_r.wall, "s");
         results.add("whole_process", "R (cpu)", t_r.cpu, "s");
-        results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall, "ratio");
+        results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall,
+                    "ratio");
         results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu, "ratio");
     }
     std::error_code ignored;

@@ -8,18 +8,17 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <thread>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "commands.h"
-#include "serve/web_study.h"
-#include "serve_http.h"
 #include "postgres/local_server.h"
 #include "protocol.h"
+#include "serve/web_study.h"
+#include "serve_http.h"
 #include "sqlite.h"
 #include "store.h"
 #include "study_store.h"
@@ -34,7 +33,8 @@ struct BenchRow {
     int commits = 0;
     double seconds = 0;  // the commit phase: first commit's start to the last one's end
     double p50_ms = 0, p99_ms = 0;
-    int failed_writers = 0;  // writers that stopped on an error (e.g. SQLite's busy timeout)
+    int failed_writers =
+        0;  // writers that stopped on an error (e.g. SQLite's busy timeout)
     std::string first_error;
 };
 
@@ -44,7 +44,8 @@ double rate(const BenchRow& r) { return r.seconds > 0 ? r.commits / r.seconds : 
 double percentile(std::vector<double> v, double q) {
     if (v.empty()) return 0;
     std::sort(v.begin(), v.end());
-    const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
+    const size_t i =
+        std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
     return v[i];
 }
 
@@ -67,7 +68,8 @@ BenchRow summarise(const std::string& backend, const WriterTimes& times) {
     BenchRow row;
     row.backend = backend;
     row.writers = static_cast<int>(times.errors.size());
-    const auto begin = *std::min_element(times.first_start.begin(), times.first_start.end());
+    const auto begin =
+        *std::min_element(times.first_start.begin(), times.first_start.end());
     const auto end = *std::max_element(times.last_end.begin(), times.last_end.end());
     row.seconds = end > begin ? std::chrono::duration<double>(end - begin).count() : 0.0;
     std::vector<double> all;
@@ -83,11 +85,12 @@ BenchRow summarise(const std::string& backend, const WriterTimes& times) {
 }
 
 // `writers` stations at once, each answering `trials` trials of its own session.
-BenchRow run_writers(const std::string& backend, const std::string& db, int writers, int trials,
-                     const std::string& journal_dir) {
+BenchRow run_writers(const std::string& backend, const std::string& db, int writers,
+                     int trials, const std::string& journal_dir) {
     const study::Protocol protocol = study::builtin_protocol("thesis");
     {
-        auto store = study::open_study_store(db);  // the study row, before the clock starts
+        auto store =
+            study::open_study_store(db);  // the study row, before the clock starts
         store->ensure_study(protocol);
     }
     using Clock = WriterTimes::Clock;
@@ -98,14 +101,17 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
         threads.emplace_back([&, w] {
             try {
                 study::StoreOptions options;
-                options.journal_path = journal_dir + "/journal-" + std::to_string(w) + ".db";
+                options.journal_path =
+                    journal_dir + "/journal-" + std::to_string(w) + ".db";
                 auto store = study::open_study_store(db, options);
                 const int64_t study_id = store->ensure_study(protocol);
-                const std::string code = "bench" + std::to_string(writers) + "w" + std::to_string(w);
+                const std::string code =
+                    "bench" + std::to_string(writers) + "w" + std::to_string(w);
                 int number = 0;
                 const int64_t pid = store->ensure_participant(study_id, code, &number);
                 const study::SessionRow s = store->create_session(
-                    study_id, pid, study::plan_trials(protocol, 1000 + w, number), 1000 + w, {});
+                    study_id, pid, study::plan_trials(protocol, 1000 + w, number),
+                    1000 + w, {});
                 const std::vector<study::TrialRow> rows = store->trials(s.id);
                 const int n = std::min<int>(trials, static_cast<int>(rows.size()));
                 for (int i = 0; i < n; ++i) {
@@ -113,18 +119,21 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
                     o.onset_ns = 1;
                     o.confirm_ns = 2;
                     for (const study::Question& q : protocol.questions)
-                        o.responses.push_back({q.id, rows[i].is_catch ? rows[i].expected
-                                                                      : 1 + (i % q.points()),
-                                               500.0, 0, 1, 2});
+                        o.responses.push_back(
+                            {q.id,
+                             rows[i].is_catch ? rows[i].expected : 1 + (i % q.points()),
+                             500.0, 0, 1, 2});
                     const auto t0 = Clock::now();
                     store->record_trial(s.id, rows[i].id, o);
                     const auto t1 = Clock::now();
                     first_start[w] = std::min(first_start[w], t0);
                     last_end[w] = std::max(last_end[w], t1);
-                    latencies[w].push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+                    latencies[w].push_back(
+                        std::chrono::duration<double, std::milli>(t1 - t0).count());
                 }
                 if (store->pending_trials() != 0)
-                    errors[w] = std::to_string(store->pending_trials()) + " trials unconfirmed";
+                    errors[w] =
+                        std::to_string(store->pending_trials()) + " trials unconfirmed";
             } catch (const std::exception& e) {
                 errors[w] = e.what();
             }
@@ -142,7 +151,8 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
     using nlohmann::json;
     const study::Protocol protocol = study::builtin_protocol("thesis");
     study::StoreOptions store_options;
-    store_options.journal_path = journal_dir + "/serve-journal-" + std::to_string(writers) + ".db";
+    store_options.journal_path =
+        journal_dir + "/serve-journal-" + std::to_string(writers) + ".db";
     auto store = study::open_study_store(db, store_options);
     study::WebStudyOptions options;
     options.secret = "bench";
@@ -155,7 +165,8 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
     httplib::Server http;
     configure_serve_http(http, web, pictures, std::max(8, writers + 4));
     const int port = bind_serve_port(http, "127.0.0.1", 0);
-    if (port < 0) throw study::StoreError("cannot listen on 127.0.0.1 for the serve rows");
+    if (port < 0)
+        throw study::StoreError("cannot listen on 127.0.0.1 for the serve rows");
     std::thread server([&] { http.listen_after_bind(); });
 
     using Clock = WriterTimes::Clock;
@@ -170,43 +181,56 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
             client.set_read_timeout(60);
             double now = 10;  // the simulated page's performance.now()
             auto post = [&](const std::string& endpoint, const json& body) {
-                const auto r = client.Post(("/api/" + endpoint).c_str(), body.dump(), "application/json");
-                if (!r) throw std::runtime_error(endpoint + ": " + httplib::to_string(r.error()));
+                const auto r = client.Post(("/api/" + endpoint).c_str(), body.dump(),
+                                           "application/json");
+                if (!r)
+                    throw std::runtime_error(endpoint + ": " +
+                                             httplib::to_string(r.error()));
                 if (r->status != 200) throw std::runtime_error(endpoint + ": " + r->body);
                 return json::parse(r->body);
             };
             try {
-                json state = post("session", {{"participant", "web" + std::to_string(writers) + "w" +
-                                                                  std::to_string(w)},
-                                              {"t_ms", now}});
+                json state =
+                    post("session", {{"participant", "web" + std::to_string(writers) +
+                                                         "w" + std::to_string(w)},
+                                     {"t_ms", now}});
                 const std::string token = state["token"];
                 int answered = 0;
                 while (state["screen"] != "done" && answered < trials) {
                     if (state["screen"] != "trial") {
                         now += 100;
-                        state = post("continue", {{"token", token}, {"view", state["view"]},
-                                                  {"shown_ms", now - 50}, {"t_ms", now}});
+                        state = post("continue", {{"token", token},
+                                                  {"view", state["view"]},
+                                                  {"shown_ms", now - 50},
+                                                  {"t_ms", now}});
                         continue;
                     }
-                    const double onset = now + state["trial"]["blank_ms"].get<double>() + 10;
+                    const double onset =
+                        now + state["trial"]["blank_ms"].get<double>() + 10;
                     json events = json::array();
-                    const bool is_catch = !state["trial"]["prompt"].get<std::string>().empty();
+                    const bool is_catch =
+                        !state["trial"]["prompt"].get<std::string>().empty();
                     for (size_t q = 0; q < protocol.questions.size(); ++q)
-                        events.push_back({{"t_ms", onset + 100.0 * (q + 1)}, {"type", "point"},
-                                          {"question", q},
-                                          {"value", is_catch ? protocol.catch_trials[0].expected
-                                                             : 1 + (answered + int(q)) % 7}});
+                        events.push_back(
+                            {{"t_ms", onset + 100.0 * (q + 1)},
+                             {"type", "point"},
+                             {"question", q},
+                             {"value", is_catch ? protocol.catch_trials[0].expected
+                                                : 1 + (answered + int(q)) % 7}});
                     events.push_back({{"t_ms", onset + 400}, {"type", "next"}});
                     now = onset + 1000;
                     const auto t0 = Clock::now();
-                    state = post("answer", {{"token", token}, {"trial", state["trial"]["id"]},
-                                            {"view", state["view"]}, {"onset_ms", onset},
+                    state = post("answer", {{"token", token},
+                                            {"trial", state["trial"]["id"]},
+                                            {"view", state["view"]},
+                                            {"onset_ms", onset},
                                             {"events", events}});
                     const auto t1 = Clock::now();
                     ++answered;
                     first_start[w] = std::min(first_start[w], t0);
                     last_end[w] = std::max(last_end[w], t1);
-                    latencies[w].push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+                    latencies[w].push_back(
+                        std::chrono::duration<double, std::milli>(t1 - t0).count());
                 }
             } catch (const std::exception& e) {
                 errors[w] = e.what();
@@ -221,11 +245,13 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
     return summarise(backend, times);
 }
 
-int run_bench_store(const std::vector<int>& writer_counts, int trials, const std::string& server,
-                    const std::string& csv) {
+int run_bench_store(const std::vector<int>& writer_counts, int trials,
+                    const std::string& server, const std::string& csv) {
     namespace fs = std::filesystem;
-    std::string pattern = (fs::temp_directory_path() / "lucent-bench-store-XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw study::StoreError("cannot create a scratch folder");
+    std::string pattern =
+        (fs::temp_directory_path() / "lucent-bench-store-XXXXXX").string();
+    if (!mkdtemp(pattern.data()))
+        throw study::StoreError("cannot create a scratch folder");
     const std::string scratch = pattern;
     std::vector<BenchRow> rows, serve_rows;
     {
@@ -234,24 +260,28 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials, const std
         int k = 0;
         for (int writers : writer_counts) {
             const std::string file = scratch + "/w" + std::to_string(writers) + ".db";
-            rows.push_back(run_writers("sqlite (WAL, synchronous=FULL)", file, writers, trials, scratch));
+            rows.push_back(run_writers("sqlite (WAL, synchronous=FULL)", file, writers,
+                                       trials, scratch));
             std::string uri = server;
             if (local) uri = local->create_database("bench_" + std::to_string(k++));
             study::init_study_store(uri);
-            rows.push_back(run_writers(local ? "postgresql (unix socket)" : "postgresql " + server,
-                                       uri, writers, trials, scratch));
+            rows.push_back(
+                run_writers(local ? "postgresql (unix socket)" : "postgresql " + server,
+                            uri, writers, trials, scratch));
         }
         // lucent serve's round trips over loopback HTTP, into each backend.
         for (int writers : writer_counts) {
-            const std::string file = scratch + "/serve-w" + std::to_string(writers) + ".db";
-            serve_rows.push_back(run_serve_writers("serve + sqlite (HTTP round trip)", file,
-                                                   writers, trials, scratch));
+            const std::string file =
+                scratch + "/serve-w" + std::to_string(writers) + ".db";
+            serve_rows.push_back(run_serve_writers("serve + sqlite (HTTP round trip)",
+                                                   file, writers, trials, scratch));
             std::string uri = server;
             if (local) uri = local->create_database("bench_serve_" + std::to_string(k++));
             study::init_study_store(uri);
-            serve_rows.push_back(run_serve_writers(
-                local ? "serve + postgresql (HTTP round trip)" : "serve + postgresql " + server,
-                uri, writers, trials, scratch));
+            serve_rows.push_back(
+                run_serve_writers(local ? "serve + postgresql (HTTP round trip)"
+                                        : "serve + postgresql " + server,
+                                  uri, writers, trials, scratch));
         }
     }
     std::error_code ec;
@@ -262,34 +292,36 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials, const std
     std::printf("%-34s %7s %8s %9s %10s %8s %8s %7s\n", "backend", "writers", "commits",
                 "seconds", "commits/s", "p50 ms", "p99 ms", "failed");
     for (const BenchRow& r : all_rows)
-        std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d\n", r.backend.c_str(), r.writers,
-                    r.commits, r.seconds, rate(r), r.p50_ms, r.p99_ms,
+        std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d\n", r.backend.c_str(),
+                    r.writers, r.commits, r.seconds, rate(r), r.p50_ms, r.p99_ms,
                     r.failed_writers);
     for (const BenchRow& r : all_rows)
         if (r.failed_writers)
-            std::printf("%s, %d writers: %d stopped, first: %s\n", r.backend.c_str(), r.writers,
-                        r.failed_writers, r.first_error.c_str());
+            std::printf("%s, %d writers: %d stopped, first: %s\n", r.backend.c_str(),
+                        r.writers, r.failed_writers, r.first_error.c_str());
     // Ratios within this run: the server against the file at the same writer count.
     for (size_t i = 0; i + 1 < rows.size(); i += 2)
         if (rate(rows[i]) > 0)
-            std::printf("writers %d: postgresql/sqlite throughput ratio %.2f\n", rows[i].writers,
-                        rate(rows[i + 1]) / rate(rows[i]));
+            std::printf("writers %d: postgresql/sqlite throughput ratio %.2f\n",
+                        rows[i].writers, rate(rows[i + 1]) / rate(rows[i]));
     // The serve rows: the same table, and each row against the store it writes into.
     for (size_t i = 0; i + 1 < serve_rows.size(); i += 2)
         for (size_t j = 0; j + 1 < rows.size(); j += 2)
             if (rows[j].writers == serve_rows[i].writers && rate(rows[j]) > 0 &&
                 rate(rows[j + 1]) > 0)
-                std::printf("writers %d: serve/sqlite throughput ratio %.2f, "
-                            "serve/postgresql %.2f\n",
-                            serve_rows[i].writers, rate(serve_rows[i]) / rate(rows[j]),
-                            rate(serve_rows[i + 1]) / rate(rows[j + 1]));
+                std::printf(
+                    "writers %d: serve/sqlite throughput ratio %.2f, "
+                    "serve/postgresql %.2f\n",
+                    serve_rows[i].writers, rate(serve_rows[i]) / rate(rows[j]),
+                    rate(serve_rows[i + 1]) / rate(rows[j + 1]));
     if (!csv.empty()) {
         std::ofstream out(csv);
-        out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,failed_writers\n";
+        out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,failed_"
+               "writers\n";
         for (const BenchRow& r : all_rows)
-            out << '"' << r.backend << "\"," << r.writers << ',' << r.commits << ',' << r.seconds
-                << ',' << rate(r) << ',' << r.p50_ms << ',' << r.p99_ms << ','
-                << r.failed_writers << "\n";
+            out << '"' << r.backend << "\"," << r.writers << ',' << r.commits << ','
+                << r.seconds << ',' << rate(r) << ',' << r.p50_ms << ',' << r.p99_ms
+                << ',' << r.failed_writers << "\n";
         if (!out) throw study::StoreError(csv + ": cannot write");
     }
     return kExitOk;
@@ -307,7 +339,8 @@ void register_bench_store(CLI::App& bench, int& exit_code) {
     auto args = std::make_shared<Args>();
     auto* cmd = bench.add_subcommand(
         "store",
-        "Trial commits per second and p50/p99 commit latency: SQLite file and PostgreSQL over "
+        "Trial commits per second and p50/p99 commit latency: SQLite file and PostgreSQL "
+        "over "
         "a Unix socket (a throwaway local server unless --server), 1, 8 and 50 writers");
     cmd->add_option("--writers", args->writers, "Concurrent writers per row")
         ->delimiter(',')
@@ -320,7 +353,8 @@ void register_bench_store(CLI::App& bench, int& exit_code) {
     cmd->add_option("--csv", args->csv, "Also write the table as CSV to this file");
     cmd->callback([args, &exit_code] {
         try {
-            exit_code = run_bench_store(args->writers, args->trials, args->server, args->csv);
+            exit_code =
+                run_bench_store(args->writers, args->trials, args->server, args->csv);
         } catch (const study::StoreError& e) {
             std::cerr << "lucent bench store: " << e.what() << "\n";
             exit_code = kExitFailure;

@@ -15,9 +15,10 @@ bool is_subcommand(CLI::App& app, const std::string& name) {
 }  // namespace
 
 int run_cli(int argc, char** argv, const std::vector<Registration>& subcommands) {
-    CLI::App app{"Lucent: stimuli, participant sessions and analysis for perceptual studies "
-                 "of translucent-looking objects",
-                 "lucent"};
+    CLI::App app{
+        "Lucent: stimuli, participant sessions and analysis for perceptual studies "
+        "of translucent-looking objects",
+        "lucent"};
     app.set_version_flag("--version", std::string("lucent ") + lucent::version_string() +
                                           " (" + lucent::build_hash() + ")");
     app.require_subcommand(1);

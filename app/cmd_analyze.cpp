@@ -1,5 +1,6 @@
 // lucent analyze: one-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch reports with plots
-// from a study database or a long CSV of ratings (participant,stimulus,factor,level,question,rating).
+// from a study database or a long CSV of ratings
+// (participant,stimulus,factor,level,question,rating).
 #include <iostream>
 
 #include "analyze.h"
@@ -35,8 +36,8 @@ int run_analyze(const AnalyzeArgs& args) {
         if (!(args.within_share > 0.0 && args.within_share <= 1.0))
             throw InputError("--within-share must lie in (0, 1]");
         std::optional<Design> plan_design;
-        const LongTable table = read_ratings(args.input, parse_scale(args.scale), &plan_design,
-                                             &options.input_notes);
+        const LongTable table = read_ratings(args.input, parse_scale(args.scale),
+                                             &plan_design, &options.input_notes);
         if (!args.images.empty()) {
             options.level_images = level_images_from_directory(table, args.images);
             if (thumbnail_maker) options.thumbnail_png = thumbnail_maker;
@@ -58,8 +59,8 @@ int run_analyze(const AnalyzeArgs& args) {
         const AnalysisResult result = analyze_table(table, request);
         options.primary = result.primary;
         options.primary_reason = result.primary_reason;
-        std::cerr << "lucent analyze: primary design " << design_name(result.primary) << ", "
-                  << result.primary_reason << "\n";
+        std::cerr << "lucent analyze: primary design " << design_name(result.primary)
+                  << ", " << result.primary_reason << "\n";
         for (const auto& path : write_report(result.pairs, args.out_dir, options))
             std::cout << path.string() << "\n";
         return kExitOk;
@@ -80,7 +81,8 @@ void register_analyze(CLI::App& app, int& exit_code) {
         "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
         "with plots, from a study database or a long CSV of ratings");
     cmd->add_option("input", args->input,
-                    "Study database, or long CSV: participant,stimulus,factor,level,question,rating")
+                    "Study database, or long CSV: "
+                    "participant,stimulus,factor,level,question,rating")
         ->required();
     cmd->add_option("--out", args->out_dir, "Directory for the report")->required();
     cmd->add_option("--alpha", args->alpha, "Significance level (Tukey CI at 1 - alpha)")

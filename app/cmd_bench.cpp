@@ -6,8 +6,9 @@ namespace lucent::app {
 
 void register_bench(CLI::App& app, int& exit_code) {
     auto* bench = app.add_subcommand(
-        "bench", "Measure speed and accuracy; each table is measured in one run and reported "
-                 "with ratios");
+        "bench",
+        "Measure speed and accuracy; each table is measured in one run and reported "
+        "with ratios");
     bench->require_subcommand(1);
     register_bench_families(*bench, exit_code);
 }

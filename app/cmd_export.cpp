@@ -16,12 +16,14 @@ void register_export(CLI::App& app, int& exit_code) {
     auto out = std::make_shared<std::string>();
     auto force = std::make_shared<bool>(false);
     auto* cmd = app.add_subcommand("export", "Write a study database's ratings as CSV");
-    cmd->add_option("db", *db, "Study database: FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
+    cmd->add_option("db", *db,
+                    "Study database: FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
         ->required()
         ->check(study_db_validator());
-    cmd->add_option("--format", *format,
-                    "long: one row per rating; wide: one row per participant; analysis: "
-                    "participant,stimulus,factor,level,question,rating for lucent analyze")
+    cmd->add_option(
+           "--format", *format,
+           "long: one row per rating; wide: one row per participant; analysis: "
+           "participant,stimulus,factor,level,question,rating for lucent analyze")
         ->check(CLI::IsMember({"long", "wide", "analysis"}));
     cmd->add_option("--out", *out,
                     "CSV file to write (never a database; written to a temporary file in "

@@ -5,12 +5,12 @@
 #include <assimp/version.h>
 #include <embree3/rtcore_config.h>
 #include <sqlite3.h>
+#include <toml++/toml.h>
 
 #include <CLI/Version.hpp>
 #include <boost/version.hpp>
 #include <glm/detail/setup.hpp>
 #include <iostream>
-#include <toml++/toml.h>
 
 #include "commands.h"
 #include "gl/context.h"
@@ -30,22 +30,24 @@ int run_info() {
                   << "GL version:       " << info.version << "\n"
                   << "GLSL version:     " << info.glsl_version << "\n"
                   << "max texture size: " << info.max_texture_size << "\n"
-                  << "timer queries:    " << (info.has_timer_query ? "yes" : "no") << "\n";
+                  << "timer queries:    " << (info.has_timer_query ? "yes" : "no")
+                  << "\n";
     } catch (const gl::ContextError& e) {
-        std::cerr << "lucent info: cannot create a headless GL context: " << e.what() << "\n";
+        std::cerr << "lucent info: cannot create a headless GL context: " << e.what()
+                  << "\n";
         return kExitFailure;
     }
     std::cout << "libraries:\n"
               << "  GLFW          " << glfwGetVersionString() << "\n"
               << "  OpenImageIO   " << OIIO_VERSION_STRING << "\n"
               << "  SQLite        " << sqlite3_libversion() << "\n"
-              << "  Assimp        " << aiGetVersionMajor() << "." << aiGetVersionMinor() << "."
-              << aiGetVersionPatch() << "\n"
+              << "  Assimp        " << aiGetVersionMajor() << "." << aiGetVersionMinor()
+              << "." << aiGetVersionPatch() << "\n"
               << "  Embree        " << RTC_VERSION_STRING << "\n"
-              << "  Boost         " << BOOST_VERSION / 100000 << "." << BOOST_VERSION / 100 % 1000
-              << "." << BOOST_VERSION % 100 << "\n"
-              << "  GLM           " << GLM_VERSION_MAJOR << "." << GLM_VERSION_MINOR << "."
-              << GLM_VERSION_PATCH << "\n"
+              << "  Boost         " << BOOST_VERSION / 100000 << "."
+              << BOOST_VERSION / 100 % 1000 << "." << BOOST_VERSION % 100 << "\n"
+              << "  GLM           " << GLM_VERSION_MAJOR << "." << GLM_VERSION_MINOR
+              << "." << GLM_VERSION_PATCH << "\n"
               << "  toml++        " << TOML_LIB_MAJOR << "." << TOML_LIB_MINOR << "."
               << TOML_LIB_PATCH << "\n"
               << "  CLI11         " << CLI11_VERSION << "\n";
@@ -56,8 +58,9 @@ int run_info() {
 
 void register_info(CLI::App& app, int& exit_code) {
     auto* cmd = app.add_subcommand(
-        "info", "Create a headless OpenGL context and print the GL implementation and the "
-                "versions of linked libraries");
+        "info",
+        "Create a headless OpenGL context and print the GL implementation and the "
+        "versions of linked libraries");
     cmd->callback([&exit_code] { exit_code = run_info(); });
 }
 

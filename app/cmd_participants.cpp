@@ -1,14 +1,13 @@
 // lucent participants: list the participants of a study database, or withdraw one.
 #include <iostream>
+#include <memory>
+#include <optional>
 
 #include "commands.h"
 #include "sqlite.h"
 #include "store.h"
 #include "study_db_option.h"
 #include "study_store.h"
-
-#include <memory>
-#include <optional>
 
 namespace lucent::app {
 namespace {
@@ -18,7 +17,8 @@ int list_participants(const std::string& db_name) {
     const std::string& db_path = source.path();
     study::check_database_file(db_path);
     study::Database db(db_path, SQLITE_OPEN_READONLY);
-    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'participants'") == 0) {
+    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'participants'") ==
+        0) {
         std::cout << "no participants\n";
         return kExitOk;
     }
@@ -37,15 +37,17 @@ int list_participants(const std::string& db_name) {
 
 int withdraw(const std::string& db_path, const std::string& code, bool yes) {
     const std::unique_ptr<study::StudyStore> store = study::open_study_store(db_path);
-    const std::optional<study::ParticipantCounts> counts = store->participant_counts(code);
+    const std::optional<study::ParticipantCounts> counts =
+        store->participant_counts(code);
     if (!counts) {
         std::cerr << "lucent participants withdraw: no participant '" << code << "' in "
                   << db_path << "\n";
         return kExitUsage;
     }
     if (!yes) {
-        std::cout << "Delete all data of participant '" << code << "' (" << counts->sessions
-                  << " sessions, " << counts->ratings << " ratings) from " << db_path
+        std::cout << "Delete all data of participant '" << code << "' ("
+                  << counts->sessions << " sessions, " << counts->ratings
+                  << " ratings) from " << db_path
                   << "? This cannot be undone. Type 'yes' to confirm: " << std::flush;
         std::string answer;
         std::getline(std::cin, answer);
@@ -55,25 +57,34 @@ int withdraw(const std::string& db_path, const std::string& code, bool yes) {
         }
     }
     store->withdraw_participant(code);
-    std::cout << "withdrew participant '" << code << "': their sessions and ratings are deleted\n"
-              << "Other copies (station files, backups) still hold them until merged: a merge "
-                 "with this database leaves them out (its withdrawal tombstones)\n";
+    std::cout
+        << "withdrew participant '" << code
+        << "': their sessions and ratings are deleted\n"
+        << "Other copies (station files, backups) still hold them until merged: a merge "
+           "with this database leaves them out (its withdrawal tombstones)\n";
     return kExitOk;
 }
 
 }  // namespace
 
 void register_participants(CLI::App& app, int& exit_code) {
-    auto* cmd = app.add_subcommand("participants", "List or withdraw the participants of a study database");
+    auto* cmd = app.add_subcommand(
+        "participants", "List or withdraw the participants of a study database");
     cmd->require_subcommand(1);
     auto db = std::make_shared<std::string>();
     auto code = std::make_shared<std::string>();
     auto yes = std::make_shared<bool>(false);
-    auto* list = cmd->add_subcommand("list", "List participants with their sessions and ratings");
-    list->add_option("--db", *db, "Study database: FILE.db or postgresql://...")->required()->check(study_db_validator());
-    auto* wd = cmd->add_subcommand("withdraw", "Delete a participant and all their data (asks first)");
+    auto* list =
+        cmd->add_subcommand("list", "List participants with their sessions and ratings");
+    list->add_option("--db", *db, "Study database: FILE.db or postgresql://...")
+        ->required()
+        ->check(study_db_validator());
+    auto* wd = cmd->add_subcommand(
+        "withdraw", "Delete a participant and all their data (asks first)");
     wd->add_option("id", *code, "Participant code")->required();
-    wd->add_option("--db", *db, "Study database: FILE.db or postgresql://...")->required()->check(study_db_validator());
+    wd->add_option("--db", *db, "Study database: FILE.db or postgresql://...")
+        ->required()
+        ->check(study_db_validator());
     wd->add_flag("--yes", *yes, "Do not ask for confirmation (scripts)");
     auto guarded = [&exit_code](auto fn) {
         try {

@@ -24,18 +24,21 @@ std::string estimate_text(const analysis::PowerEstimate& e) {
     return out.str();
 }
 
-void print_row(std::ostream& out, const std::string& label, const analysis::PowerEstimate& e) {
+void print_row(std::ostream& out, const std::string& label,
+               const analysis::PowerEstimate& e) {
     out << std::left << std::setw(34) << label << estimate_text(e) << "\n";
 }
 
 void print_result(const analysis::PowerResult& r, std::ostream& out) {
     const analysis::PowerSpec& s = r.spec;
     out << "design " << analysis::design_name(s.design) << ", " << s.participants
-        << (s.design == analysis::Design::Between ? " participants per level" : " participants")
+        << (s.design == analysis::Design::Between ? " participants per level"
+                                                  : " participants")
         << ", " << s.level_means.size() << " levels, alpha " << s.alpha << ", "
         << s.simulations << " simulations (seed " << s.seed << ")"
         << (s.likert ? ", responses rounded to 1..7" : "") << "\n";
-    out << std::left << std::setw(34) << "test" << "power +/- MC error\n";
+    out << std::left << std::setw(34) << "test"
+        << "power +/- MC error\n";
     if (r.rm_anova) {
         print_row(out, "repeated-measures ANOVA", *r.rm_anova);
         print_row(out, "  with Greenhouse-Geisser p", *r.rm_anova_gg);
@@ -48,7 +51,8 @@ void print_result(const analysis::PowerResult& r, std::ostream& out) {
         std::ostringstream value;
         value << std::fixed << std::setprecision(4) << *r.closed_form;
         out << "closed form (noncentral F) of the "
-            << (r.rm_anova ? "repeated-measures" : "one-way") << " ANOVA: " << value.str() << "\n";
+            << (r.rm_anova ? "repeated-measures" : "one-way") << " ANOVA: " << value.str()
+            << "\n";
     } else {
         out << "closed form: none for responses rounded to a rating scale\n";
     }
@@ -62,11 +66,13 @@ int run_power(PowerArgs args) {
         if (args.target > 0.0) {
             std::cerr << "searching participants in [2, " << args.max_participants
                       << "] for power " << args.target << "...\n";
-            const SampleSize size = smallest_sample(args.spec, args.target, args.max_participants);
+            const SampleSize size =
+                smallest_sample(args.spec, args.target, args.max_participants);
             print_result(size.at, std::cout);
             if (size.participants)
-                std::cout << "smallest participants reaching power " << args.target << ": "
-                          << *size.participants << " (" << size.evaluations << " sizes simulated)\n";
+                std::cout << "smallest participants reaching power " << args.target
+                          << ": " << *size.participants << " (" << size.evaluations
+                          << " sizes simulated)\n";
             else
                 std::cout << "power " << args.target << " is not reached with "
                           << args.max_participants << " participants\n";
@@ -86,9 +92,11 @@ void register_power(CLI::App& app, int& exit_code) {
     auto args = std::make_shared<PowerArgs>();
     auto* cmd = app.add_subcommand(
         "power",
-        "Power of a planned design's ANOVA, repeated-measures ANOVA and pairwise tests by "
+        "Power of a planned design's ANOVA, repeated-measures ANOVA and pairwise tests "
+        "by "
         "seeded simulation, and the smallest number of participants for a target power");
-    cmd->add_option("--design", args->design, "between (participants per level) or within")
+    cmd->add_option("--design", args->design,
+                    "between (participants per level) or within")
         ->check(CLI::IsMember({"between", "within"}))
         ->capture_default_str();
     cmd->add_option("--participants", args->spec.participants,
@@ -103,14 +111,16 @@ void register_power(CLI::App& app, int& exit_code) {
         ->capture_default_str();
     cmd->add_option("--residual-sd", args->spec.residual_sd, "SD of a single response")
         ->capture_default_str();
-    cmd->add_option("--alpha", args->spec.alpha, "Significance level")->capture_default_str();
+    cmd->add_option("--alpha", args->spec.alpha, "Significance level")
+        ->capture_default_str();
     cmd->add_option("--simulations", args->spec.simulations, "Simulated studies per size")
         ->capture_default_str();
     cmd->add_option("--seed", args->spec.seed, "Random seed")->capture_default_str();
     cmd->add_flag("--likert", args->spec.likert,
                   "Round and clamp responses to the 1..7 scale (no closed form then)");
-    cmd->add_option("--target", args->target,
-                    "Find the smallest participants whose primary test reaches this power");
+    cmd->add_option(
+        "--target", args->target,
+        "Find the smallest participants whose primary test reaches this power");
     cmd->add_option("--max-participants", args->max_participants,
                     "Upper end of the search")
         ->capture_default_str();

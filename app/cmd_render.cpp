@@ -3,10 +3,10 @@
 // (renderer/render.h), the same path batch rendering and the explorer use.
 #include <iostream>
 
+#include "batch_render.h"
 #include "commands.h"
 #include "core/technique.h"
 #include "gl/context.h"
-#include "batch_render.h"
 #include "render.h"
 #include "techniques/registry.h"
 
@@ -54,7 +54,8 @@ int run_render(const RenderOptions& options) {
         parse_size(options.size, request.width, request.height);
         request.mesh = options.mesh;
         request.technique = options.technique;
-        if (!options.density.empty()) request.settings.push_back({"density", options.density});
+        if (!options.density.empty())
+            request.settings.push_back({"density", options.density});
         for (const auto& s : options.settings)
             request.settings.push_back(parse_assignment(s));
         if (options.plan == "full")
@@ -134,8 +135,9 @@ int run_render(const RenderOptions& options) {
 
 void register_render(CLI::App& app, int& exit_code) {
     auto options = std::make_shared<RenderOptions>();
-    auto* cmd = app.add_subcommand(
-        "render", "Render one image of a mesh, or a stimulus set from a config or preset (headless)");
+    auto* cmd = app.add_subcommand("render",
+                                   "Render one image of a mesh, or a stimulus set from a "
+                                   "config or preset (headless)");
     std::string meshes;
     for (const auto& name : builtin_mesh_names())
         meshes += (meshes.empty() ? "" : ", ") + name;
@@ -149,12 +151,16 @@ void register_render(CLI::App& app, int& exit_code) {
                         "; optional face budget, e.g. torus_knot:60k) or a mesh file");
     cmd->add_option("config", options->config,
                     "stimulus-set config (TOML): render every stimulus into --out DIR");
-    cmd->add_option("--preset", options->preset, "built-in stimulus set (thesis) into --out DIR");
-    cmd->add_option("--jobs", options->jobs, "stimulus sets: parallel workers (default 1)");
-    cmd->add_flag("--force", options->force, "stimulus sets: re-render unchanged stimuli too");
-    cmd->add_option("--density", options->density,
-                    "density volume over the mesh's box for techniques with one (htsm): "
-                    "constant, cube, spheres, marble, layers[:name=value,...] or FILE.nrrd");
+    cmd->add_option("--preset", options->preset,
+                    "built-in stimulus set (thesis) into --out DIR");
+    cmd->add_option("--jobs", options->jobs,
+                    "stimulus sets: parallel workers (default 1)");
+    cmd->add_flag("--force", options->force,
+                  "stimulus sets: re-render unchanged stimuli too");
+    cmd->add_option(
+        "--density", options->density,
+        "density volume over the mesh's box for techniques with one (htsm): "
+        "constant, cube, spheres, marble, layers[:name=value,...] or FILE.nrrd");
     cmd->add_option("--technique", options->technique, "technique (" + techniques + ")");
     cmd->add_option(
         "--set", options->settings,
@@ -168,9 +174,10 @@ void register_render(CLI::App& app, int& exit_code) {
     cmd->add_option("--plan", options->plan,
                     "pruned (default) or full: run every pass, to check pruning");
     cmd->add_flag("--linear", options->linear, "write .png/.tif without sRGB encoding");
-    cmd->add_flag("--reference", options->reference,
-                  "render the technique's CPU reference (Embree) instead of the GL image: "
-                  "same scene, parameters and outputs");
+    cmd->add_flag(
+        "--reference", options->reference,
+        "render the technique's CPU reference (Embree) instead of the GL image: "
+        "same scene, parameters and outputs");
     cmd->callback([options, &exit_code] {
         // One image (--mesh) or a stimulus set (CONFIG or --preset), never both.
         const bool batch = !options->config.empty() || !options->preset.empty();
@@ -184,9 +191,11 @@ void register_render(CLI::App& app, int& exit_code) {
             exit_code = kExitUsage;
         } else if (batch) {
             exit_code = stimuli::run_render_set_command(options->config, options->preset,
-                                                        options->out, options->jobs, options->force);
+                                                        options->out, options->jobs,
+                                                        options->force);
         } else if (options->mesh.empty()) {
-            std::cerr << "lucent render: --mesh is required (or a stimulus-set CONFIG or --preset)\n";
+            std::cerr << "lucent render: --mesh is required (or a stimulus-set CONFIG or "
+                         "--preset)\n";
             exit_code = kExitUsage;
         } else {
             exit_code = run_render(*options);

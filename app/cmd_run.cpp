@@ -30,14 +30,18 @@ int run_command(RunArgs& args) {
         o.protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                          : study::builtin_protocol(args.preset);
         if (args.seed >= 0) o.seed = static_cast<uint64_t>(args.seed);
-        study::plan_trials(o.protocol, 0, 0);  // impossible randomisation fails here, early
+        study::plan_trials(o.protocol, 0,
+                           0);  // impossible randomisation fails here, early
         study::LiveOrPrerenderedStimuli stimuli(args.images_dir);
         switch (study::run_session(o, stimuli, std::cerr)) {
-        case study::RunResult::Completed:
-        case study::RunResult::SavedAndQuit:
-        case study::RunResult::Declined: return kExitOk;
-        case study::RunResult::UsageError: return kExitUsage;
-        case study::RunResult::Failure: return kExitFailure;
+            case study::RunResult::Completed:
+            case study::RunResult::SavedAndQuit:
+            case study::RunResult::Declined:
+                return kExitOk;
+            case study::RunResult::UsageError:
+                return kExitUsage;
+            case study::RunResult::Failure:
+                return kExitFailure;
         }
     } catch (const study::ProtocolError& e) {
         std::cerr << "lucent run: " << e.what() << "\n";
@@ -60,8 +64,9 @@ int run_command(RunArgs& args) {
 void register_run(CLI::App& app, int& exit_code) {
     auto args = std::make_shared<RunArgs>();
     auto* cmd = app.add_subcommand(
-        "run", "Run a participant session full-screen (ratings stored in an SQLite file or a "
-               "PostgreSQL study server)");
+        "run",
+        "Run a participant session full-screen (ratings stored in an SQLite file or a "
+        "PostgreSQL study server)");
     cmd->add_option("protocol", args->protocol_file, "Study protocol file (TOML)");
     cmd->add_option("--preset", args->preset, "Built-in protocol instead of a file")
         ->check(CLI::IsMember(study::builtin_protocol_names()));
@@ -69,14 +74,21 @@ void register_run(CLI::App& app, int& exit_code) {
                     "Study database: FILE.db (created when absent) or "
                     "postgresql://USER@HOST[:PORT]/DBNAME (after 'lucent store init')")
         ->required();
-    cmd->add_option("--participant", args->options.participant, "Participant code, e.g. P07")->required();
-    cmd->add_flag("--windowed", args->options.windowed, "A 1280x1024 window instead of full screen");
-    cmd->add_option("--monitor", args->options.monitor, "Monitor index for full screen")->check(CLI::NonNegativeNumber);
-    cmd->add_flag("--resume", args->options.resume, "Continue the participant's unfinished session");
-    cmd->add_option("--images", args->images_dir,
-                    "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr (e.g. from "
-                    "'lucent render --preset thesis --out DIR'); others render live");
-    cmd->add_option("--seed", args->seed, "Session seed (default: random; stored either way)")
+    cmd->add_option("--participant", args->options.participant,
+                    "Participant code, e.g. P07")
+        ->required();
+    cmd->add_flag("--windowed", args->options.windowed,
+                  "A 1280x1024 window instead of full screen");
+    cmd->add_option("--monitor", args->options.monitor, "Monitor index for full screen")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--resume", args->options.resume,
+                  "Continue the participant's unfinished session");
+    cmd->add_option(
+        "--images", args->images_dir,
+        "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr (e.g. from "
+        "'lucent render --preset thesis --out DIR'); others render live");
+    cmd->add_option("--seed", args->seed,
+                    "Session seed (default: random; stored either way)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--autopilot", args->options.autopilot,
                     "Simulated participant: a SEED, or a FILE of 'DELAY_MS KEY' lines");
@@ -85,8 +97,9 @@ void register_run(CLI::App& app, int& exit_code) {
         ->check(CLI::PositiveNumber);
     cmd->add_option("--screenshot", args->options.screenshot_path,
                     "Save the first rating screen as a PNG (for tests)");
-    cmd->add_option("--key-trace", args->options.key_trace_path,
-                    "Write each key press as 'X_EVENT_MS RECEIPT_NS STAMP_NS' (for tests)");
+    cmd->add_option(
+        "--key-trace", args->options.key_trace_path,
+        "Write each key press as 'X_EVENT_MS RECEIPT_NS STAMP_NS' (for tests)");
     cmd->callback([args, &exit_code] { exit_code = run_command(*args); });
 }
 

@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdlib>
 #include <cstring>
@@ -24,8 +24,8 @@
 #include "lucent/version.h"
 #include "postgres/trial_journal.h"
 #include "protocol.h"
-#include "serve_http.h"
 #include "serve/web_study.h"
+#include "serve_http.h"
 #include "session/stimulus_source.h"
 #include "store.h"
 #include "study_store.h"
@@ -56,8 +56,8 @@ std::string read_file(const std::filesystem::path& path) {
 // Every stimulus's picture as the lab shows it (load_image_rgba8: 8-bit sRGB, EXR
 // encoded on the way), written once as PNG and kept in memory: nothing else on disk is
 // ever served.
-std::map<std::string, ServedPicture> load_pictures(const study::Protocol& protocol,
-                                             const study::PrerenderedStimuli& stimuli) {
+std::map<std::string, ServedPicture> load_pictures(
+    const study::Protocol& protocol, const study::PrerenderedStimuli& stimuli) {
     std::map<std::string, ServedPicture> out;
     char scratch_template[] = "/tmp/lucent-serve-XXXXXX";
     const char* scratch = mkdtemp(scratch_template);
@@ -84,7 +84,8 @@ std::string load_or_create_secret(const std::string& path) {
     if (std::filesystem::exists(path)) {
         const std::string secret = read_file(path);
         if (secret.size() < 32)
-            throw std::runtime_error(path + ": session key file is shorter than 32 bytes");
+            throw std::runtime_error(path +
+                                     ": session key file is shorter than 32 bytes");
         return secret;
     }
     std::filesystem::create_directories(std::filesystem::absolute(path).parent_path());
@@ -93,8 +94,11 @@ std::string load_or_create_secret(const std::string& path) {
     random.read(secret.data(), static_cast<std::streamsize>(secret.size()));
     if (random.gcount() != 32) throw std::runtime_error("cannot read /dev/urandom");
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-    if (fd < 0) throw std::runtime_error(path + ": cannot create the session key file: " + std::strerror(errno));
-    const bool written = ::write(fd, secret.data(), secret.size()) == static_cast<ssize_t>(secret.size()) &&
+    if (fd < 0)
+        throw std::runtime_error(
+            path + ": cannot create the session key file: " + std::strerror(errno));
+    const bool written = ::write(fd, secret.data(), secret.size()) ==
+                             static_cast<ssize_t>(secret.size()) &&
                          ::fsync(fd) == 0;
     ::close(fd);
     if (!written) throw std::runtime_error(path + ": cannot write the session key file");
@@ -105,9 +109,11 @@ bool parse_listen(const std::string& listen, std::string& host, int& port) {
     const size_t colon = listen.rfind(':');
     if (colon == std::string::npos || colon == 0) return false;
     host = listen.substr(0, colon);
-    if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+    if (host.size() > 2 && host.front() == '[' && host.back() == ']')
+        host = host.substr(1, host.size() - 2);
     const std::string digits = listen.substr(colon + 1);
-    if (digits.empty() || digits.size() > 5 || digits.find_first_not_of("0123456789") != std::string::npos)
+    if (digits.empty() || digits.size() > 5 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
         return false;
     port = std::stoi(digits);
     return port <= 65535;
@@ -119,13 +125,15 @@ bool is_loopback(const std::string& host) {
 
 int serve_command(const ServeArgs& args) {
     if (args.protocol_file.empty() == args.preset.empty()) {
-        std::cerr << "lucent serve: give a PROTOCOL.toml or --preset NAME (exactly one)\n";
+        std::cerr
+            << "lucent serve: give a PROTOCOL.toml or --preset NAME (exactly one)\n";
         return kExitUsage;
     }
     std::string host;
     int port = 0;
     if (!parse_listen(args.listen, host, port)) {
-        std::cerr << "lucent serve: --listen '" << args.listen << "': expected HOST:PORT, e.g. 127.0.0.1:8080\n";
+        std::cerr << "lucent serve: --listen '" << args.listen
+                  << "': expected HOST:PORT, e.g. 127.0.0.1:8080\n";
         return kExitUsage;
     }
     study::Protocol protocol;
@@ -147,8 +155,9 @@ int serve_command(const ServeArgs& args) {
         for (const auto& [id, picture] : pictures) options.images[id] = picture.size;
         const std::string secret_file =
             !args.secret_file.empty() ? args.secret_file
-            : study::is_server_uri(args.db) ? study::default_journal_path(args.db) + ".serve-key"
-                                            : args.db + "-serve-key";
+            : study::is_server_uri(args.db)
+                ? study::default_journal_path(args.db) + ".serve-key"
+                : args.db + "-serve-key";
         options.secret = load_or_create_secret(secret_file);
         options.idle_timeout = std::chrono::milliseconds(
             static_cast<int64_t>(std::llround(args.idle_minutes * 60'000)));
@@ -180,7 +189,8 @@ int serve_command(const ServeArgs& args) {
     configure_serve_http(http, *web, pictures, limits);
     port = bind_serve_port(http, host, port);
     if (port < 0) {
-        std::cerr << "lucent serve: cannot listen on " << args.listen << ": " << std::strerror(errno) << "\n";
+        std::cerr << "lucent serve: cannot listen on " << args.listen << ": "
+                  << std::strerror(errno) << "\n";
         return kExitFailure;
     }
     // SIGINT/SIGTERM stop the server from a thread of their own (never in a handler).
@@ -201,22 +211,25 @@ int serve_command(const ServeArgs& args) {
     });
     std::cout << "lucent serve: study '" << protocol.name << "' (" << pictures.size()
               << " pictures) from " << store->name() << " on http://"
-              << (host.find(':') != std::string::npos ? "[" + host + "]" : host) << ":" << port
-              << "/?participant=ID" << std::endl;
+              << (host.find(':') != std::string::npos ? "[" + host + "]" : host) << ":"
+              << port << "/?participant=ID" << std::endl;
     if (!is_loopback(host))
         std::cout << "lucent serve: note: listening beyond this machine (" << host
-                  << "); serve participants through an HTTPS reverse proxy (README)" << std::endl;
+                  << "); serve participants through an HTTPS reverse proxy (README)"
+                  << std::endl;
     // Pages idle past --idle-minutes are put aside (their claims end) even when no
     // request comes to do it.
     std::mutex sweep_mutex;
     std::condition_variable sweep_wake;
     bool sweep_stop = false;
     std::thread sweeper([&] {
-        const auto every = std::clamp(std::chrono::duration_cast<std::chrono::milliseconds>(
-                                          std::chrono::duration<double>(args.idle_minutes * 15)),
-                                      std::chrono::milliseconds(50), std::chrono::milliseconds(30'000));
+        const auto every =
+            std::clamp(std::chrono::duration_cast<std::chrono::milliseconds>(
+                           std::chrono::duration<double>(args.idle_minutes * 15)),
+                       std::chrono::milliseconds(50), std::chrono::milliseconds(30'000));
         std::unique_lock lock(sweep_mutex);
-        while (!sweep_wake.wait_for(lock, every, [&] { return sweep_stop; })) web->release_idle();
+        while (!sweep_wake.wait_for(lock, every, [&] { return sweep_stop; }))
+            web->release_idle();
     });
     http.listen_after_bind();
     listen_over = true;
@@ -227,7 +240,8 @@ int serve_command(const ServeArgs& args) {
     sweep_wake.notify_all();
     sweeper.join();
     if (stopper.joinable()) {
-        pthread_kill(stopper.native_handle(), SIGTERM);  // wakes sigwait when stopped otherwise
+        pthread_kill(stopper.native_handle(),
+                     SIGTERM);  // wakes sigwait when stopped otherwise
         stopper.join();
     }
     std::cout << "lucent serve: stopped; " << web->live_sessions()
@@ -239,8 +253,9 @@ int serve_command(const ServeArgs& args) {
             std::cerr << "lucent serve: " << e.what() << "\n";
         }
         if (const int left = store->pending_trials(); left > 0)
-            std::cerr << "lucent serve: " << left << " trials are kept in the local journal until "
-                      << store->name() << " confirms them; send them with 'lucent store sync --db "
+            std::cerr << "lucent serve: " << left
+                      << " trials are kept in the local journal until " << store->name()
+                      << " confirms them; send them with 'lucent store sync --db "
                       << store->name() << "'\n";
     }
     return kExitOk;
@@ -251,27 +266,33 @@ int serve_command(const ServeArgs& args) {
 void register_serve(CLI::App& app, int& exit_code) {
     auto args = std::make_shared<ServeArgs>();
     auto* cmd = app.add_subcommand(
-        "serve", "Serve the study to online participants in a browser (same protocol as 'run')");
+        "serve",
+        "Serve the study to online participants in a browser (same protocol as 'run')");
     cmd->add_option("protocol", args->protocol_file, "Study protocol file (TOML)");
     cmd->add_option("--preset", args->preset, "Built-in protocol instead of a file")
         ->check(CLI::IsMember(study::builtin_protocol_names()));
-    cmd->add_option("--images", args->images_dir,
-                    "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr (e.g. from "
-                    "'lucent render --preset thesis --out DIR')");
+    cmd->add_option(
+        "--images", args->images_dir,
+        "Directory of pre-rendered images named <stimulus id>.png|.tif|.exr (e.g. from "
+        "'lucent render --preset thesis --out DIR')");
     cmd->add_option("--db", args->db,
                     "Study database: FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
         ->required();
     cmd->add_option("--listen", args->listen,
-                    "HOST:PORT to listen on (default 127.0.0.1:8080, loopback only; port 0 picks one)");
-    cmd->add_option("--secret-file", args->secret_file,
-                    "Key of the participants' session tokens (created when absent; default "
-                    "DB-serve-key beside an SQLite file)");
-    cmd->add_option("--threads", args->threads, "HTTP worker threads (connections served at once)")
+                    "HOST:PORT to listen on (default 127.0.0.1:8080, loopback only; port "
+                    "0 picks one)");
+    cmd->add_option(
+        "--secret-file", args->secret_file,
+        "Key of the participants' session tokens (created when absent; default "
+        "DB-serve-key beside an SQLite file)");
+    cmd->add_option("--threads", args->threads,
+                    "HTTP worker threads (connections served at once)")
         ->check(CLI::Range(2, 1024));
-    cmd->add_option("--idle-minutes", args->idle_minutes,
-                    "A page silent this long is put aside: its claim on the participant ends "
-                    "(a lab station may run them) and its cell is free for the next arrival "
-                    "(default 30)")
+    cmd->add_option(
+           "--idle-minutes", args->idle_minutes,
+           "A page silent this long is put aside: its claim on the participant ends "
+           "(a lab station may run them) and its cell is free for the next arrival "
+           "(default 30)")
         ->check(CLI::Range(0.001, 1e6));
     cmd->add_option("--request-timeout", args->request_timeout_s,
                     "Seconds a request may take to arrive; slower connections are cut "

@@ -39,8 +39,9 @@ void register_simulate(CLI::App& app, int& exit_code) {
             const analysis::LongTable table = analysis::simulate_study(*spec);
             // Replaces an earlier simulated CSV, never a database; atomically.
             output::check_output_file(*out, {}, true);
-            output::write_file_atomically(
-                *out, true, [&](std::ostream& file) { analysis::write_long_csv(file, table); });
+            output::write_file_atomically(*out, true, [&](std::ostream& file) {
+                analysis::write_long_csv(file, table);
+            });
             std::cerr << "wrote " << table.rows.size() << " ratings to " << *out << "\n";
             exit_code = kExitOk;
         } catch (const analysis::InputError& e) {

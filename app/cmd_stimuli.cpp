@@ -19,10 +19,13 @@ void register_stimuli(CLI::App& app, int& exit_code) {
         "report",
         "Write DIR/report.html and DIR/contact-sheet.png: every stimulus as a thumbnail, "
         "Delta E00 and SSIM between the levels of each series, image statistics");
-    report->add_option("dir", args->directory, "output folder of 'lucent render CONFIG --out DIR'")
+    report
+        ->add_option("dir", args->directory,
+                     "output folder of 'lucent render CONFIG --out DIR'")
         ->required();
-    report->add_option("--min-delta-e", args->min_delta_e,
-                       "warn for pairs of levels whose mean Delta E00 is below this (default 3)");
+    report->add_option(
+        "--min-delta-e", args->min_delta_e,
+        "warn for pairs of levels whose mean Delta E00 is below this (default 3)");
     report->callback([args, &exit_code] {
         stimuli::SetReportOptions options;
         options.min_delta_e = args->min_delta_e;

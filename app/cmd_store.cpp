@@ -3,28 +3,33 @@
 #include <memory>
 
 #include "commands.h"
-#include "sqlite.h"
 #include "postgres/trial_journal.h"
+#include "sqlite.h"
 #include "study_store.h"
 
 namespace lucent::app {
 
 void register_store(CLI::App& app, int& exit_code) {
     auto* cmd = app.add_subcommand(
-        "store", "Set up a study store, or send the trials a station still holds locally");
+        "store",
+        "Set up a study store, or send the trials a station still holds locally");
     cmd->require_subcommand(1);
     auto db = std::make_shared<std::string>();
     auto journal = std::make_shared<std::string>();
     auto* init = cmd->add_subcommand(
-        "init", "Create the schema, or apply the migrations this build adds (a newer schema "
-                "is refused and left unchanged)");
-    init->add_option("--db", *db, "FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")->required();
+        "init",
+        "Create the schema, or apply the migrations this build adds (a newer schema "
+        "is refused and left unchanged)");
+    init->add_option("--db", *db, "FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
+        ->required();
     auto* sync = cmd->add_subcommand(
-        "sync", "Send the trials this station's journal holds for a server until it confirms "
-                "them (idempotent: a trial the server has is not stored twice)");
+        "sync",
+        "Send the trials this station's journal holds for a server until it confirms "
+        "them (idempotent: a trial the server has is not stored twice)");
     sync->add_option("--db", *db, "postgresql://USER@HOST[:PORT]/DBNAME")->required();
-    sync->add_option("--journal", *journal,
-                     "The journal file (default: the one `lucent run` used for this server)");
+    sync->add_option(
+        "--journal", *journal,
+        "The journal file (default: the one `lucent run` used for this server)");
     auto guarded = [&exit_code](const char* verb, auto fn) {
         try {
             exit_code = fn();
@@ -46,11 +51,13 @@ void register_store(CLI::App& app, int& exit_code) {
     sync->callback([=, &exit_code] {
         guarded("sync", [&] {
             if (!study::is_server_uri(*db))
-                throw study::StoreError("--db " + *db +
-                                        ": a file store has no journal; sync is for servers");
+                throw study::StoreError(
+                    "--db " + *db + ": a file store has no journal; sync is for servers");
             study::StoreOptions options;
-            options.journal_path = journal->empty() ? study::default_journal_path(*db) : *journal;
-            // Counted from the journal itself, so an unreachable server still gets a count.
+            options.journal_path =
+                journal->empty() ? study::default_journal_path(*db) : *journal;
+            // Counted from the journal itself, so an unreachable server still gets a
+            // count.
             const int before = study::TrialJournal(options.journal_path, *db).count();
             int left = before, withdrawn = 0;
             // Trials of a session withdrawn on the server leave the journal unsent.
@@ -60,7 +67,8 @@ void register_store(CLI::App& app, int& exit_code) {
                                  : std::string();
             };
             try {
-                const std::unique_ptr<study::StudyStore> store = study::open_study_store(*db, options);
+                const std::unique_ptr<study::StudyStore> store =
+                    study::open_study_store(*db, options);
                 try {
                     store->sync();
                 } catch (const study::StoreError&) {
@@ -77,8 +85,8 @@ void register_store(CLI::App& app, int& exit_code) {
                           << options.journal_path << "\n";
                 return kExitFailure;
             }
-            std::cout << "sent " << before - left - withdrawn << " of " << before << " trials to "
-                      << *db << dropped() << "; 0 still held\n";
+            std::cout << "sent " << before - left - withdrawn << " of " << before
+                      << " trials to " << *db << dropped() << "; 0 still held\n";
             return kExitOk;
         });
         (void)exit_code;

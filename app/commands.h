@@ -1,6 +1,7 @@
 #pragma once
-// Each subcommand lives in its own cmd_<name>.cpp and registers itself here; main.cpp only
-// lists them. A subcommand's callback returns the process exit code through `exit_code`.
+// Each subcommand lives in its own cmd_<name>.cpp and registers itself here; main.cpp
+// only lists them. A subcommand's callback returns the process exit code through
+// `exit_code`.
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <string>
@@ -29,7 +30,8 @@ void register_store(CLI::App& app, int& exit_code);
 void register_stimuli(CLI::App& app, int& exit_code);
 
 // `lucent analyze --images`: how a level's picture becomes a thumbnail (PNG bytes).
-// lucent-full sets it (it links the image library); unset, the picture itself is embedded.
+// lucent-full sets it (it links the image library); unset, the picture itself is
+// embedded.
 using ThumbnailMaker = std::string (*)(const std::filesystem::path& picture);
 void set_analyze_thumbnail_maker(ThumbnailMaker maker);
 

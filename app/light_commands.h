@@ -19,10 +19,13 @@ struct LightCommand {
 
 inline const std::vector<LightCommand>& light_commands() {
     static const std::vector<LightCommand> commands = {
-        {"participants", register_participants}, {"export", register_export},
-        {"merge", register_merge},               {"store", register_store},
+        {"participants", register_participants},
+        {"export", register_export},
+        {"merge", register_merge},
+        {"store", register_store},
         {"analyze", register_analyze, {"--images"}},
-        {"stats", register_stats},               {"simulate", register_simulate},
+        {"stats", register_stats},
+        {"simulate", register_simulate},
         {"power", register_power},
     };
     return commands;

@@ -7,10 +7,10 @@
 int main(int argc, char** argv) {
     using namespace lucent::app;
     set_analyze_thumbnail_maker(level_thumbnail_png);
-    std::vector<Registration> subcommands = {register_info,    register_render,
-                                             register_run,     register_explore,
-                                             register_stimuli, register_serve,
-                                             register_bench};
-    for (const LightCommand& light : light_commands()) subcommands.push_back(light.registration);
+    std::vector<Registration> subcommands = {
+        register_info,    register_render, register_run,  register_explore,
+        register_stimuli, register_serve,  register_bench};
+    for (const LightCommand& light : light_commands())
+        subcommands.push_back(light.registration);
     return run_cli(argc, argv, subcommands);
 }

@@ -23,9 +23,9 @@ bool is_light(int argc, char** argv) {
         for (int i = 2; i < argc; ++i) {
             const std::string_view arg = argv[i];
             for (const std::string_view option : light.full_options)
-                if (arg == option || (arg.size() > option.size() &&
-                                      arg.substr(0, option.size()) == option &&
-                                      arg[option.size()] == '='))
+                if (arg == option ||
+                    (arg.size() > option.size() &&
+                     arg.substr(0, option.size()) == option && arg[option.size()] == '='))
                     return false;
         }
         return true;
@@ -35,7 +35,8 @@ bool is_light(int argc, char** argv) {
 
 int exec_full(char** argv) {
     std::error_code error;
-    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+    const std::filesystem::path self =
+        std::filesystem::read_symlink("/proc/self/exe", error);
     if (error) {
         std::cerr << "lucent: cannot locate this executable (/proc/self/exe: "
                   << error.message() << ")\n";
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
     using namespace lucent::app;
     if (!is_light(argc, argv)) return exec_full(argv);
     std::vector<Registration> subcommands;
-    for (const LightCommand& light : light_commands()) subcommands.push_back(light.registration);
+    for (const LightCommand& light : light_commands())
+        subcommands.push_back(light.registration);
     return run_cli(argc, argv, subcommands);
 }

@@ -3,12 +3,10 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
-#include <netinet/in.h>
 #include <unistd.h>
-
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -16,6 +14,7 @@
 #include <cstdlib>
 #include <list>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <thread>
@@ -48,7 +47,8 @@ std::string one_line_json_error(const std::string& why) {
 struct Tracked {
     int fd = -1;  // our dup of the connection
     ino_t inode = 0;
-    std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+    std::chrono::steady_clock::time_point deadline =
+        std::chrono::steady_clock::time_point::max();
 };
 
 struct DeadlineState {
@@ -66,9 +66,12 @@ thread_local DeadlineState* current_state = nullptr;
 std::optional<int> local_port(int fd) {
     sockaddr_storage a{};
     socklen_t len = sizeof a;
-    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) return std::nullopt;
-    if (a.ss_family == AF_INET) return ntohs(reinterpret_cast<sockaddr_in*>(&a)->sin_port);
-    if (a.ss_family == AF_INET6) return ntohs(reinterpret_cast<sockaddr_in6*>(&a)->sin6_port);
+    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0)
+        return std::nullopt;
+    if (a.ss_family == AF_INET)
+        return ntohs(reinterpret_cast<sockaddr_in*>(&a)->sin_port);
+    if (a.ss_family == AF_INET6)
+        return ntohs(reinterpret_cast<sockaddr_in6*>(&a)->sin6_port);
     return std::nullopt;
 }
 
@@ -91,7 +94,8 @@ std::vector<SocketFd> socket_fds() {
         if (::fstat(static_cast<int>(fd), &st) != 0 || !S_ISSOCK(st.st_mode)) continue;
         int accepting = 0;
         socklen_t len = sizeof accepting;
-        if (::getsockopt(static_cast<int>(fd), SOL_SOCKET, SO_ACCEPTCONN, &accepting, &len) != 0)
+        if (::getsockopt(static_cast<int>(fd), SOL_SOCKET, SO_ACCEPTCONN, &accepting,
+                         &len) != 0)
             continue;
         out.push_back({static_cast<int>(fd), st.st_ino, accepting != 0});
     }
@@ -135,7 +139,8 @@ public:
     static void renew() {
         if (!current_connection || !current_state) return;
         std::lock_guard lock(current_state->mutex);
-        current_connection->deadline = std::chrono::steady_clock::now() + current_state->limit;
+        current_connection->deadline =
+            std::chrono::steady_clock::now() + current_state->limit;
     }
 
 private:
@@ -198,19 +203,23 @@ void configure_serve_http(httplib::Server& http, study::WebStudy& web,
                           const ServeHttpLimits& limits) {
     const size_t threads = static_cast<size_t>(std::max(1, limits.threads));
     const std::chrono::milliseconds deadline = limits.request_deadline;
-    http.new_task_queue = [threads, deadline] { return new DeadlinePool(threads, deadline); };
-    http.set_logger([](const httplib::Request&, const httplib::Response&) { DeadlinePool::renew(); });
+    http.new_task_queue = [threads, deadline] {
+        return new DeadlinePool(threads, deadline);
+    };
+    http.set_logger(
+        [](const httplib::Request&, const httplib::Response&) { DeadlinePool::renew(); });
     http.set_tcp_nodelay(true);  // each reply at once: no Nagle wait for a delayed ACK
     http.set_payload_max_length(64 * 1024);  // larger bodies: 413 before they are read
     http.set_read_timeout(limits.read_timeout);
     http.set_write_timeout(10);
     http.set_keep_alive_timeout(2);
-    http.set_default_headers({{"X-Content-Type-Options", "nosniff"},
-                              {"Referrer-Policy", "no-referrer"},
-                              {"X-Frame-Options", "DENY"},
-                              {"Content-Security-Policy",
-                               "default-src 'self'; img-src 'self'; frame-ancestors 'none'"},
-                              {"Cache-Control", "no-store"}});
+    http.set_default_headers(
+        {{"X-Content-Type-Options", "nosniff"},
+         {"Referrer-Policy", "no-referrer"},
+         {"X-Frame-Options", "DENY"},
+         {"Content-Security-Policy",
+          "default-src 'self'; img-src 'self'; frame-ancestors 'none'"},
+         {"Cache-Control", "no-store"}});
     auto page_file = [](const char* name, const char* type) {
         return [name, type](const httplib::Request&, httplib::Response& res) {
             res.set_content(std::string(*embedded::serve_file(name)), type);
@@ -221,34 +230,38 @@ void configure_serve_http(httplib::Server& http, study::WebStudy& web,
     http.Get("/lucent.css", page_file("lucent.css", "text/css; charset=utf-8"));
     std::map<std::string, study::WebImage> sizes;
     for (const auto& [id, picture] : pictures) sizes[id] = picture.size;
-    http.Get(R"(/images/.*)", [sizes, &pictures](const httplib::Request& req, httplib::Response& res) {
+    http.Get(R"(/images/.*)", [sizes, &pictures](const httplib::Request& req,
+                                                 httplib::Response& res) {
         // Matched on the raw target, so no decoding here can turn a name into a path.
         const std::optional<std::string> id = study::image_of_target(req.target, sizes);
         if (!id) {
             res.status = 404;
-            res.set_content(one_line_json_error("no such picture: " + req.target), "application/json");
+            res.set_content(one_line_json_error("no such picture: " + req.target),
+                            "application/json");
             return;
         }
         res.set_header("Cache-Control", "private, max-age=3600");
         res.set_content(pictures.at(*id).png, "image/png");
     });
-    http.Post(R"(/api/([a-z_]+))", [&web](const httplib::Request& req, httplib::Response& res) {
-        const study::WebReply reply = web.handle(req.matches[1].str(), req.body);
-        res.status = reply.status;
-        res.set_content(reply.body, "application/json");
-    });
+    http.Post(
+        R"(/api/([a-z_]+))", [&web](const httplib::Request& req, httplib::Response& res) {
+            const study::WebReply reply = web.handle(req.matches[1].str(), req.body);
+            res.status = reply.status;
+            res.set_content(reply.body, "application/json");
+        });
     http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
         if (!res.body.empty()) return;
         const std::string why = res.status == 413 ? "request body over 65536 bytes"
-                                : res.status == 404 ? "not found: " + req.method + " " + req.target
-                                                    : "HTTP " + std::to_string(res.status);
+                                : res.status == 404
+                                    ? "not found: " + req.method + " " + req.target
+                                    : "HTTP " + std::to_string(res.status);
         res.set_content(one_line_json_error(why), "application/json");
     });
-    http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
-        res.status = 500;
-        res.set_content(one_line_json_error("internal error"), "application/json");
-    });
-
+    http.set_exception_handler(
+        [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
+            res.status = 500;
+            res.set_content(one_line_json_error("internal error"), "application/json");
+        });
 }
 
 int bind_serve_port(httplib::Server& http, const std::string& host, int port) {

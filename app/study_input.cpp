@@ -1,13 +1,12 @@
 #include "study_input.h"
 
-#include "study_store.h"
-
 #include <fstream>
 #include <iostream>
 
 #include "export.h"
 #include "question_scales.h"
 #include "sqlite.h"
+#include "study_store.h"
 
 namespace lucent::app {
 
@@ -15,10 +14,12 @@ bool is_sqlite_file(const std::string& path) {
     char magic[16] = {};
     std::ifstream in(path, std::ios::binary);
     in.read(magic, sizeof magic);
-    return in.gcount() == 16 && std::string(magic, 16) == std::string("SQLite format 3\0", 16);
+    return in.gcount() == 16 &&
+           std::string(magic, 16) == std::string("SQLite format 3\0", 16);
 }
 
-analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale,
+analysis::LongTable read_ratings(const std::string& path,
+                                 const analysis::RatingScale& scale,
                                  std::optional<analysis::Design>* plan_design,
                                  std::vector<std::string>* notes) {
     const bool server = study::is_server_uri(path);
@@ -28,7 +29,8 @@ analysis::LongTable read_ratings(const std::string& path, const analysis::Rating
     try {
         const study::ReadableStudyFile source(path);  // a server: one snapshot of it
         read_path = source.path();
-        study::check_stored_ratings(source.path());  // each rating on its own question's scale
+        study::check_stored_ratings(
+            source.path());  // each rating on its own question's scale
         rows = study::analysis_long_table(source.path());
     } catch (const study::StoreError& e) {
         throw analysis::InputError(e.what());

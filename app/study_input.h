@@ -1,9 +1,8 @@
 #pragma once
 // `lucent analyze` input: a long CSV, or a study database read through study/ (each
 // stimulus's parameters as factors; practice, catch and excluded participants dropped).
-#include <string>
-
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "data/long_table.h"
@@ -16,7 +15,8 @@ bool is_sqlite_file(const std::string& path);
 // Reads either kind; throws analysis::InputError (one line) on bad input. For a study
 // database, `plan_design` receives the stored protocol's primary design, and `notes` the
 // line saying how many sessions were analysed and left out, by reason (also on stderr).
-analysis::LongTable read_ratings(const std::string& path, const analysis::RatingScale& scale,
+analysis::LongTable read_ratings(const std::string& path,
+                                 const analysis::RatingScale& scale,
                                  std::optional<analysis::Design>* plan_design = nullptr,
                                  std::vector<std::string>* notes = nullptr);
 

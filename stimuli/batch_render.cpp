@@ -13,8 +13,8 @@
 #include <charconv>
 #include <chrono>
 #include <condition_variable>
-#include <deque>
 #include <cstdio>
+#include <deque>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -57,7 +57,8 @@ std::vector<ManifestField> parameter_fields(const Stimulus& stimulus) {
         // A density volume's content hash follows its spec, as mesh_hash follows mesh.
         if (knob.name == "density")
             fields.push_back({"density_hash",
-                              density_from_knobs(stimulus.parameters)->content_hash, false});
+                              density_from_knobs(stimulus.parameters)->content_hash,
+                              false});
     }
     return fields;
 }
@@ -319,7 +320,8 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
 
     // Files, statistics and the manifest row of one rendered stimulus; false when the run
     // has stopped meanwhile (the row is then not written). Throws on I/O failure.
-    const auto finish_stimulus = [&](const RenderedStimulus& item, BatchTimings& timings) {
+    const auto finish_stimulus = [&](const RenderedStimulus& item,
+                                     BatchTimings& timings) {
         const std::size_t i = item.index;
         const Stimulus& s = set.stimuli[i];
         const Image& image = item.rendered.image;

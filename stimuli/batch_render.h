@@ -24,12 +24,12 @@ struct BatchOptions {
     // Render workers, each with its own headless GL context, and as many encode workers
     // (image files, statistics, manifest), which write one image while the next renders.
     int jobs = 1;
-    bool force = false;    // re-render every stimulus
+    bool force = false;  // re-render every stimulus
     // false: each render worker encodes its own images before rendering the next (no
     // encode workers; `lucent bench render` times both ways).
     bool overlap_encode = true;
     PngEncoding png = PngEncoding::fast;  // how PNG files are compressed (same pixels)
-    bool progress = true;  // progress line on stderr
+    bool progress = true;                 // progress line on stderr
     // Called on an encode worker's thread after each rendered stimulus is in the
     // manifest, with its id and how many have finished (tests interrupt a set here; may
     // throw: the run then stops and throws).

@@ -438,8 +438,9 @@ private:
         if (const auto* node = table.get("series")) {
             series = as_string(*node, prefix + "series", errors_);
             if (!is_safe_name(series))
-                errors_.fail(*node, prefix + "series",
-                             "'" + series + "' is not a valid name (letters, digits, _ - . only)");
+                errors_.fail(
+                    *node, prefix + "series",
+                    "'" + series + "' is not a valid name (letters, digits, _ - . only)");
         }
 
         for (std::size_t index = 0; index < count; ++index) {
@@ -499,7 +500,8 @@ private:
                          "'" + id + "' is not a valid id (letters, digits, _ - . only)");
         // The set report writes DIR/contact-sheet.png beside the stimuli's images.
         if (id == "contact-sheet")
-            errors_.fail(node, key, "'contact-sheet' is reserved (the report's contact sheet)");
+            errors_.fail(node, key,
+                         "'contact-sheet' is reserved (the report's contact sheet)");
         if (!ids_.insert(id).second) errors_.fail(node, key, "duplicate id '" + id + "'");
     }
 

@@ -24,7 +24,8 @@ Database open_read_only(const std::string& path) {
 }
 
 // Parameters of every stimulus: stimulus key -> (name -> value).
-std::map<std::string, std::map<std::string, std::string>> stimulus_parameters(Database& db) {
+std::map<std::string, std::map<std::string, std::string>> stimulus_parameters(
+    Database& db) {
     std::map<std::string, std::map<std::string, std::string>> out;
     Statement s = db.prepare(
         "SELECT st.stimulus_key, p.name, p.value FROM stimulus_parameters p "
@@ -40,7 +41,8 @@ std::map<std::string, int> catch_failures(Database& db) {
         "SELECT p.code, count(DISTINCT t.id) FROM responses r "
         "JOIN trials t ON t.id = r.trial_id JOIN sessions s ON s.id = r.session_id "
         "JOIN participants p ON p.id = s.participant_id "
-        "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > coalesce(t.tolerance, 0) "
+        "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > coalesce(t.tolerance, "
+        "0) "
         "GROUP BY p.code");
     while (s.step()) failed[s.text(0)] = static_cast<int>(s.integer(1));
     return failed;
@@ -97,13 +99,15 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
         for (const std::string& n : names) out << "," << csv_cell(n);
         out << ",mesh_hash,stimulus_source,image_file,image_hash,renderer_version,"
                "renderer_build";
-        out << ",question,rating,rt_ms,changes,practice,catch,expected_rating,catch_passed\n";
+        out << ",question,rating,rt_ms,changes,practice,catch,expected_rating,catch_"
+               "passed\n";
         // What the trial's segment showed (schema 3); NULL for older ratings.
         const bool has_provenance = db.scalar_int("PRAGMA user_version") >= 3;
         Statement s = db.prepare(
-            std::string("SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, "
-                        "st.technique, st.mesh, r.question, r.rating, r.rt_ms, r.changes, "
-                        "t.practice, t.catch, t.expected_rating, coalesce(t.tolerance, 0), ") +
+            std::string(
+                "SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, "
+                "st.technique, st.mesh, r.question, r.rating, r.rt_ms, r.changes, "
+                "t.practice, t.catch, t.expected_rating, coalesce(t.tolerance, 0), ") +
             (has_provenance ? "shown.source, shown.file, shown.content_hash, "
                               "shown.software_version, shown.build_hash "
                             : "NULL, NULL, NULL, NULL, NULL ") +
@@ -137,11 +141,12 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
             const bool is_catch = s.integer(12) != 0;
             std::string passed;
             if (is_catch)
-                passed = std::abs(s.integer(8) - s.integer(13)) <= s.integer(14) ? "1" : "0";
+                passed =
+                    std::abs(s.integer(8) - s.integer(13)) <= s.integer(14) ? "1" : "0";
             out << "," << csv_cell(s.text(7)) << "," << s.integer(8) << ","
-                << format_number(s.real(9)) << "," << s.integer(10) << "," << s.integer(11)
-                << "," << s.integer(12) << "," << (is_catch ? s.text(13) : "") << ","
-                << passed << "\n";
+                << format_number(s.real(9)) << "," << s.integer(10) << ","
+                << s.integer(11) << "," << s.integer(12) << ","
+                << (is_catch ? s.text(13) : "") << "," << passed << "\n";
             ++rows;
         }
         if (notes && without_provenance > 0)
@@ -150,7 +155,8 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
                 std::to_string(rows) +
                 " ratings were recorded without provenance (a database written before "
                 "schema 3): only the protocol's own parameter values are known for them; "
-                "defaults, mesh_hash, stimulus_source, image and renderer cells are empty");
+                "defaults, mesh_hash, stimulus_source, image and renderer cells are "
+                "empty");
         return rows;
     }
 
@@ -176,7 +182,8 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
         }
         Statement c = db.prepare(
             "SELECT p.code, count(s.id) FROM participants p "
-            "LEFT JOIN sessions s ON s.participant_id = p.id GROUP BY p.code ORDER BY p.code");
+            "LEFT JOIN sessions s ON s.participant_id = p.id GROUP BY p.code ORDER BY "
+            "p.code");
         while (c.step()) sessions[c.text(0)] = static_cast<int>(c.integer(1));
     }
     out << "participant,sessions,catch_failed";
@@ -190,7 +197,8 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
         for (const std::string& c : columns) {
             const auto it = row.find(c);
             out << ",";
-            if (it != row.end()) out << format_number(it->second.first / it->second.second);
+            if (it != row.end())
+                out << format_number(it->second.first / it->second.second);
         }
         out << "\n";
         ++rows;
@@ -198,10 +206,12 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
     return rows;
 }
 
-LongTable analysis_long_table(const std::string& db_path, const LongTableOptions& options) {
+LongTable analysis_long_table(const std::string& db_path,
+                              const LongTableOptions& options) {
     Database db = open_read_only(db_path);
     const auto params = stimulus_parameters(db);
-    std::map<std::string, std::pair<std::string, std::vector<std::string>>> stimuli;  // technique, varies
+    std::map<std::string, std::pair<std::string, std::vector<std::string>>>
+        stimuli;  // technique, varies
     {
         Statement s = db.prepare("SELECT stimulus_key, technique, varies FROM stimuli");
         while (s.step()) {
@@ -225,7 +235,8 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
     // Which sessions are read: never a withdrawn one (a tombstone's UUID; its rows are
     // normally gone already), and with "completed" only completed ones.
     std::set<std::string> withdrawn;
-    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'withdrawn_sessions'") > 0) {
+    if (db.scalar_int(
+            "SELECT count(*) FROM sqlite_schema WHERE name = 'withdrawn_sessions'") > 0) {
         Statement w = db.prepare("SELECT uuid FROM withdrawn_sessions");
         while (w.step()) withdrawn.insert(w.text(0));
     }
@@ -257,7 +268,8 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
         Statement f = db.prepare(
             "SELECT r.session_id, count(DISTINCT t.id) FROM responses r "
             "JOIN trials t ON t.id = r.trial_id "
-            "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > coalesce(t.tolerance, 0) "
+            "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > "
+            "coalesce(t.tolerance, 0) "
             "GROUP BY r.session_id");
         while (f.step()) {
             const auto it = taken.find(f.integer(0));
@@ -266,17 +278,19 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
         for (const auto& [participant, n] : failed)
             if (n > allowed) {
                 excluded.insert(participant);
-                table.excluded_participants.push_back(participant + " (" + std::to_string(n) +
-                                                      " catch trials failed)");
+                table.excluded_participants.push_back(
+                    participant + " (" + std::to_string(n) + " catch trials failed)");
             }
         for (const auto& [id, participant] : taken)
             if (excluded.count(participant)) ++table.left_out.failed_catch;
     }
-    table.sessions_analysed = static_cast<int>(taken.size()) - table.left_out.failed_catch;
+    table.sessions_analysed =
+        static_cast<int>(taken.size()) - table.left_out.failed_catch;
     {
         const SessionsLeftOut& l = table.left_out;
-        std::string note = db_path + ": " + std::to_string(table.sessions_analysed) + " of " +
-                           std::to_string(table.sessions_total) + " sessions analysed (" +
+        std::string note = db_path + ": " + std::to_string(table.sessions_analysed) +
+                           " of " + std::to_string(table.sessions_total) +
+                           " sessions analysed (" +
                            (table.sessions == "completed"
                                 ? "completed sessions only, the analysis plan's default"
                                 : "sessions of every status, as the analysis plan says") +
@@ -310,11 +324,14 @@ LongTable analysis_long_table(const std::string& db_path, const LongTableOptions
         std::vector<std::pair<std::string, std::string>> factors;
         if (varies.empty()) {
             if (pit != params.end())
-                for (const auto& [name, value] : pit->second) factors.emplace_back(name, value);
+                for (const auto& [name, value] : pit->second)
+                    factors.emplace_back(name, value);
         } else {
             for (const std::string& f : varies) {
-                if (f == "technique") factors.emplace_back(f, technique);
-                else if (f.rfind("series:", 0) == 0)  // a comparison series: one level per stimulus
+                if (f == "technique")
+                    factors.emplace_back(f, technique);
+                else if (f.rfind("series:", 0) ==
+                         0)  // a comparison series: one level per stimulus
                     factors.emplace_back(f.substr(7), stimulus);
                 else if (pit != params.end() && pit->second.count(f))
                     factors.emplace_back(f, pit->second.at(f));
@@ -342,8 +359,8 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                 result.notes.push_back(table.sessions_note);
             } else if (format == "long" || format == "wide") {
                 result.rows = export_csv(
-                    db_path, format == "long" ? ExportFormat::Long : ExportFormat::Wide, out,
-                    &result.notes);
+                    db_path, format == "long" ? ExportFormat::Long : ExportFormat::Wide,
+                    out, &result.notes);
             } else {
                 throw StoreError("export: unknown format '" + format +
                                  "' (valid: long, wide, analysis)");
@@ -359,8 +376,8 @@ void write_long_table_csv(const LongTable& table, std::ostream& out) {
     out << "participant,stimulus,factor,level,question,rating\n";
     for (const LongRow& r : table.rows)
         out << csv_cell(r.participant) << "," << csv_cell(r.stimulus) << ","
-            << csv_cell(r.factor) << "," << csv_cell(r.level) << "," << csv_cell(r.question)
-            << "," << r.rating << "\n";
+            << csv_cell(r.factor) << "," << csv_cell(r.level) << ","
+            << csv_cell(r.question) << "," << r.rating << "\n";
 }
 
 }  // namespace lucent::study

@@ -65,8 +65,10 @@ struct SessionsLeftOut {
 
 struct LongTable {
     std::vector<LongRow> rows;
-    std::vector<std::string> excluded_participants;  // with the reason, "P3 (2 catch failed)"
-    std::string primary_design;  // the stored protocol's [analysis] plan; "" if unreadable
+    std::vector<std::string>
+        excluded_participants;  // with the reason, "P3 (2 catch failed)"
+    std::string
+        primary_design;  // the stored protocol's [analysis] plan; "" if unreadable
     std::string sessions = "completed";  // which sessions were taken
     int sessions_total = 0;              // in the database, withdrawn ones included
     int sessions_analysed = 0;
@@ -81,7 +83,8 @@ struct LongTable {
 // declares none); "technique" is a factor only when listed in `varies`. Only the
 // sessions the plan (or `options.sessions`) names are read: by default completed ones.
 // A session whose UUID is a withdrawal tombstone is never read.
-LongTable analysis_long_table(const std::string& db_path, const LongTableOptions& options = {});
+LongTable analysis_long_table(const std::string& db_path,
+                              const LongTableOptions& options = {});
 void write_long_table_csv(const LongTable& table, std::ostream& out);
 
 struct MergeReport {
@@ -122,7 +125,8 @@ struct MergeReport {
 // older schema are read through a migrated temporary copy; inputs holding different
 // protocols (hashes), newer schemas or foreign files are refused before anything is
 // written. Inputs are opened read-only and never modified.
-MergeReport merge_databases(const std::vector<std::string>& inputs, const std::string& out_path,
+MergeReport merge_databases(const std::vector<std::string>& inputs,
+                            const std::string& out_path,
                             const std::vector<std::string>& names = {});
 
 // One CSV cell, quoted when it holds a comma, quote or line break.

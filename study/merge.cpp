@@ -24,13 +24,14 @@ namespace {
 // An input as merge reads it: the file itself, or an upgraded temporary copy of an
 // older schema (removed when the merge ends; the input is never written).
 struct MergeInput {
-    std::string path;     // as given, for messages
-    std::string readable; // what is attached: path, or the upgraded copy
+    std::string path;      // as given, for messages
+    std::string readable;  // what is attached: path, or the upgraded copy
     std::unique_ptr<output::PendingOutput> upgraded_copy;
     std::set<std::string> protocol_hashes;
 };
 
-MergeInput open_input(const std::string& path, const std::filesystem::path& scratch_next_to,
+MergeInput open_input(const std::string& path,
+                      const std::filesystem::path& scratch_next_to,
                       std::vector<std::string>& notes) {
     check_database_file(path);  // refuses foreign, corrupt and newer databases
     MergeInput in{path, path, nullptr, {}};
@@ -40,7 +41,8 @@ MergeInput open_input(const std::string& path, const std::filesystem::path& scra
         version = db.scalar_int("PRAGMA user_version");
         if (version > 0 && version < kSchemaVersion) {
             // Copy (VACUUM INTO reads a read-only database) and migrate the copy.
-            in.upgraded_copy = std::make_unique<output::PendingOutput>(scratch_next_to, false);
+            in.upgraded_copy =
+                std::make_unique<output::PendingOutput>(scratch_next_to, false);
             in.readable = in.upgraded_copy->temporary().string();
             db.prepare("VACUUM INTO ?").bind(1, in.readable).run();
         }
@@ -62,12 +64,13 @@ MergeInput open_input(const std::string& path, const std::filesystem::path& scra
 // and which inputs hold them, the withdrawals of every input, participants without
 // sessions.
 struct Survey {
-    std::map<std::string, std::vector<SessionCopy>> copies;  // uuid -> one per input holding it
+    std::map<std::string, std::vector<SessionCopy>>
+        copies;  // uuid -> one per input holding it
     Tombstones tombstones;
-    std::set<std::string> withdrawn;  // session UUIDs the tombstones cover
+    std::set<std::string> withdrawn;               // session UUIDs the tombstones cover
     std::map<std::string, Reconciled> reconciled;  // sessions held by several inputs
-    std::set<std::string> plain_codes;     // every participant code of every input
-    std::set<std::string> dropped_codes;   // withdrawn participants without sessions
+    std::set<std::string> plain_codes;    // every participant code of every input
+    std::set<std::string> dropped_codes;  // withdrawn participants without sessions
 };
 
 Survey survey_inputs(const std::vector<MergeInput>& inputs) {
@@ -90,7 +93,8 @@ Survey survey_inputs(const std::vector<MergeInput>& inputs) {
         }
     }
     for (const auto& [code, created] : sessionless)
-        if (survey.tombstones.covers("", code, "", created)) survey.dropped_codes.insert(code);
+        if (survey.tombstones.covers("", code, "", created))
+            survey.dropped_codes.insert(code);
     // Withdrawn sessions are dropped before anything is compared.
     for (const auto& [uuid, copies] : survey.copies) {
         const SessionCopy& c = copies.front();
@@ -146,7 +150,8 @@ std::map<std::string, std::string> person_codes(const Survey& survey,
                                                 std::vector<std::string>& notes) {
     // (code, machine) -> its sessions; sessions are joined into one person when an input
     // holds both (union-find over the inputs holding each session).
-    std::map<std::pair<std::string, std::string>, std::vector<std::string>> by_code_machine;
+    std::map<std::pair<std::string, std::string>, std::vector<std::string>>
+        by_code_machine;
     for (const auto& [uuid, copies] : survey.copies) {
         if (survey.withdrawn.count(uuid)) continue;
         by_code_machine[{copies.front().code, copies.front().machine_id}].push_back(uuid);
@@ -177,15 +182,16 @@ std::map<std::string, std::string> person_codes(const Survey& survey,
         for (size_t i = 0; i < uuids.size(); ++i) {
             Person& p = groups[together ? 0 : root(i)];
             const std::string& started = kept[i]->started_utc;
-            if (p.sessions.empty() || std::tie(started, uuids[i]) <
-                                          std::tie(p.first_started, p.first_uuid)) {
+            if (p.sessions.empty() ||
+                std::tie(started, uuids[i]) < std::tie(p.first_started, p.first_uuid)) {
                 p.first_started = started;
                 p.first_uuid = uuids[i];
             }
             p.machine = key.second;
             p.sessions.push_back(uuids[i]);
         }
-        for (auto& [id, person] : groups) people_of_code[key.first].push_back(std::move(person));
+        for (auto& [id, person] : groups)
+            people_of_code[key.first].push_back(std::move(person));
     }
 
     std::map<std::string, std::string> merged;
@@ -200,7 +206,8 @@ std::map<std::string, std::string> person_codes(const Survey& survey,
         // tells them apart.
         size_t length = 8;
         auto label = [&](const std::string& machine) {
-            return machine.empty() ? std::string("unknown-machine") : machine.substr(0, length);
+            return machine.empty() ? std::string("unknown-machine")
+                                   : machine.substr(0, length);
         };
         for (;; ++length) {
             std::set<std::string> labels;
@@ -211,28 +218,32 @@ std::map<std::string, std::string> person_codes(const Survey& survey,
                            " machines are different people, kept apart as";
         for (auto& [machine, on_machine] : by_machine) {
             // Several people on one machine: numbered by their first session's start.
-            std::sort(on_machine.begin(), on_machine.end(), [](const Person* a, const Person* b) {
-                return std::tie(a->first_started, a->first_uuid) <
-                       std::tie(b->first_started, b->first_uuid);
-            });
+            std::sort(on_machine.begin(), on_machine.end(),
+                      [](const Person* a, const Person* b) {
+                          return std::tie(a->first_started, a->first_uuid) <
+                                 std::tie(b->first_started, b->first_uuid);
+                      });
             std::string names;
             for (size_t k = 0; k < on_machine.size(); ++k) {
                 std::string renamed = code + "@" + label(machine);
                 if (on_machine.size() > 1) renamed += "#" + std::to_string(k + 1);
                 if (survey.plain_codes.count(renamed))
                     throw StoreError("refusing to merge: participant code " + code +
-                                     " would be kept apart as several people, and " + renamed +
-                                     " is already another participant's code");
-                for (const std::string& uuid : on_machine[k]->sessions) merged[uuid] = renamed;
+                                     " would be kept apart as several people, and " +
+                                     renamed + " is already another participant's code");
+                for (const std::string& uuid : on_machine[k]->sessions)
+                    merged[uuid] = renamed;
                 names += " " + renamed;
             }
             line += names;
             if (on_machine.size() > 1)
-                notes.push_back(code + ": " + std::to_string(on_machine.size()) +
-                                " people on machine " + label(machine) +
-                                ": their sessions come from different files, and one file "
-                                "cannot hold them all (a code completes once per file), so "
-                                "they are kept apart as" + names);
+                notes.push_back(
+                    code + ": " + std::to_string(on_machine.size()) +
+                    " people on machine " + label(machine) +
+                    ": their sessions come from different files, and one file "
+                    "cannot hold them all (a code completes once per file), so "
+                    "they are kept apart as" +
+                    names);
         }
         if (by_machine.size() > 1) notes.push_back(line);
     }
@@ -243,14 +254,17 @@ const char* const kCopySteps[] = {
     "INSERT OR IGNORE INTO studies (name, protocol_text, protocol_hash, created_utc) "
     "SELECT name, protocol_text, protocol_hash, created_utc FROM src.studies",
 
-    "INSERT OR IGNORE INTO stimuli (study_id, stimulus_key, technique, mesh, image, varies) "
-    "SELECT ms.id, s.stimulus_key, s.technique, s.mesh, s.image, s.varies FROM src.stimuli s "
+    "INSERT OR IGNORE INTO stimuli (study_id, stimulus_key, technique, mesh, image, "
+    "varies) "
+    "SELECT ms.id, s.stimulus_key, s.technique, s.mesh, s.image, s.varies FROM "
+    "src.stimuli s "
     "JOIN src.studies ss ON ss.id = s.study_id "
     "JOIN main.studies ms ON ms.protocol_hash = ss.protocol_hash",
 
     "INSERT OR IGNORE INTO stimulus_parameters (stimulus_id, name, value) "
     "SELECT mst.id, p.name, p.value FROM src.stimulus_parameters p "
-    "JOIN src.stimuli s ON s.id = p.stimulus_id JOIN src.studies ss ON ss.id = s.study_id "
+    "JOIN src.stimuli s ON s.id = p.stimulus_id JOIN src.studies ss ON ss.id = "
+    "s.study_id "
     "JOIN main.studies ms ON ms.protocol_hash = ss.protocol_hash "
     "JOIN main.stimuli mst ON mst.study_id = ms.id AND mst.stimulus_key = s.stimulus_key",
 
@@ -278,7 +292,8 @@ const char* const kCopySteps[] = {
     "SELECT number FROM src.retired_participant_numbers",
 
     "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, cell, "
-    "block_order, status, started_utc, ended_utc, consent_utc, software_version, build_hash, "
+    "block_order, status, started_utc, ended_utc, consent_utc, software_version, "
+    "build_hash, "
     "gl_vendor, gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, "
     "refresh_note) "
     "SELECT s.uuid, ms.id, mp.id, s.machine_id, s.seed, s.cell, s.block_order, s.status, "
@@ -291,30 +306,38 @@ const char* const kCopySteps[] = {
     "JOIN temp.person_map m ON m.uuid = s.uuid "
     "JOIN main.participants mp ON mp.code = m.merged_code ORDER BY s.id",
 
-    "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, catch_id, "
-    "prompt, expected_rating, tolerance, break_before, onset_ns, confirm_ns, answered_utc, "
+    "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, "
+    "catch_id, "
+    "prompt, expected_rating, tolerance, break_before, onset_ns, confirm_ns, "
+    "answered_utc, "
     "dropped_frames, uuid) "
-    "SELECT msn.id, t.position, t.block, mst.id, t.practice, t.catch, t.catch_id, t.prompt, "
+    "SELECT msn.id, t.position, t.block, mst.id, t.practice, t.catch, t.catch_id, "
+    "t.prompt, "
     "t.expected_rating, t.tolerance, t.break_before, t.onset_ns, t.confirm_ns, "
     "t.answered_utc, t.dropped_frames, t.uuid FROM src.trials t "
-    "JOIN src.sessions s ON s.id = t.session_id JOIN temp.new_sessions n ON n.uuid = s.uuid "
+    "JOIN src.sessions s ON s.id = t.session_id JOIN temp.new_sessions n ON n.uuid = "
+    "s.uuid "
     "JOIN main.sessions msn ON msn.uuid = s.uuid "
     "JOIN src.stimuli st ON st.id = t.stimulus_id "
-    "JOIN main.stimuli mst ON mst.study_id = msn.study_id AND mst.stimulus_key = st.stimulus_key "
+    "JOIN main.stimuli mst ON mst.study_id = msn.study_id AND mst.stimulus_key = "
+    "st.stimulus_key "
     "ORDER BY t.id",
 
     "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
     "first_choice_ns, final_choice_ns) "
     "SELECT msn.id, mt.id, r.question, r.rating, r.rt_ms, r.changes, r.first_choice_ns, "
     "r.final_choice_ns FROM src.responses r JOIN src.trials t ON t.id = r.trial_id "
-    "JOIN src.sessions s ON s.id = r.session_id JOIN temp.new_sessions n ON n.uuid = s.uuid "
+    "JOIN src.sessions s ON s.id = r.session_id JOIN temp.new_sessions n ON n.uuid = "
+    "s.uuid "
     "JOIN main.sessions msn ON msn.uuid = s.uuid "
-    "JOIN main.trials mt ON mt.session_id = msn.id AND mt.position = t.position ORDER BY r.id",
+    "JOIN main.trials mt ON mt.session_id = msn.id AND mt.position = t.position ORDER BY "
+    "r.id",
 };
 
 }  // namespace
 
-MergeReport merge_databases(const std::vector<std::string>& inputs, const std::string& out_path,
+MergeReport merge_databases(const std::vector<std::string>& inputs,
+                            const std::string& out_path,
                             const std::vector<std::string>& names) {
     if (inputs.empty()) throw StoreError("merge: no input databases given");
     if (!names.empty() && names.size() != inputs.size())
@@ -331,11 +354,12 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
     std::vector<MergeInput> opened;
     int first = -1;  // the first input holding a study
     for (size_t i = 0; i < inputs.size(); ++i) {
-        MergeInput& in = opened.emplace_back(open_input(inputs[i], out_path, report.notes));
+        MergeInput& in =
+            opened.emplace_back(open_input(inputs[i], out_path, report.notes));
         if (!names.empty()) in.path = names[i];
         if (in.protocol_hashes.size() > 1)
-            throw StoreError(in.path + ": holds " + std::to_string(in.protocol_hashes.size()) +
-                             " protocols");
+            throw StoreError(in.path + ": holds " +
+                             std::to_string(in.protocol_hashes.size()) + " protocols");
         if (in.protocol_hashes.empty()) continue;
         if (first < 0) {
             first = static_cast<int>(opened.size()) - 1;
@@ -347,7 +371,8 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
         }
     }
     {
-        // Inputs upgraded from before schema 3 recorded no resolved values: nothing to compare.
+        // Inputs upgraded from before schema 3 recorded no resolved values: nothing to
+        // compare.
         std::vector<std::string> current;
         for (size_t i = 0; i < opened.size(); ++i)
             if (!opened[i].upgraded_copy) current.push_back(inputs[i]);
@@ -358,7 +383,8 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
     // does not depend on the order of the inputs.
     const Survey survey = survey_inputs(opened);
     const auto people = person_codes(survey, report.notes);
-    std::map<int, std::vector<std::string>> kept_from;  // input -> sessions copied from it
+    std::map<int, std::vector<std::string>>
+        kept_from;  // input -> sessions copied from it
     for (const auto& [uuid, copies] : survey.copies)
         if (!survey.withdrawn.count(uuid))
             kept_from[kept_copy(survey, uuid).input].push_back(uuid);
@@ -373,12 +399,16 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
     {
         Store out(pending.temporary().string());
         Database& db = out.db();
-        db.exec("CREATE TEMP TABLE person_map (uuid TEXT PRIMARY KEY, code TEXT NOT NULL, "
-                "merged_code TEXT NOT NULL)");
+        db.exec(
+            "CREATE TEMP TABLE person_map (uuid TEXT PRIMARY KEY, code TEXT NOT NULL, "
+            "merged_code TEXT NOT NULL)");
         Statement map = db.prepare("INSERT INTO temp.person_map VALUES (?, ?, ?)");
         for (const auto& [uuid, merged_code] : people) {
             map.reset();
-            map.bind(1, uuid).bind(2, survey.copies.at(uuid).front().code).bind(3, merged_code).run();
+            map.bind(1, uuid)
+                .bind(2, survey.copies.at(uuid).front().code)
+                .bind(3, merged_code)
+                .run();
         }
         db.exec("CREATE TEMP TABLE dropped_codes (code TEXT PRIMARY KEY)");
         Statement dropped = db.prepare("INSERT INTO temp.dropped_codes VALUES (?)");
@@ -388,13 +418,19 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
         }
         for (size_t i = 0; i < opened.size(); ++i) {
             const MergeInput& in = opened[i];
-            db.prepare("ATTACH DATABASE ? AS src").bind(1, file_uri(in.readable, "mode=ro")).run();
+            db.prepare("ATTACH DATABASE ? AS src")
+                .bind(1, file_uri(in.readable, "mode=ro"))
+                .run();
             try {
                 Transaction tx(db);
-                const int64_t before = db.scalar_int("SELECT count(*) FROM main.sessions");
-                if (db.scalar_int("SELECT count(*) FROM src.sqlite_schema WHERE name = 'studies'") > 0) {
+                const int64_t before =
+                    db.scalar_int("SELECT count(*) FROM main.sessions");
+                if (db.scalar_int(
+                        "SELECT count(*) FROM src.sqlite_schema WHERE name = 'studies'") >
+                    0) {
                     db.exec("CREATE TEMP TABLE new_sessions (uuid TEXT PRIMARY KEY)");
-                    Statement add = db.prepare("INSERT INTO temp.new_sessions VALUES (?)");
+                    Statement add =
+                        db.prepare("INSERT INTO temp.new_sessions VALUES (?)");
                     for (const std::string& uuid : kept_from[static_cast<int>(i)]) {
                         add.reset();
                         add.bind(1, uuid).run();
@@ -403,7 +439,8 @@ MergeReport merge_databases(const std::vector<std::string>& inputs, const std::s
                     copy_provenance(db);
                 }
                 db.exec("DROP TABLE IF EXISTS temp.new_sessions");
-                const int64_t added = db.scalar_int("SELECT count(*) FROM main.sessions") - before;
+                const int64_t added =
+                    db.scalar_int("SELECT count(*) FROM main.sessions") - before;
                 tx.commit();
                 report.sessions_added += static_cast<int>(added);
             } catch (...) {

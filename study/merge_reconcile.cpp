@@ -15,7 +15,8 @@ std::tuple<int, int> progress(const SessionCopy& c) {
     return {c.segments, rank};
 }
 
-std::string rating_text(const std::map<std::string, int64_t>& answers, const std::string& q) {
+std::string rating_text(const std::map<std::string, int64_t>& answers,
+                        const std::string& q) {
     const auto it = answers.find(q);
     return it == answers.end() ? "(none)" : std::to_string(it->second);
 }
@@ -28,26 +29,27 @@ int compare(const std::string& uuid, const SessionCopy& a, const SessionCopy& b,
     const std::string& bn = names[b.input];
     const std::string who = "refusing to merge: session " + uuid + " (" + a.code + ")";
     if (a.code != b.code || a.machine_id != b.machine_id)
-        throw StoreError(who + ": participant " + a.code + " on machine '" + a.machine_id +
-                         "' in " + an + " but " + b.code + " on machine '" + b.machine_id +
-                         "' in " + bn + " (one session UUID, two people?)");
+        throw StoreError(who + ": participant " + a.code + " on machine '" +
+                         a.machine_id + "' in " + an + " but " + b.code +
+                         " on machine '" + b.machine_id + "' in " + bn +
+                         " (one session UUID, two people?)");
     if (a.seed != b.seed || a.cell != b.cell || a.block_order != b.block_order ||
         a.plan.size() != b.plan.size())
-        throw StoreError(who + ": " + an + " and " + bn + " hold different trial plans (seed " +
-                         a.seed + ", " + std::to_string(a.plan.size()) + " trials vs seed " +
-                         b.seed + ", " + std::to_string(b.plan.size()) + " trials)");
+        throw StoreError(who + ": " + an + " and " + bn +
+                         " hold different trial plans (seed " + a.seed + ", " +
+                         std::to_string(a.plan.size()) + " trials vs seed " + b.seed +
+                         ", " + std::to_string(b.plan.size()) + " trials)");
     for (const auto& [position, planned] : a.plan) {
         const auto other = b.plan.find(position);
         SessionCopy::Planned x = planned;
         if (other != b.plan.end() && (x.uuid.empty() || other->second.uuid.empty()))
             x.uuid = other->second.uuid;  // a trial planned before schema 4 has none
         if (other == b.plan.end() || !(x == other->second))
-            throw StoreError(who + " trial " + std::to_string(position) + ": " + an + " and " +
-                             bn + " hold different trial plans (stimulus '" + planned.stimulus +
-                             "' vs '" +
-                             (other == b.plan.end() ? std::string("(none)")
-                                                    : other->second.stimulus) +
-                             "')");
+            throw StoreError(
+                who + " trial " + std::to_string(position) + ": " + an + " and " + bn +
+                " hold different trial plans (stimulus '" + planned.stimulus + "' vs '" +
+                (other == b.plan.end() ? std::string("(none)") : other->second.stimulus) +
+                "')");
     }
     int64_t only_a = -1, only_b = -1;
     for (const auto& [position, ratings] : a.answers) {
@@ -61,9 +63,10 @@ int compare(const std::string& uuid, const SessionCopy& a, const SessionCopy& b,
         for (const auto& [q, r] : other->second) questions.insert(q);
         for (const std::string& q : questions)
             if (rating_text(ratings, q) != rating_text(other->second, q))
-                throw StoreError(who + " trial " + std::to_string(position) + ": rating '" + q +
-                                 "'=" + rating_text(ratings, q) + " in " + an + " but " +
-                                 rating_text(other->second, q) + " in " + bn);
+                throw StoreError(who + " trial " + std::to_string(position) +
+                                 ": rating '" + q + "'=" + rating_text(ratings, q) +
+                                 " in " + an + " but " + rating_text(other->second, q) +
+                                 " in " + bn);
     }
     for (const auto& [position, ratings] : b.answers)
         if (!a.answers.count(position)) {
@@ -71,8 +74,9 @@ int compare(const std::string& uuid, const SessionCopy& a, const SessionCopy& b,
             break;
         }
     if (only_a >= 0 && only_b >= 0)
-        throw StoreError(who + ": trial " + std::to_string(only_a) + " is answered only in " + an +
-                         " and trial " + std::to_string(only_b) + " only in " + bn +
+        throw StoreError(who + ": trial " + std::to_string(only_a) +
+                         " is answered only in " + an + " and trial " +
+                         std::to_string(only_b) + " only in " + bn +
                          "; neither copy extends the other");
     if (only_a >= 0) return 1;
     if (only_b >= 0) return -1;
@@ -85,9 +89,12 @@ int compare(const std::string& uuid, const SessionCopy& a, const SessionCopy& b,
 std::map<std::string, SessionCopy> read_session_copies(Database& db, int input) {
     std::map<std::string, SessionCopy> out;
     Statement s = db.prepare(
-        "SELECT se.uuid, p.code, se.machine_id, se.started_utc, se.status, se.seed, se.cell, "
-        "se.block_order, (SELECT count(*) FROM session_segments g WHERE g.session_id = se.id) "
-        "FROM sessions se JOIN participants p ON p.id = se.participant_id ORDER BY se.id");
+        "SELECT se.uuid, p.code, se.machine_id, se.started_utc, se.status, se.seed, "
+        "se.cell, "
+        "se.block_order, (SELECT count(*) FROM session_segments g WHERE g.session_id = "
+        "se.id) "
+        "FROM sessions se JOIN participants p ON p.id = se.participant_id ORDER BY "
+        "se.id");
     while (s.step()) {
         SessionCopy& c = out[s.text(0)];
         c.input = input;
@@ -125,7 +132,8 @@ void read_session_details(Database& db, std::map<std::string, SessionCopy*>& wan
     }
 }
 
-Reconciled reconcile_copies(const std::string& uuid, const std::vector<SessionCopy>& copies,
+Reconciled reconcile_copies(const std::string& uuid,
+                            const std::vector<SessionCopy>& copies,
                             const std::vector<std::string>& names) {
     Reconciled out;
     // The copies only grow along the way, so a copy extending every other is reached
@@ -142,9 +150,10 @@ Reconciled reconcile_copies(const std::string& uuid, const std::vector<SessionCo
         if (i == out.kept) continue;
         const int c = compare(uuid, copies[out.kept], copies[i], names);
         if (c < 0)
-            throw StoreError("refusing to merge: session " + uuid + " (" + copies[i].code +
-                             "): no copy extends every other (" + names[copies[i].input] +
-                             " got further than " + names[copies[out.kept].input] + ")");
+            throw StoreError("refusing to merge: session " + uuid + " (" +
+                             copies[i].code + "): no copy extends every other (" +
+                             names[copies[i].input] + " got further than " +
+                             names[copies[out.kept].input] + ")");
         (c == 0 ? out.identical : out.extended)++;
     }
     return out;

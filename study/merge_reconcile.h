@@ -24,8 +24,9 @@ struct SessionCopy {
         int64_t practice = 0, is_catch = 0;
         bool operator==(const Planned&) const = default;
     };
-    std::map<int64_t, Planned> plan;                            // by position
-    std::map<int64_t, std::map<std::string, int64_t>> answers;  // position -> question -> rating
+    std::map<int64_t, Planned> plan;  // by position
+    std::map<int64_t, std::map<std::string, int64_t>>
+        answers;  // position -> question -> rating
 };
 
 // Every session of `db` (uuid -> copy, without plan and answers), read-only.
@@ -35,16 +36,17 @@ void read_session_details(Database& db, std::map<std::string, SessionCopy*>& wan
 
 // What reconciling the copies of one session decided.
 struct Reconciled {
-    size_t kept = 0;            // index of the copy that extends every other
-    int identical = 0;          // other copies equal to it (already present)
-    int extended = 0;           // other copies it extends (fewer answers, earlier status)
+    size_t kept = 0;    // index of the copy that extends every other
+    int identical = 0;  // other copies equal to it (already present)
+    int extended = 0;   // other copies it extends (fewer answers, earlier status)
 };
 
 // Chooses the copy that extends every other (`names[input]` names inputs in messages).
 // Throws StoreError, one line, when copies hold another participant or plan, disagree on
 // a rating, or no copy extends every other. The same copies in any order give the same
 // copy (or the same refusal).
-Reconciled reconcile_copies(const std::string& uuid, const std::vector<SessionCopy>& copies,
+Reconciled reconcile_copies(const std::string& uuid,
+                            const std::vector<SessionCopy>& copies,
                             const std::vector<std::string>& names);
 
 }  // namespace lucent::study

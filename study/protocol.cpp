@@ -1,13 +1,14 @@
 // Protocol parsing: TOML -> Protocol, with every error naming file, line and key.
 #include "protocol.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "embedded_study_files.h"
 #include "sha256.h"
@@ -25,8 +26,8 @@ public:
                            const std::string& reason) const {
         const toml::source_region& where = node ? node->source() : table_.source();
         std::ostringstream out;
-        out << source_ << ":" << where.begin.line << ":" << where.begin.column << ": key '"
-            << full(key) << "': " << reason;
+        out << source_ << ":" << where.begin.line << ":" << where.begin.column
+            << ": key '" << full(key) << "': " << reason;
         throw ProtocolError(out.str());
     }
     std::string full(const std::string& key) const {
@@ -36,7 +37,8 @@ public:
         used_.insert(key);
         return table_.get(key);
     }
-    std::string string(const std::string& key, std::string fallback, bool required = false) {
+    std::string string(const std::string& key, std::string fallback,
+                       bool required = false) {
         const toml::node* node = get(key);
         if (!node) {
             if (required) fail(nullptr, key, "is required");
@@ -161,8 +163,10 @@ void read_study(Protocol& p, TableReader& root) {
         }
     }
     if (const toml::array* size = r.array("stimulus_size")) {
-        std::optional<int64_t> w = size->size() == 2 ? (*size)[0].value<int64_t>() : std::nullopt;
-        std::optional<int64_t> h = size->size() == 2 ? (*size)[1].value<int64_t>() : std::nullopt;
+        std::optional<int64_t> w =
+            size->size() == 2 ? (*size)[0].value<int64_t>() : std::nullopt;
+        std::optional<int64_t> h =
+            size->size() == 2 ? (*size)[1].value<int64_t>() : std::nullopt;
         if (!w || !h || *w < 1 || *h < 1 || *w > 16384 || *h > 16384)
             r.fail(size, "stimulus_size", "must be [width, height] in pixels, 1..16384");
         p.stimulus_width = static_cast<int>(*w);
@@ -204,7 +208,8 @@ void read_questions(Protocol& p, TableReader& root) {
             r.fail(labels, "labels", "needs one label per scale point, 2 to 7 points");
         }
         for (const Question& other : p.questions)
-            if (other.id == q.id) r.fail(r.raw().get("id"), "id", "duplicate question id '" + q.id + "'");
+            if (other.id == q.id)
+                r.fail(r.raw().get("id"), "id", "duplicate question id '" + q.id + "'");
         r.reject_unknown();
         p.questions.push_back(std::move(q));
     }
@@ -222,8 +227,9 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
         s.mesh = r.string("mesh", "");
         s.image = r.string("image", "");
         if (s.technique.empty() == s.image.empty())
-            r.fail(nullptr, "technique", "stimulus '" + s.id +
-                   "' needs exactly one of technique (live) or image (pre-rendered)");
+            r.fail(nullptr, "technique",
+                   "stimulus '" + s.id +
+                       "' needs exactly one of technique (live) or image (pre-rendered)");
         // The renderer's registry (lucent_study stays GL-free, so it is listed here).
         static const std::set<std::string> techniques = {
             "empirical", "ward", "contrast_reversed", "dipole", "htsm", "thick_texture"};
@@ -232,7 +238,8 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
                    "unknown technique '" + s.technique +
                        "' (valid: empirical, ward, contrast_reversed, dipole, htsm, "
                        "thick_texture)");
-        if (!s.image.empty() && !base_dir.empty() && std::filesystem::path(s.image).is_relative())
+        if (!s.image.empty() && !base_dir.empty() &&
+            std::filesystem::path(s.image).is_relative())
             s.image = (std::filesystem::path(base_dir) / s.image).string();
         if (const toml::table* params = r.table("params")) {
             TableReader pr(*params, "stimuli.params", p.source);
@@ -278,11 +285,13 @@ void read_trials(Protocol& p, TableReader& root) {
         Block b;
         b.id = r.string("id", "", true);
         b.stimuli = r.strings("stimuli");
-        if (b.stimuli.empty()) r.fail(nullptr, "stimuli", "block '" + b.id + "' has no stimuli");
+        if (b.stimuli.empty())
+            r.fail(nullptr, "stimuli", "block '" + b.id + "' has no stimuli");
         for (const std::string& id : b.stimuli) check_stimulus_ref(p, r, "stimuli", id);
         b.repeats = r.integer("repeats", 1, 1, 1000);
         for (const Block& other : p.blocks)
-            if (other.id == b.id) r.fail(r.raw().get("id"), "id", "duplicate block id '" + b.id + "'");
+            if (other.id == b.id)
+                r.fail(r.raw().get("id"), "id", "duplicate block id '" + b.id + "'");
         r.reject_unknown();
         p.blocks.push_back(std::move(b));
     }
@@ -296,10 +305,12 @@ void read_trials(Protocol& p, TableReader& root) {
             c.block = r.string("block", p.blocks.front().id);
             if (std::none_of(p.blocks.begin(), p.blocks.end(),
                              [&](const Block& b) { return b.id == c.block; }))
-                r.fail(r.raw().get("block"), "block", "no block with id '" + c.block + "'");
+                r.fail(r.raw().get("block"), "block",
+                       "no block with id '" + c.block + "'");
             c.prompt = r.string("prompt", "", true);
             int max_points = 7;
-            for (const Question& q : p.questions) max_points = std::min(max_points, q.points());
+            for (const Question& q : p.questions)
+                max_points = std::min(max_points, q.points());
             c.expected = r.integer("expected", 7, 1, max_points);
             c.tolerance = r.integer("tolerance", 0, 0, 6);
             r.reject_unknown();
@@ -319,12 +330,13 @@ void read_randomisation(Protocol& p, TableReader& root) {
     rz.min_distance = r.integer("min_distance", 0, 0, 100000);
     rz.counterbalance_blocks = r.boolean("counterbalance_blocks", true);
     if (rz.factor != "stimulus" && rz.factor != "technique") {
-        bool known = std::any_of(p.stimuli.begin(), p.stimuli.end(), [&](const StimulusSpec& s) {
-            return s.parameters.count(rz.factor) > 0;
-        });
+        bool known = std::any_of(
+            p.stimuli.begin(), p.stimuli.end(),
+            [&](const StimulusSpec& s) { return s.parameters.count(rz.factor) > 0; });
         if (!known)
             r.fail(r.raw().get("factor"), "factor",
-                   "'" + rz.factor + "' is not 'stimulus', 'technique' or a stimulus parameter");
+                   "'" + rz.factor +
+                       "' is not 'stimulus', 'technique' or a stimulus parameter");
     }
     r.reject_unknown();
 }
@@ -335,8 +347,9 @@ void read_analysis_plan(Protocol& p, TableReader& root) {
     TableReader r(*table, "analysis", p.source);
     p.analysis.primary_design = r.string("primary_design", "within");
     if (p.analysis.primary_design != "within" && p.analysis.primary_design != "between")
-        r.fail(r.raw().get("primary_design"), "primary_design",
-               "must be \"within\" or \"between\", got '" + p.analysis.primary_design + "'");
+        r.fail(
+            r.raw().get("primary_design"), "primary_design",
+            "must be \"within\" or \"between\", got '" + p.analysis.primary_design + "'");
     p.analysis.sessions = r.string("sessions", "completed");
     if (p.analysis.sessions != "completed" && p.analysis.sessions != "all")
         r.fail(r.raw().get("sessions"), "sessions",
@@ -375,9 +388,9 @@ std::string Protocol::picture_key(const StimulusSpec& stimulus) {
     if (!stimulus.live()) {
         std::ifstream in(stimulus.image, std::ios::binary);
         std::ostringstream bytes;
-        if (in && (bytes << in.rdbuf()))
-            return "image sha256:" + sha256_hex(bytes.str());
-        return "image path:" + std::filesystem::absolute(stimulus.image).lexically_normal().string();
+        if (in && (bytes << in.rdbuf())) return "image sha256:" + sha256_hex(bytes.str());
+        return "image path:" +
+               std::filesystem::absolute(stimulus.image).lexically_normal().string();
     }
     std::string key = "live " + stimulus.technique + " " + stimulus.mesh;
     for (const auto& [name, value] : stimulus.parameters) key += " " + name + "=" + value;
@@ -396,13 +409,15 @@ std::map<std::string, std::string> Protocol::levels_of(std::string_view factor) 
     return levels;
 }
 
-std::string Protocol::level_of(const StimulusSpec& stimulus, std::string_view factor) const {
+std::string Protocol::level_of(const StimulusSpec& stimulus,
+                               std::string_view factor) const {
     if (factor == "stimulus") {
         const auto levels = levels_of(factor);
         const auto it = levels.find(stimulus.id);
         return it == levels.end() ? stimulus.id : it->second;
     }
-    if (factor == "technique") return stimulus.technique.empty() ? "image" : stimulus.technique;
+    if (factor == "technique")
+        return stimulus.technique.empty() ? "image" : stimulus.technique;
     if (factor.rfind("series:", 0) == 0) return stimulus.id;
     auto it = stimulus.parameters.find(std::string(factor));
     return it == stimulus.parameters.end() ? std::string() : it->second;
@@ -451,8 +466,10 @@ Protocol builtin_protocol(std::string_view name) {
         embedded::study_file("presets/" + std::string(name) + ".toml");
     if (!text) {
         std::string valid;
-        for (const std::string& n : builtin_protocol_names()) valid += (valid.empty() ? "" : ", ") + n;
-        throw ProtocolError("unknown preset '" + std::string(name) + "' (valid: " + valid + ")");
+        for (const std::string& n : builtin_protocol_names())
+            valid += (valid.empty() ? "" : ", ") + n;
+        throw ProtocolError("unknown preset '" + std::string(name) +
+                            "' (valid: " + valid + ")");
     }
     return parse_protocol(*text, "preset:" + std::string(name));
 }

@@ -93,14 +93,14 @@ struct Screens {
 struct Protocol {
     std::string name;
     std::string title;
-    std::string source;       // file name or "preset:thesis", for messages
-    std::string text;         // the TOML text itself (stored with its hash)
+    std::string source;                     // file name or "preset:thesis", for messages
+    std::string text;                       // the TOML text itself (stored with its hash)
     float background[3] = {0.f, 0.f, 0.f};  // linear 0..1, behind every stimulus
-    int stimulus_width = 512;  // live stimuli are rendered at this size
+    int stimulus_width = 512;               // live stimuli are rendered at this size
     int stimulus_height = 512;
-    int break_every = 0;        // break screen after every N main trials (0: never)
-    int inter_trial_ms = 500;   // blank screen between trials
-    int max_failed_catch = 0;   // participants failing more catch trials are excluded
+    int break_every = 0;       // break screen after every N main trials (0: never)
+    int inter_trial_ms = 500;  // blank screen between trials
+    int max_failed_catch = 0;  // participants failing more catch trials are excluded
     Screens screens;
     std::vector<StimulusSpec> stimuli;
     std::vector<Question> questions;
@@ -117,7 +117,8 @@ struct Protocol {
     // the id of the first stimulus with the same picture_key, so ids that show the same
     // picture (the thesis's rows 1, 4 and 7) share a level.
     std::string level_of(const StimulusSpec& stimulus, std::string_view factor) const;
-    // level_of for every stimulus at once (stimulus id -> level), hashing each image once.
+    // level_of for every stimulus at once (stimulus id -> level), hashing each image
+    // once.
     std::map<std::string, std::string> levels_of(std::string_view factor) const;
     // What the participant sees, independent of the id: a live stimulus's technique,
     // mesh and parameters (as written; a default spelled out counts as different), or a

@@ -38,21 +38,39 @@ std::string sha256_hex(std::string_view data) {
     for (size_t block = 0; block < msg.size(); block += 64) {
         uint32_t w[64];
         for (int t = 0; t < 16; ++t)
-            w[t] = uint32_t(msg[block + 4 * t]) << 24 | uint32_t(msg[block + 4 * t + 1]) << 16 |
-                   uint32_t(msg[block + 4 * t + 2]) << 8 | uint32_t(msg[block + 4 * t + 3]);
+            w[t] = uint32_t(msg[block + 4 * t]) << 24 |
+                   uint32_t(msg[block + 4 * t + 1]) << 16 |
+                   uint32_t(msg[block + 4 * t + 2]) << 8 |
+                   uint32_t(msg[block + 4 * t + 3]);
         for (int t = 16; t < 64; ++t) {
             uint32_t s0 = rotr(w[t - 15], 7) ^ rotr(w[t - 15], 18) ^ (w[t - 15] >> 3);
             uint32_t s1 = rotr(w[t - 2], 17) ^ rotr(w[t - 2], 19) ^ (w[t - 2] >> 10);
             w[t] = w[t - 16] + s0 + w[t - 7] + s1;
         }
-        uint32_t a = h[0], b = h[1], c = h[2], d = h[3], e = h[4], f = h[5], g = h[6], hh = h[7];
+        uint32_t a = h[0], b = h[1], c = h[2], d = h[3], e = h[4], f = h[5], g = h[6],
+                 hh = h[7];
         for (int t = 0; t < 64; ++t) {
-            uint32_t t1 = hh + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) + ((e & f) ^ (~e & g)) +
-                          kRound[t] + w[t];
-            uint32_t t2 = (rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
-            hh = g; g = f; f = e; e = d + t1; d = c; c = b; b = a; a = t1 + t2;
+            uint32_t t1 = hh + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) +
+                          ((e & f) ^ (~e & g)) + kRound[t] + w[t];
+            uint32_t t2 =
+                (rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
+            hh = g;
+            g = f;
+            f = e;
+            e = d + t1;
+            d = c;
+            c = b;
+            b = a;
+            a = t1 + t2;
         }
-        h[0] += a; h[1] += b; h[2] += c; h[3] += d; h[4] += e; h[5] += f; h[6] += g; h[7] += hh;
+        h[0] += a;
+        h[1] += b;
+        h[2] += c;
+        h[3] += d;
+        h[4] += e;
+        h[5] += f;
+        h[6] += g;
+        h[7] += hh;
     }
     char out[65];
     for (int i = 0; i < 8; ++i) std::snprintf(out + 8 * i, 9, "%08x", h[i]);

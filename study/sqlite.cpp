@@ -19,8 +19,10 @@ std::string file_uri(const std::string& path, const std::string& query) {
     return query.empty() ? uri : uri + "?" + query;
 }
 
-Database::Database(const std::string& path, int flags, const std::string& vfs) : path_(path) {
-    int rc = sqlite3_open_v2(path.c_str(), &db_, flags, vfs.empty() ? nullptr : vfs.c_str());
+Database::Database(const std::string& path, int flags, const std::string& vfs)
+    : path_(path) {
+    int rc =
+        sqlite3_open_v2(path.c_str(), &db_, flags, vfs.empty() ? nullptr : vfs.c_str());
     if (rc != SQLITE_OK) {
         std::string why = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);
         sqlite3_close(db_);
@@ -33,7 +35,8 @@ Database::Database(const std::string& path, int flags, const std::string& vfs) :
 
 Database::~Database() { sqlite3_close_v2(db_); }
 
-Database::Database(Database&& other) noexcept : db_(other.db_), path_(std::move(other.path_)) {
+Database::Database(Database&& other) noexcept
+    : db_(other.db_), path_(std::move(other.path_)) {
     other.db_ = nullptr;
 }
 
@@ -53,8 +56,8 @@ void Database::exec(std::string_view sql) {
 
 Statement Database::prepare(std::string_view sql) {
     sqlite3_stmt* stmt = nullptr;
-    if (sqlite3_prepare_v2(db_, sql.data(), static_cast<int>(sql.size()), &stmt, nullptr) !=
-        SQLITE_OK)
+    if (sqlite3_prepare_v2(db_, sql.data(), static_cast<int>(sql.size()), &stmt,
+                           nullptr) != SQLITE_OK)
         fail("cannot prepare '" + std::string(sql.substr(0, 60)) + "'");
     return Statement(*this, stmt);
 }

@@ -52,11 +52,17 @@ public:
     Statement(const Statement&) = delete;
 
     Statement& bind(int index, int64_t value);
-    Statement& bind(int index, int value) { return bind(index, static_cast<int64_t>(value)); }
+    Statement& bind(int index, int value) {
+        return bind(index, static_cast<int64_t>(value));
+    }
     Statement& bind(int index, double value);
     Statement& bind(int index, std::string_view value);
-    Statement& bind(int index, const char* value) { return bind(index, std::string_view(value)); }
-    Statement& bind(int index, const std::string& value) { return bind(index, std::string_view(value)); }
+    Statement& bind(int index, const char* value) {
+        return bind(index, std::string_view(value));
+    }
+    Statement& bind(int index, const std::string& value) {
+        return bind(index, std::string_view(value));
+    }
     Statement& bind_null(int index);
     template <class T>
     Statement& bind(int index, const std::optional<T>& value) {
@@ -64,8 +70,14 @@ public:
     }
     // Steps once: true while a row is available.
     bool step();
-    void run() { while (step()) {} }
-    void reset() { sqlite3_reset(stmt_); sqlite3_clear_bindings(stmt_); }
+    void run() {
+        while (step()) {
+        }
+    }
+    void reset() {
+        sqlite3_reset(stmt_);
+        sqlite3_clear_bindings(stmt_);
+    }
 
     bool is_null(int col) const { return sqlite3_column_type(stmt_, col) == SQLITE_NULL; }
     int64_t integer(int col) const { return sqlite3_column_int64(stmt_, col); }

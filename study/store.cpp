@@ -6,10 +6,9 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstring>
-
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -197,7 +196,8 @@ int64_t first_int(Statement& s) { return s.step() ? s.integer(0) : 0; }
 
 int participant_number_from_code(const std::string& code) {
     size_t end = code.size(), begin = end;
-    while (begin > 0 && std::isdigit(static_cast<unsigned char>(code[begin - 1]))) --begin;
+    while (begin > 0 && std::isdigit(static_cast<unsigned char>(code[begin - 1])))
+        --begin;
     if (begin == end || end - begin > 9) return -1;
     return std::stoi(code.substr(begin));
 }
@@ -209,7 +209,8 @@ ResolvedStimulus resolved_of(const StimulusProvenance& p) {
 }
 
 // One word for a segment's pictures: the common source, "mixed", or NULL when unknown.
-std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli) {
+std::optional<std::string> segment_source(
+    const std::vector<StimulusProvenance>& stimuli) {
     std::set<std::string> sources;
     for (const StimulusProvenance& p : stimuli) sources.insert(p.source);
     if (sources.empty()) return std::nullopt;
@@ -217,18 +218,21 @@ std::optional<std::string> segment_source(const std::vector<StimulusProvenance>&
 }
 
 const std::vector<std::string>& schema_migrations() {
-    static const std::vector<std::string> steps(std::begin(kMigrations), std::end(kMigrations));
+    static const std::vector<std::string> steps(std::begin(kMigrations),
+                                                std::end(kMigrations));
     return steps;
 }
 
 std::map<std::string, ResolvedStimulus> read_resolved_stimuli(Database& db) {
     std::map<std::string, ResolvedStimulus> out;
     if (db.scalar_int("PRAGMA user_version") < 3) return out;
-    Statement s = db.prepare("SELECT stimulus_key, technique, resolved_mesh, mesh_hash "
-                             "FROM stimuli WHERE resolved_mesh IS NOT NULL");
+    Statement s = db.prepare(
+        "SELECT stimulus_key, technique, resolved_mesh, mesh_hash "
+        "FROM stimuli WHERE resolved_mesh IS NOT NULL");
     while (s.step()) out[s.text(0)] = {s.text(1), s.text(2), s.text(3), {}};
-    Statement v = db.prepare("SELECT st.stimulus_key, v.name, v.value FROM stimulus_values v "
-                             "JOIN stimuli st ON st.id = v.stimulus_id");
+    Statement v = db.prepare(
+        "SELECT st.stimulus_key, v.name, v.value FROM stimulus_values v "
+        "JOIN stimuli st ON st.id = v.stimulus_id");
     while (v.step()) out[v.text(0)].values[v.text(1)] = v.text(2);
     return out;
 }
@@ -236,7 +240,8 @@ std::map<std::string, ResolvedStimulus> read_resolved_stimuli(Database& db) {
 std::string resolved_difference(const std::string& stimulus, const ResolvedStimulus& a,
                                 const std::string& a_name, const ResolvedStimulus& b,
                                 const std::string& b_name) {
-    auto differs = [&](const std::string& name, const std::string& x, const std::string& y) {
+    auto differs = [&](const std::string& name, const std::string& x,
+                       const std::string& y) {
         return "stimulus '" + stimulus + "': parameter '" + name + "' is " +
                (x.empty() ? "(none)" : x) + " in " + a_name + " but " +
                (y.empty() ? "(none)" : y) + " in " + b_name;
@@ -260,15 +265,18 @@ void check_database_file(const std::string& path) {
     namespace fs = std::filesystem;
     std::error_code ec;
     if (!fs::exists(path, ec)) return;  // created on open
-    if (fs::is_directory(path, ec)) throw StoreError(path + ": is a directory, not a database");
+    if (fs::is_directory(path, ec))
+        throw StoreError(path + ": is a directory, not a database");
     const auto size = fs::file_size(path, ec);
     const bool has_wal = fs::exists(path + "-wal", ec);
     if (size > 0) {
         char magic[16] = {};
         std::ifstream in(path, std::ios::binary);
         in.read(magic, sizeof magic);
-        if (in.gcount() < 16 || std::string(magic, 16) != std::string("SQLite format 3\0", 16))
-            throw StoreError(path + ": not a Lucent study database (not an SQLite file); "
+        if (in.gcount() < 16 ||
+            std::string(magic, 16) != std::string("SQLite format 3\0", 16))
+            throw StoreError(path +
+                             ": not a Lucent study database (not an SQLite file); "
                              "left unchanged");
     } else if (!has_wal) {
         return;  // an empty file: initialised on open
@@ -277,8 +285,12 @@ void check_database_file(const std::string& path) {
     // not even the -wal/-shm side files of a WAL-mode database get created.
     const std::string uri = file_uri(path, has_wal ? "mode=ro" : "mode=ro&immutable=1");
     sqlite3* raw = nullptr;
-    int rc = sqlite3_open_v2(uri.c_str(), &raw, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
-    struct Closer { sqlite3* db; ~Closer() { sqlite3_close_v2(db); } } closer{raw};
+    int rc = sqlite3_open_v2(uri.c_str(), &raw, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI,
+                             nullptr);
+    struct Closer {
+        sqlite3* db;
+        ~Closer() { sqlite3_close_v2(db); }
+    } closer{raw};
     if (rc != SQLITE_OK)
         throw StoreError(path + ": cannot open read-only: " + sqlite3_errstr(rc));
     // Other stations' writers may hold the lock a moment: wait as the store itself does,
@@ -290,7 +302,10 @@ void check_database_file(const std::string& path) {
         int r = sqlite3_prepare_v2(raw, sql, -1, &stmt, nullptr);
         if (r == SQLITE_OK) {
             r = sqlite3_step(stmt);
-            if (r == SQLITE_ROW) { out = sqlite3_column_int64(stmt, 0); r = SQLITE_OK; }
+            if (r == SQLITE_ROW) {
+                out = sqlite3_column_int64(stmt, 0);
+                r = SQLITE_OK;
+            }
         }
         std::string why = r == SQLITE_OK ? "" : sqlite3_errmsg(raw);
         busy = busy || (r & 0xFF) == SQLITE_BUSY || (r & 0xFF) == SQLITE_LOCKED;
@@ -302,22 +317,23 @@ void check_database_file(const std::string& path) {
     if (why.empty()) why = query_int("PRAGMA user_version", version);
     if (why.empty()) why = query_int("SELECT count(*) FROM sqlite_schema", tables);
     if (!why.empty() && busy)
-        throw StoreError(path + ": database is locked by another process for over 5 s (" + why +
-                         "); try again");
+        throw StoreError(path + ": database is locked by another process for over 5 s (" +
+                         why + "); try again");
     if (!why.empty())
         throw StoreError(path + ": database is corrupt (" + why + "); left unchanged");
     if (app_id == 0 && version == 0 && tables == 0) return;  // an empty SQLite file
     if (app_id != kApplicationId)
         throw StoreError(path + ": not a Lucent study database (application_id " +
-                         hex32(static_cast<uint32_t>(app_id)) + ", " + std::to_string(tables) +
-                         " schema entries); left unchanged");
+                         hex32(static_cast<uint32_t>(app_id)) + ", " +
+                         std::to_string(tables) + " schema entries); left unchanged");
     if (version > kSchemaVersion)
-        throw StoreError(path + ": written by a newer Lucent (schema " + std::to_string(version) +
-                         ", this build knows " + std::to_string(kSchemaVersion) +
-                         "); left unchanged");
+        throw StoreError(path + ": written by a newer Lucent (schema " +
+                         std::to_string(version) + ", this build knows " +
+                         std::to_string(kSchemaVersion) + "); left unchanged");
     sqlite3_stmt* stmt = nullptr;
     std::string check = "ok";
-    if (sqlite3_prepare_v2(raw, "PRAGMA quick_check(1)", -1, &stmt, nullptr) != SQLITE_OK ||
+    if (sqlite3_prepare_v2(raw, "PRAGMA quick_check(1)", -1, &stmt, nullptr) !=
+            SQLITE_OK ||
         sqlite3_step(stmt) != SQLITE_ROW) {
         check = sqlite3_errmsg(raw);
     } else {
@@ -335,14 +351,16 @@ void migrate(Database& db, int target) {
     const int current = static_cast<int>(db.scalar_int("PRAGMA user_version"));
     if (current >= target) return;
     Transaction tx(db);
-    if (current == 0) db.exec("PRAGMA application_id = " + std::to_string(kApplicationId));
+    if (current == 0)
+        db.exec("PRAGMA application_id = " + std::to_string(kApplicationId));
     for (int v = current + 1; v <= target; ++v) db.exec(kMigrations[v - 1]);
     db.exec("PRAGMA user_version = " + std::to_string(target));
     tx.commit();
 }
 
 Store::Store(const std::string& path, const std::string& vfs)
-    : db_((check_database_file(path), path), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_URI, vfs) {
+    : db_((check_database_file(path), path),
+          SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_URI, vfs) {
     db_.exec("PRAGMA journal_mode = WAL");
     db_.exec("PRAGMA synchronous = FULL");
     db_.exec("PRAGMA foreign_keys = ON");
@@ -361,9 +379,13 @@ int64_t Store::ensure_study(const Protocol& protocol) {
         }
     }
     Transaction tx(db_);
-    db_.prepare("INSERT INTO studies (name, protocol_text, protocol_hash, created_utc) "
-                "VALUES (?, ?, ?, ?)")
-        .bind(1, protocol.name).bind(2, protocol.text).bind(3, hash).bind(4, utc_now_iso8601())
+    db_.prepare(
+           "INSERT INTO studies (name, protocol_text, protocol_hash, created_utc) "
+           "VALUES (?, ?, ?, ?)")
+        .bind(1, protocol.name)
+        .bind(2, protocol.text)
+        .bind(3, hash)
+        .bind(4, utc_now_iso8601())
         .run();
     const int64_t study_id = db_.last_insert_id();
     Statement stim = db_.prepare(
@@ -375,8 +397,13 @@ int64_t Store::ensure_study(const Protocol& protocol) {
         std::string varies;
         for (const std::string& v : s.varies) varies += (varies.empty() ? "" : " ") + v;
         stim.reset();
-        stim.bind(1, study_id).bind(2, s.id).bind(3, s.technique).bind(4, s.mesh)
-            .bind(5, s.image).bind(6, varies).run();
+        stim.bind(1, study_id)
+            .bind(2, s.id)
+            .bind(3, s.technique)
+            .bind(4, s.mesh)
+            .bind(5, s.image)
+            .bind(6, varies)
+            .run();
         const int64_t stimulus_id = db_.last_insert_id();
         for (const auto& [name, value] : s.parameters) {
             param.reset();
@@ -387,7 +414,8 @@ int64_t Store::ensure_study(const Protocol& protocol) {
     return study_id;
 }
 
-int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int* number) {
+int64_t Store::ensure_participant(int64_t study_id, const std::string& code,
+                                  int* number) {
     // BEGIN IMMEDIATE: the number is read and taken under one write lock, so two
     // processes on this file never take the same one.
     Transaction tx(db_);
@@ -403,10 +431,16 @@ int64_t Store::ensure_participant(int64_t study_id, const std::string& code, int
     if (n < 0)
         n = static_cast<int>(db_.scalar_int(
                 "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
-                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) + 1;
-    db_.prepare("INSERT INTO participants (study_id, code, number, created_utc) "
-                "VALUES (?, ?, ?, ?)")
-        .bind(1, study_id).bind(2, code).bind(3, n).bind(4, utc_now_iso8601()).run();
+                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) +
+            1;
+    db_.prepare(
+           "INSERT INTO participants (study_id, code, number, created_utc) "
+           "VALUES (?, ?, ?, ?)")
+        .bind(1, study_id)
+        .bind(2, code)
+        .bind(3, n)
+        .bind(4, utc_now_iso8601())
+        .run();
     const int64_t id = db_.last_insert_id();
     tx.commit();
     if (number) *number = n;
@@ -417,7 +451,8 @@ SessionRow Store::create_session(int64_t study_id, int64_t participant_id,
                                  const TrialPlan& plan, uint64_t seed,
                                  const SessionEnvironment& env) {
     Transaction tx(db_);
-    SessionRow row = insert_session(study_id, participant_id, plan, seed, env, new_uuid_v4(), "");
+    SessionRow row =
+        insert_session(study_id, participant_id, plan, seed, env, new_uuid_v4(), "");
     tx.commit();
     return row;
 }
@@ -436,17 +471,31 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
     for (const std::string& b : plan.block_order) order += (order.empty() ? "" : ",") + b;
 
     db_.prepare(
-           "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, cell, "
+           "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, "
+           "cell, "
            "block_order, status, started_utc, software_version, build_hash, gl_vendor, "
-           "gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, refresh_note, "
-           "allocation) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
-        .bind(1, row.uuid).bind(2, study_id).bind(3, participant_id).bind(4, env.machine_id)
-        .bind(5, std::to_string(seed)).bind(6, plan.cell).bind(7, order)
-        .bind(8, utc_now_iso8601()).bind(9, env.software_version).bind(10, env.build_hash)
-        .bind(11, env.gl_vendor).bind(12, env.gl_renderer).bind(13, env.display_mode)
-        .bind(14, env.display_refresh_hz).bind(15, env.measured_refresh_hz)
+           "gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, "
+           "refresh_note, "
+           "allocation) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, "
+           "?, ?)")
+        .bind(1, row.uuid)
+        .bind(2, study_id)
+        .bind(3, participant_id)
+        .bind(4, env.machine_id)
+        .bind(5, std::to_string(seed))
+        .bind(6, plan.cell)
+        .bind(7, order)
+        .bind(8, utc_now_iso8601())
+        .bind(9, env.software_version)
+        .bind(10, env.build_hash)
+        .bind(11, env.gl_vendor)
+        .bind(12, env.gl_renderer)
+        .bind(13, env.display_mode)
+        .bind(14, env.display_refresh_hz)
+        .bind(15, env.measured_refresh_hz)
         .bind(16, env.refresh_note)
-        .bind(17, allocation.empty() ? std::nullopt : std::optional<std::string>(allocation))
+        .bind(17,
+              allocation.empty() ? std::nullopt : std::optional<std::string>(allocation))
         .run();
     row.id = db_.last_insert_id();
     Statement code = db_.prepare("SELECT code FROM participants WHERE id = ?");
@@ -459,10 +508,17 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
         "?, ?, ?, ?, ?, ?, ?, ?)");
     for (const PlannedTrial& t : plan.trials) {
         insert.reset();
-        insert.bind(1, row.id).bind(2, t.position).bind(3, t.block).bind(4, study_id)
-            .bind(5, t.stimulus).bind(6, t.practice ? 1 : 0).bind(7, t.is_catch ? 1 : 0);
+        insert.bind(1, row.id)
+            .bind(2, t.position)
+            .bind(3, t.block)
+            .bind(4, study_id)
+            .bind(5, t.stimulus)
+            .bind(6, t.practice ? 1 : 0)
+            .bind(7, t.is_catch ? 1 : 0);
         if (t.is_catch) {
-            insert.bind(8, t.catch_id).bind(9, t.prompt).bind(10, t.expected)
+            insert.bind(8, t.catch_id)
+                .bind(9, t.prompt)
+                .bind(10, t.expected)
                 .bind(11, t.tolerance);
         }
         insert.bind(12, t.break_before ? 1 : 0).bind(13, new_uuid_v4()).run();
@@ -480,9 +536,10 @@ std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int 
         if (counts[c] < counts[best]) best = c;
     }
     std::string per_cell;
-    for (int64_t n : counts) per_cell += (per_cell.empty() ? "" : ",") + std::to_string(n);
-    return {best, "online arrival " + std::to_string(number) + ": cell " + std::to_string(best) +
-                      " of " + std::to_string(cells) +
+    for (int64_t n : counts)
+        per_cell += (per_cell.empty() ? "" : ",") + std::to_string(n);
+    return {best, "online arrival " + std::to_string(number) + ": cell " +
+                      std::to_string(best) + " of " + std::to_string(cells) +
                       ", the fewest completed + active sessions (per cell " + per_cell +
                       "; active = activity since " + active_since_utc + ")"};
 }
@@ -491,16 +548,22 @@ std::string online_cell_counts_sql(bool postgres) {
     const std::string latest = postgres ? "greatest" : "max";
     const std::string study = postgres ? "$1" : "?1", since = postgres ? "$2" : "?2";
     return "SELECT s.cell, count(*) FROM sessions s WHERE s.study_id = " + study +
-           " AND (s.status = 'completed' OR (s.status IN ('running', 'paused') AND " + latest +
-           "(s.started_utc, coalesce((SELECT max(g.started_utc) FROM session_segments g WHERE "
-           "g.session_id = s.id), ''), coalesce((SELECT max(t.answered_utc) FROM trials t "
-           "WHERE t.session_id = s.id), '')) >= " + since + ")) GROUP BY s.cell";
+           " AND (s.status = 'completed' OR (s.status IN ('running', 'paused') AND " +
+           latest +
+           "(s.started_utc, coalesce((SELECT max(g.started_utc) FROM session_segments g "
+           "WHERE "
+           "g.session_id = s.id), ''), coalesce((SELECT max(t.answered_utc) FROM trials "
+           "t "
+           "WHERE t.session_id = s.id), '')) >= " +
+           since + ")) GROUP BY s.cell";
 }
 
 OnlineSession Store::enrol_online(int64_t study_id, const std::string& code,
-                                  const OnlineEnrolment& how, const SessionEnvironment& env) {
+                                  const OnlineEnrolment& how,
+                                  const SessionEnvironment& env) {
     if (how.cells < 1 || !how.plan)
-        throw StoreError(db_.path() + ": an online enrolment needs at least one cell and a plan");
+        throw StoreError(db_.path() +
+                         ": an online enrolment needs at least one cell and a plan");
     check_stimulus_values(env.stimuli);
     // BEGIN IMMEDIATE: numbers and cell counts read and taken under one write lock.
     Transaction tx(db_);
@@ -512,13 +575,19 @@ OnlineSession Store::enrol_online(int64_t study_id, const std::string& code,
         participant_id = find.integer(0);
         out.number = static_cast<int>(find.integer(1));
     } else {
-        out.number = static_cast<int>(db_.scalar_int(
-                         "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
-                         "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) +
-                     1;
-        db_.prepare("INSERT INTO participants (study_id, code, number, created_utc) "
-                    "VALUES (?, ?, ?, ?)")
-            .bind(1, study_id).bind(2, code).bind(3, out.number).bind(4, utc_now_iso8601()).run();
+        out.number =
+            static_cast<int>(db_.scalar_int(
+                "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
+                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) +
+            1;
+        db_.prepare(
+               "INSERT INTO participants (study_id, code, number, created_utc) "
+               "VALUES (?, ?, ?, ?)")
+            .bind(1, study_id)
+            .bind(2, code)
+            .bind(3, out.number)
+            .bind(4, utc_now_iso8601())
+            .run();
         participant_id = db_.last_insert_id();
     }
     std::vector<int64_t> counts(static_cast<size_t>(how.cells), 0);
@@ -526,16 +595,17 @@ OnlineSession Store::enrol_online(int64_t study_id, const std::string& code,
     per_cell.bind(1, study_id).bind(2, how.active_since_utc);
     while (per_cell.step()) {
         const int64_t cell = per_cell.integer(0);
-        if (cell >= 0 && cell < how.cells) counts[static_cast<size_t>(cell)] = per_cell.integer(1);
+        if (cell >= 0 && cell < how.cells)
+            counts[static_cast<size_t>(cell)] = per_cell.integer(1);
     }
     const auto [cell, allocation] = online_cell(counts, out.number, how.active_since_utc);
     const TrialPlan plan = how.plan(cell);
     if (plan.cell != cell)
         throw StoreError(db_.path() + ": the plan of cell " + std::to_string(cell) +
                          " is cell " + std::to_string(plan.cell));
-    out.session = insert_session(study_id, participant_id, plan, how.seed, env,
-                                 how.session_uuid.empty() ? new_uuid_v4() : how.session_uuid,
-                                 allocation);
+    out.session = insert_session(
+        study_id, participant_id, plan, how.seed, env,
+        how.session_uuid.empty() ? new_uuid_v4() : how.session_uuid, allocation);
     out.allocation = allocation;
     tx.commit();
     return out;
@@ -545,7 +615,8 @@ std::optional<SessionRow> Store::unfinished_session(const std::string& participa
     Statement s = db_.prepare(
         "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
         "FROM sessions s JOIN participants p ON p.id = s.participant_id "
-        "WHERE p.code = ? AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT 1");
+        "WHERE p.code = ? AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT "
+        "1");
     s.bind(1, participant_code);
     if (!s.step()) return std::nullopt;
     SessionRow row;
@@ -571,7 +642,8 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
     Statement s = db_.prepare(
         "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
         "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
-        "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), coalesce(t.uuid, '') "
+        "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), coalesce(t.uuid, "
+        "'') "
         "FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
         "WHERE t.session_id = ? ORDER BY t.position");
     s.bind(1, session_id);
@@ -599,19 +671,21 @@ void Store::check_stimulus_values(const std::vector<StimulusProvenance>& stimuli
     for (const StimulusProvenance& p : stimuli) {
         const auto it = stored.find(p.stimulus);
         if (it == stored.end()) continue;  // first recorded now
-        const std::string difference =
-            resolved_difference(p.stimulus, it->second, db_.path(), resolved_of(p), "this run");
+        const std::string difference = resolved_difference(
+            p.stimulus, it->second, db_.path(), resolved_of(p), "this run");
         if (!difference.empty())
-            throw StoreError(db_.path() + ": " + difference +
-                             ": its pictures would differ from the earlier sessions'; use a "
-                             "new database");
+            throw StoreError(
+                db_.path() + ": " + difference +
+                ": its pictures would differ from the earlier sessions'; use a "
+                "new database");
     }
 }
 
-void Store::insert_segment(int64_t session_id, int segment, const SessionEnvironment& env) {
+void Store::insert_segment(int64_t session_id, int segment,
+                           const SessionEnvironment& env) {
     check_stimulus_values(env.stimuli);
-    const int64_t study_id =
-        first_int(db_.prepare("SELECT study_id FROM sessions WHERE id = ?").bind(1, session_id));
+    const int64_t study_id = first_int(
+        db_.prepare("SELECT study_id FROM sessions WHERE id = ?").bind(1, session_id));
     // The study's resolved values, recorded by the first session that shows a stimulus.
     Statement first = db_.prepare(
         "UPDATE stimuli SET resolved_mesh = ?, mesh_hash = ? "
@@ -621,7 +695,11 @@ void Store::insert_segment(int64_t session_id, int segment, const SessionEnviron
         "((SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), ?, ?)");
     for (const StimulusProvenance& p : env.stimuli) {
         first.reset();
-        first.bind(1, p.mesh).bind(2, p.mesh_hash).bind(3, study_id).bind(4, p.stimulus).run();
+        first.bind(1, p.mesh)
+            .bind(2, p.mesh_hash)
+            .bind(3, study_id)
+            .bind(4, p.stimulus)
+            .run();
         if (sqlite3_changes(db_.handle()) == 0) continue;
         for (const auto& [name, text] : p.values) {
             value.reset();
@@ -633,31 +711,47 @@ void Store::insert_segment(int64_t session_id, int segment, const SessionEnviron
            "software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
            "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) "
            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
-        .bind(1, session_id).bind(2, segment).bind(3, utc_now_iso8601())
-        .bind(4, env.machine_id).bind(5, env.software_version).bind(6, env.build_hash)
-        .bind(7, env.gl_vendor).bind(8, env.gl_renderer).bind(9, env.display_mode)
-        .bind(10, env.display_refresh_hz).bind(11, env.measured_refresh_hz)
-        .bind(12, env.refresh_note).bind(13, segment_source(env.stimuli))
+        .bind(1, session_id)
+        .bind(2, segment)
+        .bind(3, utc_now_iso8601())
+        .bind(4, env.machine_id)
+        .bind(5, env.software_version)
+        .bind(6, env.build_hash)
+        .bind(7, env.gl_vendor)
+        .bind(8, env.gl_renderer)
+        .bind(9, env.display_mode)
+        .bind(10, env.display_refresh_hz)
+        .bind(11, env.measured_refresh_hz)
+        .bind(12, env.refresh_note)
+        .bind(13, segment_source(env.stimuli))
         .run();
     const int64_t segment_id = db_.last_insert_id();
     Statement shown = db_.prepare(
-        "INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, content_hash, "
+        "INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, "
+        "content_hash, "
         "software_version, build_hash) VALUES "
-        "(?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), ?, ?, ?, ?, ?)");
+        "(?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), ?, ?, ?, "
+        "?, ?)");
     for (const StimulusProvenance& p : env.stimuli) {
         shown.reset();
-        shown.bind(1, segment_id).bind(2, study_id).bind(3, p.stimulus).bind(4, p.source)
-            .bind(5, p.file).bind(6, p.content_hash).bind(7, p.software_version)
-            .bind(8, p.build_hash).run();
+        shown.bind(1, segment_id)
+            .bind(2, study_id)
+            .bind(3, p.stimulus)
+            .bind(4, p.source)
+            .bind(5, p.file)
+            .bind(6, p.content_hash)
+            .bind(7, p.software_version)
+            .bind(8, p.build_hash)
+            .run();
     }
 }
 
 int Store::begin_segment(int64_t session_id, const SessionEnvironment& env) {
     Transaction tx(db_);
-    const int segment = static_cast<int>(
-        first_int(db_.prepare("SELECT coalesce(max(segment), 0) + 1 FROM session_segments "
-                              "WHERE session_id = ?")
-                      .bind(1, session_id)));
+    const int segment = static_cast<int>(first_int(
+        db_.prepare("SELECT coalesce(max(segment), 0) + 1 FROM session_segments "
+                    "WHERE session_id = ?")
+            .bind(1, session_id)));
     insert_segment(session_id, segment, env);
     tx.commit();
     return segment;
@@ -666,7 +760,8 @@ int Store::begin_segment(int64_t session_id, const SessionEnvironment& env) {
 int Store::resume_segment(int64_t session_id, const SessionEnvironment& env) {
     Transaction tx(db_);
     Statement newest = db_.prepare(
-        "SELECT g.id, g.segment, EXISTS (SELECT 1 FROM trials t WHERE t.segment_id = g.id) "
+        "SELECT g.id, g.segment, EXISTS (SELECT 1 FROM trials t WHERE t.segment_id = "
+        "g.id) "
         "FROM session_segments g WHERE g.session_id = ? ORDER BY g.segment DESC LIMIT 1");
     newest.bind(1, session_id);
     const bool found = newest.step();
@@ -687,30 +782,46 @@ int Store::resume_segment(int64_t session_id, const SessionEnvironment& env) {
 }
 
 // The session row keeps the first segment's environment (what older readers show).
-void Store::copy_environment_to_session_row(int64_t session_id, const SessionEnvironment& env) {
-    db_.prepare("UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
-                "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
-                "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
-        .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
-        .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
-        .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
-        .bind(9, env.refresh_note).bind(10, session_id)
+void Store::copy_environment_to_session_row(int64_t session_id,
+                                            const SessionEnvironment& env) {
+    db_.prepare(
+           "UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
+           "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
+           "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
+        .bind(1, env.machine_id)
+        .bind(2, env.software_version)
+        .bind(3, env.build_hash)
+        .bind(4, env.gl_vendor)
+        .bind(5, env.gl_renderer)
+        .bind(6, env.display_mode)
+        .bind(7, env.display_refresh_hz)
+        .bind(8, env.measured_refresh_hz)
+        .bind(9, env.refresh_note)
+        .bind(10, session_id)
         .run();
 }
 
 void Store::update_environment(int64_t session_id, const SessionEnvironment& env) {
     Transaction tx(db_);
-    db_.prepare("UPDATE session_segments SET machine_id = ?, software_version = ?, "
-                "build_hash = ?, gl_vendor = ?, gl_renderer = ?, display_mode = ?, "
-                "display_refresh_hz = ?, measured_refresh_hz = ?, refresh_note = ? "
-                "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = ?)")
-        .bind(1, env.machine_id).bind(2, env.software_version).bind(3, env.build_hash)
-        .bind(4, env.gl_vendor).bind(5, env.gl_renderer).bind(6, env.display_mode)
-        .bind(7, env.display_refresh_hz).bind(8, env.measured_refresh_hz)
-        .bind(9, env.refresh_note).bind(10, session_id)
+    db_.prepare(
+           "UPDATE session_segments SET machine_id = ?, software_version = ?, "
+           "build_hash = ?, gl_vendor = ?, gl_renderer = ?, display_mode = ?, "
+           "display_refresh_hz = ?, measured_refresh_hz = ?, refresh_note = ? "
+           "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = ?)")
+        .bind(1, env.machine_id)
+        .bind(2, env.software_version)
+        .bind(3, env.build_hash)
+        .bind(4, env.gl_vendor)
+        .bind(5, env.gl_renderer)
+        .bind(6, env.display_mode)
+        .bind(7, env.display_refresh_hz)
+        .bind(8, env.measured_refresh_hz)
+        .bind(9, env.refresh_note)
+        .bind(10, session_id)
         .run();
-    if (first_int(db_.prepare("SELECT count(*) FROM session_segments WHERE session_id = ?")
-                      .bind(1, session_id)) > 1) {
+    if (first_int(
+            db_.prepare("SELECT count(*) FROM session_segments WHERE session_id = ?")
+                .bind(1, session_id)) > 1) {
         tx.commit();
         return;
     }
@@ -719,8 +830,9 @@ void Store::update_environment(int64_t session_id, const SessionEnvironment& env
 }
 
 void Store::count_declined_consent(int64_t study_id) {
-    db_.prepare("INSERT INTO consent_declines (study_id, declined) VALUES (?, 1) "
-                "ON CONFLICT (study_id) DO UPDATE SET declined = declined + 1")
+    db_.prepare(
+           "INSERT INTO consent_declines (study_id, declined) VALUES (?, 1) "
+           "ON CONFLICT (study_id) DO UPDATE SET declined = declined + 1")
         .bind(1, study_id)
         .run();
 }
@@ -728,16 +840,20 @@ void Store::count_declined_consent(int64_t study_id) {
 bool Store::forget_declined_session(int64_t session_id) {
     Transaction tx(db_);
     Statement s = db_.prepare(
-        "SELECT study_id, participant_id FROM sessions WHERE id = ? AND consent_utc IS NULL "
+        "SELECT study_id, participant_id FROM sessions WHERE id = ? AND consent_utc IS "
+        "NULL "
         "AND NOT EXISTS (SELECT 1 FROM responses r WHERE r.session_id = sessions.id)");
     s.bind(1, session_id);
     if (!s.step()) return false;
     const int64_t study_id = s.integer(0), participant_id = s.integer(1);
     s.reset();
     db_.prepare("DELETE FROM sessions WHERE id = ?").bind(1, session_id).run();
-    db_.prepare("DELETE FROM participants WHERE id = ? AND NOT EXISTS "
-                "(SELECT 1 FROM sessions WHERE participant_id = ?)")
-        .bind(1, participant_id).bind(2, participant_id).run();
+    db_.prepare(
+           "DELETE FROM participants WHERE id = ? AND NOT EXISTS "
+           "(SELECT 1 FROM sessions WHERE participant_id = ?)")
+        .bind(1, participant_id)
+        .bind(2, participant_id)
+        .run();
     count_declined_consent(study_id);
     tx.commit();
     return true;
@@ -745,16 +861,20 @@ bool Store::forget_declined_session(int64_t session_id) {
 
 void Store::set_consent(int64_t session_id) {
     db_.prepare("UPDATE sessions SET consent_utc = ? WHERE id = ?")
-        .bind(1, utc_now_iso8601()).bind(2, session_id).run();
+        .bind(1, utc_now_iso8601())
+        .bind(2, session_id)
+        .run();
 }
 
 bool Store::has_consent(int64_t session_id) {
-    Statement s = db_.prepare("SELECT consent_utc IS NOT NULL FROM sessions WHERE id = ?");
+    Statement s =
+        db_.prepare("SELECT consent_utc IS NOT NULL FROM sessions WHERE id = ?");
     s.bind(1, session_id);
     return s.step() && s.integer(0) != 0;
 }
 
-bool Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) {
+bool Store::record_trial(int64_t session_id, int64_t trial_id,
+                         const TrialOutcome& outcome) {
     Transaction tx(db_);
     {
         Statement check = db_.prepare(
@@ -783,27 +903,43 @@ bool Store::record_trial(int64_t session_id, int64_t trial_id, const TrialOutcom
         "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
     for (const Response& r : outcome.responses) {
         insert.reset();
-        insert.bind(1, session_id).bind(2, trial_id).bind(3, r.question).bind(4, r.rating)
-            .bind(5, r.rt_ms).bind(6, r.changes).bind(7, r.first_choice_ns)
-            .bind(8, r.final_choice_ns).run();
+        insert.bind(1, session_id)
+            .bind(2, trial_id)
+            .bind(3, r.question)
+            .bind(4, r.rating)
+            .bind(5, r.rt_ms)
+            .bind(6, r.changes)
+            .bind(7, r.first_choice_ns)
+            .bind(8, r.final_choice_ns)
+            .run();
     }
     // The trial belongs to the segment on screen: the session's newest.
-    db_.prepare("UPDATE trials SET onset_ns = ?, confirm_ns = ?, dropped_frames = ?, "
-                "answered_utc = ?, segment_id = (SELECT max(id) FROM session_segments "
-                "WHERE session_id = ?) WHERE id = ?")
-        .bind(1, outcome.onset_ns).bind(2, outcome.confirm_ns).bind(3, outcome.dropped_frames)
-        .bind(4, utc_now_iso8601()).bind(5, session_id).bind(6, trial_id).run();
+    db_.prepare(
+           "UPDATE trials SET onset_ns = ?, confirm_ns = ?, dropped_frames = ?, "
+           "answered_utc = ?, segment_id = (SELECT max(id) FROM session_segments "
+           "WHERE session_id = ?) WHERE id = ?")
+        .bind(1, outcome.onset_ns)
+        .bind(2, outcome.confirm_ns)
+        .bind(3, outcome.dropped_frames)
+        .bind(4, utc_now_iso8601())
+        .bind(5, session_id)
+        .bind(6, trial_id)
+        .run();
     const bool completed = complete_session_if_answered(session_id);  // same transaction
     tx.commit();
     return completed;
 }
 
 bool Store::complete_session_if_answered(int64_t session_id) {
-    db_.prepare("UPDATE sessions SET status = 'completed', ended_utc = coalesce(ended_utc, ?) "
-                "WHERE id = ? AND status != 'completed' AND NOT EXISTS (SELECT 1 FROM trials t "
-                "WHERE t.session_id = sessions.id AND NOT EXISTS "
-                "(SELECT 1 FROM responses r WHERE r.trial_id = t.id))")
-        .bind(1, utc_now_iso8601()).bind(2, session_id).run();
+    db_.prepare(
+           "UPDATE sessions SET status = 'completed', ended_utc = coalesce(ended_utc, ?) "
+           "WHERE id = ? AND status != 'completed' AND NOT EXISTS (SELECT 1 FROM trials "
+           "t "
+           "WHERE t.session_id = sessions.id AND NOT EXISTS "
+           "(SELECT 1 FROM responses r WHERE r.trial_id = t.id))")
+        .bind(1, utc_now_iso8601())
+        .bind(2, session_id)
+        .run();
     Statement s = db_.prepare("SELECT status = 'completed' FROM sessions WHERE id = ?");
     s.bind(1, session_id);
     return s.step() && s.integer(0) != 0;
@@ -816,7 +952,8 @@ const QuestionPoints& Store::question_points_of_session(int64_t session_id) {
     s.bind(1, session_id);
     if (!s.step())
         throw StoreError(db_.path() + ": no session " + std::to_string(session_id));
-    return question_points_by_session_.emplace(session_id, stored_question_points(db_, s.integer(0)))
+    return question_points_by_session_
+        .emplace(session_id, stored_question_points(db_, s.integer(0)))
         .first->second;
 }
 
@@ -830,10 +967,15 @@ void Store::set_status(int64_t session_id, const std::string& status, bool ended
     }
     if (ended) {
         db_.prepare("UPDATE sessions SET status = ?, ended_utc = ? WHERE id = ?")
-            .bind(1, status).bind(2, utc_now_iso8601()).bind(3, session_id).run();
+            .bind(1, status)
+            .bind(2, utc_now_iso8601())
+            .bind(3, session_id)
+            .run();
     } else {
         db_.prepare("UPDATE sessions SET status = ?, ended_utc = NULL WHERE id = ?")
-            .bind(1, status).bind(2, session_id).run();
+            .bind(1, status)
+            .bind(2, session_id)
+            .run();
     }
 }
 
@@ -844,20 +986,25 @@ bool Store::withdraw_participant(const std::string& code) {
     const std::string now = utc_now_iso8601();
     std::vector<std::pair<std::string, std::string>> sessions;  // uuid, machine
     {
-        Statement s = db_.prepare("SELECT se.uuid, se.machine_id FROM sessions se JOIN "
-                                  "participants p ON p.id = se.participant_id WHERE p.code = ?");
+        Statement s = db_.prepare(
+            "SELECT se.uuid, se.machine_id FROM sessions se JOIN "
+            "participants p ON p.id = se.participant_id WHERE p.code = ?");
         s.bind(1, code);
         while (s.step()) sessions.emplace_back(s.text(0), s.text(1));
     }
-    if (first_int(db_.prepare("SELECT count(*) FROM participants WHERE code = ?").bind(1, code)) > 0) {
+    if (first_int(db_.prepare("SELECT count(*) FROM participants WHERE code = ?")
+                      .bind(1, code)) > 0) {
         Tombstones tombstones;
         for (const auto& [uuid, machine] : sessions) tombstones.add_session(uuid, now);
-        for (const WithdrawnCode& c : code_tombstones(code, sessions, now)) tombstones.add_code(c);
+        for (const WithdrawnCode& c : code_tombstones(code, sessions, now))
+            tombstones.add_code(c);
         tombstones.write(db_);
     }
-    db_.prepare("INSERT OR IGNORE INTO retired_participant_numbers (number) "
-                "SELECT number FROM participants WHERE code = ?")
-        .bind(1, code).run();
+    db_.prepare(
+           "INSERT OR IGNORE INTO retired_participant_numbers (number) "
+           "SELECT number FROM participants WHERE code = ?")
+        .bind(1, code)
+        .run();
     db_.prepare("DELETE FROM participants WHERE code = ?").bind(1, code).run();
     const bool deleted = sqlite3_changes(db_.handle()) > 0;
     tx.commit();
@@ -892,12 +1039,14 @@ void Store::claim_participant(const std::string& code) {
     struct flock lock {};
     lock.l_type = F_WRLCK;
     lock.l_whence = SEEK_SET;
-    lock.l_start = static_cast<off_t>(std::hash<std::string>{}(code) & 0x3FFFFFFFFFFFFFFFull);
+    lock.l_start =
+        static_cast<off_t>(std::hash<std::string>{}(code)&0x3FFFFFFFFFFFFFFFull);
     lock.l_len = 1;
     if (fcntl(claim_fd_, F_OFD_SETLK, &lock) != 0)
-        throw StoreError(db_.path() + ": participant '" + code +
-                         "' is in a session on this machine now; refusing to run it twice "
-                         "at once");
+        throw StoreError(
+            db_.path() + ": participant '" + code +
+            "' is in a session on this machine now; refusing to run it twice "
+            "at once");
     claimed_[code] = lock.l_start;
 }
 
@@ -924,14 +1073,15 @@ Store::~Store() {
 std::string utc_iso8601(std::chrono::system_clock::time_point t) {
     // Floor, not truncation: a time before 1970 keeps its milliseconds in [0, 1000).
     const auto secs = std::chrono::floor<std::chrono::seconds>(t);
-    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t - secs).count();
+    const auto ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(t - secs).count();
     const std::time_t whole = std::chrono::system_clock::to_time_t(secs);
     std::tm tm{};
     gmtime_r(&whole, &tm);
     char out[64];
-    std::snprintf(out, sizeof out, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
-                  tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec,
-                  static_cast<int>(ms));
+    std::snprintf(out, sizeof out, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ",
+                  tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min,
+                  tm.tm_sec, static_cast<int>(ms));
     return out;
 }
 
@@ -939,11 +1089,12 @@ std::string utc_now_iso8601() { return utc_iso8601(std::chrono::system_clock::no
 
 std::string new_uuid_v4() {
     std::random_device device;
-    std::mt19937_64 rng((uint64_t(device()) << 32) ^ device() ^
-                        uint64_t(std::chrono::steady_clock::now().time_since_epoch().count()));
+    std::mt19937_64 rng(
+        (uint64_t(device()) << 32) ^ device() ^
+        uint64_t(std::chrono::steady_clock::now().time_since_epoch().count()));
     uint64_t hi = rng(), lo = rng();
-    hi = (hi & ~0xF000ull) | 0x4000ull;                     // version 4
-    lo = (lo & ~(0xC000ull << 48)) | (0x8000ull << 48);     // variant 10xx
+    hi = (hi & ~0xF000ull) | 0x4000ull;                  // version 4
+    lo = (lo & ~(0xC000ull << 48)) | (0x8000ull << 48);  // variant 10xx
     char out[40];
     std::snprintf(out, sizeof out, "%08x-%04x-%04x-%04x-%012llx", uint32_t(hi >> 32),
                   uint32_t(hi >> 16) & 0xFFFF, uint32_t(hi) & 0xFFFF, uint32_t(lo >> 48),

@@ -64,7 +64,8 @@ public:
 
     const std::string& name() const override { return db_.path(); }
     int64_t ensure_study(const Protocol& protocol) override;
-    int64_t ensure_participant(int64_t study_id, const std::string& code, int* number) override;
+    int64_t ensure_participant(int64_t study_id, const std::string& code,
+                               int* number) override;
     // Within one machine: an open-file-description lock on `<db>-participants.lock`,
     // released when this store closes or the process dies.
     void claim_participant(const std::string& code) override;
@@ -74,9 +75,11 @@ public:
                                const OnlineEnrolment& how,
                                const SessionEnvironment& env) override;
     void check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) override;
-    SessionRow create_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
-                              uint64_t seed, const SessionEnvironment& env) override;
-    std::optional<SessionRow> unfinished_session(const std::string& participant_code) override;
+    SessionRow create_session(int64_t study_id, int64_t participant_id,
+                              const TrialPlan& plan, uint64_t seed,
+                              const SessionEnvironment& env) override;
+    std::optional<SessionRow> unfinished_session(
+        const std::string& participant_code) override;
     bool has_completed_session(const std::string& participant_code) override;
     std::vector<TrialRow> trials(int64_t session_id) override;
     int begin_segment(int64_t session_id, const SessionEnvironment& env) override;
@@ -86,7 +89,8 @@ public:
     void count_declined_consent(int64_t study_id) override;
     bool forget_declined_session(int64_t session_id) override;
     bool has_consent(int64_t session_id) override;
-    bool record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) override;
+    bool record_trial(int64_t session_id, int64_t trial_id,
+                      const TrialOutcome& outcome) override;
     // Also repairs sessions written before completion was atomic.
     bool complete_session_if_answered(int64_t session_id) override;
     void set_status(int64_t session_id, const std::string& status, bool ended) override;
@@ -98,13 +102,16 @@ public:
     Database& db() { return db_; }
 
 private:
-    // Stores (first time) or checks env.stimuli's resolved values, then the segment's rows.
+    // Stores (first time) or checks env.stimuli's resolved values, then the segment's
+    // rows.
     void insert_segment(int64_t session_id, int segment, const SessionEnvironment& env);
-    void copy_environment_to_session_row(int64_t session_id, const SessionEnvironment& env);
+    void copy_environment_to_session_row(int64_t session_id,
+                                         const SessionEnvironment& env);
     // The session row, its first segment and its trials, inside the caller's transaction.
-    SessionRow insert_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
-                              uint64_t seed, const SessionEnvironment& env,
-                              const std::string& uuid, const std::string& allocation);
+    SessionRow insert_session(int64_t study_id, int64_t participant_id,
+                              const TrialPlan& plan, uint64_t seed,
+                              const SessionEnvironment& env, const std::string& uuid,
+                              const std::string& allocation);
 
     const QuestionPoints& question_points_of_session(int64_t session_id);
 

@@ -14,14 +14,14 @@ struct StimulusProvenance {
     std::string source;     // "live", "images" (a --images file checked against its
                             // manifest) or "image" (the protocol's own image file)
     std::string technique;  // "" for image stimuli
-    std::string mesh;       // resolved mesh spec (the default when the protocol names none)
+    std::string mesh;  // resolved mesh spec (the default when the protocol names none)
     std::string mesh_hash;  // content hash of that mesh
     // Every knob of the technique and the scene, defaults included, in knob order, as
     // format_knob_value() writes them; empty for image stimuli.
     std::vector<std::pair<std::string, std::string>> values;
     std::string software_version;  // the lucent that made the picture (the manifest's for
     std::string build_hash;        // --images files)
-    std::string file;          // the image file shown; "" when rendered live
+    std::string file;              // the image file shown; "" when rendered live
     std::string content_hash;  // the manifest's content hash of that file; "" when live
 };
 
@@ -32,11 +32,11 @@ struct SessionEnvironment {
     std::string build_hash;
     std::string gl_vendor;
     std::string gl_renderer;
-    std::string display_mode;                  // e.g. "1280x1024 fullscreen, mode 60 Hz"
-    std::optional<double> display_refresh_hz;  // video mode's rate; NULL when it says 0
-    std::optional<double> measured_refresh_hz; // from swap intervals; NULL when unknown
-    std::string refresh_note;                  // why a refresh is NULL, or a warning
-    std::vector<StimulusProvenance> stimuli;   // what this segment shows (may be empty)
+    std::string display_mode;                   // e.g. "1280x1024 fullscreen, mode 60 Hz"
+    std::optional<double> display_refresh_hz;   // video mode's rate; NULL when it says 0
+    std::optional<double> measured_refresh_hz;  // from swap intervals; NULL when unknown
+    std::string refresh_note;                   // why a refresh is NULL, or a warning
+    std::vector<StimulusProvenance> stimuli;    // what this segment shows (may be empty)
 };
 
 struct SessionRow {
@@ -66,16 +66,16 @@ struct TrialRow {
 // One rating as the runner collected it.
 struct Response {
     std::string question;
-    int rating = 0;          // 1..points
-    double rt_ms = 0;        // from stimulus onset to the final choice
-    int changes = 0;         // times the choice changed after the first one
+    int rating = 0;               // 1..points
+    double rt_ms = 0;             // from stimulus onset to the final choice
+    int changes = 0;              // times the choice changed after the first one
     int64_t first_choice_ns = 0;  // steady-clock timestamps (raw, monotonic)
     int64_t final_choice_ns = 0;
 };
 
 struct TrialOutcome {
-    int64_t onset_ns = 0;    // first swap showing the stimulus, after glFinish
-    int64_t confirm_ns = 0;  // when the answer was made final
+    int64_t onset_ns = 0;               // first swap showing the stimulus, after glFinish
+    int64_t confirm_ns = 0;             // when the answer was made final
     std::optional<int> dropped_frames;  // NULL when the refresh is unknown
     std::vector<Response> responses;
 };

@@ -22,13 +22,15 @@ namespace {
 void refuse_unknown_scheme(const std::string& db) {
     const size_t colon = db.find("://");
     if (colon == std::string::npos || is_server_uri(db)) return;
-    throw StoreError("--db " + db + ": unknown store '" + db.substr(0, colon) +
-                     "'; valid: a FILE.db (SQLite) or postgresql://USER@HOST[:PORT]/DBNAME");
+    throw StoreError(
+        "--db " + db + ": unknown store '" + db.substr(0, colon) +
+        "'; valid: a FILE.db (SQLite) or postgresql://USER@HOST[:PORT]/DBNAME");
 }
 
 }  // namespace
 
-std::unique_ptr<StudyStore> open_study_store(const std::string& db, const StoreOptions& options) {
+std::unique_ptr<StudyStore> open_study_store(const std::string& db,
+                                             const StoreOptions& options) {
     refuse_unknown_scheme(db);
     if (is_server_uri(db)) return std::make_unique<PostgresStore>(db, options);
     return std::make_unique<Store>(db, options.vfs);
@@ -40,7 +42,8 @@ std::pair<int, int> init_study_store(const std::string& db) {
     check_database_file(db);
     int before = 0;
     if (std::filesystem::exists(db) && std::filesystem::file_size(db) > 0)
-        before = static_cast<int>(Database(db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"));
+        before = static_cast<int>(
+            Database(db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"));
     Store store(db);  // migrates on open
     return {before, kSchemaVersion};
 }
@@ -53,12 +56,14 @@ ReadableStudyFile::ReadableStudyFile(const std::string& db) {
     }
     std::string pattern =
         (std::filesystem::temp_directory_path() / "lucent-snapshot-XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw StoreError("cannot create a temporary folder for " + db);
+    if (!mkdtemp(pattern.data()))
+        throw StoreError("cannot create a temporary folder for " + db);
     temporary_dir_ = pattern;
     path_ = temporary_dir_ + "/snapshot.db";
     try {
         StoreOptions options;
-        options.journal_path = temporary_dir_ + "/unused-journal.db";  // reads journal nothing
+        options.journal_path =
+            temporary_dir_ + "/unused-journal.db";  // reads journal nothing
         PostgresStore(db, options).snapshot_to_sqlite(path_);
     } catch (...) {
         std::error_code ec;

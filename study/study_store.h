@@ -23,13 +23,16 @@ namespace lucent::study {
 
 // How `lucent serve` enrols a participant who has just consented (enrol_online).
 struct OnlineEnrolment {
-    std::string session_uuid;  // chosen before consent: the page's token is derived from it
+    std::string
+        session_uuid;  // chosen before consent: the page's token is derived from it
     uint64_t seed = 0;
-    int cells = 1;  // counterbalancing cells (Latin-square rows; 1 without counterbalancing)
+    int cells =
+        1;  // counterbalancing cells (Latin-square rows; 1 without counterbalancing)
     // A session that is neither completed nor active since this time (ISO 8601 UTC, as
     // stored) is abandoned: its cell counts as free again.
     std::string active_since_utc;
-    std::function<TrialPlan(int cell)> plan;  // the plan of the cell chosen (plan.cell == cell)
+    std::function<TrialPlan(int cell)>
+        plan;  // the plan of the cell chosen (plan.cell == cell)
 };
 
 struct OnlineSession {
@@ -73,7 +76,8 @@ public:
 
     // Throws StoreError naming the stimulus and parameter when `stimuli` resolve to other
     // values than the earlier sessions recorded (new values are not stored).
-    virtual void check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) = 0;
+    virtual void check_stimulus_values(
+        const std::vector<StimulusProvenance>& stimuli) = 0;
     // Writes the session, its first segment (env, env.stimuli) and its full planned trial
     // order (each trial with a new UUID) in one transaction.
     virtual SessionRow create_session(int64_t study_id, int64_t participant_id,
@@ -91,7 +95,8 @@ public:
     virtual int resume_segment(int64_t session_id, const SessionEnvironment& env) = 0;
     // Updates the newest segment's environment (e.g. the measured refresh); the session
     // row's copy (the first segment's) only while the session has one segment.
-    virtual void update_environment(int64_t session_id, const SessionEnvironment& env) = 0;
+    virtual void update_environment(int64_t session_id,
+                                    const SessionEnvironment& env) = 0;
     virtual void set_consent(int64_t session_id) = 0;
     // One more declined consent of the study (consent_declines: a count, nothing else).
     virtual void count_declined_consent(int64_t study_id) = 0;
@@ -111,11 +116,13 @@ public:
     // Sets `completed` when every planned trial has its ratings; true when completed.
     virtual bool complete_session_if_answered(int64_t session_id) = 0;
     // A completed session is final: any other status for it throws StoreError.
-    virtual void set_status(int64_t session_id, const std::string& status, bool ended) = 0;
+    virtual void set_status(int64_t session_id, const std::string& status,
+                            bool ended) = 0;
     // Deletes a participant and everything recorded for them; false when unknown.
     virtual bool withdraw_participant(const std::string& code) = 0;
     // Sessions and ratings held for `code`; nullopt when no such participant.
-    virtual std::optional<ParticipantCounts> participant_counts(const std::string& code) = 0;
+    virtual std::optional<ParticipantCounts> participant_counts(
+        const std::string& code) = 0;
 
     // One integer from a constant, read-only SQL query both backends accept (tests and
     // diagnostics; never user input).

@@ -13,7 +13,8 @@ namespace {
 uint64_t uniform_below(std::mt19937_64& rng, uint64_t n) {
     const uint64_t limit = UINT64_MAX - UINT64_MAX % n;
     uint64_t x;
-    do x = rng(); while (x >= limit);
+    do x = rng();
+    while (x >= limit);
     return x % n;
 }
 
@@ -26,7 +27,8 @@ bool may_place(const std::vector<const std::string*>& placed, const std::string&
             if (*placed[n - back] == level) return false;
     if (c.max_repeat > 0 && n >= c.max_repeat) {
         bool run = true;
-        for (int back = 1; back <= c.max_repeat && run; ++back) run = *placed[n - back] == level;
+        for (int back = 1; back <= c.max_repeat && run; ++back)
+            run = *placed[n - back] == level;
         if (run) return false;
     }
     return true;
@@ -47,16 +49,19 @@ public:
         for (const auto& block : blocks) {
             std::vector<int>& levels = blocks_.emplace_back();
             for (const std::string& l : block)
-                levels.push_back(ids.emplace(l, static_cast<int>(ids.size())).first->second);
+                levels.push_back(
+                    ids.emplace(l, static_cast<int>(ids.size())).first->second);
         }
         levels_ = static_cast<int>(ids.size());
-        window_ = std::max(c.min_distance > 1 ? c.min_distance - 1 : 0, std::max(c.max_repeat, 0));
+        window_ = std::max(c.min_distance > 1 ? c.min_distance - 1 : 0,
+                           std::max(c.max_repeat, 0));
     }
 
     struct State {
         size_t block = 0;
-        std::vector<int> left;    // trials left per level in this block
-        std::vector<int> recent;  // the last window_ levels placed, oldest first; -1: none
+        std::vector<int> left;  // trials left per level in this block
+        std::vector<int>
+            recent;  // the last window_ levels placed, oldest first; -1: none
     };
     State start() const {
         State s{0, counts(0), std::vector<int>(window_, -1)};
@@ -71,7 +76,8 @@ public:
                 if (recent[n - back] == level) return false;
         if (c_.max_repeat > 0) {
             bool run = true;
-            for (int back = 1; back <= c_.max_repeat && run; ++back) run = recent[n - back] == level;
+            for (int back = 1; back <= c_.max_repeat && run; ++back)
+                run = recent[n - back] == level;
             if (run) return false;
         }
         return true;
@@ -88,13 +94,17 @@ public:
             next.left = counts(++next.block);
         return next;
     }
-    bool done(const State& s) const { return s.block + 1 >= blocks_.size() && empty(s.left); }
+    bool done(const State& s) const {
+        return s.block + 1 >= blocks_.size() && empty(s.left);
+    }
     // Valid completions of `s`.
     long double completions(const State& s) {
         if (done(s)) return 1.0L;
         std::string key(reinterpret_cast<const char*>(&s.block), sizeof s.block);
-        key.append(reinterpret_cast<const char*>(s.left.data()), s.left.size() * sizeof(int));
-        key.append(reinterpret_cast<const char*>(s.recent.data()), s.recent.size() * sizeof(int));
+        key.append(reinterpret_cast<const char*>(s.left.data()),
+                   s.left.size() * sizeof(int));
+        key.append(reinterpret_cast<const char*>(s.recent.data()),
+                   s.recent.size() * sizeof(int));
         if (const auto it = memo_.find(key); it != memo_.end()) return it->second;
         long double total = 0.0L;
         for (int level = 0; level < levels_; ++level)
@@ -132,7 +142,8 @@ private:
 }  // namespace
 
 // Necessary conditions on level counts; a violation means no order exists.
-void check_feasible(const std::vector<std::string>& levels, const SequenceConstraints& c) {
+void check_feasible(const std::vector<std::string>& levels,
+                    const SequenceConstraints& c) {
     std::map<std::string, int> counts;
     for (const std::string& l : levels) ++counts[l];
     const long n = static_cast<long>(levels.size());
@@ -278,7 +289,8 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
     for (int i = 0; i < n_blocks; ++i) order[i] = i;
     if (protocol.randomisation.counterbalance_blocks) {
         plan.cell = ((participant_number % latin_square_rows(n_blocks)) +
-                     latin_square_rows(n_blocks)) % latin_square_rows(n_blocks);
+                     latin_square_rows(n_blocks)) %
+                    latin_square_rows(n_blocks);
         order = latin_square_row(n_blocks, participant_number);
     }
 
@@ -343,7 +355,8 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
             ++main_index;
             plan.trials.push_back(std::move(t));
         }
-    for (int i = 0; i < static_cast<int>(plan.trials.size()); ++i) plan.trials[i].position = i;
+    for (int i = 0; i < static_cast<int>(plan.trials.size()); ++i)
+        plan.trials[i].position = i;
     return plan;
 }
 

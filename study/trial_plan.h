@@ -19,9 +19,9 @@ public:
 };
 
 struct PlannedTrial {
-    int position = 0;     // 0-based over the whole session, practice first
-    std::string block;    // block id; "practice" for practice trials
-    std::string stimulus; // stimulus id
+    int position = 0;      // 0-based over the whole session, practice first
+    std::string block;     // block id; "practice" for practice trials
+    std::string stimulus;  // stimulus id
     bool practice = false;
     bool is_catch = false;
     std::string catch_id;  // catch trials: which one, its prompt and expected rating
@@ -32,8 +32,8 @@ struct PlannedTrial {
 };
 
 struct TrialPlan {
-    int cell = 0;                         // counterbalancing cell (Latin-square row)
-    std::vector<std::string> block_order; // block ids in the order shown
+    int cell = 0;                          // counterbalancing cell (Latin-square row)
+    std::vector<std::string> block_order;  // block ids in the order shown
     std::vector<PlannedTrial> trials;
 };
 

@@ -12,7 +12,8 @@ namespace {
 
 // Splits CODE@LABEL[#N] where LABEL names `machine_id`; returns (base, had #N) or
 // ("", false) when the code carries no such suffix.
-std::pair<std::string, bool> split_suffix(const std::string& code, const std::string& machine_id) {
+std::pair<std::string, bool> split_suffix(const std::string& code,
+                                          const std::string& machine_id) {
     const size_t at = code.rfind('@');
     if (at == std::string::npos || at == 0) return {"", false};
     std::string label = code.substr(at + 1);
@@ -33,7 +34,8 @@ std::pair<std::string, bool> split_suffix(const std::string& code, const std::st
 std::string random_salt() {
     std::random_device device;
     char out[40];
-    std::snprintf(out, sizeof out, "%08x%08x%08x%08x", device(), device(), device(), device());
+    std::snprintf(out, sizeof out, "%08x%08x%08x%08x", device(), device(), device(),
+                  device());
     return out;
 }
 
@@ -56,7 +58,8 @@ std::string withdrawn_code_hash(const std::string& salt, const std::string& code
 }
 
 std::vector<WithdrawnCode> code_tombstones(
-    const std::string& code, const std::vector<std::pair<std::string, std::string>>& sessions,
+    const std::string& code,
+    const std::vector<std::pair<std::string, std::string>>& sessions,
     const std::string& withdrawn_utc) {
     std::set<std::string> machines;
     for (const auto& [uuid, machine] : sessions) {
@@ -67,18 +70,21 @@ std::vector<WithdrawnCode> code_tombstones(
     std::vector<WithdrawnCode> out;
     for (const std::string& machine : machines) {
         const std::string salt = random_salt();
-        out.push_back({salt, withdrawn_code_hash(salt, enrolled_code(code, machine), machine),
+        out.push_back({salt,
+                       withdrawn_code_hash(salt, enrolled_code(code, machine), machine),
                        withdrawn_utc});
     }
     return out;
 }
 
 void Tombstones::read(Database& db) {
-    if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'withdrawn_sessions'") == 0)
+    if (db.scalar_int(
+            "SELECT count(*) FROM sqlite_schema WHERE name = 'withdrawn_sessions'") == 0)
         return;
     Statement s = db.prepare("SELECT uuid, withdrawn_utc FROM withdrawn_sessions");
     while (s.step()) add_session(s.text(0), s.text(1));
-    Statement c = db.prepare("SELECT salt, code_hash, withdrawn_utc FROM withdrawn_codes");
+    Statement c =
+        db.prepare("SELECT salt, code_hash, withdrawn_utc FROM withdrawn_codes");
     while (c.step()) add_code({c.text(0), c.text(1), c.text(2)});
 }
 
@@ -90,14 +96,16 @@ void Tombstones::add_session(const std::string& uuid, const std::string& withdra
 void Tombstones::add_code(const WithdrawnCode& code) {
     for (WithdrawnCode& held : codes_)
         if (held.salt == code.salt && held.code_hash == code.code_hash) {
-            if (code.withdrawn_utc < held.withdrawn_utc) held.withdrawn_utc = code.withdrawn_utc;
+            if (code.withdrawn_utc < held.withdrawn_utc)
+                held.withdrawn_utc = code.withdrawn_utc;
             return;
         }
     codes_.push_back(code);
 }
 
 bool Tombstones::covers(const std::string& uuid, const std::string& code,
-                        const std::string& machine_id, const std::string& started_utc) const {
+                        const std::string& machine_id,
+                        const std::string& started_utc) const {
     if (!uuid.empty() && sessions_.count(uuid)) return true;
     if (codes_.empty()) return false;
     const std::string enrolled = enrolled_code(code, machine_id);
@@ -110,7 +118,8 @@ bool Tombstones::covers(const std::string& uuid, const std::string& code,
 
 void Tombstones::write(Database& db) const {
     Statement s = db.prepare(
-        "INSERT INTO withdrawn_sessions (uuid, withdrawn_utc) VALUES (?, ?) ON CONFLICT (uuid) "
+        "INSERT INTO withdrawn_sessions (uuid, withdrawn_utc) VALUES (?, ?) ON CONFLICT "
+        "(uuid) "
         "DO UPDATE SET withdrawn_utc = min(withdrawn_utc, excluded.withdrawn_utc)");
     for (const auto& [uuid, utc] : sessions_) {
         s.reset();

@@ -18,7 +18,8 @@ namespace lucent::study {
 // "unknown-machine" for an empty one); that suffix is dropped when it names this
 // session's machine. Any other code is returned as it is.
 std::string enrolled_code(const std::string& code, const std::string& machine_id);
-// True for CODE@MACHINE#N: one of several people merge found under one code on one machine.
+// True for CODE@MACHINE#N: one of several people merge found under one code on one
+// machine.
 bool is_split_on_one_machine(const std::string& code, const std::string& machine_id);
 
 // Lower-case hex SHA-256 of salt + code + "\n" + machine_id.
@@ -35,7 +36,8 @@ struct WithdrawnCode {
 // split on one machine (CODE@MACHINE#N) gets no code row: another person holds the
 // same code on that machine, so only the UUIDs carry this withdrawal.
 std::vector<WithdrawnCode> code_tombstones(
-    const std::string& code, const std::vector<std::pair<std::string, std::string>>& sessions,
+    const std::string& code,
+    const std::vector<std::pair<std::string, std::string>>& sessions,
     const std::string& withdrawn_utc);
 
 // Every tombstone of some databases, and the test against them.
@@ -50,8 +52,8 @@ public:
     // matches a code tombstone and it started before that withdrawal (a later session
     // under the same code on that machine is someone else). For a participant without
     // sessions pass uuid "" and machine "", with the enrolment time as started_utc.
-    bool covers(const std::string& uuid, const std::string& code, const std::string& machine_id,
-                const std::string& started_utc) const;
+    bool covers(const std::string& uuid, const std::string& code,
+                const std::string& machine_id, const std::string& started_utc) const;
     bool empty() const { return sessions_.empty() && codes_.empty(); }
 
     // Writes every tombstone into `db` (the merge's output), keeping rows already there.

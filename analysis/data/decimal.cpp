@@ -108,7 +108,8 @@ double exact_difference(std::string_view value, std::string_view origin) {
     // exception without a location, as std::stod's "stod" was).
     const std::string text = difference.str(40, std::ios_base::scientific);
     double rounded = 0.0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), rounded);
+    const auto [end, error] =
+        std::from_chars(text.data(), text.data() + text.size(), rounded);
     if (error == std::errc::result_out_of_range) {
         if (abs(difference) < 1) return 0.0;  // below the smallest subnormal
         return difference < 0 ? -std::numeric_limits<double>::infinity()

@@ -20,7 +20,8 @@ struct Pool {
 };
 
 Pool& pool() {
-    static Pool* instance = new Pool;  // never destroyed: labels outlive static destructors
+    static Pool* instance =
+        new Pool;  // never destroyed: labels outlive static destructors
     return *instance;
 }
 

@@ -17,7 +17,8 @@ namespace lucent::analysis {
 class Label {
 public:
     Label();
-    Label(std::string_view text);  // NOLINT: implicit, so `row.level = "18"` reads naturally
+    Label(std::string_view
+              text);  // NOLINT: implicit, so `row.level = "18"` reads naturally
     Label(const std::string& text) : Label(std::string_view(text)) {}
     Label(const char* text) : Label(std::string_view(text)) {}
 
@@ -36,8 +37,12 @@ public:
     friend std::strong_ordering operator<=>(const Label& a, const Label& b) {
         return a.text_ == b.text_ ? std::strong_ordering::equal : *a.text_ <=> *b.text_;
     }
-    friend std::string operator+(const Label& a, const std::string& b) { return *a.text_ + b; }
-    friend std::string operator+(const std::string& a, const Label& b) { return a + *b.text_; }
+    friend std::string operator+(const Label& a, const std::string& b) {
+        return *a.text_ + b;
+    }
+    friend std::string operator+(const std::string& a, const Label& b) {
+        return a + *b.text_;
+    }
     friend std::string operator+(const Label& a, const char* b) { return *a.text_ + b; }
     friend std::string operator+(const char* a, const Label& b) { return a + *b.text_; }
     friend std::ostream& operator<<(std::ostream& out, const Label& label) {

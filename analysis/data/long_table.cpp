@@ -1,5 +1,10 @@
 #include "data/long_table.h"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -7,17 +12,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <thread>
 
 #include "data/decimal.h"
-
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace lucent::analysis {
 namespace {
@@ -46,8 +46,8 @@ public:
         if (position_ >= text_.size()) return std::nullopt;
         const char* begin = text_.data() + position_;
         const void* newline = std::memchr(begin, '\n', text_.size() - position_);
-        const std::size_t length =
-            newline ? static_cast<const char*>(newline) - begin : text_.size() - position_;
+        const std::size_t length = newline ? static_cast<const char*>(newline) - begin
+                                           : text_.size() - position_;
         position_ += length + 1;
         ++line_no_;
         std::string_view line(begin, length);
@@ -55,7 +55,9 @@ public:
         return line;
     }
     std::size_t line_no() const { return line_no_; }
-    std::string_view rest() const { return text_.substr(std::min(position_, text_.size())); }
+    std::string_view rest() const {
+        return text_.substr(std::min(position_, text_.size()));
+    }
     // Lines after this one (at least as many as the records still to come): counted
     // once so that a million rows are placed without a reallocation.
     std::size_t lines_left() const {
@@ -75,7 +77,8 @@ private:
 // at its commas in place: the views point into the text. A quoted record is decoded into
 // `decoded` (quotes may span lines: more lines are then pulled from `lines`).
 void split_record(std::string_view line, LineCursor& lines, const std::string& source,
-                  std::vector<std::string>& decoded, std::vector<std::string_view>& views) {
+                  std::vector<std::string>& decoded,
+                  std::vector<std::string_view>& views) {
     views.clear();
     if (std::memchr(line.data(), '"', line.size()) == nullptr) {
         // Fields are short: one pass over the characters beats a memchr per field.
@@ -141,7 +144,8 @@ public:
         struct stat info {};
         if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_size > 0) {
             size_ = static_cast<std::size_t>(info.st_size);
-            void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+            void* map =
+                ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
             if (map != MAP_FAILED) data_ = static_cast<const char*>(map);
         }
         ::close(fd);
@@ -194,7 +198,8 @@ private:
     };
     static std::uint64_t fnv1a(std::string_view text) {
         std::uint64_t hash = 0xcbf29ce484222325ULL;
-        for (const char c : text) hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+        for (const char c : text)
+            hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
         return hash;
     }
     void grow() {
@@ -223,7 +228,8 @@ struct Origin {
 
 // "FILE:LINE: column N (rating): " for a message about one rating cell.
 std::string rating_cell(const std::string& source, std::size_t line, int column) {
-    return location(source, line) + ": column " + std::to_string(column + 1) + " (rating): ";
+    return location(source, line) + ": column " + std::to_string(column + 1) +
+           " (rating): ";
 }
 
 // Why a rating text is not a number the analysis takes: beyond the double range
@@ -235,14 +241,14 @@ std::string rating_cell(const std::string& source, std::size_t line, int column)
     double value = 0.0;
     const auto [end, error] =
         std::from_chars(digits.data(), digits.data() + digits.size(), value);
-    const bool out_of_range = error == std::errc::result_out_of_range &&
-                              end == digits.data() + digits.size() &&
-                              digits.find_first_not_of("0123456789.eE+-") ==
-                                  std::string_view::npos;
+    const bool out_of_range =
+        error == std::errc::result_out_of_range && end == digits.data() + digits.size() &&
+        digits.find_first_not_of("0123456789.eE+-") == std::string_view::npos;
     throw InputError(rating_cell(source, line, column) + "rating '" + std::string(text) +
-                     (out_of_range ? "' is beyond the range of a double (magnitudes up to "
-                                     "about 1.8e308): rescale the ratings"
-                                   : "' is not a finite number"));
+                     (out_of_range
+                          ? "' is beyond the range of a double (magnitudes up to "
+                            "about 1.8e308): rescale the ratings"
+                          : "' is not a finite number"));
 }
 
 // The data records of a long CSV after its header, appended to `rows`. `column` gives
@@ -284,7 +290,8 @@ void parse_rows(LineCursor& lines, const std::string& source,
             origin.value = *value;
             origin.line = line_no;
         }
-        if (rating_text.size() == 1 && is_digit(rating_text[0]) && origin.text.size() == 1) {
+        if (rating_text.size() == 1 && is_digit(rating_text[0]) &&
+            origin.text.size() == 1) {
             // Every Likert rating: one digit against a one-digit origin, exact.
             row.rating = static_cast<double>(rating_text[0] - origin.text[0]);
             continue;
@@ -294,8 +301,9 @@ void parse_rows(LineCursor& lines, const std::string& source,
         row.rating = exact_difference(rating_text, origin.text);
         if (!std::isfinite(*row.rating))  // 1e308 after -1e308: no double holds the gap
             throw InputError(rating_cell(source, line_no, column[5]) + "rating '" +
-                             std::string(rating_text) + "' lies further from the rating '" +
-                             origin.text + "' (line " + std::to_string(origin.line) +
+                             std::string(rating_text) +
+                             "' lies further from the rating '" + origin.text +
+                             "' (line " + std::to_string(origin.line) +
                              ") than a double can hold: ratings this far apart cannot be "
                              "analysed; rescale them");
     }
@@ -325,12 +333,13 @@ void check_spread(const LongTable& table, const std::string& source, int column)
     char span_text[32], limit_text[32];
     std::snprintf(span_text, sizeof span_text, "%.3g", span);
     std::snprintf(limit_text, sizeof limit_text, "%.3g", limit);
-    throw InputError(rating_cell(source, later.source_line, column) + "the ratings span " +
-                     (std::isfinite(span) ? std::string(span_text) : "more than 1.8e308") +
-                     " (this rating and line " + std::to_string(earlier.source_line) +
-                     "); the sums of squares of " + std::to_string(n) +
-                     " ratings stay finite only up to a span of " + limit_text +
-                     ": rescale the ratings");
+    throw InputError(
+        rating_cell(source, later.source_line, column) + "the ratings span " +
+        (std::isfinite(span) ? std::string(span_text) : "more than 1.8e308") +
+        " (this rating and line " + std::to_string(earlier.source_line) +
+        "); the sums of squares of " + std::to_string(n) +
+        " ratings stay finite only up to a span of " + limit_text +
+        ": rescale the ratings");
 }
 
 // Files this large are parsed in two halves at once (when they have no quoted field,
@@ -351,7 +360,8 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
         if (!next) break;
         std::string_view line = *next;
         const std::size_t line_no = lines.line_no();
-        if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);  // BOM
+        if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF")
+            line.remove_prefix(3);  // BOM
         if (trimmed(line).empty()) continue;
         split_record(line, lines, source, decoded, fields);
         // Header: find each required column by name.
@@ -370,18 +380,19 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
     table.rows.reserve(lines.lines_left());
     Origin origin;
     const std::string_view body = lines.rest();
-    const std::size_t cut =
-        body.size() >= kParallelParseBytes && std::thread::hardware_concurrency() > 1 &&
-                std::memchr(body.data(), '"', body.size()) == nullptr
-            ? body.find('\n', body.size() / 2)
-            : std::string_view::npos;
+    const std::size_t cut = body.size() >= kParallelParseBytes &&
+                                    std::thread::hardware_concurrency() > 1 &&
+                                    std::memchr(body.data(), '"', body.size()) == nullptr
+                                ? body.find('\n', body.size() / 2)
+                                : std::string_view::npos;
     if (cut == std::string_view::npos) {
         parse_rows(lines, source, column, header_fields, origin, table.rows);
     } else {
         // The origin first (the first rating of the file), so that both halves store
         // differences from the same text; then the second half on its own thread, its
         // line numbers counted on from the first half's.
-        const std::string_view first = body.substr(0, cut + 1), second = body.substr(cut + 1);
+        const std::string_view first = body.substr(0, cut + 1),
+                               second = body.substr(cut + 1);
         {
             LineCursor scout(first, lines.line_no());
             std::vector<RatingRow> scratch;
@@ -401,7 +412,8 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
                 const std::size_t first_lines = static_cast<std::size_t>(
                     std::count(first.begin(), first.end(), '\n'));
                 second_rows.reserve(static_cast<std::size_t>(
-                    std::count(second.begin(), second.end(), '\n')) + 1);
+                                        std::count(second.begin(), second.end(), '\n')) +
+                                    1);
                 LineCursor second_lines(second, header_lines + first_lines);
                 parse_rows(second_lines, source, column, header_fields, origin,
                            second_rows);
@@ -412,7 +424,8 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
         std::exception_ptr first_error;
         try {
             LineCursor first_lines(first, header_lines);
-            parse_rows(first_lines, source, column, header_fields, first_origin, table.rows);
+            parse_rows(first_lines, source, column, header_fields, first_origin,
+                       table.rows);
         } catch (...) {
             first_error = std::current_exception();
         }
@@ -485,7 +498,8 @@ LongTable read_long_csv(std::istream& in, const std::string& source,
 
 LongTable read_long_csv(const std::filesystem::path& path, const RatingScale& scale) {
     const MappedFile mapped(path);
-    if (const auto text = mapped.text()) return parse_long_csv(*text, path.string(), scale);
+    if (const auto text = mapped.text())
+        return parse_long_csv(*text, path.string(), scale);
     std::ifstream in(path, std::ios::binary);  // a pipe or an empty file
     if (!in) throw InputError(path.string() + ": cannot open for reading");
     return read_long_csv(in, path.string(), scale);

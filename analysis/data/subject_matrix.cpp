@@ -31,7 +31,8 @@ SubjectMatrix subject_by_level(const LongTable& table, const std::string& questi
             column_at = column->second;
         }
         if (!previous || row.participant != previous->participant) {
-            auto [it, inserted] = participant_row.emplace(row.participant, participants.size());
+            auto [it, inserted] =
+                participant_row.emplace(row.participant, participants.size());
             if (inserted) {
                 participants.push_back(row.participant);
                 cells.emplace_back(levels.size());
@@ -54,7 +55,8 @@ SubjectMatrix subject_by_level(const LongTable& table, const std::string& questi
         }
         m.complete.participants.push_back(participants[i]);
         for (const Cell& c : cells[i])
-            m.complete.values.push_back(static_cast<double>(c.sum / static_cast<long double>(c.count)));
+            m.complete.values.push_back(
+                static_cast<double>(c.sum / static_cast<long double>(c.count)));
     }
     return m;
 }

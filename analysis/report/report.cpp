@@ -8,9 +8,9 @@
 #include <sstream>
 
 #include "data/long_table.h"
-#include "report/html_page.h"
 #include "output_file.h"
 #include "report/format.h"
+#include "report/html_page.h"
 #include "report/svg_plot.h"
 
 namespace lucent::analysis {
@@ -87,7 +87,8 @@ std::string used_cell(const OneWayAnalysis& a, Design design) {
     const int total =
         a.within.participants + static_cast<int>(a.within.excluded_participants.size());
     if (design == Design::Between)
-        return std::to_string(total) + (total == 1 ? " participant, " : " participants, ") +
+        return std::to_string(total) +
+               (total == 1 ? " participant, " : " participants, ") +
                std::to_string(ratings) + (ratings == 1 ? " rating" : " ratings");
     return std::to_string(a.within.participants) + " of " + std::to_string(total) +
            " participants complete";
@@ -124,29 +125,34 @@ std::vector<Block> within_subject_blocks(const OneWayAnalysis& a, double alpha) 
         doc.push_back({Block::kParagraph, "Not computed: " + w.note + "."});
         return doc;
     }
-    doc.push_back({Block::kParagraph,
-                   participants_note(w) + ". A participant's value at a level is the mean "
-                   "of their ratings of that level's stimuli."});
+    doc.push_back(
+        {Block::kParagraph, participants_note(w) +
+                                ". A participant's value at a level is the mean "
+                                "of their ratings of that level's stimuli."});
     const RepeatedMeasuresAnova& r = w.anova;
     Table rm{{"source", "SS", "df", "MS", "F", "p", "p (G-G)", "p (H-F)"}, {}};
     rm.rows.push_back({a.factor, format_short(r.ss_effect), format_short(r.df_effect),
                        format_short(r.ss_effect / r.df_effect), format_short(r.f),
-                       format_p_short(r.p), format_p_short(r.p_gg), format_p_short(r.p_hf)});
+                       format_p_short(r.p), format_p_short(r.p_gg),
+                       format_p_short(r.p_hf)});
     rm.rows.push_back({"participants", format_short(r.ss_participants),
-                       format_short(static_cast<double>(r.participants - 1)), "", "", "", "", ""});
-    rm.rows.push_back({"error (" + a.factor + " x participants)", format_short(r.ss_error),
-                       format_short(r.df_error),
-                       r.df_error > 0 ? format_short(r.ss_error / r.df_error) : "undefined",
-                       "", "", "", ""});
+                       format_short(static_cast<double>(r.participants - 1)), "", "", "",
+                       "", ""});
+    rm.rows.push_back(
+        {"error (" + a.factor + " x participants)", format_short(r.ss_error),
+         format_short(r.df_error),
+         r.df_error > 0 ? format_short(r.ss_error / r.df_error) : "undefined", "", "", "",
+         ""});
     doc.push_back({Block::kHeading, "Repeated-measures ANOVA", {}, {}, 4});
     doc.push_back({Block::kTable, "", rm});
     doc.push_back({Block::kParagraph,
-                   "Mauchly's W = " + format_short(r.mauchly_w) + ", p = " +
-                       format_p_short(r.mauchly_p) + "; Greenhouse-Geisser epsilon = " +
-                       format_short(r.gg_epsilon) + ", Huynh-Feldt epsilon = " +
-                       format_short(r.hf_epsilon) + " (its p uses min(1, epsilon)); " +
-                       "partial eta squared = " + format_short(r.partial_eta_sq) +
-                       ", generalized eta squared = " + format_short(r.generalized_eta_sq) +
+                   "Mauchly's W = " + format_short(r.mauchly_w) +
+                       ", p = " + format_p_short(r.mauchly_p) +
+                       "; Greenhouse-Geisser epsilon = " + format_short(r.gg_epsilon) +
+                       ", Huynh-Feldt epsilon = " + format_short(r.hf_epsilon) +
+                       " (its p uses min(1, epsilon)); " + "partial eta squared = " +
+                       format_short(r.partial_eta_sq) + ", generalized eta squared = " +
+                       format_short(r.generalized_eta_sq) +
                        (r.note.empty() ? "" : ". Note: " + r.note)});
     const FriedmanResult& f = w.friedman;
     doc.push_back({Block::kParagraph,
@@ -158,10 +164,10 @@ std::vector<Block> within_subject_blocks(const OneWayAnalysis& a, double alpha) 
                   "significant at alpha"},
                  {}};
     for (const PairedComparison& c : w.paired)
-        paired.rows.push_back({c.level_a, c.level_b, format_short(c.diff), format_short(c.t),
-                               format_short(c.df), format_p_short(c.p),
-                               format_p_short(c.p_holm),
-                               c.note.empty() ? significant_at(c.p_holm, alpha) : c.note});
+        paired.rows.push_back(
+            {c.level_a, c.level_b, format_short(c.diff), format_short(c.t),
+             format_short(c.df), format_p_short(c.p), format_p_short(c.p_holm),
+             c.note.empty() ? significant_at(c.p_holm, alpha) : c.note});
     doc.push_back({Block::kHeading, "Paired t-tests, Holm-adjusted", {}, {}, 4});
     doc.push_back({Block::kTable, "", paired});
     return doc;
@@ -183,7 +189,8 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
     const Design primary = options.primary;
     const Design secondary = primary == Design::Within ? Design::Between : Design::Within;
     Table summary{
-        {"configuration", "design", "test", "p", "F", "significant at alpha", "used"}, {}};
+        {"configuration", "design", "test", "p", "F", "significant at alpha", "used"},
+        {}};
     for (const OneWayAnalysis& a : analyses)
         for (Design design : {primary, secondary}) {
             std::vector<std::string> row{configuration(a),
@@ -194,14 +201,15 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
             summary.rows.push_back(std::move(row));
         }
     doc.push_back({Block::kHeading, "Summary", {}, {}, 2});
-    doc.push_back({Block::kParagraph,
-                   std::string("Primary design: ") + design_name(primary) +
-                       (primary == Design::Within
-                            ? " (repeated-measures tests on the means of the participants "
-                              "who rated every level)"
-                            : " (levels compared as independent groups of ratings)") +
-                       (options.primary_reason.empty() ? "" : ", " + options.primary_reason) +
-                       ". Column \"used\": the participants and ratings each test used."});
+    doc.push_back(
+        {Block::kParagraph,
+         std::string("Primary design: ") + design_name(primary) +
+             (primary == Design::Within
+                  ? " (repeated-measures tests on the means of the participants "
+                    "who rated every level)"
+                  : " (levels compared as independent groups of ratings)") +
+             (options.primary_reason.empty() ? "" : ", " + options.primary_reason) +
+             ". Column \"used\": the participants and ratings each test used."});
     doc.push_back({Block::kTable, "", summary});
 
     // One figure per factor, its questions side by side on one scale (thesis Fig. 4.5).
@@ -222,7 +230,8 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
     for (const OneWayAnalysis& a : analyses) {
         doc.push_back({Block::kHeading, configuration(a), {}, {}, 2});
         Block plot{Block::kPlot, plot_file_name(a.question, a.factor), {}, {}};
-        plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives, a.factor);
+        plot.svg =
+            mean_ci_plot_svg(configuration(a), a.question, a.descriptives, a.factor);
         doc.push_back(plot);
         Block thumbnails{Block::kImages, "", {}, {}};
         for (const Descriptives& d : a.descriptives) {
@@ -234,7 +243,8 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         }
         if (!thumbnails.images.empty()) doc.push_back(thumbnails);
         const std::vector<Block> within = within_subject_blocks(a, options.alpha);
-        if (primary == Design::Within) doc.insert(doc.end(), within.begin(), within.end());
+        if (primary == Design::Within)
+            doc.insert(doc.end(), within.begin(), within.end());
 
         Table desc{{"level", "n", "mean", "SD", "SE", "median", "95% CI"}, {}};
         for (const Descriptives& d : a.descriptives)
@@ -273,10 +283,10 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                          "lower", "upper", "p adj < " + format_short(tk.alpha)},
                         {}};
             for (const TukeyPair& p : tk.pairs)
-                tukey.rows.push_back({p.level_a, p.level_b, format_short(p.diff),
-                                      format_short(p.se), format_short(p.q),
-                                      format_p_short(p.p_adj), format_short(p.lower),
-                                      format_short(p.upper), significant_at(p.p_adj, tk.alpha)});
+                tukey.rows.push_back(
+                    {p.level_a, p.level_b, format_short(p.diff), format_short(p.se),
+                     format_short(p.q), format_p_short(p.p_adj), format_short(p.lower),
+                     format_short(p.upper), significant_at(p.p_adj, tk.alpha)});
             doc.push_back({Block::kTable, "", tukey});
             std::string hsd = "q critical (alpha " + format_short(tk.alpha) +
                               ") = " + format_short(tk.q_critical);
@@ -307,7 +317,8 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         if (a.missing_ratings > 0)
             notes += std::to_string(a.missing_ratings) + " missing ratings were skipped.";
         if (!notes.empty()) doc.push_back({Block::kParagraph, notes});
-        if (primary == Design::Between) doc.insert(doc.end(), within.begin(), within.end());
+        if (primary == Design::Between)
+            doc.insert(doc.end(), within.begin(), within.end());
     }
     return doc;
 }
@@ -348,7 +359,8 @@ void render_markdown(const std::vector<Block>& doc, std::ostream& out) {
 // The PNG bytes shown for a level's picture: a thumbnail when the caller can make one
 // (lucent-full decodes images; the analysis library does not), else the file itself,
 // scaled by the browser. Empty when neither can be read.
-std::string embedded_picture(const std::filesystem::path& path, const ReportOptions& options) {
+std::string embedded_picture(const std::filesystem::path& path,
+                             const ReportOptions& options) {
     if (options.thumbnail_png) {
         try {
             return options.thumbnail_png(path);
@@ -393,8 +405,10 @@ void render_html(const std::vector<Block>& doc, const ReportOptions& options,
                             << "\" src=\"data:image/png;base64," << base64_encode(png)
                             << "\">";
                     else
-                        out << "(image unreadable: " << html_escape(image.path.string()) << ")";
-                    out << "<figcaption>" << html_escape(image.caption) << "</figcaption></figure>";
+                        out << "(image unreadable: " << html_escape(image.path.string())
+                            << ")";
+                    out << "<figcaption>" << html_escape(image.caption)
+                        << "</figcaption></figure>";
                 }
                 out << "</div>\n";
                 break;
@@ -427,8 +441,9 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
     welch << "question,factor,f,df1,df2,p\n";
     desc << "question,factor,level,n,mean,sd,se,median,ci_low,ci_high\n";
     std::ostringstream rm_anova, friedman, paired;
-    rm_anova << "question,factor,n_participants,f,df_effect,df_error,p,mauchly_w,mauchly_p,"
-                "gg_epsilon,p_gg,hf_epsilon,p_hf,partial_eta_sq,generalized_eta_sq\n";
+    rm_anova
+        << "question,factor,n_participants,f,df_effect,df_error,p,mauchly_w,mauchly_p,"
+           "gg_epsilon,p_gg,hf_epsilon,p_hf,partial_eta_sq,generalized_eta_sq\n";
     friedman << "question,factor,n_participants,chi_sq,df,p,kendall_w\n";
     paired << "question,factor,level_a,level_b,diff,t,df,p,p_holm\n";
     for (const OneWayAnalysis& a : analyses) {
@@ -459,10 +474,10 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
         rm_anova << key << w.participants << ',' << format_full(rm.f) << ','
                  << format_full(rm.df_effect) << ',' << format_full(rm.df_error) << ','
                  << format_p_full(rm.p) << ',' << format_full(rm.mauchly_w) << ','
-                 << format_p_full(rm.mauchly_p) << ',' << format_full(rm.gg_epsilon) << ','
-                 << format_p_full(rm.p_gg) << ',' << format_full(rm.hf_epsilon) << ','
-                 << format_p_full(rm.p_hf) << ',' << format_full(rm.partial_eta_sq) << ','
-                 << format_full(rm.generalized_eta_sq) << '\n';
+                 << format_p_full(rm.mauchly_p) << ',' << format_full(rm.gg_epsilon)
+                 << ',' << format_p_full(rm.p_gg) << ',' << format_full(rm.hf_epsilon)
+                 << ',' << format_p_full(rm.p_hf) << ',' << format_full(rm.partial_eta_sq)
+                 << ',' << format_full(rm.generalized_eta_sq) << '\n';
         const FriedmanResult& f = w.friedman;
         friedman << key << w.participants << ',' << format_full(f.chi_sq) << ','
                  << format_full(f.df) << ',' << format_p_full(f.p) << ','
@@ -511,23 +526,28 @@ namespace {
 std::string svg_file_name(const std::string& prefix, const std::string& text) {
     std::string name = prefix;
     for (char c : text)
-        name += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '-';
+        name +=
+            std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '-';
     return name + ".svg";
 }
 }  // namespace
 
-std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
-level_images_from_directory(const LongTable& table, const std::filesystem::path& directory) {
+std::map<std::pair<std::string, std::string>,
+         std::pair<std::string, std::filesystem::path>>
+level_images_from_directory(const LongTable& table,
+                            const std::filesystem::path& directory) {
     std::error_code error;
     if (!std::filesystem::is_directory(directory, error))
         throw InputError("--images " + directory.string() + ": not a directory");
-    std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
+    std::map<std::pair<std::string, std::string>,
+             std::pair<std::string, std::filesystem::path>>
         images;
     for (const RatingRow& row : table.rows) {
         const std::pair<std::string, std::string> key{row.factor, row.level};
         if (images.count(key)) continue;
         const std::filesystem::path png = directory / (row.stimulus + ".png");
-        if (std::filesystem::is_regular_file(png, error)) images[key] = {row.stimulus, png};
+        if (std::filesystem::is_regular_file(png, error))
+            images[key] = {row.stimulus, png};
     }
     return images;
 }
@@ -554,8 +574,9 @@ std::vector<std::filesystem::path> write_report(
     std::error_code error;
     if (std::filesystem::exists(directory, error) &&
         !std::filesystem::is_directory(directory, error))
-        throw InputError(directory.string() +
-                         ": is a file; the report is written into a folder (refusing to touch it)");
+        throw InputError(
+            directory.string() +
+            ": is a file; the report is written into a folder (refusing to touch it)");
     std::filesystem::create_directories(directory, error);
     if (error)
         throw InputError(directory.string() +

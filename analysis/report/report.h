@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <string>
 #include <string_view>
 #include <utility>
-#include <string>
 #include <vector>
 
 #include "data/long_table.h"
@@ -24,24 +24,28 @@ struct ReportOptions {
     // them, or any SQLite database, is refused before anything is written.
     std::vector<std::filesystem::path> inputs;
     Design primary = Design::Between;  // shown first in the summary and in each section
-    std::string primary_reason;  // why it leads (AnalysisResult::primary_reason); may be empty
+    std::string
+        primary_reason;  // why it leads (AnalysisResult::primary_reason); may be empty
     // Paragraphs after the input line: what the input reader left out and why (sessions
     // not completed, failed catch trials, withdrawn).
     std::vector<std::string> input_notes;
     // A picture of each level's stimulus, shown beside its descriptives (HTML embeds the
     // PNG, so the report stays one file): (factor, level) -> (stimulus id, PNG path).
-    std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
+    std::map<std::pair<std::string, std::string>,
+             std::pair<std::string, std::filesystem::path>>
         level_images;
     // Makes the PNG bytes of a small thumbnail of a picture file (throws when it cannot
     // be decoded). Unset: the file itself is embedded and the browser scales it.
     std::function<std::string(const std::filesystem::path&)> thumbnail_png;
 };
 
-// The picture of each (factor, level) from a folder of rendered stimuli (`lucent render`'s
-// output): the first stimulus rated at that level that has `DIR/<stimulus>.png`. Throws
-// InputError naming the folder when it is not one.
-std::map<std::pair<std::string, std::string>, std::pair<std::string, std::filesystem::path>>
-level_images_from_directory(const LongTable& table, const std::filesystem::path& directory);
+// The picture of each (factor, level) from a folder of rendered stimuli (`lucent
+// render`'s output): the first stimulus rated at that level that has
+// `DIR/<stimulus>.png`. Throws InputError naming the folder when it is not one.
+std::map<std::pair<std::string, std::string>,
+         std::pair<std::string, std::filesystem::path>>
+level_images_from_directory(const LongTable& table,
+                            const std::filesystem::path& directory);
 
 // RFC 4648 base64 of `bytes` (for images embedded in the HTML report).
 std::string base64_encode(std::string_view bytes);

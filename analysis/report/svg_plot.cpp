@@ -58,9 +58,10 @@ void padded_range(double& lo, double& hi) {
 }
 
 // One panel's axes, ticks, level labels and mean/CI marks, at (x0, y0), size w x h.
-void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double h, double lo,
-                double hi, const std::string& title, const std::string& y_label,
-                const std::vector<Descriptives>& levels, const std::string& x_label) {
+void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double h,
+                double lo, double hi, const std::string& title,
+                const std::string& y_label, const std::vector<Descriptives>& levels,
+                const std::string& x_label) {
     constexpr double kLeft = 60, kRight = 20, kTop = 40, kBottom = 60;
     const double left = x0 + kLeft, top = y0 + kTop;
     const double plot_w = w - kLeft - kRight, plot_h = h - kTop - kBottom;
@@ -68,9 +69,10 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
     const std::size_t n = std::max<std::size_t>(levels.size(), 1);
     auto x_of = [&](std::size_t i) { return left + plot_w * (i + 0.5) / n; };
     svg << "<text x=\"" << num(x0 + w / 2) << "\" y=\"" << num(y0 + 20)
-        << "\" text-anchor=\"middle\" font-size=\"14\">" << escape_xml(title) << "</text>\n"
-        << "<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left
-        << "\" y2=\"" << top + plot_h << "\" stroke=\"black\"/>\n"
+        << "\" text-anchor=\"middle\" font-size=\"14\">" << escape_xml(title)
+        << "</text>\n"
+        << "<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\"" << left << "\" y2=\""
+        << top + plot_h << "\" stroke=\"black\"/>\n"
         << "<line x1=\"" << left << "\" y1=\"" << top + plot_h << "\" x2=\""
         << left + plot_w << "\" y2=\"" << top + plot_h << "\" stroke=\"black\"/>\n";
     for (int t = 0; t <= 4; ++t) {
@@ -132,7 +134,8 @@ std::string mean_ci_plot_svg(const std::string& title, const std::string& y_labe
     return svg.str();
 }
 
-std::string factor_figure_svg(const std::string& factor, const std::vector<QuestionPanel>& panels) {
+std::string factor_figure_svg(const std::string& factor,
+                              const std::vector<QuestionPanel>& panels) {
     constexpr double kPanelWidth = 320, kHeight = 320;
     double lo = INFINITY, hi = -INFINITY;  // shared, so panels compare at a glance
     for (const QuestionPanel& p : panels) widen_range(p.levels, lo, hi);
@@ -143,8 +146,8 @@ std::string factor_figure_svg(const std::string& factor, const std::vector<Quest
     svg << "<text x=\"" << num(width / 2) << "\" y=\"16\" text-anchor=\"middle\" "
         << "font-size=\"15\" font-weight=\"bold\">" << escape_xml(factor) << "</text>\n";
     for (std::size_t i = 0; i < panels.size(); ++i)
-        draw_panel(svg, kPanelWidth * i, 24, kPanelWidth, kHeight, lo, hi, panels[i].question,
-                   "mean rating", panels[i].levels, factor);
+        draw_panel(svg, kPanelWidth * i, 24, kPanelWidth, kHeight, lo, hi,
+                   panels[i].question, "mean rating", panels[i].levels, factor);
     svg << "</svg>\n";
     return svg.str();
 }
@@ -173,8 +176,8 @@ std::string histogram_svg(const std::string& title, const std::vector<double>& s
         const double s = std::isfinite(shares[i]) ? std::max(shares[i], 0.0) : 0.0;
         const double h = plot_h * s / top_share;
         svg << "<rect x=\"" << num(kLeft + bar_w * double(i)) << "\" y=\""
-            << num(kTop + plot_h - h) << "\" width=\"" << num(bar_w * 0.9) << "\" height=\""
-            << num(h) << "\" fill=\"#1f77b4\"/>";
+            << num(kTop + plot_h - h) << "\" width=\"" << num(bar_w * 0.9)
+            << "\" height=\"" << num(h) << "\" fill=\"#1f77b4\"/>";
     }
     svg << "\n<line x1=\"" << kLeft << "\" y1=\"" << kTop + plot_h << "\" x2=\""
         << kLeft + plot_w << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/>"
@@ -194,8 +197,10 @@ std::string histogram_svg(const std::string& title, const std::vector<double>& s
     return svg.str();
 }
 
-std::string level_values_svg(const std::string& title, const std::vector<std::string>& levels,
-                             const std::vector<double>& values, const std::string& x_label) {
+std::string level_values_svg(const std::string& title,
+                             const std::vector<std::string>& levels,
+                             const std::vector<double>& values,
+                             const std::string& x_label) {
     constexpr double kWidth = 240, kHeight = 160, kLeft = 48, kRight = 12, kTop = 22,
                      kBottom = 44;
     const double plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
@@ -205,15 +210,17 @@ std::string level_values_svg(const std::string& title, const std::vector<std::st
     padded_range(lo, hi);
     auto y_of = [&](double v) { return kTop + plot_h * (hi - v) / (hi - lo); };
     const std::size_t n = std::max<std::size_t>(levels.size(), 1);
-    auto x_of = [&](std::size_t i) { return kLeft + plot_w * (double(i) + 0.5) / double(n); };
+    auto x_of = [&](std::size_t i) {
+        return kLeft + plot_w * (double(i) + 0.5) / double(n);
+    };
     std::ostringstream svg;
     svg << svg_header(kWidth, kHeight);
     svg << "<text x=\"" << num(kWidth / 2) << "\" y=\"14\" text-anchor=\"middle\" "
         << "font-size=\"11\">" << escape_xml(title) << "</text>\n"
-        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop << "\" x2=\"" << kLeft << "\" y2=\""
-        << kTop + plot_h << "\" stroke=\"black\"/><line x1=\"" << kLeft << "\" y1=\""
-        << kTop + plot_h << "\" x2=\"" << kLeft + plot_w << "\" y2=\"" << kTop + plot_h
-        << "\" stroke=\"black\"/>\n";
+        << "<line x1=\"" << kLeft << "\" y1=\"" << kTop << "\" x2=\"" << kLeft
+        << "\" y2=\"" << kTop + plot_h << "\" stroke=\"black\"/><line x1=\"" << kLeft
+        << "\" y1=\"" << kTop + plot_h << "\" x2=\"" << kLeft + plot_w << "\" y2=\""
+        << kTop + plot_h << "\" stroke=\"black\"/>\n";
     for (int t = 0; t <= 2; ++t) {
         const double v = lo + (hi - lo) * t / 2.0;
         svg << "<text x=\"" << kLeft - 4 << "\" y=\"" << num(y_of(v) + 3)

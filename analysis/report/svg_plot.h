@@ -20,7 +20,8 @@ struct QuestionPanel {
     std::string question;
     std::vector<Descriptives> levels;
 };
-std::string factor_figure_svg(const std::string& factor, const std::vector<QuestionPanel>& panels);
+std::string factor_figure_svg(const std::string& factor,
+                              const std::vector<QuestionPanel>& panels);
 
 }  // namespace lucent::analysis
 
@@ -36,7 +37,8 @@ std::string histogram_svg(const std::string& title, const std::vector<double>& s
                           const std::string& x_label = "luminance");
 // one value per level, as dots joined by a line, on an axis spanning the values; the
 // levels' names under the axis, `x_label` (e.g. the factor) below them.
-std::string level_values_svg(const std::string& title, const std::vector<std::string>& levels,
+std::string level_values_svg(const std::string& title,
+                             const std::vector<std::string>& levels,
                              const std::vector<double>& values,
                              const std::string& x_label = "");
 

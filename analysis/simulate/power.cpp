@@ -66,8 +66,8 @@ std::optional<double> closed_form_power(const PowerSpec& spec) {
     const double critical = boost::math::quantile(
         boost::math::complement(boost::math::fisher_f(df1, df2), spec.alpha));
     if (lambda == 0.0) return spec.alpha;
-    return boost::math::cdf(boost::math::complement(
-        boost::math::non_central_f(df1, df2, lambda), critical));
+    return boost::math::cdf(
+        boost::math::complement(boost::math::non_central_f(df1, df2, lambda), critical));
 }
 
 PowerResult estimate_power(const PowerSpec& spec) {
@@ -99,8 +99,8 @@ PowerResult estimate_power(const PowerSpec& spec) {
             const double shared = within ? spec.participant_sd * normal.next() : 0.0;
             for (std::size_t j = 0; j < k; ++j) {
                 const double own = within ? shared : spec.participant_sd * normal.next();
-                const double y =
-                    response(spec, spec.level_means[j] + own + spec.residual_sd * normal.next());
+                const double y = response(
+                    spec, spec.level_means[j] + own + spec.residual_sd * normal.next());
                 groups.groups[j].values[i] = y;
                 matrix.values[i * k + j] = y;
             }
@@ -118,7 +118,8 @@ PowerResult estimate_power(const PowerSpec& spec) {
         } else {
             // Simultaneous intervals at 1 - alpha exclude 0 exactly when p adj < alpha.
             const TukeyResult tukey = tukey_hsd(groups, anova, {spec.alpha, false});
-            for (std::size_t c = 0; c < tukey.pairs.size() && c < significant.size(); ++c) {
+            for (std::size_t c = 0; c < tukey.pairs.size() && c < significant.size();
+                 ++c) {
                 const TukeyPair& p = tukey.pairs[c];
                 significant[c] = p.lower && p.upper && (*p.lower > 0.0 || *p.upper < 0.0);
             }
@@ -144,8 +145,7 @@ PowerResult estimate_power(const PowerSpec& spec) {
 SampleSize smallest_sample(PowerSpec spec, double target, int max_participants) {
     if (!(target > 0.0 && target < 1.0))
         throw InputError("--target must lie strictly between 0 and 1");
-    if (max_participants < 2)
-        throw InputError("--max-participants must be at least 2");
+    if (max_participants < 2) throw InputError("--max-participants must be at least 2");
     SampleSize size;
     auto power_at = [&](int participants) {
         spec.participants = participants;
@@ -157,7 +157,8 @@ SampleSize smallest_sample(PowerSpec spec, double target, int max_participants) 
         size.at = std::move(high);
         return size;
     }
-    int lo = 1, hi = max_participants;  // power(lo) < target (by convention), power(hi) >= target
+    int lo = 1,
+        hi = max_participants;  // power(lo) < target (by convention), power(hi) >= target
     while (hi - lo > 1) {
         const int mid = lo + (hi - lo) / 2;
         PowerResult at_mid = power_at(std::max(2, mid));

@@ -24,8 +24,8 @@ namespace lucent::analysis {
 
 struct PowerSpec {
     Design design = Design::Within;
-    int participants = 38;             // within: in all; between: per level
-    std::vector<double> level_means;   // expected mean response per level
+    int participants = 38;            // within: in all; between: per level
+    std::vector<double> level_means;  // expected mean response per level
     double participant_sd = 0.0;
     double residual_sd = 1.0;
     double alpha = 0.10;

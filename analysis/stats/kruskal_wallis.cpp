@@ -1,8 +1,8 @@
 #include "stats/kruskal_wallis.h"
 
 #include <algorithm>
-#include <cmath>
 #include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
 #include <numeric>
 
 #include "stats/summation.h"
@@ -39,8 +39,8 @@ KruskalWallisResult kruskal_wallis(const OneWayData& data) {
         highest - lowest < kHistogramSpan &&
         (highest - lowest + 1) * static_cast<double>(groups.size()) <= 1 << 20) {
         const std::size_t span = static_cast<std::size_t>(highest - lowest) + 1;
-        std::vector<std::vector<std::size_t>> histogram(groups.size(),
-                                                        std::vector<std::size_t>(span, 0));
+        std::vector<std::vector<std::size_t>> histogram(
+            groups.size(), std::vector<std::size_t>(span, 0));
         for (std::size_t g = 0; g < groups.size(); ++g)
             for (double x : groups[g]->values)
                 ++histogram[g][static_cast<std::size_t>(x - lowest)];

@@ -29,7 +29,8 @@ double chi_sq_upper(double x, double df) {
 
 // log|det A| of a symmetric positive semi-definite matrix by Cholesky in long double;
 // empty when A is not positive definite (singular: fewer participants than contrasts).
-std::optional<double> log_det_positive_definite(std::vector<long double> a, std::size_t n) {
+std::optional<double> log_det_positive_definite(std::vector<long double> a,
+                                                std::size_t n) {
     long double log_det = 0.0L;
     for (std::size_t j = 0; j < n; ++j) {
         long double d = a[j * n + j];
@@ -92,8 +93,10 @@ RepeatedMeasuresAnova repeated_measures_anova(const SubjectByLevel& d) {
     }
     const Margins m = margins(d);
     long double ss_effect = 0, ss_participants = 0, ss_error = 0;
-    for (std::size_t j = 0; j < k; ++j) ss_effect += (m.column[j] - m.grand) * (m.column[j] - m.grand);
-    for (std::size_t i = 0; i < n; ++i) ss_participants += (m.row[i] - m.grand) * (m.row[i] - m.grand);
+    for (std::size_t j = 0; j < k; ++j)
+        ss_effect += (m.column[j] - m.grand) * (m.column[j] - m.grand);
+    for (std::size_t i = 0; i < n; ++i)
+        ss_participants += (m.row[i] - m.grand) * (m.row[i] - m.grand);
     for (std::size_t i = 0; i < n; ++i)
         for (std::size_t j = 0; j < k; ++j) {
             const long double e = d.value(i, j) - m.row[i] - m.column[j] + m.grand;
@@ -112,7 +115,8 @@ RepeatedMeasuresAnova repeated_measures_anova(const SubjectByLevel& d) {
 
     if (r.ss_effect + r.ss_error > 0.0) {
         r.partial_eta_sq = r.ss_effect / (r.ss_effect + r.ss_error);
-        r.generalized_eta_sq = r.ss_effect / (r.ss_effect + r.ss_participants + r.ss_error);
+        r.generalized_eta_sq =
+            r.ss_effect / (r.ss_effect + r.ss_participants + r.ss_error);
     }
     if (r.ss_error > 0.0) {
         r.f = (r.ss_effect / r.df_effect) / (r.ss_error / r.df_error);
@@ -131,7 +135,8 @@ RepeatedMeasuresAnova repeated_measures_anova(const SubjectByLevel& d) {
     const std::size_t pp = k - 1;
     std::vector<long double> z(n * pp), mean(pp, 0.0L);
     for (std::size_t c = 0; c < pp; ++c) {
-        const long double scale = 1.0L / std::sqrt(static_cast<long double>((c + 1) * (c + 2)));
+        const long double scale =
+            1.0L / std::sqrt(static_cast<long double>((c + 1) * (c + 2)));
         for (std::size_t i = 0; i < n; ++i) {
             long double s = 0.0L;
             for (std::size_t j = 0; j <= c; ++j) s += d.value(i, j);
@@ -156,11 +161,13 @@ RepeatedMeasuresAnova repeated_measures_anova(const SubjectByLevel& d) {
         trace_sq += b[a * pp + a] * b[a * pp + a];
     }
     if (!(trace > noise * noise * ss_total)) {
-        r.note = with_reason(r.note, "the level differences have zero variance: no "
-                                     "sphericity test or correction");
+        r.note = with_reason(r.note,
+                             "the level differences have zero variance: no "
+                             "sphericity test or correction");
         return r;
     }
-    const double gg = static_cast<double>(trace * trace / (trace_sq * static_cast<long double>(pp)));
+    const double gg =
+        static_cast<double>(trace * trace / (trace_sq * static_cast<long double>(pp)));
     r.gg_epsilon = gg;
     const double big_n = static_cast<double>(n), dp = static_cast<double>(pp);
     const double hf_den = dp * (big_n - 1.0 - dp * gg);
@@ -181,16 +188,19 @@ RepeatedMeasuresAnova repeated_measures_anova(const SubjectByLevel& d) {
         // One contrast: sphericity holds by construction (W = 1); R's chi-square with
         // 0 df would print p = 0, which reads as a violation.
         r.mauchly_w = 1.0;
-        r.note = with_reason(r.note, "two levels: sphericity holds trivially, no Mauchly p");
+        r.note =
+            with_reason(r.note, "two levels: sphericity holds trivially, no Mauchly p");
         return r;
     }
     if (n - 1 < pp) {
-        r.note = with_reason(r.note, "Mauchly's test needs at least as many participants as levels");
+        r.note = with_reason(
+            r.note, "Mauchly's test needs at least as many participants as levels");
         return r;
     }
     const std::optional<double> log_det = log_det_positive_definite(b, pp);
     if (!log_det) {
-        r.note = with_reason(r.note, "the contrasts' covariance is singular: no Mauchly test");
+        r.note =
+            with_reason(r.note, "the contrasts' covariance is singular: no Mauchly test");
         return r;
     }
     const double log_w = *log_det - dp * std::log(static_cast<double>(trace) / dp);
@@ -222,8 +232,9 @@ FriedmanResult friedman_test(const SubjectByLevel& d) {
     std::vector<std::size_t> order(k);
     for (std::size_t i = 0; i < n; ++i) {
         std::iota(order.begin(), order.end(), 0);
-        std::sort(order.begin(), order.end(),
-                  [&](std::size_t a, std::size_t b) { return d.value(i, a) < d.value(i, b); });
+        std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+            return d.value(i, a) < d.value(i, b);
+        });
         for (std::size_t a = 0; a < k;) {
             std::size_t b = a;
             while (b < k && d.value(i, order[b]) == d.value(i, order[a])) ++b;
@@ -262,7 +273,8 @@ std::vector<Statistic> holm_adjust(const std::vector<Statistic>& p) {
     const double m = static_cast<double>(defined.size());
     double running_max = 0.0;
     for (std::size_t rank = 0; rank < defined.size(); ++rank) {
-        running_max = std::max(running_max, (m - static_cast<double>(rank)) * *p[defined[rank]]);
+        running_max =
+            std::max(running_max, (m - static_cast<double>(rank)) * *p[defined[rank]]);
         adjusted[defined[rank]] = std::min(1.0, running_max);
     }
     return adjusted;
@@ -289,14 +301,16 @@ std::vector<PairedComparison> paired_t_tests_holm(const SubjectByLevel& d) {
             }
             c.diff = static_cast<double>(mean);
             c.df = static_cast<double>(n - 1);
-            const double se = static_cast<double>(
-                std::sqrt(squares / static_cast<long double>(n - 1) / static_cast<long double>(n)));
+            const double se = static_cast<double>(std::sqrt(
+                squares / static_cast<long double>(n - 1) / static_cast<long double>(n)));
             // R's t.test: "data are essentially constant" below 10 eps of the mean.
-            if (!(se > 10.0 * std::numeric_limits<double>::epsilon() * std::fabs(*c.diff))) {
+            if (!(se >
+                  10.0 * std::numeric_limits<double>::epsilon() * std::fabs(*c.diff))) {
                 c.note = "the differences have zero variance: t is undefined";
             } else {
                 c.t = *c.diff / se;
-                c.p = 2.0 * cdf(complement(boost::math::students_t(*c.df), std::fabs(*c.t)));
+                c.p = 2.0 *
+                      cdf(complement(boost::math::students_t(*c.df), std::fabs(*c.t)));
                 c.p = std::min(1.0, *c.p);
             }
             pairs.push_back(c);

@@ -36,8 +36,8 @@ struct RepeatedMeasuresAnova {
     int participants = 0, levels = 0;
     double df_effect = 0, df_error = 0;
     double ss_effect = 0, ss_participants = 0, ss_error = 0;
-    Statistic f, p;                 // +inf F (zero error variance, different means): p 0
-    Statistic mauchly_w, mauchly_p; // need at least `levels` participants
+    Statistic f, p;                  // +inf F (zero error variance, different means): p 0
+    Statistic mauchly_w, mauchly_p;  // need at least `levels` participants
     Statistic gg_epsilon, p_gg, hf_epsilon, p_hf;  // hf_epsilon as computed (may pass 1)
     Statistic partial_eta_sq, generalized_eta_sq;
     std::string note;  // why something is undefined; "" when all is defined

@@ -19,7 +19,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-[[noreturn]] void fail(const std::string& what) { throw DensityError("density: " + what); }
+[[noreturn]] void fail(const std::string& what) {
+    throw DensityError("density: " + what);
+}
 
 // [SECTION] spec parsing
 
@@ -56,8 +58,10 @@ std::string list_of(const std::vector<std::string>& names) {
 
 bool parse_number(std::string_view text, double& value) {
     if (text.empty()) return false;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    return error == std::errc() && end == text.data() + text.size() && std::isfinite(value);
+    const auto [end, error] =
+        std::from_chars(text.data(), text.data() + text.size(), value);
+    return error == std::errc() && end == text.data() + text.size() &&
+           std::isfinite(value);
 }
 
 bool ends_with(std::string_view text, std::string_view suffix) {
@@ -87,7 +91,8 @@ double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 
 double value_noise(std::uint64_t seed, glm::dvec3 p) {
     const glm::dvec3 cell = glm::floor(p), f = p - cell;
-    const auto ix = std::int64_t(cell.x), iy = std::int64_t(cell.y), iz = std::int64_t(cell.z);
+    const auto ix = std::int64_t(cell.x), iy = std::int64_t(cell.y),
+               iz = std::int64_t(cell.z);
     const double u = fade(f.x), v = fade(f.y), w = fade(f.z);
     double sum = 0.0;
     for (int k = 0; k < 8; ++k) {
@@ -135,7 +140,8 @@ std::vector<float> generate(const DensitySpec& spec, int r) {
                 } else if (spec.generator == "cube") {
                     const double half = 0.5 * param("size");
                     const glm::dvec3 d = glm::abs(t - 0.5);
-                    rho = std::max({d.x, d.y, d.z}) < half ? param("inside") : param("outside");
+                    rho = std::max({d.x, d.y, d.z}) < half ? param("inside")
+                                                           : param("outside");
                 } else if (spec.generator == "spheres") {
                     rho = param("outside");
                     for (const glm::dvec4& s : spheres)
@@ -146,7 +152,8 @@ std::vector<float> generate(const DensitySpec& spec, int r) {
                     rho = 0.5 + 0.5 * std::sin(2.0 * kPi * param("frequency") * t.x +
                                                param("turbulence") * 2.0 * kPi * turb);
                 } else if (spec.generator == "layers") {
-                    rho = 0.5 + 0.5 * std::cos(2.0 * kPi * param("count") * t[int(param("axis"))]);
+                    rho = 0.5 + 0.5 * std::cos(2.0 * kPi * param("count") *
+                                               t[int(param("axis"))]);
                 }
                 // Quantise the trigonometric generators to 2^-20 so a last-bit
                 // difference of sin/cos between C libraries cannot change the hash.
@@ -184,7 +191,8 @@ std::vector<float> read_nrrd(const std::string& path, glm::ivec3& size) {
         if (it == fields.end()) bad("field '" + name + "' is missing");
         return it->second;
     };
-    if (field("dimension") != "3") bad("field 'dimension': '" + fields["dimension"] + "' (only 3)");
+    if (field("dimension") != "3")
+        bad("field 'dimension': '" + fields["dimension"] + "' (only 3)");
     const std::string type = field("type");
     const bool bytes = type == "uchar" || type == "unsigned char" || type == "uint8" ||
                        type == "uint8_t";
@@ -196,7 +204,8 @@ std::vector<float> read_nrrd(const std::string& path, glm::ivec3& size) {
         if (const std::string e = field("endian"); e != "little")
             bad("field 'endian': '" + e + "' (only little)");
     }
-    if (fields.count("data file")) bad("field 'data file': detached data is not supported");
+    if (fields.count("data file"))
+        bad("field 'data file': detached data is not supported");
     std::istringstream sizes(field("sizes"));
     for (int a = 0; a < 3; ++a) {
         long long s = 0;
@@ -265,7 +274,8 @@ const std::vector<std::string>& density_generator_names() {
 DensitySpec parse_density_spec(std::string_view text) {
     DensitySpec spec;
     if (ends_with(text, ".nrrd") || ends_with(text, ".nhdr")) {
-        if (ends_with(text, ".nhdr")) fail(std::string(text) + ": detached headers (.nhdr) are not supported");
+        if (ends_with(text, ".nhdr"))
+            fail(std::string(text) + ": detached headers (.nhdr) are not supported");
         spec.file = std::string(text);
         return spec;
     }
@@ -275,33 +285,40 @@ DensitySpec parse_density_spec(std::string_view text) {
     if (it == generators().end())
         fail("'" + spec.generator + "' is not a generator (valid: " +
              list_of(density_generator_names()) + ") or an .nrrd file");
-    for (const auto& range : it->second) spec.parameters[range.name] = range.default_value;
+    for (const auto& range : it->second)
+        spec.parameters[range.name] = range.default_value;
     if (colon == std::string_view::npos) return spec;
     std::string_view rest = text.substr(colon + 1);
     while (!rest.empty()) {
         const auto comma = rest.find(',');
         const std::string_view item = rest.substr(0, comma);
-        rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+        rest =
+            comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
         const auto equals = item.find('=');
         const std::string key(item.substr(0, equals));
-        const auto range = std::find_if(it->second.begin(), it->second.end(),
-                                        [&](const ParameterRange& r) { return r.name == key; });
+        const auto range =
+            std::find_if(it->second.begin(), it->second.end(),
+                         [&](const ParameterRange& r) { return r.name == key; });
         if (equals == std::string_view::npos || range == it->second.end()) {
             std::vector<std::string> names;
             for (const auto& r : it->second) names.push_back(r.name);
-            fail(spec.generator + ": '" + std::string(item) + "' is not name=value for a parameter (" +
-                 list_of(names) + ")");
+            fail(spec.generator + ": '" + std::string(item) +
+                 "' is not name=value for a parameter (" + list_of(names) + ")");
         }
         std::string_view value_text = item.substr(equals + 1);
         double value = 0;
-        if (key == "axis" && value_text.size() == 1 && value_text[0] >= 'x' && value_text[0] <= 'z')
+        if (key == "axis" && value_text.size() == 1 && value_text[0] >= 'x' &&
+            value_text[0] <= 'z')
             value = value_text[0] - 'x';
-        else if (!parse_number(value_text, value) || value < range->min || value > range->max)
+        else if (!parse_number(value_text, value) || value < range->min ||
+                 value > range->max)
             fail(spec.generator + ": " + key + " '" + std::string(value_text) +
                  "' is not a number in [" + std::to_string(range->min) + ", " +
                  std::to_string(range->max) + "]");
-        if ((key == "count" || key == "octaves" || key == "seed") && value != std::floor(value))
-            fail(spec.generator + ": " + key + " '" + std::string(value_text) + "' is not a whole number");
+        if ((key == "count" || key == "octaves" || key == "seed") &&
+            value != std::floor(value))
+            fail(spec.generator + ": " + key + " '" + std::string(value_text) +
+                 "' is not a whole number");
         spec.parameters[key] = value;
     }
     return spec;
@@ -315,7 +332,8 @@ double DensityVolume::sample(glm::dvec3 t) const {
     for (int k = 0; k < 8; ++k) {
         const glm::ivec3 d(k & 1, (k >> 1) & 1, k >> 2);
         const glm::ivec3 i = glm::clamp(i0 + d, glm::ivec3(0), size - 1);
-        const double weight = (d.x ? f.x : 1 - f.x) * (d.y ? f.y : 1 - f.y) * (d.z ? f.z : 1 - f.z);
+        const double weight =
+            (d.x ? f.x : 1 - f.x) * (d.y ? f.y : 1 - f.y) * (d.z ? f.z : 1 - f.z);
         sum += weight * voxel(i.x, i.y, i.z);
     }
     return sum;
@@ -341,7 +359,8 @@ DensityVolume finish_density_volume(glm::ivec3 size, std::vector<float> voxels,
 }
 
 std::shared_ptr<const DensityVolume> make_density_volume(std::string_view text,
-                                                         int resolution, double contrast) {
+                                                         int resolution,
+                                                         double contrast) {
     const DensitySpec spec = parse_density_spec(text);
     glm::ivec3 size(resolution);
     std::vector<float> voxels;
@@ -358,8 +377,9 @@ std::shared_ptr<const DensityVolume> make_density_volume(std::string_view text,
         for (float x : voxels) sum += x;
         const float mean = float(sum / double(voxels.size()));
         for (float& x : voxels)
-            x = contrast == 0.0 ? mean
-                                : std::clamp(float(mean + contrast * (x - mean)), 0.0f, 1.0f);
+            x = contrast == 0.0
+                    ? mean
+                    : std::clamp(float(mean + contrast * (x - mean)), 0.0f, 1.0f);
     }
     return std::make_shared<const DensityVolume>(
         finish_density_volume(size, std::move(voxels), std::string(text)));
@@ -382,16 +402,18 @@ std::shared_ptr<const DensityVolume> density_from_knobs(const KnobValues& values
     const double contrast = values.scalar("density_contrast");
     // The last few volumes, so the explorer (a scene per frame) and batch rendering (a
     // scene per stimulus) build each once. A file's key includes its size and time.
-    std::string key = spec + "|" + std::to_string(resolution) + "|" + std::to_string(contrast);
+    std::string key =
+        spec + "|" + std::to_string(resolution) + "|" + std::to_string(contrast);
     if (ends_with(spec, ".nrrd")) {
         std::error_code error;
-        key += "|" + std::to_string(std::filesystem::file_size(spec, error)) + "|" +
-               std::to_string(std::filesystem::last_write_time(spec, error)
-                                  .time_since_epoch()
-                                  .count());
+        key +=
+            "|" + std::to_string(std::filesystem::file_size(spec, error)) + "|" +
+            std::to_string(
+                std::filesystem::last_write_time(spec, error).time_since_epoch().count());
     }
     static std::mutex mutex;
-    static std::vector<std::pair<std::string, std::shared_ptr<const DensityVolume>>> cache;
+    static std::vector<std::pair<std::string, std::shared_ptr<const DensityVolume>>>
+        cache;
     {
         std::lock_guard lock(mutex);
         for (const auto& [k, volume] : cache)

@@ -10,8 +10,8 @@
 //   constant[:value=V]                          rho = V everywhere
 //   cube[:size=S,inside=I,outside=O]            a centred box inclusion (Shopf Fig. 5.8)
 //   spheres[:count=N,radius=R,inside=I,outside=O,seed=K]   jade-like inclusions
-//   marble[:frequency=F,turbulence=A,octaves=N,seed=K]     0.5 + 0.5 sin(2 pi F x + A turb)
-//   layers[:count=N,axis=x|y|z]                 0.5 + 0.5 cos(2 pi N t_axis)
+//   marble[:frequency=F,turbulence=A,octaves=N,seed=K]     0.5 + 0.5 sin(2 pi F x + A
+//   turb) layers[:count=N,axis=x|y|z]                 0.5 + 0.5 cos(2 pi N t_axis)
 //   PATH.nrrd                                   3-D, uchar (/255) or float in [0, 1],
 //                                               raw encoding, little endian
 #include <glm/glm.hpp>
@@ -33,7 +33,7 @@ public:
 };
 
 struct DensityVolume {
-    glm::ivec3 size{1, 1, 1};  // voxels per axis
+    glm::ivec3 size{1, 1, 1};   // voxels per axis
     std::vector<float> voxels;  // x fastest, then y, then z; each in [0, 1]
     std::string spec;           // as given
     std::string content_hash;   // of size and voxels (16 hex digits)

@@ -14,7 +14,8 @@ std::vector<Uniform> mesh_transform_uniforms(const glm::mat4& view,
             {"u_normal_matrix", glm::inverseTranspose(glm::mat3(view))}};
 }
 
-std::vector<Uniform> with_uniforms(std::vector<Uniform> a, const std::vector<Uniform>& b) {
+std::vector<Uniform> with_uniforms(std::vector<Uniform> a,
+                                   const std::vector<Uniform>& b) {
     a.insert(a.end(), b.begin(), b.end());
     return a;
 }
@@ -272,7 +273,9 @@ void PlanBuilder::add(Pass pass) {
 
 void PlanBuilder::set_output(std::string resource) { output_ = std::move(resource); }
 
-void PlanBuilder::also_keep(std::string resource) { also_keep_.push_back(std::move(resource)); }
+void PlanBuilder::also_keep(std::string resource) {
+    also_keep_.push_back(std::move(resource));
+}
 
 FramePlan PlanBuilder::compile() const {
     // Resolve every resource's size and level count.

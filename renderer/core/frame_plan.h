@@ -182,7 +182,7 @@ struct Pass {
     bool clear = true;
     Blend blend = Blend::none;
     FaceCulling cull = FaceCulling::none;  // draw_mesh only
-    DataSource data;  // upload only
+    DataSource data;                       // upload only
 };
 
 enum class PlanMode {

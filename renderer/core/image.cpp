@@ -48,7 +48,8 @@ std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
         return out;
     }
     for (std::size_t i = 0; i < values; ++i)
-        out[i] = static_cast<T>(encode_channel(image.rgba[i / 3 * 4 + i % 3], linear, scale));
+        out[i] =
+            static_cast<T>(encode_channel(image.rgba[i / 3 * 4 + i % 3], linear, scale));
     return out;
 }
 
@@ -115,7 +116,9 @@ std::uint8_t encode_srgb8(const Srgb8Table& table, float v) {
 
 }  // namespace
 
-std::uint8_t srgb_encode_8bit(float linear) { return encode_srgb8(srgb8_table(), linear); }
+std::uint8_t srgb_encode_8bit(float linear) {
+    return encode_srgb8(srgb8_table(), linear);
+}
 
 std::size_t replace_non_finite(Image& image) {
     std::size_t replaced = 0;
@@ -167,7 +170,8 @@ void write_image(const std::filesystem::path& path, const Image& input,
     if (ext == ".exr") {
         OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
         spec.attribute("compression", "zip");
-        spec.attribute("DateTime", "");  // OIIO stamps the time otherwise: same image, other bytes
+        spec.attribute("DateTime",
+                       "");  // OIIO stamps the time otherwise: same image, other bytes
         ok = out->open(temporary.string(), spec) &&
              out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data());
     } else if (ext == ".png") {

@@ -46,7 +46,8 @@ public:
 // bytes on every write), they differ in encoding time and file size.
 enum class PngEncoding {
     fast,     // Paeth filter on every row, zlib run-length strategy
-    compact,  // libpng's defaults: adaptive filters, zlib level 6 (~4x slower, ~15% smaller)
+    compact,  // libpng's defaults: adaptive filters, zlib level 6 (~4x slower, ~15%
+              // smaller)
 };
 
 struct ImageWriteOptions {

@@ -223,7 +223,8 @@ bool bounds_solid_facing_out(const std::vector<glm::vec3>& positions,
     }
     std::sort(edges.begin(), edges.end());
     for (std::size_t i = 0; i < edges.size(); i += 2)
-        if (i + 1 == edges.size() || (edges[i] & 1u) != 0 || edges[i + 1] != (edges[i] | 1u) ||
+        if (i + 1 == edges.size() || (edges[i] & 1u) != 0 ||
+            edges[i + 1] != (edges[i] | 1u) ||
             (i + 2 < edges.size() && edges[i + 2] >> 1 == edges[i] >> 1))
             return false;
     return six_volume > 0.0 && std::isfinite(six_volume);

@@ -268,7 +268,8 @@ Mesh make_hand(std::size_t budget) {
 
 // A sheet of (columns x rows) cells over x, y in [-1, 1]: z = height(x, y) and the uv
 // of each vertex from `uv(x, y)`, two triangles per cell, counter-clockwise from +Z.
-Mesh make_sheet(unsigned columns, unsigned rows, const std::function<double(double, double)>& height,
+Mesh make_sheet(unsigned columns, unsigned rows,
+                const std::function<double(double, double)>& height,
                 const std::function<glm::dvec2(double, double)>& uv) {
     Mesh mesh;
     for (unsigned i = 0; i <= rows; ++i)
@@ -334,12 +335,9 @@ struct Builtin {
     std::size_t default_budget = kDefaultFaceBudget;
     std::size_t min_budget = kMinFaceBudget;
 };
-const Builtin kBuiltins[] = {{"sphere", make_sphere},
-                             {"torus", make_torus},
-                             {"torus_knot", make_torus_knot},
-                             {"hand", make_hand},
-                             {"square", make_square, 2, 2},
-                             {"wave", make_wave, 800, 2},
+const Builtin kBuiltins[] = {{"sphere", make_sphere},         {"torus", make_torus},
+                             {"torus_knot", make_torus_knot}, {"hand", make_hand},
+                             {"square", make_square, 2, 2},   {"wave", make_wave, 800, 2},
                              {"drape", make_drape, 12800, 2}};
 
 const Builtin* find_builtin(const std::string& name) {
@@ -352,7 +350,8 @@ std::size_t parse_face_budget(const std::string& spec, const std::string& text,
                               std::size_t min_budget) {
     const std::string usage = spec +
                               ": face budget must be a whole number like 30000 or 240k, "
-                              "between " + std::to_string(min_budget) + " and 20m";
+                              "between " +
+                              std::to_string(min_budget) + " and 20m";
     std::size_t value = 0;
     const char* end = text.data() + text.size();
     const auto [rest, error] = std::from_chars(text.data(), end, value);

@@ -115,8 +115,8 @@ Mesh clean(const std::string& path, RawMesh raw) {
         with_uvs = std::isfinite(raw.uvs[i].x) && std::isfinite(raw.uvs[i].y);
     for (std::size_t i = 0; i < raw.positions.size(); ++i) {
         const glm::vec2 uv = with_uvs ? raw.uvs[i] : glm::vec2(0.0f);
-        const auto [it, inserted] = welded.try_emplace(key_of(raw.positions[i], uv),
-                                                       static_cast<unsigned>(i));
+        const auto [it, inserted] =
+            welded.try_emplace(key_of(raw.positions[i], uv), static_cast<unsigned>(i));
         representative[i] = it->second;
         if (!inserted && normals_agree &&
             glm::dot(raw.normals[i], raw.normals[it->second]) <

@@ -43,15 +43,16 @@ std::optional<KnobValues> ProgressiveAccumulator::next(const KnobValues& values,
 }
 
 void ProgressiveAccumulator::add(const Image& frame) {
-    if (pending_samples_ <= 0) throw std::logic_error("ProgressiveAccumulator::add without next()");
+    if (pending_samples_ <= 0)
+        throw std::logic_error("ProgressiveAccumulator::add without next()");
     if (frames_ == 0) {
         mean_ = frame;
     } else {
         if (frame.width != mean_.width || frame.height != mean_.height)
             throw std::logic_error("ProgressiveAccumulator::add: frame size changed");
         // Running mean weighted by sample counts: mean += (frame - mean) w / (n + w).
-        const float weight =
-            static_cast<float>(pending_samples_) / static_cast<float>(samples_ + pending_samples_);
+        const float weight = static_cast<float>(pending_samples_) /
+                             static_cast<float>(samples_ + pending_samples_);
         for (std::size_t i = 0; i < mean_.rgba.size(); ++i)
             mean_.rgba[i] += (frame.rgba[i] - mean_.rgba[i]) * weight;
     }

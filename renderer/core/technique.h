@@ -73,7 +73,9 @@ public:
     virtual ProgressiveRefinement progressive_refinement() const { return {}; }
     // The cost comparison of `lucent bench frame --technique NAME`; none: the bench
     // sweeps the first quality knob instead.
-    virtual std::optional<FrameComparison> frame_comparison() const { return std::nullopt; }
+    virtual std::optional<FrameComparison> frame_comparison() const {
+        return std::nullopt;
+    }
 };
 
 // The plan of `scene` under its technique: technique.plan() then compile(), keeping also

@@ -134,8 +134,8 @@ std::vector<float> bake_ambient_occlusion(const Mesh& mesh,
             // Start just above the surface so the vertex's own triangles are not hit.
             const glm::vec3 origin = mesh.positions[v] + offset * normals[v];
             const double t1 = timed ? thread_cpu_seconds() : 0.0;
-            result[v] = float(counter.count_escaping(origin, directions)) /
-                        float(options.rays);
+            result[v] =
+                float(counter.count_escaping(origin, directions)) / float(options.rays);
             if (timed) {
                 const double t2 = thread_cpu_seconds();
                 setup += t1 - t0;

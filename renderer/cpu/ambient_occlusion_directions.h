@@ -21,10 +21,11 @@ public:
     // The directions for vertex `vertex` with unit normal `normal` (all with
     // dot(direction, normal) > 0, never exactly grazing), into `out`. Depends only on
     // (vertex, normal, rays): never on the thread or on the order of calls.
-    void generate(std::size_t vertex, glm::vec3 normal, std::vector<glm::vec3>& out) const;
+    void generate(std::size_t vertex, glm::vec3 normal,
+                  std::vector<glm::vec3>& out) const;
 
 private:
-    std::vector<double> cos_theta_base_;    // (i + 1/2) / N
+    std::vector<double> cos_theta_base_;   // (i + 1/2) / N
     std::vector<glm::dvec2> cos_sin_phi_;  // of 2 pi frac(i / golden ratio)
 };
 

@@ -49,14 +49,14 @@ RTCScene build_scene(RTCDevice device, const Mesh& mesh,
         for (std::size_t i = 0; i < mesh.positions.size(); ++i)
             for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.positions[i][k];
         if (quads) {
-            auto* indices = static_cast<unsigned*>(
-                rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4,
-                                        4 * sizeof(unsigned), quads->size()));
+            auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+                geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4,
+                4 * sizeof(unsigned), quads->size()));
             std::memcpy(indices, quads->data(), quads->size() * sizeof(glm::uvec4));
         } else {
             auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-                geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                mesh.triangles.size()));
+                geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                3 * sizeof(unsigned), mesh.triangles.size()));
             std::memcpy(indices, mesh.triangles.data(),
                         mesh.triangles.size() * sizeof(glm::uvec3));
         }

@@ -93,7 +93,7 @@ OcclusionCounter::OcclusionCounter(const Mesh& mesh, OcclusionScene layout)
     // Quads stored with their vertices in 8-wide nodes (AVX) traced fastest; Embree's
     // robust default stores indices (quad4i), 1.3x slower here. Same answers either way.
     const bool quads = layout == OcclusionScene::paired_quads;
-    impl_->device = embree::new_device(!quads ? nullptr
+    impl_->device = embree::new_device(!quads      ? nullptr
                                        : has_avx() ? "quad_accel=bvh8.quad4v"
                                                    : "quad_accel=bvh4.quad4v");
     if (quads) {
@@ -117,7 +117,8 @@ std::size_t OcclusionCounter::paired_triangles() const { return impl_->paired; }
 std::size_t OcclusionCounter::count_escaping(glm::vec3 origin,
                                              const std::vector<glm::vec3>& directions,
                                              float t_min, OcclusionQuery query) const {
-    if (!embree::finite(origin)) return directions.size();  // an unusable ray hits nothing
+    if (!embree::finite(origin))
+        return directions.size();  // an unusable ray hits nothing
     const embree::FlushDenormals flush;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);  // incoherent: the rays fan out over a hemisphere

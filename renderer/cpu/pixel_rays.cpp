@@ -19,7 +19,8 @@ PixelRays::PixelRays(const Camera& camera, int width, int height)
 
 std::optional<RayHit> PixelRays::front_hit(const RayCaster& caster, glm::dvec3 direction,
                                            int max_hits) const {
-    for (const RayHit& hit : caster.hits(glm::vec3(eye_), glm::vec3(direction), max_hits)) {
+    for (const RayHit& hit :
+         caster.hits(glm::vec3(eye_), glm::vec3(direction), max_hits)) {
         const double z = eye_depth(hit.distance, direction);
         if (z >= near_ && z < far_) return hit;
     }
@@ -30,7 +31,8 @@ glm::dvec3 PixelRays::direction(int x, int row) const {
     return direction_at(x, row, 0.5, 0.5);
 }
 
-glm::dvec3 PixelRays::direction_at(int x, int row, double offset_x, double offset_y) const {
+glm::dvec3 PixelRays::direction_at(int x, int row, double offset_x,
+                                   double offset_y) const {
     const int gl_y = height_ - 1 - row;  // image rows are top first, GL's bottom first
     // Un-project the point's far-plane point and aim at it from the eye (GL y: offset_y
     // counts from the bottom edge of the pixel).
@@ -45,7 +47,8 @@ SurfaceSample interpolate_at(const Mesh& mesh, const RayHit& hit,
     const glm::uvec3 tri = mesh.triangles[hit.triangle];
     const double u = hit.barycentric.x, v = hit.barycentric.y, t = 1.0 - u - v;
     SurfaceSample sample;
-    sample.normal = t * glm::dvec3(mesh.normals[tri.x]) + u * glm::dvec3(mesh.normals[tri.y]) +
+    sample.normal = t * glm::dvec3(mesh.normals[tri.x]) +
+                    u * glm::dvec3(mesh.normals[tri.y]) +
                     v * glm::dvec3(mesh.normals[tri.z]);
     if (!vertex_ao.empty())
         sample.ao = t * vertex_ao[tri.x] + u * vertex_ao[tri.y] + v * vertex_ao[tri.z];
@@ -53,7 +56,8 @@ SurfaceSample interpolate_at(const Mesh& mesh, const RayHit& hit,
 }
 
 void for_each_row_parallel(int height, const std::function<void(int)>& row) {
-    const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int threads =
+        static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     std::vector<std::thread> pool;
     for (int t = 0; t < threads; ++t)
         pool.emplace_back([&, t] {

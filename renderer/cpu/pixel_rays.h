@@ -3,9 +3,8 @@
 // one ray per pixel centre through the scene's camera (image rows top first), the
 // eye-space depth of a hit, vertex attributes interpolated at a hit, and rows rendered
 // in parallel.
-#include <glm/glm.hpp>
-
 #include <functional>
+#include <glm/glm.hpp>
 #include <optional>
 #include <vector>
 

@@ -28,8 +28,9 @@ void ensure_glfw_initialised() {
         if (ok) std::atexit(glfwTerminate);
     });
     if (!ok) {
-        throw ContextError("GLFW (X11/Wayland window): glfwInit failed: " + g_last_glfw_error +
-                           " (no display? run under xvfb-run, or use the headless commands)");
+        throw ContextError(
+            "GLFW (X11/Wayland window): glfwInit failed: " + g_last_glfw_error +
+            " (no display? run under xvfb-run, or use the headless commands)");
     }
 }
 
@@ -68,7 +69,8 @@ std::unique_ptr<WindowContext> create_window_context(const WindowOptions& window
         if (count == 0) throw ContextError(label + ": no monitor is connected");
         if (window.monitor < 0 || window.monitor >= count)
             throw ContextError(label + ": monitor " + std::to_string(window.monitor) +
-                               " does not exist (" + std::to_string(count) + " connected)");
+                               " does not exist (" + std::to_string(count) +
+                               " connected)");
         monitor = monitors[window.monitor];
         const GLFWvidmode* mode = glfwGetVideoMode(monitor);
         width = mode->width;
@@ -93,7 +95,8 @@ std::unique_ptr<WindowContext> create_window_context(const WindowOptions& window
     if (!handle) {
         throw ContextError(label + ": glfwCreateWindow failed for OpenGL " +
                            std::to_string(options.gl_major) + "." +
-                           std::to_string(options.gl_minor) + " core: " + g_last_glfw_error);
+                           std::to_string(options.gl_minor) +
+                           " core: " + g_last_glfw_error);
     }
     glfwMakeContextCurrent(handle);
     glfwSwapInterval(window.vsync ? 1 : 0);

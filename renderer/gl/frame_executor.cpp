@@ -183,8 +183,9 @@ struct FrameExecutor::Impl {
         glVertexArrayAttribBinding(vao, 2, 2);
         if (mesh.has_uvs() && mesh.tangents.size() == mesh.positions.size()) {
             // Texture coordinates (3) and tangents with handedness (4).
-            uvs = make_buffer(mesh.uvs.data(),
-                              static_cast<GLsizeiptr>(mesh.uvs.size() * sizeof(glm::vec2)));
+            uvs =
+                make_buffer(mesh.uvs.data(),
+                            static_cast<GLsizeiptr>(mesh.uvs.size() * sizeof(glm::vec2)));
             tangents = make_buffer(
                 mesh.tangents.data(),
                 static_cast<GLsizeiptr>(mesh.tangents.size() * sizeof(glm::vec4)));

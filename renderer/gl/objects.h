@@ -1,6 +1,7 @@
 #pragma once
 // Move-only owners of OpenGL objects. Raw GLuint names never leave renderer/gl: technique
-// code holds these and passes them to the helpers below. All use direct state access (4.5).
+// code holds these and passes them to the helpers below. All use direct state access
+// (4.5).
 #include <epoxy/gl.h>
 
 #include <utility>

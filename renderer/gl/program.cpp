@@ -71,7 +71,8 @@ std::string shader_source(std::string_view relative_path) {
             return text.str();
         }
     }
-    if (auto text = lucent::embedded::renderer_file(relative_path)) return std::string(*text);
+    if (auto text = lucent::embedded::renderer_file(relative_path))
+        return std::string(*text);
     throw ShaderError("unknown shader '" + std::string(relative_path) + "'");
 }
 
@@ -92,7 +93,8 @@ std::string expand_includes(const std::string& source, std::string_view name, in
             if (end == std::string::npos || depth >= 8)
                 throw ShaderError(std::string(name) + ":" + std::to_string(number) +
                                   ": bad #include");
-            const std::string path = line.substr(directive.size(), end - directive.size());
+            const std::string path =
+                line.substr(directive.size(), end - directive.size());
             out += "#line 1\n" + expand_includes(shader_source(path), path, depth + 1);
             out += "#line " + std::to_string(number + 1) + "\n";
             continue;

@@ -17,8 +17,8 @@ public:
 };
 
 struct ShaderStage {
-    GLenum type;         // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, ...
-    std::string name;    // shown in errors, e.g. "techniques/empirical/shaders/shade.frag"
+    GLenum type;       // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, ...
+    std::string name;  // shown in errors, e.g. "techniques/empirical/shaders/shade.frag"
     std::string source;  // full GLSL text, #version line included
 };
 

@@ -11,7 +11,8 @@ void shade_deferred(PlanBuilder& plan, Pass& lighting, const std::vector<Uniform
     plan.create("surface_normal_eye", ResourceFormat::rgba32f);
     Pass surface{"surface",
                  std::string("nearest surface, once: object position, normal") +
-                     (ambient_occlusion ? ", AO" : "") + (eye_normal ? ", eye normal" : ""),
+                     (ambient_occlusion ? ", AO" : "") +
+                     (eye_normal ? ", eye normal" : ""),
                  PassKind::draw_mesh,
                  {"techniques/dipole/shaders/mesh.vert",
                   "techniques/dipole/shaders/surface.frag",
@@ -34,7 +35,8 @@ void shade_deferred(PlanBuilder& plan, Pass& lighting, const std::vector<Uniform
     lighting.shader.vertex = "gl/shaders/fullscreen.vert";
     lighting.shader.defines.push_back("DEFERRED");
     if (eye_normal) lighting.shader.defines.push_back("WITH_EYE_NORMAL");
-    std::erase_if(lighting.reads, [](const Read& r) { return r.resource == "vertex_ao"; });
+    std::erase_if(lighting.reads,
+                  [](const Read& r) { return r.resource == "vertex_ao"; });
     lighting.reads.push_back({"surface_position", ""});
     lighting.reads.push_back({"surface_normal", ""});
     if (eye_normal) lighting.reads.push_back({"surface_normal_eye", ""});

@@ -15,12 +15,8 @@ const Technique& thick_texture_technique();
 
 const std::vector<const Technique*>& all_techniques() {
     static const std::vector<const Technique*> techniques = {
-        &empirical_technique(),
-        &ward_technique(),
-        &contrast_reversed_technique(),
-        &dipole_technique(),
-        &htsm_technique(),
-        &thick_texture_technique(),
+        &empirical_technique(), &ward_technique(), &contrast_reversed_technique(),
+        &dipole_technique(),    &htsm_technique(), &thick_texture_technique(),
     };
     return techniques;
 }

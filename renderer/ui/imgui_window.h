@@ -27,11 +27,13 @@ public:
 
     gl::WindowContext& context() { return *context_; }
     GLFWwindow* glfw() const { return context_->window(); }
-    void framebuffer_size(int& width, int& height) const { context_->framebuffer_size(width, height); }
+    void framebuffer_size(int& width, int& height) const {
+        context_->framebuffer_size(width, height);
+    }
 
-    void begin_frame();     // polls events, starts an ImGui frame
-    void render_imgui();    // draws the ImGui frame into the back buffer
-    void swap();            // presents the back buffer
+    void begin_frame();   // polls events, starts an ImGui frame
+    void render_imgui();  // draws the ImGui frame into the back buffer
+    void swap();          // presents the back buffer
 
 private:
     std::unique_ptr<gl::WindowContext> context_;

@@ -71,7 +71,8 @@ void knob_widget(ParameterSet& set, const Knob& knob, ExplorerSession& session,
         case KnobKind::text: {
             // Applied on Enter, so a half-typed spec is never rendered.
             char buffer[512];
-            std::snprintf(buffer, sizeof buffer, "%s", std::get<std::string>(value).c_str());
+            std::snprintf(buffer, sizeof buffer, "%s",
+                          std::get<std::string>(value).c_str());
             if (ImGui::InputText(label, buffer, sizeof buffer,
                                  ImGuiInputTextFlags_EnterReturnsTrue)) {
                 value = std::string(buffer);

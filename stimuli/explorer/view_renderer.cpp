@@ -149,8 +149,8 @@ void ViewRenderer::render_side(const ExplorerSession& session,
         const glm::vec3 direction = view_direction(session);
         char view[160];
         std::snprintf(view, sizeof view, "%s %dx%d %.9g,%.9g,%.9g ao=%d",
-                      mesh->content_hash.c_str(), width, height, direction.x,
-                      direction.y, direction.z, session.ambient_occlusion ? 1 : 0);
+                      mesh->content_hash.c_str(), width, height, direction.x, direction.y,
+                      direction.z, session.ambient_occlusion ? 1 : 0);
         const auto knobs = knobs_for(technique);
         const auto seed = std::find_if(knobs.begin(), knobs.end(), [&](const Knob& k) {
             return k.name == refinement.seed_knob;
@@ -160,14 +160,14 @@ void ViewRenderer::render_side(const ExplorerSession& session,
         if (!frame_values && side.valid) return;  // converged: nothing runs
         if (frame_values) values = std::move(*frame_values);
     }
-    Scene scene =
-        make_scene(mesh, technique, std::move(values), width, height, view_direction(session));
+    Scene scene = make_scene(mesh, technique, std::move(values), width, height,
+                             view_direction(session));
     // A depth view keeps the pass that makes its layer even where the image does not
     // need it (a closed mesh's smoothing happens inside `shade`).
     const std::string viewed = buffer_resource(session.buffer_view);
-    FramePlan plan = make_frame_plan(scene, technique, PlanMode::pruned,
-                                     viewed.empty() ? std::vector<std::string>{}
-                                                    : std::vector<std::string>{viewed});
+    FramePlan plan = make_frame_plan(
+        scene, technique, PlanMode::pruned,
+        viewed.empty() ? std::vector<std::string>{} : std::vector<std::string>{viewed});
     // The scene is published first: the AO source looks the mesh up through it.
     const Scene previous = std::move(side.scene);
     side.scene = scene;
@@ -195,7 +195,8 @@ void ViewRenderer::render_side(const ExplorerSession& session,
     side.image = shading.read_output(plan);
     ++side.read_backs;
     replace_non_finite(side.image);
-    if (side.refinement && side.refinement->target() > 0 && !side.refinement->converged()) {
+    if (side.refinement && side.refinement->target() > 0 &&
+        !side.refinement->converged()) {
         side.refinement->add(side.image);
         side.image = side.refinement->mean();
     }

@@ -4,14 +4,14 @@
 // `lucent render`, or a debug view of an intermediate buffer. Results are uploaded to
 // 8-bit sRGB textures for display. Needs the window's GL context to be current.
 #include <map>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/frame_plan.h"
-#include "core/progressive.h"
 #include "core/image.h"
+#include "core/progressive.h"
 #include "core/scene.h"
 #include "explorer/ao_bakes.h"
 #include "explorer/session.h"

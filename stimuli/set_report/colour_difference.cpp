@@ -54,8 +54,8 @@ std::vector<Lab> SrgbToLab::convert(std::span<const float> rgb) const {
     constexpr std::size_t kChunk = 1 << 20;
     for (std::size_t start = 0; start < pixels; start += kChunk) {
         const std::size_t n = std::min(kChunk, pixels - start);
-        cmsDoTransform(handles_->transform, clamped.data() + start * 3, xyz.data() + start,
-                       cmsUInt32Number(n));
+        cmsDoTransform(handles_->transform, clamped.data() + start * 3,
+                       xyz.data() + start, cmsUInt32Number(n));
     }
     std::vector<Lab> out(pixels);
     for (std::size_t i = 0; i < pixels; ++i) {
@@ -74,7 +74,8 @@ double ciede2000(const Lab& first, const Lab& second) {
     return std::isfinite(difference) ? difference : 0.0;
 }
 
-DeltaEStatistics delta_e_statistics(std::span<const Lab> first, std::span<const Lab> second,
+DeltaEStatistics delta_e_statistics(std::span<const Lab> first,
+                                    std::span<const Lab> second,
                                     std::span<const std::uint8_t> mask) {
     if (first.size() != second.size() || first.size() != mask.size())
         throw std::invalid_argument("delta_e_statistics: images of different sizes");

@@ -1,8 +1,8 @@
 #pragma once
 // Perceptual colour differences between two displayed images (sRGB as shown on screen):
 // each pixel to CIELAB through littleCMS (its built-in sRGB profile to XYZ, adapted to
-// D65 with littleCMS's Bradford transform, Lab relative to D65), CIEDE2000 per pixel (littleCMS's cmsCIE2000DeltaE,
-// kL = kC = kH = 1), summarised over the object's pixels.
+// D65 with littleCMS's Bradford transform, Lab relative to D65), CIEDE2000 per pixel
+// (littleCMS's cmsCIE2000DeltaE, kL = kC = kH = 1), summarised over the object's pixels.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -38,14 +38,15 @@ private:
 
 // Delta E00 over the pixels where `mask` is non-zero (both images the same size).
 struct DeltaEStatistics {
-    std::size_t pixels = 0;       // pixels compared
-    double mean = 0.0;            // mean Delta E00 (0 without pixels)
-    double percentile_95 = 0.0;   // nearest-rank 95th percentile
-    double share_above_1 = 0.0;   // fraction of pixels with Delta E00 > 1
+    std::size_t pixels = 0;      // pixels compared
+    double mean = 0.0;           // mean Delta E00 (0 without pixels)
+    double percentile_95 = 0.0;  // nearest-rank 95th percentile
+    double share_above_1 = 0.0;  // fraction of pixels with Delta E00 > 1
     double max = 0.0;
 };
 // Throws std::invalid_argument when the sizes disagree.
-DeltaEStatistics delta_e_statistics(std::span<const Lab> first, std::span<const Lab> second,
+DeltaEStatistics delta_e_statistics(std::span<const Lab> first,
+                                    std::span<const Lab> second,
                                     std::span<const std::uint8_t> mask);
 
 }  // namespace lucent::stimuli

@@ -53,17 +53,20 @@ void draw_text(OIIO::ImageBuf& sheet, int x, int y, int width, int height,
 
 }  // namespace
 
-Thumbnail make_thumbnail(const std::vector<float>& rgb, int width, int height, int max_side) {
+Thumbnail make_thumbnail(const std::vector<float>& rgb, int width, int height,
+                         int max_side) {
     Thumbnail out;
     if (width <= 0 || height <= 0) return out;
-    const double scale = std::min(1.0, double(max_side) / double(std::max(width, height)));
+    const double scale =
+        std::min(1.0, double(max_side) / double(std::max(width, height)));
     out.width = std::max(1, int(std::lround(width * scale)));
     out.height = std::max(1, int(std::lround(height * scale)));
     out.rgb.assign(std::size_t(out.width) * out.height * 3, 0.0f);
     for (int ty = 0; ty < out.height; ++ty)
         for (int tx = 0; tx < out.width; ++tx) {
             // The source pixels this thumbnail pixel covers (at least one).
-            const int x0 = tx * width / out.width, x1 = std::max(x0 + 1, (tx + 1) * width / out.width);
+            const int x0 = tx * width / out.width,
+                      x1 = std::max(x0 + 1, (tx + 1) * width / out.width);
             const int y0 = ty * height / out.height,
                       y1 = std::max(y0 + 1, (ty + 1) * height / out.height);
             double sum[3] = {0, 0, 0};
@@ -88,10 +91,11 @@ void write_contact_sheet(const std::filesystem::path& file,
                          const std::vector<ContactSheetGroup>& groups) {
     const auto font = contact_sheet_font();
     if (font.empty())
-        throw std::runtime_error(file.string() +
-                                 ": no font to label the contact sheet "
-                                 "(/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf, Debian "
-                                 "package fonts-dejavu-core)");
+        throw std::runtime_error(
+            file.string() +
+            ": no font to label the contact sheet "
+            "(/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf, Debian "
+            "package fonts-dejavu-core)");
     const int cell_w = kThumbnailSide + kPadding;
     const int cell_h = kThumbnailSide + kLabelLines * kLineHeight + kPadding;
     std::size_t widest = 1;
@@ -101,7 +105,8 @@ void write_contact_sheet(const std::filesystem::path& file,
         widest = std::max(widest, std::min<std::size_t>(n, kPerRow));
         height += kHeadingHeight + int((n + kPerRow - 1) / kPerRow) * cell_h;
     }
-    // Wide enough for the cells and, roughly (10 px a character at size 17), the headings.
+    // Wide enough for the cells and, roughly (10 px a character at size 17), the
+    // headings.
     int width = kPadding + int(widest) * cell_w;
     for (const auto& group : groups)
         width = std::max(width, 2 * kPadding + 10 * int(group.heading.size()));
@@ -109,8 +114,8 @@ void write_contact_sheet(const std::filesystem::path& file,
 
     int y = kPadding;
     for (const auto& group : groups) {
-        draw_text(sheet, kPadding, y, width - 2 * kPadding, kHeadingHeight, group.heading, 17,
-                  font);
+        draw_text(sheet, kPadding, y, width - 2 * kPadding, kHeadingHeight, group.heading,
+                  17, font);
         y += kHeadingHeight;
         for (std::size_t i = 0; i < group.cells.size(); ++i) {
             const int x = kPadding + int(i % kPerRow) * cell_w;
@@ -124,9 +129,11 @@ void write_contact_sheet(const std::filesystem::path& file,
                         sheet.setpixel(ox + tx, oy + ty,
                                        &t->rgb[(std::size_t(ty) * t->width + tx) * 3], 3);
             }
-            for (int line = 0; line < kLabelLines && line < int(cell.label.size()); ++line)
+            for (int line = 0; line < kLabelLines && line < int(cell.label.size());
+                 ++line)
                 draw_text(sheet, x, top + kThumbnailSide + line * kLineHeight,
-                          kThumbnailSide, kLineHeight, cell.label[std::size_t(line)], 12, font);
+                          kThumbnailSide, kLineHeight, cell.label[std::size_t(line)], 12,
+                          font);
         }
         y += int((std::max<std::size_t>(group.cells.size(), 1) + kPerRow - 1) / kPerRow) *
              cell_h;
@@ -138,7 +145,8 @@ void write_contact_sheet(const std::filesystem::path& file,
     sheet.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
                      pixels.data());
     for (std::size_t i = 0, n = std::size_t(width) * height; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) image.rgba[i * 4 + c] = srgb_decode(pixels[i * 3 + c]);
+        for (int c = 0; c < 3; ++c)
+            image.rgba[i * 4 + c] = srgb_decode(pixels[i * 3 + c]);
         image.rgba[i * 4 + 3] = 1.0f;
     }
     write_image(file, image);
@@ -150,7 +158,8 @@ std::string thumbnail_png(const Thumbnail& thumbnail) {
                       ("lucent-thumbnail-" + std::to_string(getpid()) + "-" +
                        std::to_string(counter++) + ".png");
     Image image(thumbnail.width, thumbnail.height);
-    for (std::size_t i = 0, n = std::size_t(thumbnail.width) * thumbnail.height; i < n; ++i) {
+    for (std::size_t i = 0, n = std::size_t(thumbnail.width) * thumbnail.height; i < n;
+         ++i) {
         for (int c = 0; c < 3; ++c)
             image.rgba[i * 4 + c] = srgb_decode(thumbnail.rgb[i * 3 + c]);
         image.rgba[i * 4 + 3] = 1.0f;

@@ -16,7 +16,8 @@ struct Thumbnail {
 };
 
 // Box-filters `rgb` (width x height, 3 values per pixel) to fit in max_side x max_side.
-Thumbnail make_thumbnail(const std::vector<float>& rgb, int width, int height, int max_side);
+Thumbnail make_thumbnail(const std::vector<float>& rgb, int width, int height,
+                         int max_side);
 
 struct ContactSheetCell {
     const Thumbnail* thumbnail = nullptr;

@@ -22,11 +22,11 @@
 #include "core/progress.h"
 #include "manifest.h"
 #include "output_file.h"
-#include "set_report/contact_sheet.h"
 #include "report/html_page.h"
 #include "report/report.h"
-#include "set_report/ssim.h"
 #include "report/svg_plot.h"
+#include "set_report/contact_sheet.h"
+#include "set_report/ssim.h"
 
 namespace lucent::stimuli {
 namespace {
@@ -38,14 +38,16 @@ constexpr int kThumbnailSide = 160;
 
 [[noreturn]] void fail(const std::string& message) { throw SetReportError(message); }
 
-std::string cell(const std::map<std::string, std::string>& row, const std::string& column) {
+std::string cell(const std::map<std::string, std::string>& row,
+                 const std::string& column) {
     const auto it = row.find(column);
     return it == row.end() ? std::string() : it->second;
 }
 
 std::optional<double> number(const std::string& text) {
     double value = 0.0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    const auto [end, error] =
+        std::from_chars(text.data(), text.data() + text.size(), value);
     if (error != std::errc() || end != text.data() + text.size() || text.empty() ||
         !std::isfinite(value))
         return std::nullopt;
@@ -80,11 +82,13 @@ struct ManifestTable {
 ManifestTable read_manifest_strictly(const fs::path& directory) {
     std::error_code error;
     if (!fs::is_directory(directory, error))
-        fail(directory.string() + ": not a directory (give the --out DIR of 'lucent render')");
+        fail(directory.string() +
+             ": not a directory (give the --out DIR of 'lucent render')");
     const fs::path file = directory / "manifest.csv";
     if (!fs::is_regular_file(file, error))
         fail(file.string() +
-             ": missing: not a Lucent stimulus set ('lucent render CONFIG --out DIR' writes "
+             ": missing: not a Lucent stimulus set ('lucent render CONFIG --out DIR' "
+             "writes "
              "one)");
     std::ifstream in(file, std::ios::binary);
     std::string line;
@@ -146,7 +150,8 @@ std::vector<fs::path> checked_files(const fs::path& directory,
     }
     if (hasher.hex() != cell(row, "content_hash")) {
         std::string names;
-        for (const auto& path : files) names += (names.empty() ? "" : ", ") + path.string();
+        for (const auto& path : files)
+            names += (names.empty() ? "" : ", ") + path.string();
         fail(names + ": changed since " + manifest + " was written (content hash " +
              hasher.hex() + ", listed " + cell(row, "content_hash") + ")");
     }
@@ -281,11 +286,12 @@ void build_series(SetReport& report, const std::vector<std::string>& header) {
             for (std::size_t m : series.members)
                 numeric &= number(cell(report.stimuli[m].cells, column)).has_value();
             if (numeric)
-                std::stable_sort(series.members.begin(), series.members.end(),
-                                 [&](std::size_t a, std::size_t b) {
-                                     return *number(cell(report.stimuli[a].cells, column)) <
-                                            *number(cell(report.stimuli[b].cells, column));
-                                 });
+                std::stable_sort(
+                    series.members.begin(), series.members.end(),
+                    [&](std::size_t a, std::size_t b) {
+                        return *number(cell(report.stimuli[a].cells, column)) <
+                               *number(cell(report.stimuli[b].cells, column));
+                    });
         }
         for (std::size_t m : series.members) {
             std::string level;
@@ -311,8 +317,8 @@ std::vector<std::pair<std::size_t, std::size_t>> all_pairs(std::size_t n) {
 // each level and the next; and where several parameters vary (a grid), for each of them
 // the levels that share every other varying value, ordered by that parameter (by value
 // when all are numbers, else in level order), each with the next. O(n log n) pairs.
-std::vector<std::pair<std::size_t, std::size_t>> neighbour_pairs(const SetReport& report,
-                                                                 const ReportSeries& series) {
+std::vector<std::pair<std::size_t, std::size_t>> neighbour_pairs(
+    const SetReport& report, const ReportSeries& series) {
     const std::size_t n = series.members.size();
     std::set<std::pair<std::size_t, std::size_t>> pairs;
     for (std::size_t a = 0; a + 1 < n; ++a) pairs.emplace(a, a + 1);
@@ -334,12 +340,16 @@ std::vector<std::pair<std::size_t, std::size_t>> neighbour_pairs(const SetReport
                                            column))
                                    .has_value();
                 if (numeric)
-                    std::stable_sort(line.begin(), line.end(), [&](std::size_t a, std::size_t b) {
-                        return *number(cell(report.stimuli[series.members[a]].cells, column)) <
-                               *number(cell(report.stimuli[series.members[b]].cells, column));
-                    });
+                    std::stable_sort(
+                        line.begin(), line.end(), [&](std::size_t a, std::size_t b) {
+                            return *number(cell(report.stimuli[series.members[a]].cells,
+                                                column)) <
+                                   *number(cell(report.stimuli[series.members[b]].cells,
+                                                column));
+                        });
                 for (std::size_t k = 0; k + 1 < line.size(); ++k)
-                    pairs.emplace(std::min(line[k], line[k + 1]), std::max(line[k], line[k + 1]));
+                    pairs.emplace(std::min(line[k], line[k + 1]),
+                                  std::max(line[k], line[k + 1]));
             }
         }
     }
@@ -349,19 +359,22 @@ std::vector<std::pair<std::size_t, std::size_t>> neighbour_pairs(const SetReport
 std::string set_name_of(const fs::path& directory) {
     // manifest.json's "set" value; the folder's name when it has none.
     std::ifstream in(directory / "manifest.json", std::ios::binary);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string text((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
     const std::string key = "\"set\": \"";
     const auto start = text.find(key);
     if (start != std::string::npos) {
         const auto end = text.find('"', start + key.size());
-        if (end != std::string::npos) return text.substr(start + key.size(), end - start - key.size());
+        if (end != std::string::npos)
+            return text.substr(start + key.size(), end - start - key.size());
     }
     return fs::absolute(directory).lexically_normal().filename().string();
 }
 
 }  // namespace
 
-SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions& options) {
+SetReport measure_stimulus_set(const fs::path& directory,
+                               const SetReportOptions& options) {
     if (!(options.min_delta_e >= 0.0) || !std::isfinite(options.min_delta_e))
         fail("--min-delta-e: " + std::to_string(options.min_delta_e) +
              " is not a non-negative number");
@@ -373,11 +386,17 @@ SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions
 
     // Every listed file first, so that a bad set is refused before any decoding.
     std::vector<fs::path> images;
-    for (const auto& row : table.rows) images.push_back(displayed_file(checked_files(directory, row)));
+    for (const auto& row : table.rows)
+        images.push_back(displayed_file(checked_files(directory, row)));
     for (std::size_t i = 0; i < table.rows.size(); ++i) {
         const auto& row = table.rows[i];
-        report.stimuli.push_back({cell(row, "id"), cell(row, "technique"), cell(row, "series"),
-                                  images[i], row, "", {}});
+        report.stimuli.push_back({cell(row, "id"),
+                                  cell(row, "technique"),
+                                  cell(row, "series"),
+                                  images[i],
+                                  row,
+                                  "",
+                                  {}});
     }
     build_series(report, table.header);
 
@@ -403,7 +422,8 @@ SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions
         const std::size_t n = series.members.size();
         series.pairs_possible = n * (n - 1) / 2;
         series.all_pairs = n <= options.all_pairs_up_to;
-        compared.push_back(series.all_pairs ? all_pairs(n) : neighbour_pairs(report, series));
+        compared.push_back(series.all_pairs ? all_pairs(n)
+                                            : neighbour_pairs(report, series));
         total_pairs += compared.back().size();
     }
     std::size_t pairs_done = 0;
@@ -415,10 +435,13 @@ SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions
         // its later member) and released after its last pair: a grid compared on
         // neighbours holds about one row of measurements, not the whole series.
         std::vector<std::size_t> last_use(n, 0);
-        std::vector<std::vector<std::size_t>> ending_at(n);  // pairs by their later member
+        std::vector<std::vector<std::size_t>> ending_at(
+            n);  // pairs by their later member
         for (std::size_t k = 0; k < pairs.size(); ++k) {
-            last_use[pairs[k].first] = std::max(last_use[pairs[k].first], pairs[k].second);
-            last_use[pairs[k].second] = std::max(last_use[pairs[k].second], pairs[k].second);
+            last_use[pairs[k].first] =
+                std::max(last_use[pairs[k].first], pairs[k].second);
+            last_use[pairs[k].second] =
+                std::max(last_use[pairs[k].second], pairs[k].second);
             ending_at[pairs[k].second].push_back(k);
         }
         std::vector<std::optional<Measured>> measured(n);
@@ -441,14 +464,16 @@ SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions
                 pair.first = series.members[a];
                 pair.second = series.members[b];
                 pair.adjacent = !series.all_pairs || b == a + 1;
-                const std::string names = "series '" + series.name + "': " +
-                                          report.stimuli[pair.first].id + " vs " +
+                const std::string names = "series '" + series.name +
+                                          "': " + report.stimuli[pair.first].id + " vs " +
                                           report.stimuli[pair.second].id;
                 if (x.displayed.width != y.displayed.width ||
                     x.displayed.height != y.displayed.height) {
-                    outcomes[k].warning = names + ": images of different sizes, not compared";
+                    outcomes[k].warning =
+                        names + ": images of different sizes, not compared";
                 } else {
-                    // Object pixels of either image: a level that grows the object counts.
+                    // Object pixels of either image: a level that grows the object
+                    // counts.
                     std::vector<std::uint8_t> mask(x.displayed.mask.size());
                     for (std::size_t i = 0; i < mask.size(); ++i)
                         mask[i] = x.displayed.mask[i] || y.displayed.mask[i];
@@ -478,7 +503,8 @@ SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions
 
     // Identical pictures anywhere in the set: each stimulus is meant to be its own image.
     std::map<std::string, std::vector<std::size_t>> by_pixels;
-    for (std::size_t i = 0; i < report.stimuli.size(); ++i) by_pixels[pixel_hashes[i]].push_back(i);
+    for (std::size_t i = 0; i < report.stimuli.size(); ++i)
+        by_pixels[pixel_hashes[i]].push_back(i);
     std::vector<std::vector<std::size_t>> groups;
     for (auto& [hash, members] : by_pixels)
         if (members.size() > 1) groups.push_back(members);
@@ -486,10 +512,12 @@ SetReport measure_stimulus_set(const fs::path& directory, const SetReportOptions
     for (const auto& members : groups) {
         std::string names;
         for (std::size_t k = 0; k < members.size(); ++k)
-            names += std::string(k == 0 ? "" : k + 1 == members.size() ? " and " : ", ") +
+            names += std::string(k == 0                    ? ""
+                                 : k + 1 == members.size() ? " and "
+                                                           : ", ") +
                      report.stimuli[members[k]].id;
-        report.warnings.push_back(names +
-                                  " are identical images (separate stimuli, meant to differ)");
+        report.warnings.push_back(
+            names + " are identical images (separate stimuli, meant to differ)");
     }
     return report;
 }
@@ -512,7 +540,8 @@ std::vector<std::string> label_of(const ReportStimulus& s) {
 }
 
 // The groups of the sheet: each series in level order, then the stimuli of none.
-std::vector<std::pair<std::string, std::vector<std::size_t>>> sheet_groups(const SetReport& r) {
+std::vector<std::pair<std::string, std::vector<std::size_t>>> sheet_groups(
+    const SetReport& r) {
     std::vector<std::pair<std::string, std::vector<std::size_t>>> groups;
     std::vector<bool> placed(r.stimuli.size(), false);
     for (const auto& series : r.series) {
@@ -529,7 +558,8 @@ std::vector<std::pair<std::string, std::vector<std::size_t>>> sheet_groups(const
     std::vector<std::size_t> rest;
     for (std::size_t i = 0; i < r.stimuli.size(); ++i)
         if (!placed[i]) rest.push_back(i);
-    if (!rest.empty()) groups.emplace_back(r.series.empty() ? "stimuli" : "other stimuli", rest);
+    if (!rest.empty())
+        groups.emplace_back(r.series.empty() ? "stimuli" : "other stimuli", rest);
     return groups;
 }
 
@@ -559,15 +589,19 @@ void write_html(std::ostream& out, const SetReport& r) {
         << "figure img{background:#292929;display:block}"
         << "figcaption{font-size:.8em;overflow-wrap:anywhere}"
         << "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;"
-        << "padding:.2em .5em;text-align:right}td:first-child,th:first-child{text-align:left}"
+        << "padding:.2em "
+           ".5em;text-align:right}td:first-child,th:first-child{text-align:left}"
         << ".warn{color:#a00}.plots svg{margin:.2em}</style>\n"
         // Marks the page once every picture has decoded, for headless-browser checks.
         << analysis::images_drawn_script() << "</head><body>\n";
     out << "<h1>Stimulus set " << markup_escape(r.set_name) << "</h1>\n<p>"
         << r.stimuli.size() << " stimuli from <code>"
-        << markup_escape((r.directory / "manifest.csv").string()) << "</code>, rendered by lucent "
-        << markup_escape(cell(r.stimuli.front().cells, "software_version")) << ". Differences "
-        << "are CIEDE2000 between the images as displayed (sRGB, littleCMS) over the pixels "
+        << markup_escape((r.directory / "manifest.csv").string())
+        << "</code>, rendered by lucent "
+        << markup_escape(cell(r.stimuli.front().cells, "software_version"))
+        << ". Differences "
+        << "are CIEDE2000 between the images as displayed (sRGB, littleCMS) over the "
+           "pixels "
         << "of either object, and SSIM of luminance (11x11 Gaussian window).</p>\n";
 
     out << "<h2>Warnings</h2>\n";
@@ -576,11 +610,13 @@ void write_html(std::ostream& out, const SetReport& r) {
             << fixed(r.min_delta_e, 2) << " and no two stimuli are the same image.</p>\n";
     else {
         out << "<ul>\n";
-        for (const auto& w : r.warnings) out << "<li class=\"warn\">" << markup_escape(w) << "</li>\n";
+        for (const auto& w : r.warnings)
+            out << "<li class=\"warn\">" << markup_escape(w) << "</li>\n";
         out << "</ul>\n";
     }
 
-    out << "<h2>Contact sheet</h2>\n<p>Also as <a href=\"contact-sheet.png\">contact-sheet.png"
+    out << "<h2>Contact sheet</h2>\n<p>Also as <a "
+           "href=\"contact-sheet.png\">contact-sheet.png"
         << "</a>.</p>\n";
     for (const auto& [heading, members] : sheet_groups(r)) {
         out << "<h3>" << markup_escape(heading) << "</h3>\n<div>";
@@ -589,10 +625,12 @@ void write_html(std::ostream& out, const SetReport& r) {
             out << "<figure><img width=\"" << s.thumbnail.width << "\" height=\""
                 << s.thumbnail.height << "\" alt=\"" << markup_escape(s.id)
                 << "\" src=\"data:image/png;base64,"
-                << analysis::base64_encode(thumbnail_png(s.thumbnail)) << "\"><figcaption>";
+                << analysis::base64_encode(thumbnail_png(s.thumbnail))
+                << "\"><figcaption>";
             const auto lines = label_of(s);
             for (std::size_t k = 0; k < lines.size(); ++k)
-                out << (k ? "<br>" : "<b>") << markup_escape(lines[k]) << (k ? "" : "</b>");
+                out << (k ? "<br>" : "<b>") << markup_escape(lines[k])
+                    << (k ? "" : "</b>");
             out << "</figcaption></figure>";
         }
         out << "</div>\n";
@@ -600,14 +638,16 @@ void write_html(std::ostream& out, const SetReport& r) {
 
     out << "<h2>Differences between levels</h2>\n";
     if (r.series.empty())
-        out << "<p>The manifest names no factor series (column <code>series</code>).</p>\n";
+        out << "<p>The manifest names no factor series (column "
+               "<code>series</code>).</p>\n";
     for (const auto& series : r.series) {
         out << "<h3>Series " << markup_escape(series.name) << "</h3>\n";
         if (!series.all_pairs) {
             std::size_t compared = 0;
             for (const auto& p : r.pairs) compared += p.series == series.name;
-            out << "<p>" << series.members.size() << " levels: neighbouring levels compared ("
-                << compared << " of " << series.pairs_possible
+            out << "<p>" << series.members.size()
+                << " levels: neighbouring levels compared (" << compared << " of "
+                << series.pairs_possible
                 << " pairs): each level and the next, and where several parameters vary, "
                 << "the next value of each with the others equal.</p>\n";
         }
@@ -618,14 +658,18 @@ void write_html(std::ostream& out, const SetReport& r) {
             if (p.series != series.name) continue;
             const auto &a = r.stimuli[p.first], &b = r.stimuli[p.second];
             const bool low = p.delta_e.mean < r.min_delta_e;
-            out << "<tr" << (low ? " class=\"warn\"" : "") << "><td>" << markup_escape(a.id)
-                << " vs " << markup_escape(b.id) << (p.adjacent ? " (adjacent)" : "")
-                << "</td><td>" << markup_escape(a.level) << " / " << markup_escape(b.level)
+            out << "<tr" << (low ? " class=\"warn\"" : "") << "><td>"
+                << markup_escape(a.id) << " vs " << markup_escape(b.id)
+                << (p.adjacent ? " (adjacent)" : "") << "</td><td>"
+                << markup_escape(a.level) << " / " << markup_escape(b.level)
                 << "</td><td>" << fixed(p.delta_e.mean, 2) << "</td><td>"
                 << fixed(p.delta_e.percentile_95, 2) << "</td><td>"
-                << fixed(100.0 * p.delta_e.share_above_1, 1) << "%</td><td>" << fixed(p.ssim, 4)
-                << "</td><td>" << p.delta_e.pixels << "</td><td>"
-                << (p.identical ? "identical" : low ? "below threshold" : "") << "</td></tr>\n";
+                << fixed(100.0 * p.delta_e.share_above_1, 1) << "%</td><td>"
+                << fixed(p.ssim, 4) << "</td><td>" << p.delta_e.pixels << "</td><td>"
+                << (p.identical ? "identical"
+                    : low       ? "below threshold"
+                                : "")
+                << "</td></tr>\n";
         }
         out << "</table>\n<div class=\"plots\">";
         // Tick labels: the value of the one varying parameter, else the technique, else
@@ -649,24 +693,27 @@ void write_html(std::ostream& out, const SetReport& r) {
                  {"skewness", "skewness"},
                  {"saturation_intensity_correlation", "saturation-intensity r"}}) {
             std::vector<double> values;
-            for (std::size_t m : series.members) values.push_back(statistic(r.stimuli[m], column));
+            for (std::size_t m : series.members)
+                values.push_back(statistic(r.stimuli[m], column));
             out << analysis::level_values_svg(title, levels, values, axis);
         }
         out << "</div>\n";
     }
 
-    out << "<h2>Image statistics per stimulus</h2>\n<p>From the manifest: over the object's "
+    out << "<h2>Image statistics per stimulus</h2>\n<p>From the manifest: over the "
+           "object's "
         << "pixels of the linear image (stimuli/README.md).</p>\n";
     out << "<table><tr><th>stimulus</th><th>object pixels</th><th>mean luminance</th>"
         << "<th>RMS contrast</th><th>skewness</th><th>saturation-intensity r</th>"
         << "<th>luminance histogram</th></tr>\n";
     for (const auto& s : r.stimuli) {
-        out << "<tr><td>" << markup_escape(s.id) << "</td><td>" << markup_escape(cell(s.cells, "object_pixels"))
-            << "</td>";
+        out << "<tr><td>" << markup_escape(s.id) << "</td><td>"
+            << markup_escape(cell(s.cells, "object_pixels")) << "</td>";
         for (const char* column : {"mean_luminance", "rms_contrast", "skewness",
                                    "saturation_intensity_correlation"})
             out << "<td>" << fixed(statistic(s, column), 3) << "</td>";
-        out << "<td>" << analysis::histogram_svg(s.id, histogram_shares(s)) << "</td></tr>\n";
+        out << "<td>" << analysis::histogram_svg(s.id, histogram_shares(s))
+            << "</td></tr>\n";
     }
     out << "</table>\n</body></html>\n";
 }
@@ -677,7 +724,8 @@ std::vector<fs::path> write_set_report(const SetReport& report) {
     const fs::path html = report.directory / "report.html";
     const fs::path sheet = report.directory / "contact-sheet.png";
     if (contact_sheet_font().empty())
-        fail(sheet.string() + ": no font to label the contact sheet "
+        fail(sheet.string() +
+             ": no font to label the contact sheet "
              "(/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf, Debian package "
              "fonts-dejavu-core)");
     std::vector<fs::path> inputs = {report.directory / "manifest.csv",
@@ -693,11 +741,13 @@ std::vector<fs::path> write_set_report(const SetReport& report) {
     for (const auto& [heading, members] : sheet_groups(report)) {
         ContactSheetGroup group{heading, {}};
         for (std::size_t m : members)
-            group.cells.push_back({&report.stimuli[m].thumbnail, label_of(report.stimuli[m])});
+            group.cells.push_back(
+                {&report.stimuli[m].thumbnail, label_of(report.stimuli[m])});
         groups.push_back(std::move(group));
     }
     write_contact_sheet(sheet, groups);
-    output::write_file_atomically(html, true, [&](std::ostream& out) { write_html(out, report); });
+    output::write_file_atomically(html, true,
+                                  [&](std::ostream& out) { write_html(out, report); });
     return {html, sheet};
 }
 
@@ -734,7 +784,8 @@ int run_stimuli_report(const fs::path& directory, const SetReportOptions& option
     for (const auto& warning : report.warnings)
         std::cerr << command << ": warning: " << warning << "\n";
     try {
-        for (const auto& file : write_set_report(report)) std::cout << "wrote " << file.string() << "\n";
+        for (const auto& file : write_set_report(report))
+            std::cout << "wrote " << file.string() << "\n";
     } catch (const SetReportError& e) {
         std::cerr << command << ": " << e.what() << "\n";
         return 2;

@@ -45,16 +45,16 @@ struct ReportStimulus {
     std::string id, technique, series;
     std::filesystem::path image;  // the file measured (PNG first: what is displayed)
     std::map<std::string, std::string> cells;  // every manifest column
-    std::string level;  // the series' varying parameters, e.g. "thickness_exponent=18"
+    std::string level;    // the series' varying parameters, e.g. "thickness_exponent=18"
     Thumbnail thumbnail;  // for the contact sheet and the page
 };
 
 // A factor series: the manifest's `series` column, members in level order.
 struct ReportSeries {
     std::string name;
-    std::vector<std::string> varying;        // the columns whose values differ
-    std::vector<std::size_t> members;        // indices into SetReport::stimuli
-    bool all_pairs = true;        // false: neighbouring levels only (all_pairs_up_to)
+    std::vector<std::string> varying;  // the columns whose values differ
+    std::vector<std::size_t> members;  // indices into SetReport::stimuli
+    bool all_pairs = true;           // false: neighbouring levels only (all_pairs_up_to)
     std::size_t pairs_possible = 0;  // every pair of its levels: n (n - 1) / 2
 };
 
@@ -74,9 +74,10 @@ struct SetReport {
     std::filesystem::path directory;
     double min_delta_e = 3.0;
     std::vector<ReportStimulus> stimuli;  // manifest order
-    std::vector<ReportSeries> series;     // first-seen order; stimuli without one are left out
-    std::vector<PairDifference> pairs;    // per series, (i, j) with i < j in level order
-    std::vector<std::string> warnings;    // one line each
+    std::vector<ReportSeries>
+        series;  // first-seen order; stimuli without one are left out
+    std::vector<PairDifference> pairs;  // per series, (i, j) with i < j in level order
+    std::vector<std::string> warnings;  // one line each
 };
 
 // Reads and measures; writes nothing. Throws SetReportError.
@@ -92,7 +93,8 @@ std::vector<std::filesystem::path> write_set_report(const SetReport& report);
 // ("lucent stimuli report: warning: ..."), writes, prints the files. Returns 0, 2 for a
 // directory that is not a valid set (one line, nothing written) or 1 on a write failure.
 // `command` prefixes messages ("lucent stimuli report", "lucent render").
-int run_stimuli_report(const std::filesystem::path& directory, const SetReportOptions& options,
+int run_stimuli_report(const std::filesystem::path& directory,
+                       const SetReportOptions& options,
                        const std::string& command = "lucent stimuli report");
 
 }  // namespace lucent::stimuli

@@ -40,17 +40,20 @@ std::vector<double> local_mean(const std::vector<double>& values, int width, int
 }
 
 // Eq. 13 from the five local moments.
-double index(double mx, double my, double xx, double yy, double xy, double c1, double c2) {
+double index(double mx, double my, double xx, double yy, double xy, double c1,
+             double c2) {
     const double vx = std::max(xx - mx * mx, 0.0), vy = std::max(yy - my * my, 0.0);
     const double cov = xy - mx * my;
-    return ((2 * mx * my + c1) * (2 * cov + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+    return ((2 * mx * my + c1) * (2 * cov + c2)) /
+           ((mx * mx + my * my + c1) * (vx + vy + c2));
 }
 
 }  // namespace
 
 double ssim(const GreyImageView& first, const GreyImageView& second,
             std::span<const std::uint8_t> mask, const SsimOptions& options) {
-    const std::size_t n = std::size_t(std::max(first.width, 0)) * std::max(first.height, 0);
+    const std::size_t n =
+        std::size_t(std::max(first.width, 0)) * std::max(first.height, 0);
     if (first.width != second.width || first.height != second.height ||
         first.values.size() != n || second.values.size() != n ||
         (!mask.empty() && mask.size() != n))
@@ -89,10 +92,12 @@ double ssim(const GreyImageView& first, const GreyImageView& second,
         kernel[std::size_t(k + options.radius)] =
             std::exp(-0.5 * k * k / (options.sigma * options.sigma));
     std::vector<double> xx(n), yy(n), xy(n);
-    for (std::size_t i = 0; i < n; ++i) xx[i] = x[i] * x[i], yy[i] = y[i] * y[i], xy[i] = x[i] * y[i];
+    for (std::size_t i = 0; i < n; ++i)
+        xx[i] = x[i] * x[i], yy[i] = y[i] * y[i], xy[i] = x[i] * y[i];
     const int w = first.width, h = first.height, r = options.radius;
     const auto mx = local_mean(x, w, h, kernel, r), my = local_mean(y, w, h, kernel, r);
-    const auto mxx = local_mean(xx, w, h, kernel, r), myy = local_mean(yy, w, h, kernel, r);
+    const auto mxx = local_mean(xx, w, h, kernel, r),
+               myy = local_mean(yy, w, h, kernel, r);
     const auto mxy = local_mean(xy, w, h, kernel, r);
     double sum = 0.0;
     std::size_t count = 0;

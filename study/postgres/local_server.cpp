@@ -6,11 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <pqxx/pqxx>
-
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
+#include <pqxx/pqxx>
 #include <vector>
 
 #include "sqlite.h"
@@ -31,26 +30,31 @@ std::string LocalPostgres::binary_dir() {
 
 LocalPostgres::LocalPostgres() : bin_(binary_dir()) {
     if (bin_.empty())
-        throw StoreError("no PostgreSQL server binaries (install Debian's 'postgresql' package: "
-                         "scripts/install-deps)");
-    std::string pattern = (std::filesystem::temp_directory_path() / "lucent-pg-XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw StoreError("cannot create a folder for PostgreSQL");
+        throw StoreError(
+            "no PostgreSQL server binaries (install Debian's 'postgresql' package: "
+            "scripts/install-deps)");
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / "lucent-pg-XXXXXX").string();
+    if (!mkdtemp(pattern.data()))
+        throw StoreError("cannot create a folder for PostgreSQL");
     folder_ = pattern;
     if (geteuid() == 0) {
         const char* user = std::getenv("LUCENT_PG_USER");
         run_as_ = user && *user ? user : "nobody";
         const passwd* pw = getpwnam(run_as_.c_str());
         if (!pw || chown(folder_.c_str(), pw->pw_uid, pw->pw_gid) != 0)
-            throw StoreError(folder_ + ": cannot hand the folder to user '" + run_as_ + "'");
+            throw StoreError(folder_ + ": cannot hand the folder to user '" + run_as_ +
+                             "'");
     }
-    if (run("initdb", {"-D", folder_ + "/data", "-U", "lucent", "--auth=trust", "-E", "UTF8",
-                       "--no-sync", "--no-instructions"}) != 0)
+    if (run("initdb", {"-D", folder_ + "/data", "-U", "lucent", "--auth=trust", "-E",
+                       "UTF8", "--no-sync", "--no-instructions"}) != 0)
         throw StoreError("initdb failed; see " + folder_ + "/server.log");
     start();
 }
 
 LocalPostgres::~LocalPostgres() {
-    if (running_) run("pg_ctl", {"-D", folder_ + "/data", "-m", "immediate", "-w", "stop"});
+    if (running_)
+        run("pg_ctl", {"-D", folder_ + "/data", "-m", "immediate", "-w", "stop"});
     std::error_code ec;
     std::filesystem::remove_all(folder_, ec);
 }
@@ -85,13 +89,15 @@ std::string LocalPostgres::create_database(const std::string& name) {
     return uri(name);
 }
 
-int LocalPostgres::run(const std::string& tool, const std::vector<std::string>& args) const {
+int LocalPostgres::run(const std::string& tool,
+                       const std::vector<std::string>& args) const {
     std::vector<std::string> argv;
     if (!run_as_.empty()) argv = {"/usr/sbin/runuser", "-u", run_as_, "--"};
     argv.push_back(bin_ + "/" + tool);
     argv.insert(argv.end(), args.begin(), args.end());
     const std::string log = folder_ + "/commands.log";
-    std::vector<char*> raw;  // built before fork: the child only calls async-signal-safe code
+    std::vector<char*>
+        raw;  // built before fork: the child only calls async-signal-safe code
     for (std::string& a : argv) raw.push_back(a.data());
     raw.push_back(nullptr);
     const pid_t pid = fork();
@@ -107,7 +113,8 @@ int LocalPostgres::run(const std::string& tool, const std::vector<std::string>& 
         _exit(127);
     }
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

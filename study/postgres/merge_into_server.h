@@ -18,7 +18,8 @@
 
 namespace lucent::study {
 
-MergeReport merge_into_server(const std::vector<std::string>& files, const std::string& uri,
+MergeReport merge_into_server(const std::vector<std::string>& files,
+                              const std::string& uri,
                               const std::vector<std::string>& names = {});
 
 }  // namespace lucent::study

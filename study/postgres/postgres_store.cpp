@@ -5,9 +5,8 @@
 // [4] trials: journal, send, sync  [5] status, withdrawal, counts  [6] snapshot
 #include "postgres/postgres_store.h"
 
-#include <pqxx/pqxx>
-
 #include <chrono>
+#include <pqxx/pqxx>
 
 #include "store.h"
 #include "withdrawal.h"
@@ -67,7 +66,8 @@ auto PostgresStore::guarded(const char* what, F&& body) {
         throw;
     } catch (const pqxx::broken_connection& e) {
         drop_connection();
-        throw Unreachable(name_ + ": lost the server while " + what + ": " + first_line(e.what()));
+        throw Unreachable(name_ + ": lost the server while " + what + ": " +
+                          first_line(e.what()));
     } catch (const pqxx::in_doubt_error& e) {
         drop_connection();
         throw Unreachable(name_ + ": lost the server during a commit (" + what +
@@ -87,9 +87,11 @@ auto PostgresStore::guarded(const char* what, F&& body) {
 
 std::string checked_server_uri(const std::string& uri) {
     const size_t scheme_end = uri.find("://");
-    if (scheme_end == std::string::npos) throw StoreError(uri + ": not a postgresql:// URI");
+    if (scheme_end == std::string::npos)
+        throw StoreError(uri + ": not a postgresql:// URI");
     const size_t authority_end = uri.find_first_of("/?", scheme_end + 3);
-    const std::string authority = uri.substr(scheme_end + 3, authority_end - scheme_end - 3);
+    const std::string authority =
+        uri.substr(scheme_end + 3, authority_end - scheme_end - 3);
     const size_t at = authority.rfind('@');
     const bool password_in_user =
         at != std::string::npos && authority.substr(0, at).find(':') != std::string::npos;
@@ -98,8 +100,9 @@ std::string checked_server_uri(const std::string& uri) {
                                 (uri.find("?password=", query) != std::string::npos ||
                                  uri.find("&password=", query) != std::string::npos);
     if (password_in_user || password_param)
-        throw StoreError("--db: the server URI holds a password; give it through PGPASSWORD or "
-                         "~/.pgpass (PGPASSFILE), never on the command line");
+        throw StoreError(
+            "--db: the server URI holds a password; give it through PGPASSWORD or "
+            "~/.pgpass (PGPASSFILE), never on the command line");
     if (uri.find("connect_timeout=") != std::string::npos) return uri;
     return uri + (query == std::string::npos ? "?" : "&") + "connect_timeout=5";
 }
@@ -108,21 +111,25 @@ PostgresStore::PostgresStore(const std::string& uri, const StoreOptions& options
     : uri_(checked_server_uri(uri)),
       name_(uri),
       options_(options),
-      journal_(options.journal_path.empty() ? default_journal_path(uri) : options.journal_path,
-               uri) {
+      journal_(
+          options.journal_path.empty() ? default_journal_path(uri) : options.journal_path,
+          uri) {
     // Refuse an uninitialised or newer schema now, with one line, before any session.
     guarded("opening", [&] {
         pqxx::work tx(connection());
         const pqxx::result has = tx.exec_params(
-            "SELECT to_regclass('lucent_schema') IS NOT NULL, to_regclass('studies') IS NOT NULL");
+            "SELECT to_regclass('lucent_schema') IS NOT NULL, to_regclass('studies') IS "
+            "NOT NULL");
         if (!has[0][0].as<bool>()) {
-            throw StoreError(name_ + (has[0][1].as<bool>()
-                                          ? ": holds tables but no lucent_schema: not a Lucent "
-                                            "study database; left unchanged"
-                                          : ": no Lucent schema yet; run 'lucent store init "
-                                            "--db URI' first"));
+            throw StoreError(name_ +
+                             (has[0][1].as<bool>()
+                                  ? ": holds tables but no lucent_schema: not a Lucent "
+                                    "study database; left unchanged"
+                                  : ": no Lucent schema yet; run 'lucent store init "
+                                    "--db URI' first"));
         }
-        const pqxx::result v = tx.exec_params("SELECT application_id, version FROM lucent_schema");
+        const pqxx::result v =
+            tx.exec_params("SELECT application_id, version FROM lucent_schema");
         if (v.empty() || v[0][0].as<int64_t>() != kApplicationId)
             throw StoreError(name_ + ": lucent_schema is not Lucent's; left unchanged");
         const int version = v[0][1].as<int>();
@@ -132,7 +139,8 @@ PostgresStore::PostgresStore(const std::string& uri, const StoreOptions& options
                              std::to_string(kSchemaVersion) + "); left unchanged");
         if (version < kSchemaVersion)
             throw StoreError(name_ + ": schema " + std::to_string(version) +
-                             " is older than this build's " + std::to_string(kSchemaVersion) +
+                             " is older than this build's " +
+                             std::to_string(kSchemaVersion) +
                              "; run 'lucent store init --db URI' to migrate it");
         tx.commit();
         return 0;
@@ -168,7 +176,8 @@ std::vector<std::string> postgres_migrations() {
     // same, so the two schemas cannot drift apart.
     std::vector<std::string> out;
     auto replace_all = [](std::string s, const std::string& from, const std::string& to) {
-        for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size()))
+        for (size_t at = s.find(from); at != std::string::npos;
+             at = s.find(from, at + to.size()))
             s.replace(at, from.size(), to);
         return s;
     };
@@ -189,29 +198,34 @@ std::pair<int, int> init_postgres_schema(const std::string& uri) {
         pqxx::work tx(c);
         tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kStudyLock);
         const pqxx::result has = tx.exec_params(
-            "SELECT to_regclass('lucent_schema') IS NOT NULL, to_regclass('studies') IS NOT NULL");
+            "SELECT to_regclass('lucent_schema') IS NOT NULL, to_regclass('studies') IS "
+            "NOT NULL");
         int version = 0;
         if (has[0][0].as<bool>()) {
-            const pqxx::result v = tx.exec_params("SELECT application_id, version FROM lucent_schema");
+            const pqxx::result v =
+                tx.exec_params("SELECT application_id, version FROM lucent_schema");
             if (v.empty() || v[0][0].as<int64_t>() != kApplicationId)
                 throw StoreError(uri + ": lucent_schema is not Lucent's; left unchanged");
             version = v[0][1].as<int>();
         } else if (has[0][1].as<bool>()) {
-            throw StoreError(uri + ": holds tables but no lucent_schema: not a Lucent study "
+            throw StoreError(uri +
+                             ": holds tables but no lucent_schema: not a Lucent study "
                              "database; left unchanged");
         }
         if (version > kSchemaVersion)
-            throw StoreError(uri + ": written by a newer Lucent (schema " + std::to_string(version) +
-                             ", this build knows " + std::to_string(kSchemaVersion) +
-                             "); left unchanged");
+            throw StoreError(uri + ": written by a newer Lucent (schema " +
+                             std::to_string(version) + ", this build knows " +
+                             std::to_string(kSchemaVersion) + "); left unchanged");
         if (version == 0)
-            tx.exec("CREATE TABLE lucent_schema (application_id BIGINT NOT NULL, "
-                    "version INTEGER NOT NULL)");
+            tx.exec(
+                "CREATE TABLE lucent_schema (application_id BIGINT NOT NULL, "
+                "version INTEGER NOT NULL)");
         const std::vector<std::string> steps = postgres_migrations();
         for (int v = version + 1; v <= kSchemaVersion; ++v) tx.exec(steps[v - 1]);
         tx.exec_params("DELETE FROM lucent_schema");
-        tx.exec_params("INSERT INTO lucent_schema (application_id, version) VALUES ($1, $2)",
-                       static_cast<int64_t>(kApplicationId), kSchemaVersion);
+        tx.exec_params(
+            "INSERT INTO lucent_schema (application_id, version) VALUES ($1, $2)",
+            static_cast<int64_t>(kApplicationId), kSchemaVersion);
         tx.commit();
         return {version, kSchemaVersion};
     } catch (const StoreError&) {
@@ -228,29 +242,35 @@ int64_t PostgresStore::ensure_study(const Protocol& protocol) {
     return guarded("storing the study", [&]() -> int64_t {
         pqxx::work tx(connection());
         tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kStudyLock);
-        for (const pqxx::row& r : tx.exec_params("SELECT id, protocol_hash, name FROM studies")) {
+        for (const pqxx::row& r :
+             tx.exec_params("SELECT id, protocol_hash, name FROM studies")) {
             if (r[1].as<std::string>() == hash) return r[0].as<int64_t>();
-            throw StoreError(name_ + ": holds study '" + r[2].as<std::string>() + "' (protocol " +
-                             r[1].as<std::string>().substr(0, 12) + "), not this protocol (" +
-                             hash.substr(0, 12) + "); use a new database per protocol");
+            throw StoreError(name_ + ": holds study '" + r[2].as<std::string>() +
+                             "' (protocol " + r[1].as<std::string>().substr(0, 12) +
+                             "), not this protocol (" + hash.substr(0, 12) +
+                             "); use a new database per protocol");
         }
         const int64_t study_id =
-            tx.exec_params1("INSERT INTO studies (name, protocol_text, protocol_hash, "
-                            "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
-                            protocol.name, protocol.text, hash, utc_now_iso8601())[0]
+            tx.exec_params1(
+                  "INSERT INTO studies (name, protocol_text, protocol_hash, "
+                  "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
+                  protocol.name, protocol.text, hash, utc_now_iso8601())[0]
                 .as<int64_t>();
         for (const StimulusSpec& s : protocol.stimuli) {
             std::string varies;
-            for (const std::string& v : s.varies) varies += (varies.empty() ? "" : " ") + v;
+            for (const std::string& v : s.varies)
+                varies += (varies.empty() ? "" : " ") + v;
             const int64_t stimulus_id =
-                tx.exec_params1("INSERT INTO stimuli (study_id, stimulus_key, technique, mesh, "
-                                "image, varies) VALUES ($1, $2, $3, $4, $5, $6) RETURNING id",
-                                study_id, s.id, s.technique, s.mesh, s.image, varies)[0]
+                tx.exec_params1(
+                      "INSERT INTO stimuli (study_id, stimulus_key, technique, mesh, "
+                      "image, varies) VALUES ($1, $2, $3, $4, $5, $6) RETURNING id",
+                      study_id, s.id, s.technique, s.mesh, s.image, varies)[0]
                     .as<int64_t>();
             for (const auto& [name, value] : s.parameters)
-                tx.exec_params("INSERT INTO stimulus_parameters (stimulus_id, name, value) "
-                               "VALUES ($1, $2, $3)",
-                               stimulus_id, name, value);
+                tx.exec_params(
+                    "INSERT INTO stimulus_parameters (stimulus_id, name, value) "
+                    "VALUES ($1, $2, $3)",
+                    stimulus_id, name, value);
         }
         tx.commit();
         return study_id;
@@ -272,14 +292,18 @@ int64_t PostgresStore::ensure_participant(int64_t study_id, const std::string& c
         }
         int n = participant_number_from_code(code);
         if (n < 0)
-            n = tx.exec_params1("SELECT greatest(coalesce((SELECT max(number) FROM participants), 0), "
-                                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")[0]
+            n = tx.exec_params1(
+                      "SELECT greatest(coalesce((SELECT max(number) FROM participants), "
+                      "0), "
+                      "coalesce((SELECT max(number) FROM retired_participant_numbers), "
+                      "0))")[0]
                     .as<int>() +
                 1;
         const int64_t id =
-            tx.exec_params1("INSERT INTO participants (study_id, code, number, created_utc) "
-                            "VALUES ($1, $2, $3, $4) RETURNING id",
-                            study_id, code, n, utc_now_iso8601())[0]
+            tx.exec_params1(
+                  "INSERT INTO participants (study_id, code, number, created_utc) "
+                  "VALUES ($1, $2, $3, $4) RETURNING id",
+                  study_id, code, n, utc_now_iso8601())[0]
                 .as<int64_t>();
         tx.commit();
         if (number) *number = n;
@@ -291,20 +315,23 @@ void PostgresStore::claim_participant(const std::string& code) {
     if (claimed_.count(code)) return;
     const bool taken = guarded("claiming the participant", [&] {
         pqxx::nontransaction n(connection());
-        return n.exec_params1("SELECT pg_try_advisory_lock(hashtextextended($1, 0))",
-                              "lucent participant " + code)[0]
+        return n
+            .exec_params1("SELECT pg_try_advisory_lock(hashtextextended($1, 0))",
+                          "lucent participant " + code)[0]
             .as<bool>();
     });
     if (!taken)
-        throw StoreError(name_ + ": participant '" + code +
-                         "' is in a session on another station now; refusing to run it twice "
-                         "at once");
+        throw StoreError(
+            name_ + ": participant '" + code +
+            "' is in a session on another station now; refusing to run it twice "
+            "at once");
     claimed_.insert(code);
 }
 
 void PostgresStore::release_participant(const std::string& code) {
     if (!claimed_.erase(code)) return;
-    if (!conn_ || !conn_->is_open()) return;  // the server ended the session's locks with it
+    if (!conn_ || !conn_->is_open())
+        return;  // the server ended the session's locks with it
     try {
         pqxx::nontransaction n(*conn_);
         n.exec_params("SELECT pg_advisory_unlock(hashtextextended($1, 0))",
@@ -314,34 +341,41 @@ void PostgresStore::release_participant(const std::string& code) {
     }
 }
 
-void PostgresStore::check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) {
+void PostgresStore::check_stimulus_values(
+    const std::vector<StimulusProvenance>& stimuli) {
     guarded("checking stimulus values", [&] {
         pqxx::work tx(connection());
         std::map<std::string, ResolvedStimulus> stored;
         for (const pqxx::row& r : tx.exec_params(
                  "SELECT stimulus_key, technique, resolved_mesh, mesh_hash FROM stimuli "
                  "WHERE resolved_mesh IS NOT NULL"))
-            stored[r[0].as<std::string>()] = {r[1].as<std::string>(), r[2].as<std::string>(),
-                                              r[3].is_null() ? "" : r[3].as<std::string>(), {}};
+            stored[r[0].as<std::string>()] = {
+                r[1].as<std::string>(),
+                r[2].as<std::string>(),
+                r[3].is_null() ? "" : r[3].as<std::string>(),
+                {}};
         for (const pqxx::row& r : tx.exec_params(
                  "SELECT st.stimulus_key, v.name, v.value FROM stimulus_values v "
                  "JOIN stimuli st ON st.id = v.stimulus_id"))
-            stored[r[0].as<std::string>()].values[r[1].as<std::string>()] = r[2].as<std::string>();
+            stored[r[0].as<std::string>()].values[r[1].as<std::string>()] =
+                r[2].as<std::string>();
         for (const StimulusProvenance& p : stimuli) {
             const auto it = stored.find(p.stimulus);
             if (it == stored.end()) continue;
-            const std::string difference =
-                resolved_difference(p.stimulus, it->second, name_, resolved_of(p), "this run");
+            const std::string difference = resolved_difference(
+                p.stimulus, it->second, name_, resolved_of(p), "this run");
             if (!difference.empty())
-                throw StoreError(name_ + ": " + difference +
-                                 ": its pictures would differ from the earlier sessions'; use a "
-                                 "new database");
+                throw StoreError(
+                    name_ + ": " + difference +
+                    ": its pictures would differ from the earlier sessions'; use a "
+                    "new database");
         }
         return 0;
     });
 }
 
-// ---- [3] sessions, segments ------------------------------------------------------------
+// ---- [3] sessions, segments
+// ------------------------------------------------------------
 
 namespace {
 
@@ -349,38 +383,44 @@ namespace {
 void insert_segment(pqxx::work& tx, int64_t session_id, int segment,
                     const SessionEnvironment& env) {
     const int64_t study_id =
-        tx.exec_params1("SELECT study_id FROM sessions WHERE id = $1", session_id)[0].as<int64_t>();
+        tx.exec_params1("SELECT study_id FROM sessions WHERE id = $1", session_id)[0]
+            .as<int64_t>();
     for (const StimulusProvenance& p : env.stimuli) {
         // Row lock: a station racing to record the same stimulus first waits, then sees
         // it recorded (affected rows 0) and does not add values twice.
         const pqxx::result first = tx.exec_params(
-            "UPDATE stimuli SET resolved_mesh = $1, mesh_hash = $2 WHERE study_id = $3 AND "
+            "UPDATE stimuli SET resolved_mesh = $1, mesh_hash = $2 WHERE study_id = $3 "
+            "AND "
             "stimulus_key = $4 AND resolved_mesh IS NULL",
             p.mesh, p.mesh_hash, study_id, p.stimulus);
         if (first.affected_rows() == 0) continue;
         for (const auto& [name, text] : p.values)
-            tx.exec_params("INSERT INTO stimulus_values (stimulus_id, name, value) VALUES "
-                           "((SELECT id FROM stimuli WHERE study_id = $1 AND stimulus_key = $2), "
-                           "$3, $4)",
-                           study_id, p.stimulus, name, text);
+            tx.exec_params(
+                "INSERT INTO stimulus_values (stimulus_id, name, value) VALUES "
+                "((SELECT id FROM stimuli WHERE study_id = $1 AND stimulus_key = $2), "
+                "$3, $4)",
+                study_id, p.stimulus, name, text);
     }
     const int64_t segment_id =
         tx.exec_params1(
-              "INSERT INTO session_segments (session_id, segment, started_utc, machine_id, "
+              "INSERT INTO session_segments (session_id, segment, started_utc, "
+              "machine_id, "
               "software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
-              "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) VALUES "
+              "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) "
+              "VALUES "
               "($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13) RETURNING id",
-              session_id, segment, utc_now_iso8601(), env.machine_id, env.software_version,
-              env.build_hash, env.gl_vendor, env.gl_renderer, env.display_mode,
-              env.display_refresh_hz, env.measured_refresh_hz, env.refresh_note,
-              segment_source(env.stimuli))[0]
+              session_id, segment, utc_now_iso8601(), env.machine_id,
+              env.software_version, env.build_hash, env.gl_vendor, env.gl_renderer,
+              env.display_mode, env.display_refresh_hz, env.measured_refresh_hz,
+              env.refresh_note, segment_source(env.stimuli))[0]
             .as<int64_t>();
     for (const StimulusProvenance& p : env.stimuli)
-        tx.exec_params("INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, "
-                       "content_hash, software_version, build_hash) VALUES ($1, (SELECT id FROM "
-                       "stimuli WHERE study_id = $2 AND stimulus_key = $3), $4, $5, $6, $7, $8)",
-                       segment_id, study_id, p.stimulus, p.source, p.file, p.content_hash,
-                       p.software_version, p.build_hash);
+        tx.exec_params(
+            "INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, "
+            "content_hash, software_version, build_hash) VALUES ($1, (SELECT id FROM "
+            "stimuli WHERE study_id = $2 AND stimulus_key = $3), $4, $5, $6, $7, $8)",
+            segment_id, study_id, p.stimulus, p.source, p.file, p.content_hash,
+            p.software_version, p.build_hash);
 }
 
 SessionRow session_row(const pqxx::row& r) {
@@ -401,8 +441,9 @@ namespace {
 
 // The session row, its first segment and its trials, inside `tx`.
 SessionRow insert_session(pqxx::work& tx, int64_t study_id, int64_t participant_id,
-                          const TrialPlan& plan, uint64_t seed, const SessionEnvironment& env,
-                          const std::string& uuid, const std::optional<std::string>& allocation) {
+                          const TrialPlan& plan, uint64_t seed,
+                          const SessionEnvironment& env, const std::string& uuid,
+                          const std::optional<std::string>& allocation) {
     SessionRow row;
     row.uuid = uuid;
     row.participant_id = participant_id;
@@ -410,19 +451,23 @@ SessionRow insert_session(pqxx::work& tx, int64_t study_id, int64_t participant_
     row.cell = plan.cell;
     row.status = "running";
     {
-        row.id = tx.exec_params1(
-                       "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, "
-                       "cell, block_order, status, started_utc, software_version, build_hash, "
-                       "gl_vendor, gl_renderer, display_mode, display_refresh_hz, "
-                       "measured_refresh_hz, refresh_note, allocation) VALUES ($1, $2, $3, $4, "
-                       "$5, $6, $7, 'running', $8, $9, $10, $11, $12, $13, $14, $15, $16, $17) "
-                       "RETURNING id",
-                       row.uuid, study_id, participant_id, env.machine_id, std::to_string(seed),
-                       plan.cell, flag_list(plan.block_order), utc_now_iso8601(),
-                       env.software_version, env.build_hash, env.gl_vendor, env.gl_renderer,
-                       env.display_mode, env.display_refresh_hz, env.measured_refresh_hz,
-                       env.refresh_note, allocation)[0]
-                     .as<int64_t>();
+        row.id =
+            tx.exec_params1(
+                  "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, "
+                  "seed, "
+                  "cell, block_order, status, started_utc, software_version, build_hash, "
+                  "gl_vendor, gl_renderer, display_mode, display_refresh_hz, "
+                  "measured_refresh_hz, refresh_note, allocation) VALUES ($1, $2, $3, "
+                  "$4, "
+                  "$5, $6, $7, 'running', $8, $9, $10, $11, $12, $13, $14, $15, $16, "
+                  "$17) "
+                  "RETURNING id",
+                  row.uuid, study_id, participant_id, env.machine_id,
+                  std::to_string(seed), plan.cell, flag_list(plan.block_order),
+                  utc_now_iso8601(), env.software_version, env.build_hash, env.gl_vendor,
+                  env.gl_renderer, env.display_mode, env.display_refresh_hz,
+                  env.measured_refresh_hz, env.refresh_note, allocation)[0]
+                .as<int64_t>();
         row.participant = tx.exec_params1("SELECT code FROM participants WHERE id = $1",
                                           participant_id)[0]
                               .as<std::string>();
@@ -436,14 +481,15 @@ SessionRow insert_session(pqxx::work& tx, int64_t study_id, int64_t participant_
                 expected = t.expected;
                 tolerance = t.tolerance;
             }
-            tx.exec_params("INSERT INTO trials (session_id, position, block, stimulus_id, "
-                           "practice, catch, catch_id, prompt, expected_rating, tolerance, "
-                           "break_before, uuid) VALUES ($1, $2, $3, (SELECT id FROM stimuli "
-                           "WHERE study_id = $4 AND stimulus_key = $5), $6, $7, $8, $9, $10, "
-                           "$11, $12, $13)",
-                           row.id, t.position, t.block, study_id, t.stimulus, t.practice ? 1 : 0,
-                           t.is_catch ? 1 : 0, catch_id, prompt, expected, tolerance,
-                           t.break_before ? 1 : 0, new_uuid_v4());
+            tx.exec_params(
+                "INSERT INTO trials (session_id, position, block, stimulus_id, "
+                "practice, catch, catch_id, prompt, expected_rating, tolerance, "
+                "break_before, uuid) VALUES ($1, $2, $3, (SELECT id FROM stimuli "
+                "WHERE study_id = $4 AND stimulus_key = $5), $6, $7, $8, $9, $10, "
+                "$11, $12, $13)",
+                row.id, t.position, t.block, study_id, t.stimulus, t.practice ? 1 : 0,
+                t.is_catch ? 1 : 0, catch_id, prompt, expected, tolerance,
+                t.break_before ? 1 : 0, new_uuid_v4());
         }
     }
     return row;
@@ -458,8 +504,8 @@ SessionRow PostgresStore::create_session(int64_t study_id, int64_t participant_i
     const std::string uuid = new_uuid_v4();
     return guarded("creating the session", [&] {
         pqxx::work tx(connection());
-        SessionRow row = insert_session(tx, study_id, participant_id, plan, seed, env, uuid,
-                                        std::nullopt);
+        SessionRow row = insert_session(tx, study_id, participant_id, plan, seed, env,
+                                        uuid, std::nullopt);
         tx.commit();
         return row;
     });
@@ -469,7 +515,8 @@ OnlineSession PostgresStore::enrol_online(int64_t study_id, const std::string& c
                                           const OnlineEnrolment& how,
                                           const SessionEnvironment& env) {
     if (how.cells < 1 || !how.plan)
-        throw StoreError(name_ + ": an online enrolment needs at least one cell and a plan");
+        throw StoreError(name_ +
+                         ": an online enrolment needs at least one cell and a plan");
     check_stimulus_values(env.stimuli);
     const std::string uuid = how.session_uuid.empty() ? new_uuid_v4() : how.session_uuid;
     return guarded("enrolling the participant", [&] {
@@ -486,30 +533,34 @@ OnlineSession PostgresStore::enrol_online(int64_t study_id, const std::string& c
             participant_id = found[0][0].as<int64_t>();
             out.number = found[0][1].as<int>();
         } else {
-            out.number = tx.exec_params1(
-                               "SELECT greatest(coalesce((SELECT max(number) FROM participants), "
-                               "0), coalesce((SELECT max(number) FROM "
-                               "retired_participant_numbers), 0))")[0]
-                             .as<int>() +
-                         1;
-            participant_id = tx.exec_params1("INSERT INTO participants (study_id, code, number, "
-                                             "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
-                                             study_id, code, out.number, utc_now_iso8601())[0]
+            out.number =
+                tx.exec_params1(
+                      "SELECT greatest(coalesce((SELECT max(number) FROM participants), "
+                      "0), coalesce((SELECT max(number) FROM "
+                      "retired_participant_numbers), 0))")[0]
+                    .as<int>() +
+                1;
+            participant_id = tx.exec_params1(
+                                   "INSERT INTO participants (study_id, code, number, "
+                                   "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
+                                   study_id, code, out.number, utc_now_iso8601())[0]
                                  .as<int64_t>();
         }
         std::vector<int64_t> counts(static_cast<size_t>(how.cells), 0);
-        for (const pqxx::row& r :
-             tx.exec_params(online_cell_counts_sql(true), study_id, how.active_since_utc)) {
+        for (const pqxx::row& r : tx.exec_params(online_cell_counts_sql(true), study_id,
+                                                 how.active_since_utc)) {
             const int64_t cell = r[0].as<int64_t>();
-            if (cell >= 0 && cell < how.cells) counts[static_cast<size_t>(cell)] = r[1].as<int64_t>();
+            if (cell >= 0 && cell < how.cells)
+                counts[static_cast<size_t>(cell)] = r[1].as<int64_t>();
         }
-        const auto [cell, allocation] = online_cell(counts, out.number, how.active_since_utc);
+        const auto [cell, allocation] =
+            online_cell(counts, out.number, how.active_since_utc);
         const TrialPlan plan = how.plan(cell);
         if (plan.cell != cell)
-            throw StoreError(name_ + ": the plan of cell " + std::to_string(cell) + " is cell " +
-                             std::to_string(plan.cell));
-        out.session = insert_session(tx, study_id, participant_id, plan, how.seed, env, uuid,
-                                     allocation);
+            throw StoreError(name_ + ": the plan of cell " + std::to_string(cell) +
+                             " is cell " + std::to_string(plan.cell));
+        out.session = insert_session(tx, study_id, participant_id, plan, how.seed, env,
+                                     uuid, allocation);
         out.allocation = allocation;
         tx.commit();
         return out;
@@ -522,7 +573,8 @@ std::optional<SessionRow> PostgresStore::unfinished_session(const std::string& c
         const pqxx::result r = tx.exec_params(
             "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
             "FROM sessions s JOIN participants p ON p.id = s.participant_id "
-            "WHERE p.code = $1 AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT 1",
+            "WHERE p.code = $1 AND s.status IN ('running', 'paused') ORDER BY s.id DESC "
+            "LIMIT 1",
             code);
         if (r.empty()) return std::nullopt;
         return session_row(r[0]);
@@ -532,10 +584,11 @@ std::optional<SessionRow> PostgresStore::unfinished_session(const std::string& c
 bool PostgresStore::has_completed_session(const std::string& code) {
     return guarded("finding the session", [&] {
         pqxx::work tx(connection());
-        return tx.exec_params1("SELECT count(*) FROM sessions s JOIN participants p ON "
-                               "p.id = s.participant_id WHERE p.code = $1 AND "
-                               "s.status = 'completed'",
-                               code)[0]
+        return tx.exec_params1(
+                     "SELECT count(*) FROM sessions s JOIN participants p ON "
+                     "p.id = s.participant_id WHERE p.code = $1 AND "
+                     "s.status = 'completed'",
+                     code)[0]
                    .as<int64_t>() > 0;
     });
 }
@@ -544,13 +597,15 @@ std::vector<TrialRow> PostgresStore::trials(int64_t session_id) {
     std::vector<TrialRow> out = guarded("reading the trials", [&] {
         pqxx::work tx(connection());
         std::vector<TrialRow> rows;
-        for (const pqxx::row& r : tx.exec_params(
-                 "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
-                 "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
-                 "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), "
-                 "coalesce(t.uuid, '') FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
-                 "WHERE t.session_id = $1 ORDER BY t.position",
-                 session_id)) {
+        for (
+            const pqxx::row& r : tx.exec_params(
+                "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
+                "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
+                "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), "
+                "coalesce(t.uuid, '') FROM trials t JOIN stimuli st ON st.id = "
+                "t.stimulus_id "
+                "WHERE t.session_id = $1 ORDER BY t.position",
+                session_id)) {
             TrialRow t;
             t.id = r[0].as<int64_t>();
             t.position = r[1].as<int>();
@@ -588,19 +643,23 @@ PostgresStore::SessionCache& PostgresStore::session_cache(int64_t session_id) {
             "SELECT s.uuid, st.name, st.protocol_text FROM sessions s JOIN studies st ON "
             "st.id = s.study_id WHERE s.id = $1",
             session_id);
-        if (r.empty()) throw StoreError(name_ + ": no session " + std::to_string(session_id));
+        if (r.empty())
+            throw StoreError(name_ + ": no session " + std::to_string(session_id));
         SessionCache c;
         c.uuid = r[0][0].as<std::string>();
         try {
-            c.points = question_points(parse_protocol(
-                r[0][2].as<std::string>(), name_ + " (study '" + r[0][1].as<std::string>() + "')"));
+            c.points = question_points(
+                parse_protocol(r[0][2].as<std::string>(),
+                               name_ + " (study '" + r[0][1].as<std::string>() + "')"));
         } catch (const ProtocolError& e) {
-            throw StoreError(name_ + ": the stored protocol no longer parses: " + e.what());
+            throw StoreError(name_ +
+                             ": the stored protocol no longer parses: " + e.what());
         }
-        for (const pqxx::row& t : tx.exec_params(
-                 "SELECT t.id, coalesce(t.uuid, ''), EXISTS (SELECT 1 FROM responses x WHERE "
-                 "x.trial_id = t.id) FROM trials t WHERE t.session_id = $1",
-                 session_id)) {
+        for (const pqxx::row& t :
+             tx.exec_params("SELECT t.id, coalesce(t.uuid, ''), EXISTS (SELECT 1 FROM "
+                            "responses x WHERE "
+                            "x.trial_id = t.id) FROM trials t WHERE t.session_id = $1",
+                            session_id)) {
             c.trial_uuid[t[0].as<int64_t>()] = t[1].as<std::string>();
             if (t[2].as<bool>()) c.answered.insert(t[0].as<int64_t>());
         }
@@ -613,9 +672,10 @@ int PostgresStore::begin_segment(int64_t session_id, const SessionEnvironment& e
     check_stimulus_values(env.stimuli);
     return guarded("starting a segment", [&] {
         pqxx::work tx(connection());
-        const int segment = tx.exec_params1("SELECT coalesce(max(segment), 0) + 1 FROM "
-                                            "session_segments WHERE session_id = $1",
-                                            session_id)[0]
+        const int segment = tx.exec_params1(
+                                  "SELECT coalesce(max(segment), 0) + 1 FROM "
+                                  "session_segments WHERE session_id = $1",
+                                  session_id)[0]
                                 .as<int>();
         insert_segment(tx, session_id, segment, env);
         tx.commit();
@@ -628,24 +688,27 @@ int PostgresStore::resume_segment(int64_t session_id, const SessionEnvironment& 
     return guarded("starting a segment", [&] {
         pqxx::work tx(connection());
         const pqxx::result newest = tx.exec_params(
-            "SELECT g.id, g.segment, EXISTS (SELECT 1 FROM trials t WHERE t.segment_id = g.id) "
-            "FROM session_segments g WHERE g.session_id = $1 ORDER BY g.segment DESC LIMIT 1 "
+            "SELECT g.id, g.segment, EXISTS (SELECT 1 FROM trials t WHERE t.segment_id = "
+            "g.id) "
+            "FROM session_segments g WHERE g.session_id = $1 ORDER BY g.segment DESC "
+            "LIMIT 1 "
             "FOR UPDATE OF g",
             session_id);
         int segment = 1;
         if (!newest.empty() && !newest[0][2].as<bool>()) {
             // Nothing was answered under the newest segment: replaced, not added to.
             segment = newest[0][1].as<int>();
-            tx.exec_params("DELETE FROM session_segments WHERE id = $1", newest[0][0].as<int64_t>());
+            tx.exec_params("DELETE FROM session_segments WHERE id = $1",
+                           newest[0][0].as<int64_t>());
             if (segment == 1)
-                tx.exec_params("UPDATE sessions SET machine_id = $1, software_version = $2, "
-                               "build_hash = $3, gl_vendor = $4, gl_renderer = $5, "
-                               "display_mode = $6, display_refresh_hz = $7, "
-                               "measured_refresh_hz = $8, refresh_note = $9 WHERE id = $10",
-                               env.machine_id, env.software_version, env.build_hash,
-                               env.gl_vendor, env.gl_renderer, env.display_mode,
-                               env.display_refresh_hz, env.measured_refresh_hz,
-                               env.refresh_note, session_id);
+                tx.exec_params(
+                    "UPDATE sessions SET machine_id = $1, software_version = $2, "
+                    "build_hash = $3, gl_vendor = $4, gl_renderer = $5, "
+                    "display_mode = $6, display_refresh_hz = $7, "
+                    "measured_refresh_hz = $8, refresh_note = $9 WHERE id = $10",
+                    env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
+                    env.gl_renderer, env.display_mode, env.display_refresh_hz,
+                    env.measured_refresh_hz, env.refresh_note, session_id);
         } else if (!newest.empty()) {
             segment = newest[0][1].as<int>() + 1;
         }
@@ -655,26 +718,29 @@ int PostgresStore::resume_segment(int64_t session_id, const SessionEnvironment& 
     });
 }
 
-void PostgresStore::update_environment(int64_t session_id, const SessionEnvironment& env) {
+void PostgresStore::update_environment(int64_t session_id,
+                                       const SessionEnvironment& env) {
     guarded("updating the environment", [&] {
         pqxx::work tx(connection());
-        tx.exec_params("UPDATE session_segments SET machine_id = $1, software_version = $2, "
-                       "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
-                       "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
-                       "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = $10)",
-                       env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
-                       env.gl_renderer, env.display_mode, env.display_refresh_hz,
-                       env.measured_refresh_hz, env.refresh_note, session_id);
+        tx.exec_params(
+            "UPDATE session_segments SET machine_id = $1, software_version = $2, "
+            "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
+            "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
+            "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = $10)",
+            env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
+            env.gl_renderer, env.display_mode, env.display_refresh_hz,
+            env.measured_refresh_hz, env.refresh_note, session_id);
         if (tx.exec_params1("SELECT count(*) FROM session_segments WHERE session_id = $1",
                             session_id)[0]
                 .as<int64_t>() == 1)
-            tx.exec_params("UPDATE sessions SET machine_id = $1, software_version = $2, "
-                           "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
-                           "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
-                           "WHERE id = $10",
-                           env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
-                           env.gl_renderer, env.display_mode, env.display_refresh_hz,
-                           env.measured_refresh_hz, env.refresh_note, session_id);
+            tx.exec_params(
+                "UPDATE sessions SET machine_id = $1, software_version = $2, "
+                "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
+                "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
+                "WHERE id = $10",
+                env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
+                env.gl_renderer, env.display_mode, env.display_refresh_hz,
+                env.measured_refresh_hz, env.refresh_note, session_id);
         tx.commit();
         return 0;
     });
@@ -683,10 +749,11 @@ void PostgresStore::update_environment(int64_t session_id, const SessionEnvironm
 namespace {
 // One more declined consent of `study_id`, inside the caller's transaction.
 void add_declined_consent(pqxx::work& tx, int64_t study_id) {
-    tx.exec_params("INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
-                   "ON CONFLICT (study_id) DO UPDATE SET declined = "
-                   "consent_declines.declined + 1",
-                   study_id);
+    tx.exec_params(
+        "INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
+        "ON CONFLICT (study_id) DO UPDATE SET declined = "
+        "consent_declines.declined + 1",
+        study_id);
 }
 }  // namespace
 
@@ -703,7 +770,8 @@ bool PostgresStore::forget_declined_session(int64_t session_id) {
     return guarded("forgetting a declined session", [&] {
         pqxx::work tx(connection());
         const pqxx::result found = tx.exec_params(
-            "SELECT study_id, participant_id FROM sessions WHERE id = $1 AND consent_utc IS NULL "
+            "SELECT study_id, participant_id FROM sessions WHERE id = $1 AND consent_utc "
+            "IS NULL "
             "AND NOT EXISTS (SELECT 1 FROM responses r WHERE r.session_id = sessions.id) "
             "FOR UPDATE",
             session_id);
@@ -711,9 +779,10 @@ bool PostgresStore::forget_declined_session(int64_t session_id) {
         const int64_t study_id = found[0][0].as<int64_t>();
         const int64_t participant_id = found[0][1].as<int64_t>();
         tx.exec_params("DELETE FROM sessions WHERE id = $1", session_id);
-        tx.exec_params("DELETE FROM participants WHERE id = $1 AND NOT EXISTS "
-                       "(SELECT 1 FROM sessions WHERE participant_id = $1)",
-                       participant_id);
+        tx.exec_params(
+            "DELETE FROM participants WHERE id = $1 AND NOT EXISTS "
+            "(SELECT 1 FROM sessions WHERE participant_id = $1)",
+            participant_id);
         add_declined_consent(tx, study_id);
         tx.commit();
         return true;
@@ -723,8 +792,8 @@ bool PostgresStore::forget_declined_session(int64_t session_id) {
 void PostgresStore::set_consent(int64_t session_id) {
     guarded("recording consent", [&] {
         pqxx::work tx(connection());
-        tx.exec_params("UPDATE sessions SET consent_utc = $1 WHERE id = $2", utc_now_iso8601(),
-                       session_id);
+        tx.exec_params("UPDATE sessions SET consent_utc = $1 WHERE id = $2",
+                       utc_now_iso8601(), session_id);
         tx.commit();
         return 0;
     });
@@ -745,34 +814,40 @@ namespace {
 
 // Sets the session completed when every planned trial has ratings, inside `tx`.
 bool complete_if_answered(pqxx::work& tx, int64_t session_id) {
-    tx.exec_params("UPDATE sessions SET status = 'completed', ended_utc = coalesce(ended_utc, $1) "
-                   "WHERE id = $2 AND status <> 'completed' AND NOT EXISTS (SELECT 1 FROM trials t "
-                   "WHERE t.session_id = sessions.id AND NOT EXISTS (SELECT 1 FROM responses r "
-                   "WHERE r.trial_id = t.id))",
-                   utc_now_iso8601(), session_id);
-    const pqxx::result r =
-        tx.exec_params("SELECT status = 'completed' FROM sessions WHERE id = $1", session_id);
+    tx.exec_params(
+        "UPDATE sessions SET status = 'completed', ended_utc = coalesce(ended_utc, $1) "
+        "WHERE id = $2 AND status <> 'completed' AND NOT EXISTS (SELECT 1 FROM trials t "
+        "WHERE t.session_id = sessions.id AND NOT EXISTS (SELECT 1 FROM responses r "
+        "WHERE r.trial_id = t.id))",
+        utc_now_iso8601(), session_id);
+    const pqxx::result r = tx.exec_params(
+        "SELECT status = 'completed' FROM sessions WHERE id = $1", session_id);
     return !r.empty() && r[0][0].as<bool>();
 }
 
 }  // namespace
 
-PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict, bool* completed) {
+PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict,
+                                        bool* completed) {
     return guarded("sending a trial", [&] {
         pqxx::work tx(connection());
         // A withdrawn participant's trial is never sent back (withdrawal.h).
-        if (!tx.exec_params("SELECT 1 FROM withdrawn_sessions WHERE uuid = $1", j.session_uuid)
+        if (!tx.exec_params("SELECT 1 FROM withdrawn_sessions WHERE uuid = $1",
+                            j.session_uuid)
                  .empty())
             return Sent::Withdrawn;
         const pqxx::result t = tx.exec_params(
             "SELECT id, session_id FROM trials WHERE uuid = $1 FOR UPDATE", j.trial_uuid);
         if (t.empty())
-            throw StoreError(name_ + ": trial " + j.trial_uuid + " (session " + j.session_uuid +
+            throw StoreError(name_ + ": trial " + j.trial_uuid + " (session " +
+                             j.session_uuid +
                              ") is not on the server (participant withdrawn?); kept in " +
                              journal_.path());
-        const int64_t trial_id = t[0][0].as<int64_t>(), session_id = t[0][1].as<int64_t>();
+        const int64_t trial_id = t[0][0].as<int64_t>(),
+                      session_id = t[0][1].as<int64_t>();
         const pqxx::result held = tx.exec_params(
-            "SELECT question, rating FROM responses WHERE trial_id = $1 ORDER BY question",
+            "SELECT question, rating FROM responses WHERE trial_id = $1 ORDER BY "
+            "question",
             trial_id);
         if (!held.empty()) {
             if (strict)
@@ -781,26 +856,29 @@ PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict, bo
             // A resend of a commit whose reply was lost: the same ratings confirm it.
             std::map<std::string, int> mine, theirs;
             for (const Response& r : j.outcome.responses) mine[r.question] = r.rating;
-            for (const pqxx::row& r : held) theirs[r[0].as<std::string>()] = r[1].as<int>();
+            for (const pqxx::row& r : held)
+                theirs[r[0].as<std::string>()] = r[1].as<int>();
             if (mine != theirs)
                 throw StoreError(name_ + ": trial " + j.trial_uuid +
-                                 " holds other ratings on the server than in " + journal_.path() +
-                                 "; kept in the journal");
+                                 " holds other ratings on the server than in " +
+                                 journal_.path() + "; kept in the journal");
             if (completed) *completed = complete_if_answered(tx, session_id);
             tx.commit();
             return Sent::AlreadyThere;
         }
         for (const Response& r : j.outcome.responses)
-            tx.exec_params("INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, "
-                           "changes, first_choice_ns, final_choice_ns) VALUES ($1, $2, $3, $4, $5, "
-                           "$6, $7, $8)",
-                           session_id, trial_id, r.question, r.rating, r.rt_ms, r.changes,
-                           r.first_choice_ns, r.final_choice_ns);
-        tx.exec_params("UPDATE trials SET onset_ns = $1, confirm_ns = $2, dropped_frames = $3, "
-                       "answered_utc = $4, segment_id = (SELECT max(id) FROM session_segments "
-                       "WHERE session_id = $5) WHERE id = $6",
-                       j.outcome.onset_ns, j.outcome.confirm_ns, j.outcome.dropped_frames,
-                       j.recorded_utc, session_id, trial_id);
+            tx.exec_params(
+                "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, "
+                "changes, first_choice_ns, final_choice_ns) VALUES ($1, $2, $3, $4, $5, "
+                "$6, $7, $8)",
+                session_id, trial_id, r.question, r.rating, r.rt_ms, r.changes,
+                r.first_choice_ns, r.final_choice_ns);
+        tx.exec_params(
+            "UPDATE trials SET onset_ns = $1, confirm_ns = $2, dropped_frames = $3, "
+            "answered_utc = $4, segment_id = (SELECT max(id) FROM session_segments "
+            "WHERE session_id = $5) WHERE id = $6",
+            j.outcome.onset_ns, j.outcome.confirm_ns, j.outcome.dropped_frames,
+            j.recorded_utc, session_id, trial_id);
         const bool done = complete_if_answered(tx, session_id);
         tx.commit();
         if (completed) *completed = done;
@@ -821,12 +899,15 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
     const std::string where = name_ + ": trial " + std::to_string(trial_id);
     if (cache.answered.count(trial_id) || journal_.contains(uuid->second))
         throw StoreError(where + " already has ratings; refusing to record it twice");
-    for (const Response& r : outcome.responses) check_rating_on_scale(cache.points, r.question, r.rating, where);
+    for (const Response& r : outcome.responses)
+        check_rating_on_scale(cache.points, r.question, r.rating, where);
     std::set<std::string> questions;
     for (const Response& r : outcome.responses) questions.insert(r.question);
-    if (outcome.responses.size() != cache.points.size() || questions.size() != cache.points.size())
+    if (outcome.responses.size() != cache.points.size() ||
+        questions.size() != cache.points.size())
         throw StoreError(where + " has " + std::to_string(outcome.responses.size()) +
-                         " ratings for " + std::to_string(cache.points.size()) + " questions");
+                         " ratings for " + std::to_string(cache.points.size()) +
+                         " questions");
 
     // Durable on this machine first; only then the network.
     const JournaledTrial journaled{uuid->second, cache.uuid, utc_now_iso8601(), outcome};
@@ -840,7 +921,8 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
     const TrialJournal::SendLock sending(journal_);
     const int64_t attempt = next_attempt_ns_;
     flush(journaled.trial_uuid);
-    if (next_attempt_ns_ != attempt) return local_completed;  // unreachable: all stay journaled
+    if (next_attempt_ns_ != attempt)
+        return local_completed;  // unreachable: all stay journaled
     // Another station sent it from the shared journal while this one waited: confirmed.
     if (!journal_.contains(journaled.trial_uuid)) return local_completed;
     bool completed = local_completed;
@@ -877,7 +959,8 @@ int PostgresStore::flush(const std::string& skip_uuid) {
             }
             ++confirmed;
         } catch (const Unreachable&) {
-            next_attempt_ns_ = steady_ns() + int64_t(options_.retry_interval_ms) * 1'000'000;
+            next_attempt_ns_ =
+                steady_ns() + int64_t(options_.retry_interval_ms) * 1'000'000;
             break;
         } catch (const StoreError&) {
             continue;  // refused (e.g. withdrawn): kept for `lucent store sync` to report
@@ -914,7 +997,8 @@ bool PostgresStore::complete_session_if_answered(int64_t session_id) {
 
 // ---- [5] status, withdrawal, counts ---------------------------------------------------
 
-void PostgresStore::set_status(int64_t session_id, const std::string& status, bool ended) {
+void PostgresStore::set_status(int64_t session_id, const std::string& status,
+                               bool ended) {
     try {
         guarded("setting the session status", [&] {
             pqxx::work tx(connection());
@@ -925,11 +1009,13 @@ void PostgresStore::set_status(int64_t session_id, const std::string& status, bo
                 throw StoreError(name_ + ": session " + current[0][1].as<std::string>() +
                                  " is completed; refusing to set it " + status);
             if (ended)
-                tx.exec_params("UPDATE sessions SET status = $1, ended_utc = $2 WHERE id = $3",
-                               status, utc_now_iso8601(), session_id);
+                tx.exec_params(
+                    "UPDATE sessions SET status = $1, ended_utc = $2 WHERE id = $3",
+                    status, utc_now_iso8601(), session_id);
             else
-                tx.exec_params("UPDATE sessions SET status = $1, ended_utc = NULL WHERE id = $2",
-                               status, session_id);
+                tx.exec_params(
+                    "UPDATE sessions SET status = $1, ended_utc = NULL WHERE id = $2",
+                    status, session_id);
             tx.commit();
             return 0;
         });
@@ -947,23 +1033,26 @@ bool PostgresStore::withdraw_participant(const std::string& code) {
         if (!tx.exec_params("SELECT 1 FROM participants WHERE code = $1", code).empty()) {
             const std::string now = utc_now_iso8601();
             std::vector<std::pair<std::string, std::string>> sessions;  // uuid, machine
-            for (const pqxx::row& r :
-                 tx.exec_params("SELECT se.uuid, se.machine_id FROM sessions se JOIN "
-                                "participants p ON p.id = se.participant_id WHERE p.code = $1",
-                                code))
+            for (const pqxx::row& r : tx.exec_params(
+                     "SELECT se.uuid, se.machine_id FROM sessions se JOIN "
+                     "participants p ON p.id = se.participant_id WHERE p.code = $1",
+                     code))
                 sessions.emplace_back(r[0].as<std::string>(), r[1].as<std::string>());
             for (const auto& [uuid, machine] : sessions)
-                tx.exec_params("INSERT INTO withdrawn_sessions (uuid, withdrawn_utc) VALUES "
-                               "($1, $2) ON CONFLICT DO NOTHING",
-                               uuid, now);
+                tx.exec_params(
+                    "INSERT INTO withdrawn_sessions (uuid, withdrawn_utc) VALUES "
+                    "($1, $2) ON CONFLICT DO NOTHING",
+                    uuid, now);
             for (const WithdrawnCode& c : code_tombstones(code, sessions, now))
-                tx.exec_params("INSERT INTO withdrawn_codes (salt, code_hash, withdrawn_utc) "
-                               "VALUES ($1, $2, $3) ON CONFLICT DO NOTHING",
-                               c.salt, c.code_hash, c.withdrawn_utc);
+                tx.exec_params(
+                    "INSERT INTO withdrawn_codes (salt, code_hash, withdrawn_utc) "
+                    "VALUES ($1, $2, $3) ON CONFLICT DO NOTHING",
+                    c.salt, c.code_hash, c.withdrawn_utc);
         }
-        tx.exec_params("INSERT INTO retired_participant_numbers (number) SELECT number FROM "
-                       "participants WHERE code = $1 ON CONFLICT DO NOTHING",
-                       code);
+        tx.exec_params(
+            "INSERT INTO retired_participant_numbers (number) SELECT number FROM "
+            "participants WHERE code = $1 ON CONFLICT DO NOTHING",
+            code);
         const pqxx::result gone =
             tx.exec_params("DELETE FROM participants WHERE code = $1", code);
         tx.commit();
@@ -971,13 +1060,15 @@ bool PostgresStore::withdraw_participant(const std::string& code) {
     });
 }
 
-std::optional<ParticipantCounts> PostgresStore::participant_counts(const std::string& code) {
+std::optional<ParticipantCounts> PostgresStore::participant_counts(
+    const std::string& code) {
     return guarded("counting", [&]() -> std::optional<ParticipantCounts> {
         pqxx::work tx(connection());
         const pqxx::result r = tx.exec_params(
             "SELECT count(DISTINCT se.id), count(r.id) FROM participants p "
             "LEFT JOIN sessions se ON se.participant_id = p.id "
-            "LEFT JOIN responses r ON r.session_id = se.id WHERE p.code = $1 GROUP BY p.id",
+            "LEFT JOIN responses r ON r.session_id = se.id WHERE p.code = $1 GROUP BY "
+            "p.id",
             code);
         if (r.empty()) return std::nullopt;
         return ParticipantCounts{r[0][0].as<int64_t>(), r[0][1].as<int64_t>()};
@@ -997,10 +1088,11 @@ int64_t PostgresStore::query_int(const std::string& sql) {
 void PostgresStore::snapshot_to_sqlite(const std::string& sqlite_path) {
     // Parents before children, so every foreign key finds its row.
     static const char* const kTables[] = {
-        "studies",         "stimuli",         "stimulus_parameters", "stimulus_values",
-        "participants",    "retired_participant_numbers",            "sessions",
-        "session_segments", "segment_stimuli", "trials",              "responses",
-        "withdrawn_sessions", "withdrawn_codes", "consent_declines"};
+        "studies",         "stimuli",          "stimulus_parameters",
+        "stimulus_values", "participants",     "retired_participant_numbers",
+        "sessions",        "session_segments", "segment_stimuli",
+        "trials",          "responses",        "withdrawn_sessions",
+        "withdrawn_codes", "consent_declines"};
     Store out(sqlite_path);
     Database& db = out.db();
     guarded("taking a snapshot", [&] {
@@ -1008,9 +1100,11 @@ void PostgresStore::snapshot_to_sqlite(const std::string& sqlite_path) {
         pqxx::transaction<pqxx::repeatable_read, pqxx::read_only> tx(connection());
         Transaction write(db);
         for (const char* table : kTables) {
-            std::vector<std::pair<std::string, std::string>> columns;  // name, declared type
+            std::vector<std::pair<std::string, std::string>>
+                columns;  // name, declared type
             {
-                Statement info = db.prepare("SELECT name, type FROM pragma_table_info(?)");
+                Statement info =
+                    db.prepare("SELECT name, type FROM pragma_table_info(?)");
                 info.bind(1, table);
                 while (info.step()) columns.emplace_back(info.text(0), info.text(1));
             }
@@ -1019,13 +1113,14 @@ void PostgresStore::snapshot_to_sqlite(const std::string& sqlite_path) {
                 names += (names.empty() ? "" : ", ") + name;
                 marks += marks.empty() ? "?" : ", ?";
             }
-            Statement insert = db.prepare(std::string("INSERT INTO ") + table + " (" + names +
-                                          ") VALUES (" + marks + ")");
+            Statement insert = db.prepare(std::string("INSERT INTO ") + table + " (" +
+                                          names + ") VALUES (" + marks + ")");
             // Table and column names are this build's constants, never input.
-            for (const pqxx::row& r : tx.exec(std::string("SELECT ") + names + " FROM " + table +
-                                              " ORDER BY 1")) {
+            for (const pqxx::row& r : tx.exec(std::string("SELECT ") + names + " FROM " +
+                                              table + " ORDER BY 1")) {
                 insert.reset();
-                for (pqxx::row::size_type c = 0; c < pqxx::row::size_type(columns.size()); ++c) {
+                for (pqxx::row::size_type c = 0; c < pqxx::row::size_type(columns.size());
+                     ++c) {
                     const int index = static_cast<int>(c) + 1;
                     if (r[c].is_null())
                         insert.bind_null(index);

@@ -38,7 +38,8 @@ public:
 
     const std::string& name() const override { return name_; }
     int64_t ensure_study(const Protocol& protocol) override;
-    int64_t ensure_participant(int64_t study_id, const std::string& code, int* number) override;
+    int64_t ensure_participant(int64_t study_id, const std::string& code,
+                               int* number) override;
     void claim_participant(const std::string& code) override;
     // pg_advisory_unlock on this connection (a lost connection released it already).
     void release_participant(const std::string& code) override;
@@ -46,8 +47,9 @@ public:
                                const OnlineEnrolment& how,
                                const SessionEnvironment& env) override;
     void check_stimulus_values(const std::vector<StimulusProvenance>& stimuli) override;
-    SessionRow create_session(int64_t study_id, int64_t participant_id, const TrialPlan& plan,
-                              uint64_t seed, const SessionEnvironment& env) override;
+    SessionRow create_session(int64_t study_id, int64_t participant_id,
+                              const TrialPlan& plan, uint64_t seed,
+                              const SessionEnvironment& env) override;
     std::optional<SessionRow> unfinished_session(const std::string& code) override;
     bool has_completed_session(const std::string& code) override;
     std::vector<TrialRow> trials(int64_t session_id) override;
@@ -60,7 +62,8 @@ public:
     bool has_consent(int64_t session_id) override;
     // Journal first, then the server (see the file comment); the return value is the
     // server's when it answered, else whether every trial is now recorded here.
-    bool record_trial(int64_t session_id, int64_t trial_id, const TrialOutcome& outcome) override;
+    bool record_trial(int64_t session_id, int64_t trial_id,
+                      const TrialOutcome& outcome) override;
     bool complete_session_if_answered(int64_t session_id) override;
     // 'paused' while the server is unreachable is left as 'running' there (both resume).
     void set_status(int64_t session_id, const std::string& status, bool ended) override;
@@ -85,7 +88,7 @@ private:
     };
     enum class Sent { Stored, AlreadyThere, Withdrawn };
 
-    struct Connection;  // the libpqxx connection, kept out of this header
+    struct Connection;         // the libpqxx connection, kept out of this header
     Connection& connection();  // (re)connects; throws StoreError when unreachable
     void drop_connection();
     template <class F>
@@ -107,7 +110,8 @@ private:
     std::set<std::string> claimed_;
     std::map<int64_t, SessionCache> sessions_;
     int withdrawn_dropped_ = 0;  // journaled trials dropped: their session was withdrawn
-    int64_t next_attempt_ns_ = 0;  // steady clock; no server attempt before it after a failure
+    int64_t next_attempt_ns_ =
+        0;  // steady clock; no server attempt before it after a failure
 };
 
 }  // namespace lucent::study

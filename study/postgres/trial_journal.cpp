@@ -40,8 +40,10 @@ CREATE TABLE IF NOT EXISTS pending_responses (
 
 std::string state_dir() {
     if (const char* d = std::getenv("LUCENT_JOURNAL_DIR"); d && *d) return d;
-    if (const char* d = std::getenv("XDG_STATE_HOME"); d && *d) return std::string(d) + "/lucent";
-    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.local/state/lucent";
+    if (const char* d = std::getenv("XDG_STATE_HOME"); d && *d)
+        return std::string(d) + "/lucent";
+    if (const char* h = std::getenv("HOME"); h && *h)
+        return std::string(h) + "/.local/state/lucent";
     return ".";
 }
 
@@ -52,12 +54,13 @@ std::string default_journal_path(const std::string& server) {
 }
 
 TrialJournal::TrialJournal(const std::string& path, const std::string& server)
-    : db_(([&] {
-              std::error_code ec;
-              const auto parent = std::filesystem::path(path).parent_path();
-              if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-          }(),
-          path),
+    : db_((
+              [&] {
+                  std::error_code ec;
+                  const auto parent = std::filesystem::path(path).parent_path();
+                  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+              }(),
+              path),
           SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE),
       server_(server) {
     db_.exec("PRAGMA journal_mode = WAL");
@@ -78,13 +81,15 @@ TrialJournal::SendLock::SendLock(const TrialJournal& journal) {
     const std::string path = journal.path() + ".send-lock";
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
     if (fd_ < 0)
-        throw StoreError(path + ": cannot open the journal's send lock: " + std::strerror(errno));
+        throw StoreError(
+            path + ": cannot open the journal's send lock: " + std::strerror(errno));
     while (::flock(fd_, LOCK_EX) != 0) {
         if (errno == EINTR) continue;
         const int error = errno;
         ::close(fd_);
         fd_ = -1;
-        throw StoreError(path + ": cannot lock the journal for sending: " + std::strerror(error));
+        throw StoreError(
+            path + ": cannot lock the journal for sending: " + std::strerror(error));
     }
 }
 
@@ -100,11 +105,16 @@ bool TrialJournal::contains(const std::string& trial_uuid) {
 
 void TrialJournal::add(const JournaledTrial& t) {
     Transaction tx(db_);
-    db_.prepare("INSERT INTO pending_trials (trial_uuid, server, session_uuid, recorded_utc, "
-                "onset_ns, confirm_ns, dropped_frames, seq) VALUES (?, ?, ?, ?, ?, ?, ?, "
-                "(SELECT coalesce(max(seq), 0) + 1 FROM pending_trials))")
-        .bind(1, t.trial_uuid).bind(2, server_).bind(3, t.session_uuid).bind(4, t.recorded_utc)
-        .bind(5, t.outcome.onset_ns).bind(6, t.outcome.confirm_ns)
+    db_.prepare(
+           "INSERT INTO pending_trials (trial_uuid, server, session_uuid, recorded_utc, "
+           "onset_ns, confirm_ns, dropped_frames, seq) VALUES (?, ?, ?, ?, ?, ?, ?, "
+           "(SELECT coalesce(max(seq), 0) + 1 FROM pending_trials))")
+        .bind(1, t.trial_uuid)
+        .bind(2, server_)
+        .bind(3, t.session_uuid)
+        .bind(4, t.recorded_utc)
+        .bind(5, t.outcome.onset_ns)
+        .bind(6, t.outcome.confirm_ns)
         .bind(7, t.outcome.dropped_frames)
         .run();
     Statement r = db_.prepare(
@@ -112,20 +122,29 @@ void TrialJournal::add(const JournaledTrial& t) {
         "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?)");
     for (const Response& x : t.outcome.responses) {
         r.reset();
-        r.bind(1, t.trial_uuid).bind(2, x.question).bind(3, x.rating).bind(4, x.rt_ms)
-            .bind(5, x.changes).bind(6, x.first_choice_ns).bind(7, x.final_choice_ns).run();
+        r.bind(1, t.trial_uuid)
+            .bind(2, x.question)
+            .bind(3, x.rating)
+            .bind(4, x.rt_ms)
+            .bind(5, x.changes)
+            .bind(6, x.first_choice_ns)
+            .bind(7, x.final_choice_ns)
+            .run();
     }
     tx.commit();
 }
 
 void TrialJournal::remove(const std::string& trial_uuid) {
-    db_.prepare("DELETE FROM pending_trials WHERE trial_uuid = ?").bind(1, trial_uuid).run();
+    db_.prepare("DELETE FROM pending_trials WHERE trial_uuid = ?")
+        .bind(1, trial_uuid)
+        .run();
 }
 
 std::vector<JournaledTrial> TrialJournal::pending() {
     std::vector<JournaledTrial> out;
     Statement s = db_.prepare(
-        "SELECT trial_uuid, session_uuid, recorded_utc, onset_ns, confirm_ns, dropped_frames "
+        "SELECT trial_uuid, session_uuid, recorded_utc, onset_ns, confirm_ns, "
+        "dropped_frames "
         "FROM pending_trials WHERE server = ? ORDER BY seq");
     s.bind(1, server_);
     while (s.step()) {
@@ -145,9 +164,9 @@ std::vector<JournaledTrial> TrialJournal::pending() {
         r.reset();
         r.bind(1, t.trial_uuid);
         while (r.step())
-            t.outcome.responses.push_back({r.text(0), static_cast<int>(r.integer(1)), r.real(2),
-                                           static_cast<int>(r.integer(3)), r.integer(4),
-                                           r.integer(5)});
+            t.outcome.responses.push_back({r.text(0), static_cast<int>(r.integer(1)),
+                                           r.real(2), static_cast<int>(r.integer(3)),
+                                           r.integer(4), r.integer(5)});
     }
     return out;
 }

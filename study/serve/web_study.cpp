@@ -4,12 +4,11 @@
 // the state a page shows.
 #include "serve/web_study.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <stdexcept>
 
@@ -23,7 +22,8 @@ using nlohmann::json;
 
 namespace {
 
-// ---- [SECTION] tokens and names ----------------------------------------------------------
+// ---- [SECTION] tokens and names
+// ----------------------------------------------------------
 std::string bytes_of_hex(const std::string& hex) {
     std::string out;
     for (size_t i = 0; i + 1 < hex.size(); i += 2)
@@ -46,10 +46,12 @@ int hex_digit(char c) {
     return -1;
 }
 
-// ---- [SECTION] request fields ------------------------------------------------------------
-// A refused request: HTTP status and one line.
+// ---- [SECTION] request fields
+// ------------------------------------------------------------ A refused request: HTTP
+// status and one line.
 struct RequestError : std::runtime_error {
-    RequestError(int status, const std::string& what) : std::runtime_error(what), status(status) {}
+    RequestError(int status, const std::string& what)
+        : std::runtime_error(what), status(status) {}
     int status;
 };
 
@@ -73,10 +75,12 @@ const json* field(const json& body, const char* key) {
     return it == body.end() || it->is_null() ? nullptr : &*it;
 }
 
-std::string text_field(const json& body, const char* key, size_t max_length, bool required) {
+std::string text_field(const json& body, const char* key, size_t max_length,
+                       bool required) {
     const json* value = field(body, key);
     if (!value) {
-        if (required) throw RequestError(400, std::string("field '") + key + "' is required");
+        if (required)
+            throw RequestError(400, std::string("field '") + key + "' is required");
         return "";
     }
     if (!value->is_string())
@@ -89,11 +93,12 @@ std::string text_field(const json& body, const char* key, size_t max_length, boo
 }
 
 // A finite number in [lo, hi].
-std::optional<double> number_field(const json& body, const char* key, double lo, double hi,
-                                   bool required) {
+std::optional<double> number_field(const json& body, const char* key, double lo,
+                                   double hi, bool required) {
     const json* value = field(body, key);
     if (!value) {
-        if (required) throw RequestError(400, std::string("field '") + key + "' is required");
+        if (required)
+            throw RequestError(400, std::string("field '") + key + "' is required");
         return std::nullopt;
     }
     if (!value->is_number())
@@ -118,13 +123,15 @@ void check_code(const std::string& code, const char* what) {
 
 int64_t random_seed() {
     std::random_device device;
-    return static_cast<int64_t>((uint64_t(device()) << 32 | device()) & 0x7FFFFFFFFFFFFFFFull);
+    return static_cast<int64_t>((uint64_t(device()) << 32 | device()) &
+                                0x7FFFFFFFFFFFFFFFull);
 }
 
 std::string css_colour(const float rgb[3]) {
     // The protocol's background is linear; the page takes sRGB.
     auto encode = [](float c) {
-        const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+        const double s =
+            c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
         return static_cast<int>(std::lround(std::clamp(s, 0.0, 1.0) * 255));
     };
     char out[8];
@@ -135,14 +142,21 @@ std::string css_colour(const float rgb[3]) {
 
 const char* screen_name(Screen screen) {
     switch (screen) {
-    case Screen::Consent: return "consent";
-    case Screen::Instructions: return "instructions";
-    case Screen::PracticeDone: return "practice_done";
-    case Screen::Blank:
-    case Screen::Trial: return "trial";
-    case Screen::Break: return "break";
-    case Screen::Debrief: return "debrief";
-    case Screen::Done: return "done";
+        case Screen::Consent:
+            return "consent";
+        case Screen::Instructions:
+            return "instructions";
+        case Screen::PracticeDone:
+            return "practice_done";
+        case Screen::Blank:
+        case Screen::Trial:
+            return "trial";
+        case Screen::Break:
+            return "break";
+        case Screen::Debrief:
+            return "debrief";
+        case Screen::Done:
+            return "done";
     }
     return "done";
 }
@@ -151,7 +165,8 @@ const char* screen_name(Screen screen) {
 
 std::string hmac_sha256_hex(std::string_view key, std::string_view message) {
     constexpr size_t kBlock = 64;
-    std::string k = key.size() > kBlock ? bytes_of_hex(sha256_hex(key)) : std::string(key);
+    std::string k =
+        key.size() > kBlock ? bytes_of_hex(sha256_hex(key)) : std::string(key);
     k.resize(kBlock, '\0');
     std::string inner(kBlock, '\0'), outer(kBlock, '\0');
     for (size_t i = 0; i < kBlock; ++i) {
@@ -176,8 +191,8 @@ std::string session_token(std::string_view secret, std::string_view code,
     return std::string(code) + "." + hmac_sha256_hex(secret, session_uuid);
 }
 
-std::optional<std::string> image_of_target(std::string_view target,
-                                           const std::map<std::string, WebImage>& images) {
+std::optional<std::string> image_of_target(
+    std::string_view target, const std::map<std::string, WebImage>& images) {
     target = target.substr(0, target.find('?'));
     std::string path;
     for (size_t i = 0; i < target.size(); ++i) {
@@ -185,32 +200,38 @@ std::optional<std::string> image_of_target(std::string_view target,
             path += target[i];
             continue;
         }
-        if (i + 2 >= target.size() || hex_digit(target[i + 1]) < 0 || hex_digit(target[i + 2]) < 0)
+        if (i + 2 >= target.size() || hex_digit(target[i + 1]) < 0 ||
+            hex_digit(target[i + 2]) < 0)
             return std::nullopt;
-        path += static_cast<char>(hex_digit(target[i + 1]) * 16 + hex_digit(target[i + 2]));
+        path +=
+            static_cast<char>(hex_digit(target[i + 1]) * 16 + hex_digit(target[i + 2]));
         i += 2;
     }
     const std::string_view prefix = "/images/", suffix = ".png";
-    if (path.size() <= prefix.size() + suffix.size() || path.compare(0, prefix.size(), prefix) != 0 ||
+    if (path.size() <= prefix.size() + suffix.size() ||
+        path.compare(0, prefix.size(), prefix) != 0 ||
         path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
         return std::nullopt;
-    const std::string id = path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
+    const std::string id =
+        path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
     // A name, never a path: no separator, no parent, nothing a file system would resolve.
-    if (id.find_first_of("/\\%") != std::string::npos || id.find("..") != std::string::npos ||
-        id.find('\0') != std::string::npos || !images.count(id))
+    if (id.find_first_of("/\\%") != std::string::npos ||
+        id.find("..") != std::string::npos || id.find('\0') != std::string::npos ||
+        !images.count(id))
         return std::nullopt;
     return id;
 }
 
-// ---- [SECTION] sessions -----------------------------------------------------------------
-// A page is `pending` from its first request until the participant agrees on the consent
-// screen: held in memory only (the session UUID and so its token, the seed, what the
-// browser said), nothing stored. Agreeing enrols it (StudyStore::enrol_online), and from
-// then on it is a session like a lab station's.
+// ---- [SECTION] sessions
+// ----------------------------------------------------------------- A page is `pending`
+// from its first request until the participant agrees on the consent screen: held in
+// memory only (the session UUID and so its token, the seed, what the browser said),
+// nothing stored. Agreeing enrols it (StudyStore::enrol_online), and from then on it is a
+// session like a lab station's.
 struct WebStudy::Live {
     std::string code;
     bool pending = false;
-    uint64_t seed = 0;  // pending: the seed its plan will have
+    uint64_t seed = 0;   // pending: the seed its plan will have
     SessionRow session;  // pending: only the UUID
     std::string token;
     std::vector<TrialRow> trials;  // as stored when loaded; `answered` kept up to date
@@ -230,7 +251,8 @@ namespace {
 constexpr int kConsentView = 1;
 
 const char* const kWithdrawn =
-    "this session was withdrawn: nothing more of it is recorded. You may close this window.";
+    "this session was withdrawn: nothing more of it is recorded. You may close this "
+    "window.";
 
 }  // namespace
 
@@ -238,7 +260,8 @@ WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions 
     : protocol_(protocol), store_(store), options_(std::move(options)) {
     for (const StimulusSpec& s : protocol_.stimuli)
         if (!options_.images.count(s.id))
-            throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id + "'");
+            throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id +
+                                        "'");
     if (!options_.clock) options_.clock = [] { return std::chrono::system_clock::now(); };
     study_id_ = store_.ensure_study(protocol_);
     store_.check_stimulus_values(options_.environment.stimuli);
@@ -249,8 +272,9 @@ WebStudy::~WebStudy() = default;
 std::chrono::system_clock::time_point WebStudy::now() const { return options_.clock(); }
 
 std::string WebStudy::active_since_utc() const {
-    return utc_iso8601(now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
-                               options_.idle_timeout));
+    return utc_iso8601(now() -
+                       std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                           options_.idle_timeout));
 }
 
 size_t WebStudy::live_sessions() const {
@@ -273,18 +297,22 @@ size_t WebStudy::release_idle() {
 }
 
 size_t WebStudy::release_idle_locked() {
-    const auto cutoff = now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
-                                    options_.idle_timeout);
+    const auto cutoff =
+        now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                    options_.idle_timeout);
     std::vector<std::string> idle;
     for (const auto& [code, live] : live_)
         if (live->seen < cutoff) idle.push_back(code);
     for (const std::string& code : idle) {
         Live& live = *live_.at(code);
-        if (!live.pending && live.flow && live.flow->answered_trials() < live.flow->total_trials()) {
+        if (!live.pending && live.flow &&
+            live.flow->answered_trials() < live.flow->total_trials()) {
             try {
-                store_.set_status(live.session.id, "paused", false);  // as a lab quit leaves it
+                store_.set_status(live.session.id, "paused",
+                                  false);  // as a lab quit leaves it
             } catch (const std::exception&) {
-                // Withdrawn, completed meanwhile, or the server away: the claim ends anyway.
+                // Withdrawn, completed meanwhile, or the server away: the claim ends
+                // anyway.
             }
         }
         drop(code);
@@ -320,13 +348,15 @@ WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
         });
     } catch (const json::out_of_range&) {
         // A number beyond a double (e.g. 1e999): the parser stops at it.
-        return error_reply(400, last_key.empty()
-                                    ? std::string("a number in the request is beyond a double's range")
-                                    : "field '" + last_key + "' holds a number beyond a double's range");
+        return error_reply(
+            400, last_key.empty()
+                     ? std::string("a number in the request is beyond a double's range")
+                     : "field '" + last_key + "' holds a number beyond a double's range");
     } catch (const json::exception& e) {
         return error_reply(400, std::string("malformed JSON: ") + e.what());
     }
-    if (!request.is_object()) return error_reply(400, "the request body must be a JSON object");
+    if (!request.is_object())
+        return error_reply(400, "the request body must be a JSON object");
     std::lock_guard lock(mutex_);
     try {
         release_idle_locked();
@@ -389,12 +419,14 @@ WebReply WebStudy::start(const json& body) {
     std::string code = text_field(body, "participant", kMaxCodeLength + 1, false);
     std::string prolific_study, prolific_session;
     if (const json* prolific = field(body, "prolific")) {
-        if (!prolific->is_object()) throw RequestError(400, "field 'prolific' must be an object");
-        const std::string pid = text_field(*prolific, "PROLIFIC_PID", kMaxCodeLength + 1, true);
+        if (!prolific->is_object())
+            throw RequestError(400, "field 'prolific' must be an object");
+        const std::string pid =
+            text_field(*prolific, "PROLIFIC_PID", kMaxCodeLength + 1, true);
         check_code(pid, "PROLIFIC_PID");
         if (!code.empty() && code != pid)
-            throw RequestError(400, "participant '" + code + "' and PROLIFIC_PID '" + pid +
-                                        "' differ");
+            throw RequestError(
+                400, "participant '" + code + "' and PROLIFIC_PID '" + pid + "' differ");
         code = pid;
         prolific_study = text_field(*prolific, "STUDY_ID", kMaxCodeLength + 1, false);
         prolific_session = text_field(*prolific, "SESSION_ID", kMaxCodeLength + 1, false);
@@ -402,21 +434,29 @@ WebReply WebStudy::start(const json& body) {
         if (!prolific_session.empty()) check_code(prolific_session, "SESSION_ID");
     }
     if (code.empty())
-        throw RequestError(400, "no participant code (the link needs ?participant=ID or "
-                                "Prolific's PROLIFIC_PID)");
+        throw RequestError(400,
+                           "no participant code (the link needs ?participant=ID or "
+                           "Prolific's PROLIFIC_PID)");
     check_code(code, "participant code");
     const std::string token = text_field(body, "token", kMaxTokenLength, false);
     const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
 
     Live browser;  // what this page says about itself
     if (const json* client = field(body, "client")) {
-        if (!client->is_object()) throw RequestError(400, "field 'client' must be an object");
-        browser.user_agent = text_field(*client, "user_agent", kMaxUserAgentLength, false);
-        browser.window_width = static_cast<int>(number_field(*client, "window_width", 0, 1e5, false).value_or(0));
-        browser.window_height = static_cast<int>(number_field(*client, "window_height", 0, 1e5, false).value_or(0));
-        browser.screen_width = static_cast<int>(number_field(*client, "screen_width", 0, 1e5, false).value_or(0));
-        browser.screen_height = static_cast<int>(number_field(*client, "screen_height", 0, 1e5, false).value_or(0));
-        browser.device_pixel_ratio = number_field(*client, "device_pixel_ratio", 0.05, 16, false).value_or(0);
+        if (!client->is_object())
+            throw RequestError(400, "field 'client' must be an object");
+        browser.user_agent =
+            text_field(*client, "user_agent", kMaxUserAgentLength, false);
+        browser.window_width = static_cast<int>(
+            number_field(*client, "window_width", 0, 1e5, false).value_or(0));
+        browser.window_height = static_cast<int>(
+            number_field(*client, "window_height", 0, 1e5, false).value_or(0));
+        browser.screen_width = static_cast<int>(
+            number_field(*client, "screen_width", 0, 1e5, false).value_or(0));
+        browser.screen_height = static_cast<int>(
+            number_field(*client, "screen_height", 0, 1e5, false).value_or(0));
+        browser.device_pixel_ratio =
+            number_field(*client, "device_pixel_ratio", 0.05, 16, false).value_or(0);
         browser.refresh_hz = number_field(*client, "refresh_hz", 1, 1000, false);
     }
     browser.prolific_study = prolific_study;
@@ -433,17 +473,20 @@ WebReply WebStudy::start(const json& body) {
         live.prolific_session = browser.prolific_session;
     };
     const std::string in_progress =
-        "participant '" + code + "' has a session in progress in another browser; continue "
+        "participant '" + code +
+        "' has a session in progress in another browser; continue "
         "it there (the study link in that browser holds its key)";
 
     std::optional<SessionRow> unfinished = store_.unfinished_session(code);
-    if (const auto it = live_.find(code); it != live_.end() && !it->second->pending &&
-                                          (!unfinished || unfinished->id != it->second->session.id)) {
+    if (const auto it = live_.find(code);
+        it != live_.end() && !it->second->pending &&
+        (!unfinished || unfinished->id != it->second->session.id)) {
         // The loaded session is no longer an unfinished one of the store: completed, or
         // withdrawn (`participants withdraw`) while its page was open.
         const bool same_page = same_secret_text(token, it->second->token);
         drop(code);
-        if (same_page && !store_.has_completed_session(code) && !store_.participant_counts(code))
+        if (same_page && !store_.has_completed_session(code) &&
+            !store_.participant_counts(code))
             throw RequestError(410, kWithdrawn);
     }
     if (unfinished && store_.complete_session_if_answered(unfinished->id)) {
@@ -453,7 +496,8 @@ WebReply WebStudy::start(const json& body) {
     // A page (re)loaded for a session in progress: from the first unanswered trial, as
     // `lucent run --resume` does; a new segment only once the last one has an answer.
     if (unfinished) {
-        const std::string expected = session_token(options_.secret, code, unfinished->uuid);
+        const std::string expected =
+            session_token(options_.secret, code, unfinished->uuid);
         if (!same_secret_text(token, expected)) throw RequestError(403, in_progress);
         store_.claim_participant(code);
         Live probe;
@@ -479,19 +523,22 @@ WebReply WebStudy::start(const json& body) {
     // A new participant: the consent screen, nothing stored (the same page reloaded
     // keeps its pending session; another page without its token starts a new one).
     const auto it = live_.find(code);
-    if (it == live_.end() || !it->second->pending || !same_secret_text(token, it->second->token)) {
+    if (it == live_.end() || !it->second->pending ||
+        !same_secret_text(token, it->second->token)) {
         drop(code);
         if (live_.size() >= options_.max_pending) {
             // Forget the pending page idle longest (it holds nothing but memory).
             auto oldest = live_.end();
             for (auto i = live_.begin(); i != live_.end(); ++i)
-                if (i->second->pending && (oldest == live_.end() || i->second->seen < oldest->second->seen))
+                if (i->second->pending &&
+                    (oldest == live_.end() || i->second->seen < oldest->second->seen))
                     oldest = i;
             if (oldest != live_.end()) live_.erase(oldest);
         }
         SessionRow planned;
         planned.uuid = new_uuid_v4();
-        Live& live = load(code, planned, session_token(options_.secret, code, planned.uuid));
+        Live& live =
+            load(code, planned, session_token(options_.secret, code, planned.uuid));
         live.pending = true;
         live.seed = static_cast<uint64_t>(random_seed());
     }
@@ -521,10 +568,12 @@ WebReply WebStudy::consent(Live& live, bool decline, double shown_ms, double t_m
     if (decline) {
         store_.count_declined_consent(study_id_);
         drop(code);
-        return {200, to_text(json{{"screen", "declined"},
-                          {"text", "You did not agree to take part. Nothing of yours was "
-                                   "stored; the study counts only that one person declined. "
-                                   "You may close this window."}})};
+        return {200,
+                to_text(json{{"screen", "declined"},
+                             {"text",
+                              "You did not agree to take part. Nothing of yours was "
+                              "stored; the study counts only that one person declined. "
+                              "You may close this window."}})};
     }
     store_.claim_participant(code);
     OnlineSession enrolled;
@@ -574,7 +623,8 @@ json WebStudy::pending_state(const Live& live) const {
     return out;
 }
 
-// ---- [SECTION] actions -------------------------------------------------------------------
+// ---- [SECTION] actions
+// -------------------------------------------------------------------
 WebReply WebStudy::act(std::string_view endpoint, const json& body) {
     const std::string token = text_field(body, "token", kMaxTokenLength, true);
     const size_t dot = token.rfind('.');
@@ -584,8 +634,9 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
         // Not loaded here (the server restarted, the page was idle, or the session
         // ended): the page starts again through /api/session, which checks the token
         // against the store.
-        throw RequestError(409, "session of '" + code + "' is not loaded; start it again "
-                                "(POST /api/session with its token)");
+        throw RequestError(409, "session of '" + code +
+                                    "' is not loaded; start it again "
+                                    "(POST /api/session with its token)");
     }
     if (it == live_.end() || !same_secret_text(token, it->second->token))
         throw RequestError(403, "unknown session token");
@@ -595,7 +646,8 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
     if (live.pending) {
         if (endpoint == "state") return {200, to_text(pending_state(live))};
         if (endpoint == "environment") {
-            live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);  // kept in memory
+            live.refresh_hz =
+                number_field(body, "refresh_hz", 1, 1000, true);  // kept in memory
             return {200, to_text(pending_state(live))};
         }
         if (endpoint == "answer")
@@ -608,7 +660,8 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
                                         " is no longer shown (now view " +
                                         std::to_string(kConsentView) + ")");
         if (t_ms < shown_ms)
-            throw RequestError(400, "the key came before the screen was shown (t_ms < shown_ms)");
+            throw RequestError(
+                400, "the key came before the screen was shown (t_ms < shown_ms)");
         return consent(live, endpoint == "decline", shown_ms, t_ms);
     }
 
@@ -623,7 +676,8 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
         if (endpoint == "answer") {
             WebReply reply = answer(live, body);
             if (live.flow->answered_trials() == live.flow->total_trials())
-                store_.release_participant(code);  // completed: the debrief writes nothing
+                store_.release_participant(
+                    code);  // completed: the debrief writes nothing
             return reply;
         }
 
@@ -646,14 +700,17 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
         next.presented(next.serial(), ms_to_ns(shown_ms));
         next.key({decline ? Key::Decline : Key::Enter, 0, ms_to_ns(t_ms)});
         if (next.serial() == flow.serial() && !next.finished())
-            throw RequestError(400, "the key came before the screen was shown (t_ms < shown_ms)");
+            throw RequestError(
+                400, "the key came before the screen was shown (t_ms < shown_ms)");
         if (decline) {
             // A session stored before consent (by a lab station, or an older lucent
             // serve) is left 'aborted', as a lab decline leaves it.
             drop(code);
-            return {200, to_text(json{{"screen", "declined"},
-                              {"text", "You did not agree to take part. You may close this "
-                                       "window."}})};
+            return {200,
+                    to_text(json{{"screen", "declined"},
+                                 {"text",
+                                  "You did not agree to take part. You may close this "
+                                  "window."}})};
         }
         live.flow.emplace(next);
         if (next.screen() == Screen::Done) {
@@ -677,10 +734,12 @@ WebReply WebStudy::answer(Live& live, const json& body) {
     const std::string trial_uuid = text_field(body, "trial", 64, true);
     const TrialRow* current = flow.trial();
     if (!current || current->uuid != trial_uuid) {
-        const auto it = std::find_if(live.trials.begin(), live.trials.end(),
-                                     [&](const TrialRow& t) { return t.uuid == trial_uuid; });
+        const auto it =
+            std::find_if(live.trials.begin(), live.trials.end(),
+                         [&](const TrialRow& t) { return t.uuid == trial_uuid; });
         if (it == live.trials.end())
-            throw RequestError(404, "trial '" + trial_uuid + "' is not one of this session's trials");
+            throw RequestError(
+                404, "trial '" + trial_uuid + "' is not one of this session's trials");
         if (it->answered)
             throw RequestError(409, "trial " + std::to_string(it->position + 1) +
                                         " is already answered");
@@ -697,11 +756,13 @@ WebReply WebStudy::answer(Live& live, const json& body) {
     if (!events || !events->is_array())
         throw RequestError(400, "field 'events' must be an array");
     if (events->size() > kMaxEventsPerAnswer)
-        throw RequestError(400, "more than " + std::to_string(kMaxEventsPerAnswer) + " events");
+        throw RequestError(
+            400, "more than " + std::to_string(kMaxEventsPerAnswer) + " events");
 
     // Every event checked before any is replayed.
     int max_points = 0;
-    for (const Question& q : protocol_.questions) max_points = std::max(max_points, q.points());
+    for (const Question& q : protocol_.questions)
+        max_points = std::max(max_points, q.points());
     struct Event {
         enum class Kind { Key, Point, Next } kind;
         Key key = Key::Enter;
@@ -720,7 +781,8 @@ WebReply WebStudy::answer(Live& live, const json& body) {
                 ev.key = Key::Digit;
                 ev.digit = key[0] - '0';
                 if (ev.digit > max_points)
-                    throw RequestError(400, "key '" + key + "' is outside every scale (1.." +
+                    throw RequestError(400, "key '" + key +
+                                                "' is outside every scale (1.." +
                                                 std::to_string(max_points) + ")");
             } else if (key == "Enter") {
                 ev.key = Key::Enter;
@@ -738,20 +800,20 @@ WebReply WebStudy::answer(Live& live, const json& body) {
         } else if (type == "point") {
             ev.kind = Event::Kind::Point;
             const double q = *number_field(e, "question", 0, 1e6, true);
-            if (q != std::floor(q) || q >= static_cast<double>(protocol_.questions.size()))
-                throw RequestError(400, "question index " + json(q).dump() +
-                                            " is not one of the " +
-                                            std::to_string(protocol_.questions.size()) +
-                                            " questions");
+            if (q != std::floor(q) ||
+                q >= static_cast<double>(protocol_.questions.size()))
+                throw RequestError(
+                    400, "question index " + json(q).dump() + " is not one of the " +
+                             std::to_string(protocol_.questions.size()) + " questions");
             ev.question = static_cast<int>(q);
             const Question& question = protocol_.questions[ev.question];
             const json* v = field(e, "value");
             if (!v || !v->is_number_integer() || v->get<int64_t>() < 1 ||
                 v->get<int64_t>() > question.points())
-                throw RequestError(400, "rating " + (v ? v->dump() : std::string("(none)")) +
-                                            " is outside 1.." +
-                                            std::to_string(question.points()) +
-                                            " of question '" + question.id + "'");
+                throw RequestError(
+                    400, "rating " + (v ? v->dump() : std::string("(none)")) +
+                             " is outside 1.." + std::to_string(question.points()) +
+                             " of question '" + question.id + "'");
             ev.value = static_cast<int>(v->get<int64_t>());
         } else if (type == "next") {
             ev.kind = Event::Kind::Next;
@@ -773,23 +835,32 @@ WebReply WebStudy::answer(Live& live, const json& body) {
     next.presented(next.serial(), onset_ns);
     const size_t answered_before = next.answered_trials();
     for (const Event& ev : replay) {
-        if (next.answered_trials() != answered_before) break;  // confirmed: the rest is late
+        if (next.answered_trials() != answered_before)
+            break;  // confirmed: the rest is late
         switch (ev.kind) {
-        case Event::Kind::Key: next.key({ev.key, ev.digit, ev.t_ns}); break;
-        case Event::Kind::Point: next.click_point(ev.question, ev.value, ev.t_ns); break;
-        case Event::Kind::Next: next.click_next(ev.t_ns); break;
+            case Event::Kind::Key:
+                next.key({ev.key, ev.digit, ev.t_ns});
+                break;
+            case Event::Kind::Point:
+                next.click_point(ev.question, ev.value, ev.t_ns);
+                break;
+            case Event::Kind::Next:
+                next.click_next(ev.t_ns);
+                break;
         }
     }
     if (next.answered_trials() == answered_before)
-        throw RequestError(400, "the events do not rate every question and confirm it "
-                                "(Enter or Next) after the picture's onset");
+        throw RequestError(400,
+                           "the events do not rate every question and confirm it "
+                           "(Enter or Next) after the picture's onset");
     for (TrialRow& t : live.trials)
         if (t.uuid == trial_uuid) t.answered = true;
     live.flow.emplace(next);
     return {200, to_text(state(live))};
 }
 
-// ---- [SECTION] the state a page shows ---------------------------------------------------
+// ---- [SECTION] the state a page shows
+// ---------------------------------------------------
 json WebStudy::done_state() const {
     json out{{"screen", "done"},
              {"text", "Thank you: the study is complete and your answers are saved."}};
@@ -809,7 +880,8 @@ json WebStudy::state(const Live& live) const {
     out["view"] = flow.serial();
     out["title"] = protocol_.title;
     out["background"] = css_colour(protocol_.background);
-    out["progress"] = {{"done", flow.main_trials_done()}, {"total", flow.main_trials_total()}};
+    out["progress"] = {{"done", flow.main_trials_done()},
+                       {"total", flow.main_trials_total()}};
     json questions = json::array();
     for (const Question& q : protocol_.questions)
         questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});

@@ -13,8 +13,6 @@
 // in the lab, and the trial is committed to the store before the reply names the next
 // screen. A refused request (4xx, one-line reason) changes nothing: each action runs on
 // a copy of the participant's flow, kept only when it succeeded.
-#include <nlohmann/json_fwd.hpp>
-
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -22,6 +20,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -106,7 +105,8 @@ private:
     nlohmann::json state(const Live& live) const;
     nlohmann::json done_state() const;
     SessionEnvironment environment_for(const Live& live) const;
-    Live& load(const std::string& code, const SessionRow& session, const std::string& token);
+    Live& load(const std::string& code, const SessionRow& session,
+               const std::string& token);
     // Forgets a page; ends the claim when its session was loaded.
     void drop(const std::string& code);
     size_t release_idle_locked();

@@ -10,8 +10,9 @@
 namespace lucent::study {
 namespace {
 
-const std::set<std::string> kKeys = {"1", "2", "3", "4", "5", "6", "7", "8", "9", "Enter",
-                                     "Escape", "Left", "Right", "Up", "Down", "Q", "R"};
+const std::set<std::string> kKeys = {"1",     "2",  "3",    "4",     "5",      "6",
+                                     "7",     "8",  "9",    "Enter", "Escape", "Left",
+                                     "Right", "Up", "Down", "Q",     "R"};
 
 }  // namespace
 
@@ -35,9 +36,10 @@ Autopilot Autopilot::from_file(const std::string& path) {
         std::string key;
         if (!(words >> delay)) continue;  // blank or comment
         if (!(words >> key) || !kKeys.count(key) || delay < 0 || !std::isfinite(delay))
-            throw std::runtime_error(path + ":" + std::to_string(n) +
-                                     ": expected 'DELAY_MS KEY' with KEY one of 1-9, Enter, "
-                                     "Escape, Left, Right, Up, Down, Q, R");
+            throw std::runtime_error(
+                path + ":" + std::to_string(n) +
+                ": expected 'DELAY_MS KEY' with KEY one of 1-9, Enter, "
+                "Escape, Left, Right, Up, Down, Q, R");
         a.script_.emplace_back(delay, key);
     }
     return a;
@@ -63,25 +65,33 @@ void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
         queue_.push_back({now_ns + static_cast<int64_t>(t * 1e6), key});
     };
     switch (view.kind) {
-    case ScreenView::Kind::Blank: break;
-    case ScreenView::Kind::Text: press(delay_ms(1500), "Enter"); break;
-    case ScreenView::Kind::Pause: press(delay_ms(800), "Enter"); break;
-    case ScreenView::Kind::Rating: {
-        std::bernoulli_distribution change_mind(0.15);
-        for (size_t q = 0; q < view.points.size(); ++q) {
-            const int points = std::max(1, view.points[q]);  // this question's own scale
-            std::uniform_int_distribution<int> point(1, points);
-            const int rating = view.is_catch ? view.expected : point(rng_);
-            if (change_mind(rng_) && !view.is_catch) {  // first pick, then a correction
-                press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating % points + 1));
-                press(delay_ms(350), std::to_string(rating));
-            } else {
-                press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating));
+        case ScreenView::Kind::Blank:
+            break;
+        case ScreenView::Kind::Text:
+            press(delay_ms(1500), "Enter");
+            break;
+        case ScreenView::Kind::Pause:
+            press(delay_ms(800), "Enter");
+            break;
+        case ScreenView::Kind::Rating: {
+            std::bernoulli_distribution change_mind(0.15);
+            for (size_t q = 0; q < view.points.size(); ++q) {
+                const int points =
+                    std::max(1, view.points[q]);  // this question's own scale
+                std::uniform_int_distribution<int> point(1, points);
+                const int rating = view.is_catch ? view.expected : point(rng_);
+                if (change_mind(rng_) &&
+                    !view.is_catch) {  // first pick, then a correction
+                    press(delay_ms(q == 0 ? 1200 : 700),
+                          std::to_string(rating % points + 1));
+                    press(delay_ms(350), std::to_string(rating));
+                } else {
+                    press(delay_ms(q == 0 ? 1200 : 700), std::to_string(rating));
+                }
+                press(delay_ms(250), "Enter");  // next statement; after the last: confirm
             }
-            press(delay_ms(250), "Enter");  // next statement; after the last: confirm
+            break;
         }
-        break;
-    }
     }
 }
 

@@ -16,13 +16,14 @@ struct ScreenView {
     Kind kind = Kind::Blank;
     int serial = 0;           // increases whenever a new screen appears
     std::vector<int> points;  // rating screens: each question's scale length
-    bool is_catch = false;  // catch trials: the prompt asks for `expected`
+    bool is_catch = false;    // catch trials: the prompt asks for `expected`
     int expected = 0;
 };
 
 struct ScheduledKey {
     int64_t at_ns = 0;
-    std::string key;  // "1".."9", "Enter", "Escape", "Left", "Right", "Up", "Down", "Q", "R"
+    std::string
+        key;  // "1".."9", "Enter", "Escape", "Left", "Right", "Up", "Down", "Q", "R"
 };
 
 class Autopilot {

@@ -6,22 +6,26 @@
 
 namespace lucent::study {
 
-RefreshEstimate estimate_refresh(int mode_refresh_hz, const std::vector<int64_t>& swaps_ns) {
+RefreshEstimate estimate_refresh(int mode_refresh_hz,
+                                 const std::vector<int64_t>& swaps_ns) {
     RefreshEstimate e;
     if (mode_refresh_hz <= 0) {
-        e.note = "refresh unknown: the video mode reports 0 Hz (e.g. Xvfb), so swaps are not "
-                 "paced by a display; recorded as NULL";
+        e.note =
+            "refresh unknown: the video mode reports 0 Hz (e.g. Xvfb), so swaps are not "
+            "paced by a display; recorded as NULL";
         return e;
     }
     e.mode_hz = mode_refresh_hz;
     std::vector<int64_t> intervals;
     for (size_t i = 1; i < swaps_ns.size(); ++i)
-        if (swaps_ns[i] > swaps_ns[i - 1]) intervals.push_back(swaps_ns[i] - swaps_ns[i - 1]);
+        if (swaps_ns[i] > swaps_ns[i - 1])
+            intervals.push_back(swaps_ns[i] - swaps_ns[i - 1]);
     if (intervals.size() < 10) {
         e.note = "refresh not measured: fewer than 10 swap intervals";
         return e;
     }
-    std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
+    std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2,
+                     intervals.end());
     const double median_ns = static_cast<double>(intervals[intervals.size() / 2]);
     e.measured_hz = 1e9 / median_ns;
     const double rel = std::abs(*e.measured_hz - mode_refresh_hz) / mode_refresh_hz;

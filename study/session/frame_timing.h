@@ -18,7 +18,8 @@ struct RefreshEstimate {
 // swaps_ns: steady-clock times right after consecutive vsynced swaps. A mode of 0 Hz
 // (Xvfb, some virtual displays) means swaps are not paced by a display: the refresh is
 // unknown and nothing is invented.
-RefreshEstimate estimate_refresh(int mode_refresh_hz, const std::vector<int64_t>& swaps_ns);
+RefreshEstimate estimate_refresh(int mode_refresh_hz,
+                                 const std::vector<int64_t>& swaps_ns);
 
 // Frames that took longer than 1.5 periods between consecutive swaps count as dropped
 // (an interval of k periods drops k-1 frames, rounded).

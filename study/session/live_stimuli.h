@@ -10,7 +10,8 @@ namespace lucent::study {
 
 class LiveOrPrerenderedStimuli : public StimulusRenderer {
 public:
-    explicit LiveOrPrerenderedStimuli(std::string images_dir) : images_(std::move(images_dir)) {}
+    explicit LiveOrPrerenderedStimuli(std::string images_dir)
+        : images_(std::move(images_dir)) {}
     // Pre-rendered file if there is one, else renders technique + parameters at
     // width x height into a texture (GL context current), sRGB-encoded as PNG output.
     StimulusTexture render(const StimulusSpec& spec, int width, int height) override;

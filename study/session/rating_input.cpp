@@ -10,9 +10,12 @@ RatingInput::RatingInput(std::vector<int> points, int64_t onset_ns)
 void RatingInput::set(int question, int value, int64_t t_ns) {
     if (confirmed_ || value < 1 || value > points_[question]) return;
     State& s = state_[question];
-    if (!s.rating) s.first_ns = t_ns;
-    else if (*s.rating != value) ++s.changes;
-    else return;  // the same value again is not a change
+    if (!s.rating)
+        s.first_ns = t_ns;
+    else if (*s.rating != value)
+        ++s.changes;
+    else
+        return;  // the same value again is not a change
     s.rating = value;
     s.final_ns = t_ns;
 }
@@ -23,25 +26,36 @@ void RatingInput::key(RatingKey key, int digit, int64_t t_ns) {
     State& s = state_[focus_];
     const int points = points_[focus_];
     switch (key) {
-    case RatingKey::Digit: set(focus_, digit, t_ns); break;
-    // The first arrow press picks the middle point: nothing is chosen before a key.
-    case RatingKey::Left: set(focus_, s.rating ? std::max(1, *s.rating - 1) : (points + 1) / 2, t_ns); break;
-    case RatingKey::Right: set(focus_, s.rating ? std::min(points, *s.rating + 1) : (points + 1) / 2, t_ns); break;
-    case RatingKey::Up: focus_ = std::max(0, focus_ - 1); break;
-    case RatingKey::Down: focus_ = std::min(n - 1, focus_ + 1); break;
-    case RatingKey::Enter:
-        if (!s.rating) break;  // Enter never answers for the participant
-        if (all_answered()) {
-            confirmed_ = true;
-            confirm_ns_ = t_ns;
+        case RatingKey::Digit:
+            set(focus_, digit, t_ns);
             break;
-        }
-        for (int step = 1; step <= n; ++step)  // on to the next unanswered statement
-            if (!state_[(focus_ + step) % n].rating) {
-                focus_ = (focus_ + step) % n;
+        // The first arrow press picks the middle point: nothing is chosen before a key.
+        case RatingKey::Left:
+            set(focus_, s.rating ? std::max(1, *s.rating - 1) : (points + 1) / 2, t_ns);
+            break;
+        case RatingKey::Right:
+            set(focus_, s.rating ? std::min(points, *s.rating + 1) : (points + 1) / 2,
+                t_ns);
+            break;
+        case RatingKey::Up:
+            focus_ = std::max(0, focus_ - 1);
+            break;
+        case RatingKey::Down:
+            focus_ = std::min(n - 1, focus_ + 1);
+            break;
+        case RatingKey::Enter:
+            if (!s.rating) break;  // Enter never answers for the participant
+            if (all_answered()) {
+                confirmed_ = true;
+                confirm_ns_ = t_ns;
                 break;
             }
-        break;
+            for (int step = 1; step <= n; ++step)  // on to the next unanswered statement
+                if (!state_[(focus_ + step) % n].rating) {
+                    focus_ = (focus_ + step) % n;
+                    break;
+                }
+            break;
     }
 }
 
@@ -58,10 +72,12 @@ void RatingInput::click_next(int64_t t_ns) {
 }
 
 bool RatingInput::all_answered() const {
-    return std::all_of(state_.begin(), state_.end(), [](const State& s) { return s.rating.has_value(); });
+    return std::all_of(state_.begin(), state_.end(),
+                       [](const State& s) { return s.rating.has_value(); });
 }
 
-std::vector<Response> RatingInput::responses(const std::vector<std::string>& question_ids) const {
+std::vector<Response> RatingInput::responses(
+    const std::vector<std::string>& question_ids) const {
     std::vector<Response> out;
     for (size_t q = 0; q < state_.size(); ++q) {
         const State& s = state_[q];

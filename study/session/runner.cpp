@@ -33,33 +33,47 @@ namespace {
 
 int64_t now_ns() {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch()).count();
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
 }
 
-// ---- [SECTION] keys --------------------------------------------------------------------
-// Keys come from XKeyEvents (stamped by its thread when the X server sends them). Only
-// without X11 (GLFW on Wayland) do they come from GLFW's callback, stamped when
-// glfwPollEvents delivers them, up to a frame late; the runner says so in the log.
+// ---- [SECTION] keys
+// -------------------------------------------------------------------- Keys come from
+// XKeyEvents (stamped by its thread when the X server sends them). Only without X11 (GLFW
+// on Wayland) do they come from GLFW's callback, stamped when glfwPollEvents delivers
+// them, up to a frame late; the runner says so in the log.
 struct GlfwKeyLog {
     std::vector<TimedKey> presses;
     GLFWkeyfun chained = nullptr;  // ImGui's callback, called after logging
 };
 
 std::optional<Key> key_for_glfw(int key, int* digit) {
-    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) return *digit = key - GLFW_KEY_0, Key::Digit;
-    if (key >= GLFW_KEY_KP_1 && key <= GLFW_KEY_KP_9) return *digit = key - GLFW_KEY_KP_0, Key::Digit;
+    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9)
+        return *digit = key - GLFW_KEY_0, Key::Digit;
+    if (key >= GLFW_KEY_KP_1 && key <= GLFW_KEY_KP_9)
+        return *digit = key - GLFW_KEY_KP_0, Key::Digit;
     switch (key) {
-    case GLFW_KEY_ENTER:
-    case GLFW_KEY_KP_ENTER: return Key::Enter;
-    case GLFW_KEY_ESCAPE: return Key::Escape;
-    case GLFW_KEY_LEFT: return Key::Left;
-    case GLFW_KEY_RIGHT: return Key::Right;
-    case GLFW_KEY_UP: return Key::Up;
-    case GLFW_KEY_DOWN: return Key::Down;
-    case GLFW_KEY_Q: return Key::Quit;
-    case GLFW_KEY_R: return Key::Resume;
-    case GLFW_KEY_N: return Key::Decline;
-    default: return std::nullopt;
+        case GLFW_KEY_ENTER:
+        case GLFW_KEY_KP_ENTER:
+            return Key::Enter;
+        case GLFW_KEY_ESCAPE:
+            return Key::Escape;
+        case GLFW_KEY_LEFT:
+            return Key::Left;
+        case GLFW_KEY_RIGHT:
+            return Key::Right;
+        case GLFW_KEY_UP:
+            return Key::Up;
+        case GLFW_KEY_DOWN:
+            return Key::Down;
+        case GLFW_KEY_Q:
+            return Key::Quit;
+        case GLFW_KEY_R:
+            return Key::Resume;
+        case GLFW_KEY_N:
+            return Key::Decline;
+        default:
+            return std::nullopt;
     }
 }
 
@@ -67,15 +81,19 @@ void on_glfw_key(GLFWwindow* window, int key, int scancode, int action, int mods
     auto* log = static_cast<GlfwKeyLog*>(glfwGetWindowUserPointer(window));
     int digit = 0;
     if (action == GLFW_PRESS)
-        if (const auto k = key_for_glfw(key, &digit)) log->presses.push_back({*k, digit, now_ns()});
+        if (const auto k = key_for_glfw(key, &digit))
+            log->presses.push_back({*k, digit, now_ns()});
     if (log->chained) log->chained(window, key, scancode, action, mods);
 }
 
 void centred_text_window(const char* id, const std::string& text, int w, int h) {
-    ImGui::SetNextWindowPos(ImVec2(w * 0.5f, h * 0.45f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+    ImGui::SetNextWindowPos(ImVec2(w * 0.5f, h * 0.45f), ImGuiCond_Always,
+                            ImVec2(0.5f, 0.5f));
     ImGui::SetNextWindowSize(ImVec2(std::min(1100.f, w * 0.85f), 0));
-    ImGui::Begin(id, nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
-                                  ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings);
+    ImGui::Begin(id, nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                     ImGuiWindowFlags_AlwaysAutoResize |
+                     ImGuiWindowFlags_NoSavedSettings);
     ImGui::PushTextWrapPos(0.f);
     ImGui::TextUnformatted(text.c_str());
     ImGui::PopTextWrapPos();
@@ -84,7 +102,8 @@ void centred_text_window(const char* id, const std::string& text, int w, int h) 
 
 }  // namespace
 
-// ---- [SECTION] the session -------------------------------------------------------------
+// ---- [SECTION] the session
+// -------------------------------------------------------------
 class Session {
 public:
     Session(const RunOptions& o, StimulusRenderer& s, std::ostream& log)
@@ -124,7 +143,8 @@ private:
     std::vector<int64_t> calibration_swaps_;
     bool calibrated_ = false;
 
-    std::map<std::string, StimulusTexture> textures_;  // by stimulus id; before window_ dies
+    std::map<std::string, StimulusTexture>
+        textures_;  // by stimulus id; before window_ dies
     // Clicks and buttons seen while drawing, applied once the frame is drawn, so the
     // screen never changes half way through drawing it.
     std::vector<std::function<void()>> ui_actions_;
@@ -140,11 +160,13 @@ RunResult Session::prepare_store() {
     resumable_ = store_->unfinished_session(opt_.participant);
     // Every trial answered but still open: left so by a build where completion was not
     // atomic. It is complete; mark it so instead of reopening it.
-    const bool repaired = resumable_ && store_->complete_session_if_answered(resumable_->id);
+    const bool repaired =
+        resumable_ && store_->complete_session_if_answered(resumable_->id);
     if (repaired) resumable_.reset();
     if (!resumable_ && store_->has_completed_session(opt_.participant)) {
-        log_ << "lucent run: participant '" << opt_.participant << "' already completed this study in "
-             << opt_.db_path << (repaired ? " (every trial answered; session now marked completed)" : "")
+        log_ << "lucent run: participant '" << opt_.participant
+             << "' already completed this study in " << opt_.db_path
+             << (repaired ? " (every trial answered; session now marked completed)" : "")
              << "; nothing to " << (opt_.resume ? "resume" : "run")
              << " (a new participant code starts a new session)\n";
         return RunResult::UsageError;
@@ -193,13 +215,14 @@ void Session::open_window() {
     env_.build_hash = build_hash();
     env_.gl_vendor = info.vendor;
     env_.gl_renderer = info.renderer;
-    env_.display_mode = std::to_string(fw) + "x" + std::to_string(fh) +
-                        (opt_.windowed ? " windowed" : " fullscreen") + ", video mode " +
-                        (mode ? std::to_string(mode->width) + "x" + std::to_string(mode->height) +
-                                    " @ " + std::to_string(mode->refreshRate) + " Hz"
-                              : std::string("unknown"));
-    env_.display_refresh_hz = mode_refresh_hz_ > 0 ? std::optional<double>(mode_refresh_hz_)
-                                                   : std::nullopt;
+    env_.display_mode =
+        std::to_string(fw) + "x" + std::to_string(fh) +
+        (opt_.windowed ? " windowed" : " fullscreen") + ", video mode " +
+        (mode ? std::to_string(mode->width) + "x" + std::to_string(mode->height) + " @ " +
+                    std::to_string(mode->refreshRate) + " Hz"
+              : std::string("unknown"));
+    env_.display_refresh_hz =
+        mode_refresh_hz_ > 0 ? std::optional<double>(mode_refresh_hz_) : std::nullopt;
     if (!opt_.autopilot.empty()) {
         autopilot_ = Autopilot::from_argument(opt_.autopilot, opt_.autopilot_speed);
         x_keyboard_.emplace(window_->glfw());
@@ -214,15 +237,20 @@ void Session::start_or_resume_session() {
         store_->begin_segment(session_.id, env_);  // a new row: earlier machines' kept
     } else {
         int number = 0;
-        const int64_t participant_id = store_->ensure_participant(study_id_, opt_.participant, &number);
-        uint64_t seed = opt_.seed ? *opt_.seed : (uint64_t(std::random_device{}()) << 32 | std::random_device{}());
+        const int64_t participant_id =
+            store_->ensure_participant(study_id_, opt_.participant, &number);
+        uint64_t seed =
+            opt_.seed ? *opt_.seed
+                      : (uint64_t(std::random_device{}()) << 32 | std::random_device{}());
         seed &= 0x7FFFFFFFFFFFFFFFull;
         session_ = store_->create_session(study_id_, participant_id,
                                           plan_trials(p_, seed, number), seed, env_);
     }
     const std::vector<TrialRow> trials = store_->trials(session_.id);
-    log_ << "lucent run: session " << session_.uuid << " for '" << opt_.participant << "', "
-         << std::count_if(trials.begin(), trials.end(), [](const TrialRow& t) { return t.answered; })
+    log_ << "lucent run: session " << session_.uuid << " for '" << opt_.participant
+         << "', "
+         << std::count_if(trials.begin(), trials.end(),
+                          [](const TrialRow& t) { return t.answered; })
          << " of " << trials.size() << " trials already answered\n";
 }
 
@@ -245,33 +273,41 @@ void Session::prepare_stimuli() {
         ImGui::End();
         window_->render_imgui();
         window_->swap();
-        log_ << "\rlucent run: preparing stimuli " << k + 1 << "/" << ids.size() << std::flush;
-        textures_.emplace(ids[k], stimuli_.render(*p_.find_stimulus(ids[k]), p_.stimulus_width,
-                                                  p_.stimulus_height));
+        log_ << "\rlucent run: preparing stimuli " << k + 1 << "/" << ids.size()
+             << std::flush;
+        textures_.emplace(ids[k], stimuli_.render(*p_.find_stimulus(ids[k]),
+                                                  p_.stimulus_width, p_.stimulus_height));
     }
     if (!ids.empty()) log_ << "\n";
 }
 
 void Session::feed_keys() {
     std::vector<TimedKey> presses;
-    if (x_keys_) presses = x_keys_->take();
-    else presses.swap(glfw_keys_.presses);
+    if (x_keys_)
+        presses = x_keys_->take();
+    else
+        presses.swap(glfw_keys_.presses);
     for (const TimedKey& k : presses) {
         if (flow_->finished()) break;
         flow_->key(k);
     }
 }
 
-// ---- [SECTION] drawing ------------------------------------------------------------------
+// ---- [SECTION] drawing
+// ------------------------------------------------------------------
 void Session::draw_rating_panel(const ScreenLayout& layout) {
     const TrialRow& t = *flow_->trial();
     const RatingInput* input = flow_->rating();
     ImGui::SetNextWindowPos(ImVec2(float(layout.panel.x), float(layout.panel.y)));
-    ImGui::SetNextWindowSize(ImVec2(float(layout.panel.width), float(layout.panel.height)));
-    ImGui::Begin("rating", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
-                                        ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBackground);
-    if (t.is_catch) ImGui::TextColored(ImVec4(1, 0.85f, 0.3f, 1), "%s", t.prompt.c_str());
-    else ImGui::TextUnformatted(t.practice ? "Practice" : "");
+    ImGui::SetNextWindowSize(
+        ImVec2(float(layout.panel.width), float(layout.panel.height)));
+    ImGui::Begin("rating", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                     ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBackground);
+    if (t.is_catch)
+        ImGui::TextColored(ImVec4(1, 0.85f, 0.3f, 1), "%s", t.prompt.c_str());
+    else
+        ImGui::TextUnformatted(t.practice ? "Practice" : "");
     const float button = ImGui::GetFrameHeight() * 1.4f;
     for (size_t q = 0; q < p_.questions.size(); ++q) {
         const Question& question = p_.questions[q];
@@ -279,24 +315,27 @@ void Session::draw_rating_panel(const ScreenLayout& layout) {
         const bool focused = input && input->focus() == static_cast<int>(q);
         ImGui::SetCursorPosX(layout.panel.width * 0.5f -
                              ImGui::CalcTextSize(question.text.c_str()).x * 0.5f);
-        ImGui::TextColored(focused ? ImVec4(1, 1, 1, 1) : ImVec4(0.6f, 0.6f, 0.6f, 1), "%s",
-                           question.text.c_str());
+        ImGui::TextColored(focused ? ImVec4(1, 1, 1, 1) : ImVec4(0.6f, 0.6f, 0.6f, 1),
+                           "%s", question.text.c_str());
         // The question's own scale, centred: left label, points 1..n, right label.
         const ImGuiStyle& style = ImGui::GetStyle();
         const float scale_width = ImGui::CalcTextSize(question.labels.front().c_str()).x +
                                   ImGui::CalcTextSize(question.labels.back().c_str()).x +
                                   question.points() * (button + style.ItemSpacing.x) +
                                   style.ItemSpacing.x;
-        ImGui::SetCursorPosX(std::max(0.f, layout.panel.width * 0.5f - scale_width * 0.5f));
+        ImGui::SetCursorPosX(
+            std::max(0.f, layout.panel.width * 0.5f - scale_width * 0.5f));
         ImGui::TextDisabled("%s", question.labels.front().c_str());
         for (int v = 1; v <= question.points(); ++v) {
             ImGui::SameLine();
             const bool chosen = input && input->rating(static_cast<int>(q)) == v;
-            ImGui::PushStyleColor(ImGuiCol_Button, chosen ? ImVec4(0.9f, 0.6f, 0.1f, 1)
-                                                          : ImVec4(0.25f, 0.25f, 0.3f, 1));
+            ImGui::PushStyleColor(ImGuiCol_Button, chosen
+                                                       ? ImVec4(0.9f, 0.6f, 0.1f, 1)
+                                                       : ImVec4(0.25f, 0.25f, 0.3f, 1));
             if (ImGui::Button(std::to_string(v).c_str(), ImVec2(button, 0))) {
                 const int64_t t_ns = now_ns();
-                ui_actions_.push_back([this, q, v, t_ns] { flow_->click_point(int(q), v, t_ns); });
+                ui_actions_.push_back(
+                    [this, q, v, t_ns] { flow_->click_point(int(q), v, t_ns); });
             }
             ImGui::PopStyleColor();
         }
@@ -327,16 +366,20 @@ void Session::draw(int w, int h) {
     if (screen != Screen::Consent && screen != Screen::Done) {
         ImGui::SetNextWindowPos(ImVec2(20, 12));
         ImGui::SetNextWindowSize(ImVec2(320, 0));
-        ImGui::Begin("progress", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoSavedSettings |
-                                              ImGuiWindowFlags_NoBackground | ImGuiWindowFlags_NoInputs);
+        ImGui::Begin("progress", nullptr,
+                     ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoSavedSettings |
+                         ImGuiWindowFlags_NoBackground | ImGuiWindowFlags_NoInputs);
         const int done = flow_->main_trials_done(), total = flow_->main_trials_total();
-        ImGui::ProgressBar(total ? float(done) / total : 0.f, ImVec2(-1, 0),
-                           (std::to_string(done) + " of " + std::to_string(total)).c_str());
+        ImGui::ProgressBar(
+            total ? float(done) / total : 0.f, ImVec2(-1, 0),
+            (std::to_string(done) + " of " + std::to_string(total)).c_str());
         ImGui::End();
     }
     if (flow_->paused()) {
-        centred_text_window("pause", "Paused. Your answers so far are saved.\n\n"
-                                     "Enter or R: resume      Q: save and quit", w, h);
+        centred_text_window("pause",
+                            "Paused. Your answers so far are saved.\n\n"
+                            "Enter or R: resume      Q: save and quit",
+                            w, h);
         button_key("Resume", Key::Resume);
         ImGui::SameLine();
         button_key("Save and quit", Key::Quit);
@@ -344,42 +387,49 @@ void Session::draw(int w, int h) {
         return;
     }
     switch (screen) {
-    case Screen::Consent:
-        centred_text_window("consent", flow_->text(), w, h);
-        button_key("I agree (Enter)", Key::Enter);
-        ImGui::SameLine();
-        button_key("I do not agree (N)", Key::Decline);
-        ImGui::End();
-        break;
-    case Screen::Instructions:
-    case Screen::PracticeDone:
-    case Screen::Break:
-    case Screen::Debrief:
-        centred_text_window("text", flow_->text().empty() ? std::string("Press Enter.") : flow_->text(), w, h);
-        button_key("Continue (Enter)", Key::Enter);
-        ImGui::End();
-        break;
-    case Screen::Trial: {
-        const StimulusTexture& texture = textures_.at(flow_->trial()->stimulus);
-        const ScreenLayout layout = compute_layout(w, h, texture.width, texture.height,
-                                                   static_cast<int>(p_.questions.size()),
-                                                   static_cast<int>(ImGui::GetFrameHeightWithSpacing() * 1.25f));
-        ImGui::GetBackgroundDrawList()->AddImage(
-            ui::imgui_texture(texture.texture), ImVec2(float(layout.image.x), float(layout.image.y)),
-            ImVec2(float(layout.image.x + layout.image.width), float(layout.image.y + layout.image.height)));
-        draw_rating_panel(layout);
-        break;
-    }
-    case Screen::Blank:
-    case Screen::Done:
-        break;
+        case Screen::Consent:
+            centred_text_window("consent", flow_->text(), w, h);
+            button_key("I agree (Enter)", Key::Enter);
+            ImGui::SameLine();
+            button_key("I do not agree (N)", Key::Decline);
+            ImGui::End();
+            break;
+        case Screen::Instructions:
+        case Screen::PracticeDone:
+        case Screen::Break:
+        case Screen::Debrief:
+            centred_text_window(
+                "text",
+                flow_->text().empty() ? std::string("Press Enter.") : flow_->text(), w,
+                h);
+            button_key("Continue (Enter)", Key::Enter);
+            ImGui::End();
+            break;
+        case Screen::Trial: {
+            const StimulusTexture& texture = textures_.at(flow_->trial()->stimulus);
+            const ScreenLayout layout = compute_layout(
+                w, h, texture.width, texture.height,
+                static_cast<int>(p_.questions.size()),
+                static_cast<int>(ImGui::GetFrameHeightWithSpacing() * 1.25f));
+            ImGui::GetBackgroundDrawList()->AddImage(
+                ui::imgui_texture(texture.texture),
+                ImVec2(float(layout.image.x), float(layout.image.y)),
+                ImVec2(float(layout.image.x + layout.image.width),
+                       float(layout.image.y + layout.image.height)));
+            draw_rating_panel(layout);
+            break;
+        }
+        case Screen::Blank:
+        case Screen::Done:
+            break;
     }
 }
 
-// ---- [SECTION] the frame loop -----------------------------------------------------------
-// Draws and presents one frame, and tells the flow when it reached the display. A
-// screen's first frame is finished on the GPU before and after the swap, so its time is
-// when it appeared (on a trial: the stimulus onset).
+// ---- [SECTION] the frame loop
+// ----------------------------------------------------------- Draws and presents one
+// frame, and tells the flow when it reached the display. A screen's first frame is
+// finished on the GPU before and after the swap, so its time is when it appeared (on a
+// trial: the stimulus onset).
 void Session::present(int w, int h) {
     const int serial = flow_->serial();
     const bool first = flow_->awaiting_presentation();
@@ -388,8 +438,8 @@ void Session::present(int w, int h) {
     window_->render_imgui();
     if (first) {
         gl::wait_for_gpu();
-        if (flow_->screen() == Screen::Trial && !flow_->paused() && !opt_.screenshot_path.empty() &&
-            !screenshot_done_) {
+        if (flow_->screen() == Screen::Trial && !flow_->paused() &&
+            !opt_.screenshot_path.empty() && !screenshot_done_) {
             std::vector<uint8_t> pixels = gl::read_framebuffer_rgba8(w, h);
             CpuImage shot{w, h, std::vector<uint8_t>(pixels.size())};
             const size_t row = static_cast<size_t>(w) * 4;
@@ -438,7 +488,8 @@ RunResult Session::run() {
         return RunResult::UsageError;
     }
     if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY")) {
-        log_ << "lucent run: no display (DISPLAY is not set): run under 'xvfb-run -a lucent run "
+        log_ << "lucent run: no display (DISPLAY is not set): run under 'xvfb-run -a "
+                "lucent run "
                 "...' or use the headless commands (lucent render, lucent export)\n";
         return RunResult::Failure;
     }
@@ -456,7 +507,8 @@ RunResult Session::run() {
         store_->set_status(session_.id, "paused", false);
         return RunResult::Failure;
     }
-    // The first screen's clock starts now; keys pressed while preparing count for nothing.
+    // The first screen's clock starts now; keys pressed while preparing count for
+    // nothing.
     flow_.emplace(p_, *store_, session_.id, store_->trials(session_.id),
                   store_->has_consent(session_.id), now_ns());
     if (x_keys_) x_keys_->take();
@@ -471,7 +523,8 @@ RunResult Session::run() {
         }
         const int64_t now = now_ns();
         if (autopilot_ && autopilot_->scripted() && !script_sent_) {
-            x_keyboard_->play(autopilot_->script());  // the whole script, timed by the server
+            x_keyboard_->play(
+                autopilot_->script());  // the whole script, timed by the server
             script_sent_ = true;
         } else if (autopilot_ && !autopilot_->scripted()) {
             const std::vector<std::string> keys = autopilot_->due(now, flow_->view());
@@ -490,7 +543,8 @@ RunResult Session::run() {
         const int64_t swapped = now_ns();
         if (mode_refresh_hz_ <= 0) {
             const int64_t next = last_swap + 16'666'667;
-            if (next > swapped) std::this_thread::sleep_for(std::chrono::nanoseconds(next - swapped));
+            if (next > swapped)
+                std::this_thread::sleep_for(std::chrono::nanoseconds(next - swapped));
         }
         last_swap = now_ns();
     }
@@ -512,14 +566,16 @@ RunResult Session::run() {
             log_ << "lucent run: " << e.what() << "\n";
         }
         if (const int left = store_->pending_trials(); left > 0)
-            log_ << "lucent run: " << left << " trials are kept in the local journal until "
-                 << store_->name() << " confirms them; send them with 'lucent store sync --db "
+            log_ << "lucent run: " << left
+                 << " trials are kept in the local journal until " << store_->name()
+                 << " confirms them; send them with 'lucent store sync --db "
                  << store_->name() << "'\n";
     }
     return result;
 }
 
-RunResult run_session(const RunOptions& options, StimulusRenderer& stimuli, std::ostream& log) {
+RunResult run_session(const RunOptions& options, StimulusRenderer& stimuli,
+                      std::ostream& log) {
     Session session(options, stimuli, log);
     return session.run();
 }

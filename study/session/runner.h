@@ -16,18 +16,19 @@ struct RunOptions {
     Protocol protocol;
     std::string db_path;
     std::string participant;
-    bool windowed = false;       // a 1280x1024 window instead of full screen
+    bool windowed = false;  // a 1280x1024 window instead of full screen
     int monitor = 0;
-    bool resume = false;         // continue the participant's unfinished session
+    bool resume = false;           // continue the participant's unfinished session
     std::optional<uint64_t> seed;  // session seed (default: random, stored)
-    std::string autopilot;       // "" (a person), a seed, or a script file
+    std::string autopilot;         // "" (a person), a seed, or a script file
     double autopilot_speed = 1.0;
-    std::string screenshot_path;   // save the first rating screen as PNG (tests)
-    std::string key_trace_path;    // each key press's X event time and stamp (tests)
+    std::string screenshot_path;  // save the first rating screen as PNG (tests)
+    std::string key_trace_path;   // each key press's X event time and stamp (tests)
 };
 
 // Outcome: RunResult (session_flow.h), mapped to exit codes by the caller. A participant
 // who already completed the study is refused (UsageError), with or without --resume.
-RunResult run_session(const RunOptions& options, StimulusRenderer& stimuli, std::ostream& log);
+RunResult run_session(const RunOptions& options, StimulusRenderer& stimuli,
+                      std::ostream& log);
 
 }  // namespace lucent::study

@@ -65,7 +65,8 @@ void check_against_manifest(StimulusProvenance& resolved, const std::vector<Knob
                 resolved.mesh_hash + " (mesh " + resolved.mesh + ")");
     for (const auto& [name, value] : resolved.values) {
         const Knob* knob = find_knob(knobs, name);
-        const std::string listed = knob ? canonical(*knob, field(row, name)) : field(row, name);
+        const std::string listed =
+            knob ? canonical(*knob, field(row, name)) : field(row, name);
         if (listed != value) differs("parameter '" + name + "'", field(row, name), value);
     }
     // The content hash covers every format's file, as the batch renderer computed it.

@@ -2,13 +2,13 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
+#include <filesystem>
+
 #include "core/image.h"
 #include "gl/errors.h"
 #include "gl/upload.h"
 #include "session/stimulus_provenance.h"
-
-#include <cmath>
-#include <filesystem>
 
 namespace lucent::study {
 
@@ -23,8 +23,8 @@ CpuImage load_image_rgba8(const std::string& path) {
     auto in = OIIO::ImageInput::open(path);
     if (!in) throw StimulusError(path + ": cannot read image: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > 16384 ||
-        spec.height > 16384)
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 ||
+        spec.width > 16384 || spec.height > 16384)
         throw StimulusError(path + ": unusable image size");
     CpuImage image;
     image.width = spec.width;
@@ -41,9 +41,10 @@ CpuImage load_image_rgba8(const std::string& path) {
         float rgb[3] = {v[0], channels >= 3 ? v[1] : v[0], channels >= 3 ? v[2] : v[0]};
         const float alpha = channels == 4 ? v[3] : channels == 2 ? v[1] : 1.f;
         for (int c = 0; c < 3; ++c)
-            image.rgba[i * 4 + c] = linear ? encode_srgb(rgb[c])
-                                           : static_cast<uint8_t>(std::lround(
-                                                 std::fmin(std::fmax(rgb[c], 0.f), 1.f) * 255.f));
+            image.rgba[i * 4 + c] =
+                linear ? encode_srgb(rgb[c])
+                       : static_cast<uint8_t>(
+                             std::lround(std::fmin(std::fmax(rgb[c], 0.f), 1.f) * 255.f));
         image.rgba[i * 4 + 3] = static_cast<uint8_t>(
             std::lround(std::fmin(std::fmax(alpha, 0.f), 1.f) * 255.f));
     }
@@ -59,7 +60,8 @@ void save_image_rgba8(const std::string& path, const CpuImage& image) {
 }
 
 StimulusTexture upload_texture(const CpuImage& image, const std::string& what) {
-    const std::string size = std::to_string(image.width) + "x" + std::to_string(image.height);
+    const std::string size =
+        std::to_string(image.width) + "x" + std::to_string(image.height);
     const auto fail = [&](const std::string& why) {
         throw StimulusError(what + ": the " + size + " picture cannot be shown: " + why);
     };
@@ -90,7 +92,8 @@ StimulusTexture upload_texture(const CpuImage& image, const std::string& what) {
     } catch (const gl::GlError& e) {
         fail(e.what());
     }
-    // Complete: level 0 holds the whole picture (a texture without storage samples black).
+    // Complete: level 0 holds the whole picture (a texture without storage samples
+    // black).
     GLint width = 0, height = 0;
     glGetTextureLevelParameteriv(t.texture.id(), 0, GL_TEXTURE_WIDTH, &width);
     glGetTextureLevelParameteriv(t.texture.id(), 0, GL_TEXTURE_HEIGHT, &height);
@@ -119,10 +122,11 @@ std::string how_to_render(const Protocol& protocol, const std::string& dir) {
     const std::string out = dir.empty() ? "DIR" : dir;
     const std::string preset = "preset:";
     if (protocol.source.rfind(preset, 0) == 0)
-        return "'lucent render --preset " + protocol.source.substr(preset.size()) + " --out " +
-               out + "' writes every picture of the built-in study, practice included";
-    return "render a stimulus set that lists it ('lucent render CONFIG.toml --out " + out +
-           "') and pass that folder";
+        return "'lucent render --preset " + protocol.source.substr(preset.size()) +
+               " --out " + out +
+               "' writes every picture of the built-in study, practice included";
+    return "render a stimulus set that lists it ('lucent render CONFIG.toml --out " +
+           out + "') and pass that folder";
 }
 
 }  // namespace
@@ -132,18 +136,20 @@ void PrerenderedStimuli::check(const Protocol& protocol) const {
         const std::string path = path_for(s);
         if (path.empty())
             throw StimulusError(
-                protocol.source + ": stimulus '" + s.id + "' (technique " + s.technique + "): " +
+                protocol.source + ": stimulus '" + s.id + "' (technique " + s.technique +
+                "): " +
                 (images_dir_.empty()
                      ? "no pre-rendered picture: pass --images DIR; "
                      : "no " + s.id + ".png, .tif or .exr in " + images_dir_ + "; ") +
                 how_to_render(protocol, images_dir_));
         if (!std::filesystem::exists(path))
-            throw StimulusError(protocol.source + ": stimulus '" + s.id + "': image " + path +
-                                " does not exist");
+            throw StimulusError(protocol.source + ": stimulus '" + s.id + "': image " +
+                                path + " does not exist");
     }
 }
 
-std::vector<StimulusProvenance> PrerenderedStimuli::provenance(const Protocol& protocol) const {
+std::vector<StimulusProvenance> PrerenderedStimuli::provenance(
+    const Protocol& protocol) const {
     return resolve_stimuli(protocol, images_dir_);
 }
 

@@ -46,18 +46,21 @@ public:
     // Checks, before any window opens, that every stimulus can be provided.
     virtual void check(const Protocol& protocol) const = 0;
     // What each stimulus will be, for the database: resolved values, mesh hash, and for
-    // pre-rendered files the manifest check (stimulus_provenance.h). Throws StimulusError.
-    virtual std::vector<StimulusProvenance> provenance(const Protocol& protocol) const = 0;
+    // pre-rendered files the manifest check (stimulus_provenance.h). Throws
+    // StimulusError.
+    virtual std::vector<StimulusProvenance> provenance(
+        const Protocol& protocol) const = 0;
 };
 
-// Image stimuli from their `image` path; live stimuli from `images_dir/<id>.png|.tif|.exr`
-// (e.g. the output of `lucent render --preset thesis --out DIR`, which holds every picture
-// of the built-in study, practice included). check() refuses a live stimulus without such
-// a file in one line naming what to render (`lucent serve` shows files only;
-// LiveOrPrerenderedStimuli renders the others).
+// Image stimuli from their `image` path; live stimuli from
+// `images_dir/<id>.png|.tif|.exr` (e.g. the output of `lucent render --preset thesis
+// --out DIR`, which holds every picture of the built-in study, practice included).
+// check() refuses a live stimulus without such a file in one line naming what to render
+// (`lucent serve` shows files only; LiveOrPrerenderedStimuli renders the others).
 class PrerenderedStimuli : public StimulusRenderer {
 public:
-    explicit PrerenderedStimuli(std::string images_dir) : images_dir_(std::move(images_dir)) {}
+    explicit PrerenderedStimuli(std::string images_dir)
+        : images_dir_(std::move(images_dir)) {}
     StimulusTexture render(const StimulusSpec& spec, int width, int height) override;
     void check(const Protocol& protocol) const override;
     std::vector<StimulusProvenance> provenance(const Protocol& protocol) const override;

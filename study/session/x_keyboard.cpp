@@ -21,13 +21,26 @@ namespace lucent::study {
 namespace {
 
 KeyCode keycode(Display* dpy, const std::string& key) {
-    static const std::map<std::string, KeySym> kSyms = {
-        {"1", XK_1}, {"2", XK_2}, {"3", XK_3}, {"4", XK_4}, {"5", XK_5}, {"6", XK_6},
-        {"7", XK_7}, {"8", XK_8}, {"9", XK_9}, {"Enter", XK_Return}, {"Escape", XK_Escape},
-        {"Left", XK_Left}, {"Right", XK_Right}, {"Up", XK_Up}, {"Down", XK_Down},
-        {"Q", XK_q}, {"R", XK_r}};
+    static const std::map<std::string, KeySym> kSyms = {{"1", XK_1},
+                                                        {"2", XK_2},
+                                                        {"3", XK_3},
+                                                        {"4", XK_4},
+                                                        {"5", XK_5},
+                                                        {"6", XK_6},
+                                                        {"7", XK_7},
+                                                        {"8", XK_8},
+                                                        {"9", XK_9},
+                                                        {"Enter", XK_Return},
+                                                        {"Escape", XK_Escape},
+                                                        {"Left", XK_Left},
+                                                        {"Right", XK_Right},
+                                                        {"Up", XK_Up},
+                                                        {"Down", XK_Down},
+                                                        {"Q", XK_q},
+                                                        {"R", XK_r}};
     const auto it = kSyms.find(key);
-    if (it == kSyms.end()) throw std::runtime_error("autopilot: unknown key '" + key + "'");
+    if (it == kSyms.end())
+        throw std::runtime_error("autopilot: unknown key '" + key + "'");
     return XKeysymToKeycode(dpy, it->second);
 }
 
@@ -36,12 +49,14 @@ KeyCode keycode(Display* dpy, const std::string& key) {
 XKeyboard::XKeyboard(GLFWwindow* window) : window_(window) {
     Display* glfw_display = glfwGetX11Display();
     if (!glfw_display)
-        throw std::runtime_error("autopilot needs an X11 display (XTest); none is in use");
+        throw std::runtime_error(
+            "autopilot needs an X11 display (XTest); none is in use");
     display_ = XOpenDisplay(DisplayString(glfw_display));
-    if (!display_) throw std::runtime_error("autopilot: cannot open a second X connection");
+    if (!display_)
+        throw std::runtime_error("autopilot: cannot open a second X connection");
     int event_base, error_base, major, minor;
-    if (!XTestQueryExtension(static_cast<Display*>(display_), &event_base, &error_base, &major,
-                             &minor)) {
+    if (!XTestQueryExtension(static_cast<Display*>(display_), &event_base, &error_base,
+                             &major, &minor)) {
         XCloseDisplay(static_cast<Display*>(display_));
         throw std::runtime_error("autopilot: the X server has no XTest extension");
     }

@@ -92,7 +92,8 @@ TEST(AnalyzeTable, EveryParticipantRatingEveryLevelIsWithin) {
 // many participants and ratings each test used.
 TEST(AnalyzeTable, TwelveParticipantsOfWhomTenRatedOneLevelEachAreNotWithin) {
     std::string csv = "participant,stimulus,factor,level,question,rating\n";
-    // p1, p2: both levels; p3..p7 level 1 only; p8..p12 level 2 only: 4 + 10 = 14 ratings.
+    // p1, p2: both levels; p3..p7 level 1 only; p8..p12 level 2 only: 4 + 10 = 14
+    // ratings.
     csv += "p1,a,f,1,q,2\np1,b,f,2,q,5\np2,a,f,1,q,3\np2,b,f,2,q,6\n";
     for (int i = 3; i <= 12; ++i)
         csv += "p" + std::to_string(i) + (i <= 7 ? ",a,f,1,q," : ",b,f,2,q,") +
@@ -105,7 +106,8 @@ TEST(AnalyzeTable, TwelveParticipantsOfWhomTenRatedOneLevelEachAreNotWithin) {
     EXPECT_EQ(pair_participants(a), 12);
     EXPECT_EQ(pair_ratings(a), 14u);
     EXPECT_EQ(result.primary, Design::Between);
-    EXPECT_NE(result.primary_reason.find("only 2 of 12 participants rated every level of q ~ f"),
+    EXPECT_NE(result.primary_reason.find(
+                  "only 2 of 12 participants rated every level of q ~ f"),
               std::string::npos)
         << result.primary_reason;
 
@@ -116,10 +118,12 @@ TEST(AnalyzeTable, TwelveParticipantsOfWhomTenRatedOneLevelEachAreNotWithin) {
     options.primary_reason = result.primary_reason;
     write_report(result.pairs, dir, options);
     std::ifstream in(dir / "report.md");
-    const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string md((std::istreambuf_iterator<char>(in)),
+                         std::istreambuf_iterator<char>());
     EXPECT_NE(md.find("Primary design: between"), std::string::npos) << md;
     EXPECT_EQ(md.find("every participant rated every level"), std::string::npos) << md;
-    EXPECT_NE(md.find("| q ~ f | between (primary) | one-way ANOVA |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| q ~ f | between (primary) | one-way ANOVA |"), std::string::npos)
+        << md;
     EXPECT_NE(md.find("| 12 participants, 14 ratings |"), std::string::npos) << md;
     EXPECT_NE(md.find("| 2 of 12 participants complete |"), std::string::npos) << md;
 

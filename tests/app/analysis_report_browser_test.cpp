@@ -2,6 +2,7 @@
 // lucent-full, which makes the thumbnails) writes one self-contained report.html that a
 // real browser (headless chromium) draws offline: every plot and every level's picture.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -9,8 +10,6 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <unistd.h>
 
 #include "browser.h"
 #include "core/image.h"
@@ -33,12 +32,18 @@ std::string base64_decode(const std::string& text) {
     int bits = 0, value = 0;
     for (const char c : text) {
         int v;
-        if (c >= 'A' && c <= 'Z') v = c - 'A';
-        else if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
-        else if (c >= '0' && c <= '9') v = c - '0' + 52;
-        else if (c == '+') v = 62;
-        else if (c == '/') v = 63;
-        else break;  // '=' padding or the closing quote
+        if (c >= 'A' && c <= 'Z')
+            v = c - 'A';
+        else if (c >= 'a' && c <= 'z')
+            v = c - 'a' + 26;
+        else if (c >= '0' && c <= '9')
+            v = c - '0' + 52;
+        else if (c == '+')
+            v = 62;
+        else if (c == '/')
+            v = 63;
+        else
+            break;  // '=' padding or the closing quote
         value = (value << 6) | v;
         bits += 6;
         if (bits >= 8) {
@@ -62,13 +67,15 @@ std::pair<int, int> png_size(const std::string& png) {
 }
 
 TEST(AnalysisReportInBrowser, PlotsAndLevelThumbnailsAreDrawn) {
-    const fs::path dir = fs::path(LUCENT_BINARY_DIR) / "test-scratch" / "analysis_report_browser";
+    const fs::path dir =
+        fs::path(LUCENT_BINARY_DIR) / "test-scratch" / "analysis_report_browser";
     fs::remove_all(dir);
     fs::create_directories(dir / "stimuli");
     // Three levels, each with a 256x256 picture of its own saturated colour, so the
     // screenshot shows whether the thumbnails were drawn (and the report's pixels alone
     // cannot contain them: its plots are black, grey, white and blue).
-    const float colours[3][3] = {{0.9f, 0.05f, 0.9f}, {0.05f, 0.8f, 0.1f}, {0.95f, 0.5f, 0.0f}};
+    const float colours[3][3] = {
+        {0.9f, 0.05f, 0.9f}, {0.05f, 0.8f, 0.1f}, {0.95f, 0.5f, 0.0f}};
     const char* levels[3] = {"18", "25", "30"};
     for (int l = 0; l < 3; ++l) {
         Image image(256, 256);
@@ -84,8 +91,8 @@ TEST(AnalysisReportInBrowser, PlotsAndLevelThumbnailsAreDrawn) {
         for (int p = 1; p <= 8; ++p)
             for (int l = 0; l < 3; ++l)
                 for (const char* q : {"translucent", "realistic"})
-                    csv << 'p' << p << ",s" << levels[l] << ",thickness_exponent," << levels[l]
-                        << ',' << q << ',' << 1 + (p + 2 * l) % 7 << '\n';
+                    csv << 'p' << p << ",s" << levels[l] << ",thickness_exponent,"
+                        << levels[l] << ',' << q << ',' << 1 + (p + 2 * l) % 7 << '\n';
     }
     const std::string command = std::string("'") + LUCENT_EXECUTABLE + "' analyze '" +
                                 (dir / "ratings.csv").string() + "' --out '" +
@@ -108,10 +115,11 @@ TEST(AnalysisReportInBrowser, PlotsAndLevelThumbnailsAreDrawn) {
     }
     EXPECT_GE(thumbnails, 3);
 
-    const test::BrowserPage page =
-        test::open_in_browser(dir / "report" / "report.html", dir / "screenshot.png", 1280, 4000);
+    const test::BrowserPage page = test::open_in_browser(
+        dir / "report" / "report.html", dir / "screenshot.png", 1280, 4000);
     ASSERT_TRUE(page.ok) << page.error;
-    EXPECT_EQ(page.images_drawn, std::to_string(thumbnails) + "/" + std::to_string(thumbnails));
+    EXPECT_EQ(page.images_drawn,
+              std::to_string(thumbnails) + "/" + std::to_string(thumbnails));
     // The plots are inline SVG: one figure per factor and one per question ~ factor.
     std::size_t svgs = 0;
     for (std::size_t at = page.dom.find("<svg"); at != std::string::npos;
@@ -121,18 +129,19 @@ TEST(AnalysisReportInBrowser, PlotsAndLevelThumbnailsAreDrawn) {
     // Drawn, not only present: the plots' blue means and each thumbnail's colour.
     const auto near = [](float a, float b) { return std::abs(a - b) < 0.08f; };
     EXPECT_GT(page.count_pixels([&](float r, float g, float b) {
-                  return near(r, 0x1f / 255.0f) && near(g, 0x77 / 255.0f) && near(b, 0xb4 / 255.0f);
-              }),
+        return near(r, 0x1f / 255.0f) && near(g, 0x77 / 255.0f) && near(b, 0xb4 / 255.0f);
+    }),
               50u);
-    // write_image stores linear values sRGB-encoded (IEC 61966-2-1): the page shows those.
+    // write_image stores linear values sRGB-encoded (IEC 61966-2-1): the page shows
+    // those.
     const auto encoded = [](float c) {
         return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
     };
     for (const auto& colour : colours)
         EXPECT_GT(page.count_pixels([&](float r, float g, float b) {
-                      return near(r, encoded(colour[0])) && near(g, encoded(colour[1])) &&
-                             near(b, encoded(colour[2]));
-                  }),
+            return near(r, encoded(colour[0])) && near(g, encoded(colour[1])) &&
+                   near(b, encoded(colour[2]));
+        }),
                   1000u)  // a 128x128 thumbnail is 16,384 pixels
             << colour[0] << "," << colour[1] << "," << colour[2];
 }

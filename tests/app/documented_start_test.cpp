@@ -2,7 +2,8 @@
 // item 9): `lucent render --preset NAME --out DIR`, then `lucent serve --preset NAME
 // --images DIR ...` and `lucent run --preset NAME --images DIR ...` from the folder that
 // render wrote. The three command lines are read from README.md as written (they must be
-// there, in that order) and run in a scratch folder; the test adds only what a test needs:
+// there, in that order) and run in a scratch folder; the test adds only what a test
+// needs:
 // `--listen 127.0.0.1:0` to serve (a free port) and the autopilot participant to run. For
 // `fabrics` the same lines run with the study's name in place of `thesis`.
 #include <fcntl.h>
@@ -50,8 +51,10 @@ std::vector<std::string> readme_start_commands() {
     for (std::string line; std::getline(readme, line);) lines.push_back(line);
     for (size_t i = 0; i + 2 < lines.size(); ++i) {
         if (lines[i].rfind("    lucent render --preset thesis --out ", 0) != 0) continue;
-        if (lines[i + 1].rfind("    lucent serve --preset thesis --images ", 0) != 0) continue;
-        if (lines[i + 2].rfind("    lucent run --preset thesis --images ", 0) != 0) continue;
+        if (lines[i + 1].rfind("    lucent serve --preset thesis --images ", 0) != 0)
+            continue;
+        if (lines[i + 2].rfind("    lucent run --preset thesis --images ", 0) != 0)
+            continue;
         return {lines[i], lines[i + 1], lines[i + 2]};
     }
     return {};
@@ -59,7 +62,8 @@ std::vector<std::string> readme_start_commands() {
 
 // `line` for study `name` (the README writes thesis), as argv after "lucent".
 std::vector<std::string> args_of(std::string line, const std::string& name) {
-    for (size_t at = 0; (at = line.find("thesis", at)) != std::string::npos; at += name.size())
+    for (size_t at = 0; (at = line.find("thesis", at)) != std::string::npos;
+         at += name.size())
         line.replace(at, 6, name);
     std::vector<std::string> w = words(line);
     w.erase(w.begin());  // "lucent"
@@ -73,8 +77,8 @@ struct Child {
 };
 
 // Starts lucent with `args` in `cwd`; stdout to a pipe (read by the caller) or a file.
-Child start(const std::vector<std::string>& args, const fs::path& cwd, const std::string& tag,
-            bool pipe_stdout) {
+Child start(const std::vector<std::string>& args, const fs::path& cwd,
+            const std::string& tag, bool pipe_stdout) {
     Child c;
     c.stderr_path = cwd / (tag + ".stderr");
     const fs::path out_path = cwd / (tag + ".stdout");
@@ -128,7 +132,8 @@ void documented_start(const std::string& name) {
     LUCENT_REQUIRE_DISPLAY();
     const std::vector<std::string> readme = readme_start_commands();
     ASSERT_EQ(readme.size(), 3u)
-        << "README.md has no block of the three lines 'lucent render --preset thesis --out "
+        << "README.md has no block of the three lines 'lucent render --preset thesis "
+           "--out "
            "DIR', 'lucent serve --preset thesis --images DIR ...', 'lucent run --preset "
            "thesis --images DIR ...'";
     const fs::path dir = test::scratch_dir("documented_start");
@@ -143,7 +148,8 @@ void documented_start(const std::string& name) {
         EXPECT_TRUE(fs::exists(pictures / (s.id + ".png"))) << s.id;
     for (const std::string& id : protocol.practice) {
         const std::string manifest = read_file(pictures / "manifest.csv");
-        EXPECT_NE(manifest.find("\n" + id + ","), std::string::npos) << id << " has no manifest row";
+        EXPECT_NE(manifest.find("\n" + id + ","), std::string::npos)
+            << id << " has no manifest row";
     }
 
     // 2. lucent serve --preset NAME --images DIR --db study.db: starts, and a participant
@@ -160,11 +166,12 @@ void documented_start(const std::string& name) {
     }
     {
         httplib::Client client("127.0.0.1", std::stoi(line.substr(at + 17)));
-        const auto session = client.Post("/api/session", R"({"participant": "WEB1", "t_ms": 0})",
-                                         "application/json");
+        const auto session = client.Post(
+            "/api/session", R"({"participant": "WEB1", "t_ms": 0})", "application/json");
         ASSERT_TRUE(session) << httplib::to_string(session.error());
         EXPECT_EQ(session->status, 200) << session->body;
-        EXPECT_NE(session->body.find("\"screen\":\"consent\""), std::string::npos) << session->body;
+        EXPECT_NE(session->body.find("\"screen\":\"consent\""), std::string::npos)
+            << session->body;
         for (const std::string& id : protocol.practice) {
             const auto png = client.Get(("/images/" + id + ".png").c_str());
             ASSERT_TRUE(png) << id;
@@ -187,18 +194,26 @@ void documented_start(const std::string& name) {
     }
     study::Database d((dir / db).string(), SQLITE_OPEN_READONLY);
     const std::string session =
-        "(SELECT s.id FROM sessions s JOIN participants p ON p.id = s.participant_id WHERE "
-        "p.code = '" + participant + "' AND s.status = 'completed')";
-    const int64_t trials = d.scalar_int("SELECT count(*) FROM trials WHERE session_id = " + session);
-    EXPECT_EQ(trials, static_cast<int64_t>(study::plan_trials(protocol, 1, 1).trials.size()));
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE practice = 1 AND session_id = " + session),
-              static_cast<int64_t>(protocol.practice.size()));
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses WHERE session_id = " + session),
-              trials * static_cast<int64_t>(protocol.questions.size()));
+        "(SELECT s.id FROM sessions s JOIN participants p ON p.id = s.participant_id "
+        "WHERE "
+        "p.code = '" +
+        participant + "' AND s.status = 'completed')";
+    const int64_t trials =
+        d.scalar_int("SELECT count(*) FROM trials WHERE session_id = " + session);
+    EXPECT_EQ(trials,
+              static_cast<int64_t>(study::plan_trials(protocol, 1, 1).trials.size()));
+    EXPECT_EQ(
+        d.scalar_int("SELECT count(*) FROM trials WHERE practice = 1 AND session_id = " +
+                     session),
+        static_cast<int64_t>(protocol.practice.size()));
+    EXPECT_EQ(
+        d.scalar_int("SELECT count(*) FROM responses WHERE session_id = " + session),
+        trials * static_cast<int64_t>(protocol.questions.size()));
     // Every picture came from the folder (none rendered live), practice included.
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM segment_stimuli ss JOIN session_segments g ON "
-                           "g.id = ss.segment_id WHERE ss.source = 'images' AND g.session_id = " +
-                           session),
+    EXPECT_EQ(d.scalar_int(
+                  "SELECT count(*) FROM segment_stimuli ss JOIN session_segments g ON "
+                  "g.id = ss.segment_id WHERE ss.source = 'images' AND g.session_id = " +
+                  session),
               static_cast<int64_t>(protocol.stimuli.size()));
 }
 

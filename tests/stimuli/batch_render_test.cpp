@@ -129,7 +129,8 @@ TEST(BatchRender, SecondRunReusesForceRerendersByteIdentically) {
 // three; the stimulus before it stays finished and listed, nothing after it is.
 TEST(BatchRender, AnEncodeFailureStopsTheRunAndKeepsWhatFinished) {
     for (const int jobs : {1, 3}) {
-        const auto dir = test::scratch_dir("batch_encode_failure_" + std::to_string(jobs));
+        const auto dir =
+            test::scratch_dir("batch_encode_failure_" + std::to_string(jobs));
         std::filesystem::create_directories(dir / "w_0.3.png" / "blocker");
         try {
             render(small_set(), dir, /*force=*/false, jobs);

@@ -4,9 +4,9 @@
 
 #include <chrono>
 #include <fstream>
-#include <thread>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "batch_render.h"
 #include "core/density_volume.h"
@@ -52,9 +52,11 @@ TEST(HeterogeneousPreset, ManifestCarriesTheDensityHashAndAChangedFileRerenders)
     const std::string volume_path = (dir / "volume.nrrd").string();
     const std::filesystem::path out = dir / "out";
     write_density_nrrd(*make_density_volume("cube", 8, 1.0), volume_path);
-    const std::string config = "name = \"d\"\nresolution = [24, 24]\n[meshes]\nball = "
-                               "\"sphere:1k\"\n[[stimuli]]\nid = \"h\"\ntechnique = "
-                               "\"htsm\"\ndensity = \"" + volume_path + "\"\n";
+    const std::string config =
+        "name = \"d\"\nresolution = [24, 24]\n[meshes]\nball = "
+        "\"sphere:1k\"\n[[stimuli]]\nid = \"h\"\ntechnique = "
+        "\"htsm\"\ndensity = \"" +
+        volume_path + "\"\n";
     const auto set = parse_stimulus_set(config, "d.toml", dir, default_catalog());
     BatchOptions options;
     options.out_dir = out;

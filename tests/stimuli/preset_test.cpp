@@ -65,8 +65,9 @@ TEST(ThesisPreset, EachSeriesIsOneColourAndRows147DifferOnlyInColour) {
         if (row / 3 == 1) EXPECT_TRUE(c.g > 2 * c.r && c.g > 2 * c.b) << "green " << row;
         if (row / 3 == 2) EXPECT_TRUE(c.b > 2 * c.r && c.b > 2 * c.g) << "blue " << row;
         EXPECT_EQ(format_knob_value(s.parameters.get("albedo")),
-                  format_knob_value(find(set, "empirical_row_" + std::to_string(row / 3 * 3 + 1))
-                                        .parameters.get("albedo")))
+                  format_knob_value(
+                      find(set, "empirical_row_" + std::to_string(row / 3 * 3 + 1))
+                          .parameters.get("albedo")))
             << "one colour per series, row " << row;
     }
     const auto& one = find(set, "empirical_row_1");
@@ -76,7 +77,8 @@ TEST(ThesisPreset, EachSeriesIsOneColourAndRows147DifferOnlyInColour) {
                   format_knob_value(one.parameters.get("albedo")));
         for (const auto& [name, value] : one.parameters.all())
             if (name != "albedo")
-                EXPECT_EQ(format_knob_value(value), format_knob_value(s.parameters.get(name)))
+                EXPECT_EQ(format_knob_value(value),
+                          format_knob_value(s.parameters.get(name)))
                     << other << " " << name;
     }
 }
@@ -147,7 +149,8 @@ namespace {
 // The built-in `fabrics` set (issue 14 section 6): a net and a weave, two thicknesses,
 // three tilts, on the wavy curtain; four factor series whose levels are the tilts.
 TEST(FabricsPreset, TwoFabricsTwoThicknessesThreeAnglesInFourSeries) {
-    std::ifstream in(test::source_dir() / "stimuli/presets/fabrics.toml", std::ios::binary);
+    std::ifstream in(test::source_dir() / "stimuli/presets/fabrics.toml",
+                     std::ios::binary);
     std::ostringstream file;
     file << in.rdbuf();
     ASSERT_TRUE(preset_text("fabrics").has_value());

@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "gl_test_fixture.h"
-#include "scene_for_test.h"
 #include "image_statistics.h"
 #include "render.h"
+#include "scene_for_test.h"
 
 namespace lucent::stimuli {
 namespace {
@@ -15,8 +15,8 @@ class RmsContrastTest : public test::HeadlessGlTest {};
 ImageStatistics statistics_of(gl::FrameExecutor& executor, const std::string& mesh,
                               const std::string& technique,
                               std::vector<KnobAssignment> settings) {
-    const Image image =
-        render_image(executor, test::scene_for(technique, std::move(settings), mesh, 128));
+    const Image image = render_image(
+        executor, test::scene_for(technique, std::move(settings), mesh, 128));
     return compute_image_statistics(
         FloatImageView{image.width, image.height, 4, image.rgba});
 }

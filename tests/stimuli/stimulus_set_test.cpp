@@ -181,25 +181,30 @@ TEST(StimulusSet, ErrorsNameFileLineAndKey) {
 }
 
 TEST(StimulusSet, SeriesAreNamedOrTheIdPatternOfAnExpandingEntry) {
-    const auto set = parse(kHeader +
-                           "[[stimuli]]\nid = \"w_{weight}\"\ntechnique = \"alpha\"\n"
-                           "[stimuli.vary]\nweight = [1, 2]\n"
-                           "[[stimuli]]\nid = \"one\"\ntechnique = \"alpha\"\n"
-                           "[[stimuli]]\nid = \"p\"\nseries = \"pair\"\ntechnique = \"alpha\"\n"
-                           "[[stimuli]]\nid = \"q\"\nseries = \"pair\"\ntechnique = \"beta\"\n");
+    const auto set =
+        parse(kHeader +
+              "[[stimuli]]\nid = \"w_{weight}\"\ntechnique = \"alpha\"\n"
+              "[stimuli.vary]\nweight = [1, 2]\n"
+              "[[stimuli]]\nid = \"one\"\ntechnique = \"alpha\"\n"
+              "[[stimuli]]\nid = \"p\"\nseries = \"pair\"\ntechnique = \"alpha\"\n"
+              "[[stimuli]]\nid = \"q\"\nseries = \"pair\"\ntechnique = \"beta\"\n");
     ASSERT_EQ(set.stimuli.size(), 5u);
     EXPECT_EQ(set.stimuli[0].series, "w_{weight}");
     EXPECT_EQ(set.stimuli[1].series, "w_{weight}");
     EXPECT_EQ(set.stimuli[2].series, "");  // a single stimulus is no series
     EXPECT_EQ(set.stimuli[3].series, "pair");
     EXPECT_EQ(set.stimuli[4].series, "pair");
-    EXPECT_EQ(error_of(kHeader + "[[stimuli]]\nid = \"a\"\nseries = \"a b\"\ntechnique = \"alpha\"\n"),
-              "set.toml:5:10: stimuli[0].series: 'a b' is not a valid name (letters, digits, _ - . "
-              "only)");
+    EXPECT_EQ(
+        error_of(kHeader +
+                 "[[stimuli]]\nid = \"a\"\nseries = \"a b\"\ntechnique = \"alpha\"\n"),
+        "set.toml:5:10: stimuli[0].series: 'a b' is not a valid name (letters, digits, _ "
+        "- . "
+        "only)");
     // The report writes contact-sheet.png beside the images: no stimulus may take it.
-    EXPECT_NE(error_of(kHeader + "[[stimuli]]\nid = \"contact-sheet\"\ntechnique = \"alpha\"\n")
-                  .find("stimuli[0].id: 'contact-sheet' is reserved"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of(kHeader + "[[stimuli]]\nid = \"contact-sheet\"\ntechnique = \"alpha\"\n")
+            .find("stimuli[0].id: 'contact-sheet' is reserved"),
+        std::string::npos);
 }
 
 TEST(StimulusSet, RelativeMeshPathsResolveAgainstTheConfigFile) {

@@ -28,7 +28,8 @@ int run_partial_session(Store& store, const Protocol& p, const std::string& code
     const int64_t study_id = store.ensure_study(p);
     int number = 0;
     const int64_t pid = store.ensure_participant(study_id, code, &number);
-    const SessionRow s = store.create_session(study_id, pid, plan_trials(p, seed, number), seed, {});
+    const SessionRow s =
+        store.create_session(study_id, pid, plan_trials(p, seed, number), seed, {});
     int answered = 0;
     for (const TrialRow& t : store.trials(s.id)) {
         if (answered == rated) break;
@@ -70,7 +71,8 @@ protected:
         const std::string withdrawn_uuid = uuid_of(path_, withdrawn_id);
         Database db(path_, SQLITE_OPEN_READWRITE);
         db.exec("INSERT INTO withdrawn_sessions (uuid, withdrawn_utc) VALUES ('" +
-                withdrawn_uuid + "', '2026-01-02T10:00:00Z'), "
+                withdrawn_uuid +
+                "', '2026-01-02T10:00:00Z'), "
                 "('00000000-0000-4000-8000-000000000000', '2026-01-01T10:00:00Z')");
     }
     fs::path dir_;
@@ -89,8 +91,9 @@ TEST_F(AnalysisSessions, OnlyCompletedSessionsAreAnalysedAndTheRestCountedByReas
     EXPECT_EQ(table.sessions_total, 7);  // 6 present (P6 withdrawn) + 1 tombstone only
     EXPECT_EQ(table.sessions_analysed, 1);
     EXPECT_EQ(table.left_out.incomplete, 3);
-    EXPECT_EQ(table.left_out.incomplete_by_status,
-              (std::map<std::string, int>{{"aborted", 1}, {"paused", 1}, {"running", 1}}));
+    EXPECT_EQ(
+        table.left_out.incomplete_by_status,
+        (std::map<std::string, int>{{"aborted", 1}, {"paused", 1}, {"running", 1}}));
     EXPECT_EQ(table.left_out.failed_catch, 1);
     EXPECT_EQ(table.left_out.withdrawn, 2);
     EXPECT_EQ(table.sessions_analysed + table.left_out.total(), table.sessions_total);
@@ -101,9 +104,10 @@ TEST_F(AnalysisSessions, OnlyCompletedSessionsAreAnalysedAndTheRestCountedByReas
     EXPECT_EQ(r.rows, 6);
     ASSERT_EQ(r.notes.size(), 1u);
     EXPECT_EQ(r.notes[0],
-              path_ + ": 1 of 7 sessions analysed (completed sessions only, the analysis "
-                      "plan's default); left out: 3 incomplete (1 aborted, 1 paused, "
-                      "1 running), 1 failed catch trials, 2 withdrawn");
+              path_ +
+                  ": 1 of 7 sessions analysed (completed sessions only, the analysis "
+                  "plan's default); left out: 3 incomplete (1 aborted, 1 paused, "
+                  "1 running), 1 failed catch trials, 2 withdrawn");
     std::ifstream in(csv);
     std::set<std::string> participants;
     std::string line;
@@ -134,16 +138,17 @@ TEST_F(AnalysisSessions, TheProtocolsAnalysisPlanCanTakeEverySession) {
     const LongTable table = analysis_long_table(path_);
     EXPECT_EQ(table.sessions, "all");
     EXPECT_EQ(table.sessions_analysed, 4);
-    EXPECT_NE(table.sessions_note.find("sessions of every status, as the analysis plan says"),
-              std::string::npos)
+    EXPECT_NE(
+        table.sessions_note.find("sessions of every status, as the analysis plan says"),
+        std::string::npos)
         << table.sessions_note;
     // An explicit option wins over the plan.
     EXPECT_EQ(analysis_long_table(path_, {.sessions = "completed"}).sessions_analysed, 1);
 }
 
 TEST(AnalysisPlanSessions, AnUnknownValueIsRefusedNamingFileAndLine) {
-    const std::string text =
-        std::string(lucent::test::kSmallProtocol) + "\n[analysis]\nsessions = \"finished\"\n";
+    const std::string text = std::string(lucent::test::kSmallProtocol) +
+                             "\n[analysis]\nsessions = \"finished\"\n";
     try {
         parse_protocol(text, "bad.toml");
         ADD_FAILURE() << "accepted";

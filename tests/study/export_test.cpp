@@ -27,13 +27,20 @@ std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
     for (size_t i = 0; i < text.size(); ++i) {
         const char c = text[i];
         if (quoted) {
-            if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') rows.back().back() += '"', ++i;
-            else if (c == '"') quoted = false;
-            else rows.back().back() += c;
-        } else if (c == '"') quoted = true;
-        else if (c == ',') rows.back().emplace_back();
-        else if (c == '\n') rows.emplace_back(1);
-        else rows.back().back() += c;
+            if (c == '"' && i + 1 < text.size() && text[i + 1] == '"')
+                rows.back().back() += '"', ++i;
+            else if (c == '"')
+                quoted = false;
+            else
+                rows.back().back() += c;
+        } else if (c == '"')
+            quoted = true;
+        else if (c == ',')
+            rows.back().emplace_back();
+        else if (c == '\n')
+            rows.emplace_back(1);
+        else
+            rows.back().back() += c;
     }
     if (rows.back().size() == 1 && rows.back()[0].empty()) rows.pop_back();
     return rows;
@@ -56,11 +63,13 @@ TEST(CsvCell, QuotesOnlyWhenNeeded) {
 class ExportTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = lucent::test::scratch_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = lucent::test::scratch_dir(
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
         path_ = (dir_ / "study.db").string();
         Store store(path_);
         lucent::test::run_full_session(store, p_, "P1", 11);
-        lucent::test::run_full_session(store, p_, "P2", 12, /*catch_rating=*/2);  // fails catch
+        lucent::test::run_full_session(store, p_, "P2", 12,
+                                       /*catch_rating=*/2);  // fails catch
     }
     std::string export_text(ExportFormat f) {
         std::ostringstream out;
@@ -83,7 +92,8 @@ TEST_F(ExportTest, LongHasOneRowPerRatingWithParametersAndFlags) {
               pos = column(h, "trial_position"), q = column(h, "question"),
               practice = column(h, "practice"), is_catch = column(h, "catch"),
               passed = column(h, "catch_passed");
-    const std::map<std::string, std::string> r_of = {{"a", "18"}, {"b", "25"}, {"c", "30"}, {"p", ""}};
+    const std::map<std::string, std::string> r_of = {
+        {"a", "18"}, {"b", "25"}, {"c", "30"}, {"p", ""}};
     for (size_t i = 1; i < rows.size(); ++i) {
         const auto& row = rows[i];
         ASSERT_EQ(row.size(), h.size());
@@ -92,7 +102,8 @@ TEST_F(ExportTest, LongHasOneRowPerRatingWithParametersAndFlags) {
         EXPECT_EQ(row[practice], row[stimulus] == "p" ? "1" : "0");
         const int question = row[q] == "translucent" ? 0 : 1;
         if (row[is_catch] == "0")
-            EXPECT_EQ(std::stoi(row[rating]), lucent::test::rating_for(std::stoi(row[pos]), question));
+            EXPECT_EQ(std::stoi(row[rating]),
+                      lucent::test::rating_for(std::stoi(row[pos]), question));
         else
             EXPECT_EQ(row[passed], row[0] == "P1" ? "1" : "0");
         for (const std::string& cell : row) EXPECT_EQ(cell.find('{'), std::string::npos);
@@ -110,7 +121,8 @@ TEST_F(ExportTest, WideHasOneRowPerParticipantWithEachRating) {
         if (t.practice || t.is_catch) continue;
         for (int q = 0; q < 2; ++q) {
             const int c = column(h, t.stimulus + "." + p_.questions[q].id);
-            EXPECT_EQ(rows[1][c], std::to_string(lucent::test::rating_for(t.position, q)));
+            EXPECT_EQ(rows[1][c],
+                      std::to_string(lucent::test::rating_for(t.position, q)));
         }
     }
     EXPECT_EQ(rows[1][column(h, "catch_failed")], "0");
@@ -126,7 +138,8 @@ TEST_F(ExportTest, AnalysisLongTableExcludesPracticeCatchAndFailedParticipants) 
     for (const LongRow& r : table.rows) {
         EXPECT_EQ(r.participant, "P1");
         EXPECT_EQ(r.factor, "thickness_exponent");
-        EXPECT_EQ(r.level, p_.find_stimulus(r.stimulus)->parameters.at("thickness_exponent"));
+        EXPECT_EQ(r.level,
+                  p_.find_stimulus(r.stimulus)->parameters.at("thickness_exponent"));
         EXPECT_NE(r.stimulus, "p");
     }
     const LongTable all = analysis_long_table(path_, {.exclude_failed_catch = false});
@@ -142,7 +155,8 @@ TEST_F(ExportTest, AnalysisLongTableExcludesPracticeCatchAndFailedParticipants) 
 TEST(ExportSeries, ComparisonSeriesLevelsAreTheStimuli) {
     std::string text = lucent::test::kSmallProtocol;
     for (const char* id : {"\"a\"", "\"c\""}) {
-        const size_t at = text.find("varies = [\"thickness_exponent\"]", text.find("id = " + std::string(id)));
+        const size_t at = text.find("varies = [\"thickness_exponent\"]",
+                                    text.find("id = " + std::string(id)));
         ASSERT_NE(at, std::string::npos);
         text.replace(at, 32, "varies = [\"thickness_exponent\", \"series:pair\"]");
     }
@@ -192,15 +206,16 @@ int temporaries_in(const fs::path& dir) {
 }
 
 TEST_F(ExportTest, ExportFileNeverReplacesTheDatabaseOrAnyDatabase) {
-    const int64_t ratings = Store(path_).db().scalar_int("SELECT count(*) FROM responses");
+    const int64_t ratings =
+        Store(path_).db().scalar_int("SELECT count(*) FROM responses");
     const std::string before = file_bytes(path_);
     fs::create_symlink(path_, dir_ / "ratings.csv");
     fs::create_directories(dir_ / "sub");
     const fs::path cwd = fs::current_path();
     fs::current_path(dir_ / "sub");
     for (const std::string& out :
-         {path_, (dir_ / "ratings.csv").string(), (dir_ / "sub" / ".." / "study.db").string(),
-          std::string("../study.db")}) {
+         {path_, (dir_ / "ratings.csv").string(),
+          (dir_ / "sub" / ".." / "study.db").string(), std::string("../study.db")}) {
         for (const char* format : {"long", "wide", "analysis"}) {
             try {
                 export_file(path_, format, out, /*force=*/true);
@@ -218,7 +233,9 @@ TEST_F(ExportTest, ExportFileNeverReplacesTheDatabaseOrAnyDatabase) {
     const std::string other = (dir_ / "other.db").string();
     Store(other).db();
     EXPECT_THROW(export_file(path_, "long", other, true), StoreError);
-    EXPECT_EQ(Store(other).db().scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'responses'"), 1);
+    EXPECT_EQ(Store(other).db().scalar_int(
+                  "SELECT count(*) FROM sqlite_schema WHERE name = 'responses'"),
+              1);
 }
 
 TEST_F(ExportTest, ExportFileReplacesAnExistingCsvOnlyWithForce) {
@@ -271,26 +288,30 @@ std::vector<RatingRow> rating_rows(const std::string& path) {
     Database db(path, SQLITE_OPEN_READONLY);
     Statement s = db.prepare(
         "SELECT se.uuid, t.position, r.question, p.code, se.machine_id, st.stimulus_key, "
-        "r.rating, r.rt_ms, r.changes, r.first_choice_ns, r.final_choice_ns FROM responses r "
+        "r.rating, r.rt_ms, r.changes, r.first_choice_ns, r.final_choice_ns FROM "
+        "responses r "
         "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
         "JOIN participants p ON p.id = se.participant_id "
         "JOIN stimuli st ON st.id = t.stimulus_id");
     std::vector<RatingRow> rows;
     while (s.step())
-        rows.emplace_back(s.text(0), s.integer(1), s.text(2), s.text(3), s.text(4), s.text(5),
-                          s.integer(6), s.real(7), s.integer(8), s.integer(9), s.integer(10));
+        rows.emplace_back(s.text(0), s.integer(1), s.text(2), s.text(3), s.text(4),
+                          s.text(5), s.integer(6), s.real(7), s.integer(8), s.integer(9),
+                          s.integer(10));
     std::sort(rows.begin(), rows.end());
     return rows;
 }
 
 // A wide export as participant -> (column -> cell).
-std::map<std::string, std::map<std::string, std::string>> wide_rows(const std::string& path) {
+std::map<std::string, std::map<std::string, std::string>> wide_rows(
+    const std::string& path) {
     std::ostringstream out;
     export_csv(path, ExportFormat::Wide, out);
     const auto rows = parse_csv(out.str());
     std::map<std::string, std::map<std::string, std::string>> by_participant;
     for (size_t r = 1; r < rows.size(); ++r)
-        for (size_t c = 1; c < rows[0].size(); ++c) by_participant[rows[r][0]][rows[0][c]] = rows[r][c];
+        for (size_t c = 1; c < rows[0].size(); ++c)
+            by_participant[rows[r][0]][rows[0][c]] = rows[r][c];
     return by_participant;
 }
 
@@ -309,8 +330,9 @@ TEST_F(ExportTest, MergeKeepsOneCodeFromTwoMachinesApartAsTwoPeople) {
         lucent::test::run_full_session(store, p_, "P03", 32);
         store.db().exec("UPDATE sessions SET machine_id = 'bbbbbbbb33334444'");
         // Different answers from the second P01, so averaging would show.
-        store.db().exec("UPDATE responses SET rating = 8 - rating WHERE trial_id IN "
-                        "(SELECT id FROM trials WHERE catch = 0)");
+        store.db().exec(
+            "UPDATE responses SET rating = 8 - rating WHERE trial_id IN "
+            "(SELECT id FROM trials WHERE catch = 0)");
     }
     const std::string out = (dir_ / "all.db").string();
     const MergeReport report = merge_databases({a, b}, out);
@@ -322,8 +344,10 @@ TEST_F(ExportTest, MergeKeepsOneCodeFromTwoMachinesApartAsTwoPeople) {
 
     // Row by row: every input rating is in the merge once, under its person's code.
     const std::map<std::pair<std::string, std::string>, std::string> code_of = {
-        {{"P01", "aaaaaaaa11112222"}, "P01@aaaaaaaa"}, {{"P02", "aaaaaaaa11112222"}, "P02"},
-        {{"P01", "bbbbbbbb33334444"}, "P01@bbbbbbbb"}, {{"P03", "bbbbbbbb33334444"}, "P03"}};
+        {{"P01", "aaaaaaaa11112222"}, "P01@aaaaaaaa"},
+        {{"P02", "aaaaaaaa11112222"}, "P02"},
+        {{"P01", "bbbbbbbb33334444"}, "P01@bbbbbbbb"},
+        {{"P03", "bbbbbbbb33334444"}, "P03"}};
     std::vector<RatingRow> expected;
     for (const std::string& input : {a, b})
         for (RatingRow row : rating_rows(input)) {
@@ -349,7 +373,8 @@ TEST_F(ExportTest, MergeReadsAnOlderSchemaThroughAnUpgradedCopyAndLeavesItAlone)
         // Back to schema 1, as a build of that schema left it.
         lucent::test::downgrade_schema(store.db(), 1);
     }
-    ASSERT_EQ(Database(old_db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"), 1);
+    ASSERT_EQ(Database(old_db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"),
+              1);
     const std::string before = file_bytes(old_db);
     const std::string out = (dir_ / "all.db").string();
     const MergeReport report = merge_databases({old_db, path_}, out);
@@ -357,7 +382,8 @@ TEST_F(ExportTest, MergeReadsAnOlderSchemaThroughAnUpgradedCopyAndLeavesItAlone)
     ASSERT_EQ(report.notes.size(), 1u);
     EXPECT_NE(report.notes[0].find("schema 1"), std::string::npos) << report.notes[0];
     EXPECT_EQ(file_bytes(old_db), before);
-    EXPECT_EQ(Database(old_db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"), 1);
+    EXPECT_EQ(Database(old_db, SQLITE_OPEN_READONLY).scalar_int("PRAGMA user_version"),
+              1);
     std::vector<RatingRow> expected = rating_rows(old_db);
     for (const RatingRow& row : rating_rows(path_)) expected.push_back(row);
     std::sort(expected.begin(), expected.end());
@@ -375,7 +401,8 @@ TEST_F(ExportTest, MergeNeverWritesOverAnInputOrAnotherDatabase) {
             merge_databases({path_, b}, out);
             ADD_FAILURE() << "merged over " << out;
         } catch (const StoreError& e) {
-            EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos)
+                << e.what();
         }
     }
     EXPECT_EQ(file_bytes(path_), before);
@@ -392,7 +419,8 @@ TEST_F(ExportTest, MergeRefusesDifferentProtocolsAndWritesNothing) {
         merge_databases({path_, other}, out);
         FAIL();
     } catch (const StoreError& e) {
-        EXPECT_NE(std::string(e.what()).find("refusing to merge"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("refusing to merge"), std::string::npos)
+            << e.what();
     }
     EXPECT_FALSE(fs::exists(out));
 }

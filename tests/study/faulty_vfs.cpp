@@ -16,23 +16,43 @@ int f_close(sqlite3_file* f) { return real(f)->pMethods->xClose(real(f)); }
 int f_read(sqlite3_file* f, void* b, int n, sqlite3_int64 o) {
     return real(f)->pMethods->xRead(real(f), b, n, o);
 }
-int f_truncate(sqlite3_file* f, sqlite3_int64 s) { return real(f)->pMethods->xTruncate(real(f), s); }
-int f_sync(sqlite3_file* f, int flags) { return real(f)->pMethods->xSync(real(f), flags); }
-int f_size(sqlite3_file* f, sqlite3_int64* s) { return real(f)->pMethods->xFileSize(real(f), s); }
+int f_truncate(sqlite3_file* f, sqlite3_int64 s) {
+    return real(f)->pMethods->xTruncate(real(f), s);
+}
+int f_sync(sqlite3_file* f, int flags) {
+    return real(f)->pMethods->xSync(real(f), flags);
+}
+int f_size(sqlite3_file* f, sqlite3_int64* s) {
+    return real(f)->pMethods->xFileSize(real(f), s);
+}
 int f_lock(sqlite3_file* f, int l) { return real(f)->pMethods->xLock(real(f), l); }
 int f_unlock(sqlite3_file* f, int l) { return real(f)->pMethods->xUnlock(real(f), l); }
-int f_reserved(sqlite3_file* f, int* r) { return real(f)->pMethods->xCheckReservedLock(real(f), r); }
-int f_control(sqlite3_file* f, int op, void* a) { return real(f)->pMethods->xFileControl(real(f), op, a); }
+int f_reserved(sqlite3_file* f, int* r) {
+    return real(f)->pMethods->xCheckReservedLock(real(f), r);
+}
+int f_control(sqlite3_file* f, int op, void* a) {
+    return real(f)->pMethods->xFileControl(real(f), op, a);
+}
 int f_sector(sqlite3_file* f) { return real(f)->pMethods->xSectorSize(real(f)); }
-int f_device(sqlite3_file* f) { return real(f)->pMethods->xDeviceCharacteristics(real(f)); }
+int f_device(sqlite3_file* f) {
+    return real(f)->pMethods->xDeviceCharacteristics(real(f));
+}
 int f_shm_map(sqlite3_file* f, int i, int s, int e, void volatile** p) {
     return real(f)->pMethods->xShmMap(real(f), i, s, e, p);
 }
-int f_shm_lock(sqlite3_file* f, int o, int n, int fl) { return real(f)->pMethods->xShmLock(real(f), o, n, fl); }
+int f_shm_lock(sqlite3_file* f, int o, int n, int fl) {
+    return real(f)->pMethods->xShmLock(real(f), o, n, fl);
+}
 void f_shm_barrier(sqlite3_file* f) { real(f)->pMethods->xShmBarrier(real(f)); }
-int f_shm_unmap(sqlite3_file* f, int d) { return real(f)->pMethods->xShmUnmap(real(f), d); }
-int f_fetch(sqlite3_file* f, sqlite3_int64 o, int n, void** p) { return real(f)->pMethods->xFetch(real(f), o, n, p); }
-int f_unfetch(sqlite3_file* f, sqlite3_int64 o, void* p) { return real(f)->pMethods->xUnfetch(real(f), o, p); }
+int f_shm_unmap(sqlite3_file* f, int d) {
+    return real(f)->pMethods->xShmUnmap(real(f), d);
+}
+int f_fetch(sqlite3_file* f, sqlite3_int64 o, int n, void** p) {
+    return real(f)->pMethods->xFetch(real(f), o, n, p);
+}
+int f_unfetch(sqlite3_file* f, sqlite3_int64 o, void* p) {
+    return real(f)->pMethods->xUnfetch(real(f), o, p);
+}
 
 }  // namespace
 
@@ -47,11 +67,12 @@ int faulty_write(sqlite3_file* f, const void* b, int n, sqlite3_int64 o) {
 namespace {
 
 const sqlite3_io_methods g_methods = {
-    3, f_close, f_read, faulty_write, f_truncate, f_sync, f_size, f_lock, f_unlock,
-    f_reserved, f_control, f_sector, f_device, f_shm_map, f_shm_lock, f_shm_barrier,
-    f_shm_unmap, f_fetch, f_unfetch};
+    3,          f_close,       f_read,      faulty_write, f_truncate, f_sync,   f_size,
+    f_lock,     f_unlock,      f_reserved,  f_control,    f_sector,   f_device, f_shm_map,
+    f_shm_lock, f_shm_barrier, f_shm_unmap, f_fetch,      f_unfetch};
 
-int f_open(sqlite3_vfs*, const char* name, sqlite3_file* file, int flags, int* out_flags) {
+int f_open(sqlite3_vfs*, const char* name, sqlite3_file* file, int flags,
+           int* out_flags) {
     auto* ff = reinterpret_cast<FaultyFile*>(file);
     ff->real = reinterpret_cast<sqlite3_file*>(ff + 1);
     ff->base.pMethods = nullptr;

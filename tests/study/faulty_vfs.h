@@ -11,10 +11,17 @@ public:
     // Registers the VFS once (not as default).
     static void install();
     // Fail the Nth write from now (1-based); 0 disarms.
-    static void fail_write(int n) { countdown_ = n; writes_ = 0; }
+    static void fail_write(int n) {
+        countdown_ = n;
+        writes_ = 0;
+    }
     static int writes() { return writes_; }
     static bool fired() { return fired_; }
-    static void reset() { countdown_ = 0; writes_ = 0; fired_ = false; }
+    static void reset() {
+        countdown_ = 0;
+        writes_ = 0;
+        fired_ = false;
+    }
 
 private:
     friend int faulty_write(sqlite3_file*, const void*, int, sqlite3_int64);

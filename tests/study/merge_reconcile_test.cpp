@@ -55,7 +55,8 @@ protected:
         const int64_t pid = store.ensure_participant(study, code, &number);
         SessionEnvironment env;
         env.machine_id = machine;
-        const SessionRow s = store.create_session(study, pid, plan_trials(p_, seed, number), seed, env);
+        const SessionRow s =
+            store.create_session(study, pid, plan_trials(p_, seed, number), seed, env);
         uuid_[s.id] = s.uuid;
         return s.id;
     }
@@ -66,7 +67,8 @@ protected:
             if (t.answered) continue;
             if (n-- == 0) break;
             const TrialOutcome o = lucent::test::outcome_for(p_, t);
-            for (const Response& r : o.responses) written_[{t.position, r.question}] = r.rating;
+            for (const Response& r : o.responses)
+                written_[{t.position, r.question}] = r.rating;
             store.record_trial(session, t.id, o);
         }
     }
@@ -102,8 +104,7 @@ TEST_F(MergeReconcile, PausedCopyThenCompletedCopyKeepsAllTenRatings) {
     const std::string uuid = uuid_.at(session_);
     ASSERT_EQ(ratings_of_session(path("paused.db"), uuid).size(), 4u);
     // Either order: the completed copy extends the paused one and wins.
-    for (const auto& [order, inputs] :
-         std::map<std::string, std::vector<std::string>>{
+    for (const auto& [order, inputs] : std::map<std::string, std::vector<std::string>>{
              {"paused_first", {path("paused.db"), path("completed.db")}},
              {"completed_first", {path("completed.db"), path("paused.db")}}}) {
         SCOPED_TRACE(order);
@@ -116,8 +117,10 @@ TEST_F(MergeReconcile, PausedCopyThenCompletedCopyKeepsAllTenRatings) {
         EXPECT_EQ(count_of(out, "SELECT count(*) FROM responses"), 10);
         EXPECT_EQ(text_of(out, "SELECT status FROM sessions"), "completed");
         EXPECT_NE(text_of(out, "SELECT ended_utc FROM sessions"), "");
-        EXPECT_EQ(count_of(out, "SELECT count(*) FROM session_segments"), 2);  // start, resume
-        EXPECT_EQ(count_of(out, "SELECT count(*) FROM trials WHERE answered_utc IS NULL"), 0);
+        EXPECT_EQ(count_of(out, "SELECT count(*) FROM session_segments"),
+                  2);  // start, resume
+        EXPECT_EQ(count_of(out, "SELECT count(*) FROM trials WHERE answered_utc IS NULL"),
+                  0);
         EXPECT_EQ(text_of(out, "SELECT group_concat(code) FROM participants"), "P07");
     }
 }
@@ -128,7 +131,7 @@ TEST_F(MergeReconcile, IdenticalCopiesAreAlreadyPresentNotExtended) {
     const MergeReport report = merge_databases(
         {path("completed.db"), path("paused.db"), path("completed2.db")}, path("out.db"));
     EXPECT_EQ(report.sessions_added, 1);
-    EXPECT_EQ(report.sessions_extended, 1);        // the paused copy
+    EXPECT_EQ(report.sessions_extended, 1);         // the paused copy
     EXPECT_EQ(report.sessions_already_present, 1);  // the second completed copy
     EXPECT_EQ(count_of(path("out.db"), "SELECT count(*) FROM responses"), 10);
 }
@@ -148,11 +151,16 @@ TEST_F(MergeReconcile, DisagreeingRatingIsRefusedNamingSessionAndTrial) {
     ASSERT_GE(position, 0);
     const int64_t other = written % 7 + 1;
     Database(path("edited.db"), SQLITE_OPEN_READWRITE)
-        .prepare("UPDATE responses SET rating = ? WHERE question = 'translucent' AND trial_id = "
-                 "(SELECT id FROM trials WHERE position = ?)")
-        .bind(1, other).bind(2, position).run();
-    for (const auto& inputs : {std::vector<std::string>{path("completed.db"), path("edited.db")},
-                               std::vector<std::string>{path("edited.db"), path("completed.db")}}) {
+        .prepare(
+            "UPDATE responses SET rating = ? WHERE question = 'translucent' AND trial_id "
+            "= "
+            "(SELECT id FROM trials WHERE position = ?)")
+        .bind(1, other)
+        .bind(2, position)
+        .run();
+    for (const auto& inputs :
+         {std::vector<std::string>{path("completed.db"), path("edited.db")},
+          std::vector<std::string>{path("edited.db"), path("completed.db")}}) {
         const std::string out = path("out.db");
         try {
             merge_databases(inputs, out);
@@ -162,19 +170,24 @@ TEST_F(MergeReconcile, DisagreeingRatingIsRefusedNamingSessionAndTrial) {
             EXPECT_NE(what.find("refusing to merge"), std::string::npos) << what;
             EXPECT_NE(what.find(uuid), std::string::npos) << what;
             EXPECT_NE(what.find("(P07)"), std::string::npos) << what;
-            EXPECT_NE(what.find("trial " + std::to_string(position)), std::string::npos) << what;
+            EXPECT_NE(what.find("trial " + std::to_string(position)), std::string::npos)
+                << what;
             EXPECT_NE(what.find("'translucent'"), std::string::npos) << what;
-            EXPECT_NE(what.find(std::to_string(written) + " in"), std::string::npos) << what;
-            EXPECT_NE(what.find(std::to_string(other) + " in"), std::string::npos) << what;
+            EXPECT_NE(what.find(std::to_string(written) + " in"), std::string::npos)
+                << what;
+            EXPECT_NE(what.find(std::to_string(other) + " in"), std::string::npos)
+                << what;
             EXPECT_NE(what.find("edited.db"), std::string::npos) << what;
             EXPECT_EQ(what.find('\n'), std::string::npos);
         }
         EXPECT_FALSE(fs::exists(out));
     }
-    // The paused copy agrees with both on what it holds: still refused, the pair disagrees.
-    EXPECT_THROW(merge_databases({path("paused.db"), path("edited.db"), path("completed.db")},
-                                 path("out.db")),
-                 StoreError);
+    // The paused copy agrees with both on what it holds: still refused, the pair
+    // disagrees.
+    EXPECT_THROW(
+        merge_databases({path("paused.db"), path("edited.db"), path("completed.db")},
+                        path("out.db")),
+        StoreError);
 }
 
 TEST_F(MergeReconcile, CopiesThatEachHoldAnswersTheOtherLacksAreRefused) {
@@ -182,24 +195,29 @@ TEST_F(MergeReconcile, CopiesThatEachHoldAnswersTheOtherLacksAreRefused) {
     fs::copy_file(path("completed.db"), path("a.db"));
     fs::copy_file(path("completed.db"), path("b.db"));
     // a lacks the last trial's answers, b the one before.
-    for (const auto& [file, offset] : {std::pair{std::string("a.db"), 0}, std::pair{std::string("b.db"), 1}}) {
+    for (const auto& [file, offset] :
+         {std::pair{std::string("a.db"), 0}, std::pair{std::string("b.db"), 1}}) {
         Database db(path(file), SQLITE_OPEN_READWRITE);
-        db.prepare("DELETE FROM responses WHERE trial_id = (SELECT id FROM trials ORDER BY "
-                   "position DESC LIMIT 1 OFFSET ?)")
-            .bind(1, offset).run();
+        db.prepare(
+              "DELETE FROM responses WHERE trial_id = (SELECT id FROM trials ORDER BY "
+              "position DESC LIMIT 1 OFFSET ?)")
+            .bind(1, offset)
+            .run();
         db.exec("UPDATE sessions SET status = 'paused'");
     }
     try {
         merge_databases({path("a.db"), path("b.db")}, path("out.db"));
         ADD_FAILURE() << "merged two copies neither of which extends the other";
     } catch (const StoreError& e) {
-        EXPECT_NE(std::string(e.what()).find(uuid_.at(session_)), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("neither copy extends the other"), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find(uuid_.at(session_)), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("neither copy extends the other"),
+                  std::string::npos)
             << e.what();
     }
     // The completed copy extends both: with it the three reconcile, in any order.
-    const MergeReport report =
-        merge_databases({path("a.db"), path("b.db"), path("completed.db")}, path("out.db"));
+    const MergeReport report = merge_databases(
+        {path("a.db"), path("b.db"), path("completed.db")}, path("out.db"));
     EXPECT_EQ(report.sessions_extended, 1);
     EXPECT_EQ(ratings_of_session(path("out.db"), uuid_.at(session_)), written_);
 }
@@ -238,25 +256,33 @@ TEST_F(Merge, TwoCompletedSessionsOfOneCodeFromOneMachineAreTwoPeople) {
     answer(b, second, -1);
     const Ratings second_ratings = written_;
     // Tell the two apart by start time: Monday's session came first.
-    Database(a, SQLITE_OPEN_READWRITE).exec("UPDATE sessions SET started_utc = '2024-03-04T09:00:00.000Z'");
-    Database(b, SQLITE_OPEN_READWRITE).exec("UPDATE sessions SET started_utc = '2024-03-05T09:00:00.000Z'");
-    for (const auto& inputs : {std::vector<std::string>{a, b}, std::vector<std::string>{b, a}}) {
+    Database(a, SQLITE_OPEN_READWRITE)
+        .exec("UPDATE sessions SET started_utc = '2024-03-04T09:00:00.000Z'");
+    Database(b, SQLITE_OPEN_READWRITE)
+        .exec("UPDATE sessions SET started_utc = '2024-03-05T09:00:00.000Z'");
+    for (const auto& inputs :
+         {std::vector<std::string>{a, b}, std::vector<std::string>{b, a}}) {
         const std::string out = path("out_" + std::to_string(inputs[0] == a) + ".db");
         const MergeReport report = merge_databases(inputs, out);
         EXPECT_EQ(report.sessions_added, 2);
         EXPECT_EQ(count_of(out, "SELECT count(*) FROM participants"), 2);
-        EXPECT_EQ(text_of(out, "SELECT p.code FROM participants p JOIN sessions s ON "
-                               "s.participant_id = p.id WHERE s.uuid = '" + first_uuid + "'"),
+        EXPECT_EQ(text_of(out,
+                          "SELECT p.code FROM participants p JOIN sessions s ON "
+                          "s.participant_id = p.id WHERE s.uuid = '" +
+                              first_uuid + "'"),
                   "P01@labmachi#1");
-        EXPECT_EQ(text_of(out, "SELECT p.code FROM participants p JOIN sessions s ON "
-                               "s.participant_id = p.id WHERE s.uuid = '" + second_uuid + "'"),
+        EXPECT_EQ(text_of(out,
+                          "SELECT p.code FROM participants p JOIN sessions s ON "
+                          "s.participant_id = p.id WHERE s.uuid = '" +
+                              second_uuid + "'"),
                   "P01@labmachi#2");
         EXPECT_EQ(ratings_of_session(out, first_uuid), first_ratings);
         EXPECT_EQ(ratings_of_session(out, second_uuid), second_ratings);
         ASSERT_EQ(report.notes.size(), 1u);
         EXPECT_NE(report.notes[0].find("2 people on machine labmachi"), std::string::npos)
             << report.notes[0];
-        EXPECT_NE(report.notes[0].find("P01@labmachi#1 P01@labmachi#2"), std::string::npos)
+        EXPECT_NE(report.notes[0].find("P01@labmachi#1 P01@labmachi#2"),
+                  std::string::npos)
             << report.notes[0];
     }
 }
@@ -272,8 +298,9 @@ TEST_F(Merge, OneSessionInTwoFilesOfOneMachineIsOnePerson) {
     start(path("later.db"), "P02", 2, machine);
     const MergeReport report = merge_databases({a, path("later.db")}, path("out.db"));
     EXPECT_TRUE(report.notes.empty());
-    EXPECT_EQ(text_of(path("out.db"), "SELECT group_concat(code, ' ') FROM (SELECT code FROM "
-                                      "participants ORDER BY code)"),
+    EXPECT_EQ(text_of(path("out.db"),
+                      "SELECT group_concat(code, ' ') FROM (SELECT code FROM "
+                      "participants ORDER BY code)"),
               "P01 P02");
 }
 

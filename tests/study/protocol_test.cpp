@@ -3,10 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include <set>
-
 #include <algorithm>
 #include <fstream>
+#include <set>
 
 #include "sha256.h"
 #include "study_fixtures.h"
@@ -16,8 +15,10 @@ namespace lucent::study {
 namespace {
 
 TEST(Sha256, MatchesFipsVectors) {
-    EXPECT_EQ(sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
-    EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    EXPECT_EQ(sha256_hex(""),
+              "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+    EXPECT_EQ(sha256_hex("abc"),
+              "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
     EXPECT_EQ(sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
               "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
 }
@@ -36,7 +37,8 @@ TEST(ThesisPreset, HasTheNineStimuliOfTable43) {
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("thickness_exponent")), table[i][0]);
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("backlight")), table[i][1]);
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("diffuse_weight")), table[i][2]);
-        // Row 1 also joins the physically based comparison series (section 8 of issue 11).
+        // Row 1 also joins the physically based comparison series (section 8 of issue
+        // 11).
         ASSERT_EQ(s->varies.size(), i == 0 ? 2u : 1u);
         EXPECT_EQ(s->varies[0], varies[i / 3]);
         if (i == 0) EXPECT_EQ(s->varies[1], "series:physically_based");
@@ -66,7 +68,8 @@ TEST(ThesisPreset, ContrastReversedStimuliHaveWardCounterparts) {
     const Protocol p = builtin_protocol("thesis");
     int pairs = 0;
     for (const StimulusSpec& s : p.stimuli) {
-        if (s.technique != "contrast_reversed" || s.id.rfind("practice", 0) == 0) continue;
+        if (s.technique != "contrast_reversed" || s.id.rfind("practice", 0) == 0)
+            continue;
         for (const char* key : {"reversed_diffuse", "specular_reflectance", "roughness"})
             EXPECT_TRUE(s.parameters.count(key)) << s.id << " lacks " << key;
         const StimulusSpec* ward = p.find_stimulus("ward_" + s.id.substr(18));
@@ -152,11 +155,14 @@ TEST(ProtocolErrors, UnknownKeyNamesFileLineAndKey) {
 }
 
 TEST(ProtocolErrors, EachKindIsOneLineNamingTheKey) {
-    struct Case { std::string from, to, expect; };
+    struct Case {
+        std::string from, to, expect;
+    };
     const Case cases[] = {
         {"break_every = 2", "break_every = \"two\"", "study.break_every"},
         {"break_every = 2", "break_every = -1", "must lie in"},
-        {"stimuli = [\"a\", \"b\", \"c\"]", "stimuli = [\"a\", \"zz\"]", "no stimulus with id 'zz'"},
+        {"stimuli = [\"a\", \"b\", \"c\"]", "stimuli = [\"a\", \"zz\"]",
+         "no stimulus with id 'zz'"},
         {"technique = \"ward\"", "technique = \"raytraced\"", "unknown technique"},
         {"expected = 7", "expected = 9", "catch_trials.expected"},
         {"varies = [\"thickness_exponent\"]\n\n[[stimuli]]\nid = \"b\"",
@@ -176,8 +182,9 @@ TEST(ProtocolErrors, EachKindIsOneLineNamingTheKey) {
 }
 
 TEST(Protocol, AnalysisPlanNamesThePrimaryDesign) {
-    EXPECT_EQ(parse_protocol(lucent::test::kSmallProtocol, "p.toml").analysis.primary_design,
-              "within");  // every participant sees every stimulus
+    EXPECT_EQ(
+        parse_protocol(lucent::test::kSmallProtocol, "p.toml").analysis.primary_design,
+        "within");  // every participant sees every stimulus
     std::string text = lucent::test::kSmallProtocol;
     text += "\n[analysis]\nprimary_design = \"between\"\n";
     EXPECT_EQ(parse_protocol(text, "p.toml").analysis.primary_design, "between");
@@ -219,7 +226,8 @@ params = { backlight = 1.2, albedo = [0.1, 0.6, 0.15] }
 [[blocks]]
 id = "main"
 stimuli = ["a", "b", "c"]
-)toml", "twins.toml");
+)toml",
+                                          "twins.toml");
     EXPECT_EQ(twins.level_of(*twins.find_stimulus("b"), "stimulus"), "a");
     EXPECT_EQ(twins.level_of(*twins.find_stimulus("c"), "stimulus"), "c");  // its colour
     // The thesis's rows 1, 4 and 7 share Table 4.3's r, wb and Kb but each series has its
@@ -257,7 +265,8 @@ image = "other.png"
 [[blocks]]
 id = "main"
 stimuli = ["one", "copy", "other"]
-)toml", "images.toml", dir.string());
+)toml",
+                                      "images.toml", dir.string());
     EXPECT_EQ(p.level_of(*p.find_stimulus("copy"), "stimulus"), "one");
     EXPECT_EQ(p.level_of(*p.find_stimulus("other"), "stimulus"), "other");
 }
@@ -266,10 +275,11 @@ TEST(Protocol, LevelsAreCanonicalNumbers) {
     const Protocol p = builtin_protocol("thesis");
     EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_8"), "diffuse_weight"), "0");
     EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_9"), "diffuse_weight"), "0.5");
-    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_2"), "thickness_exponent"), "18");
-    EXPECT_EQ(p.level_of(*p.find_stimulus("contrast_reversed_jade"), "technique"), "contrast_reversed");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("empirical_row_2"), "thickness_exponent"),
+              "18");
+    EXPECT_EQ(p.level_of(*p.find_stimulus("contrast_reversed_jade"), "technique"),
+              "contrast_reversed");
 }
-
 
 TEST(OnlineSettings, CompletionCodeAndUrlAreReadAndCheckedInOneLine) {
     const std::string base = lucent::test::kSmallProtocol;
@@ -277,11 +287,14 @@ TEST(OnlineSettings, CompletionCodeAndUrlAreReadAndCheckedInOneLine) {
     EXPECT_EQ(none.online.completion_code, "");
     EXPECT_EQ(none.online.completion_url, "");
     const Protocol p = parse_protocol(
-        base + "\n[online]\ncompletion_code = \"C0DE42\"\n"
-               "completion_url = \"https://app.prolific.com/submissions/complete?cc=C0DE42\"\n",
+        base +
+            "\n[online]\ncompletion_code = \"C0DE42\"\n"
+            "completion_url = "
+            "\"https://app.prolific.com/submissions/complete?cc=C0DE42\"\n",
         "web.toml");
     EXPECT_EQ(p.online.completion_code, "C0DE42");
-    EXPECT_EQ(p.online.completion_url, "https://app.prolific.com/submissions/complete?cc=C0DE42");
+    EXPECT_EQ(p.online.completion_url,
+              "https://app.prolific.com/submissions/complete?cc=C0DE42");
     for (const char* bad : {"completion_url = \"javascript:alert(1)\"",
                             "completion_code = \"<b>\"", "completion_link = \"x\""}) {
         try {

@@ -7,8 +7,8 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <thread>
 
@@ -34,9 +34,11 @@ void expect_consistent(Database& db, int questions) {
     Statement check = db.prepare("PRAGMA integrity_check");
     ASSERT_TRUE(check.step());
     EXPECT_EQ(check.text(0), "ok");
-    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM (SELECT trial_id, count(*) c FROM responses "
-                            "GROUP BY trial_id HAVING c != " + std::to_string(questions) + ")"),
-              0);
+    EXPECT_EQ(
+        db.scalar_int("SELECT count(*) FROM (SELECT trial_id, count(*) c FROM responses "
+                      "GROUP BY trial_id HAVING c != " +
+                      std::to_string(questions) + ")"),
+        0);
 }
 
 // A session with many trials, so that kills land at random places.
@@ -52,7 +54,8 @@ void finish_session(Store& store, const Protocol& p, const std::string& code) {
     const auto s = store.unfinished_session(code);
     if (s) {
         for (const TrialRow& t : store.trials(s->id))
-            if (!t.answered) store.record_trial(s->id, t.id, lucent::test::outcome_for(p, t));
+            if (!t.answered)
+                store.record_trial(s->id, t.id, lucent::test::outcome_for(p, t));
     }
     EXPECT_FALSE(store.unfinished_session(code).has_value());
     EXPECT_TRUE(store.has_completed_session(code));
@@ -97,8 +100,8 @@ TEST(StoreFault, FailingTheNthWriteNeverLosesOrSplitsATrial) {
         }
         Store store(path.string());
         expect_consistent(store.db(), questions);
-        const int64_t answered = store.db().scalar_int(
-            "SELECT count(DISTINCT trial_id) FROM responses");
+        const int64_t answered =
+            store.db().scalar_int("SELECT count(DISTINCT trial_id) FROM responses");
         EXPECT_GE(answered, committed) << "write " << n << ": a committed trial was lost";
         EXPECT_LE(answered, committed + 1) << "write " << n;
         // Resuming completes the session with exactly one rating per (trial, question).
@@ -106,7 +109,8 @@ TEST(StoreFault, FailingTheNthWriteNeverLosesOrSplitsATrial) {
         EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM responses"),
                   store.db().scalar_int("SELECT count(*) FROM trials") * questions);
         expect_consistent(store.db(), questions);
-        if (!failed) break;  // the whole session ran before write n: every write was tried
+        if (!failed)
+            break;  // the whole session ran before write n: every write was tried
         ++faults;
     }
     EXPECT_GT(faults, 5) << "the fault loop should have failed several distinct writes";
@@ -118,7 +122,8 @@ TEST(StoreCrash, SigkillMidSessionThenResumeKeepsEveryRatingOnce) {
     const int questions = static_cast<int>(p.questions.size());
     std::mt19937 gen(2024);
     for (int round = 0; round < 4; ++round) {
-        const std::string path = (dir / ("crash" + std::to_string(round) + ".db")).string();
+        const std::string path =
+            (dir / ("crash" + std::to_string(round) + ".db")).string();
         {
             Store store(path);
             const int64_t study = store.ensure_study(p);
@@ -147,10 +152,12 @@ TEST(StoreCrash, SigkillMidSessionThenResumeKeepsEveryRatingOnce) {
         finish_session(store, p, "P1");
         EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM responses"),
                   store.db().scalar_int("SELECT count(*) FROM trials") * questions);
-        EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM (SELECT trial_id, question, "
-                                        "count(*) c FROM responses GROUP BY 1, 2 HAVING c > 1)"),
+        EXPECT_EQ(store.db().scalar_int(
+                      "SELECT count(*) FROM (SELECT trial_id, question, "
+                      "count(*) c FROM responses GROUP BY 1, 2 HAVING c > 1)"),
                   0);
-        RecordProperty("kept_before_resume_" + std::to_string(round), std::to_string(before));
+        RecordProperty("kept_before_resume_" + std::to_string(round),
+                       std::to_string(before));
     }
 }
 
@@ -181,7 +188,9 @@ TEST(StoreCorrupt, ForeignAndDamagedFilesAreRefusedAndUnchanged) {
          },
          "not a Lucent study database"},
         {"png_file",
-         [](const fs::path& p) { std::ofstream(p, std::ios::binary) << "\x89PNG\r\n\x1a\n rest"; },
+         [](const fs::path& p) {
+             std::ofstream(p, std::ios::binary) << "\x89PNG\r\n\x1a\n rest";
+         },
          "not an SQLite file"},
         {"other_application",
          [](const fs::path& p) {
@@ -205,7 +214,8 @@ TEST(StoreCorrupt, ForeignAndDamagedFilesAreRefusedAndUnchanged) {
          "corrupt"},
         {"truncated",
          [&](const fs::path& p) {
-             std::ofstream(p, std::ios::binary) << good_bytes.substr(0, good_bytes.size() / 2);
+             std::ofstream(p, std::ios::binary)
+                 << good_bytes.substr(0, good_bytes.size() / 2);
          },
          "corrupt"},
     };
@@ -219,7 +229,8 @@ TEST(StoreCorrupt, ForeignAndDamagedFilesAreRefusedAndUnchanged) {
             ADD_FAILURE() << c.name << ": opened without error";
         } catch (const StoreError& e) {
             const std::string message = e.what();
-            EXPECT_NE(message.find(c.expect), std::string::npos) << c.name << ": " << message;
+            EXPECT_NE(message.find(c.expect), std::string::npos)
+                << c.name << ": " << message;
             EXPECT_NE(message.find(path.string()), std::string::npos) << message;
             EXPECT_EQ(message.find('\n'), std::string::npos) << message;
         }

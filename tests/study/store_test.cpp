@@ -51,11 +51,12 @@ TEST(Store, WritesTheWholePlanBeforeTheFirstTrial) {
     EXPECT_EQ(s.uuid.size(), 36u);
     EXPECT_EQ(s.uuid[14], '4');
     // Stimulus parameters are stored as rows, ready to serve as factors.
-    EXPECT_EQ(store.db().scalar_int(
-                  "SELECT count(*) FROM stimulus_parameters p JOIN stimuli s ON s.id = "
-                  "p.stimulus_id WHERE s.stimulus_key = 'b' AND p.name = 'thickness_exponent' "
-                  "AND p.value = '25'"),
-              1);
+    EXPECT_EQ(
+        store.db().scalar_int(
+            "SELECT count(*) FROM stimulus_parameters p JOIN stimuli s ON s.id = "
+            "p.stimulus_id WHERE s.stimulus_key = 'b' AND p.name = 'thickness_exponent' "
+            "AND p.value = '25'"),
+        1);
 }
 
 TEST(Store, RecordsEachTrialOnceAndRefusesDuplicates) {
@@ -67,8 +68,9 @@ TEST(Store, RecordsEachTrialOnceAndRefusesDuplicates) {
     const SessionRow s = store.create_session(study, pid, plan_trials(p, 1, 1), 1, {});
     const std::vector<TrialRow> trials = store.trials(s.id);
     store.record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
-    EXPECT_THROW(store.record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0])),
-                 StoreError);
+    EXPECT_THROW(
+        store.record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0])),
+        StoreError);
     EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM responses"), 2);
     // A rating outside 1..7 violates the CHECK constraint and leaves nothing behind.
     TrialOutcome bad = lucent::test::outcome_for(p, trials[1]);
@@ -88,7 +90,8 @@ TEST(Store, ResumeFindsTheUnfinishedSessionWithItsOrder) {
         Store store(path);
         const int64_t study = store.ensure_study(p);
         const int64_t pid = store.ensure_participant(study, "P2", nullptr);
-        const SessionRow s = store.create_session(study, pid, plan_trials(p, 9, 2), 9, {});
+        const SessionRow s =
+            store.create_session(study, pid, plan_trials(p, 9, 2), 9, {});
         const auto trials = store.trials(s.id);
         for (const auto& t : trials) order.push_back(t.stimulus);
         store.record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
@@ -121,7 +124,8 @@ TEST(Store, WithdrawDeletesEverythingOfThatParticipantOnly) {
     const Protocol p = small_protocol();
     lucent::test::run_full_session(store, p, "P1", 1);
     lucent::test::run_full_session(store, p, "P2", 2);
-    const int64_t per_session = store.db().scalar_int("SELECT count(*) FROM responses") / 2;
+    const int64_t per_session =
+        store.db().scalar_int("SELECT count(*) FROM responses") / 2;
     EXPECT_TRUE(store.withdraw_participant("P1"));
     EXPECT_FALSE(store.withdraw_participant("P1"));
     Database& db = store.db();
@@ -169,15 +173,17 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRows) {
     {
         Database db(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
         migrate(db, 1);
-        db.exec("INSERT INTO studies (name, protocol_text, protocol_hash, created_utc) "
-                "VALUES ('old', 'x', 'h', 'now')");
+        db.exec(
+            "INSERT INTO studies (name, protocol_text, protocol_hash, created_utc) "
+            "VALUES ('old', 'x', 'h', 'now')");
         ASSERT_EQ(db.scalar_int("PRAGMA user_version"), 1);
     }
     Store store(path);
     EXPECT_EQ(store.db().scalar_int("PRAGMA user_version"), kSchemaVersion);
-    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM studies WHERE name = 'old'"), 1);
-    EXPECT_EQ(store.db().scalar_int(
-                  "SELECT count(*) FROM pragma_table_info('sessions') WHERE name = 'refresh_note'"),
+    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM studies WHERE name = 'old'"),
+              1);
+    EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM pragma_table_info('sessions') "
+                                    "WHERE name = 'refresh_note'"),
               1);
 }
 

@@ -20,14 +20,16 @@ inline void downgrade_schema(study::Database& db, int version) {
     std::vector<std::pair<std::string, std::string>> tables, indexes;  // name, sql
     {
         study::Statement s = model.prepare(
-            "SELECT type, name, sql FROM sqlite_schema WHERE sql IS NOT NULL ORDER BY rowid");
+            "SELECT type, name, sql FROM sqlite_schema WHERE sql IS NOT NULL ORDER BY "
+            "rowid");
         while (s.step())
             (s.text(0) == "table" ? tables : indexes).emplace_back(s.text(1), s.text(2));
     }
     db.exec("PRAGMA foreign_keys = OFF");
     std::vector<std::string> later;
     {
-        study::Statement s = db.prepare("SELECT name FROM sqlite_schema WHERE type = 'table'");
+        study::Statement s =
+            db.prepare("SELECT name FROM sqlite_schema WHERE type = 'table'");
         while (s.step()) later.push_back(s.text(0));
     }
     for (const std::string& name : later) {
@@ -43,8 +45,8 @@ inline void downgrade_schema(study::Database& db, int version) {
         std::string rebuilt = sql;
         rebuilt.replace(rebuilt.find(name), name.size(), name + "_old_schema");
         db.exec(rebuilt);
-        db.exec("INSERT INTO " + name + "_old_schema (" + columns + ") SELECT " + columns +
-                " FROM " + name);
+        db.exec("INSERT INTO " + name + "_old_schema (" + columns + ") SELECT " +
+                columns + " FROM " + name);
         db.exec("DROP TABLE " + name);
         db.exec("ALTER TABLE " + name + "_old_schema RENAME TO " + name);
     }
@@ -53,7 +55,8 @@ inline void downgrade_schema(study::Database& db, int version) {
     db.exec("PRAGMA foreign_keys = ON");
 }
 
-// 3 rated stimuli varying thickness_exponent, 1 practice, 1 catch (expected 7), 2 questions.
+// 3 rated stimuli varying thickness_exponent, 1 practice, 1 catch (expected 7), 2
+// questions.
 inline const char* kSmallProtocol = R"toml(
 [study]
 name = "small"
@@ -109,7 +112,9 @@ prompt = "Choose 7"
 expected = 7
 )toml";
 
-inline study::Protocol small_protocol() { return study::parse_protocol(kSmallProtocol, "small.toml"); }
+inline study::Protocol small_protocol() {
+    return study::parse_protocol(kSmallProtocol, "small.toml");
+}
 
 // The small protocol with mixed scales: 'translucent' keeps 7 points, 'realistic' gets 5
 // (the catch trial then asks for 5, the most every scale has).
@@ -118,8 +123,10 @@ inline std::string mixed_scale_protocol_text() {
     const std::string realistic = "text = \"The object looks realistic.\"\n";
     const size_t question = text.find(realistic) + realistic.size();
     const size_t expected = text.find("expected = 7");
-    return text.substr(0, question) + "labels = [\"not at all\", \"\", \"\", \"\", \"fully\"]\n" +
-           text.substr(question, expected - question) + "expected = 5" + text.substr(expected + 12);
+    return text.substr(0, question) +
+           "labels = [\"not at all\", \"\", \"\", \"\", \"fully\"]\n" +
+           text.substr(question, expected - question) + "expected = 5" +
+           text.substr(expected + 12);
 }
 inline study::Protocol mixed_scale_protocol() {
     return study::parse_protocol(mixed_scale_protocol_text(), "mixed.toml");
@@ -127,7 +134,9 @@ inline study::Protocol mixed_scale_protocol() {
 
 // Deterministic rating for (trial position, question index): lets tests recompute
 // expected exports independently of the database.
-inline int rating_for(int position, int question) { return 1 + (position * 3 + question * 2) % 7; }
+inline int rating_for(int position, int question) {
+    return 1 + (position * 3 + question * 2) % 7;
+}
 
 inline study::TrialOutcome outcome_for(const study::Protocol& p, const study::TrialRow& t,
                                        int catch_rating = 7) {
@@ -149,12 +158,13 @@ inline study::TrialOutcome outcome_for(const study::Protocol& p, const study::Tr
 
 // Starts a session for `code` and answers every trial; returns the session id.
 inline int64_t run_full_session(study::Store& store, const study::Protocol& p,
-                                const std::string& code, uint64_t seed, int catch_rating = 7) {
+                                const std::string& code, uint64_t seed,
+                                int catch_rating = 7) {
     const int64_t study_id = store.ensure_study(p);
     int number = 0;
     const int64_t pid = store.ensure_participant(study_id, code, &number);
-    study::SessionRow s = store.create_session(study_id, pid, study::plan_trials(p, seed, number),
-                                              seed, {});
+    study::SessionRow s = store.create_session(
+        study_id, pid, study::plan_trials(p, seed, number), seed, {});
     for (const study::TrialRow& t : store.trials(s.id))
         store.record_trial(s.id, t.id, outcome_for(p, t, catch_rating));
     store.set_status(s.id, "completed", true);

@@ -35,8 +35,8 @@ int closest_repeat(const std::vector<std::string>& s) {
 
 // Independent picture identity: what is drawn, whatever the stimulus id.
 bool same_picture(const StimulusSpec& a, const StimulusSpec& b) {
-    return a.technique == b.technique && a.mesh == b.mesh && a.parameters == b.parameters &&
-           a.image == b.image;
+    return a.technique == b.technique && a.mesh == b.mesh &&
+           a.parameters == b.parameters && a.image == b.image;
 }
 
 // Whether a sequence of trials (indices into `pictures`, a same-picture matrix) keeps
@@ -44,11 +44,13 @@ bool same_picture(const StimulusSpec& a, const StimulusSpec& b) {
 bool meets(const std::vector<int>& order, const std::vector<std::vector<bool>>& same,
            const SequenceConstraints& c) {
     for (size_t i = 0; i < order.size(); ++i) {
-        for (size_t j = i + 1; j < order.size() && static_cast<int>(j - i) < c.min_distance; ++j)
+        for (size_t j = i + 1;
+             j < order.size() && static_cast<int>(j - i) < c.min_distance; ++j)
             if (same[order[i]][order[j]]) return false;
         if (c.max_repeat > 0 && i + c.max_repeat < order.size()) {
             bool run = true;
-            for (int k = 1; k <= c.max_repeat && run; ++k) run = same[order[i]][order[i + k]];
+            for (int k = 1; k <= c.max_repeat && run; ++k)
+                run = same[order[i]][order[i + k]];
             if (run) return false;
         }
     }
@@ -79,7 +81,8 @@ std::pair<double, std::vector<double>> catch_position_counts(
         if (c.max_repeat > 0 && k >= c.max_repeat) {
             const int first = s.last[k - c.max_repeat];
             bool run = same[first][next];
-            for (int i = k - c.max_repeat + 1; i < k && run; ++i) run = same[first][s.last[i]];
+            for (int i = k - c.max_repeat + 1; i < k && run; ++i)
+                run = same[first][s.last[i]];
             if (run) return false;
         }
         return true;
@@ -127,8 +130,9 @@ TEST(PlanTrials, CatchPositionCountsEqualEnumeratingEveryOrder) {
     std::vector<std::vector<bool>> same(7, std::vector<bool>(7));
     for (int i = 0; i < 7; ++i)
         for (int j = 0; j < 7; ++j) same[i][j] = picture[i] == picture[j];
-    for (const SequenceConstraints c : {SequenceConstraints{1, 3}, SequenceConstraints{1, 2},
-                                        SequenceConstraints{2, 0}}) {
+    for (const SequenceConstraints c :
+         {SequenceConstraints{1, 3}, SequenceConstraints{1, 2},
+          SequenceConstraints{2, 0}}) {
         std::vector<int> order = {0, 1, 2, 3, 4, 5, 6};
         double valid = 0.0;
         std::vector<double> at(7, 0.0);
@@ -178,7 +182,8 @@ TEST(LatinSquare, EveryConditionOncePerPositionAndEachOrderedPairEquallyOften) {
         for (int participant = 0; participant < rows; ++participant) {
             const std::vector<int> row = latin_square_row(n, participant);
             ASSERT_EQ(static_cast<int>(row.size()), n);
-            EXPECT_EQ(std::set<int>(row.begin(), row.end()).size(), static_cast<size_t>(n));
+            EXPECT_EQ(std::set<int>(row.begin(), row.end()).size(),
+                      static_cast<size_t>(n));
             for (int pos = 0; pos < n; ++pos) ++position_count[row[pos]][pos];
             for (int pos = 0; pos + 1 < n; ++pos) ++adjacent[{row[pos], row[pos + 1]}];
         }
@@ -189,8 +194,8 @@ TEST(LatinSquare, EveryConditionOncePerPositionAndEachOrderedPairEquallyOften) {
         if (n > 1) {
             EXPECT_EQ(adjacent.size(), static_cast<size_t>(n * (n - 1))) << "n=" << n;
             for (const auto& [pair, count] : adjacent)
-                EXPECT_EQ(count, rows / n) << "n=" << n << " pair " << pair.first << ","
-                                           << pair.second;
+                EXPECT_EQ(count, rows / n)
+                    << "n=" << n << " pair " << pair.first << "," << pair.second;
         }
     }
 }
@@ -208,7 +213,8 @@ TEST(ConstrainedShuffle, ConstraintsHoldOverManySeeds) {
         std::vector<std::string> levels;
         const int n_levels = 3 + trial % 3;
         for (int l = 0; l < n_levels; ++l)
-            for (int k = 0; k < 2 + (trial + l) % 3; ++k) levels.push_back("L" + std::to_string(l));
+            for (int k = 0; k < 2 + (trial + l) % 3; ++k)
+                levels.push_back("L" + std::to_string(l));
         const SequenceConstraints c{1 + trial % 2, trial % 3 == 0 ? 2 : 0};
         const std::vector<int> perm = constrained_shuffle(levels, c, gen());
         std::vector<int> sorted = perm;
@@ -228,7 +234,8 @@ TEST(ConstrainedShuffle, DifferentSeedsGiveDifferentOrdersAndTheSameSeedTheSame)
     for (int i = 0; i < 12; ++i) levels.push_back(std::to_string(i % 4));
     const SequenceConstraints c{1, 0};
     std::set<std::vector<int>> orders;
-    for (uint64_t seed = 0; seed < 50; ++seed) orders.insert(constrained_shuffle(levels, c, seed));
+    for (uint64_t seed = 0; seed < 50; ++seed)
+        orders.insert(constrained_shuffle(levels, c, seed));
     EXPECT_GT(orders.size(), 40u);
     EXPECT_EQ(constrained_shuffle(levels, c, 99), constrained_shuffle(levels, c, 99));
 }
@@ -236,9 +243,11 @@ TEST(ConstrainedShuffle, DifferentSeedsGiveDifferentOrdersAndTheSameSeedTheSame)
 TEST(ConstrainedShuffle, ImpossibleConstraintsAreReportedQuickly) {
     const auto start = std::chrono::steady_clock::now();
     // Four 'a' among six trials cannot avoid adjacent 'a's.
-    EXPECT_THROW(constrained_shuffle({"a", "a", "a", "a", "b", "c"}, {1, 0}, 1), PlanError);
+    EXPECT_THROW(constrained_shuffle({"a", "a", "a", "a", "b", "c"}, {1, 0}, 1),
+                 PlanError);
     // Three 'a' at distance >= 3 need 7 positions.
-    EXPECT_THROW(constrained_shuffle({"a", "a", "a", "b", "c", "d"}, {0, 3}, 1), PlanError);
+    EXPECT_THROW(constrained_shuffle({"a", "a", "a", "b", "c", "d"}, {0, 3}, 1),
+                 PlanError);
     try {
         constrained_shuffle({"x", "x", "x"}, {2, 0}, 1);
         FAIL();
@@ -297,7 +306,8 @@ TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
         const int n = static_cast<int>(trials.stimuli.size());
         std::vector<std::vector<bool>> same(n, std::vector<bool>(n));
         for (int i = 0; i < n; ++i)
-            for (int j = 0; j < n; ++j) same[i][j] = same_picture(*trials.stimuli[i], *trials.stimuli[j]);
+            for (int j = 0; j < n; ++j)
+                same[i][j] = same_picture(*trials.stimuli[i], *trials.stimuli[j]);
         auto [valid, at] = catch_position_counts(same, trials.is_catch, c);
         ASSERT_GT(valid, 0.0) << block.id;
         for (double& a : at) a /= valid;
@@ -327,9 +337,11 @@ TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
                 same_picture_adjacent += same;
                 catch_next_to_own_picture += same && (t.is_catch || before.is_catch);
             }
-            for (size_t back = 1; back < static_cast<size_t>(c.min_distance) && back <= i; ++back)
-                too_close += !plan.trials[i - back].practice && !t.practice &&
-                             same_picture(*p.find_stimulus(plan.trials[i - back].stimulus), here);
+            for (size_t back = 1; back < static_cast<size_t>(c.min_distance) && back <= i;
+                 ++back)
+                too_close +=
+                    !plan.trials[i - back].practice && !t.practice &&
+                    same_picture(*p.find_stimulus(plan.trials[i - back].stimulus), here);
             if (t.practice) continue;
             const int pos = block_position[t.block]++;
             if (t.is_catch) ++catch_at[t.block][pos];
@@ -341,8 +353,8 @@ TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
     for (const auto& [block, probability] : catch_position_probability) {
         const auto [statistic, df] = chi_square(catch_at[block], probability);
         ASSERT_GE(df, 1) << block;
-        EXPECT_LT(statistic, chi_square_999(std::max(df, 3))) << block << ": chi-square "
-                                                              << statistic << " on " << df << " df";
+        EXPECT_LT(statistic, chi_square_999(std::max(df, 3)))
+            << block << ": chi-square " << statistic << " on " << df << " df";
     }
 }
 
@@ -426,7 +438,8 @@ TEST(PlanTrials, EveryValidOrderOfASmallProtocolIsEquallyLikely) {
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j)
             same[i][j] = same_picture(*p.find_stimulus(ids[i]), *p.find_stimulus(ids[j]));
-    // Brute force: every (order of block one, order of block two) meeting the constraints.
+    // Brute force: every (order of block one, order of block two) meeting the
+    // constraints.
     std::map<std::string, int> index_of_order;
     std::vector<int> one = {0, 1, 2, 3};
     do {
@@ -460,10 +473,12 @@ TEST(PlanTrials, EveryValidOrderOfASmallProtocolIsEquallyLikely) {
         tally(key);
     }
     auto [statistic, df] = chi_square(observed, uniform);
-    EXPECT_LT(statistic, chi_square_999(df)) << "planner: chi-square " << statistic << " on " << df;
+    EXPECT_LT(statistic, chi_square_999(df))
+        << "planner: chi-square " << statistic << " on " << df;
     // The exact sampler (the fallback for rare valid orders) on the same blocks.
     std::vector<std::vector<std::string>> levels(2);
-    for (int i = 0; i < n; ++i) levels[i < 4 ? 0 : 1].push_back(p.level_of(*p.find_stimulus(ids[i]), "stimulus"));
+    for (int i = 0; i < n; ++i)
+        levels[i < 4 ? 0 : 1].push_back(p.level_of(*p.find_stimulus(ids[i]), "stimulus"));
     std::fill(observed.begin(), observed.end(), 0.0);
     std::mt19937_64 rng(8);
     for (int i = 0; i < kPlans; ++i) {
@@ -474,7 +489,8 @@ TEST(PlanTrials, EveryValidOrderOfASmallProtocolIsEquallyLikely) {
         tally(key);
     }
     std::tie(statistic, df) = chi_square(observed, uniform);
-    EXPECT_LT(statistic, chi_square_999(df)) << "exact: chi-square " << statistic << " on " << df;
+    EXPECT_LT(statistic, chi_square_999(df))
+        << "exact: chi-square " << statistic << " on " << df;
 }
 
 TEST(ConstrainedShuffle, RareValidOrdersAreCountedExactlyWhenRejectionGivesUp) {
@@ -499,18 +515,22 @@ TEST(ConstrainedShuffle, RareValidOrdersAreCountedExactlyWhenRejectionGivesUp) {
         const std::vector<int> order = exact_block_shuffles({levels}, c, rng).front();
         ASSERT_TRUE(alternates(order));
         a_first += levels[order[0]] == "a";
-        const int at = static_cast<int>(std::find(order.begin(), order.end(), 0) - order.begin());
+        const int at =
+            static_cast<int>(std::find(order.begin(), order.end(), 0) - order.begin());
         ++slot_of_trial_0[at / 2];
     }
     EXPECT_NEAR(a_first, kOrders / 2, 4 * std::sqrt(kOrders / 4.0));
-    const auto [statistic, df] = chi_square(slot_of_trial_0, std::vector<double>(20, 1.0 / 20));
-    EXPECT_LT(statistic, chi_square_999(df)) << "chi-square " << statistic << " on " << df;
+    const auto [statistic, df] =
+        chi_square(slot_of_trial_0, std::vector<double>(20, 1.0 / 20));
+    EXPECT_LT(statistic, chi_square_999(df))
+        << "chi-square " << statistic << " on " << df;
     // And an impossible case that passes the count check is now a definite answer.
     try {
         exact_block_shuffles({{"a", "a", "b", "b"}}, {0, 3}, rng);
         FAIL();
     } catch (const PlanError& e) {
-        EXPECT_NE(std::string(e.what()).find("no order of the 4 trials meets"), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("no order of the 4 trials meets"),
+                  std::string::npos)
             << e.what();
     }
 }

@@ -35,7 +35,8 @@ protected:
         const int64_t pid = store.ensure_participant(study, code, &number);
         SessionEnvironment env;
         env.machine_id = machine;
-        const SessionRow s = store.create_session(study, pid, plan_trials(p_, seed, number), seed, env);
+        const SessionRow s =
+            store.create_session(study, pid, plan_trials(p_, seed, number), seed, env);
         for (const TrialRow& t : store.trials(s.id)) {
             if (answered-- == 0) break;
             store.record_trial(s.id, t.id, lucent::test::outcome_for(p_, t));
@@ -58,16 +59,18 @@ TEST_F(Withdrawal, WithdrawingLeavesTombstonesButNotTheCode) {
     }
     EXPECT_EQ(count_of(db, "SELECT count(*) FROM withdrawn_sessions"), 1);
     Database d(db, SQLITE_OPEN_READONLY);
-    Statement s = d.prepare("SELECT w.uuid, c.salt, c.code_hash FROM withdrawn_sessions w, "
-                            "withdrawn_codes c");
+    Statement s = d.prepare(
+        "SELECT w.uuid, c.salt, c.code_hash FROM withdrawn_sessions w, "
+        "withdrawn_codes c");
     ASSERT_TRUE(s.step());
     EXPECT_EQ(s.text(0), uuid);
     EXPECT_EQ(s.text(2), sha256_hex(s.text(1) + "P07\nmachine-aaaa-0001"));
     EXPECT_FALSE(s.step());  // one code row: one machine
     // The code itself is nowhere in the file's tombstones.
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM withdrawn_codes WHERE salt LIKE '%P07%' OR "
-                           "code_hash LIKE '%P07%'"),
-              0);
+    EXPECT_EQ(
+        d.scalar_int("SELECT count(*) FROM withdrawn_codes WHERE salt LIKE '%P07%' OR "
+                     "code_hash LIKE '%P07%'"),
+        0);
 }
 
 TEST_F(Withdrawal, MergingAStationFileDoesNotBringAWithdrawnParticipantBack) {
@@ -87,16 +90,22 @@ TEST_F(Withdrawal, MergingAStationFileDoesNotBringAWithdrawnParticipantBack) {
         EXPECT_EQ(report.sessions_withdrawn, 1);
         EXPECT_EQ(report.sessions_added, 1);
         EXPECT_EQ(count_of(out, "SELECT count(*) FROM sessions"), 1);
-        EXPECT_EQ(count_of(out, "SELECT count(*) FROM participants WHERE code = 'P01'"), 0);
-        EXPECT_EQ(count_of(out, "SELECT count(*) FROM participants WHERE code = 'P02'"), 1);
+        EXPECT_EQ(count_of(out, "SELECT count(*) FROM participants WHERE code = 'P01'"),
+                  0);
+        EXPECT_EQ(count_of(out, "SELECT count(*) FROM participants WHERE code = 'P02'"),
+                  1);
         EXPECT_EQ(count_of(out, "SELECT count(*) FROM responses"), 5 * 2);  // P02's only
         // The tombstones travel on, so the next merge of the station drops P01 again.
         EXPECT_EQ(count_of(out, "SELECT count(*) FROM withdrawn_sessions"), 1);
         EXPECT_EQ(count_of(out, "SELECT count(*) FROM withdrawn_codes"), 1);
-        EXPECT_EQ(count_of(out, "SELECT count(*) FROM retired_participant_numbers WHERE number = 1"), 1);
+        EXPECT_EQ(
+            count_of(out,
+                     "SELECT count(*) FROM retired_participant_numbers WHERE number = 1"),
+            1);
         const std::string again = out + ".again.db";
         EXPECT_EQ(merge_databases({station, out}, again).sessions_withdrawn, 1);
-        EXPECT_EQ(count_of(again, "SELECT count(*) FROM participants WHERE code = 'P01'"), 0);
+        EXPECT_EQ(count_of(again, "SELECT count(*) FROM participants WHERE code = 'P01'"),
+                  0);
     }
 }
 
@@ -146,7 +155,8 @@ TEST(EnrolledCode, MergedNamesLoseTheirMachineSuffixOnlyForTheirMachine) {
     EXPECT_EQ(enrolled_code("P07@3f2a9c1e#2", "3f2a9c1e0011"), "P07");
     EXPECT_EQ(enrolled_code("P07@unknown-machine", ""), "P07");
     EXPECT_EQ(enrolled_code("P07@3f2a9c1e", "77b0d2aa0011"), "P07@3f2a9c1e");
-    EXPECT_EQ(enrolled_code("anna@lab", "lab"), "anna@lab");  // under 8 characters: a code
+    EXPECT_EQ(enrolled_code("anna@lab", "lab"),
+              "anna@lab");  // under 8 characters: a code
     EXPECT_TRUE(is_split_on_one_machine("P07@3f2a9c1e#2", "3f2a9c1e0011"));
     EXPECT_FALSE(is_split_on_one_machine("P07@3f2a9c1e", "3f2a9c1e0011"));
 }

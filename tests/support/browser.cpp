@@ -43,8 +43,8 @@ int run_chromium(const std::string& arguments, const std::filesystem::path& work
         "timeout 180 chromium --headless --no-sandbox --disable-gpu --disable-quic "
         "--no-first-run --disable-background-networking --disable-component-update "
         "--disable-sync --hide-scrollbars --user-data-dir=" +
-        quoted(profile) + " " + arguments + " > " + quoted(stdout_file.string()) + " 2> " +
-        quoted((work / "chromium.log").string());
+        quoted(profile) + " " + arguments + " > " + quoted(stdout_file.string()) +
+        " 2> " + quoted((work / "chromium.log").string());
     const int status = std::system(command.c_str());
     std::error_code ignored;
     std::filesystem::remove_all(profile, ignored);
@@ -54,9 +54,11 @@ int run_chromium(const std::string& arguments, const std::filesystem::path& work
 }  // namespace
 
 BrowserPage open_in_browser(const std::filesystem::path& html,
-                            const std::filesystem::path& screenshot, int width, int height) {
+                            const std::filesystem::path& screenshot, int width,
+                            int height) {
     BrowserPage page;
-    const auto url = "file://" + std::filesystem::absolute(html).lexically_normal().string();
+    const auto url =
+        "file://" + std::filesystem::absolute(html).lexically_normal().string();
     if (!screenshot.parent_path().empty())
         std::filesystem::create_directories(screenshot.parent_path());
     // Chromium's output and log in a scratch folder of their own, removed afterwards.
@@ -75,12 +77,14 @@ BrowserPage open_in_browser(const std::filesystem::path& html,
         }
     } cleanup{work};
     if (std::system("command -v chromium > /dev/null 2>&1") != 0) {
-        page.error = "chromium is not installed (Debian package chromium; scripts/install-deps)";
+        page.error =
+            "chromium is not installed (Debian package chromium; scripts/install-deps)";
         return page;
     }
     const auto dom_file = work / "dom.html";
     if (run_chromium("--dump-dom " + quoted(url), work, dom_file) != 0) {
-        page.error = "chromium --dump-dom failed: " + last_line(read_text(work / "chromium.log"));
+        page.error =
+            "chromium --dump-dom failed: " + last_line(read_text(work / "chromium.log"));
         return page;
     }
     page.dom = read_text(dom_file);
@@ -92,11 +96,12 @@ BrowserPage open_in_browser(const std::filesystem::path& html,
 
     std::filesystem::remove(screenshot);
     const std::string size = std::to_string(width) + "," + std::to_string(height);
-    if (run_chromium("--screenshot=" + quoted(screenshot.string()) + " --window-size=" + size +
-                         " " + quoted(url),
+    if (run_chromium("--screenshot=" + quoted(screenshot.string()) +
+                         " --window-size=" + size + " " + quoted(url),
                      work, work / "screenshot.out") != 0 ||
         !std::filesystem::exists(screenshot)) {
-        page.error = "chromium --screenshot failed: " + last_line(read_text(work / "chromium.log"));
+        page.error = "chromium --screenshot failed: " +
+                     last_line(read_text(work / "chromium.log"));
         return page;
     }
     auto in = OIIO::ImageInput::open(screenshot.string());
@@ -113,7 +118,8 @@ BrowserPage open_in_browser(const std::filesystem::path& html,
     page.rgb.resize(n * 3);
     for (std::size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c)
-            page.rgb[i * 3 + c] = pixels[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
+            page.rgb[i * 3 + c] =
+                pixels[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
     page.non_background_pixels = page.count_pixels([&](float r, float g, float b) {
         return std::fabs(r - page.rgb[0]) > 2.0f / 255.0f ||
                std::fabs(g - page.rgb[1]) > 2.0f / 255.0f ||
@@ -123,7 +129,8 @@ BrowserPage open_in_browser(const std::filesystem::path& html,
     return page;
 }
 
-std::size_t BrowserPage::count_pixels(const std::function<bool(float, float, float)>& test) const {
+std::size_t BrowserPage::count_pixels(
+    const std::function<bool(float, float, float)>& test) const {
     std::size_t count = 0;
     for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
         count += test(rgb[i], rgb[i + 1], rgb[i + 2]);

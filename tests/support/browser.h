@@ -14,10 +14,10 @@
 namespace lucent::test {
 
 struct BrowserPage {
-    bool ok = false;       // chromium ran and produced both outputs
-    std::string error;     // why not, one line (with chromium's last output)
-    std::string dom;       // the serialised DOM after load
-    std::string images_drawn;  // the data-images-drawn value, or empty when absent
+    bool ok = false;            // chromium ran and produced both outputs
+    std::string error;          // why not, one line (with chromium's last output)
+    std::string dom;            // the serialised DOM after load
+    std::string images_drawn;   // the data-images-drawn value, or empty when absent
     int width = 0, height = 0;  // the screenshot
     std::vector<float> rgb;     // its pixels, 3 values in [0, 1] each, top row first
     std::size_t non_background_pixels = 0;  // differing from the top-left pixel

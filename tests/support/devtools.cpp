@@ -21,7 +21,8 @@ constexpr auto kReplyTimeout = std::chrono::seconds(30);
 
 DevToolsBrowser::DevToolsBrowser(int width, int height) {
     if (std::system("command -v chromium > /dev/null 2>&1") != 0) {
-        error_ = "chromium is not installed (Debian package chromium; scripts/install-deps)";
+        error_ =
+            "chromium is not installed (Debian package chromium; scripts/install-deps)";
         return;
     }
     char profile_template[] = "/tmp/lucent-devtools-XXXXXX";
@@ -35,7 +36,8 @@ DevToolsBrowser::DevToolsBrowser(int width, int height) {
         error_ = std::string("pipe: ") + std::strerror(errno);
         return;
     }
-    const std::string size = "--window-size=" + std::to_string(width) + "," + std::to_string(height);
+    const std::string size =
+        "--window-size=" + std::to_string(width) + "," + std::to_string(height);
     const std::string profile = "--user-data-dir=" + profile_.string();
     pid_ = fork();
     if (pid_ == 0) {
@@ -50,12 +52,22 @@ DevToolsBrowser::DevToolsBrowser(int width, int height) {
         dup2(null, 0);
         dup2(null, 1);
         dup2(null, 2);
-        const char* argv[] = {"chromium", "--headless", "--no-sandbox", "--disable-gpu",
-                              "--disable-quic", "--no-first-run",
-                              "--disable-background-networking", "--disable-component-update",
-                              "--disable-sync", "--hide-scrollbars", "--mute-audio",
-                              "--remote-debugging-pipe", size.c_str(), profile.c_str(),
-                              "about:blank", nullptr};
+        const char* argv[] = {"chromium",
+                              "--headless",
+                              "--no-sandbox",
+                              "--disable-gpu",
+                              "--disable-quic",
+                              "--no-first-run",
+                              "--disable-background-networking",
+                              "--disable-component-update",
+                              "--disable-sync",
+                              "--hide-scrollbars",
+                              "--mute-audio",
+                              "--remote-debugging-pipe",
+                              size.c_str(),
+                              profile.c_str(),
+                              "about:blank",
+                              nullptr};
         execvp("chromium", const_cast<char* const*>(argv));
         _exit(127);
     }
@@ -74,9 +86,10 @@ DevToolsBrowser::DevToolsBrowser(int width, int height) {
         for (const json& t : targets["targetInfos"])
             if (t["type"] == "page") target = t["targetId"];
         if (target.empty())
-            target = call_on("", "Target.createTarget", {{"url", "about:blank"}})["targetId"];
-        session_ = call_on("", "Target.attachToTarget", {{"targetId", target}, {"flatten", true}})
-                       ["sessionId"];
+            target =
+                call_on("", "Target.createTarget", {{"url", "about:blank"}})["targetId"];
+        session_ = call_on("", "Target.attachToTarget",
+                           {{"targetId", target}, {"flatten", true}})["sessionId"];
         call("Page.enable");
         call("Runtime.enable");
     } catch (const std::exception& e) {
@@ -118,14 +131,17 @@ json DevToolsBrowser::call(const std::string& method, json params) {
     return call_on(session_, method, std::move(params));
 }
 
-json DevToolsBrowser::call_on(const std::string& session, const std::string& method, json params) {
+json DevToolsBrowser::call_on(const std::string& session, const std::string& method,
+                              json params) {
     const int id = next_id_++;
     json message = {{"id", id}, {"method", method}, {"params", std::move(params)}};
     if (!session.empty()) message["sessionId"] = session;
     const std::string bytes = message.dump() + '\0';
     for (size_t sent = 0; sent < bytes.size();) {
         const ssize_t n = write(to_browser_, bytes.data() + sent, bytes.size() - sent);
-        if (n <= 0) throw std::runtime_error("cannot write to chromium: " + std::string(std::strerror(errno)));
+        if (n <= 0)
+            throw std::runtime_error("cannot write to chromium: " +
+                                     std::string(std::strerror(errno)));
         sent += static_cast<size_t>(n);
     }
     return read_reply(id);
@@ -135,12 +151,15 @@ json DevToolsBrowser::read_reply(int id) {
     const auto deadline = std::chrono::steady_clock::now() + kReplyTimeout;
     for (;;) {
         // Whole messages already read: events are skipped, the reply returned.
-        for (size_t end = pending_.find('\0'); end != std::string::npos; end = pending_.find('\0')) {
+        for (size_t end = pending_.find('\0'); end != std::string::npos;
+             end = pending_.find('\0')) {
             const json message = json::parse(pending_.substr(0, end), nullptr, false);
             pending_.erase(0, end + 1);
-            if (!message.is_object() || !message.contains("id") || message["id"] != id) continue;
+            if (!message.is_object() || !message.contains("id") || message["id"] != id)
+                continue;
             if (message.contains("error"))
-                throw std::runtime_error(message["error"].value("message", std::string("error")));
+                throw std::runtime_error(
+                    message["error"].value("message", std::string("error")));
             return message.value("result", json::object());
         }
         const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -155,20 +174,23 @@ json DevToolsBrowser::read_reply(int id) {
     }
 }
 
-void DevToolsBrowser::navigate(const std::string& url) { call("Page.navigate", {{"url", url}}); }
+void DevToolsBrowser::navigate(const std::string& url) {
+    call("Page.navigate", {{"url", url}});
+}
 
 void DevToolsBrowser::reload() { call("Page.reload", {{"ignoreCache", true}}); }
 
 json DevToolsBrowser::evaluate(const std::string& expression) {
-    const json result = call("Runtime.evaluate", {{"expression", expression},
-                                                  {"returnByValue", true},
-                                                  {"awaitPromise", true}});
+    const json result = call(
+        "Runtime.evaluate",
+        {{"expression", expression}, {"returnByValue", true}, {"awaitPromise", true}});
     if (result.contains("exceptionDetails"))
         throw std::runtime_error("JavaScript: " + result["exceptionDetails"].dump());
     return result["result"].value("value", json());
 }
 
-bool DevToolsBrowser::wait_until(const std::string& expression, std::chrono::milliseconds timeout) {
+bool DevToolsBrowser::wait_until(const std::string& expression,
+                                 std::chrono::milliseconds timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < deadline) {
         try {
@@ -190,7 +212,8 @@ void DevToolsBrowser::press(const std::string& key) {
         down["windowsVirtualKeyCode"] = static_cast<int>(key[0]);
         down["text"] = key;
     } else if (key.size() == 1) {
-        down["code"] = std::string("Key") + char(std::toupper(static_cast<unsigned char>(key[0])));
+        down["code"] =
+            std::string("Key") + char(std::toupper(static_cast<unsigned char>(key[0])));
         down["windowsVirtualKeyCode"] = std::toupper(static_cast<unsigned char>(key[0]));
         down["text"] = key;
     } else if (key == "Enter") {
@@ -198,7 +221,10 @@ void DevToolsBrowser::press(const std::string& key) {
         down["windowsVirtualKeyCode"] = 13;
         down["text"] = "\r";
     } else {
-        const int code = key == "ArrowLeft" ? 37 : key == "ArrowUp" ? 38 : key == "ArrowRight" ? 39 : 40;
+        const int code = key == "ArrowLeft"    ? 37
+                         : key == "ArrowUp"    ? 38
+                         : key == "ArrowRight" ? 39
+                                               : 40;
         down["code"] = key;
         down["windowsVirtualKeyCode"] = code;
     }

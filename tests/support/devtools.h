@@ -5,10 +5,9 @@
 // descriptors 3 and 4), so no port is opened and no WebSocket client is needed.
 // Keys and clicks go through Input.dispatchKeyEvent / dispatchMouseEvent, the same path
 // as real input (trusted events, with their own timestamps).
-#include <nlohmann/json.hpp>
-
 #include <chrono>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 
 namespace lucent::test {
@@ -27,7 +26,8 @@ public:
 
     // One DevTools command on the page; its result, or throws std::runtime_error with
     // the browser's error or a timeout.
-    nlohmann::json call(const std::string& method, nlohmann::json params = nlohmann::json::object());
+    nlohmann::json call(const std::string& method,
+                        nlohmann::json params = nlohmann::json::object());
     void navigate(const std::string& url);
     void reload();
     // The value of a JavaScript expression (promises awaited).

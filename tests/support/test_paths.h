@@ -29,9 +29,9 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
 }  // namespace lucent::test
 
 // Skips the current test when ../shared (or a file in it) is absent.
-#define LUCENT_REQUIRE_SHARED(relative)                                                  \
-    do {                                                                                 \
-        if (!std::filesystem::exists(::lucent::test::shared_dir() / (relative)))         \
-            GTEST_SKIP() << "test data " << (::lucent::test::shared_dir() / (relative))  \
-                         << " is absent (../shared is optional)";                        \
+#define LUCENT_REQUIRE_SHARED(relative)                                                 \
+    do {                                                                                \
+        if (!std::filesystem::exists(::lucent::test::shared_dir() / (relative)))        \
+            GTEST_SKIP() << "test data " << (::lucent::test::shared_dir() / (relative)) \
+                         << " is absent (../shared is optional)";                       \
     } while (0)

@@ -104,7 +104,8 @@ SurfaceAtlas build_surface_atlas(const Mesh& mesh, double scale_mm, int resoluti
     const double cell = std::max({extent.x, extent.y, extent.z}) / double((1 << 21) - 1);
     for (Surfel& s : surfels) {
         const glm::dvec3 q = (s.position - lo) / cell;
-        s.key = spread_bits_3(std::uint64_t(q.x)) | (spread_bits_3(std::uint64_t(q.y)) << 1) |
+        s.key = spread_bits_3(std::uint64_t(q.x)) |
+                (spread_bits_3(std::uint64_t(q.y)) << 1) |
                 (spread_bits_3(std::uint64_t(q.z)) << 2);
     }
     std::stable_sort(surfels.begin(), surfels.end(),
@@ -117,7 +118,8 @@ SurfaceAtlas build_surface_atlas(const Mesh& mesh, double scale_mm, int resoluti
     for (std::size_t m = 0; m < texels; ++m) {
         const glm::uvec2 xy = morton2_decode(std::uint32_t(m));
         const std::size_t index = std::size_t(xy.y) * resolution + xy.x;
-        atlas.position_area[index] = glm::vec4(glm::vec3(surfels[m].position), float(share));
+        atlas.position_area[index] =
+            glm::vec4(glm::vec3(surfels[m].position), float(share));
         atlas.normal[index] = glm::vec4(glm::vec3(surfels[m].normal), 0.0f);
     }
     atlas.content_hash = mesh.content_hash + "-s" + std::to_string(scale_mm) + "-a" +

@@ -18,11 +18,11 @@
 namespace lucent::dipole {
 
 struct SurfaceAtlas {
-    int resolution = 0;                     // A, a power of two
-    std::vector<glm::vec4> position_area;   // A*A, row-major: xyz in mm, w = area mm^2
-    std::vector<glm::vec4> normal;          // A*A: unit interpolated normal, w = 0
-    double total_area = 0.0;                // mm^2, = sum of w
-    std::string content_hash;               // of mesh hash, scale and resolution
+    int resolution = 0;                    // A, a power of two
+    std::vector<glm::vec4> position_area;  // A*A, row-major: xyz in mm, w = area mm^2
+    std::vector<glm::vec4> normal;         // A*A: unit interpolated normal, w = 0
+    double total_area = 0.0;               // mm^2, = sum of w
+    std::string content_hash;              // of mesh hash, scale and resolution
 };
 
 // Every texel gets total_area / A^2: texel k sits at cumulative area (k + 1/2)/A^2 of

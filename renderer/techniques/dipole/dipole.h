@@ -17,25 +17,25 @@
 namespace lucent::dipole {
 
 struct Params {
-    std::string material = "skin1";       // a JMLH01 preset or "custom"
-    glm::dvec3 sigma_a{0.032, 0.17, 0.48};        // mm^-1, [0, 100]; custom only
-    glm::dvec3 sigma_s_prime{0.74, 0.88, 1.01};   // mm^-1, [0, 1000]; custom only
-    double eta = 1.3;                     // [1, 2]; custom only (presets: 1.3)
-    double model_size = 10.0;             // mm: the mesh's bounding-box diagonal
-    int samples = 256;                    // N, [1, 65536]
-    int atlas_resolution = 512;           // A: 256, 512, 1024, 2048
-    bool hybrid = false;                  // Sec. 4 local/global split
-    int rings = 20;                       // L, [1, 32]
-    int ring_samples = 20;                // C, [1, 32]
-    double importance_bound = 0.1;        // c, mm^-1
-    double hybrid_k = 1.5;                // K, mm^-1
-    int light_map_resolution = 512;       // 256, 512, 1024
-    int sample_seed = 0;                  // stratification offset
-    std::string tone_map = "none";        // none | reinhard
-    double tone_key = 0.18;               // Reinhard key a
-    double specular = 0.5;                // ks (shared knob)
-    double shininess = 64.0;              // n (shared knob)
-    double ambient = 0.3;                 // ka (shared knob)
+    std::string material = "skin1";              // a JMLH01 preset or "custom"
+    glm::dvec3 sigma_a{0.032, 0.17, 0.48};       // mm^-1, [0, 100]; custom only
+    glm::dvec3 sigma_s_prime{0.74, 0.88, 1.01};  // mm^-1, [0, 1000]; custom only
+    double eta = 1.3;                            // [1, 2]; custom only (presets: 1.3)
+    double model_size = 10.0;                    // mm: the mesh's bounding-box diagonal
+    int samples = 256;                           // N, [1, 65536]
+    int atlas_resolution = 512;                  // A: 256, 512, 1024, 2048
+    bool hybrid = false;                         // Sec. 4 local/global split
+    int rings = 20;                              // L, [1, 32]
+    int ring_samples = 20;                       // C, [1, 32]
+    double importance_bound = 0.1;               // c, mm^-1
+    double hybrid_k = 1.5;                       // K, mm^-1
+    int light_map_resolution = 512;              // 256, 512, 1024
+    int sample_seed = 0;                         // stratification offset
+    std::string tone_map = "none";               // none | reinhard
+    double tone_key = 0.18;                      // Reinhard key a
+    double specular = 0.5;                       // ks (shared knob)
+    double shininess = 64.0;                     // n (shared knob)
+    double ambient = 0.3;                        // ka (shared knob)
     int ao_rays = 320;
 };
 

@@ -7,8 +7,8 @@ namespace lucent::dipole {
 namespace {
 
 double longest_edge(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-    return std::sqrt(std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b),
-                               glm::dot(a - c, a - c)}));
+    return std::sqrt(std::max(
+        {glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)}));
 }
 
 }  // namespace
@@ -42,10 +42,10 @@ ScatteringIntegrator::ScatteringIntegrator(const Mesh& mesh, double scale_mm,
     for (int attempt = 0; attempt < 64; ++attempt) {
         std::size_t count = 0;
         for (const glm::uvec3& t : mesh.triangles) {
-            const double edge =
-                longest_edge(glm::dvec3(mesh.positions[t.x]), glm::dvec3(mesh.positions[t.y]),
-                             glm::dvec3(mesh.positions[t.z])) *
-                scale_mm;
+            const double edge = longest_edge(glm::dvec3(mesh.positions[t.x]),
+                                             glm::dvec3(mesh.positions[t.y]),
+                                             glm::dvec3(mesh.positions[t.z])) *
+                                scale_mm;
             count += std::size_t(1) << (2 * level_for(edge, h));
         }
         if (count <= quality.max_cells) break;
@@ -60,7 +60,8 @@ ScatteringIntegrator::ScatteringIntegrator(const Mesh& mesh, double scale_mm,
         const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[t.x]),
                                  glm::dvec3(mesh.positions[t.y]),
                                  glm::dvec3(mesh.positions[t.z])};
-        const glm::dvec3 n[3] = {glm::dvec3(mesh.normals[t.x]), glm::dvec3(mesh.normals[t.y]),
+        const glm::dvec3 n[3] = {glm::dvec3(mesh.normals[t.x]),
+                                 glm::dvec3(mesh.normals[t.y]),
                                  glm::dvec3(mesh.normals[t.z])};
         const glm::dvec3 geometric = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
         const int level = level_for(longest_edge(p[0], p[1], p[2]) * scale_mm, h);
@@ -85,8 +86,7 @@ ScatteringIntegrator::ScatteringIntegrator(const Mesh& mesh, double scale_mm,
             const double mu = len > 1e-30 ? glm::dot(normal / len, l) : 0.0;
             if (!(mu > 0.0) || !(cell.area > 0.0)) return;
             if (visibility) {
-                const glm::dvec3 origin = at(g, p) +
-                                          double(ray_offset) * l +
+                const glm::dvec3 origin = at(g, p) + double(ray_offset) * l +
                                           double(ray_offset) *
                                               (glm::dot(geometric, l) >= 0 ? 1.0 : -1.0) *
                                               geometric;
@@ -180,9 +180,9 @@ glm::dvec3 ScatteringIntegrator::refine(const glm::dvec3& a, const glm::dvec3& b
         // (1/12) sum (v_i - g)(v_i - g)^T.
         const double flux = irradiance * 0.5 * glm::length(glm::cross(b - a, c - a));
         const glm::dvec3 ea = a - g, eb = b - g, ec = c - g;
-        const glm::dmat3 spread = (flux / 12.0) * (glm::outerProduct(ea, ea) +
-                                                   glm::outerProduct(eb, eb) +
-                                                   glm::outerProduct(ec, ec));
+        const glm::dmat3 spread =
+            (flux / 12.0) * (glm::outerProduct(ea, ea) + glm::outerProduct(eb, eb) +
+                             glm::outerProduct(ec, ec));
         return expansion(flux, g, spread, xo);
     }
     const glm::dvec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
@@ -207,7 +207,8 @@ glm::dvec3 ScatteringIntegrator::expansion(double flux, const glm::dvec3& centro
     const double radial = glm::dot(u, spread * u);
     const double trace = spread[0][0] + spread[1][1] + spread[2][2];
     const glm::dvec3 fp = dipole_.rd(d + h), fm = dipole_.rd(d - h);
-    const glm::dvec3 first = (fp - fm) / (2.0 * h), second = (fp - 2.0 * f0 + fm) / (h * h);
+    const glm::dvec3 first = (fp - fm) / (2.0 * h),
+                     second = (fp - 2.0 * f0 + fm) / (h * h);
     return flux * f0 + 0.5 * (second * radial + first / d * (trace - radial));
 }
 
@@ -221,7 +222,8 @@ glm::dvec3 ScatteringIntegrator::radiosity(glm::dvec3 xo) const {
         const Node& node = nodes_[stack[--top]];
         const double d = glm::length(node.centroid - xo);
         // Distance to the node's box: far-field acceptance needs xo outside it.
-        const glm::dvec3 gap = glm::max(glm::max(node.lo - xo, xo - node.hi), glm::dvec3(0));
+        const glm::dvec3 gap =
+            glm::max(glm::max(node.lo - xo, xo - node.hi), glm::dvec3(0));
         const bool outside = glm::dot(gap, gap) > 0.0;
         // Far field: small against the distance and against the decay length 1/sigma_tr.
         if (outside && node.size < quality_.opening_angle * d &&

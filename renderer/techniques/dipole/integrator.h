@@ -1,10 +1,10 @@
 #pragma once
 // The CPU reference's scattering integral B(xo) = integral_A E(xi) Rd(|xi - xo|) dA
 // (Chang et al. Eq. 3), independent of the GL path: the mesh's triangles are subdivided
-// into cells no wider than `cell_size`, each cell gets E = pi Id Ft(eta, N.L) max(N.L, 0) V
-// at its centroid (V by an Embree shadow ray), and the sum runs over a Barnes-Hut octree
-// (a node far enough away, size / distance < opening_angle, counts as its flux at its
-// flux-weighted centroid plus the second-order (quadrupole) term of its spread; JB02
+// into cells no wider than `cell_size`, each cell gets E = pi Id Ft(eta, N.L) max(N.L, 0)
+// V at its centroid (V by an Embree shadow ray), and the sum runs over a Barnes-Hut
+// octree (a node far enough away, size / distance < opening_angle, counts as its flux at
+// its flux-weighted centroid plus the second-order (quadrupole) term of its spread; JB02
 // uses the monopole with 0.3). Cells near xo are subdivided
 // further on the fly until they are small against max(distance, zr), so the r -> 0 peak
 // of Rd is integrated, not sampled; cells and nodes alike count with their quadrupole.
@@ -19,10 +19,10 @@
 namespace lucent::dipole {
 
 struct IntegratorQuality {
-    double cell_size_over_zr = 0.5;    // irradiance cell edge, in units of min zr
-    double opening_angle = 0.2;        // Barnes-Hut acceptance size / distance
-    double near_field_ratio = 0.25;    // near cells refined to edge < ratio*max(d, zr)
-    std::size_t max_cells = 4'000'000; // the cell edge grows beyond this many cells
+    double cell_size_over_zr = 0.5;     // irradiance cell edge, in units of min zr
+    double opening_angle = 0.2;         // Barnes-Hut acceptance size / distance
+    double near_field_ratio = 0.25;     // near cells refined to edge < ratio*max(d, zr)
+    std::size_t max_cells = 4'000'000;  // the cell edge grows beyond this many cells
     // The same integral with every step halved: the reference's own error estimate is
     // the difference between a quality and its halved().
     IntegratorQuality halved() const {
@@ -38,8 +38,8 @@ struct IntegratorQuality {
 class ScatteringIntegrator {
 public:
     // `light_object`: unit direction towards the light in mesh (object) space;
-    // `scale_mm` converts mesh units to mm; `visibility`: shadow rays, or nullptr for none
-    // (a convex mesh). The integrator is immutable and thread-safe once built.
+    // `scale_mm` converts mesh units to mm; `visibility`: shadow rays, or nullptr for
+    // none (a convex mesh). The integrator is immutable and thread-safe once built.
     ScatteringIntegrator(const Mesh& mesh, double scale_mm, glm::dvec3 light_object,
                          const Material& material, const IntegratorQuality& quality,
                          const RayCaster* visibility);
@@ -71,8 +71,8 @@ private:
     glm::dvec3 refine(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
                       double irradiance, const glm::dvec3& xo, int depth) const;
 
-    glm::dvec3 expansion(double flux, const glm::dvec3& centroid, const glm::dmat3& spread,
-                         const glm::dvec3& xo) const;
+    glm::dvec3 expansion(double flux, const glm::dvec3& centroid,
+                         const glm::dmat3& spread, const glm::dvec3& xo) const;
 
     DipoleRgb dipole_;
     double max_sigma_tr_ = 0.0;

@@ -20,14 +20,16 @@ const std::vector<Knob>& knobs() {
         rays.default_value = d.ao_rays;
         const auto choice = [](std::string name, std::string description,
                                std::string value, std::vector<std::string> choices) {
-            return Knob{std::move(name), std::move(description), KnobKind::choice, 0.0,
-                        0.0, std::move(value), std::move(choices)};
+            return Knob{
+                std::move(name),  std::move(description), KnobKind::choice, 0.0, 0.0,
+                std::move(value), std::move(choices)};
         };
         return std::vector<Knob>{
-            choice("material",
-                   "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta 1.3), or "
-                   "custom: sigma_a, sigma_s_prime and eta",
-                   d.material, materials),
+            choice(
+                "material",
+                "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta 1.3), or "
+                "custom: sigma_a, sigma_s_prime and eta",
+                d.material, materials),
             {"sigma_a", "custom material: absorption coefficient, mm^-1 (rgb)",
              KnobKind::rgb, 0.0, 100.0, d.sigma_a},
             {"sigma_s_prime",
@@ -54,9 +56,10 @@ const std::vector<Knob>& knobs() {
              KnobKind::scalar, 0.001, 10.0, d.importance_bound},
             {"hybrid_k", "K: steepness of the local weight around Rp (mm^-1; hybrid)",
              KnobKind::scalar, 0.01, 100.0, d.hybrid_k},
-            choice("light_map_resolution",
-                   "side of the light-view depth/flux maps (visibility, hybrid local part)",
-                   std::to_string(d.light_map_resolution), {"256", "512", "1024"}),
+            choice(
+                "light_map_resolution",
+                "side of the light-view depth/flux maps (visibility, hybrid local part)",
+                std::to_string(d.light_map_resolution), {"256", "512", "1024"}),
             {"sample_seed", "stratification offset xi = frac(0.5 + seed * 0.618...)",
              KnobKind::integer, 0.0, 1000000.0, d.sample_seed},
             choice("tone_map", "none (linear radiance) or reinhard s/(1+s)", d.tone_map,

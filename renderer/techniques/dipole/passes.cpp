@@ -1,8 +1,9 @@
 // What the dipole technique adds to a frame plan (Chang et al. Fig. 1, Sec. 3-4):
 //   ambient_occlusion    per-vertex AO bake                 -> vertex_ao      (ambient)
-//   atlas_positions      CPU surfel atlas: xyz mm, area     -> atlas_position (subsurface)
-//   atlas_normals        CPU surfel atlas: normals          -> atlas_normal   (subsurface)
-//   light_view           mesh from the light (ortho)        -> light_depth [, light_flux,
+//   atlas_positions      CPU surfel atlas: xyz mm, area     -> atlas_position
+//   (subsurface) atlas_normals        CPU surfel atlas: normals          -> atlas_normal
+//   (subsurface) light_view           mesh from the light (ortho)        -> light_depth
+//   [, light_flux,
 //                                                              light_position (hybrid)]
 //   irradiance           E A per atlas texel, with V        -> irradiance level 0
 //   irradiance_mips      exact 2x2 box means                -> irradiance levels 1..
@@ -19,8 +20,8 @@
 #include <mutex>
 
 #include "core/light_view.h"
-#include "techniques/dipole/atlas.h"
 #include "techniques/deferred_surface.h"
+#include "techniques/dipole/atlas.h"
 #include "techniques/dipole/dipole.h"
 
 namespace lucent::dipole {
@@ -35,7 +36,8 @@ struct LazyAtlas {
     std::once_flag once;
     SurfaceAtlas atlas;
     const SurfaceAtlas& get() {
-        std::call_once(once, [&] { atlas = build_surface_atlas(*mesh, scale, resolution); });
+        std::call_once(once,
+                       [&] { atlas = build_surface_atlas(*mesh, scale, resolution); });
         return atlas;
     }
 };
@@ -78,9 +80,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
 
     // Which terms can change the image (all of them in full mode).
     const bool subsurface = full || has_subsurface_term(p, scene);
-    const HybridSplit split = p.hybrid ? make_hybrid_split(dipole, p.importance_bound,
-                                                           p.hybrid_k)
-                                       : HybridSplit{};
+    const HybridSplit split =
+        p.hybrid ? make_hybrid_split(dipole, p.importance_bound, p.hybrid_k)
+                 : HybridSplit{};
     const bool local = subsurface && (full || split.any_local());
     const bool fresnel = full || material.eta != 1.0;
     const bool ambient = full || has_ambient_term(p, scene);
@@ -124,15 +126,16 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     }();
     int side = 1;
     while (side * side < p.samples) ++side;
-    const RingPattern pattern =
-        make_ring_pattern(dipole, split, p.rings, p.ring_samples);
+    const RingPattern pattern = make_ring_pattern(dipole, split, p.rings, p.ring_samples);
 
     plan.create("vertex_ao", ResourceFormat::vertex_float);
     plan.create(texture_2d("atlas_position", ResourceFormat::rgba32f, atlas, atlas));
     plan.create(texture_2d("atlas_normal", ResourceFormat::rgba32f, atlas, atlas));
-    plan.create(texture_2d("light_depth", ResourceFormat::depth32f, light_map, light_map));
+    plan.create(
+        texture_2d("light_depth", ResourceFormat::depth32f, light_map, light_map));
     plan.create(texture_2d("light_flux", ResourceFormat::r32f, light_map, light_map));
-    plan.create(texture_2d("light_position", ResourceFormat::rgba32f, light_map, light_map));
+    plan.create(
+        texture_2d("light_position", ResourceFormat::rgba32f, light_map, light_map));
     plan.create(texture_2d("irradiance", ResourceFormat::r32f, atlas, atlas, 0));
     plan.create(texture_2d("ring_pattern", ResourceFormat::rgba32f,
                            int(pattern.offset.size()), 1));
@@ -207,12 +210,12 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                             {"atlas_normal", ""},
                             {"light_depth", "", {TexelFilter::nearest}}};
         irradiance.writes = {"irradiance"};
-        irradiance.uniforms = with_uniforms(
-            {{"u_light_view_projection", light.view_projection},
-             {"u_light_object", light_object},
-             {"u_normal_offset", 1.5f * texel_object},
-             {"u_depth_bias", 0.5f / float(light_map)}},
-            profile);
+        irradiance.uniforms =
+            with_uniforms({{"u_light_view_projection", light.view_projection},
+                           {"u_light_object", light_object},
+                           {"u_normal_offset", 1.5f * texel_object},
+                           {"u_depth_bias", 0.5f / float(light_map)}},
+                          profile);
         plan.add(irradiance);
 
         Pass mips{"irradiance_mips", "mip pyramid of the texel masses (exact 2x2 box)",
@@ -221,13 +224,12 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
         plan.add(mips);
 
         // Stage 2 (Sec. 3, Fig. 2b): N stratified samples by the inverse CDF.
-        Pass samples{"samples",
-                     "inverse-CDF descent of the mip pyramid: " +
-                         std::to_string(p.samples) + " stratified samples",
-                     PassKind::fullscreen,
-                     {"gl/shaders/fullscreen.vert",
-                      "techniques/dipole/shaders/samples.frag",
-                      {}}};
+        Pass samples{
+            "samples",
+            "inverse-CDF descent of the mip pyramid: " + std::to_string(p.samples) +
+                " stratified samples",
+            PassKind::fullscreen,
+            {"gl/shaders/fullscreen.vert", "techniques/dipole/shaders/samples.frag", {}}};
         samples.reads = {{"irradiance", ""}, {"atlas_position", ""}};
         samples.writes = {"samples"};
         samples.uniforms = {{"u_sample_count", p.samples},
@@ -278,7 +280,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     prune(ambient, "ambient and AO (ka Ia = 0)");
     prune(specular, "specular (ks Is = 0)");
     Pass shade{"translucency",
-               "Eq. 11: Ft(eta, N.V) Id B / pi" + std::string(local ? " (global + local)" : "") +
+               "Eq. 11: Ft(eta, N.V) Id B / pi" +
+                   std::string(local ? " (global + local)" : "") +
                    (ambient ? " + ambient" : "") + (tone_map ? ", Reinhard" : "") +
                    (specular ? " + Blinn-Phong" : "") + pruned,
                PassKind::draw_mesh,
@@ -320,8 +323,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     if (tone_map) {
         shade.shader.defines.push_back("TONE_MAP");
         u.push_back({"u_tone_key", float(p.tone_key)});
-        u.push_back({"u_tone_average_per_flux",
-                     float(tone_map_average(p, scene, 1.0, surface_area_mm2(mesh, scale)))});
+        u.push_back(
+            {"u_tone_average_per_flux",
+             float(tone_map_average(p, scene, 1.0, surface_area_mm2(mesh, scale)))});
     }
     if (specular) {
         shade.shader.defines.push_back("WITH_SPECULAR");

@@ -20,9 +20,9 @@ Image render_reference(const Scene& scene, const IntegratorQuality& quality,
     const double scale = model_scale(mesh, p.model_size);
     const RayCaster caster(mesh);
     const bool subsurface = has_subsurface_term(p, scene);
-    const ScatteringIntegrator integrator(
-        mesh, scale, light_in_object_space(scene),
-        subsurface ? material : Material{}, quality, &caster);
+    const ScatteringIntegrator integrator(mesh, scale, light_in_object_space(scene),
+                                          subsurface ? material : Material{}, quality,
+                                          &caster);
     if (stats) {
         stats->cells = integrator.cell_count();
         stats->cell_size_mm = integrator.cell_size();

@@ -43,7 +43,8 @@ double fresnel_transmittance(double eta, double mu) {
 
 double mean_fresnel_transmittance(double eta) {
     if (eta == 1.0) return 1.0;
-    // Composite Simpson on 2 Ft(mu) mu over [0, 1]; smooth, so 4096 intervals give ~1e-12.
+    // Composite Simpson on 2 Ft(mu) mu over [0, 1]; smooth, so 4096 intervals give
+    // ~1e-12.
     constexpr int n = 4096;
     double sum = 0.0;
     for (int i = 0; i <= n; ++i) {
@@ -122,7 +123,8 @@ std::optional<double> importance_crossing(const Dipole& dipole, double c) {
 
 double local_weight(double r, std::optional<double> rp, double k) {
     if (!rp) return 0.0;
-    return r <= *rp ? 1.0 - 0.5 * std::exp(k * (r - *rp)) : 0.5 * std::exp(-k * (r - *rp));
+    return r <= *rp ? 1.0 - 0.5 * std::exp(k * (r - *rp))
+                    : 0.5 * std::exp(-k * (r - *rp));
 }
 
 glm::dvec3 HybridSplit::local(const DipoleRgb& d, double r) const {
@@ -173,7 +175,8 @@ LocalProfile local_profile(const Dipole& d, double rp, double k) {
 glm::dvec3 local_mass(const DipoleRgb& d, const HybridSplit& split) {
     glm::dvec3 z(0.0);
     for (int c = 0; c < 3; ++c)
-        if (split.rp[c]) z[c] = local_profile(d[c], *split.rp[c], split.k).cumulative.back();
+        if (split.rp[c])
+            z[c] = local_profile(d[c], *split.rp[c], split.k).cumulative.back();
     return z;
 }
 
@@ -181,7 +184,8 @@ RingPattern make_ring_pattern(const DipoleRgb& d, const HybridSplit& split, int 
                               int per_ring) {
     RingPattern pattern;
     for (int c = 0; c < 3; ++c)
-        if (split.rp[c] && (pattern.widest < 0 || *split.rp[c] > *split.rp[pattern.widest]))
+        if (split.rp[c] &&
+            (pattern.widest < 0 || *split.rp[c] > *split.rp[pattern.widest]))
             pattern.widest = c;
     if (pattern.widest < 0 || rings < 1 || per_ring < 1) {
         pattern.offset = {glm::dvec2(0.0)};
@@ -197,8 +201,8 @@ RingPattern make_ring_pattern(const DipoleRgb& d, const HybridSplit& split, int 
     const int m = rings * per_ring + 1;
     const auto inverse = [&](double share) {  // P^-1 by bisection + linear interpolation
         const double target = share * z;
-        const auto it =
-            std::lower_bound(profile.cumulative.begin(), profile.cumulative.end(), target);
+        const auto it = std::lower_bound(profile.cumulative.begin(),
+                                         profile.cumulative.end(), target);
         const std::size_t i = std::clamp<std::size_t>(
             std::size_t(it - profile.cumulative.begin()), 1, profile.r.size() - 1);
         const double c0 = profile.cumulative[i - 1], c1 = profile.cumulative[i];

@@ -53,10 +53,10 @@ public:
     // integral_0^inf 2 pi r Rd(r) dr in closed form (JMLH01 Eq. 5).
     double total_reflectance() const;
     bool scatters() const { return scatters_; }
-    double albedo() const { return albedo_; }              // alpha' = sigma_s' / sigma_t'
-    double sigma_tr() const { return sigma_tr_; }          // sqrt(3 sigma_a sigma_t')
-    double z_real() const { return z_real_; }              // zr = 1 / sigma_t', mm
-    double z_virtual() const { return z_virtual_; }        // zv = zr (1 + 4A/3), mm
+    double albedo() const { return albedo_; }        // alpha' = sigma_s' / sigma_t'
+    double sigma_tr() const { return sigma_tr_; }    // sqrt(3 sigma_a sigma_t')
+    double z_real() const { return z_real_; }        // zr = 1 / sigma_t', mm
+    double z_virtual() const { return z_virtual_; }  // zv = zr (1 + 4A/3), mm
     // The importance 2 pi r Rd(r): the radial density whose crossing with c gives Rp.
     double radial_density(double r) const { return 2.0 * kPi * r * rd(r); }
 

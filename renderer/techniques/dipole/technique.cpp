@@ -41,7 +41,11 @@ public:
             {"hybrid", {std::string("off"), std::string("on")}, std::string("off")},
             // The local pattern's L rings x C samples, which matter only with the hybrid.
             {"rings", {2, 5, 10, 20, 32}, 20, false, {{"hybrid", std::string("on")}}},
-            {"ring_samples", {4, 8, 12, 20, 32}, 20, false, {{"hybrid", std::string("on")}}},
+            {"ring_samples",
+             {4, 8, 12, 20, 32},
+             20,
+             false,
+             {{"hybrid", std::string("on")}}},
         };
     }
 };

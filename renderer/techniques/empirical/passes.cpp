@@ -23,9 +23,7 @@ double peel_epsilon(const std::string& depth_precision) {
     return depth_precision == "16" ? 1.0 / 65535.0 : 1e-6;
 }
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const Params p = params(scene);
@@ -39,7 +37,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const auto camera =
         mesh_transform_uniforms(scene.camera.view(), scene.camera.projection());
     const std::string mesh_vert = "techniques/empirical/shaders/mesh.vert";
-    const ShaderDesc depth_only{mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}};
+    const ShaderDesc depth_only{
+        mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}};
     // A closed mesh facing out, seen from outside: the nearest surface of every pixel is
     // a front face and the one behind it a back face (the first exit). The second layer
     // is then the nearest back face, rasterised with front faces culled and without
@@ -96,9 +95,10 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     std::string back_layer;
     if (backlight_term) {
         if (by_facing) {
-            Pass back{"second_layer",
-                      "the surface behind the first: nearest back face of the closed mesh",
-                      PassKind::draw_mesh, depth_only};
+            Pass back{
+                "second_layer",
+                "the surface behind the first: nearest back face of the closed mesh",
+                PassKind::draw_mesh, depth_only};
             back.writes = {"second_depth"};
             back.uniforms = camera;
             back.cull = FaceCulling::front;
@@ -111,8 +111,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                       {mesh_vert, "techniques/empirical/shaders/peel.frag", {}}};
             peel.reads = {{"front_depth", ""}};
             peel.writes = {"second_depth"};
-            peel.uniforms = with_uniforms(camera, {{"u_epsilon", static_cast<float>(peel_epsilon(
-                                                           p.depth_precision))}});
+            peel.uniforms = with_uniforms(
+                camera,
+                {{"u_epsilon", static_cast<float>(peel_epsilon(p.depth_precision))}});
             plan.add(peel);
         }
         back_layer = "second_depth";

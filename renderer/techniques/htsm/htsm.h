@@ -19,22 +19,22 @@
 namespace lucent::htsm {
 
 struct Params {
-    int samples = 5;                // knob `rays`: n = 1 + 4K rays: 1, 5, 9, 13 (Fig. 5.7/5.9)
-    int steps = 5;                  // S midpoint steps per ray, [1, 64]
-    int light_map_size = 256;       // W_L: 64 .. 1024, a power of two
-    bool light_mips = true;         // rings read their footprint's mip level (off: lod 0)
-    int density_resolution = 64;    // R of generated volumes: 16, 32, 64, 128
-    int phase_table_size = 256;     // N_f: 16, 64, 256, 1024
-    double pattern_radius = 0.02;   // r1, first ring radius, fraction of Phi
+    int samples = 5;           // knob `rays`: n = 1 + 4K rays: 1, 5, 9, 13 (Fig. 5.7/5.9)
+    int steps = 5;             // S midpoint steps per ray, [1, 64]
+    int light_map_size = 256;  // W_L: 64 .. 1024, a power of two
+    bool light_mips = true;    // rings read their footprint's mip level (off: lod 0)
+    int density_resolution = 64;   // R of generated volumes: 16, 32, 64, 128
+    int phase_table_size = 256;    // N_f: 16, 64, 256, 1024
+    double pattern_radius = 0.02;  // r1, first ring radius, fraction of Phi
     glm::dvec3 transport_colour{1.0, 0.55, 0.3};  // Tc, linear rgb [0, 4]
-    double transport_distance = 0.25;  // Td, fraction of Phi, [1e-3, 10]
-    double density_scale = 2.0;     // kappa, optical depth per Phi at rho = 1, [0, 1000]
-    double phase_g = 0.5;           // Henyey-Greenstein g, [0, 0.8]
-    double ior = 1.3;               // eta for Schlick's Fresnel, [1, 2]
+    double transport_distance = 0.25;             // Td, fraction of Phi, [1e-3, 10]
+    double density_scale = 2.0;  // kappa, optical depth per Phi at rho = 1, [0, 1000]
+    double phase_g = 0.5;        // Henyey-Greenstein g, [0, 0.8]
+    double ior = 1.3;            // eta for Schlick's Fresnel, [1, 2]
     glm::dvec3 albedo{0.8, 0.55, 0.35};  // Kd of the diffuse term (the shared default)
-    double diffuse = 0.2;           // wd, [0, 10]
-    double specular = 0.5;          // ks (the shared default)
-    double shininess = 64.0;        // n (the shared default)
+    double diffuse = 0.2;                // wd, [0, 10]
+    double specular = 0.5;               // ks (the shared default)
+    double shininess = 64.0;             // n (the shared default)
 };
 
 const std::vector<Knob>& knobs();
@@ -45,8 +45,8 @@ struct Geometry {
     glm::dvec3 box_min{0.0}, box_extent{1.0};  // AABB, each extent >= 1e-3 Phi
     double phi = 1.0;                          // bounding-sphere diameter (Lucent's unit)
     LightView light;
-    glm::dvec3 to_light{0, 0, 1};              // object space, unit
-    double texel = 1.0;                        // h_L = 2 R_L / W_L, object units
+    glm::dvec3 to_light{0, 0, 1};  // object space, unit
+    double texel = 1.0;            // h_L = 2 R_L / W_L, object units
 };
 Geometry geometry(const Scene& scene, const Params& p);
 
@@ -77,8 +77,8 @@ double constant_density(const Scene& scene);  // rho0 (0 without a volume)
 // summed-area tables for exact box footprints, an Embree camera ray per pixel, a march of
 // `steps` midpoint steps through the same voxels, exact phase, Embree shadow rays.
 struct ReferenceQuality {
-    int oversample = 8;   // F: light-image rays per W_L texel along each axis
-    int steps = 1024;     // S_ref
+    int oversample = 8;  // F: light-image rays per W_L texel along each axis
+    int steps = 1024;    // S_ref
     ReferenceQuality halved() const { return {oversample / 2, steps / 2}; }
 };
 Image render_reference(const Scene& scene, const ReferenceQuality& quality);

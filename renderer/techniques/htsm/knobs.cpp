@@ -12,25 +12,31 @@ namespace lucent::htsm {
 const std::vector<Knob>& knobs() {
     static const std::vector<Knob> list = [] {
         const Params d{};
-        Knob albedo = albedo_knob(), specular = specular_knob(), shininess = shininess_knob();
+        Knob albedo = albedo_knob(), specular = specular_knob(),
+             shininess = shininess_knob();
         albedo.default_value = d.albedo;
         specular.default_value = d.specular;
         shininess.default_value = d.shininess;
         const auto choice = [](std::string name, std::string description, int value,
                                std::vector<std::string> choices) {
-            return Knob{std::move(name), std::move(description), KnobKind::choice, 0.0,
-                        0.0, std::to_string(value), std::move(choices)};
+            return Knob{
+                std::move(name),       std::move(description), KnobKind::choice, 0.0, 0.0,
+                std::to_string(value), std::move(choices)};
         };
         Knob density{"density",
                      "the density volume over the mesh's bounding box: a generator "
                      "(constant, cube, spheres, marble, layers; e.g. marble:frequency=3) "
                      "or an .nrrd file",
-                     KnobKind::text, 0.0, 0.0, std::string("marble")};
+                     KnobKind::text,
+                     0.0,
+                     0.0,
+                     std::string("marble")};
         density.check = [](std::string_view text) -> std::string {
             try {
                 // A file is read here too, so a bad one is refused where it is named
                 // (command line, config, explorer field), not later while rendering.
-                if (!parse_density_spec(text).file.empty()) make_density_volume(text, 1, 1.0);
+                if (!parse_density_spec(text).file.empty())
+                    make_density_volume(text, 1, 1.0);
                 return "";
             } catch (const DensityError& e) {
                 std::string why = e.what();
@@ -49,18 +55,25 @@ const std::vector<Knob>& knobs() {
             Knob{"light_mips",
                  "on: each ring reads the mip level of its footprint (Sec. 4.3.1); off: "
                  "every ray reads level 0 (point samples, no prefiltering)",
-                 KnobKind::choice, 0.0, 0.0, std::string("on"), {"off", "on"}},
+                 KnobKind::choice,
+                 0.0,
+                 0.0,
+                 std::string("on"),
+                 {"off", "on"}},
             density,
-            choice("density_resolution", "R: voxels per axis of a generated density volume",
+            choice("density_resolution",
+                   "R: voxels per axis of a generated density volume",
                    d.density_resolution, {"16", "32", "64", "128"}),
             {"density_contrast",
              "c: rho = clamp(mean + c (rho - mean), 0, 1); 0 = homogeneous at the mean",
              KnobKind::scalar, 0.0, 4.0, 1.0},
-            {"density_scale", "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
+            {"density_scale",
+             "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
              KnobKind::scalar, 0.0, 1000.0, d.density_scale},
             choice("phase_table_size", "N_f: entries of the phase-function table",
                    d.phase_table_size, {"16", "64", "256", "1024"}),
-            {"pattern_radius", "r1: radius of the first ring, fraction of Phi (ring k: r1 2^(k-1))",
+            {"pattern_radius",
+             "r1: radius of the first ring, fraction of Phi (ring k: r1 2^(k-1))",
              KnobKind::scalar, 0.0, 0.5, d.pattern_radius},
             {"transport_colour", "Tc: transport colour (linear rgb)", KnobKind::rgb, 0.0,
              4.0, d.transport_colour},
@@ -149,14 +162,16 @@ double schlick(double eta, double c) {
 
 double phase(double g, double mu) {
     if (g == 0.0) return 1.0;
-    const double denominator = std::max(1.0 + g * g - 2.0 * g * std::clamp(mu, -1.0, 1.0), 1e-12);
+    const double denominator =
+        std::max(1.0 + g * g - 2.0 * g * std::clamp(mu, -1.0, 1.0), 1e-12);
     return std::pow((1.0 - g) * (1.0 - g) / denominator, 1.5);
 }
 
 double transport_weight(double tau, double td) { return std::max(0.0, 2.0 - tau / td); }
 
 bool has_transport(const Params& p, const Scene& scene) {
-    return p.transport_colour != glm::dvec3(0.0) && scene.light.diffuse != glm::vec3(0.0f);
+    return p.transport_colour != glm::dvec3(0.0) &&
+           scene.light.diffuse != glm::vec3(0.0f);
 }
 
 bool has_surface(const Params& p, const Scene& scene) {

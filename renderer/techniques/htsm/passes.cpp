@@ -2,7 +2,8 @@
 //   density_volume   CPU volume, by content hash  -> htsm_density (3-D r32f)   (a march)
 //   phase_table      CPU Henyey-Greenstein table  -> htsm_phase (N_f x 1)      (g != 0)
 //   light_view       mesh from the key light      -> htsm_irradiance, htsm_texcoord
-//                                                    [, htsm_normal full only], light_depth
+//                                                    [, htsm_normal full only],
+//                                                    light_depth
 //   irradiance_mips, texcoord_mips  exact 2x2 box means                       (a lod > 0)
 //   shade            mesh from the camera         -> colour
 // Pruned: no transport (Tc = 0 or Id = 0) drops everything but the shadow depth; a
@@ -29,7 +30,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const bool full = plan.full();
     const bool transport = full || has_transport(p, scene);
     const bool surface = full || has_surface(p, scene);
-    const bool march = transport && scene.density && (full || !density_is_constant(p, scene));
+    const bool march =
+        transport && scene.density && (full || !density_is_constant(p, scene));
     const bool table = transport && (full || p.phase_g != 0.0);
     const std::vector<PatternSample> samples = pattern(p, g);
     bool coarse = full;
@@ -44,13 +46,16 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                                       {"u_box_extent", glm::vec3(g.box_extent)}};
 
     plan.create(texture_2d("light_depth", ResourceFormat::depth32f, wl, wl));
-    plan.create(texture_2d("htsm_irradiance", ResourceFormat::rgba32f, wl, wl, mips ? 0 : 1));
-    plan.create(texture_2d("htsm_texcoord", ResourceFormat::rgba32f, wl, wl, mips ? 0 : 1));
+    plan.create(
+        texture_2d("htsm_irradiance", ResourceFormat::rgba32f, wl, wl, mips ? 0 : 1));
+    plan.create(
+        texture_2d("htsm_texcoord", ResourceFormat::rgba32f, wl, wl, mips ? 0 : 1));
     plan.create(texture_2d("htsm_normal", ResourceFormat::rgba32f, wl, wl));
     plan.create(texture_2d("htsm_phase", ResourceFormat::r32f, p.phase_table_size, 1));
     if (scene.density)
-        plan.create(texture_3d("htsm_density", ResourceFormat::r32f, scene.density->size.x,
-                               scene.density->size.y, scene.density->size.z));
+        plan.create(texture_3d("htsm_density", ResourceFormat::r32f,
+                               scene.density->size.x, scene.density->size.y,
+                               scene.density->size.z));
     plan.create("colour", ResourceFormat::rgba32f);
     plan.create("shade_depth", ResourceFormat::depth32f);
 
@@ -129,13 +134,15 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
         if (!kept) pruned += (pruned.empty() ? "; pruned: " : ", ") + std::string(what);
     };
     prune(transport, "transport passes (Tc = 0 or Id = 0)");
-    prune(!transport || march, "volume and march (constant density: tau = (1 + kappa rho0) D)");
+    prune(!transport || march,
+          "volume and march (constant density: tau = (1 + kappa rho0) D)");
     prune(!transport || table, "phase table (g = 0: isotropic)");
     prune(!transport || mips, "mips (every lod is 0)");
     prune(surface, "surface terms and shadow (wd Kd Id = 0 and ks Is = 0)");
     Pass shade{"shade",
                "L = Tc/n sum E w(D + alpha) f + shadowed diffuse + specular, n = " +
-                   std::to_string(p.samples) + ", S = " + std::to_string(p.steps) + pruned,
+                   std::to_string(p.samples) + ", S = " + std::to_string(p.steps) +
+                   pruned,
                PassKind::draw_mesh,
                {mesh_vert, "techniques/htsm/shaders/shade.frag", {}}};
     const std::vector<Uniform> camera =
@@ -143,7 +150,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     std::vector<Uniform> u = camera;
     u.push_back({"u_light_direction", scene.light.direction});
     u.push_back({"u_background", scene.background});
-    const Sampling clamp_linear{TexelFilter::linear, MipFilter::none, Wrap::clamp_to_edge};
+    const Sampling clamp_linear{TexelFilter::linear, MipFilter::none,
+                                Wrap::clamp_to_edge};
     if (transport) {
         shade.shader.defines.push_back("WITH_TRANSPORT");
         shade.shader.defines.push_back("HTSM_SAMPLES " + std::to_string(p.samples));

@@ -21,8 +21,8 @@ class LightImage {
 public:
     static constexpr int kChannels = 7;
 
-    LightImage(const Scene& scene, const Params& p, const Geometry& g, const RayCaster& caster,
-               int oversample)
+    LightImage(const Scene& scene, const Params& p, const Geometry& g,
+               const RayCaster& caster, int oversample)
         : size_(std::clamp(oversample, 1, 16) * p.light_map_size) {
         size_ = std::min(size_, 2048);
         const int n = size_ + 1;
@@ -36,17 +36,21 @@ public:
                 auto& texel = texels[std::size_t(y) * size_ + x];
                 texel.fill(0.0);
                 const glm::dvec3 origin =
-                    glm::dvec3(l.centre) + ((x + 0.5) / size_ - 0.5) * plane * glm::dvec3(l.right) +
-                    ((y + 0.5) / size_ - 0.5) * plane * glm::dvec3(l.up) + plane * g.to_light;
-                const auto hit = caster.first_hit(glm::vec3(origin), glm::vec3(-g.to_light),
-                                                  0.0f, float(2.0 * plane));
+                    glm::dvec3(l.centre) +
+                    ((x + 0.5) / size_ - 0.5) * plane * glm::dvec3(l.right) +
+                    ((y + 0.5) / size_ - 0.5) * plane * glm::dvec3(l.up) +
+                    plane * g.to_light;
+                const auto hit = caster.first_hit(
+                    glm::vec3(origin), glm::vec3(-g.to_light), 0.0f, float(2.0 * plane));
                 if (!hit) continue;
                 const glm::dvec3 y_point = origin - double(hit->distance) * g.to_light;
                 const glm::dvec3 t = (y_point - g.box_min) / g.box_extent;
                 const glm::dvec3 normal = interpolate_at(*scene.mesh, *hit, {}).normal;
                 const double length = glm::length(normal);
-                const double c = length > 0.0 ? glm::dot(normal / length, g.to_light) : 0.0;
-                const glm::dvec3 e = c > 0.0 ? id * (c * (1.0 - schlick(p.ior, c))) : glm::dvec3(0.0);
+                const double c =
+                    length > 0.0 ? glm::dot(normal / length, g.to_light) : 0.0;
+                const glm::dvec3 e =
+                    c > 0.0 ? id * (c * (1.0 - schlick(p.ior, c))) : glm::dvec3(0.0);
                 texel = {1.0, t.x, t.y, t.z, e.x, e.y, e.z};
             }
         });
@@ -66,19 +70,23 @@ public:
     // Means over the box [x0, x1] x [y0, y1] in fine texels (real-valued, may reach
     // outside the image, where everything is 0): the SAT interpolated bilinearly is the
     // exact integral of the piecewise-constant image.
-    std::array<double, kChannels> box_mean(double x0, double y0, double x1, double y1) const {
+    std::array<double, kChannels> box_mean(double x0, double y0, double x1,
+                                           double y1) const {
         std::array<double, kChannels> mean{};
         const double area = (x1 - x0) * (y1 - y0);
         if (!(area > 0.0)) return mean;
         for (int c = 0; c < kChannels; ++c)
             mean[c] = (integral(c, x1, y1) - integral(c, x0, y1) - integral(c, x1, y0) +
-                       integral(c, x0, y0)) / area;
+                       integral(c, x0, y0)) /
+                      area;
         return mean;
     }
 
 private:
     double& at(int c, int x, int y) { return sat_[c][std::size_t(y) * (size_ + 1) + x]; }
-    double get(int c, int x, int y) const { return sat_[c][std::size_t(y) * (size_ + 1) + x]; }
+    double get(int c, int x, int y) const {
+        return sat_[c][std::size_t(y) * (size_ + 1) + x];
+    }
     double integral(int c, double x, double y) const {
         x = std::clamp(x, 0.0, double(size_));
         y = std::clamp(y, 0.0, double(size_));
@@ -128,19 +136,23 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
             const glm::dvec3 point = rays.eye() + double(front->distance) * direction;
             const glm::dvec3 normal_raw = interpolate_at(mesh, *front, {}).normal;
             const double n_length = glm::length(normal_raw);
-            const glm::dvec3 n = n_length > 0.0 ? normal_raw / n_length : glm::dvec3(0, 0, 1);
+            const glm::dvec3 n =
+                n_length > 0.0 ? normal_raw / n_length : glm::dvec3(0, 0, 1);
             glm::dvec3 colour(0.0);
             if (transport) {
                 // Table 4.1 over the pattern, each footprint averaged exactly.
                 const glm::dvec3 rel = point - glm::dvec3(l.centre);
                 const glm::dvec2 uv = glm::dvec2(glm::dot(rel, glm::dvec3(l.right)),
-                                                 glm::dot(rel, glm::dvec3(l.up))) / plane + 0.5;
+                                                 glm::dot(rel, glm::dvec3(l.up))) /
+                                          plane +
+                                      0.5;
                 const glm::dvec3 start = (point - g.box_min) / g.box_extent;
                 glm::dvec3 sum(0.0);
                 for (const PatternSample& s : samples) {
                     const glm::dvec2 uv_i = uv + s.offset / plane;
                     if (uv_i.x < 0 || uv_i.y < 0 || uv_i.x > 1 || uv_i.y > 1) continue;
-                    const double half_box = 0.5 * g.texel * std::exp2(s.lod) * fine_per_plane;
+                    const double half_box =
+                        0.5 * g.texel * std::exp2(s.lod) * fine_per_plane;
                     const glm::dvec2 c = uv_i * double(light->size());
                     const auto m = light->box_mean(c.x - half_box, c.y - half_box,
                                                    c.x + half_box, c.y + half_box);
@@ -154,11 +166,14 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
                     if (density && kappa > 0.0) {
                         double accumulated = 0.0;
                         for (int k = 0; k < steps; ++k)
-                            accumulated += density->sample(start + (k + 0.5) / steps * (end - start));
+                            accumulated += density->sample(start + (k + 0.5) / steps *
+                                                                       (end - start));
                         alpha = kappa * ray * accumulated / steps;
                     }
-                    const double weight = transport_weight(ray + alpha, p.transport_distance);
-                    const glm::dvec3 dir = glm::normalize(d + std::max(0.0, eps_d - len) * g.to_light);
+                    const double weight =
+                        transport_weight(ray + alpha, p.transport_distance);
+                    const glm::dvec3 dir =
+                        glm::normalize(d + std::max(0.0, eps_d - len) * g.to_light);
                     sum += e * (weight * phase(p.phase_g, glm::dot(dir, -n)));
                 }
                 colour += p.transport_colour * sum / double(samples.size());
@@ -171,12 +186,15 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
                     glm::dvec3 geometric(front->geometric_normal);
                     if (glm::dot(geometric, g.to_light) < 0.0) geometric = -geometric;
                     const glm::dvec3 origin = point + 1e-4 * g.phi * geometric;
-                    if (!caster.occluded(glm::vec3(origin), glm::vec3(g.to_light), 0.0f, 1e30f)) {
-                        const double lobe = p.shininess == 0.0
-                                                ? 1.0
-                                                : std::pow(std::max(glm::dot(n_eye, half), 0.0),
-                                                           p.shininess);
-                        colour += p.diffuse * p.albedo * glm::dvec3(scene.light.diffuse) * n_dot_l +
+                    if (!caster.occluded(glm::vec3(origin), glm::vec3(g.to_light), 0.0f,
+                                         1e30f)) {
+                        const double lobe =
+                            p.shininess == 0.0
+                                ? 1.0
+                                : std::pow(std::max(glm::dot(n_eye, half), 0.0),
+                                           p.shininess);
+                        colour += p.diffuse * p.albedo * glm::dvec3(scene.light.diffuse) *
+                                      n_dot_l +
                                   p.specular * glm::dvec3(scene.light.specular) * lobe;
                     }
                 }

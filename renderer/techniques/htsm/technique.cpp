@@ -27,14 +27,17 @@ public:
         return {
             {"steps", {1, 2, 3, 5, 10, 20, 40}, 64},
             {"light_map_size",
-             {std::string("64"), std::string("128"), std::string("256"), std::string("512")},
+             {std::string("64"), std::string("128"), std::string("256"),
+              std::string("512")},
              std::string("512")},
             {"density_resolution",
-             {std::string("16"), std::string("32"), std::string("64"), std::string("128")},
+             {std::string("16"), std::string("32"), std::string("64"),
+              std::string("128")},
              std::string("128")},
             {"light_mips", {std::string("off"), std::string("on")}, std::string("on")},
             {"phase_table_size",
-             {std::string("16"), std::string("64"), std::string("256"), std::string("1024")},
+             {std::string("16"), std::string("64"), std::string("256"),
+              std::string("1024")},
              std::string("1024")},
             // n: each value against the reference of the same n-ray model (exact
             // footprints, fine march), so the row shows what the GL path's prefiltered
@@ -48,14 +51,15 @@ public:
     // Shopf's Fig. 5.9: the frame at n = 13, 9 and 5 rays against n = 1 (three GPUs:
     // 8.8-11.5x for n = 13), with the texture fetches each pixel makes.
     std::optional<FrameComparison> frame_comparison() const override {
-        FrameComparison comparison{"torus_knot",
-                                   {"4k"},
-                                   {{"n=13", {{"rays", "13"}}},
-                                    {"n=9", {{"rays", "9"}}},
-                                    {"n=5", {{"rays", "5"}}},
-                                    {"n=1", {{"rays", "1"}}}},
-                                   "n = rays of the hierarchical sample pattern per pixel, "
-                                   "the other knobs at their defaults"};
+        FrameComparison comparison{
+            "torus_knot",
+            {"4k"},
+            {{"n=13", {{"rays", "13"}}},
+             {"n=9", {{"rays", "9"}}},
+             {"n=5", {{"rays", "5"}}},
+             {"n=1", {{"rays", "1"}}}},
+            "n = rays of the hierarchical sample pattern per pixel, "
+            "the other knobs at their defaults"};
         comparison.detail = [](const Scene& scene) {
             return std::to_string(htsm::fetches_per_pixel(scene)) + " fetches per pixel";
         };

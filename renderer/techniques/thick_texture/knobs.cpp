@@ -14,7 +14,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 Knob choice(std::string name, std::string description, std::string value,
             std::vector<std::string> choices) {
-    return Knob{std::move(name), std::move(description), KnobKind::choice, 0.0, 0.0,
+    return Knob{std::move(name),  std::move(description), KnobKind::choice, 0.0, 0.0,
                 std::move(value), std::move(choices)};
 }
 
@@ -27,22 +27,27 @@ const std::vector<Knob>& knobs() {
                      "binary texture: net:H,W (holes H, walls W texels), stripes:H,W, "
                      "checker, random:P,SEED, weave:T,G, curtain:SEED or an image file "
                      "(alpha < 0.5 = hole)",
-                     KnobKind::text, 0.0, 0.0, d.texture};
+                     KnobKind::text,
+                     0.0,
+                     0.0,
+                     d.texture};
         // Its meaning (spec or file) is checked by Technique::check_scene, which names
         // the texture; here only that there is one.
         texture.check = [](std::string_view text) -> std::string {
             return text.empty() ? "empty" : "";
         };
         texture.accepted =
-            "non-empty text such as net:5,1, weave:2,1, random:0.5,1, curtain:1 or holes.png";
+            "non-empty text such as net:5,1, weave:2,1, random:0.5,1, curtain:1 or "
+            "holes.png";
         return std::vector<Knob>{
             texture,
             {"thickness", "h: height of the opaque texels, in level-0 texel widths",
              KnobKind::scalar, 0.0, 64.0, d.thickness},
             {"texel_density", "level-0 texels per uv unit (the sheets: per 2 mesh units)",
              KnobKind::scalar, 1.0, 8192.0, d.texel_density},
-            {"tilt", "sheet rotation about the vertical axis, degrees (the viewing angle "
-                     "of a flat sheet)",
+            {"tilt",
+             "sheet rotation about the vertical axis, degrees (the viewing angle "
+             "of a flat sheet)",
              KnobKind::scalar, 0.0, 89.0, d.tilt},
             {"azimuth", "sheet rotation about its own normal before the tilt, degrees",
              KnobKind::scalar, -180.0, 180.0, d.azimuth},
@@ -50,20 +55,23 @@ const std::vector<Knob>& knobs() {
                    "texture filtering (Fig. 4.6): nearest texel and level, linear = "
                    "nearest texel blended across levels, bilinear, trilinear",
                    d.filter, {"nearest", "linear", "bilinear", "trilinear"}),
-            choice("fetch_path",
-                   "hardware: normalised averages, hardware filtering, 3 fetches; thesis: "
-                   "Algorithm 3.1 on 8 texels, 32 fetches (Sec. 3.5)",
-                   d.fetch_path, {"hardware", "thesis"}),
-            choice("wide_hole_bins",
-                   "K: 1 = the thesis's neighbour walls only; 4 or 8 = run-length bins per "
-                   "direction (the future-work fix for holes wider than a texel)",
-                   std::to_string(d.wide_hole_bins), {"1", "4", "8"}),
+            choice(
+                "fetch_path",
+                "hardware: normalised averages, hardware filtering, 3 fetches; thesis: "
+                "Algorithm 3.1 on 8 texels, 32 fetches (Sec. 3.5)",
+                d.fetch_path, {"hardware", "thesis"}),
+            choice(
+                "wide_hole_bins",
+                "K: 1 = the thesis's neighbour walls only; 4 or 8 = run-length bins per "
+                "direction (the future-work fix for holes wider than a texel)",
+                std::to_string(d.wide_hole_bins), {"1", "4", "8"}),
             {"layers", "sheet layers by depth peeling (folds in front of folds)",
              KnobKind::integer, 1.0, 4.0, d.layers},
-            {"top_colour", "c1: colour of the opaque texels' tops (textures without colours)",
+            {"top_colour",
+             "c1: colour of the opaque texels' tops (textures without colours)",
              KnobKind::rgb, 0.0, 1.0, d.top_colour},
-            {"wall_colour", "c2: colour of the hole walls (linear rgb)", KnobKind::rgb, 0.0,
-             1.0, d.wall_colour},
+            {"wall_colour", "c2: colour of the hole walls (linear rgb)", KnobKind::rgb,
+             0.0, 1.0, d.wall_colour},
             choice("colour_source",
                    "c1 from the texture's colours (weave, curtain, files) or top_colour",
                    d.colour_source, {"texture", "knob"}),
@@ -73,8 +81,8 @@ const std::vector<Knob>& knobs() {
              d.backdrop_a},
             {"backdrop_b", "second backdrop colour (linear rgb)", KnobKind::rgb, 0.0, 1.0,
              d.backdrop_b},
-            {"backdrop_period", "backdrop squares / stripes, mesh units", KnobKind::scalar,
-             0.001, 100.0, d.backdrop_period},
+            {"backdrop_period", "backdrop squares / stripes, mesh units",
+             KnobKind::scalar, 0.001, 100.0, d.backdrop_period},
             {"reference_rays", "CPU reference: rays per pixel (n x n stratified)",
              KnobKind::integer, 1.0, 4096.0, d.reference_rays},
         };
@@ -106,7 +114,8 @@ Params params(const Scene& scene) {
 }
 
 const TexelGrid& scene_texture(const Params& p) {
-    // Textures are small; keep every one asked for (the explorer switches back and forth).
+    // Textures are small; keep every one asked for (the explorer switches back and
+    // forth).
     static std::mutex mutex;
     static std::map<std::string, std::shared_ptr<const TexelGrid>> cache;
     const glm::vec3 colour(p.top_colour);
@@ -145,7 +154,8 @@ double backdrop_distance(const Scene& scene) {
     return double(scene.bounds.diameter()) + 1.5 * double(scene.bounds.radius);
 }
 
-glm::dvec3 backdrop_colour(const Params& p, const Scene& scene, glm::dvec3 eye_direction) {
+glm::dvec3 backdrop_colour(const Params& p, const Scene& scene,
+                           glm::dvec3 eye_direction) {
     const glm::dvec3 a = p.backdrop_a, b = p.backdrop_b;
     if (p.backdrop == "plain" || !(eye_direction.z < 0.0)) return a;
     const double distance = backdrop_distance(scene);

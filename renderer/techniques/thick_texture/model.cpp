@@ -44,7 +44,8 @@ Fractions model_fractions(const TexelRecord& t, glm::dvec2 r) {
             if (r.x != 0.0) ax += bx[k] * std::clamp(std::abs(r.x) - double(k), 0.0, 1.0);
             if (r.y != 0.0) ay += by[k] * std::clamp(std::abs(r.y) - double(k), 0.0, 1.0);
         }
-        const double ax0 = r.x != 0.0 ? bx[0] * a : 0.0, ay0 = r.y != 0.0 ? by[0] * b : 0.0;
+        const double ax0 = r.x != 0.0 ? bx[0] * a : 0.0,
+                     ay0 = r.y != 0.0 ? by[0] * b : 0.0;
         occluded += (ax + ay - ax * ay / hole) - (ax0 + ay0 - ax0 * ay0 / hole);
     }
     // Step 6, clamped: never more than the holes, never negative.

@@ -1,9 +1,10 @@
 // What the thick_texture technique adds to a frame plan (David-Babin Sec. 3.5):
 //   albedo            CPU pyramid: premultiplied c1 average, rho_op      -> albedo
-//   walls, triangles  CPU pyramids of the per-texel counts (averages)   -> walls, triangles
-//   bins_*            CPU run-length histograms (wide-hole fix, K > 1)   -> bins_r0 ...
-//   layer_0..L-1      the sheet, depth peeled: premultiplied colour     -> layer_k_colour
-//   composite         layers front to back over the backdrop            -> colour
+//   walls, triangles  CPU pyramids of the per-texel counts (averages)   -> walls,
+//   triangles bins_*            CPU run-length histograms (wide-hole fix, K > 1)   ->
+//   bins_r0 ... layer_0..L-1      the sheet, depth peeled: premultiplied colour     ->
+//   layer_k_colour composite         layers front to back over the backdrop            ->
+//   colour
 // Exact prunes: h = 0 or a texture without opaque texels -> plain alpha texturing (no
 // walls, triangles, tangents); a texture without holes -> the same opaque draw, one
 // layer; a flat mesh -> one layer. In full mode the thick shader runs with every layer.
@@ -72,11 +73,12 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     const Variant variant = variant_of(p, grid);
     const bool full = plan.full();
     const bool thick = full || variant == Variant::thick;
-    // The wide-hole bins join the fast path only (the thesis path is the thesis's method).
+    // The wide-hole bins join the fast path only (the thesis path is the thesis's
+    // method).
     const int bins = thick && p.fetch_path != "thesis" ? p.wide_hole_bins : 1;
     const bool flat = is_flat(*scene.mesh);
-    const int layers = full ? p.layers
-                            : (variant == Variant::opaque || flat ? 1 : p.layers);
+    const int layers =
+        full ? p.layers : (variant == Variant::opaque || flat ? 1 : p.layers);
     const Sampling sampling = sampling_of(p.filter);
 
     // The CPU pyramid, built once per plan and only when an upload asks for it.
@@ -99,14 +101,16 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
                              "x" + std::to_string(grid.height);
     const auto upload = [&](const std::string& name, const std::string& purpose,
                             std::function<glm::dvec4(const TexelRecord&)> texel) {
-        plan.create(texture_2d(name, ResourceFormat::rgba32f, grid.width, grid.height, 0));
+        plan.create(
+            texture_2d(name, ResourceFormat::rgba32f, grid.width, grid.height, 0));
         Pass pass{name, purpose, PassKind::upload};
         pass.writes = {name};
         pass.data = {hash + "|" + name + "|k" + std::to_string(bins),
                      [lazy, texel] { return pyramid_texels(lazy->get(), texel); }};
         plan.add(pass);
     };
-    upload("albedo", "pyramid: premultiplied top colour c1 * rho_op and rho_op (averages)",
+    upload("albedo",
+           "pyramid: premultiplied top colour c1 * rho_op and rho_op (averages)",
            [](const TexelRecord& r) { return glm::dvec4(r.premultiplied, r.opaque); });
     std::vector<Read> texture_reads = {{"albedo", "", sampling}};
     if (thick) {
@@ -128,7 +132,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
                                " (wide-hole fix)",
                            [d, g](const TexelRecord& r) {
                                return glm::dvec4(r.bins[d][4 * g], r.bins[d][4 * g + 1],
-                                                 r.bins[d][4 * g + 2], r.bins[d][4 * g + 3]);
+                                                 r.bins[d][4 * g + 2],
+                                                 r.bins[d][4 * g + 3]);
                            });
                     texture_reads.push_back({name,
                                              std::string("bins_") + directions[d] + "[" +
@@ -144,7 +149,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     if (!thick) defines.push_back("THIN");
     if (thick && p.fetch_path == "thesis") {
         defines.push_back("THESIS_PATH");
-        if (sampling.filter == TexelFilter::linear) defines.push_back("FILTER_TEXEL_LINEAR");
+        if (sampling.filter == TexelFilter::linear)
+            defines.push_back("FILTER_TEXEL_LINEAR");
         if (sampling.mip == MipFilter::linear) defines.push_back("FILTER_MIP_LINEAR");
     }
     if (thick && bins > 1 && p.fetch_path != "thesis")
@@ -166,19 +172,19 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
         Pass layer{"layer_" + std::to_string(k),
                    std::string(thick ? "thick texture (Alg. 3.1" : "alpha texture (") +
                        (thick && p.fetch_path == "thesis" ? ", 8 texels x 4 fetches"
-                                                          : thick ? ", 3 filtered fetches"
-                                                                  : "1 fetch") +
+                        : thick                           ? ", 3 filtered fetches"
+                                                          : "1 fetch") +
                        (bins > 1 ? ", wide-hole bins" : "") + "), sheet layer " +
                        std::to_string(k) + (k == 0 ? pruned : ""),
                    PassKind::draw_mesh,
                    {"techniques/thick_texture/shaders/sheet.vert",
-                    "techniques/thick_texture/shaders/layer.frag",
-                    defines}};
+                    "techniques/thick_texture/shaders/layer.frag", defines}};
         layer.reads = texture_reads;
         if (k > 0) {
             layer.shader.defines.push_back("PEEL");
             layer.reads.push_back({"layer_" + std::to_string(k - 1) + "_depth",
-                                   "previous_depth", {TexelFilter::nearest}});
+                                   "previous_depth",
+                                   {TexelFilter::nearest}});
             layer.uniforms.push_back({"u_epsilon", 1e-6f});
         }
         layer.uniforms.push_back({"u_model_view", model_view});
@@ -195,25 +201,28 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
     }
 
     plan.create("colour", ResourceFormat::rgba32f);
-    Pass composite{"composite",
-                   "layers front to back over the " + p.backdrop + " backdrop (box-filtered)",
-                   PassKind::fullscreen,
-                   {"gl/shaders/fullscreen.vert",
-                    "techniques/thick_texture/shaders/composite.frag",
-                    {"LAYERS " + std::to_string(layers)}}};
+    Pass composite{
+        "composite",
+        "layers front to back over the " + p.backdrop + " backdrop (box-filtered)",
+        PassKind::fullscreen,
+        {"gl/shaders/fullscreen.vert",
+         "techniques/thick_texture/shaders/composite.frag",
+         {"LAYERS " + std::to_string(layers)}}};
     for (int k = 0; k < layers; ++k)
         composite.reads.push_back({"layer_" + std::to_string(k) + "_colour", ""});
     composite.reads.push_back({"layer_0_depth", ""});
     const double distance = backdrop_distance(scene);
-    const double half_height =
-        std::tan(0.5 * double(scene.camera.fov_y_degrees) * 3.14159265358979323846 / 180.0) *
-        distance;
+    const double half_height = std::tan(0.5 * double(scene.camera.fov_y_degrees) *
+                                        3.14159265358979323846 / 180.0) *
+                               distance;
     const double half_width = half_height * double(scene.camera.aspect);
     composite.uniforms = {
         {"u_pixel_scale", glm::vec3(float(2.0 * half_width / scene.width),
                                     float(2.0 * half_height / scene.height), 0.0f)},
         {"u_viewport", glm::vec3(float(scene.width), float(scene.height), 0.0f)},
-        {"u_backdrop", p.backdrop == "checker" ? 0 : p.backdrop == "stripes" ? 1 : 2},
+        {"u_backdrop", p.backdrop == "checker"   ? 0
+                       : p.backdrop == "stripes" ? 1
+                                                 : 2},
         {"u_backdrop_a", glm::vec3(p.backdrop_a)},
         {"u_backdrop_b", glm::vec3(p.backdrop_b)},
         {"u_period", float(p.backdrop_period)}};

@@ -18,7 +18,8 @@ void accumulate(TexelRecord& sum, const TexelRecord& r, double weight) {
     sum.opaque += weight * r.opaque;
     sum.premultiplied += weight * r.premultiplied;
     for (int d = 0; d < 4; ++d)
-        for (std::size_t k = 0; k < r.bins[d].size(); ++k) sum.bins[d][k] += weight * r.bins[d][k];
+        for (std::size_t k = 0; k < r.bins[d].size(); ++k)
+            sum.bins[d][k] += weight * r.bins[d][k];
 }
 
 }  // namespace
@@ -42,7 +43,9 @@ std::vector<TexelRecord> level0_records(const TexelGrid& g, int bins) {
                 r.premultiplied = glm::dvec3(g.colour_at(i, j));
                 continue;
             }
-            const auto b = [&](int di, int dj) { return g.at(i + di, j + dj) ? 1.0 : 0.0; };
+            const auto b = [&](int di, int dj) {
+                return g.at(i + di, j + dj) ? 1.0 : 0.0;
+            };
             // Walls in Algorithm 3.1's order: top, left, bottom, right.
             r.walls = {b(0, 1), b(-1, 0), b(0, -1), b(1, 0)};
             // Triangles (TR, TL, BL, BR): the diagonal neighbour's wall seen through each
@@ -78,12 +81,14 @@ RecordPyramid build_pyramid(const TexelGrid& grid, int bins) {
         const glm::ivec2 above = pyramid.sizes.back();
         const glm::ivec2 size = glm::ivec2(mip_size(base, l, false));
         const auto& src = pyramid.levels.back();
-        std::vector<TexelRecord> level(std::size_t(size.x) * size.y, zero_like(src.front()));
+        std::vector<TexelRecord> level(std::size_t(size.x) * size.y,
+                                       zero_like(src.front()));
         for (int y = 0; y < size.y; ++y)
             for (int x = 0; x < size.x; ++x) {
                 // 2x2 footprint, widened to the last row / column of the level above
                 // (3 when it is odd), exactly as gl/shaders/box_mip.frag.
-                const int x0 = std::min(2 * x, above.x - 1), y0 = std::min(2 * y, above.y - 1);
+                const int x0 = std::min(2 * x, above.x - 1),
+                          y0 = std::min(2 * y, above.y - 1);
                 const int x1 = x == size.x - 1 ? above.x : std::min(2 * x + 2, above.x);
                 const int y1 = y == size.y - 1 ? above.y : std::min(2 * y + 2, above.y);
                 const double weight = 1.0 / double((x1 - x0) * (y1 - y0));

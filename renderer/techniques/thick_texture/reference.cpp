@@ -29,9 +29,9 @@ Frame frame_at(const Mesh& mesh, const RayHit& hit) {
     glm::dvec3 n = mix3(glm::dvec3(mesh.normals[tri.x]), glm::dvec3(mesh.normals[tri.y]),
                         glm::dvec3(mesh.normals[tri.z]));
     n = glm::dot(n, n) > 1e-30 ? glm::normalize(n) : glm::dvec3(hit.geometric_normal);
-    const glm::dvec4 t4 = mix3(glm::dvec4(mesh.tangents[tri.x]),
-                               glm::dvec4(mesh.tangents[tri.y]),
-                               glm::dvec4(mesh.tangents[tri.z]));
+    const glm::dvec4 t4 =
+        mix3(glm::dvec4(mesh.tangents[tri.x]), glm::dvec4(mesh.tangents[tri.y]),
+             glm::dvec4(mesh.tangents[tri.z]));
     glm::dvec3 t = glm::dvec3(t4) - n * glm::dot(n, glm::dvec3(t4));
     if (glm::dot(t, t) < 1e-20)
         t = std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0))
@@ -45,7 +45,8 @@ Frame frame_at(const Mesh& mesh, const RayHit& hit) {
 
 double jitter(int x, int y, int k) {
     std::uint64_t h = std::uint64_t(x) * 0x9e3779b97f4a7c15ull ^
-                      std::uint64_t(y) * 0xc2b2ae3d27d4eb4full ^ std::uint64_t(k) * 0x165667b19e3779f9ull;
+                      std::uint64_t(y) * 0xc2b2ae3d27d4eb4full ^
+                      std::uint64_t(k) * 0x165667b19e3779f9ull;
     h = (h ^ (h >> 31)) * 0xbf58476d1ce4e5b9ull;
     h ^= h >> 29;
     return double(h >> 11) * 0x1.0p-53;
@@ -104,7 +105,8 @@ Image render_reference(const Scene& scene) {
             const glm::dvec3 centre = glm::dmat3(inverse_model) * rays.direction(x, row);
             const bool covered =
                 caster.first_hit(glm::vec3(eye_object), glm::vec3(centre)).has_value();
-            image.set(x, row, glm::vec4(glm::vec3(sum / double(n * n)), covered ? 1.0f : 0.0f));
+            image.set(x, row,
+                      glm::vec4(glm::vec3(sum / double(n * n)), covered ? 1.0f : 0.0f));
         }
     });
     return image;

@@ -31,9 +31,11 @@ public:
              {std::string("nearest"), std::string("linear"), std::string("bilinear"),
               std::string("trilinear")},
              std::string("trilinear")},
-            {"fetch_path", {std::string("hardware"), std::string("thesis")},
+            {"fetch_path",
+             {std::string("hardware"), std::string("thesis")},
              std::string("hardware")},
-            {"wide_hole_bins", {std::string("1"), std::string("4"), std::string("8")},
+            {"wide_hole_bins",
+             {std::string("1"), std::string("4"), std::string("8")},
              std::string("1")},
             // Scene knobs, each row against its own reference: the model's error grows
             // with h tan(theta) once holes wider than a texel lose their far walls.
@@ -47,8 +49,11 @@ public:
         return FrameComparison{
             "wave",
             {"100", "400", "800", "3200", "9600", "12800"},
-            {{"thick", {}}, {"thesis", {{"fetch_path", "thesis"}}}, {"alpha", {{"thickness", "0"}}}},
-            "thick = Alg. 3.1 on hardware-filtered averages; thesis = 8 texels x Alg. 3.1; "
+            {{"thick", {}},
+             {"thesis", {{"fetch_path", "thesis"}}},
+             {"alpha", {{"thickness", "0"}}}},
+            "thick = Alg. 3.1 on hardware-filtered averages; thesis = 8 texels x Alg. "
+            "3.1; "
             "alpha = the same sheet with h = 0 (a plain alpha texture)"};
     }
 };

@@ -10,9 +10,10 @@ namespace lucent::thick_texture {
 namespace {
 
 [[noreturn]] void fail(const std::string& spec, const std::string& why) {
-    throw KnobError("texture: '" + spec + "' " + why +
-                    " (accepted: net:H,W, stripes:H,W, checker, random:P,SEED, weave:T,G, "
-                    "curtain:SEED, or an image file)");
+    throw KnobError(
+        "texture: '" + spec + "' " + why +
+        " (accepted: net:H,W, stripes:H,W, checker, random:P,SEED, weave:T,G, "
+        "curtain:SEED, or an image file)");
 }
 
 // "a,b" after the colon as numbers; `count` of them.
@@ -39,8 +40,8 @@ std::vector<double> arguments(const std::string& spec, const std::string& text,
 
 int whole(const std::string& spec, double value, int lo, int hi, const char* what) {
     if (value != std::floor(value) || value < lo || value > hi)
-        fail(spec, std::string(what) + " must be a whole number in [" + std::to_string(lo) +
-                       ", " + std::to_string(hi) + "]");
+        fail(spec, std::string(what) + " must be a whole number in [" +
+                       std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return static_cast<int>(value);
 }
 
@@ -104,9 +105,9 @@ TexelGrid from_file(const std::string& spec) {
                 fail(spec, "has a non-finite pixel");
             const std::size_t k = std::size_t(j) * image.width + i;
             grid.opaque[k] = c.a >= 0.5f ? 1 : 0;
-            grid.colour[k] = linear ? glm::clamp(glm::vec3(c), 0.0f, 1.0f)
-                                    : glm::vec3(srgb_decode(c.r), srgb_decode(c.g),
-                                                srgb_decode(c.b));
+            grid.colour[k] =
+                linear ? glm::clamp(glm::vec3(c), 0.0f, 1.0f)
+                       : glm::vec3(srgb_decode(c.r), srgb_decode(c.g), srgb_decode(c.b));
         }
     return grid;
 }
@@ -159,13 +160,15 @@ TexelGrid make_texel_grid(const std::string& spec, glm::vec3 knob_colour) {
     }
     if (name == "random") {
         const auto a = args(2);
-        if (a[0] < 0.0 || a[0] > 1.0) fail(spec, "P (the hole probability) must be in [0, 1]");
+        if (a[0] < 0.0 || a[0] > 1.0)
+            fail(spec, "P (the hole probability) must be in [0, 1]");
         const int seed = whole(spec, a[1], 0, 1 << 30, "SEED");
         TexelGrid grid = blank(256, knob_colour);
         for (int j = 0; j < grid.height; ++j)
             for (int i = 0; i < grid.width; ++i)
                 grid.opaque[std::size_t(j) * grid.width + i] =
-                    uniform(std::uint64_t(seed), std::uint64_t(i), std::uint64_t(j)) >= a[0];
+                    uniform(std::uint64_t(seed), std::uint64_t(i), std::uint64_t(j)) >=
+                    a[0];
         return grid;
     }
     if (name == "weave") {
@@ -214,9 +217,11 @@ TexelGrid make_texel_grid(const std::string& spec, glm::vec3 knob_colour) {
             }
         for (int j = 0; j < grid.height; ++j)
             for (int i = 0; i < grid.width; ++i) {
-                const double band = 0.5 + 0.5 * std::sin(2.0 * 3.14159265358979 * i / 96.0);
+                const double band =
+                    0.5 + 0.5 * std::sin(2.0 * 3.14159265358979 * i / 96.0);
                 grid.colour[std::size_t(j) * grid.width + i] =
-                    knob_colour * glm::vec3(float(0.6 + 0.4 * band), float(0.5 + 0.3 * band),
+                    knob_colour * glm::vec3(float(0.6 + 0.4 * band),
+                                            float(0.5 + 0.3 * band),
                                             float(0.9 - 0.5 * band));
             }
         return grid;

@@ -25,8 +25,8 @@ struct TexelGrid {
     int width = 0, height = 0;
     std::vector<std::uint8_t> opaque;  // 1 opaque, 0 hole; row j = 0 is v = 0
     std::vector<glm::vec3> colour;     // one per texel (holes: unused)
-    bool coloured = false;             // the texture gives colours (weave, curtain, files)
-    bool at(int i, int j) const {      // wraps (the sheet repeats the tile)
+    bool coloured = false;         // the texture gives colours (weave, curtain, files)
+    bool at(int i, int j) const {  // wraps (the sheet repeats the tile)
         i %= width, j %= height;
         if (i < 0) i += width;
         if (j < 0) j += height;
@@ -61,8 +61,8 @@ struct TexelRecord {
 // Level-0 records of a tile (with `bins` > 1: histograms of K = bins).
 std::vector<TexelRecord> level0_records(const TexelGrid& grid, int bins);
 // Every level of the pyramid as averages (sum of the covered level-0 records / their
-// count): level l+1 texel = mean of its 2x2 footprint in level l, widened to 3 at the last
-// row / column of an odd level, as renderer/gl's box mip. Level 0 first.
+// count): level l+1 texel = mean of its 2x2 footprint in level l, widened to 3 at the
+// last row / column of an odd level, as renderer/gl's box mip. Level 0 first.
 struct RecordPyramid {
     std::vector<glm::ivec2> sizes;
     std::vector<std::vector<TexelRecord>> levels;
@@ -90,7 +90,8 @@ glm::dvec2 scaled_ray(glm::dvec3 d_tangent, double thickness, double cap = 64.0)
 // texel, a wall (the first opaque texel its 2D Amanatides-Woo walk enters before the
 // bottom), or nothing (through). `steps` reports the texels visited.
 enum class SlabHit { top, wall, through };
-SlabHit trace_slab(const TexelGrid& grid, glm::dvec2 p, glm::dvec2 r, int* steps = nullptr);
+SlabHit trace_slab(const TexelGrid& grid, glm::dvec2 p, glm::dvec2 r,
+                   int* steps = nullptr);
 // The wall texel's colour is needed for colour_source = texture: the texel it entered.
 SlabHit trace_slab(const TexelGrid& grid, glm::dvec2 p, glm::dvec2 r, glm::ivec2& texel,
                    int* steps = nullptr);
@@ -102,18 +103,18 @@ Fractions exact_fractions(const TexelGrid& grid, glm::dvec2 r, int samples_per_a
 
 struct Params {
     std::string texture = "net:5,1";
-    double thickness = 1.0;        // h, level-0 texels, [0, 64]
-    double texel_density = 96.0;   // level-0 texels per uv unit, [1, 8192]
-    double tilt = 0.0;             // degrees about the vertical axis, [0, 89]
-    double azimuth = 0.0;          // degrees the sheet spins about its normal first
-    std::string filter = "trilinear";   // nearest | linear | bilinear | trilinear
+    double thickness = 1.0;            // h, level-0 texels, [0, 64]
+    double texel_density = 96.0;       // level-0 texels per uv unit, [1, 8192]
+    double tilt = 0.0;                 // degrees about the vertical axis, [0, 89]
+    double azimuth = 0.0;              // degrees the sheet spins about its normal first
+    std::string filter = "trilinear";  // nearest | linear | bilinear | trilinear
     std::string fetch_path = "hardware";  // hardware (3 fetches) | thesis (32)
-    int wide_hole_bins = 1;        // K: 1 = the thesis's method, 4 or 8 = the fix
-    int layers = 2;                // depth-peeled sheet layers, [1, 4]
+    int wide_hole_bins = 1;               // K: 1 = the thesis's method, 4 or 8 = the fix
+    int layers = 2;                       // depth-peeled sheet layers, [1, 4]
     glm::dvec3 top_colour{0.85, 0.82, 0.75};
     glm::dvec3 wall_colour{0.35, 0.33, 0.3};
     std::string colour_source = "texture";  // texture | knob (c1)
-    std::string backdrop = "checker";  // checker | stripes | plain
+    std::string backdrop = "checker";       // checker | stripes | plain
     glm::dvec3 backdrop_a{0.9, 0.2, 0.15};
     glm::dvec3 backdrop_b{0.1, 0.15, 0.5};
     double backdrop_period = 0.2;  // mesh units on the backdrop plane

@@ -57,13 +57,19 @@ Fractions exact_fractions(const TexelGrid& grid, glm::dvec2 r, int s) {
         for (int i = 0; i < grid.width; ++i)
             for (int b = 0; b < s; ++b)
                 for (int a = 0; a < s; ++a) {
-                    // The y offset keeps samples off the texel diagonals, where the walk's
-                    // tie-breaking (not the geometry) would decide.
+                    // The y offset keeps samples off the texel diagonals, where the
+                    // walk's tie-breaking (not the geometry) would decide.
                     const glm::dvec2 p(i + (a + 0.5) / s, j + (b + 0.5 + 0.1234) / s);
                     switch (trace_slab(grid, p, r)) {
-                        case SlabHit::top: ++top; break;
-                        case SlabHit::wall: ++wall; break;
-                        case SlabHit::through: ++through; break;
+                        case SlabHit::top:
+                            ++top;
+                            break;
+                        case SlabHit::wall:
+                            ++wall;
+                            break;
+                        case SlabHit::through:
+                            ++through;
+                            break;
                     }
                 }
     const double n = double(top + wall + through);

@@ -35,10 +35,11 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
                                    "Y(Kd)*N.L) + Ward specular",
         PassKind::draw_mesh,
         {"techniques/ward/shaders/mesh.vert", "techniques/ward/shaders/shade.frag", {}}};
-    shade.uniforms = with_uniforms(mesh_transform_uniforms(view, scene.camera.projection()),
-                                   {{"u_albedo", glm::vec3(p.albedo)},
-                                    {"u_light_diffuse", scene.light.diffuse},
-                                    {"u_light_direction", scene.light.direction}});
+    shade.uniforms =
+        with_uniforms(mesh_transform_uniforms(view, scene.camera.projection()),
+                      {{"u_albedo", glm::vec3(p.albedo)},
+                       {"u_light_diffuse", scene.light.diffuse},
+                       {"u_light_direction", scene.light.direction}});
     if (ambient_term) {
         shade.shader.defines.push_back("WITH_AMBIENT_OCCLUSION");
         shade.reads.push_back({"vertex_ao", ""});

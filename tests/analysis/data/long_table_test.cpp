@@ -3,18 +3,17 @@
 #include "data/long_table.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <random>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
-
-#include <unistd.h>
 
 #include "data/decimal.h"
 #include "data/grouping.h"
@@ -161,7 +160,6 @@ TEST(Grouping, NumericLevelsSortNumerically) {
     EXPECT_EQ(pairs[0].data.groups[2].level, "30");
 }
 
-
 TEST(LongTable, QuotedFieldsSpanLinesAndUnterminatedQuotesNameTheirLine) {
     const LongTable t = read(
         "participant,stimulus,factor,level,question,rating\n"
@@ -170,11 +168,11 @@ TEST(LongTable, QuotedFieldsSpanLinesAndUnterminatedQuotesNameTheirLine) {
     ASSERT_EQ(t.rows.size(), 2u);
     EXPECT_EQ(t.rows[0].question, "two\nlines, \"quoted\"");
     EXPECT_EQ(t.rows[1].source_line, 4u);  // physical lines: the quoted field took two
-    const std::string message =
-        error_of("participant,stimulus,factor,level,question,rating\n"
-                 "p1,s1,f,1,q,4\n"
-                 "p1,s2,f,2,\"open,5\n"
-                 "p1,s3,f,3,q,6\n");
+    const std::string message = error_of(
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,s1,f,1,q,4\n"
+        "p1,s2,f,2,\"open,5\n"
+        "p1,s3,f,3,q,6\n");
     EXPECT_NE(message.find("ratings.csv:3: unterminated quoted field"), std::string::npos)
         << message;
 }
@@ -185,7 +183,8 @@ TEST(LongTable, FileAndStreamReadersAgree) {
     csv << "\xEF\xBB\xBFparticipant , stimulus,factor,level,question,rating\r\n";
     std::mt19937 random(5);
     for (int i = 0; i < 2000; ++i) {
-        csv << 'p' << i % 17 << ", s" << i % 101 << ",f," << i % 3 << ",q" << i % 2 << ',';
+        csv << 'p' << i % 17 << ", s" << i % 101 << ",f," << i % 3 << ",q" << i % 2
+            << ',';
         if (i % 97 == 0)
             csv << "NA";
         else
@@ -241,7 +240,8 @@ TEST(LongTable, LargeFilesParsedInTwoHalvesKeepEveryRowAndLine) {
             csv << "\n";  // a blank line: skipped, but counted
             ++line;
         }
-        Written w{"participant" + std::to_string(i % 311), std::to_string(i % 7), {}, ++line};
+        Written w{
+            "participant" + std::to_string(i % 311), std::to_string(i % 7), {}, ++line};
         if (i >= 3 && i % 1013 != 0) w.rating = 1 + static_cast<int>(random() % 7);
         csv << w.participant << ",stimulus" << i % 97 << ",thickness," << w.level
             << ",translucent," << (w.rating ? std::to_string(*w.rating) : "NA") << "\n";
@@ -266,8 +266,9 @@ TEST(LongTable, LargeFilesParsedInTwoHalvesKeepEveryRowAndLine) {
     const std::size_t late = bad.rfind(",translucent,") + 13;
     bad.replace(late, 1, "x");
     const std::string late_line = std::to_string(written.back().line);
-    EXPECT_EQ(error_of(bad), "ratings.csv:" + late_line +
-                                 ": column 6 (rating): rating 'x' is not a finite number");
+    EXPECT_EQ(error_of(bad),
+              "ratings.csv:" + late_line +
+                  ": column 6 (rating): rating 'x' is not a finite number");
     const std::size_t early = bad.find(",translucent,", bad.find("participant10,")) + 13;
     bad.replace(early, 1, "y");
     EXPECT_EQ(error_of(bad).rfind("ratings.csv:12: column 6 (rating): rating 'y'", 0), 0u)
@@ -288,7 +289,6 @@ TEST(Label, EqualTextsAreOneLabelAndOrderByText) {
     EXPECT_EQ(std::hash<Label>{}(a), std::hash<Label>{}(b));
     EXPECT_EQ("level " + a, "level thickness");
 }
-
 
 // Issue 26 item 10: ratings of +-1e308 with --scale any ended `analyze` with "lucent:
 // stod" (the exact difference of 1e308 and -1e308 is 2e308, beyond a double, and
@@ -312,30 +312,35 @@ TEST(LongTable, RatingsOfPlusAndMinus1e308AreRefusedNamingFileLineAndColumnNotSt
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     EXPECT_EQ(message.find("stod"), std::string::npos) << message;
     // The column is the rating's wherever the header puts it.
-    const std::string first =
-        error_of("rating,participant,stimulus,factor,level,question\n"
-                 "-1e308,p1,a,f,1,q\n1e308,p2,b,f,2,q\n",
-                 RatingScale{true});
+    const std::string first = error_of(
+        "rating,participant,stimulus,factor,level,question\n"
+        "-1e308,p1,a,f,1,q\n1e308,p2,b,f,2,q\n",
+        RatingScale{true});
     EXPECT_EQ(first.rfind("ratings.csv:3: column 1 (rating):", 0), 0u) << first;
 }
 
 // The overflow case: a rating text beyond the double range (1e400) is not a number the
 // analysis takes; the line says so, where, and why.
 TEST(LongTable, RatingsBeyondTheDoubleRangeAreRefusedNamingFileLineAndColumn) {
-    const std::string first = error_of(
-        "participant,stimulus,factor,level,question,rating\np1,a,f,1,q,1e400\n",
-        RatingScale{true});
-    EXPECT_EQ(first, "ratings.csv:2: column 6 (rating): rating '1e400' is beyond the range of "
-                     "a double (magnitudes up to about 1.8e308): rescale the ratings");
+    const std::string first =
+        error_of("participant,stimulus,factor,level,question,rating\np1,a,f,1,q,1e400\n",
+                 RatingScale{true});
+    EXPECT_EQ(first,
+              "ratings.csv:2: column 6 (rating): rating '1e400' is beyond the range of "
+              "a double (magnitudes up to about 1.8e308): rescale the ratings");
     const std::string later = error_of(
-        "participant,stimulus,factor,level,question,rating\np1,a,f,1,q,3\np1,b,f,2,q,-1e400\n",
+        "participant,stimulus,factor,level,question,rating\np1,a,f,1,q,3\np1,b,f,2,q,-"
+        "1e400\n",
         RatingScale{true});
-    EXPECT_EQ(later.rfind("ratings.csv:3: column 6 (rating): rating '-1e400' is beyond", 0), 0u)
+    EXPECT_EQ(
+        later.rfind("ratings.csv:3: column 6 (rating): rating '-1e400' is beyond", 0), 0u)
         << later;
     // A word stays "not a finite number".
-    EXPECT_NE(error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,abc\n")
-                  .find("ratings.csv:2: column 6 (rating): rating 'abc' is not a finite number"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of("participant,stimulus,factor,level,question,rating\np,s,f,1,q,abc\n")
+            .find(
+                "ratings.csv:2: column 6 (rating): rating 'abc' is not a finite number"),
+        std::string::npos);
 }
 
 // Finite ratings whose spread would overflow the sums of squares (0 and 1e200: one

@@ -2,8 +2,6 @@
 // SVG beside the HTML and embedded in it, hard cases spelled out.
 #include "report/report.h"
 
-#include "report/svg_plot.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +11,7 @@
 
 #include "analyze.h"
 #include "data/long_table.h"
+#include "report/svg_plot.h"
 #include "test_paths.h"
 
 namespace lucent::analysis {
@@ -95,7 +94,8 @@ TEST(Report, WritesEveryFormatWithExactHeaders) {
 }
 
 // Two-sided p of Student's t with even df, in closed form (Abramowitz & Stegun 26.7.3):
-// p = 1 - sqrt(x) * sum_{j < df/2} c_j (1 - x)^j, x = t^2 / (df + t^2), c_j = prod (2i-1)/(2i).
+// p = 1 - sqrt(x) * sum_{j < df/2} c_j (1 - x)^j, x = t^2 / (df + t^2), c_j = prod
+// (2i-1)/(2i).
 double student_t_two_sided_p_even_df(double t, int df) {
     const double x = t * t / (df + t * t);
     double c = 1.0, sum = 0.0, power = 1.0;
@@ -128,7 +128,8 @@ TEST(Report, TukeySignificanceFollowsTheReportsAlphaAndItsInterval) {
     ASSERT_GT(p_t, 0.05);
     ASSERT_LT(p_t, 0.10);
     for (const double alpha : {0.10, 0.05}) {
-        const auto dir = test::scratch_dir(alpha > 0.07 ? "tukey_alpha_10" : "tukey_alpha_05");
+        const auto dir =
+            test::scratch_dir(alpha > 0.07 ? "tukey_alpha_10" : "tukey_alpha_05");
         const OneWayAnalysis a = analyze_one_way("translucent", "r", data, alpha);
         ASSERT_EQ(a.tukey.pairs.size(), 1u);
         EXPECT_NEAR(*a.tukey.pairs[0].p_adj, p_t, 1e-6);
@@ -163,7 +164,8 @@ TEST(Report, NeverReplacesItsInputOrADatabaseAndWritesNothingThen) {
         write_report(analyses, dir, options);
         FAIL();
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("is the input"), std::string::npos)
+            << e.what();
     }
     EXPECT_EQ(slurp(input), "participant,stimulus,factor,level,question,rating\n");
     EXPECT_FALSE(std::filesystem::exists(dir / "report.md"));  // refused before writing
@@ -246,8 +248,10 @@ TEST(Report, WithinSubjectTablesLeadWhenPrimaryAndParseBack) {
     EXPECT_EQ(circles, 3u);
     EXPECT_NE(slurp(dir / "report.html").find(figure.substr(0, 40)), std::string::npos)
         << "the HTML embeds the figure";
-    for (const char* name : {"rm_anova.csv", "friedman.csv", "posthoc_paired.csv", "report.md"})
-        EXPECT_FALSE(std::regex_search(slurp(dir / name), std::regex("nan", std::regex::icase)))
+    for (const char* name :
+         {"rm_anova.csv", "friedman.csv", "posthoc_paired.csv", "report.md"})
+        EXPECT_FALSE(
+            std::regex_search(slurp(dir / name), std::regex("nan", std::regex::icase)))
             << name;
 }
 
@@ -256,13 +260,15 @@ TEST(Report, FactorFigurePutsQuestionsSideBySideOnOneScale) {
     // same value sits at the same height in each panel.
     std::vector<Descriptives> low = describe_all(groups({{1, 2, 3}, {2, 3, 4}}), 0.95);
     std::vector<Descriptives> high = describe_all(groups({{5, 6, 7}, {2, 3, 4}}), 0.95);
-    const std::string svg = factor_figure_svg("backlight", {{"translucent", low}, {"realistic", high}});
+    const std::string svg =
+        factor_figure_svg("backlight", {{"translucent", low}, {"realistic", high}});
     EXPECT_NE(svg.find("width=\"640\""), std::string::npos) << svg;
     EXPECT_NE(svg.find(">translucent</text>"), std::string::npos);
     EXPECT_NE(svg.find(">realistic</text>"), std::string::npos);
     // Level 2 has mean 3 in both panels: both circles at the same y.
     std::vector<std::string> ys;
-    for (std::size_t at = svg.find("<circle"); at != std::string::npos; at = svg.find("<circle", at + 1)) {
+    for (std::size_t at = svg.find("<circle"); at != std::string::npos;
+         at = svg.find("<circle", at + 1)) {
         const std::size_t cy = svg.find("cy=\"", at) + 4;
         ys.push_back(svg.substr(cy, svg.find('"', cy) - cy));
     }
@@ -303,9 +309,12 @@ TEST(Report, LevelPicturesAreEmbeddedBesideTheirDescriptives) {
     options.csv = false;
     write_report(analyze_table(table, AnalysisRequest{}).pairs, dir / "out", options);
     const std::string html = slurp(dir / "out" / "report.html");
-    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thin")), std::string::npos);
-    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thick")), std::string::npos);
-    EXPECT_LT(html.find(base64_encode("PNG-thin")), html.find(base64_encode("PNG-thick")));
+    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thin")),
+              std::string::npos);
+    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thick")),
+              std::string::npos);
+    EXPECT_LT(html.find(base64_encode("PNG-thin")),
+              html.find(base64_encode("PNG-thick")));
     EXPECT_NE(html.find("r 30 (thick)"), std::string::npos);
     EXPECT_THROW(level_images_from_directory(table, dir / "missing"), InputError);
 }

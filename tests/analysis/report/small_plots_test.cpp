@@ -12,14 +12,16 @@ namespace {
 
 std::size_t count(const std::string& text, const std::string& what) {
     std::size_t n = 0;
-    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+        ++n;
     return n;
 }
 
 TEST(SmallPlots, HistogramBarsAreProportionalToTheShares) {
     const std::string svg = histogram_svg("h", {0.5, 0.25, 0.0, 0.25});
     std::vector<double> heights;
-    const std::regex bar("<rect x=\"[0-9.]+\" y=\"[0-9.]+\" width=\"[0-9.]+\" height=\"([0-9.]+)\"");
+    const std::regex bar(
+        "<rect x=\"[0-9.]+\" y=\"[0-9.]+\" width=\"[0-9.]+\" height=\"([0-9.]+)\"");
     for (std::sregex_iterator it(svg.begin(), svg.end(), bar), end; it != end; ++it)
         heights.push_back(std::stod((*it)[1]));
     ASSERT_EQ(heights.size(), 4u);
@@ -31,8 +33,8 @@ TEST(SmallPlots, HistogramBarsAreProportionalToTheShares) {
 }
 
 TEST(SmallPlots, LevelValuesSkipUndefinedValuesAndNameTheAxis) {
-    const std::string svg =
-        level_values_svg("RMS contrast", {"18", "25", "30"}, {0.7, NAN, 1.2}, "thickness_exponent");
+    const std::string svg = level_values_svg("RMS contrast", {"18", "25", "30"},
+                                             {0.7, NAN, 1.2}, "thickness_exponent");
     EXPECT_EQ(count(svg, "<circle"), 2u);
     EXPECT_EQ(svg.find("nan"), std::string::npos);
     EXPECT_EQ(svg.find("inf"), std::string::npos);

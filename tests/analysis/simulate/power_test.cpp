@@ -34,7 +34,8 @@ TEST(Power, BetweenSubjectAnovaMatchesTheNoncentralF) {
     const double expected = noncentral_f_power(2, 27, 5.0, 0.05);
     ASSERT_TRUE(r.closed_form);
     EXPECT_NEAR(*r.closed_form, expected, 1e-9);
-    EXPECT_NEAR(expected, 0.4579922755, 1e-9);  // R: 1 - pf(qf(.95, 2, 27), 2, 27, ncp = 5)
+    EXPECT_NEAR(expected, 0.4579922755,
+                1e-9);  // R: 1 - pf(qf(.95, 2, 27), 2, 27, ncp = 5)
     EXPECT_NEAR(r.one_way_anova.power, expected, 4 * r.one_way_anova.mc_error)
         << "closed form " << expected;
     EXPECT_FALSE(r.rm_anova.has_value());
@@ -76,8 +77,10 @@ TEST(Power, EqualMeansRejectAtAlphaAndTheSeedFixesTheResult) {
     spec.simulations = 4000;
     const PowerResult r = estimate_power(spec);
     EXPECT_NEAR(r.rm_anova->power, 0.10, 4 * std::sqrt(0.1 * 0.9 / 4000));
-    EXPECT_NEAR(r.one_way_anova.power, 0.10, 0.04);  // conservative with offsets, not liberal
-    EXPECT_LE(r.any_pair.power, 0.10 + 4 * std::sqrt(0.1 * 0.9 / 4000));  // Holm: FWER <= alpha
+    EXPECT_NEAR(r.one_way_anova.power, 0.10,
+                0.04);  // conservative with offsets, not liberal
+    EXPECT_LE(r.any_pair.power,
+              0.10 + 4 * std::sqrt(0.1 * 0.9 / 4000));  // Holm: FWER <= alpha
     EXPECT_DOUBLE_EQ(estimate_power(spec).rm_anova->power, r.rm_anova->power);
     spec.seed = 2;
     EXPECT_NE(estimate_power(spec).rm_anova->power, r.rm_anova->power);
@@ -92,7 +95,8 @@ TEST(Power, SmallestSampleAgreesWithTheClosedForm) {
     spec.simulations = 2000;
     // The closed form's smallest n per level reaching 0.8, by scanning n.
     int closed_n = 2;
-    while (noncentral_f_power(2, 3.0 * (closed_n - 1), closed_n * 0.32, 0.05) < 0.8) ++closed_n;
+    while (noncentral_f_power(2, 3.0 * (closed_n - 1), closed_n * 0.32, 0.05) < 0.8)
+        ++closed_n;
     const SampleSize size = smallest_sample(spec, 0.8, 200);
     ASSERT_TRUE(size.participants);
     EXPECT_NEAR(*size.participants, closed_n, 2) << "closed form " << closed_n;

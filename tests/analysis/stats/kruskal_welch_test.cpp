@@ -68,7 +68,8 @@ TEST(KruskalWallis, LikertTiesMatchRankVarianceFormula) {
 }
 
 TEST(KruskalWallis, ManyDistinctValuesWithTiesMatchRankVarianceFormula) {
-    // Values that are not whole numbers: the ranks come from one sort of the pooled values.
+    // Values that are not whole numbers: the ranks come from one sort of the pooled
+    // values.
     std::mt19937 engine(5);
     std::normal_distribution<double> normal(0.0, 1.0);
     std::vector<std::vector<double>> values(4);
@@ -88,7 +89,8 @@ TEST(KruskalWallis, WholeNumbersNarrowOrWideMatchRankVarianceFormula) {
         std::uniform_int_distribution<int> value(-spread, spread);
         std::vector<std::vector<double>> values(3);
         for (int g = 0; g < 3; ++g)
-            for (int i = 0; i < 40 + 5 * g; ++i) values[g].push_back(value(engine) + 2 * g);
+            for (int i = 0; i < 40 + 5 * g; ++i)
+                values[g].push_back(value(engine) + 2 * g);
         const auto r = kruskal_wallis(groups(values));
         ASSERT_TRUE(r.h) << spread;
         EXPECT_NEAR(*r.h, h_by_rank_variance(values), 1e-10) << spread;

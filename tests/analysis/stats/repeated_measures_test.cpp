@@ -17,7 +17,8 @@ namespace {
 
 SubjectByLevel matrix(std::size_t columns, std::vector<double> values) {
     SubjectByLevel m;
-    for (std::size_t j = 0; j < columns; ++j) m.levels.push_back("L" + std::to_string(j + 1));
+    for (std::size_t j = 0; j < columns; ++j)
+        m.levels.push_back("L" + std::to_string(j + 1));
     for (std::size_t i = 0; i < values.size() / columns; ++i)
         m.participants.push_back("P" + std::to_string(i + 1));
     m.values = std::move(values);
@@ -26,18 +27,17 @@ SubjectByLevel matrix(std::size_t columns, std::vector<double> values) {
 
 const SubjectByLevel& reacttime() {
     static const SubjectByLevel m = matrix(
-        6, {420, 420, 480, 480, 600, 780, 420, 480, 480, 360, 480, 600,
-            480, 480, 540, 660, 780, 780, 420, 540, 540, 480, 780, 900,
-            540, 660, 540, 480, 660, 720, 360, 420, 360, 360, 480, 540,
-            480, 480, 600, 540, 720, 840, 480, 600, 660, 540, 720, 900,
-            540, 600, 540, 480, 720, 780, 480, 420, 540, 540, 660, 780});
+        6, {420, 420, 480, 480, 600, 780, 420, 480, 480, 360, 480, 600, 480, 480, 540,
+            660, 780, 780, 420, 540, 540, 480, 780, 900, 540, 660, 540, 480, 660, 720,
+            360, 420, 360, 360, 480, 540, 480, 480, 600, 540, 720, 840, 480, 600, 660,
+            540, 720, 900, 540, 600, 540, 480, 720, 780, 480, 420, 540, 540, 660, 780});
     return m;
 }
 
 // 7 participants x 4 levels of Likert ratings, with ties within participants.
 const SubjectByLevel& likert() {
-    static const SubjectByLevel m = matrix(
-        4, {3, 4, 4, 6, 2, 2, 5, 5, 4, 4, 4, 4, 1, 3, 2, 6, 5, 6, 6, 7, 3, 3, 5, 4, 2, 4, 4, 5});
+    static const SubjectByLevel m = matrix(4, {3, 4, 4, 6, 2, 2, 5, 5, 4, 4, 4, 4, 1, 3,
+                                               2, 6, 5, 6, 6, 7, 3, 3, 5, 4, 2, 4, 4, 5});
     return m;
 }
 
@@ -67,7 +67,8 @@ TEST(RepeatedMeasuresAnova, MatchesRAovAndAnovaMlmOnReacttime) {
     expect_relative(r.p_gg, 2.53199188582932e-08, 1e-9, "G-G p");
     expect_relative(r.p_hf, 7.39301356449841e-11, 1e-9, "H-F p");
     // Effect sizes from R's printed sums of squares (closed forms).
-    expect_relative(r.partial_eta_sq, 680700.0 / (680700 + 161100), 1e-13, "partial eta^2");
+    expect_relative(r.partial_eta_sq, 680700.0 / (680700 + 161100), 1e-13,
+                    "partial eta^2");
     expect_relative(r.generalized_eta_sq, 680700.0 / (680700 + 292140 + 161100), 1e-13,
                     "generalized eta^2");
     EXPECT_TRUE(r.note.empty()) << r.note;
@@ -75,7 +76,8 @@ TEST(RepeatedMeasuresAnova, MatchesRAovAndAnovaMlmOnReacttime) {
 
 TEST(RepeatedMeasuresAnova, MatchesROnTiedLikertRatingsWithHuynhFeldtBelowOne) {
     const RepeatedMeasuresAnova r = repeated_measures_anova(likert());
-    expect_relative(r.f, (21.8214285714285714 / 3) / (15.4285714285714286 / 18), 1e-13, "F");
+    expect_relative(r.f, (21.8214285714285714 / 3) / (15.4285714285714286 / 18), 1e-13,
+                    "F");
     expect_relative(r.f, 8.48611111111112, 1e-12, "F (R)");
     expect_relative(r.p, 0.00100080725247128, 1e-9, "p");
     EXPECT_NEAR(r.ss_effect, 21.8214285714, 1e-9);
@@ -91,8 +93,8 @@ TEST(RepeatedMeasuresAnova, MatchesROnTiedLikertRatingsWithHuynhFeldtBelowOne) {
 TEST(RepeatedMeasuresAnova, HuynhFeldtAboveOneIsReportedButItsPUsesOne) {
     // Compound symmetry up to noise: a participant offset plus small, equal-variance
     // errors, so the H-F estimate passes 1 and its p equals the uncorrected p.
-    const SubjectByLevel m = matrix(3, {1, 2, 3.1, 2, 3.1, 4, 3.2, 4, 5, 4, 5, 6.2, 5, 6.1, 7,
-                                        6.1, 7, 8, 7, 8.2, 9, 8, 9, 10.1});
+    const SubjectByLevel m = matrix(3, {1,   2, 3.1, 2, 3.1, 4, 3.2, 4, 5, 4, 5,   6.2, 5,
+                                        6.1, 7, 6.1, 7, 8,   7, 8.2, 9, 8, 9, 10.1});
     const RepeatedMeasuresAnova r = repeated_measures_anova(m);
     ASSERT_TRUE(r.hf_epsilon && r.p_hf && r.p);
     ASSERT_GT(*r.hf_epsilon, 1.0);
@@ -116,15 +118,17 @@ TEST(RepeatedMeasuresAnova, IsInvariantToTheOrderOfLevels) {
 bool finite_or_empty(const Statistic& s) { return !s || !std::isnan(*s); }
 
 void expect_no_nan(const RepeatedMeasuresAnova& r) {
-    for (const Statistic* s : {&r.f, &r.p, &r.mauchly_w, &r.mauchly_p, &r.gg_epsilon, &r.p_gg,
-                               &r.hf_epsilon, &r.p_hf, &r.partial_eta_sq, &r.generalized_eta_sq})
+    for (const Statistic* s :
+         {&r.f, &r.p, &r.mauchly_w, &r.mauchly_p, &r.gg_epsilon, &r.p_gg, &r.hf_epsilon,
+          &r.p_hf, &r.partial_eta_sq, &r.generalized_eta_sq})
         EXPECT_TRUE(finite_or_empty(*s));
     EXPECT_TRUE(std::isfinite(r.ss_effect) && std::isfinite(r.ss_error));
 }
 
 TEST(RepeatedMeasuresAnova, DegenerateCasesAreUndefinedWithAReasonNeverNaN) {
     // Two participants, three levels: F is defined, Mauchly's test needs 3 participants.
-    const RepeatedMeasuresAnova two = repeated_measures_anova(matrix(3, {1, 2, 4, 2, 4, 5}));
+    const RepeatedMeasuresAnova two =
+        repeated_measures_anova(matrix(3, {1, 2, 4, 2, 4, 5}));
     expect_no_nan(two);
     EXPECT_TRUE(two.f.has_value());
     EXPECT_FALSE(two.mauchly_w.has_value());
@@ -141,7 +145,8 @@ TEST(RepeatedMeasuresAnova, DegenerateCasesAreUndefinedWithAReasonNeverNaN) {
     EXPECT_FALSE(additive.note.empty());
 
     // Constant data: nothing to test.
-    const RepeatedMeasuresAnova constant = repeated_measures_anova(matrix(3, std::vector<double>(9, 4)));
+    const RepeatedMeasuresAnova constant =
+        repeated_measures_anova(matrix(3, std::vector<double>(9, 4)));
     expect_no_nan(constant);
     EXPECT_FALSE(constant.f.has_value());
     EXPECT_FALSE(constant.note.empty());
@@ -151,7 +156,8 @@ TEST(RepeatedMeasuresAnova, DegenerateCasesAreUndefinedWithAReasonNeverNaN) {
     EXPECT_FALSE(repeated_measures_anova(matrix(3, {1, 2, 3})).f.has_value());
 
     // Two levels: sphericity holds by construction, both corrections are 1.
-    const RepeatedMeasuresAnova pair = repeated_measures_anova(matrix(2, {1, 2, 2, 4, 3, 3, 1, 5}));
+    const RepeatedMeasuresAnova pair =
+        repeated_measures_anova(matrix(2, {1, 2, 2, 4, 3, 3, 1, 5}));
     expect_no_nan(pair);
     EXPECT_EQ(*pair.mauchly_w, 1.0);
     EXPECT_FALSE(pair.mauchly_p.has_value());
@@ -199,15 +205,17 @@ TEST(PairedT, MatchesRPairwiseTTestHolmOnReacttime) {
         {0.183937489398930454},
         {0.040468660435347178, 0.992203111049041242},
         {0.732999431602437745, 0.992203111049041242, 5.61811883513177e-01},
-        {0.000708973832545030, 0.011321546436239002, 2.76319796670867e-03, 1.52182184641622e-04},
-        {0.000114670471970932, 0.000907871300488304, 2.06387027134522e-05, 5.33152156487638e-05,
-         0.00276319796670867}};
+        {0.000708973832545030, 0.011321546436239002, 2.76319796670867e-03,
+         1.52182184641622e-04},
+        {0.000114670471970932, 0.000907871300488304, 2.06387027134522e-05,
+         5.33152156487638e-05, 0.00276319796670867}};
     const double raw_2_1 = 3.67874978797861e-02;
     const std::vector<PairedComparison> pairs = paired_t_tests_holm(reacttime());
     ASSERT_EQ(pairs.size(), 15u);
     for (const PairedComparison& c : pairs) {
         const int a = c.level_a[1] - '1', b = c.level_b[1] - '1';
-        expect_relative(c.p_holm, holm[b][a], 1e-9, (c.level_a + " vs " + c.level_b).c_str());
+        expect_relative(c.p_holm, holm[b][a], 1e-9,
+                        (c.level_a + " vs " + c.level_b).c_str());
     }
     // Levels 1 and 2: R's t.test(paired = TRUE): t = 2.449489742783, mean difference 48.
     expect_relative(pairs[0].t, 2.449489742783, 1e-11, "t");
@@ -234,12 +242,14 @@ TEST(PairedT, ZeroVarianceOfDifferencesIsUndefinedAndLeftOutOfHolm) {
     EXPECT_NE(pairs[0].note.find("zero variance"), std::string::npos);
     // Holm over the two defined p-values only: the smaller is doubled.
     const double p1 = *pairs[1].p, p2 = *pairs[2].p;
-    EXPECT_DOUBLE_EQ(*pairs[1].p_holm, std::min(1.0, p1 <= p2 ? 2 * p1 : std::max(2 * p2, p1)));
+    EXPECT_DOUBLE_EQ(*pairs[1].p_holm,
+                     std::min(1.0, p1 <= p2 ? 2 * p1 : std::max(2 * p2, p1)));
 }
 
 TEST(Holm, MatchesRPAdjustWithMissingValues) {
     // p.adjust(c(0.01, 0.04, 0.03, NA, 0.2), "holm") = 0.04 0.09 0.09 NA 0.20
-    const std::vector<Statistic> adjusted = holm_adjust({0.01, 0.04, 0.03, std::nullopt, 0.2});
+    const std::vector<Statistic> adjusted =
+        holm_adjust({0.01, 0.04, 0.03, std::nullopt, 0.2});
     EXPECT_DOUBLE_EQ(*adjusted[0], 0.04);
     EXPECT_DOUBLE_EQ(*adjusted[1], 0.09);
     EXPECT_DOUBLE_EQ(*adjusted[2], 0.09);

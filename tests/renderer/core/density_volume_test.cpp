@@ -76,7 +76,8 @@ TEST(DensityVolume, ContrastScalesAboutTheMeanAndZeroIsHomogeneous) {
     EXPECT_TRUE(none->constant());
     EXPECT_NEAR(none->mean, full->mean, 1e-6);
     for (std::size_t i = 0; i < full->voxels.size(); ++i)
-        EXPECT_NEAR(half->voxels[i], full->mean + 0.5 * (full->voxels[i] - full->mean), 1e-6);
+        EXPECT_NEAR(half->voxels[i], full->mean + 0.5 * (full->voxels[i] - full->mean),
+                    1e-6);
     EXPECT_NE(full->content_hash, half->content_hash);
 }
 
@@ -84,9 +85,9 @@ TEST(DensityVolume, TrilinearUsesVoxelCentresAndClampsToTheEdge) {
     std::vector<float> voxels(8, 0.0f);
     voxels[1] = 1.0f;  // voxel (1, 0, 0)
     const DensityVolume v = finish_density_volume({2, 2, 2}, voxels, "test");
-    EXPECT_DOUBLE_EQ(v.sample({0.75, 0.25, 0.25}), 1.0);   // its centre
-    EXPECT_DOUBLE_EQ(v.sample({0.5, 0.25, 0.25}), 0.5);    // halfway to voxel 0
-    EXPECT_DOUBLE_EQ(v.sample({1.0, 0.25, 0.25}), 1.0);    // clamp to edge
+    EXPECT_DOUBLE_EQ(v.sample({0.75, 0.25, 0.25}), 1.0);  // its centre
+    EXPECT_DOUBLE_EQ(v.sample({0.5, 0.25, 0.25}), 0.5);   // halfway to voxel 0
+    EXPECT_DOUBLE_EQ(v.sample({1.0, 0.25, 0.25}), 1.0);   // clamp to edge
     EXPECT_DOUBLE_EQ(v.sample({0.75, 0.5, 0.5}), 0.25);
 }
 
@@ -118,33 +119,46 @@ TEST(DensityVolume, BadFilesNameTheFieldOrVoxel) {
     const auto write = [&](const std::string& header, const std::vector<float>& data) {
         std::ofstream out(path, std::ios::binary);
         out << header << "\n";
-        out.write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size() * 4));
+        out.write(reinterpret_cast<const char*>(data.data()),
+                  std::streamsize(data.size() * 4));
     };
-    write("NRRD0004\ntype: float\ndimension: 2\nsizes: 2 2\nencoding: raw\nendian: little\n", {});
-    EXPECT_NE(error_of([&] { make_density_volume(path, 8, 1); }).find("field 'dimension'"),
-              std::string::npos);
+    write(
+        "NRRD0004\ntype: float\ndimension: 2\nsizes: 2 2\nencoding: raw\nendian: "
+        "little\n",
+        {});
+    EXPECT_NE(
+        error_of([&] { make_density_volume(path, 8, 1); }).find("field 'dimension'"),
+        std::string::npos);
     write("NRRD0004\ntype: double\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n", {});
     EXPECT_NE(error_of([&] { make_density_volume(path, 8, 1); }).find("field 'type'"),
               std::string::npos);
-    write("NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: gzip\nendian: little\n",
-          {0, 0});
+    write(
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: gzip\nendian: "
+        "little\n",
+        {0, 0});
     EXPECT_NE(error_of([&] { make_density_volume(path, 8, 1); }).find("field 'encoding'"),
               std::string::npos);
-    write("NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: raw\nendian: little\n",
-          {0.5f, std::nanf("")});
+    write(
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: raw\nendian: "
+        "little\n",
+        {0.5f, std::nanf("")});
     EXPECT_NE(error_of([&] { make_density_volume(path, 8, 1); }).find("voxel (1, 0, 0)"),
               std::string::npos);
-    write("NRRD0004\ntype: float\ndimension: 3\nsizes: 4 1 1\nencoding: raw\nendian: little\n",
-          {0.5f});
-    EXPECT_NE(error_of([&] { make_density_volume(path, 8, 1); }).find("data:"), std::string::npos);
+    write(
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 4 1 1\nencoding: raw\nendian: "
+        "little\n",
+        {0.5f});
+    EXPECT_NE(error_of([&] { make_density_volume(path, 8, 1); }).find("data:"),
+              std::string::npos);
     std::filesystem::remove(path);
     EXPECT_NE(error_of([&] { make_density_volume(path, 8, 1); }).find("cannot open"),
               std::string::npos);
 }
 
 TEST(DensityVolume, BadSpecsNameTheParameter) {
-    EXPECT_NE(error_of([] { parse_density_spec("marbel"); }).find("valid: constant, cube"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of([] { parse_density_spec("marbel"); }).find("valid: constant, cube"),
+        std::string::npos);
     EXPECT_NE(error_of([] { parse_density_spec("marble:freq=2"); }).find("'freq=2'"),
               std::string::npos);
     EXPECT_NE(error_of([] { parse_density_spec("cube:size=2"); }).find("size '2'"),

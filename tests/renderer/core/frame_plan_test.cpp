@@ -146,7 +146,8 @@ TEST_F(EmpiricalPlan, DepthPrecisionPicksTheLayerFormatAndPlansArePure) {
     EXPECT_NE(text.find("culled: front_depth"), std::string::npos) << text;
 }
 
-// layer_method = auto on a closed mesh facing out: the layers come from culling by facing.
+// layer_method = auto on a closed mesh facing out: the layers come from culling by
+// facing.
 TEST_F(EmpiricalPlan, AClosedMeshTakesItsLayersByFacingWithoutPeeling) {
     ASSERT_TRUE(closed_sphere()->closed_facing_out);
     const FramePlan p = plan_for(closed_sphere(), {});
@@ -189,14 +190,16 @@ TEST_F(EmpiricalPlan, ByFacingKernelOneAndZeroBacklightKeepTheirPrunes) {
     EXPECT_EQ(resource_names(direct),
               (std::vector<std::string>{"colour", "front_depth", "vertex_ao"}));
     // Full mode keeps every pass, the separate smoothing included.
-    const FramePlan full = plan_for(closed_sphere(), {{"backlight", "0"}}, PlanMode::full);
+    const FramePlan full =
+        plan_for(closed_sphere(), {{"backlight", "0"}}, PlanMode::full);
     EXPECT_EQ(pass_names(full),
               (std::vector<std::string>{"ambient_occlusion", "second_layer",
                                         "smooth_back_layer", "shade"}));
 }
 
 TEST_F(EmpiricalPlan, AViewOfTheSmoothedLayerKeepsItsPass) {
-    const FramePlan p = plan_for(closed_sphere(), {}, PlanMode::pruned, {"smoothed_depth"});
+    const FramePlan p =
+        plan_for(closed_sphere(), {}, PlanMode::pruned, {"smoothed_depth"});
     EXPECT_EQ(pass_names(p),
               (std::vector<std::string>{"ambient_occlusion", "second_layer",
                                         "smooth_back_layer", "shade"}));
@@ -225,7 +228,8 @@ TEST_F(EmpiricalPlan, AnOpenMeshOrACameraInsideIsPeeled) {
                              resolve_knob_values(knobs_for(technique), {}), 64, 48);
     EXPECT_TRUE(facing_separates_layers(scene));
     Scene inside = scene;
-    inside.camera.eye = inside.bounds.centre + glm::vec3(0.0f, 0.0f, 0.5f * inside.bounds.radius);
+    inside.camera.eye =
+        inside.bounds.centre + glm::vec3(0.0f, 0.0f, 0.5f * inside.bounds.radius);
     EXPECT_FALSE(facing_separates_layers(inside));
     EXPECT_EQ(pass_named(make_frame_plan(inside, technique), "second_layer").cull,
               FaceCulling::none);

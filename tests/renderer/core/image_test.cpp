@@ -7,9 +7,9 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <random>
 #include <string>
-#include <limits>
 
 #include "core/image_compare.h"
 #include "test_paths.h"

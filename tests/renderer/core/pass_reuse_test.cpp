@@ -186,13 +186,15 @@ TEST_F(TechniqueReuse, EmpiricalSlidersRerunOnlyThePassesTheyTouch) {
               (Names{"ambient_occlusion", "second_layer", "shade"}));
     // Without the backlight: AO rays re-run the bake and the shading only.
     executor.execute(plan("empirical", {{"backlight", "0"}, {"ao_rays", "64"}}));
-    EXPECT_EQ(executor.execute(plan("empirical", {{"backlight", "0"}, {"ao_rays", "32"}})),
-              (Names{"ambient_occlusion", "shade"}));
+    EXPECT_EQ(
+        executor.execute(plan("empirical", {{"backlight", "0"}, {"ao_rays", "32"}})),
+        (Names{"ambient_occlusion", "shade"}));
 }
 
 TEST_F(TechniqueReuse, EmpiricalPeelingSlidersRerunOnlyThePassesTheyTouch) {
     // The thesis's depth peeling (every open mesh; layer_method = peel).
-    const auto peel = [](std::vector<KnobAssignment> settings, glm::vec3 view = {0, 0, 1}) {
+    const auto peel = [](std::vector<KnobAssignment> settings,
+                         glm::vec3 view = {0, 0, 1}) {
         settings.push_back({"layer_method", "peel"});
         return plan("empirical", settings, view);
     };
@@ -213,9 +215,9 @@ TEST_F(TechniqueReuse, EmpiricalPeelingSlidersRerunOnlyThePassesTheyTouch) {
               (Names{"ambient_occlusion", "front_depth", "second_layer",
                      "smooth_back_layer", "shade"}));
     // Orbiting the camera: every drawing pass, never the AO bake.
-    EXPECT_EQ(executor.execute(peel(
-                  {{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}},
-                  {1.0f, 0.0f, 0.0f})),
+    EXPECT_EQ(executor.execute(
+                  peel({{"shininess", "30"}, {"blur_kernel", "3"}, {"ao_rays", "64"}},
+                       {1.0f, 0.0f, 0.0f})),
               (Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}));
 }
 

@@ -77,12 +77,13 @@ TEST(AmbientOcclusion, DirectionsAreTheShiftedStratifiedLattice) {
                 const double cos_theta = glm::dot(d, glm::dvec3(n));
                 ASSERT_GT(cos_theta, 0.0) << i;
                 // Stratum of cos(theta); 1e-9 slack for a value on a boundary.
-                ++strata[std::min(kRays - 1, int(std::ceil(cos_theta * kRays - 1e-9)) - 1)];
+                ++strata[std::min(kRays - 1,
+                                  int(std::ceil(cos_theta * kRays - 1e-9)) - 1)];
                 const double phi = std::atan2(glm::dot(d, e2), glm::dot(d, e1));
                 if (i == 0) first_phi = phi;
                 double expected = 2.0 * std::numbers::pi * (i * 0.6180339887498949);
-                double gap = std::remainder(phi - first_phi - expected,
-                                            2.0 * std::numbers::pi);
+                double gap =
+                    std::remainder(phi - first_phi - expected, 2.0 * std::numbers::pi);
                 EXPECT_NEAR(gap, 0.0, 2e-5) << "vertex " << vertex << " ray " << i;
             }
             EXPECT_EQ(strata, std::vector<int>(kRays, 1)) << "vertex " << vertex;

@@ -67,8 +67,8 @@ TEST(OcclusionCounter, EveryQueryAndLayoutCountsTheSameRaysAsOneAtATime) {
         std::vector<glm::vec3> directions;
         std::size_t expected = 0;
         for (std::size_t i = 0; i < count; ++i) {
-            const glm::vec3 d = glm::normalize(
-                glm::vec3(gauss(engine), gauss(engine), gauss(engine)));
+            const glm::vec3 d =
+                glm::normalize(glm::vec3(gauss(engine), gauss(engine), gauss(engine)));
             directions.push_back(d);
             if (!caster.occluded(origin, d, 0.0f, std::numeric_limits<float>::infinity()))
                 ++expected;
@@ -77,7 +77,8 @@ TEST(OcclusionCounter, EveryQueryAndLayoutCountsTheSameRaysAsOneAtATime) {
         all_escaping += expected;
         for (const OcclusionCounter* counter : {&quads, &triangles})
             for (const OcclusionQuery query : kQueries)
-                EXPECT_EQ(counter->count_escaping(origin, directions, 0.0f, query), expected)
+                EXPECT_EQ(counter->count_escaping(origin, directions, 0.0f, query),
+                          expected)
                     << count << " rays, query " << int(query);
     }
     EXPECT_GT(all_escaping, all / 10);  // both outcomes are exercised
@@ -118,9 +119,7 @@ TEST(PairTriangles, CoversEveryTriangleOnceInItsOwnWinding) {
         while (t.x > t.y || t.x > t.z) t = {t.y, t.z, t.x};
         return t;
     };
-    const auto key = [](glm::uvec3 t) {
-        return std::tuple(t.x, t.y, t.z);
-    };
+    const auto key = [](glm::uvec3 t) { return std::tuple(t.x, t.y, t.z); };
     for (const char* spec : {"sphere:2000", "torus_knot:4000", "hand:4000", "wave"}) {
         const Mesh mesh = load_mesh(spec);
         std::map<std::tuple<unsigned, unsigned, unsigned>, int> remaining;
@@ -128,8 +127,10 @@ TEST(PairTriangles, CoversEveryTriangleOnceInItsOwnWinding) {
         const PairedTriangles paired = pair_triangles(mesh.triangles);
         std::size_t decoded = 0;
         for (const glm::uvec4& q : paired.quads) {
-            for (const glm::uvec3 t : {glm::uvec3(q.x, q.y, q.w), glm::uvec3(q.z, q.w, q.y)}) {
-                if (t.y == t.z || t.x == t.y || t.x == t.z) continue;  // the unpaired filler
+            for (const glm::uvec3 t :
+                 {glm::uvec3(q.x, q.y, q.w), glm::uvec3(q.z, q.w, q.y)}) {
+                if (t.y == t.z || t.x == t.y || t.x == t.z)
+                    continue;  // the unpaired filler
                 auto it = remaining.find(key(canonical(t)));
                 ASSERT_TRUE(it != remaining.end() && it->second > 0)
                     << spec << ": quad names a triangle not in the mesh (or twice)";
@@ -149,7 +150,8 @@ TEST(PairTriangles, CoversEveryTriangleOnceInItsOwnWinding) {
     EXPECT_EQ(lone.quads[0], glm::uvec4(0, 1, 2, 2));
     EXPECT_EQ(pair_triangles({{0, 1, 2}, {0, 1, 3}}).paired, 0u);  // edge (0,1) both ways
     EXPECT_EQ(pair_triangles({{0, 1, 2}, {1, 0, 3}}).paired, 2u);
-    EXPECT_EQ(pair_triangles({{0, 1, 2}, {1, 0, 2}}).paired, 0u);  // a double-sided sliver
+    EXPECT_EQ(pair_triangles({{0, 1, 2}, {1, 0, 2}}).paired,
+              0u);  // a double-sided sliver
     EXPECT_TRUE(pair_triangles({}).quads.empty());
 }
 

@@ -5,10 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
-
-#include <cmath>
 #include <thread>
 
 #include "core/mesh.h"

@@ -330,8 +330,8 @@ TEST_F(FrameExecutorGl, ReusedPassesLeaveTheImageAFreshRenderWouldGive) {
         };
         const auto fresh = [](const Scene& scene) {
             gl::FrameExecutor executor;
-            return executor.render(scene,
-                                   make_frame_plan(scene, find_technique(scene.technique)));
+            return executor.render(
+                scene, make_frame_plan(scene, find_technique(scene.technique)));
         };
         const auto ran = [](const gl::FrameExecutor& executor) {
             Names names;
@@ -348,7 +348,8 @@ TEST_F(FrameExecutorGl, ReusedPassesLeaveTheImageAFreshRenderWouldGive) {
         const Image reference = fresh(first);
         EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba) << method;
 
-        executor.execute(first, make_frame_plan(first, find_technique("empirical")), true);
+        executor.execute(first, make_frame_plan(first, find_technique("empirical")),
+                         true);
         EXPECT_EQ(ran(executor), Names{}) << method;
         EXPECT_EQ(executor.last_timings().passes.size(), first_plan.passes.size());
         EXPECT_EQ(executor.read_output(first_plan).rgba, reference.rgba) << method;
@@ -364,8 +365,9 @@ TEST_F(FrameExecutorGl, ReusedPassesLeaveTheImageAFreshRenderWouldGive) {
                  // Back on: the layers' textures were freed with the plan that lacked
                  // them.
                  {{{"shininess", "40"}, {"blur_kernel", "3"}},
-                  peel ? Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}
-                       : Names{"second_layer", "shade"}}}) {
+                  peel
+                      ? Names{"front_depth", "second_layer", "smooth_back_layer", "shade"}
+                      : Names{"second_layer", "shade"}}}) {
             const Scene scene = scene_with(settings);
             const FramePlan plan = make_frame_plan(scene, find_technique("empirical"));
             executor.execute(scene, plan, true);

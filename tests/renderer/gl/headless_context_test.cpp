@@ -39,8 +39,9 @@ TEST_F(HeadlessGlTest, DrawsKnownTriangleIntoFramebuffer) {
     const char* fragment_src = R"(#version 450 core
         out vec4 colour;
         void main() { colour = vec4(1.0, 51.0 / 255.0, 0.0, 1.0); })";
-    gl::Program program = gl::link_program({{GL_VERTEX_SHADER, "triangle.vert", vertex_src},
-                                            {GL_FRAGMENT_SHADER, "triangle.frag", fragment_src}});
+    gl::Program program =
+        gl::link_program({{GL_VERTEX_SHADER, "triangle.vert", vertex_src},
+                          {GL_FRAGMENT_SHADER, "triangle.frag", fragment_src}});
     gl::VertexArray vao = gl::make_vertex_array();
 
     glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
@@ -81,14 +82,16 @@ TEST_F(HeadlessGlTest, ShaderCompileErrorNamesTheSource) {
                            "#version 450 core\nvoid main() { undeclared = 1.0; }\n"}});
         FAIL() << "expected ShaderError";
     } catch (const gl::ShaderError& e) {
-        EXPECT_NE(std::string(e.what()).find("broken.frag"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("broken.frag"), std::string::npos)
+            << e.what();
     }
 }
 
 TEST_F(HeadlessGlTest, EmbeddedShaderIsFoundAndDefinesAreInserted) {
-    const gl::ShaderStage stage =
-        gl::shader_stage(GL_VERTEX_SHADER, "gl/shaders/fullscreen.vert", {"LUCENT_TEST 1"});
-    EXPECT_EQ(stage.source.rfind("#version 450 core\n#define LUCENT_TEST 1\n#line 2\n", 0), 0u);
+    const gl::ShaderStage stage = gl::shader_stage(
+        GL_VERTEX_SHADER, "gl/shaders/fullscreen.vert", {"LUCENT_TEST 1"});
+    EXPECT_EQ(
+        stage.source.rfind("#version 450 core\n#define LUCENT_TEST 1\n#line 2\n", 0), 0u);
     EXPECT_THROW(gl::shader_source("no/such/shader.frag"), gl::ShaderError);
 }
 

@@ -1,12 +1,12 @@
 // Window contexts need an X server: the test command runs under xvfb-run when DISPLAY is
-// unset, so a missing DISPLAY skips only by hand and fails under scripts/test (display.h).
+// unset, so a missing DISPLAY skips only by hand and fails under scripts/test
+// (display.h).
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 
 #include "display.h"
-
 #include "gl/context.h"
 #include "gl/readback.h"
 

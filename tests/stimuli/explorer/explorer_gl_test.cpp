@@ -27,9 +27,7 @@ constexpr const char* kMesh = "torus_knot:4k";
 
 class ExplorerTest : public ::testing::Test {
 protected:
-    void SetUp() override {
-        LUCENT_REQUIRE_DISPLAY();
-    }
+    void SetUp() override { LUCENT_REQUIRE_DISPLAY(); }
 
     std::unique_ptr<Explorer> open(ExplorerSession session, int width = 800,
                                    int height = 560) {

@@ -69,8 +69,8 @@ TEST(Ciede2000, MatchesAll34PairsOfSharmaWuDalal2005) {
 }
 
 TEST(Ciede2000, PureLightnessDifferenceIsDeltaLOverSL) {
-    // CIEDE2000 Eq. (a = b = 0): Delta E00 = |Delta L| / S_L, S_L = 1 + 0.015 (Lbar - 50)^2
-    // / sqrt(20 + (Lbar - 50)^2).
+    // CIEDE2000 Eq. (a = b = 0): Delta E00 = |Delta L| / S_L, S_L = 1 + 0.015 (Lbar -
+    // 50)^2 / sqrt(20 + (Lbar - 50)^2).
     const double lbar = 75.0, d = (lbar - 50) * (lbar - 50);
     const double sl = 1 + 0.015 * d / std::sqrt(20 + d);
     EXPECT_NEAR(ciede2000({50, 0, 0}, {100, 0, 0}), 50.0 / sl, 1e-9);
@@ -83,12 +83,15 @@ TEST(SrgbToLab, PrimariesLandOnTheirD65LabValues) {
     const struct {
         float r, g, b;
         Lab expected;
-    } cases[] = {{1, 0, 0, {53.24, 80.09, 67.20}},  {0, 1, 0, {87.73, -86.18, 83.18}},
-                 {0, 0, 1, {32.30, 79.19, -107.86}}, {1, 1, 1, {100.0, 0.0, 0.0}},
+    } cases[] = {{1, 0, 0, {53.24, 80.09, 67.20}},
+                 {0, 1, 0, {87.73, -86.18, 83.18}},
+                 {0, 0, 1, {32.30, 79.19, -107.86}},
+                 {1, 1, 1, {100.0, 0.0, 0.0}},
                  {0, 0, 0, {0.0, 0.0, 0.0}}};
     for (const auto& c : cases) {
         const Lab lab = to_lab.convert(c.r, c.g, c.b);
-        SCOPED_TRACE(std::to_string(c.r) + "," + std::to_string(c.g) + "," + std::to_string(c.b));
+        SCOPED_TRACE(std::to_string(c.r) + "," + std::to_string(c.g) + "," +
+                     std::to_string(c.b));
         EXPECT_NEAR(lab.L, c.expected.L, 0.05);
         EXPECT_NEAR(lab.a, c.expected.a, 0.05);
         EXPECT_NEAR(lab.b, c.expected.b, 0.05);
@@ -103,7 +106,8 @@ TEST(SrgbToLab, PrimariesLandOnTheirD65LabValues) {
     }
     // Out-of-range values are clamped, never NaN.
     const Lab clamped = to_lab.convert(NAN, 2.0f, -1.0f);
-    EXPECT_TRUE(std::isfinite(clamped.L) && std::isfinite(clamped.a) && std::isfinite(clamped.b));
+    EXPECT_TRUE(std::isfinite(clamped.L) && std::isfinite(clamped.a) &&
+                std::isfinite(clamped.b));
 }
 
 TEST(DeltaEStatistics, MeanPercentileAndShareOverMaskedPixels) {
@@ -124,7 +128,9 @@ TEST(DeltaEStatistics, MeanPercentileAndShareOverMaskedPixels) {
     const auto none = delta_e_statistics(first, second, std::vector<std::uint8_t>(5, 0));
     EXPECT_EQ(none.pixels, 0u);
     EXPECT_EQ(none.mean, 0.0);
-    EXPECT_THROW(delta_e_statistics(first, second, std::span<const std::uint8_t>(mask).subspan(0, 2)), std::invalid_argument);
+    EXPECT_THROW(delta_e_statistics(first, second,
+                                    std::span<const std::uint8_t>(mask).subspan(0, 2)),
+                 std::invalid_argument);
 }
 
 }  // namespace

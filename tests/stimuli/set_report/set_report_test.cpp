@@ -39,39 +39,45 @@ Image disc(float r, float g, float b) {
 }
 
 // Writes DIR/ID.png and returns its manifest row (the batch renderer's layout).
-ManifestRow stimulus(const fs::path& dir, const std::string& id, const std::string& series,
-                     double albedo, const Image& image) {
+ManifestRow stimulus(const fs::path& dir, const std::string& id,
+                     const std::string& series, double albedo, const Image& image) {
     write_image(dir / (id + ".png"), image);
-    ManifestRow row = {{"id", id, false},        {"file", id + ".png", false},
-                       {"files", id + ".png", false}, {"technique", "ward", false},
-                       {"series", series, false},     {"mesh", "sphere", false},
-                       {"mesh_faces", "100", true},   {"mesh_hash", "0", false},
+    ManifestRow row = {{"id", id, false},
+                       {"file", id + ".png", false},
+                       {"files", id + ".png", false},
+                       {"technique", "ward", false},
+                       {"series", series, false},
+                       {"mesh", "sphere", false},
+                       {"mesh_faces", "100", true},
+                       {"mesh_hash", "0", false},
                        {"width", std::to_string(kSide), true},
                        {"height", std::to_string(kSide), true},
                        {"background", "0,0,0", false},
                        {"albedo", std::to_string(albedo), true}};
-    const auto stats =
-        compute_image_statistics(FloatImageView{image.width, image.height, 4, image.rgba});
+    const auto stats = compute_image_statistics(
+        FloatImageView{image.width, image.height, 4, image.rgba});
     for (const auto& field : statistics_fields(stats)) row.push_back(field);
     row.push_back({"non_finite_pixels", "0", true});
     row.push_back({"software_version", "test", false});
     row.push_back({"build_hash", "test", false});
     row.push_back({"input_hash", "0", false});
-    row.push_back({"content_hash", Hasher().add_field(hash_file(dir / (id + ".png"))).hex(), false});
+    row.push_back({"content_hash",
+                   Hasher().add_field(hash_file(dir / (id + ".png"))).hex(), false});
     return row;
 }
 
 class SmallSet : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = test::scratch_dir("set_report_" + std::string(::testing::UnitTest::GetInstance()
-                                                                  ->current_test_info()
-                                                                  ->name()));
+        dir_ = test::scratch_dir(
+            "set_report_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         const float grey = srgb_decode(128.0f / 255.0f);  // PNG code 128 exactly
         std::vector<ManifestRow> rows = {
             stimulus(dir_, "a", "grey", 0.5, disc(grey, grey, grey)),
             stimulus(dir_, "white", "grey", 1.0, disc(1, 1, 1)),
-            stimulus(dir_, "b", "grey", 0.5, disc(grey, grey, grey)),  // the same picture as a
+            stimulus(dir_, "b", "grey", 0.5,
+                     disc(grey, grey, grey)),  // the same picture as a
             stimulus(dir_, "green", "", 0.0, disc(0, 1, 0)),
         };
         write_manifest(dir_, "small", rows);
@@ -92,7 +98,8 @@ protected:
     fs::path dir_;
 };
 
-const PairDifference& pair_of(const SetReport& r, const std::string& a, const std::string& b) {
+const PairDifference& pair_of(const SetReport& r, const std::string& a,
+                              const std::string& b) {
     for (const auto& p : r.pairs)
         if (r.stimuli[p.first].id == a && r.stimuli[p.second].id == b) return p;
     throw std::runtime_error("no pair " + a + " / " + b);
@@ -137,9 +144,11 @@ TEST_F(SmallSet, MeasuresTheIdenticalAndTheDifferentPair) {
 
     // Exactly two warnings: the pair below the threshold and the identical pictures.
     ASSERT_EQ(r.warnings.size(), 2u) << ::testing::PrintToString(r.warnings);
-    EXPECT_EQ(r.warnings[0],
-              "series 'grey': a vs b: mean Delta E00 0.00 is below 3.00 (adjacent levels)");
-    EXPECT_EQ(r.warnings[1], "a and b are identical images (separate stimuli, meant to differ)");
+    EXPECT_EQ(
+        r.warnings[0],
+        "series 'grey': a vs b: mean Delta E00 0.00 is below 3.00 (adjacent levels)");
+    EXPECT_EQ(r.warnings[1],
+              "a and b are identical images (separate stimuli, meant to differ)");
 
     // A higher threshold flags the different pair too.
     SetReportOptions strict;
@@ -151,9 +160,11 @@ TEST_F(SmallSet, WritesTheReportAndTheContactSheet) {
     const auto files = write_set_report(measure_stimulus_set(dir_));
     ASSERT_EQ(files.size(), 2u);
     std::ifstream in(dir_ / "report.html");
-    const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string html((std::istreambuf_iterator<char>(in)),
+                           std::istreambuf_iterator<char>());
     std::size_t images = 0;
-    for (auto at = html.find("<img"); at != std::string::npos; at = html.find("<img", at + 1))
+    for (auto at = html.find("<img"); at != std::string::npos;
+         at = html.find("<img", at + 1))
         ++images;
     EXPECT_EQ(images, 4u);
     EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
@@ -170,8 +181,8 @@ TEST_F(SmallSet, WritesTheReportAndTheContactSheet) {
         for (int x = 0; x < sheet.width; ++x) {
             const auto p = sheet.at(x, y);
             green += p.g > 0.9f && p.r < 0.05f && p.b < 0.05f;
-            text += p.r > 0.5f && std::fabs(p.r - p.g) < 0.01f && std::fabs(p.r - p.b) < 0.01f &&
-                    p.r < 0.95f;
+            text += p.r > 0.5f && std::fabs(p.r - p.g) < 0.01f &&
+                    std::fabs(p.r - p.b) < 0.01f && p.r < 0.95f;
         }
     EXPECT_GT(green, 1200u);
     EXPECT_GT(text, 100u);
@@ -183,19 +194,24 @@ TEST_F(SmallSet, TheCommandPrintsEachWarningAndWritesBothFiles) {
     EXPECT_EQ(run_stimuli_report(dir_, {}), 0);  // warnings inform, they do not fail
     const std::string out = ::testing::internal::GetCapturedStdout();
     const std::string err = ::testing::internal::GetCapturedStderr();
-    EXPECT_EQ(err,
-              "lucent stimuli report: warning: series 'grey': a vs b: mean Delta E00 0.00 is "
-              "below 3.00 (adjacent levels)\n"
-              "lucent stimuli report: warning: a and b are identical images (separate "
-              "stimuli, meant to differ)\n");
-    EXPECT_NE(out.find("wrote " + (dir_ / "report.html").string()), std::string::npos) << out;
-    EXPECT_NE(out.find("wrote " + (dir_ / "contact-sheet.png").string()), std::string::npos);
-    EXPECT_TRUE(fs::exists(dir_ / "report.html") && fs::exists(dir_ / "contact-sheet.png"));
+    EXPECT_EQ(
+        err,
+        "lucent stimuli report: warning: series 'grey': a vs b: mean Delta E00 0.00 is "
+        "below 3.00 (adjacent levels)\n"
+        "lucent stimuli report: warning: a and b are identical images (separate "
+        "stimuli, meant to differ)\n");
+    EXPECT_NE(out.find("wrote " + (dir_ / "report.html").string()), std::string::npos)
+        << out;
+    EXPECT_NE(out.find("wrote " + (dir_ / "contact-sheet.png").string()),
+              std::string::npos);
+    EXPECT_TRUE(fs::exists(dir_ / "report.html") &&
+                fs::exists(dir_ / "contact-sheet.png"));
 }
 
 TEST_F(SmallSet, TheReportOpensInABrowserWithItsPicturesDrawn) {
     write_set_report(measure_stimulus_set(dir_));
-    const auto page = test::open_in_browser(dir_ / "report.html", dir_ / "screenshot.png", 1280, 1400);
+    const auto page =
+        test::open_in_browser(dir_ / "report.html", dir_ / "screenshot.png", 1280, 1400);
     ASSERT_TRUE(page.ok) << page.error;
     EXPECT_EQ(page.images_drawn, "4/4");
     // The green disc's thumbnail is on screen (nothing else on the page is that green).
@@ -208,15 +224,17 @@ TEST_F(SmallSet, TheReportOpensInABrowserWithItsPicturesDrawn) {
 TEST_F(SmallSet, ADirectoryWithoutAManifestIsRefusedNamingIt) {
     fs::remove(dir_ / "manifest.csv");
     const std::string why = refusal();
-    EXPECT_NE(why.find((dir_ / "manifest.csv").string() + ": missing"), std::string::npos) << why;
+    EXPECT_NE(why.find((dir_ / "manifest.csv").string() + ": missing"), std::string::npos)
+        << why;
     EXPECT_FALSE(wrote_anything());
 }
 
 TEST_F(SmallSet, AForeignCsvIsNotALucentManifest) {
     std::ofstream(dir_ / "manifest.csv") << "name,score\nx,1\n";
     const std::string why = refusal();
-    EXPECT_NE(why.find("manifest.csv: not a Lucent stimulus-set manifest (no column 'id')"),
-              std::string::npos)
+    EXPECT_NE(
+        why.find("manifest.csv: not a Lucent stimulus-set manifest (no column 'id')"),
+        std::string::npos)
         << why;
     EXPECT_FALSE(wrote_anything());
 }
@@ -224,15 +242,18 @@ TEST_F(SmallSet, AForeignCsvIsNotALucentManifest) {
 TEST_F(SmallSet, AMissingImageIsNamed) {
     fs::remove(dir_ / "white.png");
     const std::string why = refusal();
-    EXPECT_NE(why.find((dir_ / "white.png").string() + ": missing (listed in"), std::string::npos)
+    EXPECT_NE(why.find((dir_ / "white.png").string() + ": missing (listed in"),
+              std::string::npos)
         << why;
     EXPECT_FALSE(wrote_anything());
 }
 
 TEST_F(SmallSet, AnImageChangedSinceTheManifestIsNamed) {
-    fs::copy_file(dir_ / "a.png", dir_ / "white.png", fs::copy_options::overwrite_existing);
+    fs::copy_file(dir_ / "a.png", dir_ / "white.png",
+                  fs::copy_options::overwrite_existing);
     const std::string why = refusal();
-    EXPECT_NE(why.find((dir_ / "white.png").string() + ": changed since"), std::string::npos)
+    EXPECT_NE(why.find((dir_ / "white.png").string() + ": changed since"),
+              std::string::npos)
         << why;
     EXPECT_FALSE(wrote_anything());
     // The command prints that one line and exits 2.
@@ -244,11 +265,14 @@ TEST_F(SmallSet, AnImageChangedSinceTheManifestIsNamed) {
 }
 
 TEST_F(SmallSet, AnUndecodableImageListedWithItsHashIsNamed) {
-    const auto hash = [&] { return Hasher().add_field(hash_file(dir_ / "white.png")).hex(); };
+    const auto hash = [&] {
+        return Hasher().add_field(hash_file(dir_ / "white.png")).hex();
+    };
     const std::string before = hash();
     std::ofstream(dir_ / "white.png", std::ios::trunc) << "not a picture";
     std::ifstream in(dir_ / "manifest.csv");
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string text((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
     in.close();
     ASSERT_NE(text.find(before), std::string::npos);
     text.replace(text.find(before), before.size(), hash());
@@ -260,16 +284,17 @@ TEST_F(SmallSet, AnUndecodableImageListedWithItsHashIsNamed) {
 
 TEST_F(SmallSet, AFileNameOutsideTheDirectoryIsRefused) {
     std::ifstream in(dir_ / "manifest.csv");
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string text((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
     in.close();
     const auto at = text.find(",white.png,white.png,");
     ASSERT_NE(at, std::string::npos);
     text.replace(at, 21, ",white.png,../white.png,");
     std::ofstream(dir_ / "manifest.csv") << text;
     const std::string why = refusal();
-    EXPECT_NE(why.find("'../white.png' is not a file name inside"), std::string::npos) << why;
+    EXPECT_NE(why.find("'../white.png' is not a file name inside"), std::string::npos)
+        << why;
 }
-
 
 // A grid as `lucent render` writes one: an entry varying two parameters expands into
 // one series of a x b stimuli, listed row by row (id g_I_J, albedo = I, roughness = J),
@@ -284,13 +309,18 @@ void write_grid(const fs::path& dir, int side, int rows, int columns) {
             for (int y = 0; y < side; ++y)
                 for (int x = 0; x < side; ++x) {
                     const double dx = x + 0.5 - side / 2.0, dy = y + 0.5 - side / 2.0;
-                    if (dx * dx + dy * dy < side * side / 9.0) image.set(x, y, {r, g, 0.2f, 1.0f});
+                    if (dx * dx + dy * dy < side * side / 9.0)
+                        image.set(x, y, {r, g, 0.2f, 1.0f});
                 }
             write_image(dir / (id + ".png"), image);
-            ManifestRow row = {{"id", id, false},          {"file", id + ".png", false},
-                               {"files", id + ".png", false}, {"technique", "ward", false},
-                               {"series", "grid", false},     {"mesh", "sphere", false},
-                               {"mesh_faces", "100", true},   {"mesh_hash", "0", false},
+            ManifestRow row = {{"id", id, false},
+                               {"file", id + ".png", false},
+                               {"files", id + ".png", false},
+                               {"technique", "ward", false},
+                               {"series", "grid", false},
+                               {"mesh", "sphere", false},
+                               {"mesh_faces", "100", true},
+                               {"mesh_hash", "0", false},
                                {"width", std::to_string(side), true},
                                {"height", std::to_string(side), true},
                                {"background", "0,0,0", false},
@@ -304,7 +334,8 @@ void write_grid(const fs::path& dir, int side, int rows, int columns) {
             row.push_back({"build_hash", "test", false});
             row.push_back({"input_hash", "0", false});
             row.push_back({"content_hash",
-                           Hasher().add_field(hash_file(dir / (id + ".png"))).hex(), false});
+                           Hasher().add_field(hash_file(dir / (id + ".png"))).hex(),
+                           false});
             manifest.push_back(std::move(row));
         }
     write_manifest(dir, "grid", manifest);
@@ -346,10 +377,11 @@ TEST(SetReportGrid, A400StimulusGridComparesNeighbouringLevelsWithProgress) {
         EXPECT_TRUE(seen.emplace(p.first, p.second).second) << "listed twice";
         const auto [i1, j1] = grid_cell(r.stimuli[p.first].id);
         const auto [i2, j2] = grid_cell(r.stimuli[p.second].id);
-        const bool step = (i1 == i2 && std::abs(j1 - j2) == 1) ||
-                          (j1 == j2 && std::abs(i1 - i2) == 1);
+        const bool step =
+            (i1 == i2 && std::abs(j1 - j2) == 1) || (j1 == j2 && std::abs(i1 - i2) == 1);
         const bool wrap = i2 == i1 + 1 && j1 == 19 && j2 == 0;
-        EXPECT_TRUE(step || wrap) << r.stimuli[p.first].id << " vs " << r.stimuli[p.second].id;
+        EXPECT_TRUE(step || wrap)
+            << r.stimuli[p.first].id << " vs " << r.stimuli[p.second].id;
         steps += step;
         wraps += wrap;
         EXPECT_TRUE(p.adjacent);
@@ -365,10 +397,13 @@ TEST(SetReportGrid, A400StimulusGridComparesNeighbouringLevelsWithProgress) {
     EXPECT_EQ(run_stimuli_report(dir, {}), 0);
     (void)::testing::internal::GetCapturedStdout();
     const std::string err = ::testing::internal::GetCapturedStderr();
-    EXPECT_EQ(err.rfind("lucent stimuli report: report: comparing 779 pairs of levels\n", 0), 0u)
+    EXPECT_EQ(
+        err.rfind("lucent stimuli report: report: comparing 779 pairs of levels\n", 0),
+        0u)
         << err;
     std::ifstream in(dir / "report.html");
-    const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string html((std::istreambuf_iterator<char>(in)),
+                           std::istreambuf_iterator<char>());
     EXPECT_NE(html.find("400 levels: neighbouring levels compared (779 of 79800 pairs)"),
               std::string::npos);
 }

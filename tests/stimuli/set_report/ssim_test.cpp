@@ -13,7 +13,8 @@ namespace {
 constexpr double kC1 = 0.01 * 0.01, kC2 = 0.03 * 0.03;  // L = 1
 
 TEST(Ssim, ConstantImagesLeaveOnlyTheLuminanceTerm) {
-    // sigma_x = sigma_y = sigma_xy = 0 in every window: SSIM = (2ab + C1) / (a^2 + b^2 + C1).
+    // sigma_x = sigma_y = sigma_xy = 0 in every window: SSIM = (2ab + C1) / (a^2 + b^2 +
+    // C1).
     const int w = 23, h = 17;
     const std::vector<double> a(std::size_t(w) * h, 0.3), b(std::size_t(w) * h, 0.5);
     const double expected = (2 * 0.3 * 0.5 + kC1) / (0.09 + 0.25 + kC1);
@@ -34,8 +35,8 @@ TEST(Ssim, GlobalIndexOfAnAffinePair) {
     }
     SsimOptions global;
     global.global = true;
-    const double expected =
-        (2 * 0.4 * 0.3 + kC1) * (2 * 0.02 + kC2) / ((0.16 + 0.09 + kC1) * (0.04 + 0.01 + kC2));
+    const double expected = (2 * 0.4 * 0.3 + kC1) * (2 * 0.02 + kC2) /
+                            ((0.16 + 0.09 + kC1) * (0.04 + 0.01 + kC2));
     EXPECT_NEAR(ssim({w, h, x}, {w, h, y}, {}, global), expected, 1e-12);
 }
 
@@ -45,7 +46,8 @@ TEST(Ssim, IdenticalImagesGiveOneAndTheIndexIsSymmetric) {
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) {
             x[std::size_t(j) * w + i] = 0.5 + 0.4 * std::sin(0.3 * i) * std::cos(0.2 * j);
-            y[std::size_t(j) * w + i] = 0.5 + 0.4 * std::sin(0.3 * i + 0.5) * std::cos(0.2 * j);
+            y[std::size_t(j) * w + i] =
+                0.5 + 0.4 * std::sin(0.3 * i + 0.5) * std::cos(0.2 * j);
         }
     EXPECT_NEAR(ssim({w, h, x}, {w, h, x}), 1.0, 1e-12);
     const double s = ssim({w, h, x}, {w, h, y});

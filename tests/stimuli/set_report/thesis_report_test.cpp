@@ -31,19 +31,24 @@ TEST(ThesisSetReport, EveryPairOfLevelsPassesTheThresholdAndTheReportDrawsInABro
     std::map<std::string, int> pairs;
     for (const auto& p : report.pairs) {
         ++pairs[p.series];
-        const std::string what = report.stimuli[p.first].id + " vs " + report.stimuli[p.second].id;
+        const std::string what =
+            report.stimuli[p.first].id + " vs " + report.stimuli[p.second].id;
         EXPECT_GE(p.delta_e.mean, 3.0) << what;
         EXPECT_FALSE(p.identical) << what;
         EXPECT_GT(p.delta_e.pixels, 10000u) << what;
     }
-    const std::map<std::string, int> expected = {{"thickness_exponent", 3}, {"backlight", 3},
-                                                 {"diffuse_weight", 3},     {"jade", 1},
-                                                 {"wax", 1},                {"jade_strong", 1}};
+    const std::map<std::string, int> expected = {{"thickness_exponent", 3},
+                                                 {"backlight", 3},
+                                                 {"diffuse_weight", 3},
+                                                 {"jade", 1},
+                                                 {"wax", 1},
+                                                 {"jade_strong", 1}};
     EXPECT_EQ(pairs, expected);
 
     // Each series's colour: the hue that dominates its object pixels' albedo.
-    const std::map<std::string, std::string> colour = {
-        {"thickness_exponent", "purple"}, {"backlight", "green"}, {"diffuse_weight", "blue"}};
+    const std::map<std::string, std::string> colour = {{"thickness_exponent", "purple"},
+                                                       {"backlight", "green"},
+                                                       {"diffuse_weight", "blue"}};
     for (const auto& s : report.stimuli) {
         if (!colour.count(s.series)) continue;
         const auto albedo = s.cells.at("albedo");
@@ -57,8 +62,8 @@ TEST(ThesisSetReport, EveryPairOfLevelsPassesTheThresholdAndTheReportDrawsInABro
     }
 
     write_set_report(report);
-    const auto page = test::open_in_browser(dir / "report.html", dir / "report-screenshot.png",
-                                            1280, 1800);
+    const auto page = test::open_in_browser(dir / "report.html",
+                                            dir / "report-screenshot.png", 1280, 1800);
     ASSERT_TRUE(page.ok) << page.error;
     // 9 empirical, 6 ward / contrast-reversed, 3 dipole, 2 practice
     EXPECT_EQ(page.images_drawn, "20/20");
@@ -69,7 +74,8 @@ TEST(ThesisSetReport, EveryPairOfLevelsPassesTheThresholdAndTheReportDrawsInABro
         [](float r, float g, float b) { return g > r + 0.15f && g > b + 0.15f; });
     EXPECT_GT(purple, 2000u);
     EXPECT_GT(green, 2000u);
-    std::cout << "thesis report screenshot: " << (dir / "report-screenshot.png").string() << "\n";
+    std::cout << "thesis report screenshot: " << (dir / "report-screenshot.png").string()
+              << "\n";
 }
 
 }  // namespace

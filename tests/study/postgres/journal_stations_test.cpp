@@ -33,7 +33,8 @@ LocalPostgres& server() { return lucent::test::postgres_server(); }
 class JournalStations : public ::testing::Test {
 protected:
     void SetUp() override {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const std::string test =
+            ::testing::UnitTest::GetInstance()->current_test_info()->name();
         dir_ = lucent::test::scratch_dir("journal_stations");
         uri_ = lucent::test::new_postgres_database("journal_" + test);
         init_study_store(uri_);
@@ -56,21 +57,28 @@ protected:
     // they were recorded in (recorded in plan order: position), by the responses' ids.
     int64_t out_of_order(StudyStore& store) {
         return store.query_int(
-            "SELECT count(*) FROM trials t1 JOIN trials t2 ON t1.session_id = t2.session_id AND "
-            "t1.position < t2.position WHERE (SELECT min(id) FROM responses r WHERE r.trial_id = "
+            "SELECT count(*) FROM trials t1 JOIN trials t2 ON t1.session_id = "
+            "t2.session_id AND "
+            "t1.position < t2.position WHERE (SELECT min(id) FROM responses r WHERE "
+            "r.trial_id = "
             "t1.id) > (SELECT min(id) FROM responses r WHERE r.trial_id = t2.id)");
     }
     // Every planned trial of `sessions` sessions has one rating per question, once, and
     // every session is completed; the journal is empty.
     void expect_every_rating_once(StudyStore& store, int sessions) {
-        const int64_t per_session = static_cast<int64_t>(plan_trials(protocol_, 1, 1).trials.size());
+        const int64_t per_session =
+            static_cast<int64_t>(plan_trials(protocol_, 1, 1).trials.size());
         const int64_t questions = static_cast<int64_t>(protocol_.questions.size());
         EXPECT_EQ(store.query_int("SELECT count(*) FROM trials"), sessions * per_session);
-        EXPECT_EQ(store.query_int("SELECT count(*) FROM responses"), sessions * per_session * questions);
-        EXPECT_EQ(store.query_int("SELECT count(*) FROM trials t WHERE NOT EXISTS (SELECT 1 FROM "
-                                  "responses r WHERE r.trial_id = t.id)"),
+        EXPECT_EQ(store.query_int("SELECT count(*) FROM responses"),
+                  sessions * per_session * questions);
+        EXPECT_EQ(store.query_int(
+                      "SELECT count(*) FROM trials t WHERE NOT EXISTS (SELECT 1 FROM "
+                      "responses r WHERE r.trial_id = t.id)"),
                   0);
-        EXPECT_EQ(store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), sessions);
+        EXPECT_EQ(
+            store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+            sessions);
         EXPECT_EQ(store.pending_trials(), 0);
     }
 
@@ -85,20 +93,24 @@ struct Station {
     std::vector<TrialRow> trials;
 };
 
-Station start_station(std::unique_ptr<StudyStore> store, const Protocol& p, const std::string& code,
-                      uint64_t seed) {
+Station start_station(std::unique_ptr<StudyStore> store, const Protocol& p,
+                      const std::string& code, uint64_t seed) {
     Station s;
     s.store = std::move(store);
     const int64_t study = s.store->ensure_study(p);
     int number = 0;
     const int64_t participant = s.store->ensure_participant(study, code, &number);
-    s.session = s.store->create_session(study, participant, plan_trials(p, seed, number), seed, {}).id;
+    s.session =
+        s.store
+            ->create_session(study, participant, plan_trials(p, seed, number), seed, {})
+            .id;
     s.trials = s.store->trials(s.session);
     return s;
 }
 
 void record(Station& s, const Protocol& p, size_t k) {
-    s.store->record_trial(s.session, s.trials.at(k).id, lucent::test::outcome_for(p, s.trials.at(k)));
+    s.store->record_trial(s.session, s.trials.at(k).id,
+                          lucent::test::outcome_for(p, s.trials.at(k)));
 }
 
 TEST_F(JournalStations, TwoStoresInOneProcessSendEachSessionsTrialsInOrder) {
@@ -133,7 +145,8 @@ TEST_F(JournalStations, TwoStoresInOneProcessSendEachSessionsTrialsInOrder) {
 // sends what is left. Exit 0, or 1 with the error in `error_file`.
 [[noreturn]] void station_process(std::unique_ptr<StudyStore> store, const Protocol& p,
                                   const std::string& code, uint64_t seed, int to_parent,
-                                  int from_parent, const std::filesystem::path& error_file) {
+                                  int from_parent,
+                                  const std::filesystem::path& error_file) {
     try {
         Station s = start_station(std::move(store), p, code, seed);
         char byte = 0;
@@ -150,7 +163,8 @@ TEST_F(JournalStations, TwoStoresInOneProcessSendEachSessionsTrialsInOrder) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(20));
             }
         }
-        if (s.store->pending_trials() != 0) throw StoreError(code + ": journal not empty");
+        if (s.store->pending_trials() != 0)
+            throw StoreError(code + ": journal not empty");
     } catch (const std::exception& e) {
         std::ofstream(error_file) << e.what();
         _exit(1);
@@ -164,7 +178,8 @@ TEST_F(JournalStations, TwoProcessesOnOneJournalSendEachSessionsTrialsInOrder) {
         int from_child = -1, to_child = -1;
         std::filesystem::path error_file;
     };
-    signal(SIGPIPE, SIG_IGN);  // a station that died: its pipe fails the test, not the process
+    signal(SIGPIPE,
+           SIG_IGN);  // a station that died: its pipe fails the test, not the process
     std::vector<Child> children(2);
     for (size_t c = 0; c < children.size(); ++c) {
         int up[2], down[2];
@@ -182,8 +197,8 @@ TEST_F(JournalStations, TwoProcessesOnOneJournalSendEachSessionsTrialsInOrder) {
             } catch (const std::exception&) {
                 _exit(3);
             }
-            station_process(std::move(store), protocol_, "P" + std::to_string(c), 20 + c, up[1],
-                            down[0], children[c].error_file);
+            station_process(std::move(store), protocol_, "P" + std::to_string(c), 20 + c,
+                            up[1], down[0], children[c].error_file);
         }
         close(up[1]);
         close(down[0]);
@@ -204,7 +219,7 @@ TEST_F(JournalStations, TwoProcessesOnOneJournalSendEachSessionsTrialsInOrder) {
     go();
     step('j');
     server().start();
-    go();             // the rest, both stations at once
+    go();  // the rest, both stations at once
     for (Child& c : children) {
         int status = 0;
         waitpid(c.pid, &status, 0);

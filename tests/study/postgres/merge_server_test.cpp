@@ -24,13 +24,15 @@ namespace fs = std::filesystem;
 class OnServer : public ::testing::Test {
 protected:
     void SetUp() override {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const std::string test =
+            ::testing::UnitTest::GetInstance()->current_test_info()->name();
         dir_ = lucent::test::scratch_dir("merge_server_" + test);
         uri_ = lucent::test::new_postgres_database(test);
         init_study_store(uri_);
     }
     void TearDown() override {
-        if (!lucent::test::postgres_server().running()) lucent::test::postgres_server().start();
+        if (!lucent::test::postgres_server().running())
+            lucent::test::postgres_server().start();
     }
     StoreOptions options(const std::string& station) {
         StoreOptions o;
@@ -43,11 +45,13 @@ protected:
     }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
     // A session of `code` in a station file, `answered` trials rated (all when < 0).
-    int64_t session(Store& store, const std::string& code, uint64_t seed, int answered = -1) {
+    int64_t session(Store& store, const std::string& code, uint64_t seed,
+                    int answered = -1) {
         const int64_t study = store.ensure_study(p_);
         int number = 0;
         const int64_t pid = store.ensure_participant(study, code, &number);
-        const SessionRow s = store.create_session(study, pid, plan_trials(p_, seed, number), seed, {});
+        const SessionRow s =
+            store.create_session(study, pid, plan_trials(p_, seed, number), seed, {});
         uuid_ = s.uuid;
         for (const TrialRow& t : store.trials(s.id)) {
             if (answered-- == 0) break;
@@ -106,7 +110,9 @@ TEST_F(Withdrawal, AWithdrawalInAFileRemovesTheSessionFromTheServer) {
     EXPECT_EQ(s->query_int("SELECT count(*) FROM participants WHERE code = 'P01'"), 0);
     EXPECT_EQ(s->query_int("SELECT count(*) FROM responses"), 5 * 2);
     EXPECT_EQ(s->query_int("SELECT count(*) FROM withdrawn_sessions"), 1);
-    EXPECT_EQ(s->query_int("SELECT count(*) FROM retired_participant_numbers WHERE number = 1"), 1);
+    EXPECT_EQ(
+        s->query_int("SELECT count(*) FROM retired_participant_numbers WHERE number = 1"),
+        1);
 }
 
 TEST_F(Withdrawal, StoreSyncDoesNotResendAWithdrawnSession) {
@@ -114,12 +120,14 @@ TEST_F(Withdrawal, StoreSyncDoesNotResendAWithdrawnSession) {
     const int64_t study = station->ensure_study(p_);
     int number = 0;
     const int64_t pid = station->ensure_participant(study, "P04", &number);
-    const SessionRow s = station->create_session(study, pid, plan_trials(p_, 4, number), 4, {});
+    const SessionRow s =
+        station->create_session(study, pid, plan_trials(p_, 4, number), 4, {});
     const std::vector<TrialRow> trials = station->trials(s.id);
     station->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p_, trials[0]));
     lucent::test::postgres_server().stop();
     for (size_t i = 1; i < 3; ++i)  // journaled: the server is away
-        station->record_trial(s.id, trials[i].id, lucent::test::outcome_for(p_, trials[i]));
+        station->record_trial(s.id, trials[i].id,
+                              lucent::test::outcome_for(p_, trials[i]));
     EXPECT_EQ(station->pending_trials(), 2);
     lucent::test::postgres_server().start();
     EXPECT_TRUE(server("admin")->withdraw_participant("P04"));
@@ -146,7 +154,8 @@ TEST_F(MergeReconcile, IntoAServerThePausedServerCopyIsExtendedByTheCompletedFil
         store.begin_segment(id, {});
         store.set_status(id, "running", false);
         for (const TrialRow& t : store.trials(id))
-            if (!t.answered) store.record_trial(id, t.id, lucent::test::outcome_for(p_, t));
+            if (!t.answered)
+                store.record_trial(id, t.id, lucent::test::outcome_for(p_, t));
     }
     merge_into_server({path("paused.db")}, uri_);
     auto s = server();
@@ -166,12 +175,14 @@ TEST_F(MergeReconcile, IntoAServerThePausedServerCopyIsExtendedByTheCompletedFil
     // Each rating as the station wrote it (rating_for; catch trials 7).
     s->snapshot_to_sqlite(path("snapshot.db"));
     Database snap(path("snapshot.db"), SQLITE_OPEN_READONLY);
-    Statement r = snap.prepare("SELECT t.position, t.catch, r.question, r.rating FROM responses r "
-                               "JOIN trials t ON t.id = r.trial_id");
+    Statement r = snap.prepare(
+        "SELECT t.position, t.catch, r.question, r.rating FROM responses r "
+        "JOIN trials t ON t.id = r.trial_id");
     int checked = 0;
     while (r.step()) {
         const int q = r.text(2) == "translucent" ? 0 : 1;
-        EXPECT_EQ(r.integer(3), r.integer(1) ? 7 : lucent::test::rating_for(int(r.integer(0)), q));
+        EXPECT_EQ(r.integer(3),
+                  r.integer(1) ? 7 : lucent::test::rating_for(int(r.integer(0)), q));
         ++checked;
     }
     EXPECT_EQ(checked, 10);
@@ -192,8 +203,10 @@ TEST_F(MergeReconcile, IntoAServerADisagreeingCopyIsRefusedAndNothingChanges) {
     merge_into_server({station}, uri_);
     fs::copy_file(station, path("edited.db"));
     Database(path("edited.db"), SQLITE_OPEN_READWRITE)
-        .exec("UPDATE responses SET rating = rating % 7 + 1 WHERE question = 'realistic' AND "
-              "trial_id = (SELECT id FROM trials WHERE position = 2)");
+        .exec(
+            "UPDATE responses SET rating = rating % 7 + 1 WHERE question = 'realistic' "
+            "AND "
+            "trial_id = (SELECT id FROM trials WHERE position = 2)");
     try {
         merge_into_server({path("edited.db")}, uri_);
         ADD_FAILURE() << "merged a copy that disagrees with the server";

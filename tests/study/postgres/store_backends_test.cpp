@@ -5,20 +5,20 @@
 // Expected values come from the protocol and plan (trial counts, questions, the
 // deterministic rating_for()), never from the store under test.
 #include <gtest/gtest.h>
-#include <pqxx/pqxx>
 
 #include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
+#include <pqxx/pqxx>
 #include <set>
 #include <thread>
 
 #include "../study_fixtures.h"
-#include "server_environment.h"
 #include "postgres/postgres_store.h"
 #include "postgres/trial_journal.h"
+#include "server_environment.h"
 #include "session/autopilot.h"
 #include "session/session_flow.h"
 #include "store.h"
@@ -33,7 +33,8 @@ LocalPostgres& server() { return lucent::test::postgres_server(); }
 // Two blocks, counterbalanced: participants alternate between 2 Latin-square cells.
 std::string two_block_protocol_text() {
     std::string text = lucent::test::kSmallProtocol;
-    const std::string main = "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
+    const std::string main =
+        "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
     text.replace(text.find(main), main.size(),
                  "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\"]\n\n"
                  "[[blocks]]\nid = \"second\"\nstimuli = [\"c\", \"b\"]\n");
@@ -44,9 +45,12 @@ std::string two_block_protocol_text() {
 class Backend : public ::testing::TestWithParam<std::string> {
 protected:
     void SetUp() override {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const std::string test =
+            ::testing::UnitTest::GetInstance()->current_test_info()->name();
         std::string slug;
-        for (char c : test) slug += std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
+        for (char c : test)
+            slug +=
+                std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
         dir_ = lucent::test::scratch_dir("backend_" + slug);
         if (GetParam() == "sqlite") {
             db_ = (dir_ / "study.db").string();
@@ -67,7 +71,9 @@ protected:
     std::string db_;
 };
 
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
+    return info.param;
+}
 
 TEST_P(Backend, WritesTheWholePlanWithTrialUuidsBeforeTheFirstTrial) {
     auto store = open();
@@ -90,10 +96,11 @@ TEST_P(Backend, WritesTheWholePlanWithTrialUuidsBeforeTheFirstTrial) {
         uuids.insert(trials[i].uuid);
     }
     EXPECT_EQ(uuids.size(), trials.size());
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM stimulus_parameters sp JOIN stimuli s ON "
-                               "s.id = sp.stimulus_id WHERE s.stimulus_key = 'b' AND "
-                               "sp.name = 'thickness_exponent' AND sp.value = '25'"),
-              1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM stimulus_parameters sp JOIN stimuli s ON "
+                         "s.id = sp.stimulus_id WHERE s.stimulus_key = 'b' AND "
+                         "sp.name = 'thickness_exponent' AND sp.value = '25'"),
+        1);
 }
 
 TEST_P(Backend, RecordsEachTrialOnceAndRefusesDuplicatesAndBadRatings) {
@@ -104,8 +111,9 @@ TEST_P(Backend, RecordsEachTrialOnceAndRefusesDuplicatesAndBadRatings) {
     const SessionRow s = store->create_session(study, pid, plan_trials(p, 1, 1), 1, {});
     const std::vector<TrialRow> trials = store->trials(s.id);
     store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
-    EXPECT_THROW(store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0])),
-                 StoreError);
+    EXPECT_THROW(
+        store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0])),
+        StoreError);
     TrialOutcome bad = lucent::test::outcome_for(p, trials[1]);
     bad.responses[1].rating = 8;
     EXPECT_THROW(store->record_trial(s.id, trials[1].id, bad), StoreError);
@@ -114,7 +122,8 @@ TEST_P(Backend, RecordsEachTrialOnceAndRefusesDuplicatesAndBadRatings) {
     TrialOutcome missing = lucent::test::outcome_for(p, trials[1]);
     missing.responses.pop_back();
     EXPECT_THROW(store->record_trial(s.id, trials[1].id, missing), StoreError);
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 2);  // 1 trial x 2 questions
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"),
+              2);  // 1 trial x 2 questions
     EXPECT_EQ(store->pending_trials(), 0);
     // A fresh connection sees the same: committed, not cached.
     auto again = open("second");
@@ -132,12 +141,14 @@ TEST_P(Backend, ResumeFindsTheUnfinishedSessionAndTheLastTrialCompletesIt) {
         const int64_t study = store->ensure_study(p);
         int number = 0;
         const int64_t pid = store->ensure_participant(study, "P3", &number);
-        const SessionRow s = store->create_session(study, pid, plan_trials(p, 9, number), 9, {});
+        const SessionRow s =
+            store->create_session(study, pid, plan_trials(p, 9, number), 9, {});
         session_id = s.id;
         const std::vector<TrialRow> trials = store->trials(s.id);
         planned = trials.size();
         for (size_t i = 0; i < 2; ++i)
-            EXPECT_FALSE(store->record_trial(s.id, trials[i].id, lucent::test::outcome_for(p, trials[i])));
+            EXPECT_FALSE(store->record_trial(s.id, trials[i].id,
+                                             lucent::test::outcome_for(p, trials[i])));
         store->set_status(s.id, "paused", false);
     }
     auto store = open();
@@ -153,7 +164,8 @@ TEST_P(Backend, ResumeFindsTheUnfinishedSessionAndTheLastTrialCompletesIt) {
     for (const TrialRow& t : trials) {
         if (t.answered) continue;
         EXPECT_FALSE(completed) << "completed before the last trial";
-        completed = store->record_trial(session_id, t.id, lucent::test::outcome_for(p, t));
+        completed =
+            store->record_trial(session_id, t.id, lucent::test::outcome_for(p, t));
     }
     EXPECT_TRUE(completed);
     EXPECT_TRUE(store->has_completed_session("P3"));
@@ -161,9 +173,10 @@ TEST_P(Backend, ResumeFindsTheUnfinishedSessionAndTheLastTrialCompletesIt) {
     EXPECT_THROW(store->set_status(session_id, "paused", false), StoreError);
     EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"),
               static_cast<int64_t>(planned * p.questions.size()));
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE status = 'completed' AND "
-                               "ended_utc IS NOT NULL"),
-              1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM sessions WHERE status = 'completed' AND "
+                         "ended_utc IS NOT NULL"),
+        1);
 }
 
 TEST_P(Backend, WithdrawalDeletesEverythingAndRetiresTheNumber) {
@@ -175,7 +188,8 @@ TEST_P(Backend, WithdrawalDeletesEverythingAndRetiresTheNumber) {
     const int64_t bob = store->ensure_participant(study, "bob", &second);
     EXPECT_EQ(first, 1);
     EXPECT_EQ(second, 2);
-    const SessionRow s = store->create_session(study, bob, plan_trials(p, 2, second), 2, {});
+    const SessionRow s =
+        store->create_session(study, bob, plan_trials(p, 2, second), 2, {});
     const TrialRow t = store->trials(s.id)[0];
     store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
     ASSERT_TRUE(store->participant_counts("bob"));
@@ -198,15 +212,18 @@ TEST_P(Backend, ALabDeclineBeforeConsentKeepsOnlyTheCount) {
     SessionEnvironment env;
     env.machine_id = "lab-station-7";
     env.gl_renderer = "a renderer string";
-    const SessionRow s = store->create_session(study, dora, plan_trials(p, number, number), 3, env);
+    const SessionRow s =
+        store->create_session(study, dora, plan_trials(p, number, number), 3, env);
     EXPECT_TRUE(store->forget_declined_session(s.id));
     for (const char* table : {"participants", "sessions", "session_segments", "trials"})
-        EXPECT_EQ(store->query_int(std::string("SELECT count(*) FROM ") + table), 0) << table;
+        EXPECT_EQ(store->query_int(std::string("SELECT count(*) FROM ") + table), 0)
+            << table;
     EXPECT_EQ(store->query_int("SELECT declined FROM consent_declines"), 1);
 
     // A session with consent and an answer is not forgotten (it is aborted instead).
     const int64_t emil = store->ensure_participant(study, "emil", &number);
-    const SessionRow e = store->create_session(study, emil, plan_trials(p, number, number), 4, env);
+    const SessionRow e =
+        store->create_session(study, emil, plan_trials(p, number, number), 4, env);
     store->set_consent(e.id);
     const TrialRow t = store->trials(e.id)[0];
     store->record_trial(e.id, t.id, lucent::test::outcome_for(p, t));
@@ -257,8 +274,9 @@ TEST_P(Backend, RacingStationsNeverShareAParticipantNumber) {
             for (int i = 0; i < kEach; ++i) {
                 int n = 0;
                 // No trailing digits: the number is allocated by the store.
-                store->ensure_participant(study, "st" + std::string(1, char('a' + k)) + "-" +
-                                                     std::string(1, char('a' + i)),
+                store->ensure_participant(study,
+                                          "st" + std::string(1, char('a' + k)) + "-" +
+                                              std::string(1, char('a' + i)),
                                           &n);
                 numbers[k].push_back(n);
             }
@@ -290,7 +308,8 @@ TEST_P(Backend, EachRatingIsCheckedAgainstItsOwnQuestionsScale) {
         TrialOutcome o;
         o.onset_ns = 1;
         o.confirm_ns = 2;
-        o.responses = {{"translucent", translucent, 500, 0, 1, 2}, {"realistic", realistic, 500, 0, 1, 2}};
+        o.responses = {{"translucent", translucent, 500, 0, 1, 2},
+                       {"realistic", realistic, 500, 0, 1, 2}};
         return o;
     };
     store->record_trial(s.id, trials[0].id, outcome(7, 5));
@@ -311,7 +330,8 @@ TEST_P(Backend, EachRatingIsCheckedAgainstItsOwnQuestionsScale) {
     EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 4);
 }
 
-std::vector<StimulusProvenance> provenance_for(const Protocol& p, const std::string& albedo) {
+std::vector<StimulusProvenance> provenance_for(const Protocol& p,
+                                               const std::string& albedo) {
     std::vector<StimulusProvenance> out;
     for (const StimulusSpec& s : p.stimuli) {
         StimulusProvenance v;
@@ -329,7 +349,8 @@ std::vector<StimulusProvenance> provenance_for(const Protocol& p, const std::str
     return out;
 }
 
-SessionEnvironment environment(const std::string& machine, const std::string& gpu, double hz) {
+SessionEnvironment environment(const std::string& machine, const std::string& gpu,
+                               double hz) {
     SessionEnvironment env;
     env.machine_id = machine;
     env.software_version = "9.9.9";
@@ -349,7 +370,8 @@ TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
     const int64_t pid = store->ensure_participant(study, "P1", &number);
     SessionEnvironment first = environment("lab-a", "GPU A", 60);
     first.stimuli = provenance_for(p, "0.8,0.55,0.35");
-    const SessionRow s = store->create_session(study, pid, plan_trials(p, 5, number), 5, first);
+    const SessionRow s =
+        store->create_session(study, pid, plan_trials(p, 5, number), 5, first);
     const std::vector<TrialRow> trials = store->trials(s.id);
     store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
     SessionEnvironment second = environment("lab-b", "GPU B", 144);
@@ -358,28 +380,33 @@ TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
     second.measured_refresh_hz = 143.9;
     store->update_environment(s.id, second);
     store->record_trial(s.id, trials[1].id, lucent::test::outcome_for(p, trials[1]));
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments WHERE segment = 1 AND "
-                               "machine_id = 'lab-a' AND gl_renderer = 'GPU A' AND "
-                               "display_refresh_hz = 60 AND measured_refresh_hz IS NULL AND "
-                               "stimulus_source = 'live'"),
-              1);
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments WHERE segment = 2 AND "
-                               "machine_id = 'lab-b' AND measured_refresh_hz = 143.9"),
-              1);
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE gl_renderer = 'GPU A' AND "
-                               "display_refresh_hz = 60"),
-              1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM session_segments WHERE segment = 1 AND "
+                         "machine_id = 'lab-a' AND gl_renderer = 'GPU A' AND "
+                         "display_refresh_hz = 60 AND measured_refresh_hz IS NULL AND "
+                         "stimulus_source = 'live'"),
+        1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM session_segments WHERE segment = 2 AND "
+                         "machine_id = 'lab-b' AND measured_refresh_hz = 143.9"),
+        1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM sessions WHERE gl_renderer = 'GPU A' AND "
+                         "display_refresh_hz = 60"),
+        1);
     // Each trial knows the segment it was answered in.
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM trials t JOIN session_segments g ON "
-                               "g.id = t.segment_id WHERE (t.position = 0 AND g.segment = 1) OR "
-                               "(t.position = 1 AND g.segment = 2)"),
+    EXPECT_EQ(store->query_int(
+                  "SELECT count(*) FROM trials t JOIN session_segments g ON "
+                  "g.id = t.segment_id WHERE (t.position = 0 AND g.segment = 1) OR "
+                  "(t.position = 1 AND g.segment = 2)"),
               2);
     EXPECT_EQ(store->query_int("SELECT count(*) FROM segment_stimuli"),
               2 * static_cast<int64_t>(p.stimuli.size()));
     // Values are recorded once per stimulus (albedo, fov_y and its own parameters), not
     // again by the second segment.
     int64_t values = 0;
-    for (const StimulusSpec& spec : p.stimuli) values += 2 + static_cast<int64_t>(spec.parameters.size());
+    for (const StimulusSpec& spec : p.stimuli)
+        values += 2 + static_cast<int64_t>(spec.parameters.size());
     EXPECT_EQ(store->query_int("SELECT count(*) FROM stimulus_values"), values);
     try {
         store->check_stimulus_values(provenance_for(p, "0.7,0.55,0.35"));
@@ -393,7 +420,8 @@ TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
     EXPECT_NO_THROW(store->check_stimulus_values(provenance_for(p, "0.8,0.55,0.35")));
 }
 
-// ---- stations driven by the simulated participant --------------------------------------
+// ---- stations driven by the simulated participant
+// --------------------------------------
 
 Key key_of(const std::string& name, int* digit) {
     *digit = 0;
@@ -430,7 +458,8 @@ StationResult run_station(const std::function<std::unique_ptr<StudyStore>()>& op
         store->claim_participant(code);
         int number = 0;
         const int64_t pid = store->ensure_participant(study, code, &number);
-        const SessionRow s = store->create_session(study, pid, plan_trials(p, seed, number), seed, {});
+        const SessionRow s =
+            store->create_session(study, pid, plan_trials(p, seed, number), seed, {});
         out.cell = s.cell;
         const std::vector<TrialRow> trials = store->trials(s.id);
         int64_t now = 1'000'000'000;
@@ -475,13 +504,16 @@ void expect_every_rating_once(StudyStore& store, const Protocol& p, int sessions
     EXPECT_EQ(trials, sessions * per_session);
     EXPECT_EQ(store.query_int("SELECT count(*) FROM responses"),
               trials * static_cast<int64_t>(p.questions.size()));
-    EXPECT_EQ(store.query_int("SELECT count(*) FROM (SELECT DISTINCT trial_id, question FROM "
-                              "responses) d"),
-              trials * static_cast<int64_t>(p.questions.size()));
-    EXPECT_EQ(store.query_int("SELECT count(*) FROM trials t WHERE NOT EXISTS (SELECT 1 FROM "
-                              "responses r WHERE r.trial_id = t.id)"),
-              0);
-    EXPECT_EQ(store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), sessions);
+    EXPECT_EQ(
+        store.query_int("SELECT count(*) FROM (SELECT DISTINCT trial_id, question FROM "
+                        "responses) d"),
+        trials * static_cast<int64_t>(p.questions.size()));
+    EXPECT_EQ(
+        store.query_int("SELECT count(*) FROM trials t WHERE NOT EXISTS (SELECT 1 FROM "
+                        "responses r WHERE r.trial_id = t.id)"),
+        0);
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              sessions);
 }
 
 TEST_P(Backend, EightStationsAtOnceLoseNothingAndBalanceTheCells) {
@@ -492,8 +524,8 @@ TEST_P(Backend, EightStationsAtOnceLoseNothingAndBalanceTheCells) {
     std::vector<std::thread> threads;
     for (int k = 0; k < kStations; ++k)
         threads.emplace_back([&, k] {
-            results[k] = run_station([&] { return open("station" + std::to_string(k)); }, p,
-                                     "lab-" + std::string(1, char('a' + k)), 100 + k);
+            results[k] = run_station([&] { return open("station" + std::to_string(k)); },
+                                     p, "lab-" + std::string(1, char('a' + k)), 100 + k);
         });
     for (std::thread& t : threads) t.join();
     std::map<int, int> per_cell;
@@ -505,7 +537,8 @@ TEST_P(Backend, EightStationsAtOnceLoseNothingAndBalanceTheCells) {
     EXPECT_EQ(per_cell, (std::map<int, int>{{0, 4}, {1, 4}}));
     auto store = open();
     expect_every_rating_once(*store, p, kStations);
-    EXPECT_EQ(store->query_int("SELECT count(DISTINCT number) FROM participants"), kStations);
+    EXPECT_EQ(store->query_int("SELECT count(DISTINCT number) FROM participants"),
+              kStations);
 }
 
 // Issue 26 item 7: a claim ends when released, so another station may run the code; on
@@ -518,11 +551,13 @@ TEST_P(Backend, AReleasedClaimCanBeTakenByAnotherStationAtOnce) {
     for (int i = 0; i < 20; ++i) serve->release_participant("web" + std::to_string(i));
     serve->release_participant("never-claimed");  // a no-op
     if (is_server())
-        EXPECT_EQ(serve->query_int("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' "
-                                   "AND pid = pg_backend_pid()"),
-                  0);
+        EXPECT_EQ(
+            serve->query_int("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' "
+                             "AND pid = pg_backend_pid()"),
+            0);
     EXPECT_NO_THROW(lab->claim_participant("web3"));
-    // Now the lab holds it: the serve store is refused, and may claim again once released.
+    // Now the lab holds it: the serve store is refused, and may claim again once
+    // released.
     EXPECT_THROW(serve->claim_participant("web3"), StoreError);
     lab->release_participant("web3");
     EXPECT_NO_THROW(serve->claim_participant("web3"));
@@ -530,7 +565,8 @@ TEST_P(Backend, AReleasedClaimCanBeTakenByAnotherStationAtOnce) {
 
 std::string four_block_protocol_text() {
     std::string text = lucent::test::kSmallProtocol;
-    const std::string main = "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
+    const std::string main =
+        "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
     text.replace(text.find(main), main.size(),
                  "[[blocks]]\nid = \"main\"\nstimuli = [\"a\"]\n\n"
                  "[[blocks]]\nid = \"second\"\nstimuli = [\"b\"]\n\n"
@@ -561,8 +597,9 @@ TEST_P(Backend, OnlineEnrolmentsFromManyConnectionsAtOnceStayUniqueAndBalanced) 
                     how.active_since_utc = "2000-01-01T00:00:00.000Z";
                     how.plan = [&](int cell) { return plan_trials(p, how.seed, cell); };
                     // Codes whose digits would all pick one cell, and digitless ones.
-                    const std::string code = i == 0 ? "P0" + std::to_string(k * 4)
-                                                    : "web-" + std::string(1, char('a' + k));
+                    const std::string code = i == 0
+                                                 ? "P0" + std::to_string(k * 4)
+                                                 : "web-" + std::string(1, char('a' + k));
                     store->enrol_online(study, code, how, {});
                 }
                 // A lab station among them keeps the code's digits.
@@ -582,19 +619,23 @@ TEST_P(Backend, OnlineEnrolmentsFromManyConnectionsAtOnceStayUniqueAndBalanced) 
     EXPECT_EQ(store->query_int("SELECT count(DISTINCT number) FROM participants"),
               kServers * kEach + 1);
     // The online numbers: 1..16 (the lab's 90 may come before some: then 91..).
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM participants WHERE code <> 'LAB90' AND "
-                               "(number BETWEEN 1 AND 16 OR number BETWEEN 91 AND 106)"),
-              kServers * kEach);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM participants WHERE code <> 'LAB90' AND "
+                         "(number BETWEEN 1 AND 16 OR number BETWEEN 91 AND 106)"),
+        kServers * kEach);
     for (int cell = 0; cell < 4; ++cell)
         EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE cell = " +
                                    std::to_string(cell)),
                   kServers * kEach / 4)
             << "cell " << cell;
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE allocation LIKE "
-                               "'online arrival %: cell % of 4, the fewest completed + active %'"),
+    EXPECT_EQ(store->query_int(
+                  "SELECT count(*) FROM sessions WHERE allocation LIKE "
+                  "'online arrival %: cell % of 4, the fewest completed + active %'"),
               kServers * kEach);
     // Each session's plan is its cell's Latin-square row.
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE block_order NOT LIKE '%,%,%,%'"), 0);
+    EXPECT_EQ(store->query_int(
+                  "SELECT count(*) FROM sessions WHERE block_order NOT LIKE '%,%,%,%'"),
+              0);
 }
 
 // Issue 26 item 10: a reload replaces a segment nothing was answered in.
@@ -606,14 +647,17 @@ TEST_P(Backend, AResumeSegmentReplacesASegmentWithoutAnswersAndAddsOneAfterAnAns
     const int64_t pid = store->ensure_participant(study, "P1", &number);
     SessionEnvironment env;
     env.machine_id = "first";
-    const SessionRow s = store->create_session(study, pid, plan_trials(p, 1, number), 1, env);
+    const SessionRow s =
+        store->create_session(study, pid, plan_trials(p, 1, number), 1, env);
     for (int i = 0; i < 10; ++i) {
         env.machine_id = "reload" + std::to_string(i);
         EXPECT_EQ(store->resume_segment(s.id, env), 1);
     }
     EXPECT_EQ(store->query_int("SELECT count(*) FROM session_segments"), 1);
     // The replaced first segment's environment is the session row's too.
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE machine_id = 'reload9'"), 1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM sessions WHERE machine_id = 'reload9'"),
+        1);
     const std::vector<TrialRow> trials = store->trials(s.id);
     store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
     EXPECT_EQ(store->resume_segment(s.id, env), 2);
@@ -624,14 +668,17 @@ TEST_P(Backend, AResumeSegmentReplacesASegmentWithoutAnswersAndAddsOneAfterAnAns
               1);
 }
 
-INSTANTIATE_TEST_SUITE_P(Stores, Backend, ::testing::Values("sqlite", "postgresql"), param_name);
+INSTANTIATE_TEST_SUITE_P(Stores, Backend, ::testing::Values("sqlite", "postgresql"),
+                         param_name);
 
-// ---- the server alone: schema, URI, outages ----------------------------------------------
+// ---- the server alone: schema, URI, outages
+// ----------------------------------------------
 
 class Server : public ::testing::Test {
 protected:
     void SetUp() override {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const std::string test =
+            ::testing::UnitTest::GetInstance()->current_test_info()->name();
         dir_ = lucent::test::scratch_dir("server_" + test);
         uri_ = lucent::test::new_postgres_database(test);
     }
@@ -655,7 +702,8 @@ TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
     auto server = open_study_store(uri_, options("x"));
     int tables = 0;
     Statement t = model.db().prepare(
-        "SELECT name FROM sqlite_schema WHERE type = 'table' AND name NOT LIKE 'sqlite_%'");
+        "SELECT name FROM sqlite_schema WHERE type = 'table' AND name NOT LIKE "
+        "'sqlite_%'");
     while (t.step()) {
         ++tables;
         Statement c = model.db().prepare("SELECT name FROM pragma_table_info(?)");
@@ -663,10 +711,11 @@ TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
         while (c.step()) {
             // Names are the model's (this build's constants): a column missing on the
             // server counts 0.
-            EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.columns WHERE "
-                                        "table_schema = 'public' AND table_name = '" +
-                                        t.text(0) + "' AND column_name = '" + c.text(0) + "'"),
-                      1)
+            EXPECT_EQ(
+                server->query_int("SELECT count(*) FROM information_schema.columns WHERE "
+                                  "table_schema = 'public' AND table_name = '" +
+                                  t.text(0) + "' AND column_name = '" + c.text(0) + "'"),
+                1)
                 << t.text(0) << "." << c.text(0);
         }
     }
@@ -706,8 +755,10 @@ TEST_F(Server, UninitialisedOlderAndNewerSchemasAreRefusedWithOneLine) {
 }
 
 TEST_F(Server, PasswordsAndUnknownSchemesAreRefusedBeforeConnecting) {
-    EXPECT_THROW(open_study_store("postgresql://anna:secret@localhost/study"), StoreError);
-    EXPECT_THROW(open_study_store("postgresql://anna@localhost/study?password=secret"), StoreError);
+    EXPECT_THROW(open_study_store("postgresql://anna:secret@localhost/study"),
+                 StoreError);
+    EXPECT_THROW(open_study_store("postgresql://anna@localhost/study?password=secret"),
+                 StoreError);
     try {
         open_study_store("mysql://anna@localhost/study");
         FAIL();
@@ -771,8 +822,9 @@ TEST_F(Server, StoppedMidSessionEveryCommittedRatingArrivesOnce) {
                 if (!server().running()) ++journaled_during_outage;
                 std::this_thread::sleep_for(std::chrono::milliseconds(30));
             };
-            results[k] = run_station([&] { return open_study_store(uri_, options("st" + std::to_string(k))); },
-                                     p, "out-" + std::string(1, char('a' + k)), 300 + k, after);
+            results[k] = run_station(
+                [&] { return open_study_store(uri_, options("st" + std::to_string(k))); },
+                p, "out-" + std::string(1, char('a' + k)), 300 + k, after);
         });
     for (std::thread& t : threads) t.join();
     for (const StationResult& r : results) EXPECT_EQ(r.error, "");
@@ -789,7 +841,8 @@ TEST_F(Server, SnapshotHoldsEveryRowTheServerHolds) {
     for (const char* code : {"P1", "P2"}) {
         int number = 0;
         const int64_t pid = store->ensure_participant(study, code, &number);
-        const SessionRow s = store->create_session(study, pid, plan_trials(p, number, number), number, {});
+        const SessionRow s =
+            store->create_session(study, pid, plan_trials(p, number, number), number, {});
         for (const TrialRow& t : store->trials(s.id))
             store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
     }
@@ -814,12 +867,15 @@ TEST_F(Server, SnapshotHoldsEveryRowTheServerHolds) {
     EXPECT_EQ(copy.scalar_int("SELECT declined FROM consent_declines"), 1);
     // The ratings themselves, against the deterministic answers given.
     Statement s = copy.prepare(
-        "SELECT t.position, r.question, r.rating, t.catch FROM responses r JOIN trials t ON "
+        "SELECT t.position, r.question, r.rating, t.catch FROM responses r JOIN trials t "
+        "ON "
         "t.id = r.trial_id");
     int checked = 0;
     while (s.step()) {
         const int q = s.text(1) == p.questions[0].id ? 0 : 1;
-        const int expected = s.integer(3) ? 7 : lucent::test::rating_for(static_cast<int>(s.integer(0)), q);
+        const int expected =
+            s.integer(3) ? 7
+                         : lucent::test::rating_for(static_cast<int>(s.integer(0)), q);
         EXPECT_EQ(s.integer(2), expected);
         ++checked;
     }

@@ -49,12 +49,14 @@ std::string read_file(const std::filesystem::path& p) {
 class Commands : public ::testing::Test {
 protected:
     void SetUp() override {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const std::string test =
+            ::testing::UnitTest::GetInstance()->current_test_info()->name();
         dir_ = lucent::test::scratch_dir("commands_" + test);
         uri_ = lucent::test::new_postgres_database(test);
     }
     void TearDown() override {
-        if (!lucent::test::postgres_server().running()) lucent::test::postgres_server().start();
+        if (!lucent::test::postgres_server().running())
+            lucent::test::postgres_server().start();
     }
     StoreOptions options(const std::string& station) {
         StoreOptions o;
@@ -71,7 +73,8 @@ protected:
             int number = 0;
             const std::string code = "P" + std::to_string(k);
             const int64_t pid = store->ensure_participant(study, code, &number);
-            const SessionRow s = store->create_session(study, pid, plan_trials(p, k, number), k, {});
+            const SessionRow s =
+                store->create_session(study, pid, plan_trials(p, k, number), k, {});
             for (const TrialRow& t : store->trials(s.id))
                 store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
         }
@@ -83,7 +86,8 @@ protected:
 TEST_F(Commands, StoreInitMigratesOnceAndExportMatchesTheSameSessionsInAFile) {
     const Ran init = lucent({"store", "init", "--db", uri_});
     EXPECT_EQ(init.exit_code, 0) << init.output;
-    EXPECT_NE(init.output.find("schema 0 -> " + std::to_string(kSchemaVersion)), std::string::npos)
+    EXPECT_NE(init.output.find("schema 0 -> " + std::to_string(kSchemaVersion)),
+              std::string::npos)
         << init.output;
     const Ran again = lucent({"store", "init", "--db", uri_});
     EXPECT_NE(again.output.find("up to date"), std::string::npos) << again.output;
@@ -92,8 +96,10 @@ TEST_F(Commands, StoreInitMigratesOnceAndExportMatchesTheSameSessionsInAFile) {
     fill(uri_);
     fill(file);
     const auto from_server = dir_ / "server.csv", from_file = dir_ / "file.csv";
-    const Ran a = lucent({"export", uri_, "--format", "analysis", "--out", from_server.string()});
-    const Ran b = lucent({"export", file, "--format", "analysis", "--out", from_file.string()});
+    const Ran a =
+        lucent({"export", uri_, "--format", "analysis", "--out", from_server.string()});
+    const Ran b =
+        lucent({"export", file, "--format", "analysis", "--out", from_file.string()});
     ASSERT_EQ(a.exit_code, 0) << a.output;
     ASSERT_EQ(b.exit_code, 0) << b.output;
     const std::string server_csv = read_file(from_server);
@@ -108,14 +114,17 @@ TEST_F(Commands, AnalyzeReadsAServerAsItReadsTheSameSessionsInAFile) {
     const std::string file = (dir_ / "reference.db").string();
     fill(file);
     const auto from_server = dir_ / "server_report", from_file = dir_ / "file_report";
-    const Ran a = lucent({"analyze", uri_, "--out", from_server.string(), "--format", "csv"});
-    const Ran b = lucent({"analyze", file, "--out", from_file.string(), "--format", "csv"});
+    const Ran a =
+        lucent({"analyze", uri_, "--out", from_server.string(), "--format", "csv"});
+    const Ran b =
+        lucent({"analyze", file, "--out", from_file.string(), "--format", "csv"});
     ASSERT_EQ(a.exit_code, 0) << a.output;
     ASSERT_EQ(b.exit_code, 0) << b.output;
     int compared = 0;
     for (const auto& entry : std::filesystem::directory_iterator(from_file)) {
         if (entry.path().extension() != ".csv") continue;
-        EXPECT_EQ(read_file(from_server / entry.path().filename()), read_file(entry.path()))
+        EXPECT_EQ(read_file(from_server / entry.path().filename()),
+                  read_file(entry.path()))
             << entry.path().filename();
         ++compared;
     }
@@ -128,7 +137,8 @@ TEST_F(Commands, ParticipantsListAndWithdrawWorkOnAServer) {
     const Ran list = lucent({"participants", "list", "--db", uri_});
     ASSERT_EQ(list.exit_code, 0) << list.output;
     for (const char* code : {"P1", "P2", "P3"})
-        EXPECT_NE(list.output.find(std::string(code) + "  "), std::string::npos) << list.output;
+        EXPECT_NE(list.output.find(std::string(code) + "  "), std::string::npos)
+            << list.output;
     const Ran gone = lucent({"participants", "withdraw", "P2", "--db", uri_, "--yes"});
     EXPECT_EQ(gone.exit_code, 0) << gone.output;
     const Ran unknown = lucent({"participants", "withdraw", "P9", "--db", uri_, "--yes"});
@@ -148,13 +158,15 @@ TEST_F(Commands, SyncSendsWhatAStoppedServerMissedAndNothingTwice) {
         const int64_t study = store->ensure_study(p);
         int number = 0;
         const int64_t pid = store->ensure_participant(study, "P4", &number);
-        const SessionRow s = store->create_session(study, pid, plan_trials(p, 4, number), 4, {});
+        const SessionRow s =
+            store->create_session(study, pid, plan_trials(p, 4, number), 4, {});
         const std::vector<TrialRow> trials = store->trials(s.id);
         planned = trials.size();
         store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
         lucent::test::postgres_server().stop();
         for (size_t i = 1; i < trials.size(); ++i)  // the session runs on, journaled
-            store->record_trial(s.id, trials[i].id, lucent::test::outcome_for(p, trials[i]));
+            store->record_trial(s.id, trials[i].id,
+                                lucent::test::outcome_for(p, trials[i]));
         EXPECT_EQ(store->pending_trials(), static_cast<int>(planned - 1));
     }  // the station closes with trials the server never saw
     const Ran offline = lucent({"store", "sync", "--db", uri_, "--journal", journal});
@@ -171,7 +183,8 @@ TEST_F(Commands, SyncSendsWhatAStoppedServerMissedAndNothingTwice) {
     auto store = open_study_store(uri_, options("check"));
     EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"),
               static_cast<int64_t>(planned * p.questions.size()));
-    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
 }
 
 TEST_F(Commands, MergeReadsAServerAndAFileIntoOneFile) {
@@ -185,19 +198,23 @@ TEST_F(Commands, MergeReadsAServerAndAFileIntoOneFile) {
     const std::string out = (dir_ / "merged.db").string();
     const Ran merged = lucent({"merge", uri_, other, "--out", out});
     ASSERT_EQ(merged.exit_code, 0) << merged.output;
-    EXPECT_EQ(Database(out, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM sessions"), 4);
+    EXPECT_EQ(
+        Database(out, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM sessions"),
+        4);
 }
 
 TEST_F(Commands, MergeIntoAServerAddsOnlyWhatItLacksAndMatchesAMergedFile) {
     init_study_store(uri_);
     fill(uri_);
-    const std::string other = (dir_ / "other.db").string(), copy = (dir_ / "copy.db").string();
+    const std::string other = (dir_ / "other.db").string(),
+                      copy = (dir_ / "copy.db").string();
     {
         Store store(other);
         lucent::test::run_full_session(store, lucent::test::small_protocol(), "Q1", 11);
         lucent::test::run_full_session(store, lucent::test::small_protocol(), "Q2", 12);
     }
-    open_study_store(uri_, options("x"))->snapshot_to_sqlite(copy);  // the server's 3 again
+    open_study_store(uri_, options("x"))
+        ->snapshot_to_sqlite(copy);  // the server's 3 again
     // The reference: the same inputs merged into a file.
     const std::string file = (dir_ / "merged.db").string();
     ASSERT_EQ(lucent({"merge", copy, other, "--out", file}).exit_code, 0);
@@ -210,9 +227,12 @@ TEST_F(Commands, MergeIntoAServerAddsOnlyWhatItLacksAndMatchesAMergedFile) {
     EXPECT_NE(again.output.find("0 sessions added, 2 already there"), std::string::npos)
         << again.output;
     const auto a = dir_ / "server.csv", b = dir_ / "file.csv";
-    ASSERT_EQ(lucent({"export", uri_, "--format", "long", "--out", a.string()}).exit_code, 0);
-    ASSERT_EQ(lucent({"export", file, "--format", "long", "--out", b.string()}).exit_code, 0);
-    // Long rows name the session UUID, trial position, ratings and provenance of each row.
+    ASSERT_EQ(lucent({"export", uri_, "--format", "long", "--out", a.string()}).exit_code,
+              0);
+    ASSERT_EQ(lucent({"export", file, "--format", "long", "--out", b.string()}).exit_code,
+              0);
+    // Long rows name the session UUID, trial position, ratings and provenance of each
+    // row.
     EXPECT_EQ(read_file(a), read_file(b));
     auto store = open_study_store(uri_, options("check"));
     EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions"), 5);
@@ -234,11 +254,12 @@ TEST_F(Commands, MergeIntoAServerAddsOnlyWhatItLacksAndMatchesAMergedFile) {
 }
 
 TEST_F(Commands, BadServerArgumentsExitTwoWithOneLine) {
-    const Ran password = lucent({"export", "postgresql://anna:secret@localhost/study", "--out",
-                                 (dir_ / "x.csv").string()});
+    const Ran password = lucent({"export", "postgresql://anna:secret@localhost/study",
+                                 "--out", (dir_ / "x.csv").string()});
     EXPECT_EQ(password.exit_code, 2) << password.output;
     EXPECT_NE(password.output.find("PGPASSWORD"), std::string::npos) << password.output;
-    EXPECT_EQ(std::count(password.output.begin(), password.output.end(), '\n'), 1) << password.output;
+    EXPECT_EQ(std::count(password.output.begin(), password.output.end(), '\n'), 1)
+        << password.output;
     EXPECT_FALSE(std::filesystem::exists(dir_ / "x.csv"));
     const Ran scheme = lucent({"store", "init", "--db", "mysql://anna@localhost/study"});
     EXPECT_EQ(scheme.exit_code, 2) << scheme.output;

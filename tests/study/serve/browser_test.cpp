@@ -25,78 +25,88 @@ protected:
             std::string("serve_browser_") +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
         db_ = (dir_ / "study.db").string();
-        server_ = std::make_unique<lucent::test::ServeProcess>(lucent::test::write_serve_study(dir_),
-                                                              db_, dir_.string());
-        ASSERT_GT(server_->port(), 0) << "lucent serve did not start: " << server_->first_line();
+        server_ = std::make_unique<lucent::test::ServeProcess>(
+            lucent::test::write_serve_study(dir_), db_, dir_.string());
+        ASSERT_GT(server_->port(), 0)
+            << "lucent serve did not start: " << server_->first_line();
         browser_ = std::make_unique<lucent::test::DevToolsBrowser>(1280, 900);
         if (!browser_->ok()) GTEST_SKIP() << browser_->error();
     }
-    std::string screen() { return browser_->evaluate("document.body.dataset.screen").get<std::string>(); }
+    std::string screen() {
+        return browser_->evaluate("document.body.dataset.screen").get<std::string>();
+    }
     bool wait_screen(const std::string& name) {
         return browser_->wait_until("document.body.dataset.screen === '" + name + "'");
     }
     // Waits for the next screen after `view`, a text screen or a trial's rating screen.
     std::string next_screen(const std::string& view) {
-        browser_->wait_until("document.body.dataset.view !== '" + view +
-                             "' && ['blank', 'loading'].indexOf(document.body.dataset.screen) < 0");
+        browser_->wait_until(
+            "document.body.dataset.view !== '" + view +
+            "' && ['blank', 'loading'].indexOf(document.body.dataset.screen) < 0");
         return screen();
     }
-    std::string view() { return browser_->evaluate("document.body.dataset.view").get<std::string>(); }
+    std::string view() {
+        return browser_->evaluate("document.body.dataset.view").get<std::string>();
+    }
 
     // Rates the trial on screen; the k-th trial shown uses keys, arrows or clicks in
     // turn. Returns the ratings given (question 0, question 1).
     std::pair<int, int> rate(int k) {
-        const std::string prompt = browser_->evaluate("document.getElementById('prompt').textContent");
+        const std::string prompt =
+            browser_->evaluate("document.getElementById('prompt').textContent");
         const bool is_catch = prompt.find("Attention") != std::string::npos;
         switch (is_catch ? 0 : k % 3) {
-        case 0:  // digits, Enter between the statements and to confirm
-            if (is_catch) {
-                browser_->press("5");
+            case 0:  // digits, Enter between the statements and to confirm
+                if (is_catch) {
+                    browser_->press("5");
+                    browser_->press("Enter");
+                    browser_->press("5");
+                    browser_->press("Enter");
+                    return {5, 5};
+                }
+                browser_->press("3");
                 browser_->press("Enter");
-                browser_->press("5");
+                browser_->press("4");
                 browser_->press("Enter");
-                return {5, 5};
-            }
-            browser_->press("3");
-            browser_->press("Enter");
-            browser_->press("4");
-            browser_->press("Enter");
-            return {3, 4};
-        case 1:  // arrows: the first press picks the middle point (4 of 7, 3 of 5)
-            browser_->press("ArrowRight");
-            browser_->press("ArrowRight");
-            browser_->press("ArrowDown");
-            browser_->press("ArrowLeft");
-            browser_->press("ArrowLeft");
-            browser_->press("Enter");
-            return {5, 2};
-        default:  // clicks on the scales, then Next
-            EXPECT_TRUE(browser_->click("button[data-question='0'][data-value='6']"));
-            EXPECT_TRUE(browser_->click("button[data-question='1'][data-value='1']"));
-            EXPECT_TRUE(browser_->click("button[data-question='0'][data-value='7']"));
-            EXPECT_TRUE(browser_->click("#next"));
-            return {7, 1};
+                return {3, 4};
+            case 1:  // arrows: the first press picks the middle point (4 of 7, 3 of 5)
+                browser_->press("ArrowRight");
+                browser_->press("ArrowRight");
+                browser_->press("ArrowDown");
+                browser_->press("ArrowLeft");
+                browser_->press("ArrowLeft");
+                browser_->press("Enter");
+                return {5, 2};
+            default:  // clicks on the scales, then Next
+                EXPECT_TRUE(browser_->click("button[data-question='0'][data-value='6']"));
+                EXPECT_TRUE(browser_->click("button[data-question='1'][data-value='1']"));
+                EXPECT_TRUE(browser_->click("button[data-question='0'][data-value='7']"));
+                EXPECT_TRUE(browser_->click("#next"));
+                return {7, 1};
         }
     }
 
     // Runs the page from its current screen until done (or `stop_after` trials), keyed
     // by the trial id the page shows.
-    void run_page(std::map<std::string, std::pair<int, int>>& given, int stop_after = 1000) {
+    void run_page(std::map<std::string, std::pair<int, int>>& given,
+                  int stop_after = 1000) {
         for (int guard = 0; guard < 60; ++guard) {
             const std::string s = screen();
             if (s == "done") return;
             const std::string v = view();
             if (s == "trial") {
                 if (static_cast<int>(given.size()) >= stop_after) return;
-                const std::string trial = browser_->evaluate("document.body.dataset.trial");
+                const std::string trial =
+                    browser_->evaluate("document.body.dataset.trial");
                 // Pixel for pixel: the picture's CSS size times the device pixel ratio is
                 // the file's size.
-                EXPECT_EQ(browser_->evaluate(
-                              "(() => { const i = document.querySelector('#picture img'); "
-                              "const r = i.getBoundingClientRect(); return [i.naturalWidth, "
-                              "i.naturalHeight, r.width * devicePixelRatio, r.height * "
-                              "devicePixelRatio]; })()"),
-                          json::parse("[64, 48, 64.0, 48.0]"));
+                EXPECT_EQ(
+                    browser_->evaluate(
+                        "(() => { const i = document.querySelector('#picture img'); "
+                        "const r = i.getBoundingClientRect(); return [i.naturalWidth, "
+                        "i.naturalHeight, r.width * devicePixelRatio, r.height * "
+                        "devicePixelRatio]; })()"),
+                    json::parse("[64, 48, 64.0, 48.0]"));
                 given[trial] = rate(static_cast<int>(given.size()));
             } else {
                 browser_->press("Enter");
@@ -110,12 +120,15 @@ protected:
         Store store(db_);
         for (const auto& [trial, ratings] : given) {
             for (const auto& [question, rating] :
-                 {std::pair<std::string, int>{"translucent", ratings.first}, {"realistic", ratings.second}})
-                EXPECT_EQ(store.query_int("SELECT count(*) FROM responses r JOIN trials t ON "
-                                          "t.id = r.trial_id WHERE t.uuid = '" + trial +
-                                          "' AND r.question = '" + question + "' AND r.rating = " +
-                                          std::to_string(rating) + " AND r.rt_ms > 0"),
-                          1)
+                 {std::pair<std::string, int>{"translucent", ratings.first},
+                  {"realistic", ratings.second}})
+                EXPECT_EQ(
+                    store.query_int("SELECT count(*) FROM responses r JOIN trials t ON "
+                                    "t.id = r.trial_id WHERE t.uuid = '" +
+                                    trial + "' AND r.question = '" + question +
+                                    "' AND r.rating = " + std::to_string(rating) +
+                                    " AND r.rt_ms > 0"),
+                    1)
                     << trial << " " << question;
         }
         EXPECT_EQ(store.query_int("SELECT count(*) FROM responses"),
@@ -146,13 +159,17 @@ TEST_F(ServeBrowser, ChromiumCompletesAWholeSessionWithKeysArrowsAndClicks) {
     EXPECT_EQ(given.size(), size_t(lucent::test::kServeStudyTrials));
     expect_stored(given);
     Store store(db_);
-    EXPECT_EQ(store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
-    // The browser's own details, with the segment.
-    EXPECT_EQ(store.query_int("SELECT count(*) FROM session_segments WHERE gl_vendor = "
-                              "'web browser' AND gl_renderer LIKE '%Chrome/%' AND display_mode "
-                              "LIKE 'browser window 1280x%devicePixelRatio 1%'"),
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
               1);
-    EXPECT_EQ(store.query_int("SELECT count(*) FROM session_segments WHERE measured_refresh_hz > 1"), 1);
+    // The browser's own details, with the segment.
+    EXPECT_EQ(
+        store.query_int("SELECT count(*) FROM session_segments WHERE gl_vendor = "
+                        "'web browser' AND gl_renderer LIKE '%Chrome/%' AND display_mode "
+                        "LIKE 'browser window 1280x%devicePixelRatio 1%'"),
+        1);
+    EXPECT_EQ(store.query_int(
+                  "SELECT count(*) FROM session_segments WHERE measured_refresh_hz > 1"),
+              1);
 }
 
 TEST_F(ServeBrowser, AReloadInTheMiddleResumesAtTheFirstUnansweredTrial) {
@@ -164,8 +181,9 @@ TEST_F(ServeBrowser, AReloadInTheMiddleResumesAtTheFirstUnansweredTrial) {
     ASSERT_EQ(screen(), "trial");
     browser_->reload();
     // Consent is on record: the reload goes straight to the first unanswered trial.
-    ASSERT_TRUE(browser_->wait_until("document.body.dataset.screen === 'trial' || "
-                                     "document.body.dataset.screen === 'break'"))
+    ASSERT_TRUE(
+        browser_->wait_until("document.body.dataset.screen === 'trial' || "
+                             "document.body.dataset.screen === 'break'"))
         << screen();
     {
         Store store(db_);
@@ -187,8 +205,9 @@ TEST_F(ServeBrowser, AReloadInTheMiddleResumesAtTheFirstUnansweredTrial) {
 }
 
 TEST_F(ServeBrowser, AWindowTooSmallForThePictureIsToldSoAndWaits) {
-    browser_->call("Emulation.setDeviceMetricsOverride",
-                   {{"width", 60}, {"height", 40}, {"deviceScaleFactor", 1}, {"mobile", false}});
+    browser_->call(
+        "Emulation.setDeviceMetricsOverride",
+        {{"width", 60}, {"height", 40}, {"deviceScaleFactor", 1}, {"mobile", false}});
     browser_->navigate(server_->url() + "/?participant=B3");
     ASSERT_TRUE(wait_screen("consent"));
     browser_->press("Enter");
@@ -199,8 +218,9 @@ TEST_F(ServeBrowser, AWindowTooSmallForThePictureIsToldSoAndWaits) {
                   .get<std::string>()
                   .find("64 x 48"),
               std::string::npos);
-    browser_->call("Emulation.setDeviceMetricsOverride",
-                   {{"width", 1280}, {"height", 900}, {"deviceScaleFactor", 1}, {"mobile", false}});
+    browser_->call(
+        "Emulation.setDeviceMetricsOverride",
+        {{"width", 1280}, {"height", 900}, {"deviceScaleFactor", 1}, {"mobile", false}});
     EXPECT_TRUE(wait_screen("trial")) << screen();
 }
 

@@ -26,10 +26,12 @@ using lucent::test::Page;
 class ServeHttp : public ::testing::TestWithParam<std::string> {
 protected:
     void SetUp() override {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const std::string test =
+            ::testing::UnitTest::GetInstance()->current_test_info()->name();
         std::string slug;
         for (char c : test)
-            slug += std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
+            slug +=
+                std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
         dir_ = lucent::test::scratch_dir("serve_http_" + slug);
         protocol_ = lucent::test::write_serve_study(dir_);
         if (GetParam() == "sqlite") {
@@ -38,8 +40,10 @@ protected:
             db_ = lucent::test::new_postgres_database("serve_http_" + slug);
             init_study_store(db_);
         }
-        server_ = std::make_unique<lucent::test::ServeProcess>(protocol_, db_, dir_.string());
-        ASSERT_GT(server_->port(), 0) << "lucent serve did not start: " << server_->first_line();
+        server_ =
+            std::make_unique<lucent::test::ServeProcess>(protocol_, db_, dir_.string());
+        ASSERT_GT(server_->port(), 0)
+            << "lucent serve did not start: " << server_->first_line();
     }
     // Counts read through a store of its own (the server holds its own connection).
     int64_t count(const std::string& sql) {
@@ -53,7 +57,9 @@ protected:
     std::unique_ptr<lucent::test::ServeProcess> server_;
 };
 
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
+    return info.param;
+}
 
 TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     httplib::Client http("127.0.0.1", server_->port());
@@ -72,12 +78,14 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     // Paths out of the pictures, plain and encoded: never a file, always a 404.
     std::ofstream(dir_ / "secret.txt") << "not for participants";
     const std::string db_name = std::filesystem::path(db_).filename().string();
-    for (const std::string& target : std::vector<std::string>{"/images/../study.toml", "/images/..%2fstudy.toml", "/images/%2e%2e%2fstudy.toml",
-          "/images/%2E%2E/secret.txt", "/images/%252e%252e%252fsecret.txt",
-          "/images/a.png%00.txt", "/../secret.txt", "/%2e%2e/secret.txt",
-          "/images/..%5csecret.txt", "/images/" + db_name, "/images/../" + db_name,
-          "/etc/passwd", "/../../../../etc/passwd", "/images/a.png/../../secret.txt",
-          "/secret.txt", "/study.toml", "/a.png"}) {
+    for (const std::string& target : std::vector<std::string>{
+             "/images/../study.toml", "/images/..%2fstudy.toml",
+             "/images/%2e%2e%2fstudy.toml", "/images/%2E%2E/secret.txt",
+             "/images/%252e%252e%252fsecret.txt", "/images/a.png%00.txt",
+             "/../secret.txt", "/%2e%2e/secret.txt", "/images/..%5csecret.txt",
+             "/images/" + db_name, "/images/../" + db_name, "/etc/passwd",
+             "/../../../../etc/passwd", "/images/a.png/../../secret.txt", "/secret.txt",
+             "/study.toml", "/a.png"}) {
         auto r = http.Get(target.c_str());
         ASSERT_TRUE(r) << target;
         EXPECT_EQ(r->status, 404) << target;
@@ -88,7 +96,8 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     }
     // No endpoint reads data out: unknown API names, other methods.
     for (const char* name : {"export", "responses", "participants", "sessions", "dump"}) {
-        auto r = http.Post((std::string("/api/") + name).c_str(), "{}", "application/json");
+        auto r =
+            http.Post((std::string("/api/") + name).c_str(), "{}", "application/json");
         ASSERT_TRUE(r);
         EXPECT_EQ(r->status, 404) << name;
     }
@@ -113,7 +122,8 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     post("session", "{\"participant\": ", 400);
     post("session", "{\"participant\": \"\xff\"}", 400);
     post("session", json{{"participant", "../../P1"}, {"t_ms", 1}}.dump(), 400);
-    post("session", json{{"participant", std::string(1000, 'x')}, {"t_ms", 1}}.dump(), 400);
+    post("session", json{{"participant", std::string(1000, 'x')}, {"t_ms", 1}}.dump(),
+         400);
     // A number beyond a double: 400 naming the field, not a 500 (issue 26 item 10).
     post("session", "{\"participant\": \"P1\", \"t_ms\": 1e999}", 400);
     {
@@ -169,7 +179,8 @@ TEST_P(ServeHttp, FiftyParticipantsAtOnceOverHttpLoseAndDuplicateNothing) {
             page.catch_rating = 5;
             page.open({{"participant", "W" + std::to_string(i + 1)}});
             page.run();
-            if (page.state["screen"] == "done" && page.state["completion"]["code"] == "C0DE42" &&
+            if (page.state["screen"] == "done" &&
+                page.state["completion"]["code"] == "C0DE42" &&
                 page.shown.size() == size_t(lucent::test::kServeStudyTrials))
                 ++done;
         });
@@ -178,14 +189,18 @@ TEST_P(ServeHttp, FiftyParticipantsAtOnceOverHttpLoseAndDuplicateNothing) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_EQ(done, kPages);
     EXPECT_LT(seconds, 60.0);
-    std::printf("[ measured ] %d participants x %d trials over HTTP (%s): %.2f s, %.0f trials/s\n",
-                kPages, lucent::test::kServeStudyTrials, GetParam().c_str(), seconds,
-                kPages * lucent::test::kServeStudyTrials / seconds);
+    std::printf(
+        "[ measured ] %d participants x %d trials over HTTP (%s): %.2f s, %.0f "
+        "trials/s\n",
+        kPages, lucent::test::kServeStudyTrials, GetParam().c_str(), seconds,
+        kPages * lucent::test::kServeStudyTrials / seconds);
     EXPECT_EQ(server_->stop(), 0);
-    EXPECT_EQ(count("SELECT count(*) FROM responses"), kPages * lucent::test::kServeStudyTrials * 2);
-    EXPECT_EQ(count("SELECT count(*) FROM (SELECT trial_id, question FROM responses GROUP BY "
-                    "trial_id, question HAVING count(*) > 1) d"),
-              0);
+    EXPECT_EQ(count("SELECT count(*) FROM responses"),
+              kPages * lucent::test::kServeStudyTrials * 2);
+    EXPECT_EQ(
+        count("SELECT count(*) FROM (SELECT trial_id, question FROM responses GROUP BY "
+              "trial_id, question HAVING count(*) > 1) d"),
+        0);
     EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), kPages);
     // Catch trials answered as asked (5 on both scales), so nobody is excluded.
     EXPECT_EQ(count("SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
@@ -196,7 +211,8 @@ TEST_P(ServeHttp, FiftyParticipantsAtOnceOverHttpLoseAndDuplicateNothing) {
 // Issue 26 item 10: slow clients trickling header lines are cut at the request deadline,
 // so two of them cannot hold a 2-worker server; a normal request is answered promptly.
 TEST_P(ServeHttp, SlowClientsTricklingHeadersAreCutAndANormalRequestIsAnswered) {
-    if (GetParam() != "sqlite") GTEST_SKIP() << "the HTTP layer is the same for every store";
+    if (GetParam() != "sqlite")
+        GTEST_SKIP() << "the HTTP layer is the same for every store";
     server_.reset();
     server_ = std::make_unique<lucent::test::ServeProcess>(
         protocol_, db_, dir_.string(),
@@ -223,14 +239,18 @@ TEST_P(ServeHttp, SlowClientsTricklingHeadersAreCutAndANormalRequestIsAnswered) 
     std::vector<std::thread> trickle;
     for (int fd : slow)
         trickle.emplace_back([&, fd] {
-            while (!stop && std::chrono::steady_clock::now() - start < std::chrono::seconds(4)) {
+            while (!stop &&
+                   std::chrono::steady_clock::now() - start < std::chrono::seconds(4)) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(200));
                 const std::string header = "X-Slow: 1\r\n";
                 char byte = 0;
-                const bool closed = ::send(fd, header.data(), header.size(), MSG_NOSIGNAL) < 0 ||
-                                    ::recv(fd, &byte, 1, MSG_DONTWAIT) == 0;
+                const bool closed =
+                    ::send(fd, header.data(), header.size(), MSG_NOSIGNAL) < 0 ||
+                    ::recv(fd, &byte, 1, MSG_DONTWAIT) == 0;
                 if (closed) {
-                    cut_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                    cut_after = std::chrono::duration<double>(
+                                    std::chrono::steady_clock::now() - start)
+                                    .count();
                     ++cut;
                     return;
                 }
@@ -248,17 +268,19 @@ TEST_P(ServeHttp, SlowClientsTricklingHeadersAreCutAndANormalRequestIsAnswered) 
     for (int fd : slow) ::close(fd);
     ASSERT_TRUE(page);
     EXPECT_EQ(page->status, 200);
-    // Within the 0.5 s deadline plus the watchdog's tick and scheduling, far below the 4 s
-    // the slow clients would otherwise hold both workers.
+    // Within the 0.5 s deadline plus the watchdog's tick and scheduling, far below the 4
+    // s the slow clients would otherwise hold both workers.
     EXPECT_LT(answered_s, 2.0);
     EXPECT_EQ(cut, 2);
     EXPECT_LT(cut_after.load(), 2.5);
-    std::printf("[ measured ] a normal request answered after %.2f s beside 2 slow clients\n",
-                answered_s);
+    std::printf(
+        "[ measured ] a normal request answered after %.2f s beside 2 slow clients\n",
+        answered_s);
     EXPECT_EQ(server_->stop(), 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Stores, ServeHttp, ::testing::Values("sqlite", "postgresql"), param_name);
+INSTANTIATE_TEST_SUITE_P(Stores, ServeHttp, ::testing::Values("sqlite", "postgresql"),
+                         param_name);
 
 }  // namespace
 }  // namespace lucent::study

@@ -22,8 +22,13 @@ namespace lucent::test {
 // Four pictures of one colour each (64 x 48), a practice trial, a catch trial and a
 // 5-point second question; breaks after every 2 main trials.
 inline std::string write_serve_study(const std::filesystem::path& dir) {
-    const struct { const char* id; unsigned char rgb[3]; } pictures[] = {
-        {"a", {200, 30, 30}}, {"b", {30, 200, 30}}, {"c", {30, 30, 200}}, {"p", {200, 200, 30}}};
+    const struct {
+        const char* id;
+        unsigned char rgb[3];
+    } pictures[] = {{"a", {200, 30, 30}},
+                    {"b", {30, 200, 30}},
+                    {"c", {30, 30, 200}},
+                    {"p", {200, 200, 30}}};
     for (const auto& pic : pictures) {
         std::vector<unsigned char> pixels(64 * 48 * 3);
         for (size_t i = 0; i < pixels.size(); ++i) pixels[i] = pic.rgb[i % 3];
@@ -91,7 +96,8 @@ inline constexpr int kServeStudyTrials = 5;  // 1 practice + 3 rated + 1 catch
 class ServeProcess {
 public:
     // `state_dir`: the server's journal and key folder (LUCENT_JOURNAL_DIR).
-    ServeProcess(const std::string& protocol, const std::string& db, const std::string& state_dir,
+    ServeProcess(const std::string& protocol, const std::string& db,
+                 const std::string& state_dir,
                  const std::vector<std::string>& extra_args = {}) {
         int out[2];
         if (pipe(out) != 0) return;
@@ -101,8 +107,9 @@ public:
             close(out[0]);
             close(out[1]);
             setenv("LUCENT_JOURNAL_DIR", state_dir.c_str(), 1);
-            std::vector<std::string> args = {LUCENT_EXECUTABLE, "serve", protocol, "--db", db,
-                                             "--listen", "127.0.0.1:0"};
+            std::vector<std::string> args = {
+                LUCENT_EXECUTABLE, "serve",      protocol, "--db", db,
+                "--listen",        "127.0.0.1:0"};
             args.insert(args.end(), extra_args.begin(), extra_args.end());
             std::vector<char*> argv;
             for (std::string& a : args) argv.push_back(a.data());
@@ -111,7 +118,8 @@ public:
             _exit(127);
         }
         close(out[1]);
-        // The first line names the address: "... on http://127.0.0.1:PORT/?participant=ID".
+        // The first line names the address: "... on
+        // http://127.0.0.1:PORT/?participant=ID".
         std::string line;
         char c = 0;
         while (read(out[0], &c, 1) == 1 && c != '\n') line += c;
@@ -148,9 +156,11 @@ private:
 // The API over HTTP, one keep-alive connection per page.
 inline Transport over_http(httplib::Client& client) {
     return [&client](const std::string& endpoint, const std::string& body) {
-        const auto r = client.Post(("/api/" + endpoint).c_str(), body, "application/json");
+        const auto r =
+            client.Post(("/api/" + endpoint).c_str(), body, "application/json");
         if (!r)
-            return study::WebReply{0, json{{"error", "no reply: " + httplib::to_string(r.error())}}.dump()};
+            return study::WebReply{
+                0, json{{"error", "no reply: " + httplib::to_string(r.error())}}.dump()};
         return study::WebReply{r->status, r->body};
     };
 }

@@ -3,9 +3,9 @@
 // (JSON bodies, performance.now() times, the input events of each answer) over any
 // transport: WebStudy::handle directly, or HTTP to a running `lucent serve`.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -14,7 +14,8 @@
 namespace lucent::test {
 
 using nlohmann::json;
-using Transport = std::function<study::WebReply(const std::string& endpoint, const std::string& body)>;
+using Transport =
+    std::function<study::WebReply(const std::string& endpoint, const std::string& body)>;
 
 inline Transport direct(study::WebStudy& web) {
     return [&web](const std::string& endpoint, const std::string& body) {
@@ -48,9 +49,12 @@ struct Page {
     void open(const json& who, int expected = 200) {
         json body = who;
         body["t_ms"] = now;
-        body["client"] = {{"user_agent", "TestBrowser/1.0"}, {"window_width", 1280},
-                          {"window_height", 900},         {"device_pixel_ratio", 2},
-                          {"screen_width", 2560},           {"screen_height", 1440}};
+        body["client"] = {{"user_agent", "TestBrowser/1.0"},
+                          {"window_width", 1280},
+                          {"window_height", 900},
+                          {"device_pixel_ratio", 2},
+                          {"screen_width", 2560},
+                          {"screen_height", 1440}};
         const json reply = call("session", body, expected);
         if (expected != 200 || !reply.is_object()) return;
         if (reply.contains("token")) token = reply["token"];
@@ -59,7 +63,8 @@ struct Page {
     void enter() {
         const double shown_at = now;
         now += 300;
-        state = call("continue", {{"view", state["view"]}, {"shown_ms", shown_at}, {"t_ms", now}});
+        state = call("continue",
+                     {{"view", state["view"]}, {"shown_ms", shown_at}, {"t_ms", now}});
     }
     // The page's answer to the trial on screen: each question clicked 100 ms apart after
     // the onset, then Next. Returns the onset.
@@ -70,10 +75,14 @@ struct Page {
         const int n = static_cast<int>(state["questions"].size());
         const bool is_catch = !trial["prompt"].get<std::string>().empty();
         for (int q = 0; q < n; ++q)
-            events.push_back({{"t_ms", onset + 100.0 * (q + 1)}, {"type", "point"},
-                              {"question", q}, {"value", page_rating(k, q, is_catch, catch_rating)}});
+            events.push_back({{"t_ms", onset + 100.0 * (q + 1)},
+                              {"type", "point"},
+                              {"question", q},
+                              {"value", page_rating(k, q, is_catch, catch_rating)}});
         events.push_back({{"t_ms", onset + 100.0 * (n + 1)}, {"type", "next"}});
-        return {{"trial", trial["id"]}, {"view", state["view"]}, {"onset_ms", onset},
+        return {{"trial", trial["id"]},
+                {"view", state["view"]},
+                {"onset_ms", onset},
                 {"events", events}};
     }
     void answer(int k) {

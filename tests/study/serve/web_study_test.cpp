@@ -6,51 +6,56 @@
 #include "serve/web_study.h"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
 
-#include "../study_fixtures.h"
-#include "web_page.h"
 #include "../postgres/server_environment.h"
+#include "../study_fixtures.h"
 #include "store.h"
 #include "study_store.h"
 #include "test_paths.h"
+#include "web_page.h"
 
 namespace lucent::study {
 namespace {
 
-using nlohmann::json;
-using lucent::test::Page;
 using lucent::test::direct;
+using lucent::test::Page;
 using lucent::test::page_rating;
+using nlohmann::json;
 
 std::string web_protocol_text() {
     return std::string(lucent::test::kSmallProtocol) +
-           "\n[screens]\nconsent = \"Do you agree?\"\ninstructions = \"Rate each picture.\"\n"
+           "\n[screens]\nconsent = \"Do you agree?\"\ninstructions = \"Rate each "
+           "picture.\"\n"
            "debrief = \"Thank you.\"\n\n[online]\ncompletion_code = \"C0DE42\"\n"
-           "completion_url = \"https://app.prolific.com/submissions/complete?cc=C0DE42\"\n";
+           "completion_url = "
+           "\"https://app.prolific.com/submissions/complete?cc=C0DE42\"\n";
 }
 
-// Trials a session of the protocol plans: practice, each block stimulus per repeat, catch.
+// Trials a session of the protocol plans: practice, each block stimulus per repeat,
+// catch.
 size_t planned_trials(const Protocol& p) {
     size_t n = p.practice.size() + p.catch_trials.size();
-    for (const Block& b : p.blocks) n += b.stimuli.size() * static_cast<size_t>(b.repeats);
+    for (const Block& b : p.blocks)
+        n += b.stimuli.size() * static_cast<size_t>(b.repeats);
     return n;
 }
-
 
 class Serve : public ::testing::TestWithParam<std::string> {
 protected:
     void SetUp() override {
-        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        const std::string test =
+            ::testing::UnitTest::GetInstance()->current_test_info()->name();
         std::string slug;
         for (char c : test)
-            slug += std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
+            slug +=
+                std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
         dir_ = lucent::test::scratch_dir("serve_" + slug);
         if (GetParam() == "sqlite") {
             db_ = (dir_ / "study.db").string();
@@ -122,7 +127,9 @@ protected:
     std::chrono::system_clock::time_point now_ = std::chrono::system_clock::now();
 };
 
-std::string param_name(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
+    return info.param;
+}
 
 TEST_P(Serve, APageCompletesTheWholeProtocolAndEveryAnswerIsStoredAsSent) {
     Page page{direct(*web_)};
@@ -174,23 +181,26 @@ TEST_P(Serve, APageCompletesTheWholeProtocolAndEveryAnswerIsStoredAsSent) {
     for (size_t k = 0; k < n; ++k)
         for (size_t q = 0; q < protocol_.questions.size(); ++q) {
             const int rating = page_rating(int(k), int(q), trials[k].is_catch);
-            EXPECT_EQ(count("SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
-                            "WHERE t.uuid = '" + trials[k].uuid + "' AND r.question = '" +
-                            protocol_.questions[q].id + "' AND r.rating = " +
-                            std::to_string(rating) + " AND abs(r.rt_ms - " +
-                            std::to_string(100 * (q + 1)) + ") < 0.001 AND r.changes = 0"),
-                      1)
+            EXPECT_EQ(
+                count(
+                    "SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
+                    "WHERE t.uuid = '" +
+                    trials[k].uuid + "' AND r.question = '" + protocol_.questions[q].id +
+                    "' AND r.rating = " + std::to_string(rating) + " AND abs(r.rt_ms - " +
+                    std::to_string(100 * (q + 1)) + ") < 0.001 AND r.changes = 0"),
+                1)
                 << "trial " << k << " question " << q;
         }
     EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed' AND "
                     "consent_utc IS NOT NULL"),
               1);
     // The browser's details on the session's segment.
-    EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE gl_vendor = 'web browser' "
-                    "AND gl_renderer = 'TestBrowser/1.0' AND display_mode = 'browser window "
-                    "1280x900 CSS px, devicePixelRatio 2, screen 2560x1440' AND "
-                    "machine_id = 'server-machine'"),
-              1);
+    EXPECT_EQ(
+        count("SELECT count(*) FROM session_segments WHERE gl_vendor = 'web browser' "
+              "AND gl_renderer = 'TestBrowser/1.0' AND display_mode = 'browser window "
+              "1280x900 CSS px, devicePixelRatio 2, screen 2560x1440' AND "
+              "machine_id = 'server-machine'"),
+        1);
     EXPECT_EQ(web_->live_sessions(), 0u);
     // A return after completion shows the completion page and starts nothing.
     Page again{direct(*web_)};
@@ -207,13 +217,15 @@ TEST_P(Serve, TheRefreshEstimateIsStoredWithTheSegment) {
     // Kept in memory on the consent screen; stored with the segment once they agree.
     EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 0);
     page.enter();
-    EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE abs(measured_refresh_hz - "
-                    "59.94) < 1e-9"),
-              1);
+    EXPECT_EQ(
+        count("SELECT count(*) FROM session_segments WHERE abs(measured_refresh_hz - "
+              "59.94) < 1e-9"),
+        1);
     page.call("environment", {{"refresh_hz", 120}});
-    EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE abs(measured_refresh_hz - "
-                    "120) < 1e-9"),
-              1);
+    EXPECT_EQ(
+        count("SELECT count(*) FROM session_segments WHERE abs(measured_refresh_hz - "
+              "120) < 1e-9"),
+        1);
     page.call("environment", {{"refresh_hz", 0}}, 400);
     page.call("environment", {{"refresh_hz", "fast"}}, 400);
 }
@@ -229,12 +241,17 @@ TEST_P(Serve, ProlificIdsNameTheParticipantAndAreStored) {
     // Nothing of them is stored before they agree (issue 26 item 5).
     EXPECT_EQ(count("SELECT count(*) FROM participants"), 0);
     page.enter();
-    EXPECT_EQ(count("SELECT count(*) FROM participants WHERE code = '5f1a2b3c4d5e6f7a8b9c0d1e'"), 1);
-    EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE display_mode LIKE "
-                    "'%; Prolific STUDY_ID=60aabbccddeeff0011223344 SESSION_ID=abc123XYZ'"),
-              1);
+    EXPECT_EQ(
+        count(
+            "SELECT count(*) FROM participants WHERE code = '5f1a2b3c4d5e6f7a8b9c0d1e'"),
+        1);
+    EXPECT_EQ(
+        count("SELECT count(*) FROM session_segments WHERE display_mode LIKE "
+              "'%; Prolific STUDY_ID=60aabbccddeeff0011223344 SESSION_ID=abc123XYZ'"),
+        1);
     Page other{direct(*web_)};
-    other.open({{"participant", "someone"}, {"prolific", {{"PROLIFIC_PID", "else"}}}}, 400);
+    other.open({{"participant", "someone"}, {"prolific", {{"PROLIFIC_PID", "else"}}}},
+               400);
     other.open({{"prolific", {{"PROLIFIC_PID", "x"}, {"STUDY_ID", "a/b"}}}}, 400);
 }
 
@@ -271,15 +288,15 @@ TEST_P(Serve, AReloadOrARestartResumesAtTheFirstUnansweredTrialOnlyWithTheToken)
         EXPECT_EQ(count("SELECT count(*) FROM session_segments"), segments);
         return page;
     };
-    resume(2);                  // a reload: segment 1 holds answers, so segment 2 begins
-    start_server();             // the server restarted: the token still holds
+    resume(2);       // a reload: segment 1 holds answers, so segment 2 begins
+    start_server();  // the server restarted: the token still holds
     // Nothing was answered in segment 2: the reload replaces it rather than adding one.
     Page page = resume(2);
     page.shown = shown;
     page.run();
     EXPECT_EQ(page.state["screen"], "done");
-    EXPECT_EQ(responses(),
-              static_cast<int64_t>(planned_trials(protocol_) * protocol_.questions.size()));
+    EXPECT_EQ(responses(), static_cast<int64_t>(planned_trials(protocol_) *
+                                                protocol_.questions.size()));
 }
 
 // The hostile requests of issue 16: each a 4xx with one line, and nothing stored.
@@ -292,7 +309,8 @@ TEST_P(Serve, HostileRequestsAreRefusedWithOneLineAndStoreNothing) {
     other.run(1);
     while (page.state["screen"] != "trial") page.enter();
     const int64_t stored = responses();
-    const int64_t answered = count("SELECT count(*) FROM trials WHERE answered_utc IS NOT NULL");
+    const int64_t answered =
+        count("SELECT count(*) FROM trials WHERE answered_utc IS NOT NULL");
     auto refused = [&](const std::string& endpoint, const std::string& body, int status,
                        const std::string& reason) {
         const WebReply r = web_->handle(endpoint, body);
@@ -310,47 +328,81 @@ TEST_P(Serve, HostileRequestsAreRefusedWithOneLineAndStoreNothing) {
         edit(body);
         return body.dump();
     };
-    refused("answer", with([](json& b) { b["events"][0]["value"] = 0; }), 400, "rating 0 is outside 1..7");
-    refused("answer", with([](json& b) { b["events"][0]["value"] = 8; }), 400, "rating 8 is outside 1..7");
-    refused("answer", with([](json& b) { b["events"][0]["value"] = 2.5; }), 400, "outside 1..7");
-    refused("answer", with([](json& b) { b["events"][0]["question"] = 2; }), 400, "question index 2");
-    refused("answer", with([](json& b) { b["events"][0] = {{"t_ms", 1e4}, {"type", "key"}, {"key", "8"}}; }),
+    refused("answer", with([](json& b) { b["events"][0]["value"] = 0; }), 400,
+            "rating 0 is outside 1..7");
+    refused("answer", with([](json& b) { b["events"][0]["value"] = 8; }), 400,
+            "rating 8 is outside 1..7");
+    refused("answer", with([](json& b) { b["events"][0]["value"] = 2.5; }), 400,
+            "outside 1..7");
+    refused("answer", with([](json& b) { b["events"][0]["question"] = 2; }), 400,
+            "question index 2");
+    refused("answer", with([](json& b) {
+                b["events"][0] = {{"t_ms", 1e4}, {"type", "key"}, {"key", "8"}};
+            }),
             400, "key '8' is outside every scale");
-    refused("answer", with([](json& b) { b["events"][0] = {{"t_ms", 1e4}, {"type", "key"}, {"key", "Escape"}}; }),
+    refused("answer", with([](json& b) {
+                b["events"][0] = {{"t_ms", 1e4}, {"type", "key"}, {"key", "Escape"}};
+            }),
             400, "unknown key");
-    refused("answer", with([](json& b) { b["events"].erase(b["events"].size() - 1); }), 400,
-            "do not rate every question and confirm");
+    refused("answer", with([](json& b) { b["events"].erase(b["events"].size() - 1); }),
+            400, "do not rate every question and confirm");
     // Answered before the picture was on screen (events stamped before the onset).
     refused("answer", with([](json& b) {
                 for (json& e : b["events"]) e["t_ms"] = b["onset_ms"].get<double>() - 1;
             }),
             400, "do not rate every question");
     refused("answer", with([](json& b) { b["onset_ms"] = 0; }), 400, "blank ended");
-    refused("answer", with([](json& b) { b["events"][0]["t_ms"] = nullptr; }), 400, "'t_ms' is required");
-    refused("answer", with([](json& b) { b["events"][0]["t_ms"] = -5; }), 400, "'t_ms' must lie in");
-    refused("answer", with([](json& b) { b["events"] = json::array(); for (int i = 0; i < 600; ++i) b["events"].push_back({{"t_ms", 1}, {"type", "next"}}); }),
+    refused("answer", with([](json& b) { b["events"][0]["t_ms"] = nullptr; }), 400,
+            "'t_ms' is required");
+    refused("answer", with([](json& b) { b["events"][0]["t_ms"] = -5; }), 400,
+            "'t_ms' must lie in");
+    refused("answer", with([](json& b) {
+                b["events"] = json::array();
+                for (int i = 0; i < 600; ++i)
+                    b["events"].push_back({{"t_ms", 1}, {"type", "next"}});
+            }),
             400, "more than 500 events");
-    refused("answer", with([&](json& b) { b["trial"] = page.shown[0]; }), 409, "trial 1 is already answered");
-    refused("answer", with([&](json& b) { b["trial"] = other.shown[0]; }), 404, "not one of this session's trials");
-    refused("answer", with([&](json& b) { b["token"] = other.token; }), 404, "not one of this session's trials");
-    refused("answer", with([&](json& b) { b["view"] = b["view"].get<int>() + 7; }), 409, "no longer shown");
-    refused("answer", with([&](json& b) { b["token"] = "P4.0000"; }), 403, "unknown session token");
-    refused("answer", with([&](json& b) { b["token"] = "../../etc.x"; }), 403, "unknown session token");
+    refused("answer", with([&](json& b) { b["trial"] = page.shown[0]; }), 409,
+            "trial 1 is already answered");
+    refused("answer", with([&](json& b) { b["trial"] = other.shown[0]; }), 404,
+            "not one of this session's trials");
+    refused("answer", with([&](json& b) { b["token"] = other.token; }), 404,
+            "not one of this session's trials");
+    refused("answer", with([&](json& b) { b["view"] = b["view"].get<int>() + 7; }), 409,
+            "no longer shown");
+    refused("answer", with([&](json& b) { b["token"] = "P4.0000"; }), 403,
+            "unknown session token");
+    refused("answer", with([&](json& b) { b["token"] = "../../etc.x"; }), 403,
+            "unknown session token");
     refused("answer", "{\"token\": ", 400, "malformed JSON");
     refused("answer", "[1, 2]", 400, "must be a JSON object");
     refused("answer", "{\"token\": \"\xff\xfe\"}", 400, "malformed JSON");  // not UTF-8
     refused("answer", "{\"token\": 5}", 400, "'token' must be a string");
     refused("answer", std::string(70 * 1024, ' '), 413, "over the limit");
-    refused("answer", with([](json& b) { b["trial"] = std::string(5000, 'a'); }), 400, "longer than");
+    refused("answer", with([](json& b) { b["trial"] = std::string(5000, 'a'); }), 400,
+            "longer than");
     refused("wipe", "{}", 404, "no API endpoint");
-    refused("continue", json{{"token", page.token}, {"view", page.state["view"]}, {"shown_ms", 1}, {"t_ms", 2}}.dump(),
+    refused("continue",
+            json{{"token", page.token},
+                 {"view", page.state["view"]},
+                 {"shown_ms", 1},
+                 {"t_ms", 2}}
+                .dump(),
             409, "not continued with Enter");
-    for (const std::string& code : std::vector<std::string>{"", "a b", "../P1", "P1;DROP TABLE", "<script>", std::string(65, 'x'), "P\xc3\xa9"})
-        refused("session", json{{"participant", code}, {"t_ms", 1}}.dump(), 400, "participant code");
+    for (const std::string& code :
+         std::vector<std::string>{"", "a b", "../P1", "P1;DROP TABLE", "<script>",
+                                  std::string(65, 'x'), "P\xc3\xa9"})
+        refused("session", json{{"participant", code}, {"t_ms", 1}}.dump(), 400,
+                "participant code");
     refused("session", json{{"t_ms", 1}}.dump(), 400, "no participant code");
-    refused("session", json{{"participant", "P9"}, {"t_ms", 1}, {"client", {{"user_agent", std::string(600, 'u')}}}}.dump(),
+    refused("session",
+            json{{"participant", "P9"},
+                 {"t_ms", 1},
+                 {"client", {{"user_agent", std::string(600, 'u')}}}}
+                .dump(),
             400, "'user_agent' is longer than 512");
-    EXPECT_EQ(count("SELECT count(*) FROM trials WHERE answered_utc IS NOT NULL"), answered);
+    EXPECT_EQ(count("SELECT count(*) FROM trials WHERE answered_utc IS NOT NULL"),
+              answered);
     EXPECT_EQ(count("SELECT count(*) FROM participants"), 2);
     // The page still answers its trial afterwards: nothing above changed its state.
     page.answer(1);
@@ -363,18 +415,25 @@ TEST_P(Serve, TheConsentScreenCanBeDeclinedAndADoubleEnterActsOnce) {
     const json consent = page.state;
     page.enter();  // agreed; on the instructions now
     // The same Enter again (a double press, a second tab): the view it names is gone.
-    const WebReply again = web_->handle(
-        "continue", json{{"token", page.token}, {"view", consent["view"]}, {"shown_ms", 1}, {"t_ms", 2}}.dump());
+    const WebReply again = web_->handle("continue", json{{"token", page.token},
+                                                         {"view", consent["view"]},
+                                                         {"shown_ms", 1},
+                                                         {"t_ms", 2}}
+                                                        .dump());
     EXPECT_EQ(again.status, 409);
     EXPECT_EQ(page.state["screen"], "instructions");
     // A key stamped before its screen was shown counts for nothing.
-    const WebReply early = web_->handle(
-        "continue", json{{"token", page.token}, {"view", page.state["view"]}, {"shown_ms", 5000}, {"t_ms", 4000}}.dump());
+    const WebReply early = web_->handle("continue", json{{"token", page.token},
+                                                         {"view", page.state["view"]},
+                                                         {"shown_ms", 5000},
+                                                         {"t_ms", 4000}}
+                                                        .dump());
     EXPECT_EQ(early.status, 400) << early.body;
 
     Page no{direct(*web_)};
     no.open({{"participant", "P7"}});
-    const json declined = no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
+    const json declined =
+        no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
     EXPECT_EQ(declined["screen"], "declined");
     // Declined: no participant, no session; only the count (issue 26 item 5).
     EXPECT_EQ(count("SELECT count(*) FROM participants WHERE code = 'P7'"), 0);
@@ -402,15 +461,17 @@ TEST_P(Serve, FiftyParticipantsAtOnceLoseAndDuplicateNothing) {
     EXPECT_EQ(finished, kPages);
     const int64_t n = static_cast<int64_t>(planned_trials(protocol_));
     EXPECT_EQ(responses(), kPages * n * static_cast<int64_t>(protocol_.questions.size()));
-    EXPECT_EQ(count("SELECT count(*) FROM (SELECT trial_id, question FROM responses GROUP BY "
-                    "trial_id, question HAVING count(*) > 1) d"),
-              0);
+    EXPECT_EQ(
+        count("SELECT count(*) FROM (SELECT trial_id, question FROM responses GROUP BY "
+              "trial_id, question HAVING count(*) > 1) d"),
+        0);
     EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), kPages);
     EXPECT_EQ(count("SELECT count(DISTINCT number) FROM participants"), kPages);
     for (int i = 0; i < kPages; ++i) EXPECT_EQ(static_cast<int64_t>(shown[i].size()), n);
 }
 
-// ---- issue 26: consent first, claims that end, arrival-order cells, bounded rows --------
+// ---- issue 26: consent first, claims that end, arrival-order cells, bounded rows
+// --------
 
 // Item 5: before consent nothing of the person is stored; a decline leaves only a count.
 TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
@@ -422,7 +483,9 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
         EXPECT_EQ(count("SELECT count(*) FROM segment_stimuli"), 0) << when;
         EXPECT_EQ(count("SELECT count(*) FROM trials"), 0) << when;
         EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE gl_renderer LIKE "
-                        "'%TestBrowser%' OR display_mode LIKE '%" + pid + "%' OR display_mode "
+                        "'%TestBrowser%' OR display_mode LIKE '%" +
+                        pid +
+                        "%' OR display_mode "
                         "LIKE '%60aabbcc%'"),
                   0)
             << when;
@@ -442,9 +505,11 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
     nothing_of_them("after a reload and the refresh estimate");
     EXPECT_EQ(web_->pending_sessions(), 1u);
 
-    const json declined = page.call("decline", {{"view", page.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
+    const json declined = page.call(
+        "decline", {{"view", page.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
     EXPECT_EQ(declined["screen"], "declined");
-    EXPECT_NE(declined["text"].get<std::string>().find("Nothing of yours was stored"), std::string::npos);
+    EXPECT_NE(declined["text"].get<std::string>().find("Nothing of yours was stored"),
+              std::string::npos);
     nothing_of_them("after the decline");
     EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
     EXPECT_EQ(web_->pending_sessions(), 0u);
@@ -455,7 +520,8 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
     // A second person declines: the count only grows.
     Page second{direct(*web_)};
     second.open({{"participant", "P2"}});
-    second.call("decline", {{"view", second.state["view"]}, {"shown_ms", 10}, {"t_ms", 20}});
+    second.call("decline",
+                {{"view", second.state["view"]}, {"shown_ms", 10}, {"t_ms", 20}});
     EXPECT_EQ(count("SELECT declined FROM consent_declines"), 2);
     nothing_of_them("after the second decline");
 
@@ -492,7 +558,8 @@ TEST_P(Serve, CompletedSessionsLeaveNoClaimBehind) {
         page.run();
         ASSERT_EQ(page.state["screen"], "done");
     }
-    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), kSessions);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              kSessions);
     if (GetParam() == "postgresql")
         EXPECT_EQ(count("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' AND "
                         "pid = pg_backend_pid()"),
@@ -533,7 +600,8 @@ TEST_P(Serve, AParticipantWhoGaveUpOnlineCanBeRunOnALabStationAfterTheIdleTimeou
         EXPECT_NO_THROW(station->claim_participant("G1"));
         // While the station runs them, the page's return is refused and changes nothing.
         const WebReply busy = web_->handle(
-            "session", json{{"participant", "G1"}, {"token", page.token}, {"t_ms", 5}}.dump());
+            "session",
+            json{{"participant", "G1"}, {"token", page.token}, {"t_ms", 5}}.dump());
         EXPECT_EQ(busy.status, 409) << busy.body;
     }
     // The station is done with them: the page re-loads at its first unanswered trial.
@@ -550,7 +618,8 @@ TEST_P(Serve, AParticipantWhoGaveUpOnlineCanBeRunOnALabStationAfterTheIdleTimeou
 
 std::string four_block_protocol_text() {
     std::string text = web_protocol_text();
-    const std::string main = "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
+    const std::string main =
+        "[[blocks]]\nid = \"main\"\nstimuli = [\"a\", \"b\", \"c\"]\n";
     text.replace(text.find(main), main.size(),
                  "[[blocks]]\nid = \"main\"\nstimuli = [\"a\"]\n\n"
                  "[[blocks]]\nid = \"second\"\nstimuli = [\"b\"]\n\n"
@@ -566,8 +635,8 @@ TEST_P(Serve, OnlineArrivalsAreBalancedAcrossCellsWhateverTheirCodes) {
     ASSERT_EQ(latin_square_rows(4), 4);
     // A Prolific id, two codes with the same trailing digit, digitless codes, one whose
     // digits would name a later participant.
-    const std::vector<std::string> codes = {"5f3a9c1b2d4e6f708192a3b4", "-A1", "P01", "abc",
-                                            "P06", "xyz", "Q7", "a-b_c"};
+    const std::vector<std::string> codes = {
+        "5f3a9c1b2d4e6f708192a3b4", "-A1", "P01", "abc", "P06", "xyz", "Q7", "a-b_c"};
     std::vector<Page> pages;
     for (const std::string& code : codes) {
         pages.push_back(Page{direct(*web_)});
@@ -577,22 +646,28 @@ TEST_P(Serve, OnlineArrivalsAreBalancedAcrossCellsWhateverTheirCodes) {
     }
     // Numbers 1..8 in arrival order, never from the codes.
     for (size_t i = 0; i < codes.size(); ++i)
-        EXPECT_EQ(count("SELECT number FROM participants WHERE code = '" + codes[i] + "'"),
-                  static_cast<int64_t>(i + 1))
+        EXPECT_EQ(
+            count("SELECT number FROM participants WHERE code = '" + codes[i] + "'"),
+            static_cast<int64_t>(i + 1))
             << codes[i];
     // Each of the 4 cells twice; -A1 and P01 apart.
     for (int cell = 0; cell < 4; ++cell)
-        EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE cell = " + std::to_string(cell)), 2)
+        EXPECT_EQ(
+            count("SELECT count(*) FROM sessions WHERE cell = " + std::to_string(cell)),
+            2)
             << "cell " << cell;
     auto cell_of = [&](const std::string& code) {
-        return count("SELECT s.cell FROM sessions s JOIN participants p ON p.id = "
-                     "s.participant_id WHERE p.code = '" + code + "'");
+        return count(
+            "SELECT s.cell FROM sessions s JOIN participants p ON p.id = "
+            "s.participant_id WHERE p.code = '" +
+            code + "'");
     };
     EXPECT_NE(cell_of("-A1"), cell_of("P01"));
     // Every allocation is recorded: arrival, cell, the counts it saw.
-    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE allocation LIKE 'online arrival %: "
-                    "cell % of 4, the fewest completed + active sessions (per cell %'"),
-              8);
+    EXPECT_EQ(
+        count("SELECT count(*) FROM sessions WHERE allocation LIKE 'online arrival %: "
+              "cell % of 4, the fewest completed + active sessions (per cell %'"),
+        8);
     EXPECT_EQ(count("SELECT count(*) FROM sessions s JOIN participants p ON p.id = "
                     "s.participant_id WHERE p.code = 'P01' AND s.allocation LIKE "
                     "'online arrival 3: cell % of 4, % (per cell %'"),
@@ -623,11 +698,14 @@ TEST_P(Serve, OnlineArrivalsAreBalancedAcrossCellsWhateverTheirCodes) {
     expected_counts[static_cast<size_t>(ninth_cell)] = 3;
     expected_counts[static_cast<size_t>(abandoned_cell)] = 1;
     std::string per_cell;
-    for (int64_t n : expected_counts) per_cell += (per_cell.empty() ? "" : ",") + std::to_string(n);
+    for (int64_t n : expected_counts)
+        per_cell += (per_cell.empty() ? "" : ",") + std::to_string(n);
     EXPECT_EQ(count("SELECT count(*) FROM sessions s JOIN participants p ON p.id = "
                     "s.participant_id WHERE p.code = 'N10' AND s.allocation LIKE "
-                    "'online arrival 10: cell " + std::to_string(abandoned_cell) +
-                    " of 4, the fewest completed + active sessions (per cell " + per_cell + ";%'"),
+                    "'online arrival 10: cell " +
+                    std::to_string(abandoned_cell) +
+                    " of 4, the fewest completed + active sessions (per cell " +
+                    per_cell + ";%'"),
               1);
     EXPECT_EQ(count("SELECT number FROM participants WHERE code = 'N10'"), 10);
 }
@@ -638,22 +716,27 @@ TEST_P(Serve, FiftyReloadsAndDeclinesAddBoundedRows) {
     Page page{direct(*web_)};
     page.open({{"participant", "R1"}});
     page.enter();
-    for (int i = 0; i < 50; ++i) page.open({{"participant", "R1"}, {"token", page.token}});
+    for (int i = 0; i < 50; ++i)
+        page.open({{"participant", "R1"}, {"token", page.token}});
     // No trial answered yet: still one segment showing each stimulus once.
     EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 1);
     EXPECT_EQ(count("SELECT count(*) FROM segment_stimuli"), stimuli);
     EXPECT_EQ(count("SELECT count(*) FROM sessions"), 1);
     // Reloads between answers: at most one segment per answered trial, plus the first.
     page.run(1);
-    for (int i = 0; i < 50; ++i) page.open({{"participant", "R1"}, {"token", page.token}});
+    for (int i = 0; i < 50; ++i)
+        page.open({{"participant", "R1"}, {"token", page.token}});
     page.run(2);
-    for (int i = 0; i < 50; ++i) page.open({{"participant", "R1"}, {"token", page.token}});
-    const int64_t answered = count("SELECT count(*) FROM trials WHERE answered_utc IS NOT NULL");
+    for (int i = 0; i < 50; ++i)
+        page.open({{"participant", "R1"}, {"token", page.token}});
+    const int64_t answered =
+        count("SELECT count(*) FROM trials WHERE answered_utc IS NOT NULL");
     ASSERT_EQ(answered, 2);
     EXPECT_LE(count("SELECT count(*) FROM session_segments"), answered + 1);
     EXPECT_LE(count("SELECT count(*) FROM segment_stimuli"), (answered + 1) * stimuli);
     // Every answered trial names a segment that is still there.
-    EXPECT_EQ(count("SELECT count(*) FROM trials t JOIN session_segments g ON g.id = t.segment_id"),
+    EXPECT_EQ(count("SELECT count(*) FROM trials t JOIN session_segments g ON g.id = "
+                    "t.segment_id"),
               answered);
     // Fifty pages opened and declined: no rows at all, one count.
     for (int i = 0; i < 50; ++i) {
@@ -693,7 +776,8 @@ TEST_P(Serve, AWithdrawnParticipantsOpenPageIsToldTheSessionWasWithdrawn) {
     other.run(1);
     ASSERT_TRUE(admin->withdraw_participant("W2"));
     const WebReply reload = web_->handle(
-        "session", json{{"participant", "W2"}, {"token", other.token}, {"t_ms", 5}}.dump());
+        "session",
+        json{{"participant", "W2"}, {"token", other.token}, {"t_ms", 5}}.dump());
     EXPECT_EQ(reload.status, 410) << reload.body;
     EXPECT_NE(reload.body.find("withdrawn"), std::string::npos) << reload.body;
     EXPECT_EQ(count("SELECT count(*) FROM participants"), 0);
@@ -712,8 +796,10 @@ TEST_P(Serve, ANumberBeyondADoubleIsA400NamingTheField) {
         EXPECT_NE(r.body.find("'t_ms'"), std::string::npos) << r.body;
     }
     const std::string huge_integer = std::string(400, '9');
-    const WebReply r = web_->handle("session", "{\"participant\": \"P1\", \"client\": "
-                                               "{\"window_width\": " + huge_integer + "}, \"t_ms\": 1}");
+    const WebReply r = web_->handle("session",
+                                    "{\"participant\": \"P1\", \"client\": "
+                                    "{\"window_width\": " +
+                                        huge_integer + "}, \"t_ms\": 1}");
     EXPECT_EQ(r.status, 400) << r.body;
     EXPECT_NE(r.body.find("'window_width'"), std::string::npos) << r.body;
     // Inside an answer's events.
@@ -732,9 +818,11 @@ TEST_P(Serve, ANumberBeyondADoubleIsA400NamingTheField) {
     EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Stores, Serve, ::testing::Values("sqlite", "postgresql"), param_name);
+INSTANTIATE_TEST_SUITE_P(Stores, Serve, ::testing::Values("sqlite", "postgresql"),
+                         param_name);
 
-// ---- names, tokens, image paths (no store) ------------------------------------------------
+// ---- names, tokens, image paths (no store)
+// ------------------------------------------------
 TEST(ServeNames, HmacMatchesRfc4231) {
     // RFC 4231 test cases 1 and 2.
     EXPECT_EQ(hmac_sha256_hex(std::string(20, '\x0b'), "Hi There"),
@@ -751,13 +839,14 @@ TEST(ServeNames, OnlyProtocolPicturesByNameAreImages) {
     const std::map<std::string, WebImage> images = {{"emp1", {1, 1}}, {"b", {1, 1}}};
     EXPECT_EQ(image_of_target("/images/emp1.png", images), "emp1");
     EXPECT_EQ(image_of_target("/images/emp1.png?v=2", images), "emp1");
-    EXPECT_EQ(image_of_target("/images/%65mp1.png", images), "emp1");  // an encoded letter
+    EXPECT_EQ(image_of_target("/images/%65mp1.png", images),
+              "emp1");  // an encoded letter
     for (const char* bad :
          {"/images/../study.db", "/images/..%2f..%2fetc%2fpasswd", "/images/%2e%2e/b.png",
-          "/images/%2E%2E%2Fb.png", "/images/%252e%252e%252fb.png", "/images/b.png%00.txt",
-          "/images//b.png", "/images/sub/b.png", "/images/b.PNG", "/images/c.png", "/b.png",
-          "/images/.png", "/images/b.png/", "/images/%zz.png", "/images/b.png%", "/IMAGES/b.png",
-          "/images/..\\b.png"})
+          "/images/%2E%2E%2Fb.png", "/images/%252e%252e%252fb.png",
+          "/images/b.png%00.txt", "/images//b.png", "/images/sub/b.png", "/images/b.PNG",
+          "/images/c.png", "/b.png", "/images/.png", "/images/b.png/", "/images/%zz.png",
+          "/images/b.png%", "/IMAGES/b.png", "/images/..\\b.png"})
         EXPECT_FALSE(image_of_target(bad, images)) << bad;
 }
 

@@ -16,7 +16,8 @@ namespace {
 std::vector<std::pair<int64_t, std::string>> drive(Autopilot& a, ScreenView v) {
     std::vector<std::pair<int64_t, std::string>> out;
     int enters = 0;
-    for (int64_t t = 0; t < 60'000'000'000LL && enters < static_cast<int>(v.points.size());
+    for (int64_t t = 0;
+         t < 60'000'000'000LL && enters < static_cast<int>(v.points.size());
          t += 1'000'000) {
         for (const std::string& k : a.due(t, v)) {
             out.emplace_back(t, k);
@@ -31,7 +32,9 @@ TEST(Autopilot, AnswersEveryStatementWithHumanLikeDelays) {
     ScreenView v{ScreenView::Kind::Rating, 1, {7, 7, 7}, false, 0};
     const auto keys = drive(a, v);
     ASSERT_FALSE(keys.empty());
-    EXPECT_EQ(std::count_if(keys.begin(), keys.end(), [](auto& k) { return k.second == "Enter"; }), 3);
+    EXPECT_EQ(std::count_if(keys.begin(), keys.end(),
+                            [](auto& k) { return k.second == "Enter"; }),
+              3);
     EXPECT_EQ(keys.back().second, "Enter");
     // A person needs hundreds of milliseconds per statement, not microseconds.
     EXPECT_GT(keys.front().first, 300'000'000);
@@ -55,12 +58,14 @@ TEST(Autopilot, CatchTrialsGetTheExpectedAnswerAndSpeedScalesDelays) {
 TEST(Autopilot, MixedScalesGetRatingsWithinEachQuestionsOwnScale) {
     // 7 points then 5, and the other order: over many seeded screens every digit lies
     // on its question's scale, and the whole range of each scale is used.
-    for (const std::vector<int>& points : {std::vector<int>{7, 5}, std::vector<int>{5, 7}}) {
+    for (const std::vector<int>& points :
+         {std::vector<int>{7, 5}, std::vector<int>{5, 7}}) {
         std::vector<std::set<int>> used(2);
         for (uint64_t seed = 0; seed < 200; ++seed) {
             Autopilot a = Autopilot::from_seed(seed, 50.0);
             size_t question = 0;
-            for (const auto& [t, k] : drive(a, ScreenView{ScreenView::Kind::Rating, 1, points, false, 0})) {
+            for (const auto& [t, k] :
+                 drive(a, ScreenView{ScreenView::Kind::Rating, 1, points, false, 0})) {
                 if (k == "Enter") {
                     ++question;
                     continue;
@@ -68,7 +73,8 @@ TEST(Autopilot, MixedScalesGetRatingsWithinEachQuestionsOwnScale) {
                 const int digit = std::stoi(k);
                 ASSERT_LT(question, points.size());
                 EXPECT_GE(digit, 1);
-                EXPECT_LE(digit, points[question]) << "question " << question << " of " << points[0];
+                EXPECT_LE(digit, points[question])
+                    << "question " << question << " of " << points[0];
                 used[question].insert(digit);
             }
         }
@@ -78,7 +84,8 @@ TEST(Autopilot, MixedScalesGetRatingsWithinEachQuestionsOwnScale) {
 
 TEST(Autopilot, ScriptsPlayInOrderAndBadLinesNameTheLine) {
     const auto dir = lucent::test::scratch_dir("autopilot_script");
-    const std::string good = (dir / "good.txt").string(), bad = (dir / "bad.txt").string();
+    const std::string good = (dir / "good.txt").string(),
+                      bad = (dir / "bad.txt").string();
     std::ofstream(good) << "# consent\n100 Enter\n50 3\n\n10 Escape\n";
     std::ofstream(bad) << "100 Enter\n20 Space\n";
     Autopilot a = Autopilot::from_argument(good, 1.0);
@@ -90,7 +97,8 @@ TEST(Autopilot, ScriptsPlayInOrderAndBadLinesNameTheLine) {
         Autopilot::from_file(bad);
         FAIL();
     } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("bad.txt:2:"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("bad.txt:2:"), std::string::npos)
+            << e.what();
     }
     EXPECT_FALSE(Autopilot::from_argument("42", 1.0).scripted());
 }

@@ -17,14 +17,14 @@
 #include <thread>
 
 #include "../study_fixtures.h"
+#include "display.h"
 #include "lucent/version.h"
 #include "manifest.h"
-#include "session/stimulus_provenance.h"
-#include "display.h"
-#include "session/stimulus_source.h"
-#include "sha256.h"
 #include "postgres/local_server.h"
 #include "postgres/trial_journal.h"
+#include "session/stimulus_provenance.h"
+#include "session/stimulus_source.h"
+#include "sha256.h"
 #include "sqlite.h"
 #include "study_store.h"
 #include "test_paths.h"
@@ -96,14 +96,16 @@ void write_manifest_for(const fs::path& dir, const Protocol& protocol) {
     for (const StimulusProvenance& p : resolve_stimuli(protocol, "")) {
         const std::string file = p.stimulus + ".png";
         if (!fs::exists(dir / file)) continue;
-        stimuli::ManifestRow row = {{"id", p.stimulus, false},     {"file", file, false},
-                                    {"files", file, false},        {"technique", p.technique, false},
-                                    {"mesh", p.mesh, false},       {"mesh_hash", p.mesh_hash, false}};
+        stimuli::ManifestRow row = {
+            {"id", p.stimulus, false}, {"file", file, false},
+            {"files", file, false},    {"technique", p.technique, false},
+            {"mesh", p.mesh, false},   {"mesh_hash", p.mesh_hash, false}};
         for (const auto& [name, value] : p.values) row.push_back({name, value, false});
         row.push_back({"software_version", version_string(), false});
         row.push_back({"build_hash", build_hash(), false});
         row.push_back({"content_hash",
-                       stimuli::Hasher().add_field(stimuli::hash_file(dir / file)).hex(), false});
+                       stimuli::Hasher().add_field(stimuli::hash_file(dir / file)).hex(),
+                       false});
         rows.push_back(std::move(row));
     }
     stimuli::write_manifest(dir, protocol.name, rows);
@@ -122,7 +124,8 @@ std::vector<int> scale_bands(const CpuImage& screen, int from_y) {
         bool in_run = false;
         for (int x = 0; x < screen.width; ++x) {
             const uint8_t* c = &screen.rgba[(size_t(y) * screen.width + x) * 4];
-            const bool button = std::abs(c[0] - 64) <= 2 && std::abs(c[1] - 64) <= 2 && std::abs(c[2] - 77) <= 2;
+            const bool button = std::abs(c[0] - 64) <= 2 && std::abs(c[1] - 64) <= 2 &&
+                                std::abs(c[2] - 77) <= 2;
             runs += button && !in_run;
             in_run = button;
         }
@@ -137,25 +140,43 @@ std::vector<int> scale_bands(const CpuImage& screen, int from_y) {
 class SessionE2E : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = lucent::test::scratch_dir(std::string("e2e_") +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = lucent::test::scratch_dir(
+            std::string("e2e_") +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
         write_images(dir_, {"a", "b", "c", "p"}, 128);
         write_manifest_for(dir_, lucent::test::small_protocol());
     }
     // The small protocol with a short blank between trials; `repeats` per main stimulus.
-    std::string write_protocol(int repeats, const std::string& base = lucent::test::kSmallProtocol) {
+    std::string write_protocol(int repeats,
+                               const std::string& base = lucent::test::kSmallProtocol) {
         std::string text = base;
-        text.replace(text.find("break_every = 2"), 15, "break_every = 4\ninter_trial_ms = 100");
-        text += "\n[screens]\nconsent = \"Do you agree?\"\ninstructions = \"Rate each picture.\"\n";
-        text.replace(text.find("id = \"main\""), 11, "id = \"main\"\nrepeats = " + std::to_string(repeats));
+        text.replace(text.find("break_every = 2"), 15,
+                     "break_every = 4\ninter_trial_ms = 100");
+        text +=
+            "\n[screens]\nconsent = \"Do you agree?\"\ninstructions = \"Rate each "
+            "picture.\"\n";
+        text.replace(text.find("id = \"main\""), 11,
+                     "id = \"main\"\nrepeats = " + std::to_string(repeats));
         const fs::path path = dir_ / "small.toml";
         std::ofstream(path) << text;
         return path.string();
     }
     std::vector<std::string> run_args(const std::string& protocol, const std::string& db,
                                       const std::string& autopilot) {
-        return {"run", protocol, "--db", db, "--participant", "P1", "--images", dir_.string(),
-                "--autopilot", autopilot, "--autopilot-speed", "12", "--seed", "77"};
+        return {"run",
+                protocol,
+                "--db",
+                db,
+                "--participant",
+                "P1",
+                "--images",
+                dir_.string(),
+                "--autopilot",
+                autopilot,
+                "--autopilot-speed",
+                "12",
+                "--seed",
+                "77"};
     }
     fs::path dir_;
 };
@@ -174,17 +195,24 @@ TEST_F(SessionE2E, FullSessionStoresEveryRatingWithSensibleResponseTimes) {
     EXPECT_EQ(trials, 5);  // 1 practice + 3 rated + 1 catch
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 2);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
-                           "AND ended_utc IS NOT NULL AND consent_utc IS NOT NULL"), 1);
+                           "AND ended_utc IS NOT NULL AND consent_utc IS NOT NULL"),
+              1);
     // Autopilot delays at speed 12 are ~60-150 ms: RTs must be positive and bounded.
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses WHERE rt_ms < 10 OR rt_ms > 5000"), 0);
+    EXPECT_EQ(
+        d.scalar_int("SELECT count(*) FROM responses WHERE rt_ms < 10 OR rt_ms > 5000"),
+        0);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE onset_ns IS NULL OR "
-                           "confirm_ns <= onset_ns"), 0);
+                           "confirm_ns <= onset_ns"),
+              0);
     // The catch trial was answered as asked.
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
-                           "WHERE t.catch = 1 AND r.rating != t.expected_rating"), 0);
+    EXPECT_EQ(d.scalar_int(
+                  "SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
+                  "WHERE t.catch = 1 AND r.rating != t.expected_rating"),
+              0);
     // Under Xvfb the video mode says 0 Hz: the refresh is recorded as unknown, with why.
-    Statement s = d.prepare("SELECT display_refresh_hz, measured_refresh_hz, refresh_note, "
-                            "gl_renderer, software_version FROM sessions");
+    Statement s = d.prepare(
+        "SELECT display_refresh_hz, measured_refresh_hz, refresh_note, "
+        "gl_renderer, software_version FROM sessions");
     ASSERT_TRUE(s.step());
     if (s.is_null(0)) {
         EXPECT_TRUE(s.is_null(1));
@@ -194,8 +222,9 @@ TEST_F(SessionE2E, FullSessionStoresEveryRatingWithSensibleResponseTimes) {
     EXPECT_FALSE(s.text(4).empty());
     // What was shown: each --images file with the manifest's content hash.
     const auto manifest = stimuli::read_manifest_csv(dir_);
-    Statement shown = d.prepare("SELECT st.stimulus_key, x.source, x.content_hash FROM "
-                                "segment_stimuli x JOIN stimuli st ON st.id = x.stimulus_id");
+    Statement shown = d.prepare(
+        "SELECT st.stimulus_key, x.source, x.content_hash FROM "
+        "segment_stimuli x JOIN stimuli st ON st.id = x.stimulus_id");
     int listed = 0;
     for (; shown.step(); ++listed) {
         EXPECT_EQ(shown.text(1), "images");
@@ -203,13 +232,15 @@ TEST_F(SessionE2E, FullSessionStoresEveryRatingWithSensibleResponseTimes) {
     }
     EXPECT_EQ(listed, 4);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM session_segments WHERE "
-                           "stimulus_source = 'images'"), 1);
+                           "stimulus_source = 'images'"),
+              1);
     Statement rt = d.prepare("SELECT rt_ms FROM responses ORDER BY rt_ms");
     std::vector<double> rts;
     while (rt.step()) rts.push_back(rt.real(0));
     RecordProperty("median_rt_ms", std::to_string(rts[rts.size() / 2]));
-    std::printf("autopilot session: median RT %.1f ms over %zu ratings; refresh note: %s\n",
-                rts[rts.size() / 2], rts.size(), s.text(2).c_str());
+    std::printf(
+        "autopilot session: median RT %.1f ms over %zu ratings; refresh note: %s\n",
+        rts[rts.size() / 2], rts.size(), s.text(2).c_str());
 
     // Screenshot of the first rating screen (the practice stimulus 'p'): the picture sits
     // centred, pixel for pixel, on the black background.
@@ -217,16 +248,23 @@ TEST_F(SessionE2E, FullSessionStoresEveryRatingWithSensibleResponseTimes) {
     const CpuImage screen = load_image_rgba8(shot.string());
     const CpuImage stimulus = load_image_rgba8((dir_ / "p.png").string());
     const int x0 = (screen.width - 128) / 2, y0 = (screen.height - 128) / 2;
-    auto px = [&](const CpuImage& im, int x, int y) { return &im.rgba[(size_t(y) * im.width + x) * 4]; };
+    auto px = [&](const CpuImage& im, int x, int y) {
+        return &im.rgba[(size_t(y) * im.width + x) * 4];
+    };
     int mismatched = 0;
     for (int y = 0; y < 128; ++y)
         for (int x = 0; x < 128; ++x)
             for (int c = 0; c < 3; ++c)
                 mismatched += px(screen, x0 + x, y0 + y)[c] != px(stimulus, x, y)[c];
-    EXPECT_EQ(mismatched, 0) << "stimulus not shown pixel for pixel at (" << x0 << "," << y0 << ")";
+    EXPECT_EQ(mismatched, 0) << "stimulus not shown pixel for pixel at (" << x0 << ","
+                             << y0 << ")";
     for (int i = -1; i <= 128; ++i)  // a one-pixel ring around it is background
-        for (auto [x, y] : {std::pair{x0 + i, y0 - 1}, {x0 + i, y0 + 128}, {x0 - 1, y0 + i}, {x0 + 128, y0 + i}})
-            EXPECT_EQ(px(screen, x, y)[0] + px(screen, x, y)[1] + px(screen, x, y)[2], 0) << x << "," << y;
+        for (auto [x, y] : {std::pair{x0 + i, y0 - 1},
+                            {x0 + i, y0 + 128},
+                            {x0 - 1, y0 + i},
+                            {x0 + 128, y0 + i}})
+            EXPECT_EQ(px(screen, x, y)[0] + px(screen, x, y)[1] + px(screen, x, y)[2], 0)
+                << x << "," << y;
     // One 7-point scale per statement, drawn below the picture.
     EXPECT_EQ(scale_bands(screen, y0 + 128), (std::vector<int>{7, 7}));
 }
@@ -237,17 +275,21 @@ TEST_F(SessionE2E, MixedScalesAreDrawnAndAnsweredPerQuestion) {
     // 5-point scale, and the autopilot's ratings are stored, each on its own scale.
     const std::string db = (dir_ / "study.db").string();
     const fs::path shot = dir_ / "mixed.png";
-    auto args = run_args(write_protocol(3, lucent::test::mixed_scale_protocol_text()), db, "21");
+    auto args =
+        run_args(write_protocol(3, lucent::test::mixed_scale_protocol_text()), db, "21");
     args.insert(args.end(), {"--screenshot", shot.string()});
     const Process p = start_lucent(args, dir_);
     ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
     const CpuImage screen = load_image_rgba8(shot.string());
-    EXPECT_EQ(scale_bands(screen, (screen.height - 128) / 2 + 128), (std::vector<int>{7, 5}));
+    EXPECT_EQ(scale_bands(screen, (screen.height - 128) / 2 + 128),
+              (std::vector<int>{7, 5}));
     Database d(db, SQLITE_OPEN_READONLY);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), 11 * 2);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses WHERE rating < 1 OR "
-                           "(question = 'realistic' AND rating > 5)"), 0);
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+                           "(question = 'realistic' AND rating > 5)"),
+              0);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              1);
 }
 
 // `lucent run` into a real PostgreSQL server (a throwaway local one): the session
@@ -259,7 +301,8 @@ TEST_F(SessionE2E, AServerStoreRunsTheSessionAndRefusesTheSameCodeOnASecondStati
     LocalPostgres server;
     const std::string uri = server.create_database("e2e");
     init_study_store(uri);
-    setenv("LUCENT_JOURNAL_DIR", (dir_ / "journals").c_str(), 1);  // inherited by the runs
+    setenv("LUCENT_JOURNAL_DIR", (dir_ / "journals").c_str(),
+           1);  // inherited by the runs
     const std::string station_journal = default_journal_path(uri);
     const std::string protocol = write_protocol(3);  // 1 practice + 9 rated + 1 catch
     const Process first = start_lucent(run_args(protocol, uri, "5"), dir_);
@@ -270,7 +313,8 @@ TEST_F(SessionE2E, AServerStoreRunsTheSessionAndRefusesTheSameCodeOnASecondStati
     while (watch->query_int("SELECT count(*) FROM sessions") == 0 &&
            std::chrono::steady_clock::now() < deadline)
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    ASSERT_EQ(watch->query_int("SELECT count(*) FROM sessions"), 1) << read_file(first.stderr_path);
+    ASSERT_EQ(watch->query_int("SELECT count(*) FROM sessions"), 1)
+        << read_file(first.stderr_path);
     const Process second = start_lucent(run_args(protocol, uri, "6"), dir_);
     EXPECT_EQ(wait_exit(second), 2);
     const std::string refused = read_file(second.stderr_path);
@@ -282,11 +326,13 @@ TEST_F(SessionE2E, AServerStoreRunsTheSessionAndRefusesTheSameCodeOnASecondStati
     unsetenv("LUCENT_JOURNAL_DIR");
     EXPECT_EQ(watch->query_int("SELECT count(*) FROM trials"), 11);
     EXPECT_EQ(watch->query_int("SELECT count(*) FROM responses"), 22);
-    EXPECT_EQ(watch->query_int("SELECT count(*) FROM sessions WHERE status = 'completed' AND "
-                               "consent_utc IS NOT NULL"),
-              1);
-    EXPECT_EQ(watch->query_int("SELECT count(*) FROM responses r JOIN trials t ON t.id = "
-                               "r.trial_id WHERE t.catch = 1 AND r.rating <> t.expected_rating"),
+    EXPECT_EQ(
+        watch->query_int("SELECT count(*) FROM sessions WHERE status = 'completed' AND "
+                         "consent_utc IS NOT NULL"),
+        1);
+    EXPECT_EQ(watch->query_int(
+                  "SELECT count(*) FROM responses r JOIN trials t ON t.id = "
+                  "r.trial_id WHERE t.catch = 1 AND r.rating <> t.expected_rating"),
               0);
     ASSERT_TRUE(fs::exists(station_journal));  // the station journaled, then emptied it
     EXPECT_EQ(TrialJournal(station_journal, uri).count(), 0);
@@ -301,7 +347,8 @@ TEST_F(SessionE2E, AStationKilledWhileTheServerIsDownLosesNothingAfterSyncAndRes
     LocalPostgres server;
     const std::string uri = server.create_database("e2e_outage");
     init_study_store(uri);
-    setenv("LUCENT_JOURNAL_DIR", (dir_ / "journals").c_str(), 1);  // inherited by the runs
+    setenv("LUCENT_JOURNAL_DIR", (dir_ / "journals").c_str(),
+           1);  // inherited by the runs
     const std::string journal_path = default_journal_path(uri);
     const std::string protocol = write_protocol(3);  // 1 practice + 9 rated + 1 catch
     const Process first = start_lucent(run_args(protocol, uri, "21"), dir_);
@@ -313,7 +360,8 @@ TEST_F(SessionE2E, AStationKilledWhileTheServerIsDownLosesNothingAfterSyncAndRes
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
         while (on_server < 2 && std::chrono::steady_clock::now() < deadline) {
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
-            on_server = watch->query_int("SELECT count(DISTINCT trial_id) FROM responses");
+            on_server =
+                watch->query_int("SELECT count(DISTINCT trial_id) FROM responses");
         }
     }
     ASSERT_GE(on_server, 2) << read_file(first.stderr_path);
@@ -344,13 +392,16 @@ TEST_F(SessionE2E, AStationKilledWhileTheServerIsDownLosesNothingAfterSyncAndRes
     auto check = open_study_store(uri, watch_options);
     EXPECT_EQ(check->query_int("SELECT count(*) FROM trials"), 11);
     EXPECT_EQ(check->query_int("SELECT count(*) FROM responses"), 22);
-    EXPECT_EQ(check->query_int("SELECT count(*) FROM (SELECT DISTINCT trial_id, question FROM "
-                               "responses) d"),
-              22);
-    EXPECT_EQ(check->query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    EXPECT_EQ(
+        check->query_int("SELECT count(*) FROM (SELECT DISTINCT trial_id, question FROM "
+                         "responses) d"),
+        22);
+    EXPECT_EQ(
+        check->query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
     EXPECT_EQ(check->query_int("SELECT count(*) FROM session_segments"), 2);
-    std::printf("outage: %lld trials on the server before the stop, %lld journaled when killed\n",
-                static_cast<long long>(on_server), static_cast<long long>(journaled));
+    std::printf(
+        "outage: %lld trials on the server before the stop, %lld journaled when killed\n",
+        static_cast<long long>(on_server), static_cast<long long>(journaled));
 }
 
 TEST_F(SessionE2E, TheDebriefCannotReopenACompletedSessionNorCanResume) {
@@ -374,7 +425,8 @@ TEST_F(SessionE2E, TheDebriefCannotReopenACompletedSessionNorCanResume) {
         Database d(db, SQLITE_OPEN_READONLY);
         EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), 5 * 2);
         EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
-                               "AND ended_utc IS NOT NULL"), 1);
+                               "AND ended_utc IS NOT NULL"),
+                  1);
     }
     EXPECT_NE(read_file(p.stderr_path).find("session complete"), std::string::npos);
     // Neither --resume nor a new run reopens it: one line, exit 2.
@@ -389,7 +441,8 @@ TEST_F(SessionE2E, TheDebriefCannotReopenACompletedSessionNorCanResume) {
     }
     Database d(db, SQLITE_OPEN_READONLY);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
-                           "AND ended_utc IS NOT NULL"), 1);
+                           "AND ended_utc IS NOT NULL"),
+              1);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions"), 1);
 }
 
@@ -398,7 +451,8 @@ TEST_F(SessionE2E, KilledAtARandomTrialAndResumedKeepsExactlyOneRatingEach) {
     const std::string db = (dir_ / "study.db").string();
     const std::string protocol = write_protocol(3);  // 1 practice + 9 rated + 1 catch
     std::mt19937 gen(static_cast<unsigned>(std::random_device{}()));
-    const int kill_after = 2 + static_cast<int>(gen() % 6);  // trials answered before the kill
+    const int kill_after =
+        2 + static_cast<int>(gen() % 6);  // trials answered before the kill
     const Process first = start_lucent(run_args(protocol, db, "11"), dir_);
     int64_t answered = 0;
     std::vector<std::pair<int, std::string>> order_before;
@@ -418,8 +472,9 @@ TEST_F(SessionE2E, KilledAtARandomTrialAndResumedKeepsExactlyOneRatingEach) {
     ASSERT_GE(answered, kill_after) << read_file(first.stderr_path);
     {
         Database d(db, SQLITE_OPEN_READONLY);
-        Statement s = d.prepare("SELECT t.position, st.stimulus_key FROM trials t JOIN stimuli st "
-                                "ON st.id = t.stimulus_id ORDER BY t.position");
+        Statement s = d.prepare(
+            "SELECT t.position, st.stimulus_key FROM trials t JOIN stimuli st "
+            "ON st.id = t.stimulus_id ORDER BY t.position");
         while (s.step()) order_before.emplace_back(int(s.integer(0)), s.text(1));
     }
     // Without --resume the runner refuses (exit 2) rather than starting over.
@@ -435,23 +490,28 @@ TEST_F(SessionE2E, KilledAtARandomTrialAndResumedKeepsExactlyOneRatingEach) {
     const int64_t trials = d.scalar_int("SELECT count(*) FROM trials");
     EXPECT_EQ(trials, 11);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 2);
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM (SELECT trial_id, question FROM responses "
-                           "GROUP BY 1, 2 HAVING count(*) != 1)"), 0);
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    EXPECT_EQ(
+        d.scalar_int("SELECT count(*) FROM (SELECT trial_id, question FROM responses "
+                     "GROUP BY 1, 2 HAVING count(*) != 1)"),
+        0);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              1);
     // The start and the resume each have their environment row.
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM session_segments"), 2);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE segment_id IS NULL"), 0);
     std::vector<std::pair<int, std::string>> order_after;
-    Statement s = d.prepare("SELECT t.position, st.stimulus_key FROM trials t JOIN stimuli st "
-                            "ON st.id = t.stimulus_id ORDER BY t.position");
+    Statement s = d.prepare(
+        "SELECT t.position, st.stimulus_key FROM trials t JOIN stimuli st "
+        "ON st.id = t.stimulus_id ORDER BY t.position");
     while (s.step()) order_after.emplace_back(int(s.integer(0)), s.text(1));
     EXPECT_EQ(order_after, order_before);
     RecordProperty("killed_after_trials", std::to_string(answered));
-    std::printf("kill-and-resume: killed with %lld of %lld trials answered; after resume %lld "
-                "ratings = %lld trials x 2 questions, no duplicates\n",
-                static_cast<long long>(answered), static_cast<long long>(trials),
-                static_cast<long long>(d.scalar_int("SELECT count(*) FROM responses")),
-                static_cast<long long>(trials));
+    std::printf(
+        "kill-and-resume: killed with %lld of %lld trials answered; after resume %lld "
+        "ratings = %lld trials x 2 questions, no duplicates\n",
+        static_cast<long long>(answered), static_cast<long long>(trials),
+        static_cast<long long>(d.scalar_int("SELECT count(*) FROM responses")),
+        static_cast<long long>(trials));
 }
 
 TEST_F(SessionE2E, EscapeThenQuitSavesAndAScriptedAutopilotDrivesIt) {
@@ -461,13 +521,16 @@ TEST_F(SessionE2E, EscapeThenQuitSavesAndAScriptedAutopilotDrivesIt) {
     // consent, instructions, wait for the first rating screen, rate, pause, quit.
     std::ofstream(script) << "300 Enter\n300 Enter\n800 4\n100 Enter\n100 5\n100 Enter\n"
                              "900 Escape\n300 Q\n";
-    const Process p = start_lucent(run_args(write_protocol(1), db, script.string()), dir_);
+    const Process p =
+        start_lucent(run_args(write_protocol(1), db, script.string()), dir_);
     ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
     Database d(db, SQLITE_OPEN_READONLY);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'paused'"), 1);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), 2);
-    EXPECT_EQ(d.scalar_int("SELECT rating FROM responses WHERE question = 'translucent'"), 4);
-    EXPECT_EQ(d.scalar_int("SELECT rating FROM responses WHERE question = 'realistic'"), 5);
+    EXPECT_EQ(d.scalar_int("SELECT rating FROM responses WHERE question = 'translucent'"),
+              4);
+    EXPECT_EQ(d.scalar_int("SELECT rating FROM responses WHERE question = 'realistic'"),
+              5);
 }
 
 TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
@@ -484,7 +547,9 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
         out << "400 Enter\n400 Enter\n";  // consent, instructions
         for (size_t i = 0; i < d.size(); ++i) {
             if (i == 1) out << "600 Enter\n";  // "the real study starts now"
-            out << "900 3\n" << d[i].first << " 5\n150 Enter\n150 4\n" << d[i].second << " Enter\n";
+            out << "900 3\n"
+                << d[i].first << " 5\n150 Enter\n150 4\n"
+                << d[i].second << " Enter\n";
         }
         out << "900 Escape\n400 Q\n";
     }
@@ -505,10 +570,12 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
     ASSERT_EQ(server_ms_of_stamp.size(), 2 + 1 + 5 * d.size() + 2) << read_file(trace);
     Database data(db, SQLITE_OPEN_READONLY);
     Statement s = data.prepare(
-        "SELECT q1.first_choice_ns, q1.final_choice_ns, q2.first_choice_ns, q2.final_choice_ns, "
+        "SELECT q1.first_choice_ns, q1.final_choice_ns, q2.first_choice_ns, "
+        "q2.final_choice_ns, "
         "t.confirm_ns, t.onset_ns FROM trials t "
         "JOIN responses q1 ON q1.trial_id = t.id AND q1.question = 'translucent' "
-        "JOIN responses q2 ON q2.trial_id = t.id AND q2.question = 'realistic' ORDER BY t.position");
+        "JOIN responses q2 ON q2.trial_id = t.id AND q2.question = 'realistic' ORDER BY "
+        "t.position");
     std::vector<double> scripted_errors;
     size_t trials = 0;
     for (; s.step(); ++trials) {
@@ -519,8 +586,10 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
         for (int c : {0, 1, 2, 3, 4}) {
             const int64_t recorded = s.integer(c);
             const auto it = server_ms_of_stamp.find(recorded);
-            ASSERT_NE(it, server_ms_of_stamp.end()) << "trial " << trials << " column " << c;
-            const double behind_ms = recorded / 1e6 - static_cast<uint32_t>(recorded / 1000000);
+            ASSERT_NE(it, server_ms_of_stamp.end())
+                << "trial " << trials << " column " << c;
+            const double behind_ms =
+                recorded / 1e6 - static_cast<uint32_t>(recorded / 1000000);
             EXPECT_EQ(static_cast<uint32_t>(recorded / 1000000), it->second)
                 << "trial " << trials << " column " << c << " (" << behind_ms << ")";
         }
@@ -528,7 +597,8 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
         // 2. The recorded intervals are the scripted ones, up to the X server's timer.
         const auto ms = [&](int a, int b) { return (s.integer(b) - s.integer(a)) / 1e6; };
         const double measured[] = {ms(0, 1), ms(1, 2), ms(3, 4)};
-        const double expected[] = {double(d[trials].first), 300.0, double(d[trials].second)};
+        const double expected[] = {double(d[trials].first), 300.0,
+                                   double(d[trials].second)};
         for (int k = 0; k < 3; ++k) scripted_errors.push_back(measured[k] - expected[k]);
     }
     EXPECT_EQ(trials, d.size());
@@ -544,7 +614,8 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
     // after the swap instead miss by up to a frame, a median near 5 ms at 60 Hz.
     EXPECT_LE(median, 2.0) << "interval errors (ms): " << errors;
     RecordProperty("scripted_interval_errors_ms", errors);
-    std::printf("scripted key intervals: errors (ms) %s; median |error| %.3f ms\n", errors.c_str(), median);
+    std::printf("scripted key intervals: errors (ms) %s; median |error| %.3f ms\n",
+                errors.c_str(), median);
 }
 
 TEST_F(SessionE2E, AnAnsweredButOpenSessionIsMarkedCompletedNotReopened) {
@@ -565,8 +636,9 @@ TEST_F(SessionE2E, AnAnsweredButOpenSessionIsMarkedCompletedNotReopened) {
     EXPECT_NE(err.find("already completed"), std::string::npos) << err;
     EXPECT_NE(err.find("now marked completed"), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
-    EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY).scalar_int(
-                  "SELECT count(*) FROM sessions WHERE status = 'completed' AND ended_utc IS NOT NULL"),
+    EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY)
+                  .scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed' "
+                              "AND ended_utc IS NOT NULL"),
               1);
 }
 
@@ -574,20 +646,23 @@ TEST_F(SessionE2E, ForeignOrCorruptDatabaseIsRefusedAndLeftUnchanged) {
     const fs::path db = dir_ / "foreign.db";
     {
         Database other(db.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
-        other.exec("CREATE TABLE inventory (item TEXT); INSERT INTO inventory VALUES ('x')");
+        other.exec(
+            "CREATE TABLE inventory (item TEXT); INSERT INTO inventory VALUES ('x')");
     }
     const fs::path junk = dir_ / "junk.db";
     std::ofstream(junk, std::ios::binary) << std::string(5000, '\x42');
     for (const fs::path& path : {db, junk}) {
         const std::string before = sha256_hex(read_file(path));
-        const Process p = start_lucent(run_args(write_protocol(1), path.string(), "1"), dir_);
+        const Process p =
+            start_lucent(run_args(write_protocol(1), path.string(), "1"), dir_);
         EXPECT_EQ(wait_exit(p), 2);
         const std::string err = read_file(p.stderr_path);
         EXPECT_NE(err.find("not a Lucent study database"), std::string::npos) << err;
         EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
         EXPECT_EQ(sha256_hex(read_file(path)), before);
         EXPECT_FALSE(fs::exists(path.string() + "-wal"));
-        const Process e = start_lucent({"export", path.string(), "--out", (dir_ / "x.csv").string()}, dir_);
+        const Process e = start_lucent(
+            {"export", path.string(), "--out", (dir_ / "x.csv").string()}, dir_);
         EXPECT_EQ(wait_exit(e), 2);
         EXPECT_EQ(sha256_hex(read_file(path)), before);
     }
@@ -606,13 +681,13 @@ TEST_F(SessionE2E, ATamperedImageIsRefusedInOneLineBeforeAnyWindow) {
 
 TEST_F(SessionE2E, NoDisplayGivesOneLineSuggestingXvfb) {
     const std::string db = (dir_ / "study.db").string();
-    const Process p = start_lucent(run_args(write_protocol(1), db, "1"), dir_, /*without_display=*/true);
+    const Process p = start_lucent(run_args(write_protocol(1), db, "1"), dir_,
+                                   /*without_display=*/true);
     EXPECT_EQ(wait_exit(p), 1);
     const std::string err = read_file(p.stderr_path);
     EXPECT_NE(err.find("xvfb-run"), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
-
 
 TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
     LUCENT_REQUIRE_DISPLAY();
@@ -624,9 +699,10 @@ TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
     write_images(dir_, ids, 64);
     write_manifest_for(dir_, thesis);
     const std::string db = (dir_ / "thesis.db").string();
-    const Process p = start_lucent({"run", "--preset", "thesis", "--db", db, "--participant", "P4",
-                                    "--images", dir_.string(), "--autopilot", "3",
-                                    "--autopilot-speed", "25", "--windowed"}, dir_);
+    const Process p = start_lucent(
+        {"run", "--preset", "thesis", "--db", db, "--participant", "P4", "--images",
+         dir_.string(), "--autopilot", "3", "--autopilot-speed", "25", "--windowed"},
+        dir_);
     ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
     Database d(db, SQLITE_OPEN_READONLY);
     const int64_t trials = d.scalar_int("SELECT count(*) FROM trials");
@@ -634,7 +710,8 @@ TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
     EXPECT_EQ(trials, 2 + 18 + 2);
     EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), trials * 3);
     EXPECT_EQ(d.scalar_int("SELECT count(DISTINCT question) FROM responses"), 3);
-    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              1);
     // Participant 4, two blocks: Latin-square row 0 shows 'empirical' first.
     Statement order = d.prepare("SELECT block_order FROM sessions");
     ASSERT_TRUE(order.step());
@@ -647,18 +724,21 @@ TEST_F(SessionE2E, LiveStimuliAreRenderedLikeLucentRender) {
     // screen (practice stimulus 'p': ward on a sphere) must show exactly the picture
     // `lucent render` makes from the same technique and parameters.
     std::string text = lucent::test::kSmallProtocol;
-    text.replace(text.find("break_every = 2"), 15, "inter_trial_ms = 100\nstimulus_size = [96, 96]");
+    text.replace(text.find("break_every = 2"), 15,
+                 "inter_trial_ms = 100\nstimulus_size = [96, 96]");
     const fs::path protocol = dir_ / "live.toml";
     std::ofstream(protocol) << text;
     const fs::path shot = dir_ / "live_screen.png", reference = dir_ / "reference.png";
     const std::string db = (dir_ / "live.db").string();
-    const Process run = start_lucent({"run", protocol.string(), "--db", db, "--participant", "P1",
-                                      "--autopilot", "5", "--autopilot-speed", "12",
-                                      "--screenshot", shot.string()}, dir_);
+    const Process run = start_lucent(
+        {"run", protocol.string(), "--db", db, "--participant", "P1", "--autopilot", "5",
+         "--autopilot-speed", "12", "--screenshot", shot.string()},
+        dir_);
     ASSERT_EQ(wait_exit(run), 0) << read_file(run.stderr_path);
-    const Process render = start_lucent({"render", "--mesh", "sphere", "--technique", "ward",
-                                         "--set", "roughness=0.2", "--size", "96x96",
-                                         "--out", reference.string()}, dir_);
+    const Process render =
+        start_lucent({"render", "--mesh", "sphere", "--technique", "ward", "--set",
+                      "roughness=0.2", "--size", "96x96", "--out", reference.string()},
+                     dir_);
     ASSERT_EQ(wait_exit(render), 0) << read_file(render.stderr_path);
     const CpuImage screen = load_image_rgba8(shot.string());
     const CpuImage ref = load_image_rgba8(reference.string());
@@ -669,11 +749,14 @@ TEST_F(SessionE2E, LiveStimuliAreRenderedLikeLucentRender) {
             const uint8_t* a = &screen.rgba[(size_t(y0 + y) * screen.width + x0 + x) * 4];
             const uint8_t* b = &ref.rgba[(size_t(y) * 96 + x) * 4];
             object_pixels += b[0] + b[1] + b[2] > 0;
-            for (int c = 0; c < 3; ++c) max_difference = std::max(max_difference, std::abs(a[c] - b[c]));
+            for (int c = 0; c < 3; ++c)
+                max_difference = std::max(max_difference, std::abs(a[c] - b[c]));
         }
     EXPECT_GT(object_pixels, 96 * 96 / 4) << "the reference shows no object";
     EXPECT_LE(max_difference, 1) << "live stimulus differs from lucent render's image";
-    EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM responses"), 10);
+    EXPECT_EQ(
+        Database(db, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM responses"),
+        10);
 }
 
 TEST_F(SessionE2E, ALiveStimulusWithNaNPixelsStopsTheSessionBeforeTrialOne) {
@@ -681,20 +764,25 @@ TEST_F(SessionE2E, ALiveStimulusWithNaNPixelsStopsTheSessionBeforeTrialOne) {
     // A ward shader that writes NaN (the same one app.render_nan_pixels_warn_and_exit_1
     // uses): the session must refuse to show a repaired picture and store nothing.
     std::string text = lucent::test::kSmallProtocol;
-    text.replace(text.find("break_every = 2"), 15, "inter_trial_ms = 100\nstimulus_size = [48, 48]");
+    text.replace(text.find("break_every = 2"), 15,
+                 "inter_trial_ms = 100\nstimulus_size = [48, 48]");
     const fs::path protocol = dir_ / "nan.toml";
     std::ofstream(protocol) << text;
     const std::string db = (dir_ / "nan.db").string();
     setenv("LUCENT_SHADER_DIR", LUCENT_SOURCE_DIR "/tests/app/data/nan_shaders", 1);
-    const Process run = start_lucent({"run", protocol.string(), "--db", db, "--participant", "P1",
-                                      "--autopilot", "5", "--autopilot-speed", "12"}, dir_);
+    const Process run =
+        start_lucent({"run", protocol.string(), "--db", db, "--participant", "P1",
+                      "--autopilot", "5", "--autopilot-speed", "12"},
+                     dir_);
     unsetenv("LUCENT_SHADER_DIR");
     EXPECT_EQ(wait_exit(run), 1);
     const std::string err = read_file(run.stderr_path);
     EXPECT_NE(err.find("stimulus '"), std::string::npos) << err;
     EXPECT_NE(err.find("NaN or Inf values"), std::string::npos) << err;
     if (fs::exists(db))
-        EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM responses"), 0);
+        EXPECT_EQ(Database(db, SQLITE_OPEN_READONLY)
+                      .scalar_int("SELECT count(*) FROM responses"),
+                  0);
 }
 
 TEST_F(SessionE2E, BadLiveParametersAreRefusedBeforeAnyWindow) {
@@ -702,8 +790,9 @@ TEST_F(SessionE2E, BadLiveParametersAreRefusedBeforeAnyWindow) {
     text.replace(text.find("roughness = 0.2"), 15, "roughness = 0.2, sparkle = 3");
     const fs::path protocol = dir_ / "bad.toml";
     std::ofstream(protocol) << text;
-    const Process p = start_lucent({"run", protocol.string(), "--db", (dir_ / "b.db").string(),
-                                    "--participant", "P1"}, dir_);
+    const Process p = start_lucent({"run", protocol.string(), "--db",
+                                    (dir_ / "b.db").string(), "--participant", "P1"},
+                                   dir_);
     EXPECT_EQ(wait_exit(p), 2);
     const std::string err = read_file(p.stderr_path);
     EXPECT_NE(err.find("stimulus 'p'"), std::string::npos) << err;
@@ -715,8 +804,9 @@ TEST_F(SessionE2E, BadLiveParametersAreRefusedBeforeAnyWindow) {
 class DataCommands : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = lucent::test::scratch_dir(std::string("cli_") +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = lucent::test::scratch_dir(
+            std::string("cli_") +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
         db_ = (dir_ / "study.db").string();
         Store store(db_);
         lucent::test::run_full_session(store, lucent::test::small_protocol(), "P1", 1);
@@ -729,12 +819,15 @@ protected:
         if (pid == 0) {
             const int fd = open(in.c_str(), O_RDONLY);
             dup2(fd, 0);
-            const int err = open((dir_ / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            const int err =
+                open((dir_ / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
             dup2(err, 2);
-            const int out = open((dir_ / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            const int out =
+                open((dir_ / "stdout.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
             dup2(out, 1);
             std::vector<char*> argv{const_cast<char*>(LUCENT_EXECUTABLE)};
-            for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+            for (const std::string& a : args)
+                argv.push_back(const_cast<char*>(a.c_str()));
             argv.push_back(nullptr);
             execv(LUCENT_EXECUTABLE, argv.data());
             _exit(127);
@@ -743,7 +836,9 @@ protected:
         waitpid(pid, &status, 0);
         return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     }
-    int64_t count(const std::string& sql) { return Database(db_, SQLITE_OPEN_READONLY).scalar_int(sql); }
+    int64_t count(const std::string& sql) {
+        return Database(db_, SQLITE_OPEN_READONLY).scalar_int(sql);
+    }
     fs::path dir_;
     std::string db_;
 };
@@ -756,26 +851,34 @@ TEST_F(DataCommands, WithdrawAsksAndOnlyYesDeletes) {
     EXPECT_EQ(run({"participants", "withdraw", "P2", "--db", db_, "--yes"}), 0);
     EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
     EXPECT_EQ(run({"participants", "withdraw", "P9", "--db", db_, "--yes"}), 2);
-    EXPECT_NE(read_file(dir_ / "stderr.txt").find("no participant 'P9'"), std::string::npos);
+    EXPECT_NE(read_file(dir_ / "stderr.txt").find("no participant 'P9'"),
+              std::string::npos);
 }
 
 TEST_F(DataCommands, ExportWritesEachFormatAndMergeDeduplicates) {
     for (const char* format : {"long", "wide", "analysis"}) {
         const fs::path out = dir_ / (std::string(format) + ".csv");
-        ASSERT_EQ(run({"export", db_, "--format", format, "--out", out.string()}), 0) << format;
+        ASSERT_EQ(run({"export", db_, "--format", format, "--out", out.string()}), 0)
+            << format;
         const std::string text = read_file(out);
         const long lines = std::count(text.begin(), text.end(), '\n');
-        EXPECT_EQ(lines, std::string(format) == "long" ? 1 + 2 * 5 * 2
-                         : std::string(format) == "wide" ? 1 + 2 : 1 + 2 * 3 * 2) << format;
+        EXPECT_EQ(lines, std::string(format) == "long"   ? 1 + 2 * 5 * 2
+                         : std::string(format) == "wide" ? 1 + 2
+                                                         : 1 + 2 * 3 * 2)
+            << format;
         EXPECT_FALSE(fs::exists(out.string() + ".partial"));
     }
-    EXPECT_EQ(run({"export", db_, "--format", "json", "--out", (dir_ / "x").string()}), 2);
+    EXPECT_EQ(run({"export", db_, "--format", "json", "--out", (dir_ / "x").string()}),
+              2);
     const std::string copy = (dir_ / "copy.db").string();
     fs::copy_file(db_, copy);
     const std::string merged = (dir_ / "all.db").string();
     ASSERT_EQ(run({"merge", db_, copy, "--out", merged}), 0);
-    EXPECT_EQ(Database(merged, SQLITE_OPEN_READONLY).scalar_int("SELECT count(*) FROM sessions"), 2);
-    EXPECT_NE(read_file(dir_ / "stdout.txt").find("2 duplicates skipped"), std::string::npos);
+    EXPECT_EQ(Database(merged, SQLITE_OPEN_READONLY)
+                  .scalar_int("SELECT count(*) FROM sessions"),
+              2);
+    EXPECT_NE(read_file(dir_ / "stdout.txt").find("2 duplicates skipped"),
+              std::string::npos);
 }
 
 TEST_F(DataCommands, ExportNeverReplacesTheDatabaseAndOverwritesOnlyWithForce) {
@@ -785,7 +888,8 @@ TEST_F(DataCommands, ExportNeverReplacesTheDatabaseAndOverwritesOnlyWithForce) {
     const std::string err = read_file(dir_ / "stderr.txt");
     EXPECT_NE(err.find("is the input"), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
-    EXPECT_EQ(run({"export", db_, "--out", (dir_ / "." / "study.db").string(), "--force"}), 2);
+    EXPECT_EQ(
+        run({"export", db_, "--out", (dir_ / "." / "study.db").string(), "--force"}), 2);
     EXPECT_EQ(count("SELECT count(*) FROM responses"), ratings);
     const fs::path csv = dir_ / "long.csv";
     ASSERT_EQ(run({"export", db_, "--out", csv.string()}), 0);
@@ -799,7 +903,8 @@ TEST_F(DataCommands, ExportNeverReplacesTheDatabaseAndOverwritesOnlyWithForce) {
 }
 
 TEST_F(DataCommands, AnalyzeReadsTheStudyDatabaseDirectly) {
-    // Two participants x 3 levels of thickness_exponent x 2 questions (see study_fixtures).
+    // Two participants x 3 levels of thickness_exponent x 2 questions (see
+    // study_fixtures).
     const fs::path out = dir_ / "report";
     ASSERT_EQ(run({"analyze", db_, "--out", out.string(), "--format", "csv"}), 0)
         << read_file(dir_ / "stderr.txt");
@@ -818,23 +923,29 @@ TEST_F(DataCommands, AnalysisRefusesARatingOutsideItsQuestionsScale) {
         const Protocol p = lucent::test::mixed_scale_protocol();
         const int64_t study = store.ensure_study(p);
         const int64_t pid = store.ensure_participant(study, "P1", nullptr);
-        const SessionRow s = store.create_session(study, pid, plan_trials(p, 1, 1), 1, {});
+        const SessionRow s =
+            store.create_session(study, pid, plan_trials(p, 1, 1), 1, {});
         for (const TrialRow& t : store.trials(s.id)) {
             TrialOutcome o;
-            for (const char* q : {"translucent", "realistic"}) o.responses.push_back({q, 3, 50.0, 0, 1, 1});
+            for (const char* q : {"translucent", "realistic"})
+                o.responses.push_back({q, 3, 50.0, 0, 1, 1});
             store.record_trial(s.id, t.id, o);
         }
-        store.db().exec("UPDATE responses SET rating = 6 WHERE id = (SELECT max(id) FROM "
-                        "responses WHERE question = 'realistic')");
+        store.db().exec(
+            "UPDATE responses SET rating = 6 WHERE id = (SELECT max(id) FROM "
+            "responses WHERE question = 'realistic')");
     }
     EXPECT_EQ(run({"analyze", mixed.string(), "--out", (dir_ / "report").string()}), 2);
     std::string err = read_file(dir_ / "stderr.txt");
     EXPECT_NE(err.find("rating 6 for question 'realistic' is outside its scale 1..5"),
-              std::string::npos) << err;
+              std::string::npos)
+        << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
     EXPECT_FALSE(fs::exists(dir_ / "report" / "anova.csv"));
     const fs::path csv = dir_ / "analysis.csv";
-    EXPECT_EQ(run({"export", mixed.string(), "--format", "analysis", "--out", csv.string()}), 2);
+    EXPECT_EQ(
+        run({"export", mixed.string(), "--format", "analysis", "--out", csv.string()}),
+        2);
     err = read_file(dir_ / "stderr.txt");
     EXPECT_NE(err.find("outside its scale 1..5"), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(csv));

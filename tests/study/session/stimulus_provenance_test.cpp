@@ -278,12 +278,13 @@ TEST(BuiltinPresets, EachStudyShowsExactlyItsStimulusSetsPicturesValueForValue) 
             by_id.erase(s.id);
         }
         for (const auto& [id, p] : by_id)
-            ADD_FAILURE() << id << " is shown by the study but not in stimuli/presets/" << name
-                          << ".toml";
+            ADD_FAILURE() << id << " is shown by the study but not in stimuli/presets/"
+                          << name << ".toml";
         for (const std::string& id : study.practice)
-            EXPECT_NE(std::find_if(set.stimuli.begin(), set.stimuli.end(),
-                                   [&](const stimuli::Stimulus& s) { return s.id == id; }),
-                      set.stimuli.end())
+            EXPECT_NE(
+                std::find_if(set.stimuli.begin(), set.stimuli.end(),
+                             [&](const stimuli::Stimulus& s) { return s.id == id; }),
+                set.stimuli.end())
                 << "practice stimulus " << id;
     }
 }
@@ -312,7 +313,8 @@ stimuli = ["e"]
     ASSERT_EQ(resolved.size(), 1u);
     const auto values = values_of(resolved[0]);
     EXPECT_EQ(values.at("density"), "cube");
-    EXPECT_EQ(values.at("density_hash"), make_density_volume("cube", 64, 1.0)->content_hash);
+    EXPECT_EQ(values.at("density_hash"),
+              make_density_volume("cube", 64, 1.0)->content_hash);
     const auto dir = lucent::test::scratch_dir("provenance_density_hash");
     const std::string db = (dir / "study.db").string();
     store_session(db, p, resolved);
@@ -328,7 +330,8 @@ stimuli = ["e"]
         store.check_stimulus_values(resolved);
         FAIL() << "a different density volume was accepted";
     } catch (const StoreError& e) {
-        EXPECT_NE(std::string(e.what()).find("density_hash"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("density_hash"), std::string::npos)
+            << e.what();
     }
 }
 

@@ -40,7 +40,8 @@ TEST_F(StimulusUpload, APictureWiderThanTheLargestTextureIsRefusedNamingTheFile)
     ASSERT_GT(max_size, 0);
     // One row one pixel wider than the GPU takes: before the check, a texture without
     // storage (GL_INVALID_VALUE, unchecked) that samples black.
-    const CpuImage wide{max_size + 1, 1, std::vector<uint8_t>(size_t(max_size + 1) * 4, 200)};
+    const CpuImage wide{max_size + 1, 1,
+                        std::vector<uint8_t>(size_t(max_size + 1) * 4, 200)};
     const std::string why = refusal(wide);
     EXPECT_NE(why.find("pictures/wide.png"), std::string::npos) << why;
     EXPECT_NE(why.find(std::to_string(max_size + 1) + "x1 picture cannot be shown"),
@@ -72,8 +73,10 @@ TEST_F(StimulusUpload, PixelStoreStateLeftByOtherCodeDoesNotChangeThePicture) {
     glPixelStorei(GL_UNPACK_SKIP_PIXELS, 1);
     glPixelStorei(GL_UNPACK_SKIP_ROWS, 1);
     CpuImage image{3, 2, std::vector<uint8_t>(3 * 2 * 4)};
-    image.rgba.reserve(512);  // what a reader that honours those skips reaches is allocated
-    for (size_t i = 0; i < image.rgba.size(); ++i) image.rgba[i] = static_cast<uint8_t>(i * 9 + 1);
+    image.rgba.reserve(
+        512);  // what a reader that honours those skips reaches is allocated
+    for (size_t i = 0; i < image.rgba.size(); ++i)
+        image.rgba[i] = static_cast<uint8_t>(i * 9 + 1);
     const StimulusTexture t = upload_texture(image, "pictures/small.png");
     EXPECT_EQ(t.width, 3);
     EXPECT_EQ(t.height, 2);

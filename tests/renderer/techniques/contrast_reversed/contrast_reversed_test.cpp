@@ -6,8 +6,8 @@
 
 #include "core/technique.h"
 #include "gl_test_fixture.h"
-#include "scene_for_test.h"
 #include "render.h"
+#include "scene_for_test.h"
 #include "techniques/registry.h"
 #include "techniques/ward/ward.h"
 

@@ -1,12 +1,13 @@
 // The surfel atlas, the mass pyramid and the inverse-CDF descent against independent
 // sums and counts.
+#include "techniques/dipole/atlas.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
 
 #include "core/mesh.h"
-#include "techniques/dipole/atlas.h"
 #include "test_meshes.h"
 
 namespace lucent::dipole {
@@ -29,8 +30,8 @@ TEST(DipoleAtlas, PreservesAreaAndPlacesTexelsOnTheSurface) {
     for (auto p : cube.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
     const glm::vec3 side = hi - lo;
     const double scale = 4.0;  // mm per unit
-    const double area = 2.0 * (side.x * side.y + side.y * side.z + side.z * side.x) *
-                        scale * scale;
+    const double area =
+        2.0 * (side.x * side.y + side.y * side.z + side.z * side.x) * scale * scale;
     const int a = 64;
     const SurfaceAtlas atlas = build_surface_atlas(cube, scale, a);
     ASSERT_EQ(atlas.position_area.size(), std::size_t(a * a));

@@ -2,13 +2,14 @@
 // here by an independent quadrature: a puck lit along its axis (top- and bottom-face
 // centres), a sphere lit from its pole (B depends only on the angle from the pole), the
 // small- and large-scale limits and the hard cases of section 6.
+#include "techniques/dipole/integrator.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/mesh.h"
 #include "cpu/ray_caster.h"
-#include "techniques/dipole/integrator.h"
 #include "test_meshes.h"
 
 namespace lucent::dipole {
@@ -45,28 +46,37 @@ glm::dvec3 simpson(F f, int n) {
 // pi Ft(1) integral_0^R 2 pi r Rd(sqrt(r^2 + depth^2)) dr: the puck's face centres.
 glm::dvec3 puck_centre(const Material& m, double radius, double depth) {
     const double ft = fresnel_transmittance(m.eta, 1.0);
-    return M_PI * ft * simpson([&](double t) {
-               const double r = radius * t * t;  // dense near the axis
-               return 2 * M_PI * r * jensen_rd(std::hypot(r, depth), m) * (2 * radius * t);
-           }, 20000);
+    return M_PI * ft *
+           simpson(
+               [&](double t) {
+                   const double r = radius * t * t;  // dense near the axis
+                   return 2 * M_PI * r * jensen_rd(std::hypot(r, depth), m) *
+                          (2 * radius * t);
+               },
+               20000);
 }
 
 // B(theta0) on a sphere of radius R lit from +z: in spherical coordinates (gamma, psi)
 // around xo, cos(theta) = cos(theta0) cos(gamma) + sin(theta0) sin(gamma) cos(psi).
 glm::dvec3 sphere_radiosity(const Material& m, double radius, double theta0) {
     const int n = 1600;
-    return simpson([&](double t) {
-               const double gamma = M_PI * t * t, dgamma = 2 * M_PI * t;
-               const glm::dvec3 rd = jensen_rd(2 * radius * std::sin(gamma / 2), m);
-               const glm::dvec3 ring = simpson([&](double u) {
-                   const double psi = M_PI * u;
-                   const double mu = std::cos(theta0) * std::cos(gamma) +
-                                     std::sin(theta0) * std::sin(gamma) * std::cos(psi);
-                   const double e = mu > 0 ? M_PI * fresnel_transmittance(m.eta, mu) * mu : 0;
-                   return glm::dvec3(2 * M_PI * e);  // psi over [0, 2 pi] by symmetry
-               }, n);
-               return radius * radius * std::sin(gamma) * dgamma * ring * rd;
-           }, n);
+    return simpson(
+        [&](double t) {
+            const double gamma = M_PI * t * t, dgamma = 2 * M_PI * t;
+            const glm::dvec3 rd = jensen_rd(2 * radius * std::sin(gamma / 2), m);
+            const glm::dvec3 ring = simpson(
+                [&](double u) {
+                    const double psi = M_PI * u;
+                    const double mu = std::cos(theta0) * std::cos(gamma) +
+                                      std::sin(theta0) * std::sin(gamma) * std::cos(psi);
+                    const double e =
+                        mu > 0 ? M_PI * fresnel_transmittance(m.eta, mu) * mu : 0;
+                    return glm::dvec3(2 * M_PI * e);  // psi over [0, 2 pi] by symmetry
+                },
+                n);
+            return radius * radius * std::sin(gamma) * dgamma * ring * rd;
+        },
+        n);
 }
 
 void expect_relative(glm::dvec3 got, glm::dvec3 want, double tolerance,
@@ -109,9 +119,9 @@ TEST(DipoleReferenceIntegral, SphereLitFromItsPoleDependsOnlyOnTheAngle) {
             const double theta = degrees * M_PI / 180;
             const glm::dvec3 want = sphere_radiosity(m, radius, theta);
             for (double phi : {0.0, 2.0, 4.0}) {  // symmetry about the axis
-                const glm::dvec3 xo = radius * glm::dvec3(std::sin(theta) * std::cos(phi),
-                                                          std::sin(theta) * std::sin(phi),
-                                                          std::cos(theta));
+                const glm::dvec3 xo =
+                    radius * glm::dvec3(std::sin(theta) * std::cos(phi),
+                                        std::sin(theta) * std::sin(phi), std::cos(theta));
                 expect_relative(integrator.radiosity(xo), want, 1e-3,
                                 std::string(name) + " theta " + std::to_string(degrees));
             }

@@ -17,7 +17,8 @@ struct MeshBuilder {
     }
     // Counter-clockwise as seen from the side `n` points to.
     void quad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 n) {
-        const unsigned i = vertex(a, n), j = vertex(b, n), k = vertex(c, n), l = vertex(d, n);
+        const unsigned i = vertex(a, n), j = vertex(b, n), k = vertex(c, n),
+                       l = vertex(d, n);
         mesh.triangles.push_back({i, j, k});
         mesh.triangles.push_back({i, k, l});
     }

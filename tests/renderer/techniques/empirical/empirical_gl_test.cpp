@@ -35,28 +35,28 @@ TEST_F(EmpiricalGl, PrunedRenderEqualsFullRenderForEachPrunableTerm) {
                                                             {{"blur_kernel", "1"}}};
     int index = 0;
     for (const std::string method : {"auto", "peel"})
-    for (auto settings : cases) {
-        settings.push_back({"ao_rays", "32"});
-        settings.push_back({"layer_method", method});
-        const Scene scene =
-            empirical_scene(builtin_mesh("torus_knot:6k"), settings, 96, 80);
-        const FramePlan pruned =
-            make_frame_plan(scene, find_technique("empirical"), PlanMode::pruned);
-        const FramePlan full =
-            make_frame_plan(scene, find_technique("empirical"), PlanMode::full);
-        ASSERT_LT(pruned.passes.size(), full.passes.size())
-            << settings[0].key << " pruned nothing";
-        const auto a = dir / ("pruned" + std::to_string(index) + ".exr");
-        const auto b = dir / ("full" + std::to_string(index) + ".exr");
-        write_image(a, render_image(executor, scene, PlanMode::pruned));
-        write_image(b, render_image(executor, scene, PlanMode::full));
-        const Image pruned_image = read_image(a), full_image = read_image(b);
-        EXPECT_LT(test::max_abs_difference(pruned_image, full_image), 1e-6)
-            << settings[0].key << " " << method;
-        EXPECT_GT(*std::max_element(full_image.rgba.begin(), full_image.rgba.end()),
-                  0.05f);
-        ++index;
-    }
+        for (auto settings : cases) {
+            settings.push_back({"ao_rays", "32"});
+            settings.push_back({"layer_method", method});
+            const Scene scene =
+                empirical_scene(builtin_mesh("torus_knot:6k"), settings, 96, 80);
+            const FramePlan pruned =
+                make_frame_plan(scene, find_technique("empirical"), PlanMode::pruned);
+            const FramePlan full =
+                make_frame_plan(scene, find_technique("empirical"), PlanMode::full);
+            ASSERT_LT(pruned.passes.size(), full.passes.size())
+                << settings[0].key << " pruned nothing";
+            const auto a = dir / ("pruned" + std::to_string(index) + ".exr");
+            const auto b = dir / ("full" + std::to_string(index) + ".exr");
+            write_image(a, render_image(executor, scene, PlanMode::pruned));
+            write_image(b, render_image(executor, scene, PlanMode::full));
+            const Image pruned_image = read_image(a), full_image = read_image(b);
+            EXPECT_LT(test::max_abs_difference(pruned_image, full_image), 1e-6)
+                << settings[0].key << " " << method;
+            EXPECT_GT(*std::max_element(full_image.rgba.begin(), full_image.rgba.end()),
+                      0.05f);
+            ++index;
+        }
 }
 
 // Deferred shading (one full-screen pass lighting the front layer's stored normal and
@@ -71,7 +71,8 @@ TEST_F(EmpiricalGl, DeferredShadingEqualsForwardShadingBitForBit) {
         // Peeled layers: a closed mesh taken by facing is always shaded forward.
         auto peeled = settings;
         peeled.push_back({"layer_method", "peel"});
-        const Scene scene = empirical_scene(builtin_mesh("torus_knot:6k"), peeled, 96, 80);
+        const Scene scene =
+            empirical_scene(builtin_mesh("torus_knot:6k"), peeled, 96, 80);
         // The front-depth pass stores the surface the full-screen `shade` lights.
         test::expect_deferred_equals_forward(
             executor, scene,
@@ -119,10 +120,11 @@ TEST_F(EmpiricalGl, AllocatesOnlyTheTexturesThePlanNames) {
 TEST_F(EmpiricalGl, LayersByFacingArePeeledLayersButAtAFewSilhouettePixels) {
     gl::FrameExecutor executor;
     const Technique& technique = find_technique("empirical");
-    for (const std::string spec : {"torus_knot:30k", "sphere:4k", "torus:4k", "hand:8k"}) {
+    for (const std::string spec :
+         {"torus_knot:30k", "sphere:4k", "torus:4k", "hand:8k"}) {
         const int w = 160, h = 144;
         const auto render = [&](const char* method, std::vector<float>& front,
-                                 std::vector<float>& second) {
+                                std::vector<float>& second) {
             const Scene scene = empirical_scene(
                 builtin_mesh(spec), {{"ao_rays", "16"}, {"layer_method", method}}, w, h);
             const FramePlan plan = make_frame_plan(scene, technique);
@@ -137,7 +139,8 @@ TEST_F(EmpiricalGl, LayersByFacingArePeeledLayersButAtAFewSilhouettePixels) {
         std::size_t covered = 0, layers_differ = 0, colours_differ = 0;
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
-                const std::size_t i = std::size_t(y) * w + x;  // read_channel: top row first
+                const std::size_t i =
+                    std::size_t(y) * w + x;  // read_channel: top row first
                 covered += front_b[i] < 1.0f;
                 layers_differ += front_a[i] != front_b[i] || second_a[i] != second_b[i];
                 bool window_agrees = true;
@@ -217,18 +220,19 @@ TEST_F(EmpiricalGl, MatchesTheCpuReferenceOnTheBuiltInMeshes) {
             const Image cpu_image =
                 find_technique("empirical").render_reference(reference_scene);
             for (const std::string method : {"auto", "peel"}) {
-                const Scene scene = empirical_scene(
-                    builtin_mesh(spec),
-                    {{"ao_rays", "32"}, {"blur_kernel", kernel}, {"layer_method", method}},
-                    128, 112);
+                const Scene scene = empirical_scene(builtin_mesh(spec),
+                                                    {{"ao_rays", "32"},
+                                                     {"blur_kernel", kernel},
+                                                     {"layer_method", method}},
+                                                    128, 112);
                 const Image gl_image = render_image(executor, scene);
                 const ImageErrorStats d = compare_images(gl_image, cpu_image, 1);
                 std::cout << spec << " kernel " << kernel << " " << method << ": mean "
                           << d.mean * 255 << "/255, p99 " << d.p99 * 255 << "/255, max "
                           << d.max * 255 << "/255 over " << d.pixels << " pixels\n";
                 EXPECT_GT(d.pixels, 2000u) << spec;
-                EXPECT_LT(d.mean, 1.0 / 255.0) << spec << " kernel " << kernel << " "
-                                               << method;
+                EXPECT_LT(d.mean, 1.0 / 255.0)
+                    << spec << " kernel " << kernel << " " << method;
                 EXPECT_LT(d.p99, 4.0 / 255.0) << spec << " kernel " << kernel << " "
                                               << method << " (max " << d.max << ")";
             }
@@ -281,9 +285,9 @@ TEST_F(EmpiricalGl, SideOnTorusUsesTheSecondLayerNotTheLast) {
         empirical_scene(builtin_mesh("torus:40k"), test::thickness_only(), size, size);
     ASSERT_NEAR(scene.bounds.diameter(), 2.8, 1e-3);
     const double expected = 1.0 - 0.8 / 2.8;
-    const Scene peeled = empirical_scene(builtin_mesh("torus:40k"),
-                                         test::thickness_only({{"layer_method", "peel"}}),
-                                         size, size);
+    const Scene peeled =
+        empirical_scene(builtin_mesh("torus:40k"),
+                        test::thickness_only({{"layer_method", "peel"}}), size, size);
     EXPECT_NEAR(render_image(executor, peeled).at(size / 2, size / 2).r, expected, 0.01);
     EXPECT_NEAR(render_image(executor, scene).at(size / 2, size / 2).r, expected, 0.01);
     EXPECT_NEAR(

@@ -106,7 +106,8 @@ TEST_F(HtsmGl, SlabOfConstantDensityIsTheClosedForm) {
                     worst = std::max(worst, std::abs(image.at(x, y).r - anchors[ring]));
             std::printf("slab n = %2d %s: worst |L - closed form| %.3g\n", n,
                         mode == PlanMode::full ? "full  " : "pruned", worst);
-            // Measured 2.3e-6 (n = 1) to 1.8e-4 (n = 5) on llvmpipe: 8-bit filter weights.
+            // Measured 2.3e-6 (n = 1) to 1.8e-4 (n = 5) on llvmpipe: 8-bit filter
+            // weights.
             EXPECT_LT(worst, 5e-4 * anchors[ring]) << "n = " << n;
         }
     }
@@ -122,9 +123,10 @@ TEST_F(HtsmGl, ImageIsCloseToTheCpuReference) {
          {std::pair{"1", 5e-5}, std::pair{"5", 1.6e-3}, std::pair{"13", 3.5e-3}}) {
         const Scene scene = sphere_scene({{"rays", n}, {"steps", "32"}});
         const Image reference = render_reference(scene, ReferenceQuality{4, 256});
-        const ImageErrorStats e = compare_images(render_image(executor, scene), reference);
-        std::printf("n = %s: GL vs reference rmse %.4g mean %.4g p99 %.4g over %zu px\n", n,
-                    e.rmse, e.mean, e.p99, e.pixels);
+        const ImageErrorStats e =
+            compare_images(render_image(executor, scene), reference);
+        std::printf("n = %s: GL vs reference rmse %.4g mean %.4g p99 %.4g over %zu px\n",
+                    n, e.rmse, e.mean, e.p99, e.pixels);
         EXPECT_LT(e.rmse, tolerance) << "n = " << n;
         EXPECT_GT(e.pixels, 300u);
     }

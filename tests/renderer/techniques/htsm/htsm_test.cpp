@@ -1,6 +1,8 @@
 // The htsm technique without GL: its plan and prunes, the pattern, and the CPU
 // reference against closed forms (a slab of constant density for n = 1, 5, 9, 13, zero
 // density, the opaque threshold, the lit face, a sphere's chord) and its own error.
+#include "techniques/htsm/htsm.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +14,6 @@
 #include "cpu/pixel_rays.h"
 #include "cpu/ray_caster.h"
 #include "scene_for_test.h"
-#include "techniques/htsm/htsm.h"
 #include "techniques/registry.h"
 
 namespace lucent::htsm {
@@ -27,7 +28,8 @@ Scene sphere_scene(std::vector<KnobAssignment> settings, int size = 32) {
 
 // The slab of htsm.md section 4: a 1 x 1 x 0.1 box, light along +z behind it, camera
 // at -z looking at the unlit face (or at +z at the lit one).
-Scene slab_scene(std::vector<KnobAssignment> settings, bool lit_side = false, int size = 32) {
+Scene slab_scene(std::vector<KnobAssignment> settings, bool lit_side = false,
+                 int size = 32) {
     auto mesh = std::make_shared<const Mesh>(dipole::test::box({1.0f, 1.0f, 0.1f}));
     const Technique& t = find_technique("htsm");
     settings.insert(settings.begin(), {"light_direction", lit_side ? "0,0,1" : "0,0,-1"});
@@ -74,10 +76,10 @@ ReferenceQuality exact_footprints() { return {4, 64}; }
 
 TEST(HtsmPlan, IsRegisteredWithItsKnobs) {
     const Technique& t = find_technique("htsm");
-    for (const char* name : {"rays", "steps", "light_map_size", "density",
-                             "density_resolution", "density_contrast", "density_scale",
-                             "phase_table_size", "transport_colour", "transport_distance",
-                             "phase_g", "ior"})
+    for (const char* name :
+         {"rays", "steps", "light_map_size", "density", "density_resolution",
+          "density_contrast", "density_scale", "phase_table_size", "transport_colour",
+          "transport_distance", "phase_g", "ior"})
         EXPECT_NE(find_knob(t.knobs(), name), nullptr) << name;
     EXPECT_THROW(parse_knob_value(*find_knob(t.knobs(), "rays"), "7"), KnobError);
     EXPECT_THROW(parse_knob_value(*find_knob(t.knobs(), "phase_g"), "0.9"), KnobError);
@@ -109,7 +111,8 @@ TEST(HtsmPlan, DefaultPlanMarchesAVolume) {
 TEST(HtsmPlan, PrunesAreNamedAndCostNothing) {
     const Technique& t = find_technique("htsm");
     // A constant volume: closed form along the ray, no upload, no 3-D texture.
-    FramePlan plan = make_frame_plan(sphere_scene({{"density", "constant:value=0.3"}}), t);
+    FramePlan plan =
+        make_frame_plan(sphere_scene({{"density", "constant:value=0.3"}}), t);
     EXPECT_EQ(find_pass(plan, "density_volume"), nullptr);
     EXPECT_EQ(plan.resource("htsm_density"), nullptr);
     EXPECT_FALSE(has_define(find_pass(plan, "shade"), "DENSITY_VOLUME"));
@@ -124,11 +127,13 @@ TEST(HtsmPlan, PrunesAreNamedAndCostNothing) {
     for (const char* name : {"density_volume", "phase_table", "irradiance_mips"})
         EXPECT_EQ(find_pass(plan, name), nullptr) << name;
     ASSERT_NE(find_pass(plan, "light_view"), nullptr);
-    EXPECT_EQ(find_pass(plan, "light_view")->writes, std::vector<std::string>{"light_depth"});
+    EXPECT_EQ(find_pass(plan, "light_view")->writes,
+              std::vector<std::string>{"light_depth"});
     EXPECT_NE(plan.explain().find("pruned: transport passes"), std::string::npos);
     // ... and with no surface terms either, no light view at all.
     plan = make_frame_plan(
-        sphere_scene({{"transport_colour", "0"}, {"diffuse", "0"}, {"specular", "0"}}), t);
+        sphere_scene({{"transport_colour", "0"}, {"diffuse", "0"}, {"specular", "0"}}),
+        t);
     EXPECT_EQ(find_pass(plan, "light_view"), nullptr);
     // Isotropic phase: no table. n = 1: no mips.
     plan = make_frame_plan(sphere_scene({{"phase_g", "0"}, {"rays", "1"}}), t);
@@ -137,9 +142,9 @@ TEST(HtsmPlan, PrunesAreNamedAndCostNothing) {
     EXPECT_EQ(plan.resource("htsm_texcoord")->levels, 1);
     EXPECT_NE(plan.explain().find("phase table (g = 0"), std::string::npos);
     // Full mode keeps everything, the normal image included.
-    plan = make_frame_plan(sphere_scene({{"density", "constant"}, {"phase_g", "0"},
-                                         {"rays", "1"}}),
-                           t, PlanMode::full);
+    plan = make_frame_plan(
+        sphere_scene({{"density", "constant"}, {"phase_g", "0"}, {"rays", "1"}}), t,
+        PlanMode::full);
     EXPECT_TRUE(plan.culled.empty());
     EXPECT_NE(find_pass(plan, "phase_table"), nullptr);
     EXPECT_NE(find_pass(plan, "irradiance_mips"), nullptr);
@@ -206,11 +211,13 @@ TEST(HtsmReference, ZeroDensityIsPureTransport) {
 
 TEST(HtsmReference, DensityAboveTheThresholdMakesTheUnlitFaceBlack) {
     // kappa rho0 >= 2 Td Phi / h - 1 = 6.0887 (htsm.md): w clamps to exactly 0.
-    const Scene above = slab_scene({{"rays", "1"}, {"density", "constant:value=1"},
-                                    {"density_scale", "6.1"}, {"steps", "3"}});
+    const Scene above = slab_scene({{"rays", "1"},
+                                    {"density", "constant:value=1"},
+                                    {"density_scale", "6.1"},
+                                    {"steps", "3"}});
     EXPECT_EQ(centre_mean(render_reference(above, quick())), glm::dvec3(0.0));
-    const Scene below = slab_scene({{"rays", "1"}, {"density", "constant:value=1"},
-                                    {"density_scale", "6.0"}});
+    const Scene below = slab_scene(
+        {{"rays", "1"}, {"density", "constant:value=1"}, {"density_scale", "6.0"}});
     const double expected = slab_closed_form(1, 6.0);
     EXPECT_GT(expected, 0.0);
     EXPECT_NEAR(centre_mean(render_reference(below, quick())).r,
@@ -222,9 +229,11 @@ TEST(HtsmReference, LitFaceKeepsItsCentreTerm) {
     // weight 2 and mu = -N.L = -1; each ring ray runs along the face (mu = 0) with
     // D = rho / Phi.
     const double g = 0.5, kr = 3.0, phi = 2.0 * std::sqrt(0.5 + 0.0025);
-    const Scene scene = slab_scene({{"rays", "5"}, {"density", "constant:value=1"},
+    const Scene scene = slab_scene({{"rays", "5"},
+                                    {"density", "constant:value=1"},
                                     {"density_scale", std::to_string(kr)},
-                                    {"diffuse", "0"}, {"specular", "0"}},
+                                    {"diffuse", "0"},
+                                    {"specular", "0"}},
                                    true);
     const double e = 1.0 - std::pow(0.3 / 2.3, 2);
     const double rho = 0.02 * phi;
@@ -238,11 +247,14 @@ TEST(HtsmReference, LitFaceKeepsItsCentreTerm) {
 TEST(HtsmReference, SphereChordIsTheClosedForm) {
     // Light from behind, n = 1, homogeneous: END is the far end of the chord along l,
     // D = 2 sqrt(r^2 - b^2) / Phi, E = (1 - F(c)) c with c = sqrt(1 - (b/r)^2), mu = c.
-    const Scene scene = test::scene_for(
-        "htsm",
-        {{"rays", "1"}, {"density", "constant:value=0.5"}, {"density_scale", "1"},
-         {"light_direction", "0,0,-1"}, {"transport_distance", "1"}, {"phase_g", "0.3"}},
-        "sphere:20k", 48);
+    const Scene scene = test::scene_for("htsm",
+                                        {{"rays", "1"},
+                                         {"density", "constant:value=0.5"},
+                                         {"density_scale", "1"},
+                                         {"light_direction", "0,0,-1"},
+                                         {"transport_distance", "1"},
+                                         {"phase_g", "0.3"}},
+                                        "sphere:20k", 48);
     const Image image = render_reference(scene, quick());
     const Params p = params(scene);
     const double r = scene.bounds.radius;
@@ -252,11 +264,14 @@ TEST(HtsmReference, SphereChordIsTheClosedForm) {
     double worst = 0.0;
     for (int y = 0; y < 48; ++y)
         for (int x = 0; x < 48; ++x) {
-            const auto hit = caster.first_hit(glm::vec3(rays.eye()), glm::vec3(rays.direction(x, y)));
+            const auto hit =
+                caster.first_hit(glm::vec3(rays.eye()), glm::vec3(rays.direction(x, y)));
             if (!hit) continue;
-            const glm::dvec3 point = rays.eye() + double(hit->distance) * rays.direction(x, y);
+            const glm::dvec3 point =
+                rays.eye() + double(hit->distance) * rays.direction(x, y);
             const glm::dvec3 rel = point - glm::dvec3(scene.bounds.centre);
-            const glm::dvec3 l = glm::normalize(glm::dvec3(light_direction_object(scene)));
+            const glm::dvec3 l =
+                glm::normalize(glm::dvec3(light_direction_object(scene)));
             const double b = glm::length(rel - glm::dot(rel, l) * l);
             if (b > 0.8 * r) continue;  // the silhouette band
             const double c = std::sqrt(1.0 - (b / r) * (b / r));
@@ -274,16 +289,20 @@ TEST(HtsmReference, SphereChordIsTheClosedForm) {
 TEST(HtsmReference, SphereImageIsSymmetric) {
     // Light from behind along the view axis: the image of a homogeneous sphere is
     // mirror-symmetric left-right and top-bottom (to the mesh's symmetry).
-    const Scene scene = sphere_scene({{"rays", "13"}, {"density", "constant:value=0.5"},
+    const Scene scene = sphere_scene({{"rays", "13"},
+                                      {"density", "constant:value=0.5"},
                                       {"transport_distance", "1"},
-                                      {"light_direction", "0,0,-1"}}, 32);
+                                      {"light_direction", "0,0,-1"}},
+                                     32);
     const Image image = render_reference(scene, quick());
     double worst = 0.0, peak = 0.0;
     for (int y = 0; y < 32; ++y)
         for (int x = 0; x < 32; ++x) {
-            const glm::vec4 a = image.at(x, y), b = image.at(31 - x, y), c = image.at(x, 31 - y);
+            const glm::vec4 a = image.at(x, y), b = image.at(31 - x, y),
+                            c = image.at(x, 31 - y);
             if (a.a == 0 || b.a == 0 || c.a == 0) continue;
-            worst = std::max({worst, double(std::abs(a.r - b.r)), double(std::abs(a.r - c.r))});
+            worst = std::max(
+                {worst, double(std::abs(a.r - b.r)), double(std::abs(a.r - c.r))});
             peak = std::max(peak, double(a.r));
         }
     EXPECT_GT(peak, 0.1);
@@ -294,10 +313,10 @@ TEST(HtsmReference, HardCasesStayFinite) {
     const std::vector<std::vector<KnobAssignment>> cases = {
         {{"density_scale", "1000"}, {"density", "constant:value=1"}},
         {{"density_scale", "0"}},
-        {{"light_direction", "1,0,0.0001"}},                 // grazing
-        {{"light_direction", "0,1,0"}},                      // up-vector fallback
-        {{"pattern_radius", "0.5"}, {"rays", "13"}},      // samples outside the view
-        {{"density", "cube:size=0.2"}, {"steps", "1"}},      // volume feature small, S = 1
+        {{"light_direction", "1,0,0.0001"}},             // grazing
+        {{"light_direction", "0,1,0"}},                  // up-vector fallback
+        {{"pattern_radius", "0.5"}, {"rays", "13"}},     // samples outside the view
+        {{"density", "cube:size=0.2"}, {"steps", "1"}},  // volume feature small, S = 1
         {{"transport_distance", "0.001"}},
         {{"ior", "1"}, {"phase_g", "0.8"}},
     };

@@ -52,8 +52,8 @@ double model_net(int n, glm::dvec2 r) {
     return (n - a) * (n - b) / double((n + 1) * (n + 1));
 }
 double exact_net(int n, glm::dvec2 r) {
-    return (n - std::min(std::abs(r.x), double(n))) * (n - std::min(std::abs(r.y), double(n))) /
-           double((n + 1) * (n + 1));
+    return (n - std::min(std::abs(r.x), double(n))) *
+           (n - std::min(std::abs(r.y), double(n))) / double((n + 1) * (n + 1));
 }
 
 TEST(ThickTextureRecords, SingleHoleHasFourWallsAndNoTriangles) {
@@ -81,10 +81,13 @@ TEST(ThickTextureRecords, TwoByOneHoleMatchesTheHandCount) {
 }
 
 TEST(ThickTextureModel, NormalRaySeesTheHoleFraction) {
-    for (const TexelGrid& g : {net(5, 1), net(1, 1), grid_of({"#..#.", ".#...", "..###"})}) {
+    for (const TexelGrid& g :
+         {net(5, 1), net(1, 1), grid_of({"#..#.", ".#...", "..###"})}) {
         const TexelRecord mean = mean_record(g);
-        EXPECT_NEAR(model_fractions(mean, {0.0, 0.0}).transparent, g.hole_fraction(), 1e-12);
-        EXPECT_NEAR(exact_fractions(g, {0.0, 0.0}, 4).transparent, g.hole_fraction(), 1e-12);
+        EXPECT_NEAR(model_fractions(mean, {0.0, 0.0}).transparent, g.hole_fraction(),
+                    1e-12);
+        EXPECT_NEAR(exact_fractions(g, {0.0, 0.0}, 4).transparent, g.hole_fraction(),
+                    1e-12);
     }
 }
 
@@ -98,7 +101,8 @@ TEST(ThickTextureModel, StripesFollowTheTwoDimensionalFormula) {
             const TexelGrid g = grid_of({row});
             const double model = (n - std::min(dx, 1.0)) / (n + 1.0);
             const double exact = (n - std::min(dx, double(n))) / (n + 1.0);
-            EXPECT_NEAR(model_fractions(mean_record(g), {dx, 0.0}).transparent, model, 1e-12)
+            EXPECT_NEAR(model_fractions(mean_record(g), {dx, 0.0}).transparent, model,
+                        1e-12)
                 << n << " " << dx;
             EXPECT_NEAR(exact_fractions(g, {dx, 0.0}, 64).transparent, exact, 2e-3)
                 << n << " " << dx;
@@ -107,10 +111,12 @@ TEST(ThickTextureModel, StripesFollowTheTwoDimensionalFormula) {
 
 TEST(ThickTextureModel, SquareHoleNetsFollowTheClosedForms) {
     for (int n : {1, 2, 3, 5})
-        for (glm::dvec2 r : {glm::dvec2(0.3, 0.0), glm::dvec2(0.5, -0.8), glm::dvec2(-1.7, 0.4),
-                             glm::dvec2(2.5, 1.0), glm::dvec2(-6.0, -0.2)}) {
+        for (glm::dvec2 r :
+             {glm::dvec2(0.3, 0.0), glm::dvec2(0.5, -0.8), glm::dvec2(-1.7, 0.4),
+              glm::dvec2(2.5, 1.0), glm::dvec2(-6.0, -0.2)}) {
             const TexelGrid g = net(n, 1);
-            EXPECT_NEAR(model_fractions(mean_record(g), r).transparent, model_net(n, r), 1e-12)
+            EXPECT_NEAR(model_fractions(mean_record(g), r).transparent, model_net(n, r),
+                        1e-12)
                 << n << " " << r.x << "," << r.y;
             EXPECT_NEAR(exact_fractions(g, r, 48).transparent, exact_net(n, r), 4e-3)
                 << n << " " << r.x << "," << r.y;
@@ -123,7 +129,8 @@ TEST(ThickTextureModel, SquareHoleNetsFollowTheClosedForms) {
 
 TEST(ThickTextureModel, OneTexelHolesAreExactAtEveryAngle) {
     const TexelGrid g = net(1, 1);
-    for (glm::dvec2 r : {glm::dvec2(0.4, 0.2), glm::dvec2(3.0, -0.5), glm::dvec2(-20.0, 20.0)})
+    for (glm::dvec2 r :
+         {glm::dvec2(0.4, 0.2), glm::dvec2(3.0, -0.5), glm::dvec2(-20.0, 20.0)})
         EXPECT_NEAR(model_fractions(mean_record(g), r).transparent,
                     exact_fractions(g, r, 48).transparent, 3e-3);
 }
@@ -132,14 +139,15 @@ TEST(ThickTextureModel, MatchesTheExactAreaOnRandomTexturesBelowOneTexel) {
     // The 0..2 triangle rule: the summed model equals the exact area for |r| <= 1 on any
     // texture (a 0/1 rule is off by up to 0.08 here).
     for (int seed = 1; seed <= 4; ++seed) {
-        const TexelGrid full = make_texel_grid("random:0.5," + std::to_string(seed), glm::vec3(1));
+        const TexelGrid full =
+            make_texel_grid("random:0.5," + std::to_string(seed), glm::vec3(1));
         TexelGrid g;  // an 8 x 8 corner, tiled
         g.width = g.height = 8;
         for (int j = 0; j < 8; ++j)
             for (int i = 0; i < 8; ++i) g.opaque.push_back(full.at(i, j));
         g.colour.assign(64, glm::vec3(1.0f));
-        for (glm::dvec2 r : {glm::dvec2(0.7, 0.45), glm::dvec2(-0.9, 0.3), glm::dvec2(0.2, -1.0),
-                             glm::dvec2(-0.55, -0.65)}) {
+        for (glm::dvec2 r : {glm::dvec2(0.7, 0.45), glm::dvec2(-0.9, 0.3),
+                             glm::dvec2(0.2, -1.0), glm::dvec2(-0.55, -0.65)}) {
             const Fractions model = model_fractions(mean_record(g), r);
             const Fractions exact = exact_fractions(g, r, 96);
             EXPECT_NEAR(model.transparent, exact.transparent, 3e-3) << seed;
@@ -172,7 +180,8 @@ TEST(ThickTextureModel, WideHoleFixIsExactOnNetsAndAlgorithmOneBelowATexel) {
     for (glm::dvec2 r : {glm::dvec2(0.4, -0.7), glm::dvec2(-1.0, 0.2)})
         EXPECT_NEAR(model_fractions(fixed, r).transparent,
                     model_fractions(thesis, r).transparent, 1e-12);
-    for (glm::dvec2 r : {glm::dvec2(3.3, 0.0), glm::dvec2(-4.2, 1.9), glm::dvec2(7.0, 2.0)})
+    for (glm::dvec2 r :
+         {glm::dvec2(3.3, 0.0), glm::dvec2(-4.2, 1.9), glm::dvec2(7.0, 2.0)})
         EXPECT_NEAR(model_fractions(fixed, r).transparent, exact_net(5, r), 1e-12);
 }
 
@@ -188,7 +197,8 @@ TEST(ThickTexturePyramid, EachLevelIsTheMeanOfItsChildren) {
                 double opaque = 0.0, bin = 0.0;
                 for (int dy = 0; dy < 2; ++dy)
                     for (int dx = 0; dx < 2; ++dx) {
-                        const auto& c = pyramid.levels[l - 1][(2 * y + dy) * above.x + 2 * x + dx];
+                        const auto& c =
+                            pyramid.levels[l - 1][(2 * y + dy) * above.x + 2 * x + dx];
                         walls += c.walls / 4.0;
                         opaque += c.opaque / 4.0;
                         bin += c.bins[0][1] / 4.0;
@@ -217,8 +227,9 @@ TEST(ThickTexturePyramid, ThreeTimesPowerOfTwoTilesReduceExactly) {
 TEST(ThickTextureHardCases, GrazingHugeAndZeroThicknessStayFiniteAndInRange) {
     const TexelGrid g = net(5, 1);
     const TexelRecord mean = mean_record(g, 8);
-    for (glm::dvec3 d : {glm::dvec3(1, 0, 0), glm::dvec3(0.7, -0.7, 1e-30),
-                         glm::dvec3(0, 0, 1), glm::dvec3(0, 0, 0), glm::dvec3(1e-30, 0, 0)})
+    for (glm::dvec3 d :
+         {glm::dvec3(1, 0, 0), glm::dvec3(0.7, -0.7, 1e-30), glm::dvec3(0, 0, 1),
+          glm::dvec3(0, 0, 0), glm::dvec3(1e-30, 0, 0)})
         for (double h : {0.0, 1e-9, 1.0, 64.0}) {
             const glm::dvec2 r = scaled_ray(d, h);
             ASSERT_TRUE(std::isfinite(r.x) && std::isfinite(r.y));

@@ -36,7 +36,8 @@ TEST(SheetMeshes, TexelsAreSquareInWorldSpaceAndTangentsFollowU) {
             const glm::dvec3 du = (e1 * s2.y - e2 * s1.y) / det;
             const glm::dvec3 dv = (e2 * s1.x - e1 * s2.x) / det;
             ASSERT_NEAR(glm::length(du) / glm::length(dv), 1.0, 0.01) << spec;
-            ASSERT_NEAR(glm::dot(du, dv) / (glm::length(du) * glm::length(dv)), 0.0, 0.01);
+            ASSERT_NEAR(glm::dot(du, dv) / (glm::length(du) * glm::length(dv)), 0.0,
+                        0.01);
         }
         for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
             const glm::vec3 n = mesh.normals[i], tan = glm::vec3(mesh.tangents[i]);
@@ -67,10 +68,11 @@ TEST(SheetMeshes, FilesKeepUvsAndTheirSeams) {
     std::filesystem::create_directories(dir);
     // Two quads sharing the edge x = 1, but with different uvs there (a seam): the
     // shared positions must stay two vertices each.
-    std::ofstream(dir / "seam.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
-                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0\nvt 0.5 1\n"
-                                       "vt 1.5 0\nvt 1.5 1\n"
-                                       "f 1/1 2/2 3/3 4/4\nf 2/5 5/7 6/8 3/6\n";
+    std::ofstream(dir / "seam.obj")
+        << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
+           "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0\nvt 0.5 1\n"
+           "vt 1.5 0\nvt 1.5 1\n"
+           "f 1/1 2/2 3/3 4/4\nf 2/5 5/7 6/8 3/6\n";
     const Mesh seam = load_mesh((dir / "seam.obj").string());
     ASSERT_TRUE(seam.has_uvs());
     EXPECT_EQ(seam.vertex_count(), 8u);

@@ -75,7 +75,8 @@ double expected_window_mean(const Scene& scene, int w, double h, ClosedForm form
     const int x0 = (scene.width - w) / 2, y0 = (scene.height - w) / 2;
     for (int y = y0; y < y0 + w; ++y)
         for (int x = x0; x < x0 + w; ++x) {
-            const glm::dvec3 d = to_sheet * rays.direction(x, y);  // square: T, B, N = x, y, z
+            const glm::dvec3 d =
+                to_sheet * rays.direction(x, y);  // square: T, B, N = x, y, z
             sum += form(scaled_ray(d, h, 1e4));
         }
     return sum / (w * w);
@@ -83,7 +84,8 @@ double expected_window_mean(const Scene& scene, int w, double h, ClosedForm form
 
 TEST(ThickTexturePlan, IsRegisteredAndPlansTheThickVariant) {
     const Technique& t = find_technique("thick_texture");
-    for (const char* name : {"texture", "thickness", "filter", "fetch_path", "wide_hole_bins"})
+    for (const char* name :
+         {"texture", "thickness", "filter", "fetch_path", "wide_hole_bins"})
         EXPECT_NE(find_knob(t.knobs(), name), nullptr) << name;
     const FramePlan flat = make_frame_plan(scene_for({}), t);
     for (const char* name : {"albedo", "walls", "triangles", "layer_0", "composite"})
@@ -102,7 +104,8 @@ TEST(ThickTexturePlan, ZeroThicknessAndNoHolesPruneToPlainTexturing) {
     EXPECT_EQ(find_pass(thin, "walls"), nullptr);
     EXPECT_TRUE(has_define(find_pass(thin, "layer_0"), "THIN"));
     EXPECT_NE(thin.explain().find("h = 0: plain alpha texture"), std::string::npos);
-    const FramePlan opaque = make_frame_plan(scene_for({{"texture", "net:0,1"}}, "wave"), t);
+    const FramePlan opaque =
+        make_frame_plan(scene_for({{"texture", "net:0,1"}}, "wave"), t);
     EXPECT_EQ(find_pass(opaque, "triangles"), nullptr);
     EXPECT_EQ(find_pass(opaque, "layer_1"), nullptr);
     EXPECT_NE(opaque.explain().find("no hole: opaque draw"), std::string::npos);
@@ -117,7 +120,8 @@ TEST(ThickTexturePlan, MeshWithoutUvsAndBadTexturesAreOneLine) {
         scene_for({}, "sphere:200");
         ADD_FAILURE() << "a sphere was accepted";
     } catch (const MeshError& e) {
-        EXPECT_EQ(std::string(e.what()).rfind("sphere:200: has no texture coordinates", 0), 0u)
+        EXPECT_EQ(
+            std::string(e.what()).rfind("sphere:200: has no texture coordinates", 0), 0u)
             << e.what();
     }
     EXPECT_THROW(scene_for({{"texture", "net:x"}}), KnobError);
@@ -140,7 +144,8 @@ TEST_F(ThickTextureGl, PrunedEqualsFull) {
              {"square", {{"tilt", "50"}, {"layers", "3"}}},
              {"wave", {{"texture", "net:1,0"}, {"thickness", "2"}}}}) {
         const Scene scene = scene_for(settings, mesh, 48);
-        EXPECT_LE(max_difference(render(scene), render(scene, PlanMode::full)), 1e-6) << mesh;
+        EXPECT_LE(max_difference(render(scene), render(scene, PlanMode::full)), 1e-6)
+            << mesh;
     }
 }
 
@@ -156,8 +161,10 @@ TEST_F(ThickTextureGl, ThesisPathEqualsTheHardwarePath) {
                  {"random:0.5,3", "55", "300", 64},
                  {"net:1,1", "60", "192", 96}})
             for (const char* mesh : {"square", "wave"}) {
-                std::vector<KnobAssignment> s = {{"tilt", tilt}, {"azimuth", "20"},
-                                                 {"texture", texture}, {"filter", filter},
+                std::vector<KnobAssignment> s = {{"tilt", tilt},
+                                                 {"azimuth", "20"},
+                                                 {"texture", texture},
+                                                 {"filter", filter},
                                                  {"texel_density", density}};
                 const Image hardware = render(scene_for(s, mesh, size));
                 s.push_back({"fetch_path", "thesis"});
@@ -171,12 +178,14 @@ TEST_F(ThickTextureGl, NetsFollowTheClosedFormsInGlAndTheReference) {
     const Technique& t = find_technique("thick_texture");
     for (int n : {1, 3, 5})
         for (double tilt : {0.0, 30.0, 60.0}) {
-            const Scene scene = scene_for(transmittance(
-                {{"texture", "net:" + std::to_string(n) + ",1"}, {"tilt", std::to_string(tilt)}, {"texel_density", "1152"}}));
+            const Scene scene =
+                scene_for(transmittance({{"texture", "net:" + std::to_string(n) + ",1"},
+                                         {"tilt", std::to_string(tilt)},
+                                         {"texel_density", "1152"}}));
             const auto model = [n](glm::dvec2 r) { return model_net(n, r); };
             const auto exact = [n](glm::dvec2 r) { return exact_net(n, r); };
-            EXPECT_NEAR(window_mean(render(scene), 32), expected_window_mean(scene, 32, 1.0, model),
-                        6e-3)
+            EXPECT_NEAR(window_mean(render(scene), 32),
+                        expected_window_mean(scene, 32, 1.0, model), 6e-3)
                 << "GL net " << n << " at " << tilt;
             EXPECT_NEAR(window_mean(t.render_reference(scene), 32),
                         expected_window_mean(scene, 32, 1.0, exact), 6e-3)
@@ -202,15 +211,16 @@ TEST_F(ThickTextureGl, WideHoleFixFollowsTheExactNetAtSteepAngles) {
 }
 
 TEST_F(ThickTextureGl, GrazingRayThroughANetIsFullyOccludedInTheReference) {
-    const Scene scene = scene_for(transmittance({{"texture", "net:1,1"}, {"tilt", "85"},
-                                                 {"thickness", "2"}}));
+    const Scene scene = scene_for(
+        transmittance({{"texture", "net:1,1"}, {"tilt", "85"}, {"thickness", "2"}}));
     const Image reference = find_technique("thick_texture").render_reference(scene);
     int interior = 0;
     for (int y = 1; y + 1 < reference.height; ++y)
         for (int x = 1; x + 1 < reference.width; ++x) {
             bool inside = true;
             for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) inside = inside && reference.at(x + dx, y + dy).a == 1.0f;
+                for (int dx = -1; dx <= 1; ++dx)
+                    inside = inside && reference.at(x + dx, y + dy).a == 1.0f;
             if (!inside) continue;
             ++interior;
             EXPECT_EQ(reference.at(x, y).r, 0.0f) << x << "," << y;
@@ -234,7 +244,8 @@ TEST_F(ThickTextureGl, HardCasesAreFiniteAndInRange) {
     Image npot(37, 23);  // a non-power-of-two file: holes where alpha < 0.5
     for (int y = 0; y < npot.height; ++y)
         for (int x = 0; x < npot.width; ++x)
-            npot.set(x, y, glm::vec4(0.8f, 0.3f, 0.2f, (x * 7 + y * 3) % 5 < 2 ? 0.0f : 1.0f));
+            npot.set(x, y,
+                     glm::vec4(0.8f, 0.3f, 0.2f, (x * 7 + y * 3) % 5 < 2 ? 0.0f : 1.0f));
     const std::string file = (dir / "holes.exr").string();
     write_image(file, npot);
     for (const auto& settings : std::vector<std::vector<KnobAssignment>>{
