@@ -1,7 +1,7 @@
-#include "analyze.h"
+#include "analysis/analyze.h"
 
-#include "data/grouping.h"
-#include "data/subject_matrix.h"
+#include "analysis/data/grouping.h"
+#include "analysis/data/subject_matrix.h"
 
 namespace lucent::analysis {
 

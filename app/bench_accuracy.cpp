@@ -15,12 +15,12 @@
 #include <map>
 #include <sstream>
 
-#include "commands.h"
-#include "core/ambient_occlusion.h"
-#include "core/image_compare.h"
-#include "gl/context.h"
-#include "render.h"
-#include "techniques/registry.h"
+#include "app/commands.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/core/image_compare.h"
+#include "renderer/gl/context.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent::app {
 namespace {

@@ -13,12 +13,12 @@
 #include <memory>
 #include <thread>
 
-#include "bench_results.h"
-#include "commands.h"
-#include "core/ambient_occlusion.h"
-#include "core/progress.h"
-#include "cpu/ambient_occlusion_directions.h"
-#include "cpu/occlusion_counter.h"
+#include "app/bench_results.h"
+#include "app/commands.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/core/progress.h"
+#include "renderer/cpu/ambient_occlusion_directions.h"
+#include "renderer/cpu/occlusion_counter.h"
 
 namespace lucent::app {
 namespace {

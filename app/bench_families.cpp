@@ -1,5 +1,5 @@
 // The list of `lucent bench` families; one line per family.
-#include "commands.h"
+#include "app/commands.h"
 
 namespace lucent::app {
 

@@ -12,11 +12,11 @@
 #include <optional>
 #include <sstream>
 
-#include "commands.h"
-#include "gl/context.h"
-#include "output_file.h"
-#include "render.h"
-#include "techniques/registry.h"
+#include "app/commands.h"
+#include "output/output_file.h"
+#include "renderer/gl/context.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent::app {
 namespace {

@@ -13,9 +13,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "batch_render.h"
-#include "bench_results.h"
-#include "commands.h"
+#include "app/bench_results.h"
+#include "app/commands.h"
+#include "stimuli/batch_render.h"
 
 namespace lucent::app {
 namespace {

@@ -1,10 +1,10 @@
-#include "bench_results.h"
+#include "app/bench_results.h"
 
 #include <exception>
 #include <ostream>
 #include <string>
 
-#include "output_file.h"
+#include "output/output_file.h"
 
 namespace lucent::app {
 namespace {

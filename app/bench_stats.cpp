@@ -17,14 +17,14 @@
 #include <string>
 #include <vector>
 
-#include "bench_results.h"
-#include "commands.h"
-#include "data/long_table.h"
-#include "simulate/simulate.h"
-#include "stats/anova.h"
-#include "stats/kruskal_wallis.h"
-#include "stats/studentized_range.h"
-#include "stats/tukey.h"
+#include "analysis/data/long_table.h"
+#include "analysis/simulate/simulate.h"
+#include "analysis/stats/anova.h"
+#include "analysis/stats/kruskal_wallis.h"
+#include "analysis/stats/studentized_range.h"
+#include "analysis/stats/tukey.h"
+#include "app/bench_results.h"
+#include "app/commands.h"
 
 namespace lucent::app {
 namespace {

@@ -14,15 +14,15 @@
 #include <thread>
 #include <vector>
 
-#include "commands.h"
-#include "postgres/local_server.h"
-#include "protocol.h"
-#include "serve/web_study.h"
-#include "serve_http.h"
-#include "sqlite.h"
-#include "store.h"
-#include "study_store.h"
-#include "trial_plan.h"
+#include "app/commands.h"
+#include "app/serve_http.h"
+#include "study/postgres/local_server.h"
+#include "study/protocol.h"
+#include "study/serve/web_study.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
+#include "study/trial_plan.h"
 
 namespace lucent::app {
 namespace {

@@ -1,4 +1,4 @@
-#include "cli_main.h"
+#include "app/cli_main.h"
 
 #include <exception>
 #include <iostream>

@@ -4,7 +4,7 @@
 // the shared exit codes.
 #include <vector>
 
-#include "commands.h"
+#include "app/commands.h"
 
 namespace lucent::app {
 

@@ -3,12 +3,12 @@
 // (participant,stimulus,factor,level,question,rating).
 #include <iostream>
 
-#include "analyze.h"
-#include "commands.h"
-#include "data/long_table.h"
-#include "report/report.h"
-#include "stats/one_way_analysis.h"
-#include "study_input.h"
+#include "analysis/analyze.h"
+#include "analysis/data/long_table.h"
+#include "analysis/report/report.h"
+#include "analysis/stats/one_way_analysis.h"
+#include "app/commands.h"
+#include "app/study_input.h"
 
 namespace lucent::app {
 namespace {

@@ -1,6 +1,6 @@
 // lucent bench: measured speed and accuracy tables. Each family registers its own
 // sub-subcommand (bench_<family>.cpp); this file only creates the parent.
-#include "commands.h"
+#include "app/commands.h"
 
 namespace lucent::app {
 

@@ -2,12 +2,12 @@
 // turns the command line into an ExplorerSession and runs the window.
 #include <iostream>
 
-#include "commands.h"
-#include "core/image.h"
-#include "core/mesh.h"
-#include "explorer/explorer.h"
-#include "explorer/frame_stats.h"
-#include "stimulus_set.h"
+#include "app/commands.h"
+#include "renderer/core/image.h"
+#include "renderer/core/mesh.h"
+#include "stimuli/explorer/explorer.h"
+#include "stimuli/explorer/frame_stats.h"
+#include "stimuli/stimulus_set.h"
 
 namespace lucent::app {
 namespace {

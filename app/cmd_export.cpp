@@ -1,12 +1,12 @@
 // lucent export: a study database as CSV (long, wide, or the analysis long table).
 #include <iostream>
 
-#include "commands.h"
-#include "export.h"
-#include "question_scales.h"
-#include "sqlite.h"
-#include "study_db_option.h"
-#include "study_store.h"
+#include "app/commands.h"
+#include "app/study_db_option.h"
+#include "study/export.h"
+#include "study/question_scales.h"
+#include "study/sqlite/database.h"
+#include "study/study_store.h"
 
 namespace lucent::app {
 

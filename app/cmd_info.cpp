@@ -12,9 +12,9 @@
 #include <glm/detail/setup.hpp>
 #include <iostream>
 
-#include "commands.h"
-#include "gl/context.h"
+#include "app/commands.h"
 #include "lucent/version.h"
+#include "renderer/gl/context.h"
 
 namespace lucent::app {
 namespace {

@@ -2,12 +2,12 @@
 #include <iostream>
 #include <memory>
 
-#include "commands.h"
-#include "export.h"
-#include "postgres/merge_into_server.h"
-#include "sqlite.h"
-#include "study_db_option.h"
-#include "study_store.h"
+#include "app/commands.h"
+#include "app/study_db_option.h"
+#include "study/export.h"
+#include "study/postgres/merge_into_server.h"
+#include "study/sqlite/database.h"
+#include "study/study_store.h"
 
 namespace lucent::app {
 namespace {

@@ -3,11 +3,11 @@
 #include <memory>
 #include <optional>
 
-#include "commands.h"
-#include "sqlite.h"
-#include "store.h"
-#include "study_db_option.h"
-#include "study_store.h"
+#include "app/commands.h"
+#include "app/study_db_option.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
 
 namespace lucent::app {
 namespace {

@@ -5,8 +5,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "commands.h"
-#include "simulate/power.h"
+#include "analysis/simulate/power.h"
+#include "app/commands.h"
 
 namespace lucent::app {
 namespace {

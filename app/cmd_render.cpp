@@ -3,12 +3,12 @@
 // (renderer/render.h), the same path batch rendering and the explorer use.
 #include <iostream>
 
-#include "batch_render.h"
-#include "commands.h"
-#include "core/technique.h"
-#include "gl/context.h"
-#include "render.h"
-#include "techniques/registry.h"
+#include "app/commands.h"
+#include "renderer/core/technique.h"
+#include "renderer/gl/context.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "stimuli/batch_render.h"
 
 namespace lucent::app {
 namespace {

@@ -1,13 +1,13 @@
 // lucent run: a participant session from a protocol file or the built-in preset.
 #include <iostream>
 
-#include "commands.h"
-#include "protocol.h"
-#include "session/live_stimuli.h"
-#include "session/runner.h"
-#include "session/stimulus_source.h"
-#include "sqlite.h"
-#include "trial_plan.h"
+#include "app/commands.h"
+#include "study/protocol.h"
+#include "study/session/live_stimuli.h"
+#include "study/session/runner.h"
+#include "study/session/stimulus_source.h"
+#include "study/sqlite/database.h"
+#include "study/trial_plan.h"
 
 namespace lucent::app {
 namespace {

@@ -20,16 +20,16 @@
 #include <sstream>
 #include <thread>
 
-#include "commands.h"
+#include "app/commands.h"
+#include "app/serve_http.h"
 #include "lucent/version.h"
-#include "postgres/trial_journal.h"
-#include "protocol.h"
-#include "serve/web_study.h"
-#include "serve_http.h"
-#include "session/stimulus_source.h"
-#include "store.h"
-#include "study_store.h"
-#include "trial_plan.h"
+#include "study/postgres/trial_journal.h"
+#include "study/protocol.h"
+#include "study/serve/web_study.h"
+#include "study/session/stimulus_source.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
+#include "study/trial_plan.h"
 
 namespace lucent::app {
 namespace {

@@ -2,9 +2,9 @@
 // so the analysis pipeline can be exercised without a lab.
 #include <iostream>
 
-#include "commands.h"
-#include "output_file.h"
-#include "simulate/simulate.h"
+#include "analysis/simulate/simulate.h"
+#include "app/commands.h"
+#include "output/output_file.h"
 
 namespace lucent::app {
 

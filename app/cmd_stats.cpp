@@ -5,9 +5,9 @@
 #include <iostream>
 #include <stdexcept>
 
-#include "commands.h"
-#include "data/decimal.h"
-#include "stats/studentized_range.h"
+#include "analysis/data/decimal.h"
+#include "analysis/stats/studentized_range.h"
+#include "app/commands.h"
 
 namespace lucent::app {
 namespace {

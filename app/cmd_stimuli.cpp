@@ -2,8 +2,8 @@
 // image statistics of a rendered stimulus set (stimuli/set_report/set_report.h).
 #include <memory>
 
-#include "commands.h"
-#include "set_report/set_report.h"
+#include "app/commands.h"
+#include "stimuli/set_report/set_report.h"
 
 namespace lucent::app {
 

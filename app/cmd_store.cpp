@@ -2,10 +2,10 @@
 #include <iostream>
 #include <memory>
 
-#include "commands.h"
-#include "postgres/trial_journal.h"
-#include "sqlite.h"
-#include "study_store.h"
+#include "app/commands.h"
+#include "study/postgres/trial_journal.h"
+#include "study/sqlite/database.h"
+#include "study/study_store.h"
 
 namespace lucent::app {
 

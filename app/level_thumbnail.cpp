@@ -1,12 +1,12 @@
-#include "level_thumbnail.h"
+#include "app/level_thumbnail.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
 
-#include "core/image.h"
-#include "set_report/contact_sheet.h"
+#include "renderer/core/image.h"
+#include "stimuli/set_report/contact_sheet.h"
 
 namespace lucent::app {
 

@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "cli_main.h"
+#include "app/cli_main.h"
 
 namespace lucent::app {
 

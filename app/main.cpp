@@ -1,8 +1,8 @@
 // lucent-full: every subcommand. Users run `lucent` (main_dispatch.cpp), which hands
 // everything but the analysis subcommands to this program.
-#include "cli_main.h"
-#include "level_thumbnail.h"
-#include "light_commands.h"
+#include "app/cli_main.h"
+#include "app/level_thumbnail.h"
+#include "app/light_commands.h"
 
 int main(int argc, char** argv) {
     using namespace lucent::app;

@@ -9,8 +9,8 @@
 #include <iostream>
 #include <string_view>
 
-#include "cli_main.h"
-#include "light_commands.h"
+#include "app/cli_main.h"
+#include "app/light_commands.h"
 
 namespace {
 

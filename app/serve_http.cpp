@@ -1,5 +1,5 @@
 // lucent serve's HTTP layer (serve_http.h).
-#include "serve_http.h"
+#include "app/serve_http.h"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -19,7 +19,7 @@
 #include <set>
 #include <thread>
 
-#include "serve/web_files.h"
+#include "study/serve/web_files.h"
 
 namespace lucent::app {
 namespace {

@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-#include "serve/web_study.h"
+#include "study/serve/web_study.h"
 
 namespace lucent::app {
 

@@ -2,7 +2,7 @@
 // The --db argument's check: an existing study file, or a server URI (study_store.h).
 #include <CLI/CLI.hpp>
 
-#include "study_store.h"
+#include "study/study_store.h"
 
 namespace lucent::app {
 

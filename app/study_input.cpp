@@ -1,12 +1,12 @@
-#include "study_input.h"
+#include "app/study_input.h"
 
 #include <fstream>
 #include <iostream>
 
-#include "export.h"
-#include "question_scales.h"
-#include "sqlite.h"
-#include "study_store.h"
+#include "study/export.h"
+#include "study/question_scales.h"
+#include "study/sqlite/database.h"
+#include "study/study_store.h"
 
 namespace lucent::app {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "data/long_table.h"
-#include "stats/one_way_analysis.h"
+#include "analysis/data/long_table.h"
+#include "analysis/stats/one_way_analysis.h"
 
 namespace lucent::app {
 

@@ -1,6 +1,8 @@
 # Warnings and sanitizers applied to every Lucent target through one interface library,
 # so third-party code found by find_package keeps its own flags.
 add_library(lucent_compile_options INTERFACE)
+# Includes name their layer from the repository root: "renderer/core/scene.h", "study/...".
+target_include_directories(lucent_compile_options INTERFACE ${PROJECT_SOURCE_DIR})
 target_compile_options(lucent_compile_options INTERFACE -Wall -Wextra -Wpedantic
                        -Wno-missing-field-initializers)
 

@@ -1,5 +1,5 @@
 // Output path checks and atomic writes (see output_file.h).
-#include "output_file.h"
+#include "output/output_file.h"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -1,9 +1,9 @@
-#include "render.h"
+#include "renderer/render.h"
 
 #include <stdexcept>
 
-#include "core/technique.h"
-#include "techniques/registry.h"
+#include "renderer/core/technique.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent {
 

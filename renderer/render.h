@@ -4,11 +4,11 @@
 #include <string>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/knobs.h"
-#include "core/scene.h"
-#include "gl/frame_executor.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/scene.h"
+#include "renderer/gl/frame_executor.h"
 
 namespace lucent {
 

@@ -4,7 +4,7 @@
 // [SECTION] BatchProgress: stimuli done, time per stimulus, time left
 // [SECTION] render_stimulus_set(): meshes, reuse, AO pre-bake, workers, manifest
 // [SECTION] run_render_set_command(): the CLI's batch path and its exit codes
-#include "batch_render.h"
+#include "stimuli/batch_render.h"
 
 #include <unistd.h>
 
@@ -23,15 +23,15 @@
 #include <set>
 #include <thread>
 
-#include "core/ambient_occlusion.h"
-#include "core/density_volume.h"
-#include "core/mesh.h"
-#include "core/technique.h"
-#include "gl/context.h"
 #include "lucent/version.h"
-#include "render.h"
-#include "set_report/set_report.h"
-#include "techniques/registry.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/core/density_volume.h"
+#include "renderer/core/mesh.h"
+#include "renderer/core/technique.h"
+#include "renderer/gl/context.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "stimuli/set_report/set_report.h"
 
 namespace lucent::stimuli {
 namespace {

@@ -13,9 +13,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/image.h"
-#include "manifest.h"
-#include "stimulus_set.h"
+#include "renderer/core/image.h"
+#include "stimuli/manifest.h"
+#include "stimuli/stimulus_set.h"
 
 namespace lucent::stimuli {
 

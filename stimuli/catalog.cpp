@@ -1,7 +1,7 @@
 // The default SetCatalog: the technique registry and the built-in meshes.
-#include "core/mesh.h"
-#include "stimulus_set.h"
-#include "techniques/registry.h"
+#include "renderer/core/mesh.h"
+#include "renderer/techniques/registry.h"
+#include "stimuli/stimulus_set.h"
 
 namespace lucent::stimuli {
 

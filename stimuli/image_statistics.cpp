@@ -1,4 +1,4 @@
-#include "image_statistics.h"
+#include "stimuli/image_statistics.h"
 
 #include <algorithm>
 #include <cmath>

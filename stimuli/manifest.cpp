@@ -1,4 +1,4 @@
-#include "manifest.h"
+#include "stimuli/manifest.h"
 
 #include <algorithm>
 #include <cmath>

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "image_statistics.h"
+#include "stimuli/image_statistics.h"
 
 namespace lucent::stimuli {
 

@@ -3,7 +3,7 @@
 #include <string>
 #include <string_view>
 
-#include "stimulus_set.h"
+#include "stimuli/stimulus_set.h"
 
 namespace lucent::embedded {
 std::optional<std::string_view> stimuli_preset_file(std::string_view relative_path);

@@ -6,7 +6,7 @@
 // [SECTION] public entry points
 // Parameter precedence (later wins): technique defaults, [defaults], [camera], the
 // stimulus's light, its material, its own keys, its [stimuli.vary] values.
-#include "stimulus_set.h"
+#include "stimuli/stimulus_set.h"
 
 #include <toml++/toml.h>
 

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/knobs.h"
+#include "renderer/core/knobs.h"
 
 namespace lucent::stimuli {
 

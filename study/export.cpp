@@ -1,5 +1,5 @@
 // CSV export and the analysis long table.
-#include "export.h"
+#include "study/export.h"
 
 #include <cstdint>
 #include <map>
@@ -7,10 +7,10 @@
 #include <set>
 #include <sstream>
 
-#include "output_file.h"
-#include "question_scales.h"
-#include "sqlite.h"
-#include "store.h"
+#include "output/output_file.h"
+#include "study/question_scales.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 namespace {

@@ -10,13 +10,13 @@
 #include <set>
 #include <tuple>
 
-#include "export.h"
-#include "merge_provenance.h"
-#include "merge_reconcile.h"
-#include "output_file.h"
-#include "sqlite.h"
-#include "store.h"
-#include "withdrawal.h"
+#include "output/output_file.h"
+#include "study/export.h"
+#include "study/merge_provenance.h"
+#include "study/merge_reconcile.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/withdrawal.h"
 
 namespace lucent::study {
 namespace {

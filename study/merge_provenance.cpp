@@ -1,10 +1,10 @@
 // Provenance in merges: stimuli must agree value for value; segments travel with their
 // sessions (matched by session UUID and segment number, never by row id).
-#include "merge_provenance.h"
+#include "study/merge_provenance.h"
 
 #include <map>
 
-#include "store.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 namespace {

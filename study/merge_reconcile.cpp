@@ -1,9 +1,9 @@
 // Reconciling copies of one session in a merge (merge_reconcile.h).
-#include "merge_reconcile.h"
+#include "study/merge_reconcile.h"
 
 #include <tuple>
 
-#include "store.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 namespace {

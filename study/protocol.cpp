@@ -1,5 +1,5 @@
 // Protocol parsing: TOML -> Protocol, with every error naming file, line and key.
-#include "protocol.h"
+#include "study/protocol.h"
 
 #include <toml++/toml.h>
 
@@ -10,8 +10,8 @@
 #include <set>
 #include <sstream>
 
-#include "embedded_study_files.h"
-#include "sha256.h"
+#include "study/embedded_study_files.h"
+#include "study/sha256.h"
 
 namespace lucent::study {
 namespace {

@@ -1,6 +1,6 @@
-#include "question_scales.h"
+#include "study/question_scales.h"
 
-#include "store.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 

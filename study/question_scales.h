@@ -6,8 +6,8 @@
 #include <map>
 #include <string>
 
-#include "protocol.h"
-#include "sqlite.h"
+#include "study/protocol.h"
+#include "study/sqlite/database.h"
 
 namespace lucent::study {
 

@@ -1,5 +1,5 @@
 // SHA-256 after FIPS 180-4, section 6.2: pad, then 64 rounds per 512-bit block.
-#include "sha256.h"
+#include "study/sha256.h"
 
 #include <array>
 #include <cstdint>

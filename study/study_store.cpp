@@ -1,13 +1,13 @@
 // Picking a store backend by the --db argument's name (study_store.h).
-#include "study_store.h"
+#include "study/study_store.h"
 
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 
-#include "postgres/postgres_store.h"
-#include "store.h"
+#include "study/postgres/postgres_store.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "protocol.h"
-#include "store_types.h"
-#include "trial_plan.h"
+#include "study/protocol.h"
+#include "study/store_types.h"
+#include "study/trial_plan.h"
 
 namespace lucent::study {
 

@@ -1,6 +1,6 @@
 // Trial planning: practice in protocol order, then blocks in Latin-square order, each
 // block shuffled under the protocol's constraints, with catch trials mixed in.
-#include "trial_plan.h"
+#include "study/trial_plan.h"
 
 #include <algorithm>
 #include <map>

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "protocol.h"
+#include "study/protocol.h"
 
 namespace lucent::study {
 

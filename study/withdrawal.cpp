@@ -1,11 +1,11 @@
 // Withdrawal tombstones (withdrawal.h).
-#include "withdrawal.h"
+#include "study/withdrawal.h"
 
 #include <cstdio>
 #include <random>
 #include <set>
 
-#include "sha256.h"
+#include "study/sha256.h"
 
 namespace lucent::study {
 namespace {

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "sqlite.h"
+#include "study/sqlite/database.h"
 
 namespace lucent::study {
 

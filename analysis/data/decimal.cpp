@@ -1,4 +1,4 @@
-#include "data/decimal.h"
+#include "analysis/data/decimal.h"
 
 #include <algorithm>
 #include <boost/multiprecision/cpp_dec_float.hpp>

@@ -1,9 +1,9 @@
-#include "data/grouping.h"
+#include "analysis/data/grouping.h"
 
 #include <algorithm>
 #include <map>
 
-#include "data/decimal.h"
+#include "analysis/data/decimal.h"
 
 namespace lucent::analysis {
 

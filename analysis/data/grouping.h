@@ -1,8 +1,8 @@
 #pragma once
 // Splits the long table into one-way layouts: one per (question, factor) pair, the
 // factor's levels as groups.
-#include "data/long_table.h"
-#include "stats/one_way_data.h"
+#include "analysis/data/long_table.h"
+#include "analysis/stats/one_way_data.h"
 
 namespace lucent::analysis {
 

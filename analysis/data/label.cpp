@@ -1,4 +1,4 @@
-#include "data/label.h"
+#include "analysis/data/label.h"
 
 #include <mutex>
 #include <unordered_set>

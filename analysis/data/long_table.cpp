@@ -1,4 +1,4 @@
-#include "data/long_table.h"
+#include "analysis/data/long_table.h"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -17,7 +17,7 @@
 #include <sstream>
 #include <thread>
 
-#include "data/decimal.h"
+#include "analysis/data/decimal.h"
 
 namespace lucent::analysis {
 namespace {

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "data/label.h"
+#include "analysis/data/label.h"
 
 namespace lucent::analysis {
 

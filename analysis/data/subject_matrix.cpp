@@ -1,4 +1,4 @@
-#include "data/subject_matrix.h"
+#include "analysis/data/subject_matrix.h"
 
 #include <unordered_map>
 

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "data/long_table.h"
-#include "stats/repeated_measures.h"
+#include "analysis/data/long_table.h"
+#include "analysis/stats/repeated_measures.h"
 
 namespace lucent::analysis {
 

@@ -1,4 +1,4 @@
-#include "report/format.h"
+#include "analysis/report/format.h"
 
 #include <cmath>
 #include <cstdio>

@@ -4,7 +4,7 @@
 // "< 1e-300".
 #include <string>
 
-#include "stats/one_way_data.h"
+#include "analysis/stats/one_way_data.h"
 
 namespace lucent::analysis {
 

@@ -1,4 +1,4 @@
-#include "report/html_page.h"
+#include "analysis/report/html_page.h"
 
 namespace lucent::analysis {
 

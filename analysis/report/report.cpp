@@ -1,4 +1,4 @@
-#include "report/report.h"
+#include "analysis/report/report.h"
 
 #include <algorithm>
 #include <boost/archive/iterators/base64_from_binary.hpp>
@@ -7,11 +7,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "data/long_table.h"
-#include "output_file.h"
-#include "report/format.h"
-#include "report/html_page.h"
-#include "report/svg_plot.h"
+#include "analysis/data/long_table.h"
+#include "analysis/report/format.h"
+#include "analysis/report/html_page.h"
+#include "analysis/report/svg_plot.h"
+#include "output/output_file.h"
 
 namespace lucent::analysis {
 namespace {

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "data/long_table.h"
-#include "stats/one_way_analysis.h"
+#include "analysis/data/long_table.h"
+#include "analysis/stats/one_way_analysis.h"
 
 namespace lucent::analysis {
 

@@ -1,4 +1,4 @@
-#include "report/svg_plot.h"
+#include "analysis/report/svg_plot.h"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "stats/descriptives.h"
+#include "analysis/stats/descriptives.h"
 
 namespace lucent::analysis {
 

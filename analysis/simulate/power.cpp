@@ -1,14 +1,14 @@
-#include "simulate/power.h"
+#include "analysis/simulate/power.h"
 
 #include <algorithm>
 #include <boost/math/distributions/fisher_f.hpp>
 #include <boost/math/distributions/non_central_f.hpp>
 #include <cmath>
 
-#include "data/long_table.h"
-#include "simulate/normal_source.h"
-#include "stats/anova.h"
-#include "stats/tukey.h"
+#include "analysis/data/long_table.h"
+#include "analysis/simulate/normal_source.h"
+#include "analysis/stats/anova.h"
+#include "analysis/stats/tukey.h"
 
 namespace lucent::analysis {
 namespace {

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "data/long_table.h"  // InputError
-#include "stats/one_way_analysis.h"
+#include "analysis/data/long_table.h"  // InputError
+#include "analysis/stats/one_way_analysis.h"
 
 namespace lucent::analysis {
 

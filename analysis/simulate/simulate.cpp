@@ -1,9 +1,9 @@
-#include "simulate/simulate.h"
+#include "analysis/simulate/simulate.h"
 
 #include <cmath>
 #include <random>
 
-#include "simulate/normal_source.h"
+#include "analysis/simulate/normal_source.h"
 
 namespace lucent::analysis {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "data/long_table.h"
+#include "analysis/data/long_table.h"
 
 namespace lucent::analysis {
 

@@ -1,11 +1,11 @@
-#include "stats/anova.h"
+#include "analysis/stats/anova.h"
 
 #include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
 #include <limits>
 
-#include "stats/descriptives.h"
-#include "stats/summation.h"
+#include "analysis/stats/descriptives.h"
+#include "analysis/stats/summation.h"
 
 namespace lucent::analysis {
 namespace {

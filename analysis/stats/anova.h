@@ -1,6 +1,6 @@
 #pragma once
 // Classical one-way ANOVA with effect sizes, and Welch's heteroscedastic ANOVA.
-#include "stats/one_way_data.h"
+#include "analysis/stats/one_way_data.h"
 
 namespace lucent::analysis {
 

@@ -1,10 +1,10 @@
-#include "stats/descriptives.h"
+#include "analysis/stats/descriptives.h"
 
 #include <algorithm>
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 
-#include "stats/summation.h"
+#include "analysis/stats/summation.h"
 
 namespace lucent::analysis {
 

@@ -1,7 +1,7 @@
 #pragma once
 // Per-group descriptive statistics: n, mean, SD, SE, median and the t-based confidence
 // interval of the mean.
-#include "stats/one_way_data.h"
+#include "analysis/stats/one_way_data.h"
 
 namespace lucent::analysis {
 

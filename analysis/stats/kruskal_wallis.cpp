@@ -1,11 +1,11 @@
-#include "stats/kruskal_wallis.h"
+#include "analysis/stats/kruskal_wallis.h"
 
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <numeric>
 
-#include "stats/summation.h"
+#include "analysis/stats/summation.h"
 
 namespace lucent::analysis {
 

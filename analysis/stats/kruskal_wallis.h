@@ -3,7 +3,7 @@
 //   H = [12 / (N (N+1)) sum R_i^2 / n_i - 3 (N+1)] / [1 - sum (t^3 - t) / (N^3 - N)],
 // chi-square with k - 1 df. Ratings on a 7-point scale are mostly ties; the correction
 // matters.
-#include "stats/one_way_data.h"
+#include "analysis/stats/one_way_data.h"
 
 namespace lucent::analysis {
 

@@ -1,4 +1,4 @@
-#include "stats/one_way_analysis.h"
+#include "analysis/stats/one_way_analysis.h"
 
 namespace lucent::analysis {
 

@@ -1,10 +1,10 @@
 #pragma once
 // Everything the report shows for one (question, factor) pair, computed in one place.
-#include "stats/anova.h"
-#include "stats/descriptives.h"
-#include "stats/kruskal_wallis.h"
-#include "stats/repeated_measures.h"
-#include "stats/tukey.h"
+#include "analysis/stats/anova.h"
+#include "analysis/stats/descriptives.h"
+#include "analysis/stats/kruskal_wallis.h"
+#include "analysis/stats/repeated_measures.h"
+#include "analysis/stats/tukey.h"
 
 namespace lucent::analysis {
 

@@ -1,4 +1,4 @@
-#include "stats/repeated_measures.h"
+#include "analysis/stats/repeated_measures.h"
 
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -8,7 +8,7 @@
 #include <limits>
 #include <numeric>
 
-#include "stats/summation.h"
+#include "analysis/stats/summation.h"
 
 namespace lucent::analysis {
 namespace {

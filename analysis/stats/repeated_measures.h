@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "stats/one_way_data.h"
+#include "analysis/stats/one_way_data.h"
 
 namespace lucent::analysis {
 

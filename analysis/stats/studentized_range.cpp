@@ -10,7 +10,7 @@
 // summed by the trapezoid rule on the grid u_i = i h (exponentially accurate for these
 // analytic, fast-decaying integrands) in log space, marching out from the peak. Only the
 // smaller tail is summed; the other is one minus it.
-#include "stats/studentized_range.h"
+#include "analysis/stats/studentized_range.h"
 
 #include <algorithm>
 #include <array>

@@ -1,10 +1,10 @@
-#include "stats/tukey.h"
+#include "analysis/stats/tukey.h"
 
 #include <cmath>
 #include <limits>
 
-#include "stats/descriptives.h"
-#include "stats/studentized_range.h"
+#include "analysis/stats/descriptives.h"
+#include "analysis/stats/studentized_range.h"
 
 namespace lucent::analysis {
 

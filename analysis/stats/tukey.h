@@ -3,7 +3,7 @@
 // conventions: diff = mean(b) - mean(a), q = |diff| / se with
 // se = sqrt(MS_within / 2 * (1/n_a + 1/n_b)), p_adj = P(Q(k, df_within) > q), and the
 // simultaneous interval diff -/+ q_crit * se at confidence 1 - alpha.
-#include "stats/anova.h"
+#include "analysis/stats/anova.h"
 
 namespace lucent::analysis {
 

@@ -11,7 +11,7 @@
 #include <functional>
 #include <vector>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

@@ -19,8 +19,8 @@
 #include <random>
 #include <string>
 
-#include "core/ambient_occlusion.h"
-#include "core/progress.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/core/progress.h"
 
 namespace lucent {
 

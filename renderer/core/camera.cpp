@@ -1,5 +1,5 @@
 // The thesis's camera (Eq. 3.4): distance to the bounding-sphere centre = its diameter.
-#include "core/camera.h"
+#include "renderer/core/camera.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // to the bounding-sphere diameter, with near/far planes hugging the sphere.
 #include <glm/glm.hpp>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

@@ -1,4 +1,4 @@
-#include "core/common_knobs.h"
+#include "renderer/core/common_knobs.h"
 
 namespace lucent {
 

@@ -4,7 +4,7 @@
 // several techniques reuse under the same canonical names.
 #include <vector>
 
-#include "core/knobs.h"
+#include "renderer/core/knobs.h"
 
 namespace lucent {
 

@@ -2,7 +2,7 @@
 // NRRD subset, the contrast knob and the content hash.
 // [SECTION] spec parsing   [SECTION] noise   [SECTION] generators
 // [SECTION] NRRD files     [SECTION] volume assembly
-#include "core/density_volume.h"
+#include "renderer/core/density_volume.h"
 
 #include <algorithm>
 #include <charconv>

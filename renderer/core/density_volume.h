@@ -21,7 +21,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/knobs.h"
+#include "renderer/core/knobs.h"
 
 namespace lucent {
 

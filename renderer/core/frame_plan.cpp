@@ -1,4 +1,4 @@
-#include "core/frame_plan.h"
+#include "renderer/core/frame_plan.h"
 
 #include <algorithm>
 #include <glm/gtc/matrix_inverse.hpp>

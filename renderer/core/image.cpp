@@ -1,4 +1,4 @@
-#include "core/image.h"
+#include "renderer/core/image.h"
 
 #include <OpenImageIO/imageio.h>
 

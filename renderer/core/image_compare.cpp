@@ -1,4 +1,4 @@
-#include "core/image_compare.h"
+#include "renderer/core/image_compare.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 #pragma once
 // Error between two images of the same scene (GL vs CPU reference), as the tests and
 // `lucent bench accuracy` measure it.
-#include "core/image.h"
+#include "renderer/core/image.h"
 
 namespace lucent {
 

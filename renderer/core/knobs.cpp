@@ -1,4 +1,4 @@
-#include "core/knobs.h"
+#include "renderer/core/knobs.h"
 
 #include <charconv>
 #include <cmath>

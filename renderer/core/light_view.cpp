@@ -1,10 +1,10 @@
-#include "core/light_view.h"
+#include "renderer/core/light_view.h"
 
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <stdexcept>
 
-#include "core/scene.h"
+#include "renderer/core/scene.h"
 
 namespace lucent {
 

@@ -5,7 +5,7 @@
 // identically.
 #include <glm/glm.hpp>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

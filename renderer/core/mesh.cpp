@@ -1,6 +1,6 @@
 // Mesh helpers shared by the built-in shapes and the file loader: bounding sphere,
 // content hash, smooth normals, and the spec dispatch of load_mesh().
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <unordered_map>
 
-#include "core/mesh_sources.h"
+#include "renderer/core/mesh_sources.h"
 
 namespace lucent {
 

@@ -20,9 +20,9 @@
 #include <functional>
 #include <numbers>
 
-#include "core/mesh.h"
-#include "core/mesh_sources.h"
-#include "core/polygonise.h"
+#include "renderer/core/mesh.h"
+#include "renderer/core/mesh_sources.h"
+#include "renderer/core/polygonise.h"
 
 namespace lucent {
 

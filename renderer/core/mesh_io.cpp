@@ -17,8 +17,8 @@
 #include <string>
 #include <unordered_map>
 
-#include "core/mesh.h"
-#include "core/mesh_sources.h"
+#include "renderer/core/mesh.h"
+#include "renderer/core/mesh_sources.h"
 
 namespace lucent {
 

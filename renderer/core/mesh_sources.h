@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

@@ -1,4 +1,4 @@
-#include "core/pass_reuse.h"
+#include "renderer/core/pass_reuse.h"
 
 #include <cstring>
 

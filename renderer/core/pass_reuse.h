@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/frame_plan.h"
+#include "renderer/core/frame_plan.h"
 
 namespace lucent {
 

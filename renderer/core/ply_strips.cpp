@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh.h"
-#include "core/mesh_sources.h"
+#include "renderer/core/mesh.h"
+#include "renderer/core/mesh_sources.h"
 
 namespace lucent {
 

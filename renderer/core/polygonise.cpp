@@ -1,5 +1,5 @@
 // Marching tetrahedra (see polygonise.h).
-#include "core/polygonise.h"
+#include "renderer/core/polygonise.h"
 
 #include <cmath>
 #include <cstdint>

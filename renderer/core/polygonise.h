@@ -2,7 +2,7 @@
 // Marching tetrahedra: the zero set of a scalar field as a closed, outward-wound mesh.
 #include <functional>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

@@ -1,4 +1,4 @@
-#include "core/progress.h"
+#include "renderer/core/progress.h"
 
 #include <unistd.h>
 

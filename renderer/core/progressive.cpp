@@ -1,4 +1,4 @@
-#include "core/progressive.h"
+#include "renderer/core/progressive.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
-#include "core/image.h"
-#include "core/knobs.h"
+#include "renderer/core/image.h"
+#include "renderer/core/knobs.h"
 
 namespace lucent {
 

@@ -1,4 +1,4 @@
-#include "core/recording_executor.h"
+#include "renderer/core/recording_executor.h"
 
 #include <stdexcept>
 

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/pass_reuse.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/pass_reuse.h"
 
 namespace lucent {
 

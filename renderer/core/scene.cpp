@@ -1,9 +1,9 @@
-#include "core/scene.h"
+#include "renderer/core/scene.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
 namespace lucent {
 

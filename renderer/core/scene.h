@@ -6,10 +6,10 @@
 #include <memory>
 #include <string>
 
-#include "core/camera.h"
-#include "core/density_volume.h"
-#include "core/knobs.h"
-#include "core/mesh.h"
+#include "renderer/core/camera.h"
+#include "renderer/core/density_volume.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

@@ -1,4 +1,4 @@
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
 namespace lucent {
 

@@ -10,11 +10,11 @@
 #include <utility>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/knobs.h"
-#include "core/progressive.h"
-#include "core/scene.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/progressive.h"
+#include "renderer/core/scene.h"
 
 namespace lucent {
 

@@ -16,9 +16,9 @@
 #include <string>
 #include <thread>
 
-#include "core/ambient_occlusion.h"
-#include "cpu/ambient_occlusion_directions.h"
-#include "cpu/occlusion_counter.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/cpu/ambient_occlusion_directions.h"
+#include "renderer/cpu/occlusion_counter.h"
 
 namespace lucent {
 

@@ -1,4 +1,4 @@
-#include "cpu/embree_support.h"
+#include "renderer/cpu/embree_support.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <xmmintrin.h>

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent::embree {
 

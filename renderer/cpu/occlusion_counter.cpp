@@ -1,5 +1,5 @@
 // OcclusionCounter on Embree 3: a static, robust scene of paired quads (or triangles).
-#include "cpu/occlusion_counter.h"
+#include "renderer/cpu/occlusion_counter.h"
 
 #include <embree3/rtcore.h>
 
@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "cpu/embree_support.h"
+#include "renderer/cpu/embree_support.h"
 
 namespace lucent {
 

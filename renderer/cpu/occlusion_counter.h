@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

@@ -1,4 +1,4 @@
-#include "cpu/pixel_rays.h"
+#include "renderer/cpu/pixel_rays.h"
 
 #include <algorithm>
 #include <glm/gtc/matrix_inverse.hpp>

@@ -8,9 +8,9 @@
 #include <optional>
 #include <vector>
 
-#include "core/camera.h"
-#include "core/mesh.h"
-#include "cpu/ray_caster.h"
+#include "renderer/core/camera.h"
+#include "renderer/core/mesh.h"
+#include "renderer/cpu/ray_caster.h"
 
 namespace lucent {
 

@@ -1,5 +1,5 @@
 // RayCaster on Embree 3: one device and one static, robust triangle scene per mesh.
-#include "cpu/ray_caster.h"
+#include "renderer/cpu/ray_caster.h"
 
 #include <embree3/rtcore.h>
 
@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cpu/embree_support.h"
+#include "renderer/cpu/embree_support.h"
 
 namespace lucent {
 

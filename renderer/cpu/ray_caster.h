@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 

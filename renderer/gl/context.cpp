@@ -1,4 +1,4 @@
-#include "gl/context.h"
+#include "renderer/gl/context.h"
 
 #include <epoxy/gl.h>
 

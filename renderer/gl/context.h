@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "gl/errors.h"
+#include "renderer/gl/errors.h"
 
 struct GLFWwindow;
 

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <string>
 
-#include "gl/context.h"
+#include "renderer/gl/context.h"
 
 namespace lucent::gl {
 namespace {

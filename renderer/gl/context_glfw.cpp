@@ -7,7 +7,7 @@
 #include <mutex>
 #include <string>
 
-#include "gl/context.h"
+#include "renderer/gl/context.h"
 
 namespace lucent::gl {
 namespace {

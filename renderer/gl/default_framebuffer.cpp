@@ -1,4 +1,4 @@
-#include "gl/default_framebuffer.h"
+#include "renderer/gl/default_framebuffer.h"
 
 #include <epoxy/gl.h>
 

@@ -1,4 +1,4 @@
-#include "gl/errors.h"
+#include "renderer/gl/errors.h"
 
 #include <epoxy/gl.h>
 

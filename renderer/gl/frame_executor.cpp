@@ -1,13 +1,13 @@
-#include "gl/frame_executor.h"
+#include "renderer/gl/frame_executor.h"
 
 #include <chrono>
 #include <stdexcept>
 
-#include "core/ambient_occlusion.h"
-#include "core/pass_reuse.h"
-#include "gl/errors.h"
-#include "gl/program.h"
-#include "gl/readback.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/core/pass_reuse.h"
+#include "renderer/gl/errors.h"
+#include "renderer/gl/program.h"
+#include "renderer/gl/readback.h"
 
 namespace lucent::gl {
 namespace {

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/scene.h"
-#include "gl/objects.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/scene.h"
+#include "renderer/gl/objects.h"
 
 namespace lucent::gl {
 

@@ -1,4 +1,4 @@
-#include "gl/objects.h"
+#include "renderer/gl/objects.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "gl/present.h"
+#include "renderer/gl/present.h"
 
 #include <epoxy/gl.h>
 

@@ -1,4 +1,4 @@
-#include "gl/program.h"
+#include "renderer/gl/program.h"
 
 #include <cstdlib>
 #include <filesystem>

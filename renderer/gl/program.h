@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "gl/objects.h"
+#include "renderer/gl/objects.h"
 
 namespace lucent::gl {
 

@@ -1,4 +1,4 @@
-#include "gl/readback.h"
+#include "renderer/gl/readback.h"
 
 namespace lucent::gl {
 

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "gl/objects.h"
+#include "renderer/gl/objects.h"
 
 namespace lucent::gl {
 

@@ -1,9 +1,9 @@
-#include "gl/upload.h"
+#include "renderer/gl/upload.h"
 
 #include <stdexcept>
 #include <string>
 
-#include "gl/errors.h"
+#include "renderer/gl/errors.h"
 
 namespace lucent::gl {
 

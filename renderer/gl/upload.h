@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <span>
 
-#include "gl/objects.h"
+#include "renderer/gl/objects.h"
 
 namespace lucent::gl {
 

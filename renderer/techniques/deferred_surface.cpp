@@ -1,4 +1,4 @@
-#include "techniques/deferred_surface.h"
+#include "renderer/techniques/deferred_surface.h"
 
 #include <algorithm>
 

@@ -9,7 +9,7 @@
 // the forward one bit for bit (each technique tests it).
 #include <vector>
 
-#include "core/frame_plan.h"
+#include "renderer/core/frame_plan.h"
 
 namespace lucent {
 

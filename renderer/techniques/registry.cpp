@@ -1,6 +1,6 @@
-#include "techniques/registry.h"
+#include "renderer/techniques/registry.h"
 
-#include "core/common_knobs.h"
+#include "renderer/core/common_knobs.h"
 
 namespace lucent {
 

@@ -3,8 +3,8 @@
 #include <string_view>
 #include <vector>
 
-#include "core/knobs.h"
-#include "core/technique.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/technique.h"
 
 namespace lucent {
 

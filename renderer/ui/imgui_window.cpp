@@ -1,4 +1,4 @@
-#include "ui/imgui_window.h"
+#include "renderer/ui/imgui_window.h"
 
 #include <epoxy/gl.h>
 #define GLFW_INCLUDE_NONE

@@ -7,8 +7,8 @@
 #include <memory>
 #include <string>
 
-#include "gl/context.h"
-#include "gl/objects.h"
+#include "renderer/gl/context.h"
+#include "renderer/gl/objects.h"
 
 namespace lucent::ui {
 

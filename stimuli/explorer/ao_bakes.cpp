@@ -1,6 +1,6 @@
-#include "explorer/ao_bakes.h"
+#include "stimuli/explorer/ao_bakes.h"
 
-#include "core/ambient_occlusion.h"
+#include "renderer/core/ambient_occlusion.h"
 
 namespace lucent::explorer {
 

@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent::explorer {
 

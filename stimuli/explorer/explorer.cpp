@@ -1,4 +1,4 @@
-#include "explorer/explorer.h"
+#include "stimuli/explorer/explorer.h"
 
 #include <epoxy/gl.h>
 #define GLFW_INCLUDE_NONE
@@ -13,13 +13,13 @@
 #include <limits>
 #include <utility>
 
-#include "core/technique.h"
-#include "explorer/stimulus_entry.h"
-#include "gl/default_framebuffer.h"
-#include "gl/readback.h"
-#include "render.h"
-#include "techniques/registry.h"
-#include "ui/imgui_window.h"
+#include "renderer/core/technique.h"
+#include "renderer/gl/default_framebuffer.h"
+#include "renderer/gl/readback.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "renderer/ui/imgui_window.h"
+#include "stimuli/explorer/stimulus_entry.h"
 
 namespace lucent::explorer {
 namespace {

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh.h"
-#include "explorer/frame_stats.h"
-#include "explorer/input.h"
-#include "explorer/panels.h"
-#include "explorer/session.h"
-#include "explorer/view_renderer.h"
+#include "renderer/core/mesh.h"
+#include "stimuli/explorer/frame_stats.h"
+#include "stimuli/explorer/input.h"
+#include "stimuli/explorer/panels.h"
+#include "stimuli/explorer/session.h"
+#include "stimuli/explorer/view_renderer.h"
 
 namespace lucent::ui {
 class ImGuiWindow;

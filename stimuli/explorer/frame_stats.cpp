@@ -1,4 +1,4 @@
-#include "explorer/frame_stats.h"
+#include "stimuli/explorer/frame_stats.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "explorer/input.h"
+#include "stimuli/explorer/input.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>

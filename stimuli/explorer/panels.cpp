@@ -1,13 +1,13 @@
-#include "explorer/panels.h"
+#include "stimuli/explorer/panels.h"
 
 #include <imgui.h>
 
 #include <algorithm>
 #include <cstdio>
 
-#include "core/density_volume.h"
-#include "explorer/pass_times.h"
-#include "techniques/registry.h"
+#include "renderer/core/density_volume.h"
+#include "renderer/techniques/registry.h"
+#include "stimuli/explorer/pass_times.h"
 
 namespace lucent::explorer {
 namespace {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "explorer/frame_stats.h"
-#include "explorer/session.h"
-#include "gl/frame_executor.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/gl/frame_executor.h"
+#include "stimuli/explorer/frame_stats.h"
+#include "stimuli/explorer/session.h"
 
 namespace lucent::explorer {
 

@@ -1,4 +1,4 @@
-#include "explorer/pass_times.h"
+#include "stimuli/explorer/pass_times.h"
 
 #include <cstdio>
 

@@ -4,7 +4,7 @@
 // the passes it touches). No ImGui, so it is tested as text.
 #include <string>
 
-#include "gl/frame_executor.h"
+#include "renderer/gl/frame_executor.h"
 
 namespace lucent::explorer {
 

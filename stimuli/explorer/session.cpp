@@ -1,12 +1,12 @@
-#include "explorer/session.h"
+#include "stimuli/explorer/session.h"
 
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "core/common_knobs.h"
-#include "stimulus_set.h"
-#include "techniques/registry.h"
+#include "renderer/core/common_knobs.h"
+#include "renderer/techniques/registry.h"
+#include "stimuli/stimulus_set.h"
 
 namespace lucent::explorer {
 

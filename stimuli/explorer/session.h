@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/knobs.h"
-#include "render.h"
+#include "renderer/core/knobs.h"
+#include "renderer/render.h"
 
 namespace lucent::explorer {
 

@@ -1,4 +1,4 @@
-#include "explorer/stimulus_entry.h"
+#include "stimuli/explorer/stimulus_entry.h"
 
 #include <toml++/toml.h>
 
@@ -7,8 +7,8 @@
 #include <set>
 #include <sstream>
 
-#include "stimulus_set.h"
-#include "techniques/registry.h"
+#include "renderer/techniques/registry.h"
+#include "stimuli/stimulus_set.h"
 
 namespace lucent::explorer {
 namespace {

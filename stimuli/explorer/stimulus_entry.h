@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "core/knobs.h"
+#include "renderer/core/knobs.h"
 
 namespace lucent::explorer {
 

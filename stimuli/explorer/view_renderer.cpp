@@ -1,4 +1,4 @@
-#include "explorer/view_renderer.h"
+#include "stimuli/explorer/view_renderer.h"
 
 #include <epoxy/gl.h>
 
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/technique.h"
-#include "gl/upload.h"
-#include "techniques/registry.h"
+#include "renderer/core/technique.h"
+#include "renderer/gl/upload.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent::explorer {
 namespace {

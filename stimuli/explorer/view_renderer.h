@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/progressive.h"
-#include "core/scene.h"
-#include "explorer/ao_bakes.h"
-#include "explorer/session.h"
-#include "gl/frame_executor.h"
-#include "gl/objects.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/progressive.h"
+#include "renderer/core/scene.h"
+#include "renderer/gl/frame_executor.h"
+#include "renderer/gl/objects.h"
+#include "stimuli/explorer/ao_bakes.h"
+#include "stimuli/explorer/session.h"
 
 namespace lucent::explorer {
 

@@ -1,4 +1,4 @@
-#include "set_report/colour_difference.h"
+#include "stimuli/set_report/colour_difference.h"
 
 #include <lcms2.h>
 

@@ -1,4 +1,4 @@
-#include "set_report/contact_sheet.h"
+#include "stimuli/set_report/contact_sheet.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "core/image.h"
+#include "renderer/core/image.h"
 
 namespace lucent::stimuli {
 namespace {

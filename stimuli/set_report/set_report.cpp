@@ -4,7 +4,7 @@
 // [SECTION] measuring: displayed pixels, object masks, Lab, luminance; series and pairs
 // [SECTION] writing: report.html (self-contained) and contact-sheet.png
 // [SECTION] the command
-#include "set_report/set_report.h"
+#include "stimuli/set_report/set_report.h"
 
 #include <algorithm>
 #include <charconv>
@@ -18,15 +18,15 @@
 #include <set>
 #include <sstream>
 
-#include "core/image.h"
-#include "core/progress.h"
-#include "manifest.h"
-#include "output_file.h"
-#include "report/html_page.h"
-#include "report/report.h"
-#include "report/svg_plot.h"
-#include "set_report/contact_sheet.h"
-#include "set_report/ssim.h"
+#include "analysis/report/html_page.h"
+#include "analysis/report/report.h"
+#include "analysis/report/svg_plot.h"
+#include "output/output_file.h"
+#include "renderer/core/image.h"
+#include "renderer/core/progress.h"
+#include "stimuli/manifest.h"
+#include "stimuli/set_report/contact_sheet.h"
+#include "stimuli/set_report/ssim.h"
 
 namespace lucent::stimuli {
 namespace {

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "set_report/colour_difference.h"
-#include "set_report/contact_sheet.h"
+#include "stimuli/set_report/colour_difference.h"
+#include "stimuli/set_report/contact_sheet.h"
 
 namespace lucent::stimuli {
 

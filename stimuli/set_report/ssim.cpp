@@ -1,4 +1,4 @@
-#include "set_report/ssim.h"
+#include "stimuli/set_report/ssim.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // A throwaway local PostgreSQL server (local_server.h).
-#include "postgres/local_server.h"
+#include "study/postgres/local_server.h"
 
 #include <fcntl.h>
 #include <pwd.h>
@@ -12,7 +12,7 @@
 #include <pqxx/pqxx>
 #include <vector>
 
-#include "sqlite.h"
+#include "study/sqlite/database.h"
 
 namespace lucent::study {
 

@@ -1,5 +1,5 @@
 // Station files into a study server (merge_into_server.h).
-#include "postgres/merge_into_server.h"
+#include "study/postgres/merge_into_server.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -8,10 +8,10 @@
 #include <pqxx/pqxx>
 #include <set>
 
-#include "postgres/postgres_store.h"
-#include "sqlite.h"
-#include "store.h"
-#include "study_store.h"
+#include "study/postgres/postgres_store.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
 
 namespace lucent::study {
 namespace {

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "export.h"
+#include "study/export.h"
 
 namespace lucent::study {
 

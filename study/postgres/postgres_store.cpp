@@ -3,13 +3,13 @@
 //
 // [1] connection and errors  [2] studies, participants, claims  [3] sessions, segments
 // [4] trials: journal, send, sync  [5] status, withdrawal, counts  [6] snapshot
-#include "postgres/postgres_store.h"
+#include "study/postgres/postgres_store.h"
 
 #include <chrono>
 #include <pqxx/pqxx>
 
-#include "store.h"
-#include "withdrawal.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/withdrawal.h"
 
 namespace lucent::study {
 namespace {

@@ -18,9 +18,9 @@
 #include <set>
 #include <string>
 
-#include "postgres/trial_journal.h"
-#include "question_scales.h"
-#include "study_store.h"
+#include "study/postgres/trial_journal.h"
+#include "study/question_scales.h"
+#include "study/study_store.h"
 
 namespace lucent::study {
 

@@ -1,5 +1,5 @@
 // The station's journal of unconfirmed trials (trial_journal.h).
-#include "postgres/trial_journal.h"
+#include "study/postgres/trial_journal.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -10,7 +10,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "sha256.h"
+#include "study/sha256.h"
 
 namespace lucent::study {
 namespace {

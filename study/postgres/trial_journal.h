@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "sqlite.h"
-#include "store_types.h"
+#include "study/sqlite/database.h"
+#include "study/store_types.h"
 
 namespace lucent::study {
 

@@ -2,7 +2,7 @@
 // sessions (pending until consent, enrol, resume, reload, idle) | actions (continue,
 // decline, answer, environment) |
 // the state a page shows.
-#include "serve/web_study.h"
+#include "study/serve/web_study.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,9 +12,9 @@
 #include <random>
 #include <stdexcept>
 
-#include "session/session_flow.h"
-#include "sha256.h"
-#include "store.h"
+#include "study/session/session_flow.h"
+#include "study/sha256.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 

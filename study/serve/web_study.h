@@ -25,8 +25,8 @@
 #include <string>
 #include <string_view>
 
-#include "protocol.h"
-#include "study_store.h"
+#include "study/protocol.h"
+#include "study/study_store.h"
 
 namespace lucent::study {
 

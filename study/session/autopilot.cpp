@@ -1,4 +1,4 @@
-#include "session/autopilot.h"
+#include "study/session/autopilot.h"
 
 #include <algorithm>
 #include <cmath>

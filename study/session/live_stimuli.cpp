@@ -1,10 +1,10 @@
-#include "session/live_stimuli.h"
+#include "study/session/live_stimuli.h"
 
 #include <cmath>
 
-#include "core/image.h"
-#include "gl/frame_executor.h"
-#include "render.h"
+#include "renderer/core/image.h"
+#include "renderer/gl/frame_executor.h"
+#include "renderer/render.h"
 
 namespace lucent::study {
 namespace {

@@ -4,7 +4,7 @@
 // when one exists (an `image` stimulus, or <id>.png|.tif|.exr in the images directory).
 #include <string>
 
-#include "session/stimulus_source.h"
+#include "study/session/stimulus_source.h"
 
 namespace lucent::study {
 

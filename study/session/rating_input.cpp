@@ -1,4 +1,4 @@
-#include "session/rating_input.h"
+#include "study/session/rating_input.h"
 
 #include <algorithm>
 

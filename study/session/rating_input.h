@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "store.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 

@@ -1,7 +1,7 @@
 // The session runner: the window, drawing and timing around the GL-free state machine
 // (session_flow.h). [SECTIONS] keys (X key thread, GLFW fallback) | setup (store,
 // window, session, stimuli) | drawing (ImGui) | the frame loop.
-#include "session/runner.h"
+#include "study/session/runner.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -15,18 +15,18 @@
 #include <random>
 #include <thread>
 
-#include "gl/present.h"
-#include "gl/readback.h"
 #include "lucent/version.h"
-#include "session/autopilot.h"
-#include "session/frame_timing.h"
-#include "session/layout.h"
-#include "session/session_flow.h"
-#include "session/x_key_events.h"
-#include "session/x_keyboard.h"
-#include "store.h"
-#include "trial_plan.h"
-#include "ui/imgui_window.h"
+#include "renderer/gl/present.h"
+#include "renderer/gl/readback.h"
+#include "renderer/ui/imgui_window.h"
+#include "study/session/autopilot.h"
+#include "study/session/frame_timing.h"
+#include "study/session/layout.h"
+#include "study/session/session_flow.h"
+#include "study/session/x_key_events.h"
+#include "study/session/x_keyboard.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/trial_plan.h"
 
 namespace lucent::study {
 namespace {

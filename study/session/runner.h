@@ -6,9 +6,9 @@
 #include <ostream>
 #include <string>
 
-#include "protocol.h"
-#include "session/session_flow.h"
-#include "session/stimulus_source.h"
+#include "study/protocol.h"
+#include "study/session/session_flow.h"
+#include "study/session/stimulus_source.h"
 
 namespace lucent::study {
 

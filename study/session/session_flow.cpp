@@ -1,6 +1,6 @@
-#include "session/session_flow.h"
+#include "study/session/session_flow.h"
 
-#include "session/frame_timing.h"
+#include "study/session/frame_timing.h"
 
 namespace lucent::study {
 

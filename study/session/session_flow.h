@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "protocol.h"
-#include "session/autopilot.h"
-#include "session/rating_input.h"
-#include "store.h"
+#include "study/protocol.h"
+#include "study/session/autopilot.h"
+#include "study/session/rating_input.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 

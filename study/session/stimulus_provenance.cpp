@@ -1,17 +1,17 @@
 // Resolving a protocol's stimuli to the values the renderer uses, and checking
 // pre-rendered files against their stimulus set's manifest.
-#include "session/stimulus_provenance.h"
+#include "study/session/stimulus_provenance.h"
 
 #include <filesystem>
 #include <map>
 #include <memory>
 
-#include "core/density_volume.h"
-#include "core/mesh.h"
 #include "lucent/version.h"
-#include "manifest.h"
-#include "render.h"
-#include "session/stimulus_source.h"
+#include "renderer/core/density_volume.h"
+#include "renderer/core/mesh.h"
+#include "renderer/render.h"
+#include "stimuli/manifest.h"
+#include "study/session/stimulus_source.h"
 
 namespace lucent::study {
 namespace {

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "protocol.h"
-#include "stimulus_set.h"
-#include "store.h"
+#include "stimuli/stimulus_set.h"
+#include "study/protocol.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 

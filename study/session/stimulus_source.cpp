@@ -1,14 +1,14 @@
-#include "session/stimulus_source.h"
+#include "study/session/stimulus_source.h"
 
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
 #include <filesystem>
 
-#include "core/image.h"
-#include "gl/errors.h"
-#include "gl/upload.h"
-#include "session/stimulus_provenance.h"
+#include "renderer/core/image.h"
+#include "renderer/gl/errors.h"
+#include "renderer/gl/upload.h"
+#include "study/session/stimulus_provenance.h"
 
 namespace lucent::study {
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "gl/objects.h"
-#include "protocol.h"
-#include "store.h"
+#include "renderer/gl/objects.h"
+#include "study/protocol.h"
+#include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
 

@@ -1,6 +1,6 @@
-#include "session/x_key_events.h"
+#include "study/session/x_key_events.h"
 
-#include "session/frame_timing.h"
+#include "study/session/frame_timing.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>

@@ -25,7 +25,7 @@
 #include <thread>
 #include <vector>
 
-#include "session/session_flow.h"
+#include "study/session/session_flow.h"
 
 struct GLFWwindow;
 

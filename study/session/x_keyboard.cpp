@@ -1,4 +1,4 @@
-#include "session/x_keyboard.h"
+#include "study/session/x_keyboard.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>

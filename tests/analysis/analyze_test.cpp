@@ -1,6 +1,6 @@
 // The entry point from a long table: filters, progress callback, missing ratings, and a
 // clear error when nothing matches.
-#include "analyze.h"
+#include "analysis/analyze.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <regex>
 #include <sstream>
 
-#include "report/report.h"
-#include "test_paths.h"
+#include "analysis/report/report.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::analysis {
 namespace {

@@ -11,8 +11,8 @@
 #include <sstream>
 #include <string>
 
-#include "browser.h"
-#include "core/image.h"
+#include "renderer/core/image.h"
+#include "tests/support/browser.h"
 
 namespace lucent {
 namespace {

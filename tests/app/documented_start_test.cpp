@@ -19,11 +19,11 @@
 #include <string>
 #include <vector>
 
-#include "display.h"
-#include "protocol.h"
-#include "sqlite.h"
-#include "test_paths.h"
-#include "trial_plan.h"
+#include "study/protocol.h"
+#include "study/sqlite/database.h"
+#include "study/trial_plan.h"
+#include "tests/support/display.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent {
 namespace {

@@ -1,6 +1,6 @@
 // Output files: an --out that would replace an input or a database is refused whatever
 // path reaches it, existing files only go with overwrite, and writes are atomic.
-#include "output_file.h"
+#include "output/output_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "test_paths.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::output {
 namespace {

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <string>
 
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "techniques/registry.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "tests/support/gl_test_fixture.h"
 
 namespace lucent {
 namespace {

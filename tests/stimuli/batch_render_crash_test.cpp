@@ -10,11 +10,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "batch_render.h"
-#include "core/image.h"
-#include "core/mesh.h"
-#include "gl/program.h"
-#include "test_paths.h"
+#include "renderer/core/image.h"
+#include "renderer/core/mesh.h"
+#include "renderer/gl/program.h"
+#include "stimuli/batch_render.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

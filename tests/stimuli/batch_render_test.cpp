@@ -1,6 +1,6 @@
 // Batch rendering: images + complete manifest, byte-identical re-runs, re-rendering only
 // what changed, atomic files, and config errors that write nothing.
-#include "batch_render.h"
+#include "stimuli/batch_render.h"
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,10 @@
 #include <sstream>
 #include <thread>
 
-#include "core/image.h"
-#include "core/mesh.h"
 #include "lucent/version.h"
-#include "test_paths.h"
+#include "renderer/core/image.h"
+#include "renderer/core/mesh.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

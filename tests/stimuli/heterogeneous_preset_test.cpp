@@ -8,11 +8,11 @@
 #include <sstream>
 #include <thread>
 
-#include "batch_render.h"
-#include "core/density_volume.h"
-#include "manifest.h"
-#include "stimulus_set.h"
-#include "test_paths.h"
+#include "renderer/core/density_volume.h"
+#include "stimuli/batch_render.h"
+#include "stimuli/manifest.h"
+#include "stimuli/stimulus_set.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

@@ -1,5 +1,5 @@
 // Image statistics against hand-computable images and degenerate ones.
-#include "image_statistics.h"
+#include "stimuli/image_statistics.h"
 
 #include <gtest/gtest.h>
 

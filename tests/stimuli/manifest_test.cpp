@@ -1,5 +1,5 @@
 // Manifest pieces: hashing, CSV quoting, and writing then reading a manifest back.
-#include "manifest.h"
+#include "stimuli/manifest.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <limits>
 #include <sstream>
 
-#include "test_paths.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

@@ -6,8 +6,8 @@
 #include <map>
 #include <sstream>
 
-#include "stimulus_set.h"
-#include "test_paths.h"
+#include "stimuli/stimulus_set.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

@@ -2,10 +2,10 @@
 // (a narrower luminance histogram) than the ward render with the same parameters.
 #include <gtest/gtest.h>
 
-#include "gl_test_fixture.h"
-#include "image_statistics.h"
-#include "render.h"
-#include "scene_for_test.h"
+#include "renderer/render.h"
+#include "stimuli/image_statistics.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent::stimuli {
 namespace {

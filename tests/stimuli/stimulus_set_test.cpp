@@ -1,11 +1,11 @@
 // The stimulus-set TOML loader: expansion, precedence, and errors naming file, line, key.
-#include "stimulus_set.h"
+#include "stimuli/stimulus_set.h"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 
-#include "test_paths.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

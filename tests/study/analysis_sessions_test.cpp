@@ -9,11 +9,11 @@
 #include <set>
 #include <string>
 
-#include "export.h"
-#include "sqlite.h"
-#include "store.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/export.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -1,5 +1,5 @@
 // Data out: CSV exports, the analysis long table, and merging databases.
-#include "export.h"
+#include "study/export.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <sstream>
 #include <tuple>
 
-#include "store.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

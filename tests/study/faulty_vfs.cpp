@@ -1,4 +1,4 @@
-#include "faulty_vfs.h"
+#include "tests/study/faulty_vfs.h"
 
 namespace lucent::test {
 namespace {

@@ -1,5 +1,5 @@
 // Protocol parsing: the thesis preset's content, and errors naming file, line and key.
-#include "protocol.h"
+#include "study/protocol.h"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <fstream>
 #include <set>
 
-#include "sha256.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/sha256.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <sstream>
 
-#include "export.h"
-#include "store.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/export.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

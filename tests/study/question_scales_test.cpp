@@ -1,12 +1,12 @@
 // Per-question scale lengths in the store and in what the analysis reads: a rating must
 // lie within 1..points of its own question, whatever the other questions allow.
-#include "question_scales.h"
+#include "study/question_scales.h"
 
 #include <gtest/gtest.h>
 
-#include "store.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

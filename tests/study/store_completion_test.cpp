@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "faulty_vfs.h"
-#include "store.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/faulty_vfs.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

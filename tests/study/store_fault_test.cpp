@@ -12,11 +12,11 @@
 #include <random>
 #include <thread>
 
-#include "faulty_vfs.h"
-#include "sha256.h"
-#include "store.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/sha256.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/faulty_vfs.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -1,15 +1,14 @@
 // The study store: pragmas, schema version and migration, planned order written before
 // trial 1, one transaction per trial, resume and withdrawal.
-#include "store.h"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <memory>
 #include <thread>
 
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -5,9 +5,9 @@
 #include <utility>
 #include <vector>
 
-#include "protocol.h"
-#include "store.h"
-#include "trial_plan.h"
+#include "study/protocol.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/trial_plan.h"
 
 namespace lucent::test {
 

@@ -1,6 +1,6 @@
 // Trial planning: Latin-square balance, constrained shuffles over many seeds, and
 // impossible constraints reported instead of searched forever.
-#include "trial_plan.h"
+#include "study/trial_plan.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <random>
 #include <set>
 
-#include "study_fixtures.h"
+#include "tests/study/study_fixtures.h"
 
 namespace lucent::study {
 namespace {

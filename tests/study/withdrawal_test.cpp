@@ -1,6 +1,6 @@
 // Withdrawals that stay withdrawn through merges (issue 26 item 2): the tombstones a
 // withdrawal leaves, and merges of station files and backups that still hold the data.
-#include "withdrawal.h"
+#include "study/withdrawal.h"
 
 #include <gtest/gtest.h>
 
@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <thread>
 
-#include "export.h"
-#include "sha256.h"
-#include "store.h"
-#include "study_fixtures.h"
-#include "test_paths.h"
+#include "study/export.h"
+#include "study/sha256.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

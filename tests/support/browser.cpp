@@ -1,4 +1,4 @@
-#include "browser.h"
+#include "tests/support/browser.h"
 
 #include <OpenImageIO/imageio.h>
 #include <stdlib.h>

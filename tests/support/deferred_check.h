@@ -8,10 +8,10 @@
 #include <functional>
 #include <string>
 
-#include "core/technique.h"
-#include "gl/frame_executor.h"
-#include "scene_for_test.h"
-#include "techniques/registry.h"
+#include "renderer/core/technique.h"
+#include "renderer/gl/frame_executor.h"
+#include "renderer/techniques/registry.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent::test {
 

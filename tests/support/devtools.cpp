@@ -1,4 +1,4 @@
-#include "devtools.h"
+#include "tests/support/devtools.h"
 
 #include <fcntl.h>
 #include <poll.h>

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "gl/context.h"
+#include "renderer/gl/context.h"
 
 namespace lucent::test {
 

@@ -6,7 +6,7 @@
 #include <map>
 #include <utility>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent::test {
 

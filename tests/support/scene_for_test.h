@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "render.h"
+#include "renderer/render.h"
 
 namespace lucent::test {
 

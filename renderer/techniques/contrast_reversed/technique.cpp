@@ -2,9 +2,9 @@
 // diffuse term reversed. It shares ward's shader (variant REVERSED_DIFFUSE), planner and
 // CPU reference; only the diffuse term and its knob differ. See README.md beside this
 // file.
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
-#include "techniques/ward/ward.h"
+#include "renderer/techniques/ward/ward.h"
 
 namespace lucent {
 namespace {

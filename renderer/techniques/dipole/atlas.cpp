@@ -1,4 +1,4 @@
-#include "techniques/dipole/atlas.h"
+#include "renderer/techniques/dipole/atlas.h"
 
 #include <algorithm>
 #include <cmath>

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent::dipole {
 

@@ -6,13 +6,13 @@
 #include <string>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/knobs.h"
-#include "core/scene.h"
-#include "techniques/deferred_surface.h"
-#include "techniques/dipole/integrator.h"
-#include "techniques/dipole/scattering.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/scene.h"
+#include "renderer/techniques/deferred_surface.h"
+#include "renderer/techniques/dipole/integrator.h"
+#include "renderer/techniques/dipole/scattering.h"
 
 namespace lucent::dipole {
 

@@ -1,4 +1,4 @@
-#include "techniques/dipole/integrator.h"
+#include "renderer/techniques/dipole/integrator.h"
 
 #include <algorithm>
 #include <cmath>

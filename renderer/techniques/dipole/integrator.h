@@ -12,9 +12,9 @@
 #include <memory>
 #include <vector>
 
-#include "core/mesh.h"
-#include "cpu/ray_caster.h"
-#include "techniques/dipole/scattering.h"
+#include "renderer/core/mesh.h"
+#include "renderer/cpu/ray_caster.h"
+#include "renderer/techniques/dipole/scattering.h"
 
 namespace lucent::dipole {
 

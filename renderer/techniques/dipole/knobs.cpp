@@ -1,8 +1,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/common_knobs.h"
-#include "techniques/dipole/dipole.h"
+#include "renderer/core/common_knobs.h"
+#include "renderer/techniques/dipole/dipole.h"
 
 namespace lucent::dipole {
 

@@ -19,10 +19,10 @@
 #include <memory>
 #include <mutex>
 
-#include "core/light_view.h"
-#include "techniques/deferred_surface.h"
-#include "techniques/dipole/atlas.h"
-#include "techniques/dipole/dipole.h"
+#include "renderer/core/light_view.h"
+#include "renderer/techniques/deferred_surface.h"
+#include "renderer/techniques/dipole/atlas.h"
+#include "renderer/techniques/dipole/dipole.h"
 
 namespace lucent::dipole {
 namespace {

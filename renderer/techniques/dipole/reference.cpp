@@ -5,10 +5,10 @@
 // tone map, + Blinn-Phong specular, in double precision.
 #include <cmath>
 
-#include "core/ambient_occlusion.h"
-#include "cpu/pixel_rays.h"
-#include "cpu/ray_caster.h"
-#include "techniques/dipole/dipole.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/cpu/pixel_rays.h"
+#include "renderer/cpu/ray_caster.h"
+#include "renderer/techniques/dipole/dipole.h"
 
 namespace lucent::dipole {
 

@@ -1,4 +1,4 @@
-#include "techniques/dipole/scattering.h"
+#include "renderer/techniques/dipole/scattering.h"
 
 #include <algorithm>
 #include <cmath>

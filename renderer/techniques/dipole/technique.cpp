@@ -1,8 +1,8 @@
 // Registers the dipole technique: Chang et al.'s texture-space importance sampling of
 // Jensen's dipole BSSRDF, in physical units.
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
-#include "techniques/dipole/dipole.h"
+#include "renderer/techniques/dipole/dipole.h"
 
 namespace lucent {
 namespace {

@@ -3,11 +3,11 @@
 // and its CPU reference share. See README.md beside this file for the equations.
 #include <array>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/scene.h"
-#include "techniques/deferred_surface.h"
-#include "techniques/empirical/knobs.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/scene.h"
+#include "renderer/techniques/deferred_surface.h"
+#include "renderer/techniques/empirical/knobs.h"
 
 namespace lucent::empirical {
 

@@ -1,6 +1,6 @@
-#include "techniques/empirical/knobs.h"
+#include "renderer/techniques/empirical/knobs.h"
 
-#include "core/common_knobs.h"
+#include "renderer/core/common_knobs.h"
 
 namespace lucent::empirical {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "core/knobs.h"
-#include "core/scene.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/scene.h"
 
 namespace lucent::empirical {
 

@@ -9,7 +9,7 @@
 // Terms that cannot change the image select a shader variant without them, and the
 // passes that only fed them are culled by PlanBuilder::compile().
 
-#include "techniques/empirical/empirical.h"
+#include "renderer/techniques/empirical/empirical.h"
 
 namespace lucent::empirical {
 

@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/ambient_occlusion.h"
-#include "cpu/pixel_rays.h"
-#include "cpu/ray_caster.h"
-#include "techniques/empirical/empirical.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/cpu/pixel_rays.h"
+#include "renderer/cpu/ray_caster.h"
+#include "renderer/techniques/empirical/empirical.h"
 
 namespace lucent::empirical {
 namespace {

@@ -1,7 +1,7 @@
 // Registers the empirical technique: its knobs, passes and CPU reference.
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
-#include "techniques/empirical/empirical.h"
+#include "renderer/techniques/empirical/empirical.h"
 
 namespace lucent {
 namespace {

@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/knobs.h"
-#include "core/light_view.h"
-#include "core/scene.h"
-#include "techniques/deferred_surface.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/light_view.h"
+#include "renderer/core/scene.h"
+#include "renderer/techniques/deferred_surface.h"
 
 namespace lucent::htsm {
 

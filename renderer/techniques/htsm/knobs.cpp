@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/common_knobs.h"
-#include "core/density_volume.h"
-#include "techniques/htsm/htsm.h"
+#include "renderer/core/common_knobs.h"
+#include "renderer/core/density_volume.h"
+#include "renderer/techniques/htsm/htsm.h"
 
 namespace lucent::htsm {
 

@@ -11,7 +11,7 @@
 // ring with a lod above 0 the mips; no diffuse or specular the shadow read.
 #include <cstdio>
 
-#include "techniques/htsm/htsm.h"
+#include "renderer/techniques/htsm/htsm.h"
 
 namespace lucent::htsm {
 namespace {

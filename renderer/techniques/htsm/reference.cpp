@@ -9,9 +9,9 @@
 #include <cmath>
 #include <optional>
 
-#include "cpu/pixel_rays.h"
-#include "cpu/ray_caster.h"
-#include "techniques/htsm/htsm.h"
+#include "renderer/cpu/pixel_rays.h"
+#include "renderer/cpu/ray_caster.h"
+#include "renderer/techniques/htsm/htsm.h"
 
 namespace lucent::htsm {
 namespace {

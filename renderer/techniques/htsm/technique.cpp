@@ -1,7 +1,7 @@
 // Registers the htsm technique: Shopf's heterogeneous translucent shadow maps.
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
-#include "techniques/htsm/htsm.h"
+#include "renderer/techniques/htsm/htsm.h"
 
 namespace lucent {
 namespace {

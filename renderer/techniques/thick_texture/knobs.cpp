@@ -5,7 +5,7 @@
 #include <memory>
 #include <mutex>
 
-#include "techniques/thick_texture/thick_texture.h"
+#include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
 namespace {

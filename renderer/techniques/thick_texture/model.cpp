@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "techniques/thick_texture/thick_texture.h"
+#include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
 

@@ -1,7 +1,7 @@
 // Per-texel records (Sec. 3.4) and their pyramid of averages.
 #include <algorithm>
 
-#include "techniques/thick_texture/thick_texture.h"
+#include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
 namespace {

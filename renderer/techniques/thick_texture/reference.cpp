@@ -6,9 +6,9 @@
 // next layer, finally the backdrop). The pixel is the mean of its rays.
 #include <cmath>
 
-#include "cpu/pixel_rays.h"
-#include "cpu/ray_caster.h"
-#include "techniques/thick_texture/thick_texture.h"
+#include "renderer/cpu/pixel_rays.h"
+#include "renderer/cpu/ray_caster.h"
+#include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
 namespace {

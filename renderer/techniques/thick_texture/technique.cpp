@@ -1,8 +1,8 @@
 // Registers the thick_texture technique: David-Babin's semi-transparent textures of
 // opaque and transparent texels with a thickness.
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
-#include "techniques/thick_texture/thick_texture.h"
+#include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent {
 namespace {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "techniques/thick_texture/thick_texture.h"
+#include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
 namespace {

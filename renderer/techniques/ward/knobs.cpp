@@ -1,5 +1,5 @@
-#include "core/common_knobs.h"
-#include "techniques/ward/ward.h"
+#include "renderer/core/common_knobs.h"
+#include "renderer/techniques/ward/ward.h"
 
 namespace lucent::ward {
 

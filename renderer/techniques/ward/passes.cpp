@@ -4,7 +4,7 @@
 // A zero diffuse weight or zero specular reflectance compiles that term out of the
 // shader; no AO term culls the bake.
 
-#include "techniques/ward/ward.h"
+#include "renderer/techniques/ward/ward.h"
 
 namespace lucent::ward {
 

@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/ambient_occlusion.h"
-#include "cpu/pixel_rays.h"
-#include "cpu/ray_caster.h"
-#include "techniques/ward/ward.h"
-#include "techniques/ward/ward_brdf.h"
+#include "renderer/core/ambient_occlusion.h"
+#include "renderer/cpu/pixel_rays.h"
+#include "renderer/cpu/ray_caster.h"
+#include "renderer/techniques/ward/ward.h"
+#include "renderer/techniques/ward/ward_brdf.h"
 
 namespace lucent::ward {
 

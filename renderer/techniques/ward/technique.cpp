@@ -1,7 +1,7 @@
 // Registers the ward technique: Ward's isotropic BRDF under the key light plus ambient.
-#include "core/technique.h"
+#include "renderer/core/technique.h"
 
-#include "techniques/ward/ward.h"
+#include "renderer/techniques/ward/ward.h"
 
 namespace lucent {
 namespace {

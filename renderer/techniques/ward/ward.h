@@ -5,10 +5,10 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "core/frame_plan.h"
-#include "core/image.h"
-#include "core/knobs.h"
-#include "core/scene.h"
+#include "renderer/core/frame_plan.h"
+#include "renderer/core/image.h"
+#include "renderer/core/knobs.h"
+#include "renderer/core/scene.h"
 
 namespace lucent::ward {
 

@@ -1,4 +1,4 @@
-#include "techniques/ward/ward_brdf.h"
+#include "renderer/techniques/ward/ward_brdf.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // The long CSV reader: CRLF, quotes, missing ratings, exact decimal origin, scale checks
 // and error messages that name the line.
-#include "data/long_table.h"
+#include "analysis/data/long_table.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -15,8 +15,8 @@
 #include <random>
 #include <sstream>
 
-#include "data/decimal.h"
-#include "data/grouping.h"
+#include "analysis/data/decimal.h"
+#include "analysis/data/grouping.h"
 
 namespace lucent::analysis {
 namespace {

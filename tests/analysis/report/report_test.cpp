@@ -1,6 +1,6 @@
 // Reports: exact CSV headers, 17-digit numbers that parse back, no NaN/Inf anywhere, the
 // SVG beside the HTML and embedded in it, hard cases spelled out.
-#include "report/report.h"
+#include "analysis/report/report.h"
 
 #include <gtest/gtest.h>
 
@@ -9,10 +9,10 @@
 #include <regex>
 #include <sstream>
 
-#include "analyze.h"
-#include "data/long_table.h"
-#include "report/svg_plot.h"
-#include "test_paths.h"
+#include "analysis/analyze.h"
+#include "analysis/data/long_table.h"
+#include "analysis/report/svg_plot.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::analysis {
 namespace {

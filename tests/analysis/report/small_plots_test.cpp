@@ -5,7 +5,7 @@
 #include <cmath>
 #include <regex>
 
-#include "report/svg_plot.h"
+#include "analysis/report/svg_plot.h"
 
 namespace lucent::analysis {
 namespace {

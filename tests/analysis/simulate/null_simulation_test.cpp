@@ -2,9 +2,9 @@
 // simulated studies, and Tukey's HSD must declare any pair different in at most 6%.
 #include <gtest/gtest.h>
 
-#include "data/grouping.h"
-#include "simulate/simulate.h"
-#include "stats/tukey.h"
+#include "analysis/data/grouping.h"
+#include "analysis/simulate/simulate.h"
+#include "analysis/stats/tukey.h"
 
 namespace lucent::analysis {
 namespace {

@@ -2,7 +2,7 @@
 // path): a balanced between-subject one-way ANOVA, and the repeated-measures ANOVA under
 // the compound symmetry of the simulation model; the null case gives alpha; the
 // smallest sample agrees with the closed form's.
-#include "simulate/power.h"
+#include "analysis/simulate/power.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
 // One-way ANOVA: hand-computed examples and every hard case the issue names.
-#include "stats/anova.h"
+#include "analysis/stats/anova.h"
 
 #include <gtest/gtest.h>
 
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 
-#include "report/format.h"
-#include "stats/descriptives.h"
+#include "analysis/report/format.h"
+#include "analysis/stats/descriptives.h"
 
 namespace lucent::analysis {
 namespace {

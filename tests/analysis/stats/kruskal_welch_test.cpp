@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
-#include "stats/anova.h"
-#include "stats/kruskal_wallis.h"
+#include "analysis/stats/anova.h"
+#include "analysis/stats/kruskal_wallis.h"
 
 namespace lucent::analysis {
 namespace {

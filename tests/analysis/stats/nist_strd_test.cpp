@@ -6,10 +6,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "data/grouping.h"
-#include "data/long_table.h"
-#include "stats/anova.h"
-#include "test_paths.h"
+#include "analysis/data/grouping.h"
+#include "analysis/data/long_table.h"
+#include "analysis/stats/anova.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::analysis {
 namespace {

@@ -5,7 +5,7 @@
 //   friedman.test(Y), pairwise.t.test(y, level, paired = TRUE, p.adjust.method = "holm"),
 //   p.adjust(p, "holm").
 // `reacttime` is the data set of R's ?SSD example (Baron & Li, after Maxwell & Delaney).
-#include "stats/repeated_measures.h"
+#include "analysis/stats/repeated_measures.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // t (df 1..1e9, q up to 1e17), published table values, identities (cdf + upper = 1,
 // monotone, the density integrating to 1 and matching the CDF's slope, continuity where
 // df switches to infinity), the quantile's round trip, and thread safety.
-#include "stats/studentized_range.h"
+#include "analysis/stats/studentized_range.h"
 
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "stats/studentized_range_reference.h"
+#include "tests/analysis/stats/studentized_range_reference.h"
 
 namespace lucent::analysis {
 namespace {

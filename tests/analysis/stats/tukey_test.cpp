@@ -1,13 +1,13 @@
 // Tukey HSD: the k = 2 identity with the pooled t test, R's documented warpbreaks
 // example, the Tukey-Kramer standard error, and the interval/p-value agreement.
-#include "stats/tukey.h"
+#include "analysis/stats/tukey.h"
 
 #include <gtest/gtest.h>
 
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 
-#include "stats/studentized_range_reference.h"
+#include "tests/analysis/stats/studentized_range_reference.h"
 
 namespace lucent::analysis {
 namespace {

@@ -1,7 +1,7 @@
 // fit_camera against the thesis's rule (Eq. 3.4): eye one diameter from the centre,
 // near/far planes touching the bounding sphere; projection's depth mapping checked on
 // points placed at the planes.
-#include "core/camera.h"
+#include "renderer/core/camera.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Density volumes: generators against their definitions, determinism and content hash,
 // the contrast knob, the trilinear convention, the NRRD subset and its errors.
-#include "core/density_volume.h"
+#include "renderer/core/density_volume.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,14 +1,14 @@
 // The frame planner with no GL: which passes exist for each scene, that culled passes
 // are never visited, and that the plan is a pure function of (scene, knobs).
-#include "core/frame_plan.h"
+#include "renderer/core/frame_plan.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
-#include "core/recording_executor.h"
-#include "core/technique.h"
-#include "techniques/registry.h"
+#include "renderer/core/recording_executor.h"
+#include "renderer/core/technique.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent {
 namespace {

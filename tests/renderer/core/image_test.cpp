@@ -1,5 +1,5 @@
 // Image output: formats, encodings, atomic writes, and no NaN/Inf ever written.
-#include "core/image.h"
+#include "renderer/core/image.h"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <random>
 #include <string>
 
-#include "core/image_compare.h"
-#include "test_paths.h"
+#include "renderer/core/image_compare.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent {
 namespace {

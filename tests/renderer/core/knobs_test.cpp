@@ -1,6 +1,6 @@
 // Knob parsing and validation: values, grey shorthand, and one-line errors that name the
 // key and the accepted range.
-#include "core/knobs.h"
+#include "renderer/core/knobs.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <fstream>
 #include <map>
 
-#include "core/common_knobs.h"
-#include "techniques/registry.h"
-#include "test_paths.h"
+#include "renderer/core/common_knobs.h"
+#include "renderer/techniques/registry.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent {
 namespace {

@@ -1,16 +1,16 @@
 // The light's orthographic view, checked against where it must put the bounding sphere:
 // the sphere's extreme points along the image axes land on the clip-space edges, its
 // nearest and farthest points along the light on the depth range's ends.
-#include "core/light_view.h"
+#include "renderer/core/light_view.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "core/scene.h"
-#include "core/technique.h"
-#include "techniques/registry.h"
+#include "renderer/core/scene.h"
+#include "renderer/core/technique.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent {
 namespace {

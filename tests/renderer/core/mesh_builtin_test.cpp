@@ -6,8 +6,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/mesh.h"
-#include "mesh_checks.h"
+#include "renderer/core/mesh.h"
+#include "tests/support/mesh_checks.h"
 
 namespace lucent {
 namespace {

@@ -8,9 +8,9 @@
 #include <numbers>
 #include <random>
 
-#include "core/mesh.h"
-#include "mesh_checks.h"
-#include "test_paths.h"
+#include "renderer/core/mesh.h"
+#include "tests/support/mesh_checks.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent {
 namespace {

@@ -2,13 +2,13 @@
 // executor (no GL): a second identical frame runs nothing, a changed uniform re-runs its
 // pass and what depends on it, new storage re-runs its writers, and uploads call their
 // producer only when the content hash changes.
-#include "core/pass_reuse.h"
+#include "renderer/core/pass_reuse.h"
 
 #include <gtest/gtest.h>
 
-#include "core/recording_executor.h"
-#include "core/technique.h"
-#include "techniques/registry.h"
+#include "renderer/core/recording_executor.h"
+#include "renderer/core/technique.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent {
 namespace {

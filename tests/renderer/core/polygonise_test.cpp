@@ -1,13 +1,13 @@
 // Marching tetrahedra on fields with known zero sets: closed, outward, right genus, and
 // enclosing the analytic volume.
-#include "core/polygonise.h"
+#include "renderer/core/polygonise.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "mesh_checks.h"
+#include "tests/support/mesh_checks.h"
 
 namespace lucent {
 namespace {

@@ -1,5 +1,5 @@
 // ProgressBar output as a terminal would see it (forced), and its silence otherwise.
-#include "core/progress.h"
+#include "renderer/core/progress.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

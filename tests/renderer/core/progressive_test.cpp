@@ -1,6 +1,6 @@
 // Progressive refinement (core/progressive.h): frame sample counts and seeds, the mean
 // weighted by sample counts (against the closed form), and what restarts it.
-#include "core/progressive.h"
+#include "renderer/core/progressive.h"
 
 #include <gtest/gtest.h>
 

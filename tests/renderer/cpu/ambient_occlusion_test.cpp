@@ -2,7 +2,7 @@
 // (AO exactly 1), a vertex inside a closed box none of it (exactly 0), and the centre
 // of an open box's floor sees the opening's solid angle over 2 pi (uniform hemisphere).
 // Plus determinism across thread counts and the cache's round trip and corruption.
-#include "core/ambient_occlusion.h"
+#include "renderer/core/ambient_occlusion.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <numbers>
 #include <thread>
 
-#include "cpu/ambient_occlusion_directions.h"
-#include "test_paths.h"
+#include "renderer/cpu/ambient_occlusion_directions.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent {
 namespace {

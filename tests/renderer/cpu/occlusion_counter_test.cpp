@@ -1,7 +1,7 @@
 // The AO bake's escape counts: against analytic cones, against RayCaster's single rays
 // on the mesh's own triangles (an independent scene), across query types and layouts,
 // and the pairing of triangles into quads checked triangle by triangle.
-#include "cpu/occlusion_counter.h"
+#include "renderer/cpu/occlusion_counter.h"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <map>
 #include <random>
 
-#include "core/mesh.h"
-#include "cpu/ambient_occlusion_directions.h"
-#include "cpu/ray_caster.h"
+#include "renderer/core/mesh.h"
+#include "renderer/cpu/ambient_occlusion_directions.h"
+#include "renderer/cpu/ray_caster.h"
 
 namespace lucent {
 namespace {

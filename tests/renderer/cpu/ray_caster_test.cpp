@@ -1,7 +1,7 @@
 // RayCaster against analytic distances: the built-in sphere has vertices on its poles
 // and the torus vertices where the axis-aligned rays below cross it, so those hits are
 // exact; rays through edges and vertices must give an even number of layers.
-#include "cpu/ray_caster.h"
+#include "renderer/cpu/ray_caster.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <random>
 #include <thread>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 namespace {

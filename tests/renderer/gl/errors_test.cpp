@@ -1,7 +1,7 @@
 // GL errors are reported, not rendered as black: an invalid upload and an invalid call
 // inside a pass throw one-line GlErrors naming what failed, and a debug context adds the
 // driver's message for the call.
-#include "gl/errors.h"
+#include "renderer/gl/errors.h"
 
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "gl/frame_executor.h"
-#include "gl/upload.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "techniques/registry.h"
+#include "renderer/gl/frame_executor.h"
+#include "renderer/gl/upload.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "tests/support/gl_test_fixture.h"
 
 namespace lucent {
 namespace {

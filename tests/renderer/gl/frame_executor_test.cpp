@@ -2,7 +2,7 @@
 // computed independently on the CPU: exact box mips (double-precision block means),
 // uploads only on a content-hash change, sampler state per read (hand-derived filter
 // weights), any number of colour attachments with the viewport they imply, and blending.
-#include "gl/frame_executor.h"
+#include "renderer/gl/frame_executor.h"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "core/technique.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "techniques/registry.h"
-#include "test_paths.h"
+#include "renderer/core/technique.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent {
 namespace {

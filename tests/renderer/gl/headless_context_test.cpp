@@ -1,11 +1,11 @@
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
-#include "gl/context.h"
-#include "gl/objects.h"
-#include "gl/program.h"
-#include "gl/readback.h"
-#include "gl_test_fixture.h"
+#include "renderer/gl/context.h"
+#include "renderer/gl/objects.h"
+#include "renderer/gl/program.h"
+#include "renderer/gl/readback.h"
+#include "tests/support/gl_test_fixture.h"
 
 namespace lucent {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <cstdlib>
 
-#include "display.h"
-#include "gl/context.h"
-#include "gl/readback.h"
+#include "renderer/gl/context.h"
+#include "renderer/gl/readback.h"
+#include "tests/support/display.h"
 
 namespace lucent {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "explorer/view_renderer.h"
+#include "stimuli/explorer/view_renderer.h"
 
 namespace lucent::explorer {
 namespace {

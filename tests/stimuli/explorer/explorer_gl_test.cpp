@@ -11,14 +11,14 @@
 #include <iostream>
 #include <sstream>
 
-#include "display.h"
-#include "explorer/explorer.h"
+#include "stimuli/explorer/explorer.h"
+#include "tests/support/display.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
-#include "core/image.h"
-#include "test_paths.h"
+#include "renderer/core/image.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::explorer {
 namespace {

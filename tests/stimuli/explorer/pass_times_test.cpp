@@ -1,5 +1,5 @@
 // The status bar's per-pass times: a pass that was not re-run shows as cached.
-#include "explorer/pass_times.h"
+#include "stimuli/explorer/pass_times.h"
 
 #include <gtest/gtest.h>
 

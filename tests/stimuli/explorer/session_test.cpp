@@ -1,14 +1,14 @@
 // The explorer's session without a window: parameter sets validate and round values the
 // way `--set` does, the request for `lucent render` reproduces them, and the view
 // helpers (orbit, light drag, zoom) move in the documented directions and stay in range.
-#include "explorer/session.h"
+#include "stimuli/explorer/session.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/common_knobs.h"
-#include "techniques/registry.h"
+#include "renderer/core/common_knobs.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent::explorer {
 namespace {

@@ -2,16 +2,16 @@
 // comments kept, the stimulus-set loader reads back exactly the explorer's values, a new
 // mesh is added under [meshes], and a result that does not load leaves the file as it
 // was.
-#include "explorer/stimulus_entry.h"
+#include "stimuli/explorer/stimulus_entry.h"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <sstream>
 
-#include "stimulus_set.h"
-#include "techniques/registry.h"
-#include "test_paths.h"
+#include "renderer/techniques/registry.h"
+#include "stimuli/stimulus_set.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::explorer {
 namespace {

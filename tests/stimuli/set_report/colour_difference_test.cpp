@@ -1,7 +1,7 @@
 // CIEDE2000 against the published test data of Sharma, Wu and Dalal (2005, Table 1),
 // sRGB -> Lab against the primaries' textbook values, and the per-image summary against
 // hand-computed statistics.
-#include "set_report/colour_difference.h"
+#include "stimuli/set_report/colour_difference.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // a pair whose Delta E00 has a closed form (grey vs white discs), plus one stimulus of
 // no series; refusals of sets that are not Lucent sets or whose files changed; the page
 // in a real browser (headless chromium) with its pictures drawn.
-#include "set_report/set_report.h"
+#include "stimuli/set_report/set_report.h"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <iostream>
 #include <set>
 
-#include "browser.h"
-#include "core/image.h"
-#include "image_statistics.h"
-#include "manifest.h"
-#include "test_paths.h"
+#include "renderer/core/image.h"
+#include "stimuli/image_statistics.h"
+#include "stimuli/manifest.h"
+#include "tests/support/browser.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

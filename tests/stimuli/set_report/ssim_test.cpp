@@ -1,6 +1,6 @@
 // SSIM against closed forms: constant images (only the luminance term is left), the
 // global index of an affine pair, identity, and symmetry.
-#include "set_report/ssim.h"
+#include "stimuli/set_report/ssim.h"
 
 #include <gtest/gtest.h>
 

@@ -9,10 +9,10 @@
 #include <iostream>
 #include <map>
 
-#include "batch_render.h"
-#include "browser.h"
-#include "set_report/set_report.h"
-#include "test_paths.h"
+#include "stimuli/batch_render.h"
+#include "stimuli/set_report/set_report.h"
+#include "tests/support/browser.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {

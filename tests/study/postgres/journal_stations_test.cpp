@@ -18,12 +18,12 @@
 #include <thread>
 #include <vector>
 
-#include "../study_fixtures.h"
-#include "postgres/local_server.h"
-#include "server_environment.h"
-#include "study_store.h"
-#include "test_paths.h"
-#include "trial_plan.h"
+#include "study/postgres/local_server.h"
+#include "study/study_store.h"
+#include "study/trial_plan.h"
+#include "tests/study/postgres/server_environment.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -6,15 +6,15 @@
 #include <filesystem>
 #include <memory>
 
-#include "../study_fixtures.h"
-#include "export.h"
-#include "postgres/merge_into_server.h"
-#include "server_environment.h"
-#include "sha256.h"
-#include "sqlite.h"
-#include "store.h"
-#include "study_store.h"
-#include "test_paths.h"
+#include "study/export.h"
+#include "study/postgres/merge_into_server.h"
+#include "study/sha256.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
+#include "tests/study/postgres/server_environment.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -1,5 +1,5 @@
 // The suite's PostgreSQL server (server_environment.h).
-#include "server_environment.h"
+#include "tests/study/postgres/server_environment.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 // environment before the first test and stopped after the last. Never a mock.
 #include <string>
 
-#include "postgres/local_server.h"
+#include "study/postgres/local_server.h"
 
 namespace lucent::test {
 

@@ -15,15 +15,15 @@
 #include <set>
 #include <thread>
 
-#include "../study_fixtures.h"
-#include "postgres/postgres_store.h"
-#include "postgres/trial_journal.h"
-#include "server_environment.h"
-#include "session/autopilot.h"
-#include "session/session_flow.h"
-#include "store.h"
-#include "study_store.h"
-#include "test_paths.h"
+#include "study/postgres/postgres_store.h"
+#include "study/postgres/trial_journal.h"
+#include "study/session/autopilot.h"
+#include "study/session/session_flow.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
+#include "tests/study/postgres/server_environment.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -8,12 +8,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "../study_fixtures.h"
-#include "server_environment.h"
-#include "sqlite.h"
-#include "store.h"
-#include "study_store.h"
-#include "test_paths.h"
+#include "study/sqlite/database.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
+#include "tests/study/postgres/server_environment.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

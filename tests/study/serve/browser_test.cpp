@@ -8,10 +8,10 @@
 #include <map>
 #include <thread>
 
-#include "devtools.h"
-#include "serve_process.h"
-#include "store.h"
-#include "test_paths.h"
+#include "study/sqlite/sqlite_store.h"
+#include "tests/study/serve/serve_process.h"
+#include "tests/support/devtools.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

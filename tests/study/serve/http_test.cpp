@@ -12,10 +12,10 @@
 #include <fstream>
 #include <thread>
 
-#include "../postgres/server_environment.h"
-#include "serve_process.h"
-#include "study_store.h"
-#include "test_paths.h"
+#include "study/study_store.h"
+#include "tests/study/postgres/server_environment.h"
+#include "tests/study/serve/serve_process.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "web_page.h"
+#include "tests/study/serve/web_page.h"
 
 namespace lucent::test {
 

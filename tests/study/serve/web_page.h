@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "serve/web_study.h"
+#include "study/serve/web_study.h"
 
 namespace lucent::test {
 

@@ -3,7 +3,7 @@
 // events of each answer. Expected values come from the protocol (trial counts, scales,
 // screen texts), the order the page was given, and the times the test chose; never from
 // the server under test.
-#include "serve/web_study.h"
+#include "study/serve/web_study.h"
 
 #include <gtest/gtest.h>
 
@@ -14,12 +14,12 @@
 #include <set>
 #include <thread>
 
-#include "../postgres/server_environment.h"
-#include "../study_fixtures.h"
-#include "store.h"
-#include "study_store.h"
-#include "test_paths.h"
-#include "web_page.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/study_store.h"
+#include "tests/study/postgres/server_environment.h"
+#include "tests/study/serve/web_page.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

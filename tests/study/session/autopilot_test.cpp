@@ -1,5 +1,5 @@
 // The simulated participant's decisions and timing (the X side is tested end to end).
-#include "session/autopilot.h"
+#include "study/session/autopilot.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <fstream>
 #include <set>
 
-#include "test_paths.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

@@ -16,18 +16,18 @@
 #include <random>
 #include <thread>
 
-#include "../study_fixtures.h"
-#include "display.h"
 #include "lucent/version.h"
-#include "manifest.h"
-#include "postgres/local_server.h"
-#include "postgres/trial_journal.h"
-#include "session/stimulus_provenance.h"
-#include "session/stimulus_source.h"
-#include "sha256.h"
-#include "sqlite.h"
-#include "study_store.h"
-#include "test_paths.h"
+#include "stimuli/manifest.h"
+#include "study/postgres/local_server.h"
+#include "study/postgres/trial_journal.h"
+#include "study/session/stimulus_provenance.h"
+#include "study/session/stimulus_source.h"
+#include "study/sha256.h"
+#include "study/sqlite/database.h"
+#include "study/study_store.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/display.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

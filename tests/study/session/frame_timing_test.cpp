@@ -1,4 +1,4 @@
-#include "session/frame_timing.h"
+#include "study/session/frame_timing.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "session/layout.h"
+#include "study/session/layout.h"
 
 #include <gtest/gtest.h>
 

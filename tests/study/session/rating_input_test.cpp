@@ -1,5 +1,5 @@
 // The rating screen's input rules: no preselection, keys and clicks, changes and times.
-#include "session/rating_input.h"
+#include "study/session/rating_input.h"
 
 #include <gtest/gtest.h>
 

@@ -1,14 +1,14 @@
 // The session state machine without GL: synthetic timestamped keys, a fake clock and a
 // real study database in a scratch folder. Expected screen sequences are derived from
 // the stored trial plan (practice flags, break_before), not from the flow itself.
-#include "session/session_flow.h"
+#include "study/session/session_flow.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
-#include "../study_fixtures.h"
-#include "test_paths.h"
+#include "tests/study/study_fixtures.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

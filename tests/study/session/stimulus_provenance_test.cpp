@@ -1,7 +1,7 @@
 // What a session shows, resolved before it starts: every knob value of a stimulus's
 // technique (defaults from the knob registry), pre-rendered files checked against their
 // stimulus set's manifest, and each built-in protocol agreeing with its stimulus set.
-#include "session/stimulus_provenance.h"
+#include "study/session/stimulus_provenance.h"
 
 #include <gtest/gtest.h>
 
@@ -11,14 +11,14 @@
 #include <map>
 #include <sstream>
 
-#include "batch_render.h"
-#include "core/density_volume.h"
-#include "core/mesh.h"
-#include "export.h"
-#include "session/stimulus_source.h"
-#include "store.h"
-#include "test_paths.h"
-#include "trial_plan.h"
+#include "renderer/core/density_volume.h"
+#include "renderer/core/mesh.h"
+#include "stimuli/batch_render.h"
+#include "study/export.h"
+#include "study/session/stimulus_source.h"
+#include "study/sqlite/sqlite_store.h"
+#include "study/trial_plan.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {

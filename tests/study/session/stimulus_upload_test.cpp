@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "gl/errors.h"
-#include "gl_test_fixture.h"
-#include "session/stimulus_source.h"
+#include "renderer/gl/errors.h"
+#include "study/session/stimulus_source.h"
+#include "tests/support/gl_test_fixture.h"
 
 namespace lucent::study {
 namespace {

@@ -4,12 +4,12 @@
 
 #include <cmath>
 
-#include "core/technique.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "scene_for_test.h"
-#include "techniques/registry.h"
-#include "techniques/ward/ward.h"
+#include "renderer/core/technique.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "renderer/techniques/ward/ward.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent {
 namespace {

@@ -1,14 +1,14 @@
 // The surfel atlas, the mass pyramid and the inverse-CDF descent against independent
 // sums and counts.
-#include "techniques/dipole/atlas.h"
+#include "renderer/techniques/dipole/atlas.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
 
-#include "core/mesh.h"
-#include "test_meshes.h"
+#include "renderer/core/mesh.h"
+#include "tests/renderer/techniques/dipole/test_meshes.h"
 
 namespace lucent::dipole {
 namespace {

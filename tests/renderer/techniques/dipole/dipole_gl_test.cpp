@@ -8,15 +8,15 @@
 #include <cstdio>
 #include <map>
 
-#include "core/image_compare.h"
-#include "core/technique.h"
-#include "deferred_check.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "scene_for_test.h"
-#include "techniques/dipole/atlas.h"
-#include "techniques/dipole/dipole.h"
-#include "techniques/registry.h"
+#include "renderer/core/image_compare.h"
+#include "renderer/core/technique.h"
+#include "renderer/render.h"
+#include "renderer/techniques/dipole/atlas.h"
+#include "renderer/techniques/dipole/dipole.h"
+#include "renderer/techniques/registry.h"
+#include "tests/support/deferred_check.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent::dipole {
 namespace {

@@ -2,15 +2,15 @@
 // here by an independent quadrature: a puck lit along its axis (top- and bottom-face
 // centres), a sphere lit from its pole (B depends only on the angle from the pole), the
 // small- and large-scale limits and the hard cases of section 6.
-#include "techniques/dipole/integrator.h"
+#include "renderer/techniques/dipole/integrator.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/mesh.h"
-#include "cpu/ray_caster.h"
-#include "test_meshes.h"
+#include "renderer/core/mesh.h"
+#include "renderer/cpu/ray_caster.h"
+#include "tests/renderer/techniques/dipole/test_meshes.h"
 
 namespace lucent::dipole {
 namespace {

@@ -2,7 +2,7 @@
 // dipole: JMLH01's printed form of Rd (a different algebraic form), quadrature of the
 // closed forms, the note's table (shared/techniques/dipole.md, python stdlib) and the
 // section-6 hard cases.
-#include "techniques/dipole/scattering.h"
+#include "renderer/techniques/dipole/scattering.h"
 
 #include <gtest/gtest.h>
 

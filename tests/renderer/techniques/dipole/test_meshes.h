@@ -4,7 +4,7 @@
 // scales them by.
 #include <cmath>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent::dipole::test {
 

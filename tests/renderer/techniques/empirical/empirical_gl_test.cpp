@@ -7,14 +7,14 @@
 #include <cmath>
 #include <iostream>
 
-#include "deferred_check.h"
-#include "empirical_support.h"
-#include "gl/frame_executor.h"
-#include "gl/readback.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "techniques/empirical/empirical.h"
-#include "test_paths.h"
+#include "renderer/gl/frame_executor.h"
+#include "renderer/gl/readback.h"
+#include "renderer/render.h"
+#include "renderer/techniques/empirical/empirical.h"
+#include "tests/renderer/techniques/empirical/empirical_support.h"
+#include "tests/support/deferred_check.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent {
 namespace {

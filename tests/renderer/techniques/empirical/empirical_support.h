@@ -7,9 +7,9 @@
 #include <map>
 #include <memory>
 
-#include "core/image_compare.h"
-#include "core/technique.h"
-#include "techniques/registry.h"
+#include "renderer/core/image_compare.h"
+#include "renderer/core/technique.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent::test {
 

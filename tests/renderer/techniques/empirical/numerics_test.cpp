@@ -4,10 +4,10 @@
 // straight behind the object.
 #include <gtest/gtest.h>
 
-#include "empirical_support.h"
-#include "gl/frame_executor.h"
-#include "gl_test_fixture.h"
-#include "render.h"
+#include "renderer/gl/frame_executor.h"
+#include "renderer/render.h"
+#include "tests/renderer/techniques/empirical/empirical_support.h"
+#include "tests/support/gl_test_fixture.h"
 
 namespace lucent {
 namespace {

@@ -7,15 +7,15 @@
 #include <cmath>
 #include <cstdio>
 
-#include "../dipole/test_meshes.h"
-#include "core/image_compare.h"
-#include "core/technique.h"
-#include "deferred_check.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "scene_for_test.h"
-#include "techniques/htsm/htsm.h"
-#include "techniques/registry.h"
+#include "renderer/core/image_compare.h"
+#include "renderer/core/technique.h"
+#include "renderer/render.h"
+#include "renderer/techniques/htsm/htsm.h"
+#include "renderer/techniques/registry.h"
+#include "tests/renderer/techniques/dipole/test_meshes.h"
+#include "tests/support/deferred_check.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent::htsm {
 namespace {

@@ -1,7 +1,7 @@
 // The htsm technique without GL: its plan and prunes, the pattern, and the CPU
 // reference against closed forms (a slab of constant density for n = 1, 5, 9, 13, zero
 // density, the opaque threshold, the lit face, a sphere's chord) and its own error.
-#include "techniques/htsm/htsm.h"
+#include "renderer/techniques/htsm/htsm.h"
 
 #include <gtest/gtest.h>
 
@@ -9,12 +9,12 @@
 #include <cmath>
 #include <cstdio>
 
-#include "../dipole/test_meshes.h"
-#include "core/technique.h"
-#include "cpu/pixel_rays.h"
-#include "cpu/ray_caster.h"
-#include "scene_for_test.h"
-#include "techniques/registry.h"
+#include "renderer/core/technique.h"
+#include "renderer/cpu/pixel_rays.h"
+#include "renderer/cpu/ray_caster.h"
+#include "renderer/techniques/registry.h"
+#include "tests/renderer/techniques/dipole/test_meshes.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent::htsm {
 namespace {

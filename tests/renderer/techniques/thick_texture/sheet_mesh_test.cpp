@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/mesh.h"
+#include "renderer/core/mesh.h"
 
 namespace lucent {
 namespace {

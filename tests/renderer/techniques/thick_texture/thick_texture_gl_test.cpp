@@ -9,13 +9,13 @@
 #include <filesystem>
 #include <tuple>
 
-#include "core/technique.h"
-#include "cpu/pixel_rays.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "scene_for_test.h"
-#include "techniques/registry.h"
-#include "techniques/thick_texture/thick_texture.h"
+#include "renderer/core/technique.h"
+#include "renderer/cpu/pixel_rays.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "renderer/techniques/thick_texture/thick_texture.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent::thick_texture {
 namespace {

@@ -1,5 +1,5 @@
 // Ward's isotropic BRDF against analytic values and numerical energy integrals.
-#include "techniques/ward/ward_brdf.h"
+#include "renderer/techniques/ward/ward_brdf.h"
 
 #include <gtest/gtest.h>
 

@@ -6,14 +6,14 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/image_compare.h"
-#include "core/technique.h"
-#include "gl_test_fixture.h"
-#include "render.h"
-#include "scene_for_test.h"
-#include "techniques/registry.h"
-#include "techniques/ward/ward.h"
-#include "techniques/ward/ward_brdf.h"
+#include "renderer/core/image_compare.h"
+#include "renderer/core/technique.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
+#include "renderer/techniques/ward/ward.h"
+#include "renderer/techniques/ward/ward_brdf.h"
+#include "tests/support/gl_test_fixture.h"
+#include "tests/support/scene_for_test.h"
 
 namespace lucent {
 namespace {

@@ -1,4 +1,4 @@
-#include "sqlite.h"
+#include "study/sqlite/database.h"
 
 #include <cstdio>
 #include <filesystem>

@@ -1,6 +1,6 @@
 // The study database: schema and migrations, the read-only safety check, sessions,
 // trials and responses.
-#include "store.h"
+#include "study/sqlite/sqlite_store.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -16,7 +16,7 @@
 #include <set>
 #include <sstream>
 
-#include "withdrawal.h"
+#include "study/withdrawal.h"
 
 namespace lucent::study {
 namespace {

@@ -18,12 +18,12 @@
 #include <string>
 #include <vector>
 
-#include "protocol.h"
-#include "question_scales.h"
-#include "sqlite.h"
-#include "store_types.h"
-#include "study_store.h"
-#include "trial_plan.h"
+#include "study/protocol.h"
+#include "study/question_scales.h"
+#include "study/sqlite/database.h"
+#include "study/store_types.h"
+#include "study/study_store.h"
+#include "study/trial_plan.h"
 
 namespace lucent::study {
 
