@@ -79,13 +79,18 @@ Statistic within_summary_p(const WithinSubjectAnalysis& w) {
     return w.anova.p_gg ? w.anova.p_gg : w.anova.p;
 }
 
+// Every participant who rated the pair, complete or not.
+int participants_of(const OneWayAnalysis& a) {
+    return a.within.participants +
+           static_cast<int>(a.within.excluded_participants.size());
+}
+
 // Who a test used: the between-subject tests every rating of the pair; the
 // within-subject tests the participants who rated every level.
 std::string used_cell(const OneWayAnalysis& a, Design design) {
     std::size_t ratings = 0;
     for (const Descriptives& d : a.descriptives) ratings += d.n;
-    const int total =
-        a.within.participants + static_cast<int>(a.within.excluded_participants.size());
+    const int total = participants_of(a);
     if (design == Design::Between)
         return std::to_string(total) +
                (total == 1 ? " participant, " : " participants, ") +
@@ -94,18 +99,53 @@ std::string used_cell(const OneWayAnalysis& a, Design design) {
            " participants complete";
 }
 
+// The summary's verdict: yes / no at alpha, or, where the test has no p-value, why not
+// in words ("undefined: needs ..."), so a reader of the summary alone is not left with
+// a bare "undefined".
+std::string verdict_cell(const Statistic& p, double alpha, const std::string& why) {
+    if (p || why.empty()) return significant_at(p, alpha);
+    return "undefined: " + why;
+}
+
+// Why the between-subject ANOVA of a pair has no p-value.
+std::string why_between_undefined(const AnovaResult& r) {
+    if (r.groups >= 2 && r.df_within <= 0.0)
+        return "needs at least 2 ratings in some level (each level has 1)";
+    return r.note;
+}
+
+// Why the within-subject tests of a pair were not computed.
+std::string why_within_not_computed(const OneWayAnalysis& a) {
+    const std::size_t levels = a.descriptives.size() - a.empty_levels.size();
+    if (a.within.participants < 2 && levels >= 2)
+        return "needs at least 2 participants who rated every level (" +
+               std::to_string(a.within.participants) + " did)";
+    return a.within.note;
+}
+
 std::vector<std::string> summary_cells(const OneWayAnalysis& a, Design design,
                                        double alpha) {
     if (design == Design::Between)
         return {"one-way ANOVA", format_p_short(a.anova.p), format_short(a.anova.f),
-                significant_at(a.anova.p, alpha), used_cell(a, design)};
+                verdict_cell(a.anova.p, alpha, why_between_undefined(a.anova)),
+                used_cell(a, design)};
     if (!a.within.computed)
-        return {"repeated measures", "undefined", "undefined", "undefined",
+        return {"repeated measures", "undefined", "undefined",
+                verdict_cell({}, alpha, why_within_not_computed(a)),
                 used_cell(a, design)};
     const Statistic p = within_summary_p(a.within);
     return {"repeated measures (G-G)", format_p_short(p), format_short(a.within.anova.f),
-            significant_at(p, alpha), used_cell(a, design)};
+            verdict_cell(p, alpha, a.within.anova.note), used_cell(a, design)};
 }
+
+// Said under the summary when the analysis holds one participant (a first pilot, or
+// scripts/run-default): why most of its tests are undefined.
+constexpr const char* kOneParticipant =
+    "One participant: a test that is undefined says why in its row. A test weighs the "
+    "differences between levels against the spread between participants, or between "
+    "ratings of one level, and one person rating each stimulus once leaves none. The "
+    "descriptives and figures show this participant's ratings; the within-subject "
+    "tests need two or more participants.";
 
 std::string participants_note(const WithinSubjectAnalysis& w) {
     std::string text = std::to_string(w.participants) + " participants rated every level";
@@ -211,6 +251,10 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
              (options.primary_reason.empty() ? "" : ", " + options.primary_reason) +
              ". Column \"used\": the participants and ratings each test used."});
     doc.push_back({Block::kTable, "", summary});
+    int participants = 0;
+    for (const OneWayAnalysis& a : analyses)
+        participants = std::max(participants, participants_of(a));
+    if (participants == 1) doc.push_back({Block::kParagraph, kOneParticipant});
 
     // One figure per factor, its questions side by side on one scale (thesis Fig. 4.5).
     std::vector<std::string> factors;

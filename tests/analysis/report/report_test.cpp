@@ -255,6 +255,74 @@ TEST(Report, WithinSubjectTablesLeadWhenPrimaryAndParseBack) {
             << name;
 }
 
+// The summary row of `configuration` and `design` in report.md, split into cells.
+std::vector<std::string> summary_row(const std::string& md, const std::string& start) {
+    const std::size_t at = md.find("| " + start + " |");
+    if (at == std::string::npos) return {};
+    std::vector<std::string> cells;
+    std::stringstream line(md.substr(at + 1, md.find('\n', at) - at - 1));
+    for (std::string cell; std::getline(line, cell, '|');)
+        cells.push_back(cell.substr(1, cell.size() - 2));
+    return cells;
+}
+
+TEST(Report, OneParticipantsSummarySaysWhyItsTestsAreUndefined) {
+    // What scripts/run-default analyses: one participant, one stimulus per level (no
+    // test has spread to work with), and a factor with two stimuli per level (its
+    // between-subject ANOVA is defined; its within-subject tests are not).
+    std::istringstream csv(
+        "participant,stimulus,factor,level,question,rating\n"
+        "P1,a,r,18,q,2\nP1,b,r,25,q,4\nP1,c,r,30,q,5\n"
+        "P1,d,t,ward,q,3\nP1,e,t,ward,q,4\nP1,f,t,reversed,q,6\nP1,g,t,reversed,q,7\n");
+    const LongTable table = read_long_csv(csv, "one.csv", RatingScale{});
+    const AnalysisResult result = analyze_table(table, AnalysisRequest{});
+    const auto dir = test::scratch_dir("report_one_participant");
+    ReportOptions options;
+    options.primary = Design::Within;  // as the thesis protocol states
+    write_report(result.pairs, dir, options);
+    const std::string md = slurp(dir / "report.md");
+
+    const std::vector<std::string> within = summary_row(md, "q ~ r | within (primary)");
+    ASSERT_EQ(within.size(), 7u) << md;
+    EXPECT_EQ(within[3], "undefined");  // p and F stay the number columns' word
+    EXPECT_EQ(within[5],
+              "undefined: needs at least 2 participants who rated every level (1 did)");
+    const std::vector<std::string> between = summary_row(md, "q ~ r | between");
+    ASSERT_EQ(between.size(), 7u) << md;
+    EXPECT_EQ(between[3], "undefined");
+    EXPECT_EQ(between[5],
+              "undefined: needs at least 2 ratings in some level (each level has 1)");
+    // Two ratings per level: the between-subject test is defined and says yes or no.
+    const std::vector<std::string> defined = summary_row(md, "q ~ t | between");
+    ASSERT_EQ(defined.size(), 7u) << md;
+    EXPECT_TRUE(defined[5] == "yes" || defined[5] == "no") << defined[5];
+    EXPECT_EQ(summary_row(md, "q ~ t | within (primary)")[5],
+              "undefined: needs at least 2 participants who rated every level (1 did)");
+
+    // No verdict cell is a bare "undefined", and a paragraph says why, in both formats.
+    EXPECT_EQ(md.find("| undefined | 1 participant"), std::string::npos) << md;
+    EXPECT_EQ(md.find("| undefined | 1 of 1"), std::string::npos) << md;
+    const std::string why = "One participant: a test that is undefined says why";
+    EXPECT_NE(md.find(why), std::string::npos) << md;
+    EXPECT_NE(slurp(dir / "report.html").find(why), std::string::npos);
+}
+
+TEST(Report, TwoParticipantsNeedNoWordOnOneParticipant) {
+    std::istringstream csv(
+        "participant,stimulus,factor,level,question,rating\n"
+        "P1,a,r,18,q,2\nP1,b,r,25,q,4\nP1,c,r,30,q,5\n"
+        "P2,a,r,18,q,3\nP2,b,r,25,q,3\nP2,c,r,30,q,6\n");
+    const LongTable table = read_long_csv(csv, "two.csv", RatingScale{});
+    const AnalysisResult result = analyze_table(table, AnalysisRequest{});
+    const auto dir = test::scratch_dir("report_two_participants");
+    write_report(result.pairs, dir, ReportOptions{});
+    const std::string md = slurp(dir / "report.md");
+    EXPECT_EQ(md.find("One participant"), std::string::npos) << md;
+    const std::vector<std::string> within = summary_row(md, "q ~ r | within");
+    ASSERT_EQ(within.size(), 7u) << md;
+    EXPECT_TRUE(within[5] == "yes" || within[5] == "no") << within[5];
+}
+
 TEST(Report, FactorFigurePutsQuestionsSideBySideOnOneScale) {
     // Two questions of one factor: two panels 320 wide, one y range for both, so the
     // same value sits at the same height in each panel.
