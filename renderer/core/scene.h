@@ -43,6 +43,10 @@ struct Scene {
 Scene make_scene(std::shared_ptr<const Mesh> mesh, const Technique& technique,
                  KnobValues values, int width, int height,
                  glm::vec3 view_direction = {0.0f, 0.0f, 1.0f});
+// Sets the image size and fits the camera to it as make_scene() does (the mesh, density
+// and values stay: a resolved scene drawn at another size loads nothing again).
+void fit_scene_camera(Scene& scene, int width, int height,
+                      glm::vec3 view_direction = {0.0f, 0.0f, 1.0f});
 
 // True when a mesh pass may drop triangles by facing and keep the same layers: the mesh
 // bounds a solid facing out (Mesh::closed_facing_out) and the camera sees all of it from

@@ -7,47 +7,52 @@
 #include "renderer/render.h"
 
 namespace lucent::study {
-namespace {
 
-RenderRequest request_for(const StimulusSpec& spec, int width, int height) {
-    RenderRequest r;
-    if (!spec.mesh.empty()) r.mesh = spec.mesh;
-    r.technique = spec.technique;
-    for (const auto& [name, value] : spec.parameters)
-        r.settings.push_back(parse_assignment(name + "=" + value));
-    r.width = width;
-    r.height = height;
-    return r;
+const std::vector<ResolvedProtocolStimulus>& LiveOrPrerenderedStimuli::resolved(
+    const Protocol& protocol) const {
+    if (!is_resolved_) {
+        resolved_ = resolve_protocol_stimuli(protocol, images_.images_dir());
+        for (const ResolvedProtocolStimulus& r : resolved_)
+            if (r.scene) scenes_[r.provenance.stimulus] = r.scene;
+        is_resolved_ = true;
+    }
+    return resolved_;
 }
 
-}  // namespace
-
 void LiveOrPrerenderedStimuli::check(const Protocol& protocol) const {
-    for (const StimulusSpec& s : protocol.stimuli) {
-        if (!images_.path_for(s).empty() || !s.image.empty()) continue;
-        try {
-            build_scene(
-                request_for(s, protocol.stimulus_width, protocol.stimulus_height));
-        } catch (const std::exception& e) {
-            throw StimulusError(protocol.source + ": stimulus '" + s.id +
-                                "': " + e.what());
-        }
-    }
+    resolved(protocol);
     Protocol images_only = protocol;  // image stimuli: their files must exist
     std::erase_if(images_only.stimuli,
                   [](const StimulusSpec& s) { return s.image.empty(); });
     images_.check(images_only);
 }
 
+std::vector<StimulusProvenance> LiveOrPrerenderedStimuli::provenance(
+    const Protocol& protocol) const {
+    std::vector<StimulusProvenance> rows;
+    for (const ResolvedProtocolStimulus& r : resolved(protocol))
+        rows.push_back(r.provenance);
+    return rows;
+}
+
 StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int width,
                                                  int height) {
     if (!images_.path_for(spec).empty()) return images_.render(spec, width, height);
+    const auto resolved_scene = scenes_.find(spec.id);
+    if (resolved_scene == scenes_.end())
+        throw StimulusError(
+            "stimulus '" + spec.id +
+            "': not resolved before rendering (check() the protocol first)");
     RenderedImage rendered;
     try {
+        // The resolved scene at the window's size: same mesh, density and values, the
+        // camera refitted.
+        Scene scene = *resolved_scene->second;
+        fit_scene_camera(scene, width, height);
+        if (on_render) on_render(scene);
         // One executor per stimulus: its GL objects are gone before the window closes.
         gl::FrameExecutor executor;
-        rendered =
-            render_image_counted(executor, build_scene(request_for(spec, width, height)));
+        rendered = render_image_counted(executor, scene);
     } catch (const std::exception& e) {
         throw StimulusError("stimulus '" + spec.id + "': " + e.what());
     }

@@ -2,8 +2,13 @@
 // Stimuli rendered live by the renderer's techniques (render.h: the same single-image
 // path as `lucent render` and the stimulus batch), or taken from a pre-rendered image
 // when one exists (an `image` stimulus, or <id>.png|.tif|.exr in the images directory).
+#include <functional>
+#include <map>
+#include <memory>
 #include <string>
 
+#include "renderer/core/scene.h"
+#include "study/session/stimulus_provenance.h"
 #include "study/session/stimulus_source.h"
 
 namespace lucent::study {
@@ -12,17 +17,28 @@ class LiveOrPrerenderedStimuli : public StimulusRenderer {
 public:
     explicit LiveOrPrerenderedStimuli(std::string images_dir)
         : images_(std::move(images_dir)) {}
-    // Pre-rendered file if there is one, else renders technique + parameters at
-    // width x height into a texture (GL context current), sRGB-encoded as PNG output.
+    // Pre-rendered file if there is one, else renders the scene resolved for the
+    // stimulus (resolve_protocol_stimuli: the scene whose values the database records)
+    // at width x height into a texture (GL context current), sRGB-encoded as PNG output.
     StimulusTexture render(const StimulusSpec& spec, int width, int height) override;
-    // Without GL: every live stimulus's technique, parameters and mesh are valid.
+    // Without GL: resolves every stimulus once (technique, parameters, mesh, the
+    // technique's own scene checks) and keeps the result for provenance() and render().
     void check(const Protocol& protocol) const override;
-    std::vector<StimulusProvenance> provenance(const Protocol& protocol) const override {
-        return images_.provenance(protocol);
-    }
+    // The rows of the resolution check() made (made now if check() was not called).
+    std::vector<StimulusProvenance> provenance(const Protocol& protocol) const override;
+
+    // Called with each scene just before it is rendered (tests: the scene the renderer
+    // received).
+    std::function<void(const Scene&)> on_render;
 
 private:
+    const std::vector<ResolvedProtocolStimulus>& resolved(const Protocol& protocol) const;
+
     PrerenderedStimuli images_;
+    // The one resolution of the protocol's stimuli, and each live scene by stimulus id.
+    mutable std::vector<ResolvedProtocolStimulus> resolved_;
+    mutable std::map<std::string, std::shared_ptr<const Scene>> scenes_;
+    mutable bool is_resolved_ = false;
 };
 
 }  // namespace lucent::study

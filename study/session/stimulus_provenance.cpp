@@ -9,7 +9,9 @@
 #include "lucent/version.h"
 #include "renderer/core/density_volume.h"
 #include "renderer/core/mesh.h"
+#include "renderer/core/technique.h"
 #include "renderer/render.h"
+#include "renderer/techniques/registry.h"
 #include "stimuli/manifest.h"
 #include "study/session/stimulus_source.h"
 
@@ -99,14 +101,15 @@ void check_against_manifest(StimulusProvenance& resolved, const std::vector<Knob
 
 }  // namespace
 
-std::vector<StimulusProvenance> resolve_stimuli(const Protocol& protocol,
-                                                const std::string& images_dir,
-                                                const stimuli::SetCatalog& catalog) {
+std::vector<ResolvedProtocolStimulus> resolve_protocol_stimuli(
+    const Protocol& protocol, const std::string& images_dir,
+    const stimuli::SetCatalog& catalog) {
     const PrerenderedStimuli images(images_dir);
     const ManifestRows manifest =
         images_dir.empty() ? ManifestRows{} : stimuli::read_manifest_csv(images_dir);
-    std::map<std::string, std::string> mesh_hashes;  // by spec: each mesh loaded once
-    std::vector<StimulusProvenance> out;
+    // By spec: each mesh loaded once and shared by every scene that shows it.
+    std::map<std::string, std::shared_ptr<const Mesh>> meshes;
+    std::vector<ResolvedProtocolStimulus> out;
     for (const StimulusSpec& spec : protocol.stimuli) {
         StimulusProvenance p;
         p.stimulus = spec.id;
@@ -122,7 +125,7 @@ std::vector<StimulusProvenance> resolve_stimuli(const Protocol& protocol,
             } catch (const std::exception& e) {
                 throw StimulusError(where + e.what());
             }
-            out.push_back(std::move(p));
+            out.push_back({std::move(p), nullptr});
             continue;
         }
         p.source = "live";
@@ -131,31 +134,52 @@ std::vector<StimulusProvenance> resolve_stimuli(const Protocol& protocol,
         const auto knobs = catalog.knobs_of(spec.technique);
         if (!knobs)
             throw StimulusError(where + "technique '" + spec.technique + "' is unknown");
+        const std::string file = images.path_for(spec);
+        std::shared_ptr<const Scene> scene;
         try {
             std::vector<KnobAssignment> assignments;
             for (const auto& [name, value] : spec.parameters)
                 assignments.push_back({name, value});
-            const KnobValues values = resolve_knob_values(*knobs, assignments);
-            for (const Knob& knob : *knobs) {
-                p.values.emplace_back(knob.name,
-                                      format_knob_value(values.get(knob.name)));
-                // The density volume's content hash beside its spec, like mesh_hash
-                // beside the mesh: a changed file under the same spec is noticed.
-                if (knob.name == "density")
-                    p.values.emplace_back("density_hash",
-                                          density_from_knobs(values)->content_hash);
-            }
-            auto [hash, is_new] = mesh_hashes.try_emplace(p.mesh);
-            if (is_new) hash->second = load_mesh(p.mesh).content_hash;
-            p.mesh_hash = hash->second;
+            auto [mesh, is_new] = meshes.try_emplace(p.mesh);
+            if (is_new) mesh->second = std::make_shared<const Mesh>(load_mesh(p.mesh));
+            const Technique& technique = find_technique(spec.technique);
+            auto built = std::make_shared<Scene>(make_scene(
+                mesh->second, technique, resolve_knob_values(*knobs, assignments),
+                protocol.stimulus_width, protocol.stimulus_height));
+            // A picture shown from a file is not rendered here: only its values and
+            // hashes are checked against the manifest below.
+            if (file.empty()) technique.check_scene(*built);
+            scene = std::move(built);
         } catch (const std::exception& e) {
             throw StimulusError(where + e.what());
         }
-        if (const std::string file = images.path_for(spec); !file.empty())
+        // The row is the scene's own values, in the catalog's knob order.
+        for (const Knob& knob : *knobs) {
+            p.values.emplace_back(knob.name,
+                                  format_knob_value(scene->values.get(knob.name)));
+            // The density volume's content hash beside its spec, like mesh_hash beside
+            // the mesh: a changed file under the same spec is noticed.
+            if (knob.name == "density" && scene->density)
+                p.values.emplace_back("density_hash", scene->density->content_hash);
+        }
+        p.mesh_hash = scene->mesh->content_hash;
+        if (!file.empty()) {
             check_against_manifest(p, *knobs, images_dir, manifest, file);
-        out.push_back(std::move(p));
+            scene = nullptr;
+        }
+        out.push_back({std::move(p), std::move(scene)});
     }
     return out;
+}
+
+std::vector<StimulusProvenance> resolve_stimuli(const Protocol& protocol,
+                                                const std::string& images_dir,
+                                                const stimuli::SetCatalog& catalog) {
+    std::vector<StimulusProvenance> rows;
+    for (ResolvedProtocolStimulus& resolved :
+         resolve_protocol_stimuli(protocol, images_dir, catalog))
+        rows.push_back(std::move(resolved.provenance));
+    return rows;
 }
 
 }  // namespace lucent::study

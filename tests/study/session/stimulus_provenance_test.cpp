@@ -13,11 +13,15 @@
 
 #include "renderer/core/density_volume.h"
 #include "renderer/core/mesh.h"
+#include "renderer/render.h"
+#include "renderer/techniques/registry.h"
 #include "stimuli/batch_render.h"
 #include "study/export.h"
+#include "study/session/live_stimuli.h"
 #include "study/session/stimulus_source.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/trial_plan.h"
+#include "tests/support/gl_test_fixture.h"
 #include "tests/support/test_paths.h"
 
 namespace lucent::study {
@@ -82,7 +86,8 @@ TEST(ResolveStimuli, AProtocolSettingOneParameterStoresEveryParameterOfTheTechni
     const Protocol p = parse_protocol(kOneParameter, "one.toml");
     const std::vector<StimulusProvenance> resolved = resolve_stimuli(p, "");
     ASSERT_EQ(resolved.size(), 1u);
-    // The README's parameter table: the scene knobs and empirical's own, with defaults.
+    // The parameter table (docs/parameters.md): the scene knobs and empirical's own,
+    // with defaults.
     const std::map<std::string, std::string> expected = {{"light_ambient", "0.6,0.6,0.6"},
                                                          {"light_diffuse", "1,1,1"},
                                                          {"light_specular", "1,1,1"},
@@ -378,6 +383,76 @@ TEST(ThesisPresets, TheDatabaseRecordsEachRowsColour) {
     };
     EXPECT_EQ(without_albedo("empirical_row_1"), without_albedo("empirical_row_4"));
     EXPECT_EQ(without_albedo("empirical_row_1"), without_albedo("empirical_row_7"));
+}
+
+// Issue 27 item 1: a stimulus is resolved once. Every stimulus of every built-in study is
+// rendered as a lab session renders it, and the values the database records are those
+// of the scene the renderer received: every knob of the technique (recomputed here from
+// the scene's own values, not from the protocol text), the mesh's hash, the technique.
+class ResolvedOnce : public lucent::test::HeadlessGlTest {};
+
+TEST_F(ResolvedOnce, TheDatabaseRecordsTheValuesOfTheSceneTheRendererReceived) {
+    for (const std::string& name : builtin_protocol_names()) {
+        SCOPED_TRACE(name);
+        const Protocol study = builtin_protocol(name);
+        LiveOrPrerenderedStimuli stimuli("");
+        std::map<std::string, Scene> drawn;
+        std::string rendering;
+        stimuli.on_render = [&](const Scene& scene) { drawn.emplace(rendering, scene); };
+        stimuli.check(study);
+        const auto dir = lucent::test::scratch_dir("resolved_once_" + name);
+        const std::string db = (dir / "study.db").string();
+        {
+            Store store(db);
+            const int64_t id = store.ensure_study(study);
+            int number = 0;
+            const int64_t participant = store.ensure_participant(id, "P1", &number);
+            SessionEnvironment env;
+            env.stimuli = stimuli.provenance(study);
+            store.create_session(id, participant, plan_trials(study, 1, number), 1, env);
+        }
+        // Small pictures: the values, not the pixels, are under test here.
+        for (const StimulusSpec& spec : study.stimuli) {
+            rendering = spec.id;
+            (void)stimuli.render(spec, 24, 16);
+        }
+        Database database(db, SQLITE_OPEN_READONLY);
+        const auto stored = read_resolved_stimuli(database);
+        ASSERT_EQ(drawn.size(), study.stimuli.size());
+        for (const auto& [id, scene] : drawn) {
+            SCOPED_TRACE(id);
+            ASSERT_TRUE(stored.count(id));
+            const ResolvedStimulus& row = stored.at(id);
+            EXPECT_EQ(scene.width, 24);
+            EXPECT_EQ(row.technique, scene.technique);
+            EXPECT_EQ(row.mesh_hash, scene.mesh->content_hash);
+            std::map<std::string, std::string> received;
+            for (const Knob& knob : knobs_for(find_technique(scene.technique))) {
+                received[knob.name] = format_knob_value(scene.values.get(knob.name));
+                if (knob.name == "density")
+                    received["density_hash"] = scene.density->content_hash;
+            }
+            EXPECT_EQ(row.values, received);
+            // And the scene is the one `lucent render` builds from the protocol's
+            // parameters at that size: the same values, camera and light to the bit.
+            const StimulusSpec& spec = *study.find_stimulus(id);
+            RenderRequest request;
+            if (!spec.mesh.empty()) request.mesh = spec.mesh;
+            request.technique = spec.technique;
+            for (const auto& [key, value] : spec.parameters)
+                request.settings.push_back({key, value});
+            request.width = 24;
+            request.height = 16;
+            const Scene rendered_alone = build_scene(request);
+            for (const Knob& knob : knobs_for(find_technique(scene.technique)))
+                EXPECT_EQ(format_knob_value(rendered_alone.values.get(knob.name)),
+                          received.at(knob.name))
+                    << knob.name;
+            EXPECT_EQ(rendered_alone.camera.view(), scene.camera.view());
+            EXPECT_EQ(rendered_alone.camera.projection(), scene.camera.projection());
+            EXPECT_EQ(rendered_alone.light.direction, scene.light.direction);
+        }
+    }
 }
 
 }  // namespace
