@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "app/commands.h"
-#include "output/output_file.h"
+#include "common/output_file.h"
 #include "renderer/gl/context.h"
 #include "renderer/render.h"
 #include "renderer/techniques/registry.h"
@@ -37,7 +37,7 @@ struct FrameBenchOptions {
 bool write_table_csv(const std::string& path,
                      const std::vector<std::vector<std::string>>& table) {
     try {
-        output::write_file_atomically(path, true, [&](std::ostream& out) {
+        common::write_file_atomically(path, true, [&](std::ostream& out) {
             for (const auto& row : table) {
                 for (std::size_t c = 0; c < row.size(); ++c)
                     out << (c ? "," : "")

@@ -4,7 +4,7 @@
 #include <ostream>
 #include <string>
 
-#include "output/output_file.h"
+#include "common/output_file.h"
 
 namespace lucent::app {
 namespace {
@@ -21,7 +21,7 @@ std::string quoted(const std::string& text) {
 
 bool BenchResults::write_csv(const std::string& path) const {
     try {
-        output::write_file_atomically(path, true, [&](std::ostream& out) {
+        common::write_file_atomically(path, true, [&](std::ostream& out) {
             out.precision(10);
             out << "section,name,value,unit\n";
             for (const Row& r : rows)

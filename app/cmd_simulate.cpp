@@ -4,7 +4,7 @@
 
 #include "analysis/simulate/simulate.h"
 #include "app/commands.h"
-#include "output/output_file.h"
+#include "common/output_file.h"
 
 namespace lucent::app {
 
@@ -38,8 +38,8 @@ void register_simulate(CLI::App& app, int& exit_code) {
         try {
             const analysis::LongTable table = analysis::simulate_study(*spec);
             // Replaces an earlier simulated CSV, never a database; atomically.
-            output::check_output_file(*out, {}, true);
-            output::write_file_atomically(*out, true, [&](std::ostream& file) {
+            common::check_output_file(*out, {}, true);
+            common::write_file_atomically(*out, true, [&](std::ostream& file) {
                 analysis::write_long_csv(file, table);
             });
             std::cerr << "wrote " << table.rows.size() << " ratings to " << *out << "\n";
@@ -47,7 +47,7 @@ void register_simulate(CLI::App& app, int& exit_code) {
         } catch (const analysis::InputError& e) {
             std::cerr << "lucent simulate: " << e.what() << "\n";
             exit_code = kExitUsage;
-        } catch (const output::OutputError& e) {
+        } catch (const common::OutputError& e) {
             std::cerr << "lucent simulate: " << e.what() << "\n";
             exit_code = kExitUsage;
         }

@@ -7,7 +7,7 @@
 #include <set>
 #include <sstream>
 
-#include "output/output_file.h"
+#include "common/output_file.h"
 #include "study/question_scales.h"
 #include "study/sqlite/database.h"
 #include "study/sqlite/sqlite_store.h"
@@ -348,8 +348,8 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                              const std::string& out_path, bool force) {
     ExportFileResult result;
     try {
-        output::check_output_file(out_path, {db_path}, force);
-        output::write_file_atomically(out_path, force, [&](std::ostream& out) {
+        common::check_output_file(out_path, {db_path}, force);
+        common::write_file_atomically(out_path, force, [&](std::ostream& out) {
             if (format == "analysis") {
                 check_stored_ratings(db_path);  // no impossible rating enters an analysis
                 const LongTable table = analysis_long_table(db_path);
@@ -366,7 +366,7 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                                  "' (valid: long, wide, analysis)");
             }
         });
-    } catch (const output::OutputError& e) {
+    } catch (const common::OutputError& e) {
         throw StoreError(e.what());
     }
     return result;

@@ -10,7 +10,7 @@
 #include <set>
 #include <tuple>
 
-#include "output/output_file.h"
+#include "common/output_file.h"
 #include "study/export.h"
 #include "study/merge_provenance.h"
 #include "study/merge_reconcile.h"
@@ -26,7 +26,7 @@ namespace {
 struct MergeInput {
     std::string path;      // as given, for messages
     std::string readable;  // what is attached: path, or the upgraded copy
-    std::unique_ptr<output::PendingOutput> upgraded_copy;
+    std::unique_ptr<common::PendingOutput> upgraded_copy;
     std::set<std::string> protocol_hashes;
 };
 
@@ -42,7 +42,7 @@ MergeInput open_input(const std::string& path,
         if (version > 0 && version < kSchemaVersion) {
             // Copy (VACUUM INTO reads a read-only database) and migrate the copy.
             in.upgraded_copy =
-                std::make_unique<output::PendingOutput>(scratch_next_to, false);
+                std::make_unique<common::PendingOutput>(scratch_next_to, false);
             in.readable = in.upgraded_copy->temporary().string();
             db.prepare("VACUUM INTO ?").bind(1, in.readable).run();
         }
@@ -346,8 +346,8 @@ MergeReport merge_databases(const std::vector<std::string>& inputs,
     MergeReport report;
     try {
         // A new file only, never an input or any database.
-        output::check_output_file(out_path, {inputs.begin(), inputs.end()}, false, "");
-    } catch (const output::OutputError& e) {
+        common::check_output_file(out_path, {inputs.begin(), inputs.end()}, false, "");
+    } catch (const common::OutputError& e) {
         throw StoreError(std::string(e.what()) + "; merge writes a new database");
     }
     // Check every input before creating anything.
@@ -395,7 +395,7 @@ MergeReport merge_databases(const std::vector<std::string>& inputs,
     }
 
     // Written under a temporary name and renamed when complete: nobody sees half a merge.
-    output::PendingOutput pending(out_path, false);
+    common::PendingOutput pending(out_path, false);
     {
         Store out(pending.temporary().string());
         Database& db = out.db();
@@ -456,7 +456,7 @@ MergeReport merge_databases(const std::vector<std::string>& inputs,
     }
     try {
         pending.commit();
-    } catch (const output::OutputError& e) {
+    } catch (const common::OutputError& e) {
         throw StoreError(e.what());
     }
     return report;

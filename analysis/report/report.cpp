@@ -11,7 +11,7 @@
 #include "analysis/report/format.h"
 #include "analysis/report/html_page.h"
 #include "analysis/report/svg_plot.h"
-#include "output/output_file.h"
+#include "common/output_file.h"
 
 namespace lucent::analysis {
 namespace {
@@ -647,13 +647,13 @@ std::vector<std::filesystem::path> write_report(
     std::vector<std::filesystem::path> written;
     try {
         for (const auto& [name, text] : files)
-            output::check_output_file(directory / name, options.inputs, true);
+            common::check_output_file(directory / name, options.inputs, true);
         for (const auto& [name, text] : files) {
             written.push_back(directory / name);
-            output::write_file_atomically(written.back(), true,
+            common::write_file_atomically(written.back(), true,
                                           [&](std::ostream& out) { out << text; });
         }
-    } catch (const output::OutputError& e) {
+    } catch (const common::OutputError& e) {
         throw InputError(e.what());
     }
     return written;

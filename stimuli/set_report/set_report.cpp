@@ -21,7 +21,7 @@
 #include "analysis/report/html_page.h"
 #include "analysis/report/report.h"
 #include "analysis/report/svg_plot.h"
-#include "output/output_file.h"
+#include "common/output_file.h"
 #include "renderer/core/image.h"
 #include "renderer/core/progress.h"
 #include "stimuli/manifest.h"
@@ -732,9 +732,9 @@ std::vector<fs::path> write_set_report(const SetReport& report) {
                                     report.directory / "manifest.json"};
     for (const auto& s : report.stimuli) inputs.push_back(s.image);
     try {
-        output::check_output_file(html, inputs, true);
-        output::check_output_file(sheet, inputs, true);
-    } catch (const output::OutputError& e) {
+        common::check_output_file(html, inputs, true);
+        common::check_output_file(sheet, inputs, true);
+    } catch (const common::OutputError& e) {
         fail(e.what());
     }
     std::vector<ContactSheetGroup> groups;
@@ -746,7 +746,7 @@ std::vector<fs::path> write_set_report(const SetReport& report) {
         groups.push_back(std::move(group));
     }
     write_contact_sheet(sheet, groups);
-    output::write_file_atomically(html, true,
+    common::write_file_atomically(html, true,
                                   [&](std::ostream& out) { write_html(out, report); });
     return {html, sheet};
 }

@@ -1,5 +1,5 @@
 // Output path checks and atomic writes (see output_file.h).
-#include "output/output_file.h"
+#include "common/output_file.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -9,7 +9,7 @@
 #include <fstream>
 #include <random>
 
-namespace lucent::output {
+namespace lucent::common {
 namespace {
 
 namespace fs = std::filesystem;
@@ -149,4 +149,4 @@ void write_file_atomically(const fs::path& out, bool overwrite,
     pending.commit();
 }
 
-}  // namespace lucent::output
+}  // namespace lucent::common

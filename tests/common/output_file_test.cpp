@@ -1,6 +1,6 @@
 // Output files: an --out that would replace an input or a database is refused whatever
 // path reaches it, existing files only go with overwrite, and writes are atomic.
-#include "output/output_file.h"
+#include "common/output_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,7 +10,7 @@
 
 #include "tests/support/test_paths.h"
 
-namespace lucent::output {
+namespace lucent::common {
 namespace {
 
 namespace fs = std::filesystem;
@@ -149,4 +149,4 @@ TEST(PendingOutput, WithoutOverwriteAFileThatAppearedMeanwhileIsKept) {
 }
 
 }  // namespace
-}  // namespace lucent::output
+}  // namespace lucent::common

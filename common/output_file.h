@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace lucent::output {
+namespace lucent::common {
 
 // A refused or failed output; what() is one line naming the path.
 class OutputError : public std::runtime_error {
@@ -59,4 +59,4 @@ private:
 void write_file_atomically(const std::filesystem::path& out, bool overwrite,
                            const std::function<void(std::ostream&)>& write);
 
-}  // namespace lucent::output
+}  // namespace lucent::common
