@@ -1,9 +1,9 @@
-// The README's start of a built-in study from its pictures, command for command (issue 26
-// item 9): `lucent render --preset NAME --out DIR`, then `lucent serve --preset NAME
+// The documented start of a built-in study from its pictures, command for command (issue
+// 26 item 9): `lucent render --preset NAME --out DIR`, then `lucent serve --preset NAME
 // --images DIR ...` and `lucent run --preset NAME --images DIR ...` from the folder that
-// render wrote. The three command lines are read from README.md as written (they must be
-// there, in that order) and run in a scratch folder; the test adds only what a test
-// needs:
+// render wrote. The three command lines are read as written from README.md and the pages
+// of docs/ (they must be on at least one, in that order, and the same wherever they are
+// shown) and run in a scratch folder; the test adds only what a test needs:
 // `--listen 127.0.0.1:0` to serve (a free port) and the autopilot participant to run. For
 // `fabrics` the same lines run with the study's name in place of `thesis`.
 #include <fcntl.h>
@@ -42,25 +42,51 @@ std::vector<std::string> words(const std::string& line) {
     return out;
 }
 
-// The README's three command lines of the online start, in order ("    lucent render
-// --preset thesis ...", "    lucent serve ...", "    lucent run ..."): the indented block
-// whose first line renders the preset. Empty when the README lacks them.
-std::vector<std::string> readme_start_commands() {
-    std::istringstream readme(read_file(test::source_dir() / "README.md"));
+// The pages a user reads: README.md and every page of docs/.
+std::vector<fs::path> documentation_pages() {
+    std::vector<fs::path> pages{test::source_dir() / "README.md"};
+    for (const fs::directory_entry& entry :
+         fs::directory_iterator(test::source_dir() / "docs"))
+        if (entry.path().extension() == ".md") pages.push_back(entry.path());
+    return pages;
+}
+
+// Every block of the online start's three command lines in `page`: three indented lines
+// in a row, `lucent render --preset thesis ...`, `lucent serve ...`, `lucent run ...`.
+std::vector<std::vector<std::string>> start_blocks(const fs::path& page) {
+    std::istringstream text(read_file(page));
     std::vector<std::string> lines;
-    for (std::string line; std::getline(readme, line);) lines.push_back(line);
+    for (std::string line; std::getline(text, line);) lines.push_back(line);
+    std::vector<std::vector<std::string>> blocks;
     for (size_t i = 0; i + 2 < lines.size(); ++i) {
         if (lines[i].rfind("    lucent render --preset thesis --out ", 0) != 0) continue;
         if (lines[i + 1].rfind("    lucent serve --preset thesis --images ", 0) != 0)
             continue;
         if (lines[i + 2].rfind("    lucent run --preset thesis --images ", 0) != 0)
             continue;
-        return {lines[i], lines[i + 1], lines[i + 2]};
+        blocks.push_back({lines[i], lines[i + 1], lines[i + 2]});
     }
-    return {};
+    return blocks;
 }
 
-// `line` for study `name` (the README writes thesis), as argv after "lucent".
+// The documented three lines; empty when no page shows them. Every page that shows them
+// must show the same lines (so the lines run here are the ones each reader sees).
+std::vector<std::string> documented_start_commands() {
+    std::vector<std::string> first;
+    fs::path first_page;
+    for (const fs::path& page : documentation_pages())
+        for (const std::vector<std::string>& block : start_blocks(page)) {
+            if (first.empty()) {
+                first = block;
+                first_page = page;
+            }
+            EXPECT_EQ(block, first)
+                << page << " shows other start commands than " << first_page;
+        }
+    return first;
+}
+
+// `line` for study `name` (the pages write thesis), as argv after "lucent".
 std::vector<std::string> args_of(std::string line, const std::string& name) {
     for (size_t at = 0; (at = line.find("thesis", at)) != std::string::npos;
          at += name.size())
@@ -130,17 +156,16 @@ std::string first_line(int fd) {
 
 void documented_start(const std::string& name) {
     LUCENT_REQUIRE_DISPLAY();
-    const std::vector<std::string> readme = readme_start_commands();
-    ASSERT_EQ(readme.size(), 3u)
-        << "README.md has no block of the three lines 'lucent render --preset thesis "
-           "--out "
-           "DIR', 'lucent serve --preset thesis --images DIR ...', 'lucent run --preset "
-           "thesis --images DIR ...'";
+    const std::vector<std::string> documented = documented_start_commands();
+    ASSERT_EQ(documented.size(), 3u)
+        << "neither README.md nor docs/ has a block of the three lines 'lucent render "
+           "--preset thesis --out DIR', 'lucent serve --preset thesis --images DIR ...', "
+           "'lucent run --preset thesis --images DIR ...'";
     const fs::path dir = test::scratch_dir("documented_start");
     const study::Protocol protocol = study::builtin_protocol(name);
 
     // 1. lucent render --preset NAME --out DIR: every picture the study shows.
-    const std::vector<std::string> render = args_of(readme[0], name);
+    const std::vector<std::string> render = args_of(documented[0], name);
     Child r = start(render, dir, "render", false);
     ASSERT_EQ(wait_exit(r), 0) << read_file(r.stderr_path);
     const fs::path pictures = dir / render.back();
@@ -154,7 +179,7 @@ void documented_start(const std::string& name) {
 
     // 2. lucent serve --preset NAME --images DIR --db study.db: starts, and a participant
     // gets the consent screen; the practice pictures are served.
-    std::vector<std::string> serve = args_of(readme[1], name);
+    std::vector<std::string> serve = args_of(documented[1], name);
     serve.insert(serve.end(), {"--listen", "127.0.0.1:0"});
     Child s = start(serve, dir, "serve", true);
     const std::string line = first_line(s.stdout_fd);
@@ -183,7 +208,7 @@ void documented_start(const std::string& name) {
 
     // 3. lucent run --preset NAME --images DIR --db study.db --participant P01: the
     // whole session, every picture from the folder.
-    std::vector<std::string> run = args_of(readme[2], name);
+    std::vector<std::string> run = args_of(documented[2], name);
     run.insert(run.end(), {"--autopilot", "3", "--autopilot-speed", "25"});
     Child l = start(run, dir, "run", false);
     ASSERT_EQ(wait_exit(l), 0) << read_file(l.stderr_path);

@@ -153,11 +153,11 @@ TEST(Registry, UnknownTechniqueListsTheValidNames) {
 namespace lucent {
 namespace {
 
-// README.md's parameter table is the user's documentation: each knob has a row whose
-// default column parses to the knob's default.
+// The parameter table (docs/parameters.md) is the user's documentation: each knob has a
+// row whose default column parses to the knob's default.
 TEST(Knobs, ReadmeTableListsEveryKnobWithItsDefault) {
-    std::ifstream file(test::source_dir() / "README.md");
-    ASSERT_TRUE(file) << "README.md not found";
+    std::ifstream file(test::source_dir() / "docs" / "parameters.md");
+    ASSERT_TRUE(file) << "docs/parameters.md not found";
     std::map<std::string, std::string> defaults;
     for (std::string line; std::getline(file, line);) {
         if (line.rfind("| `", 0) != 0) continue;
@@ -171,7 +171,7 @@ TEST(Knobs, ReadmeTableListsEveryKnobWithItsDefault) {
     for (const Technique* technique : all_techniques())
         for (const Knob& knob : knobs_for(*technique)) {
             ASSERT_TRUE(defaults.count(knob.name))
-                << knob.name << " missing from README.md";
+                << knob.name << " missing from docs/parameters.md";
             EXPECT_EQ(parse_knob_value(knob, defaults[knob.name]), knob.default_value)
                 << knob.name;
         }
