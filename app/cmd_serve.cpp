@@ -215,7 +215,8 @@ int serve_command(const ServeArgs& args) {
               << port << "/?participant=ID" << std::endl;
     if (!is_loopback(host))
         std::cout << "lucent serve: note: listening beyond this machine (" << host
-                  << "); serve participants through an HTTPS reverse proxy (README)"
+                  << "); serve participants through an HTTPS reverse proxy "
+                     "(docs/run-and-serve.md)"
                   << std::endl;
     // Pages idle past --idle-minutes are put aside (their claims end) even when no
     // request comes to do it.
