@@ -2,11 +2,12 @@
 // knob in Technique::quality_sweeps(), render the GL image at each value (the other
 // quality knobs at their reference values), measure its error against the technique's
 // CPU reference at the reference values (RMSE, 99th percentile, outside a 1-pixel
-// silhouette band), its median GPU frame time, and the precomputation it needs (the AO
-// bake, timed uncached). Prints a table and writes an SVG of error vs time per knob.
-// Techniques join by declaring quality_sweeps(); nothing here names a technique's knobs.
-// A sweep of a scene knob (thick_texture's thickness and tilt) is measured against the
-// reference of each of its values.
+// silhouette band), its median GPU frame time, and the precomputation it needs (its
+// bakes, e.g. the AO: uploads of ProductionCost::bake, timed uncached). Prints a table
+// and writes an SVG of error vs time per knob. Techniques join by declaring
+// quality_sweeps(); nothing here names a technique's knobs. A sweep of a scene knob
+// (thick_texture's thickness and tilt) is measured against the reference of each of its
+// values.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,7 +17,6 @@
 #include <sstream>
 
 #include "app/commands.h"
-#include "renderer/core/ambient_occlusion.h"
 #include "renderer/core/image_compare.h"
 #include "renderer/gl/context.h"
 #include "renderer/render.h"
@@ -78,7 +78,7 @@ double median_of(std::vector<double> values) {
     return values[values.size() / 2];
 }
 
-// Median GPU frame time (the AO bake excluded) and the median of each pass, as
+// Median GPU frame time (bakes excluded) and the median of each pass, as
 // "name=ms;name=ms".
 double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene,
                        const FramePlan& plan, int frames,
@@ -90,7 +90,7 @@ double median_frame_ms(gl::FrameExecutor& executor, const Scene& scene,
         double ms = 0.0;
         const auto& passes = executor.last_timings().passes;
         for (std::size_t p = 0; p < passes.size(); ++p)
-            if (plan.passes[p].kind != PassKind::bake_ambient_occlusion) {
+            if (!is_bake(plan.passes[p])) {
                 ms += passes[p].milliseconds;
                 if (i > 0 && p < per_pass.size())
                     per_pass[p].push_back(passes[p].milliseconds);
@@ -167,7 +167,7 @@ void write_svg(const std::string& path, const std::vector<Row>& rows,
             << oy - h << "' stroke='black'/>\n"
             << "<text x='" << ox + w / 2 << "' y='" << oy + 30
             << "' text-anchor='middle'>"
-            << (by_precompute ? "AO bake time (s)" : "GPU frame time (ms)") << ", max "
+            << (by_precompute ? "bake time (s)" : "GPU frame time (ms)") << ", max "
             << max_x / 1.15 << "</text>\n"
             << "<text x='" << ox - 8 << "' y='" << oy - h / 2
             << "' text-anchor='middle' transform='rotate(-90 " << ox - 36 << " "
@@ -224,27 +224,29 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
         std::cerr << "lucent bench accuracy: " << e.what() << "\n";
         return kExitFailure;
     }
-    // AO bakes timed uncached, once per ray count; the GL path then uses those values.
-    std::map<int, std::pair<std::vector<float>, double>> bakes;
-    const auto bake = [&](const Mesh& mesh,
-                          int rays) -> const std::pair<std::vector<float>, double>& {
-        auto it = bakes.find(rays);
+    // Bakes (the AO) timed uncached, once per content hash (per ray count); the GL path
+    // then uses those values.
+    std::map<std::string, std::pair<TextureData, double>> bakes;
+    const auto bake = [&](const Pass& pass) -> const std::pair<TextureData, double>& {
+        auto it = bakes.find(pass.data.content_hash);
         if (it == bakes.end()) {
-            std::cerr << "baking AO with " << rays << " rays per vertex...\n";
-            AoBakeOptions bake_options;
-            bake_options.rays = rays;
+            std::cerr << "baking " << pass.name << " (" << pass.data.content_hash
+                      << ")...\n";
+            ProduceOptions uncached;
+            uncached.use_caches = false;
             const auto start = std::chrono::steady_clock::now();
-            auto values = bake_ambient_occlusion(mesh, bake_options);
+            TextureData data = pass.data.produce(uncached);
             it = bakes
-                     .emplace(rays,
-                              std::make_pair(std::move(values), seconds_since(start)))
+                     .emplace(pass.data.content_hash,
+                              std::make_pair(std::move(data), seconds_since(start)))
                      .first;
         }
         return it->second;
     };
     gl::FrameExecutor executor;
-    executor.set_ambient_occlusion_source(
-        [&](const Mesh& mesh, int rays) { return bake(mesh, rays).first; });
+    executor.set_upload_producer([&](const Pass& pass) {
+        return is_bake(pass) ? bake(pass).first : produce_upload(pass);
+    });
 
     std::cerr << "CPU reference...\n";
     const auto reference_start = std::chrono::steady_clock::now();
@@ -283,8 +285,7 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
                 row.error = compare_images(image, truth, 1);
                 row.block_rmse = block_mean_rmse(image, truth);
                 for (const auto& pass : plan.passes)
-                    if (pass.kind == PassKind::bake_ambient_occlusion)
-                        row.precompute_s += bake(*scene.mesh, pass.ao_rays).second;
+                    if (is_bake(pass)) row.precompute_s += bake(pass).second;
                 rows.push_back(row);
             }
         write_svg(options.svg, rows,

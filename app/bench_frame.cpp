@@ -3,8 +3,8 @@
 // as the thesis's Table 4.2) gets its variants per mesh with the ratio to the baseline;
 // otherwise, or with `--sweep KNOB=V1,V2,...`, one row per mesh and value with the
 // total, the costliest pass and the cost per unit of the value (the dipole's time per
-// sample, as Chang et al.'s Table 2). The AO bake is precomputed (cached) and not part
-// of the frame, as in the thesis.
+// sample, as Chang et al.'s Table 2). Bakes (ProductionCost::bake uploads: the AO) are
+// precomputed (cached) and not part of the frame, as in the thesis.
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -65,7 +65,7 @@ double median(std::vector<double> values) {
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// One frame's GPU time: the sum of its GPU passes (the CPU AO pass excluded).
+// One frame's GPU time: the sum of its passes but the bakes (precomputed, e.g. the AO).
 struct Sampler {
     gl::FrameExecutor executor;
     FramePlan plan;
@@ -78,7 +78,7 @@ struct Sampler {
         pass_ms.resize(plan.passes.size());
         double ms = 0.0;
         for (std::size_t p = 0; p < timings.passes.size(); ++p) {
-            if (plan.passes[p].kind == PassKind::bake_ambient_occlusion) continue;
+            if (is_bake(plan.passes[p])) continue;
             ms += timings.passes[p].milliseconds;
             if (record) pass_ms[p].push_back(timings.passes[p].milliseconds);
         }
@@ -117,7 +117,7 @@ void print_heading(const FrameBenchOptions& options, const RenderRequest& reques
               << "timing: "
               << (gpu_timer ? "GL timer queries (GL_TIME_ELAPSED), summed over passes"
                             : "wall time around glFinish per pass (no timer queries)")
-              << "; AO bake precomputed, not in the frame\n";
+              << "; bakes (the AO) precomputed, not in the frame\n";
 }
 
 int finish_csv(const FrameBenchOptions& options,

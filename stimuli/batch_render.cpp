@@ -20,11 +20,9 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <thread>
 
 #include "lucent/version.h"
-#include "renderer/core/ambient_occlusion.h"
 #include "renderer/core/density_volume.h"
 #include "renderer/core/mesh.h"
 #include "renderer/core/technique.h"
@@ -268,26 +266,24 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     // Drop the rows of everything about to be re-rendered before any file is replaced.
     write_complete_rows(dir, set, rows);
 
-    // Bake (or load) the AO each pending plan reads once, here, so parallel workers never
-    // bake the same mesh twice and the bake's own progress bar is not interleaved.
+    // Produce the bakes (ProductionCost::bake uploads: the AO) the pending plans upload
+    // once each, here, by content hash, so parallel workers never bake the same data
+    // twice and a bake's own progress bar is not interleaved; workers are handed the
+    // results (see render_worker).
     double prebake_seconds = 0.0;
+    std::map<std::string, TextureData> baked;  // read-only once the workers start
     {
-        std::set<std::pair<std::string, int>> bakes;
+        std::map<std::string, Pass> bakes;
         for (const std::size_t i : pending) {
             const Stimulus& s = set.stimuli[i];
             const Technique& technique = find_technique(s.technique);
             const Scene scene = make_scene(meshes.at(s.mesh_spec), technique,
                                            s.parameters, set.width, set.height);
             for (const Pass& pass : make_frame_plan(scene, technique).passes)
-                if (pass.kind == PassKind::bake_ambient_occlusion)
-                    bakes.emplace(s.mesh_spec, pass.ao_rays);
+                if (is_bake(pass)) bakes.emplace(pass.data.content_hash, pass);
         }
         const auto start = Clock::now();
-        for (const auto& [spec, rays] : bakes) {
-            AoBakeOptions ao;
-            ao.rays = rays;
-            (void)load_or_bake_ambient_occlusion(*meshes.at(spec), ao);
-        }
+        for (const auto& [hash, pass] : bakes) baked.emplace(hash, produce_upload(pass));
         prebake_seconds = seconds_since(start);
     }
 
@@ -359,13 +355,15 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
         try {
             auto context = gl::create_headless_context();
             gl::FrameExecutor executor;
-            executor.set_ambient_occlusion_source([&timings](const Mesh& mesh, int rays) {
+            // Bakes come from the pre-bake above; their time (and that of any bake it
+            // missed) counts as bake time, not GL time.
+            executor.set_upload_producer([&timings, &baked](const Pass& pass) {
+                if (!is_bake(pass)) return produce_upload(pass);
                 const auto start = Clock::now();
-                AoBakeOptions ao;
-                ao.rays = rays;
-                auto values = load_or_bake_ambient_occlusion(mesh, ao);
+                const auto it = baked.find(pass.data.content_hash);
+                TextureData data = it != baked.end() ? it->second : produce_upload(pass);
                 timings.ao_seconds += seconds_since(start);
-                return values;
+                return data;
             });
             for (std::size_t k; (k = next++) < pending.size();) {
                 {

@@ -39,8 +39,9 @@ struct BatchOptions {
 // Where the time went (seconds, summed over workers; render and encode workers run at
 // once, so the stages can add up to more than the wall time).
 struct BatchTimings {
-    double ao_seconds = 0.0;          // AO bakes and cache loads
-    double gl_seconds = 0.0;          // plan + GL passes + read-back, AO excluded
+    // Bakes (ProductionCost::bake uploads: the AO) and their cache loads.
+    double ao_seconds = 0.0;
+    double gl_seconds = 0.0;          // plan + GL passes + read-back, bakes excluded
     double encode_seconds = 0.0;      // image encoding and writing (all formats)
     double statistics_seconds = 0.0;  // image statistics and content hashes
     double wall_seconds = 0.0;        // the whole batch, start to manifest

@@ -45,8 +45,6 @@ const char* format_name(ResourceFormat format) {
             return "rgba16f";
         case ResourceFormat::rgba32f:
             return "rgba32f";
-        case ResourceFormat::vertex_float:
-            return "vertex float";
     }
     return "?";
 }
@@ -65,16 +63,12 @@ int format_channels(ResourceFormat format) {
         case ResourceFormat::rgba16f:
         case ResourceFormat::rgba32f:
             return 4;
-        case ResourceFormat::vertex_float:
-            return 0;
     }
     return 0;
 }
 
 const char* pass_kind_name(PassKind kind) {
     switch (kind) {
-        case PassKind::bake_ambient_occlusion:
-            return "bake_ambient_occlusion";
         case PassKind::draw_mesh:
             return "draw_mesh";
         case PassKind::fullscreen:
@@ -100,6 +94,18 @@ ResourceDesc texture_3d(std::string name, ResourceFormat format, int width, int 
                         int depth) {
     return {std::move(name), format, ResourceShape::fixed_3d, {width, height, depth}, 1};
 }
+
+ResourceDesc vertex_stream(std::string name, ResourceFormat format, int vertex_count,
+                           int attribute) {
+    return {std::move(name),      format, ResourceShape::vertex_stream,
+            {vertex_count, 1, 1}, 1,      attribute};
+}
+
+bool is_bake(const Pass& pass) {
+    return pass.kind == PassKind::upload && pass.data.cost == ProductionCost::bake;
+}
+
+TextureData produce_upload(const Pass& upload) { return upload.data.produce({}); }
 
 glm::ivec3 mip_size(glm::ivec3 base, int level, bool three_d) {
     glm::ivec3 size = base;
@@ -131,6 +137,9 @@ std::string size_text(glm::ivec3 size, bool three_d) {
 }
 
 bool is_3d(const ResourceDesc& desc) { return desc.shape == ResourceShape::fixed_3d; }
+bool is_stream(const ResourceDesc& desc) {
+    return desc.shape == ResourceShape::vertex_stream;
+}
 
 // Passes whose attachments keep their earlier contents depend on them like on a read.
 bool reads_own_writes(const Pass& pass) {
@@ -191,7 +200,7 @@ const ResourceDesc* FramePlan::resource(const std::string& name) const {
 glm::ivec2 FramePlan::viewport(const Pass& pass) const {
     for (const auto& w : pass.writes)
         if (const ResourceDesc* desc = resource(w))
-            if (desc->format != ResourceFormat::vertex_float)
+            if (!is_stream(*desc))
                 return glm::ivec2(mip_size(desc->size, pass.level, is_3d(*desc)));
     return {width, height};
 }
@@ -200,14 +209,14 @@ std::string FramePlan::explain() const {
     std::string text;
     for (const auto& r : resources) {
         text += "resource " + r.name + ": ";
-        if (r.format == ResourceFormat::vertex_float) {
-            text += "one float per vertex\n";
+        if (is_stream(r)) {
+            text += std::to_string(r.size.x) + " vertices x " + format_name(r.format) +
+                    " at attribute " + std::to_string(r.attribute) + "\n";
             continue;
         }
         text += size_text(r.size, is_3d(r)) + " " + format_name(r.format);
         if (r.levels > 1) text += ", " + std::to_string(r.levels) + " levels";
-        if (r.shape == ResourceShape::frame && r.format != ResourceFormat::vertex_float)
-            text += " (frame)";
+        if (r.shape == ResourceShape::frame) text += " (frame)";
         text += "\n";
     }
     for (const auto& pass : passes) {
@@ -216,7 +225,7 @@ std::string FramePlan::explain() const {
             reads += (reads.empty() ? "" : ", ") + r.resource;
             const ResourceDesc* desc = resource(r.resource);
             const Sampling defaults{};
-            if (desc && desc->format != ResourceFormat::vertex_float &&
+            if (desc && !is_stream(*desc) &&
                 (r.sampling.filter != defaults.filter || r.sampling.mip != defaults.mip ||
                  r.sampling.wrap != defaults.wrap))
                 reads += " (" + describe(r.sampling) + ")";
@@ -265,9 +274,36 @@ void PlanBuilder::create(ResourceDesc desc) {
 }
 
 void PlanBuilder::add(Pass pass) {
+    const std::string where = "frame plan: pass '" + pass.name + "'";
     for (const auto& p : passes_)
-        if (p.name == pass.name)
-            throw std::logic_error("frame plan: pass '" + pass.name + "' added twice");
+        if (p.name == pass.name) throw std::logic_error(where + " added twice");
+    const auto created = [&](const std::string& name) {
+        return std::any_of(resources_.begin(), resources_.end(),
+                           [&](const ResourceDesc& r) { return r.name == name; });
+    };
+    const auto written = [&](const std::string& name) {
+        return std::find(written_.begin(), written_.end(), name) != written_.end();
+    };
+    for (const auto& read : pass.reads) {
+        if (!created(read.resource))
+            throw std::logic_error(where + " reads '" + read.resource +
+                                   "', which no create() declared");
+        if (!written(read.resource))
+            throw std::logic_error(where + " reads '" + read.resource +
+                                   "' before any pass writes it");
+        if (std::find(pass.writes.begin(), pass.writes.end(), read.resource) !=
+            pass.writes.end())
+            throw std::logic_error(where + " reads '" + read.resource +
+                                   "' while writing it");
+    }
+    for (const auto& w : pass.writes) {
+        if (!created(w)) throw std::logic_error(where + " writes undeclared '" + w + "'");
+        if (reads_own_writes(pass) && !written(w))
+            throw std::logic_error(where + " keeps the contents of '" + w +
+                                   "' before any pass writes it");
+    }
+    for (const auto& w : pass.writes)
+        if (!written(w)) written_.push_back(w);
     passes_.push_back(std::move(pass));
 }
 
@@ -284,8 +320,25 @@ FramePlan PlanBuilder::compile() const {
         const std::string where = "frame plan: resource '" + r.name + "'";
         if (r.shape == ResourceShape::frame) r.size = {width_, height_, 1};
         if (r.shape == ResourceShape::fixed_2d) r.size.z = 1;
-        if (r.format == ResourceFormat::vertex_float) {
+        if (is_stream(r)) {
+            r.size = {r.size.x, 1, 1};
             r.levels = 1;
+            if (r.size.x <= 0)
+                throw std::logic_error(where + " has " + std::to_string(r.size.x) +
+                                       " vertices");
+            if (r.format != ResourceFormat::r32f && r.format != ResourceFormat::rg32f &&
+                r.format != ResourceFormat::rgba32f)
+                throw std::logic_error(where +
+                                       ": a vertex stream is r32f, rg32f or "
+                                       "rgba32f, not " +
+                                       std::string(format_name(r.format)));
+            const bool taken =
+                std::find(std::begin(kMeshAttributes), std::end(kMeshAttributes),
+                          r.attribute) != std::end(kMeshAttributes);
+            if (r.attribute < 0 || r.attribute > 15 || taken)
+                throw std::logic_error(where + ": attribute " +
+                                       std::to_string(r.attribute) +
+                                       " is not a free vertex attribute location");
             continue;
         }
         if (r.size.x <= 0 || r.size.y <= 0 || r.size.z <= 0)
@@ -307,30 +360,26 @@ FramePlan PlanBuilder::compile() const {
         return nullptr;
     };
 
-    // Validate the declared data flow: reads follow writes, writes name created
-    // resources, attachments agree, special passes write one fitting resource.
-    std::set<std::string> written;
+    // Validate what add() could not: attachments agree, special passes write one
+    // fitting resource, vertex streams are uploaded and read by mesh passes. (add()
+    // checked that every name is created and that reads follow writes.)
     for (const auto& pass : passes_) {
         const std::string where = "frame plan: pass '" + pass.name + "'";
-        for (const auto& read : pass.reads) {
-            if (!written.count(read.resource))
-                throw std::logic_error(where + " reads '" + read.resource +
-                                       "' before any pass writes it");
-            if (std::find(pass.writes.begin(), pass.writes.end(), read.resource) !=
-                pass.writes.end())
-                throw std::logic_error(where + " reads '" + read.resource +
-                                       "' while writing it");
-        }
+        for (const auto& read : pass.reads)
+            if (is_stream(*find(read.resource)) && pass.kind != PassKind::draw_mesh)
+                throw std::logic_error(where + " reads the vertex stream '" +
+                                       read.resource + "' but draws no mesh");
         glm::ivec3 attachment_size{0};
         std::string first_attachment;
         int depth_attachments = 0;
         for (const auto& w : pass.writes) {
             const ResourceDesc* desc = find(w);
-            if (!desc) throw std::logic_error(where + " writes undeclared '" + w + "'");
-            if (reads_own_writes(pass) && !written.count(w))
-                throw std::logic_error(where + " keeps the contents of '" + w +
-                                       "' before any pass writes it");
-            if (desc->format == ResourceFormat::vertex_float) continue;
+            if (is_stream(*desc)) {
+                if (pass.kind != PassKind::upload)
+                    throw std::logic_error(where + " draws into the vertex stream '" + w +
+                                           "'; streams are uploaded");
+                continue;
+            }
             if (pass.level < 0 || pass.level >= desc->levels)
                 throw std::logic_error(where + " writes level " +
                                        std::to_string(pass.level) + " of '" + w +
@@ -357,8 +406,8 @@ FramePlan PlanBuilder::compile() const {
         if (pass.kind == PassKind::upload || pass.kind == PassKind::build_mips) {
             const ResourceDesc* desc =
                 pass.writes.size() == 1 ? find(pass.writes[0]) : nullptr;
-            if (!desc || desc->format == ResourceFormat::vertex_float ||
-                is_depth_format(desc->format))
+            if (!desc || is_depth_format(desc->format) ||
+                (is_stream(*desc) && pass.kind != PassKind::upload))
                 throw std::logic_error(where + " (" + pass_kind_name(pass.kind) +
                                        ") must write exactly one colour resource");
             if (!pass.reads.empty())
@@ -373,9 +422,9 @@ FramePlan PlanBuilder::compile() const {
                 throw std::logic_error(where + " builds mips of '" + desc->name +
                                        "', which needs a 2D resource of several levels");
         }
-        for (const auto& w : pass.writes) written.insert(w);
     }
-    if (output_.empty() || !written.count(output_))
+    if (output_.empty() ||
+        std::find(written_.begin(), written_.end(), output_) == written_.end())
         throw std::logic_error("frame plan: no pass writes the output '" + output_ + "'");
 
     // Cull: walk backwards from the output, keeping a pass only when something needed

@@ -35,8 +35,13 @@ bool same_storage(const ResourceDesc& a, const ResourceDesc& b) {
            a.levels == b.levels;
 }
 
-bool uses_mesh(PassKind kind) {
-    return kind == PassKind::draw_mesh || kind == PassKind::bake_ambient_occlusion;
+// Mesh passes, and uploads into a vertex stream, whose elements are the mesh's vertices.
+bool uses_mesh(const Pass& pass, const FramePlan& plan) {
+    if (pass.kind == PassKind::draw_mesh) return true;
+    for (const auto& w : pass.writes)
+        if (const ResourceDesc* desc = plan.resource(w))
+            if (desc->shape == ResourceShape::vertex_stream) return true;
+    return false;
 }
 
 }  // namespace
@@ -66,7 +71,6 @@ std::uint64_t pass_description_hash(const Pass& pass) {
         std::visit([&](const auto& v) { h.value(v); }, u.value);
     }
     h.value(pass.clear_colour);
-    h.value(pass.ao_rays);
     h.value(pass.level);
     h.value(pass.clear);
     h.value(pass.blend);
@@ -128,7 +132,7 @@ std::vector<bool> PassReuse::schedule(const FramePlan& plan, const std::string& 
         }
         Hasher h;
         h.value(pass_description_hash(pass));
-        if (uses_mesh(pass.kind)) h.text(mesh_key);
+        if (uses_mesh(pass, plan)) h.text(mesh_key);
         for (const auto& s : inputs) {
             const std::uint64_t v = logical[s];
             h.value(v);

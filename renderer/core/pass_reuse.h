@@ -26,8 +26,8 @@ class PassReuse {
 public:
     // One entry per pass of `plan`, in order: true = run it. Records the frame as if the
     // passes marked true ran (call forget() if running them then fails). `mesh_key`
-    // identifies the mesh for draw_mesh and AO passes. With `reuse` false every pass runs
-    // (benchmarks) while versions are still kept.
+    // identifies the mesh for draw_mesh passes and uploads into vertex streams. With
+    // `reuse` false every pass runs (benchmarks) while versions are still kept.
     std::vector<bool> schedule(const FramePlan& plan, const std::string& mesh_key,
                                bool reuse = true);
     // Resources the last schedule() found newly allocated (their contents undefined).

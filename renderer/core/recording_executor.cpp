@@ -18,7 +18,7 @@ std::vector<std::string> RecordingExecutor::execute(const FramePlan& plan,
             const std::string& target = pass.writes.at(0);
             if (uploaded_hash_[target] == pass.data.content_hash) return;
             const std::string problem =
-                check_texture_data(*plan.resource(target), pass.data.produce());
+                check_texture_data(*plan.resource(target), producer_(pass));
             if (!problem.empty())
                 throw std::runtime_error("pass '" + pass.name + "': data for '" + target +
                                          "': " + problem);

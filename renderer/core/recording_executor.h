@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "renderer/core/frame_plan.h"
@@ -20,6 +21,8 @@ public:
     // `reuse_unchanged_passes` as FrameExecutor::set_reuse_unchanged_passes.
     explicit RecordingExecutor(bool reuse_unchanged_passes = true)
         : reuse_(reuse_unchanged_passes) {}
+    // As FrameExecutor::set_upload_producer: called for every upload performed.
+    void set_upload_producer(UploadProducer producer) { producer_ = std::move(producer); }
 
     // Runs `plan` and returns the names of the passes that ran, in order. Throws
     // std::runtime_error (naming the pass and resource) for data that does not fit.
@@ -30,6 +33,7 @@ public:
 
 private:
     bool reuse_;
+    UploadProducer producer_ = produce_upload;
     PassReuse reuse_state_;
     std::map<std::string, std::string> uploaded_hash_;
     std::vector<std::string> last_run_;

@@ -1,9 +1,10 @@
 #include "renderer/gl/frame_executor.h"
 
+#include <algorithm>
 #include <chrono>
+#include <set>
 #include <stdexcept>
 
-#include "renderer/core/ambient_occlusion.h"
 #include "renderer/core/pass_reuse.h"
 #include "renderer/gl/errors.h"
 #include "renderer/gl/program.h"
@@ -32,8 +33,6 @@ GLenum internal_format(ResourceFormat format) {
             return GL_RGBA16F;
         case ResourceFormat::rgba32f:
             return GL_RGBA32F;
-        case ResourceFormat::vertex_float:
-            break;
     }
     throw std::logic_error("not a texture format");
 }
@@ -93,9 +92,37 @@ std::string program_key(const ShaderDesc& shader) {
     return key;
 }
 
-void set_uniform(GLuint program, const Uniform& uniform) {
-    const GLint location = glGetUniformLocation(program, uniform.name.c_str());
-    if (location < 0) return;  // unused by this variant: the compiler removed it
+bool is_stream(const ResourceDesc& desc) {
+    return desc.shape == ResourceShape::vertex_stream;
+}
+
+// A linked pass program and what its source declares, to tell a name that is inactive in
+// this variant (compiled out by a define, or optimised away) from one the shaders lack.
+struct PassProgram {
+    Program program;
+    std::string stages;              // "a.vert + b.frag", for errors
+    std::set<std::string> uniforms;  // declared in either stage
+    std::set<int> vertex_inputs;     // attribute locations the vertex stage declares
+};
+
+// The location of `name` (a uniform or sampler the pass sets), -1 when inactive in this
+// variant; a name the shaders do not declare at all fails the pass, naming both.
+GLint uniform_location(const PassProgram& program, const Pass& pass,
+                       const std::string& name, const char* what) {
+    const GLint location = glGetUniformLocation(program.program.id(), name.c_str());
+    if (location >= 0) return location;
+    const std::string declared = name.substr(0, name.find_first_of("[."));
+    if (!program.uniforms.count(declared))
+        throw std::logic_error("pass '" + pass.name + "': " + what + " '" + name +
+                               "' is not declared in " + program.stages);
+    return -1;
+}
+
+void set_uniform(const PassProgram& pass_program, const Pass& pass,
+                 const Uniform& uniform) {
+    const GLuint program = pass_program.program.id();
+    const GLint location = uniform_location(pass_program, pass, uniform.name, "uniform");
+    if (location < 0) return;  // inactive in this variant: the compiler removed it
     std::visit(
         [&](const auto& v) {
             using T = std::decay_t<decltype(v)>;
@@ -115,10 +142,8 @@ void set_uniform(GLuint program, const Uniform& uniform) {
         uniform.value);
 }
 
-// Passes timed by wall clock: CPU work (a bake, producing and uploading data).
-bool cpu_pass(PassKind kind) {
-    return kind == PassKind::bake_ambient_occlusion || kind == PassKind::upload;
-}
+// Passes timed by wall clock: CPU work (producing and uploading data).
+bool cpu_pass(PassKind kind) { return kind == PassKind::upload; }
 
 }  // namespace
 
@@ -130,27 +155,30 @@ struct FrameExecutor::Impl {
         int width() const { return desc.size.x; }
         int height() const { return desc.size.y; }
     };
+    // A vertex stream: a buffer of desc.size.x vertices, filled by its upload pass and
+    // bound at desc.attribute of the mesh passes that read it.
+    struct VertexStream {
+        ResourceDesc desc;
+        Buffer buffer;
+        std::string uploaded_hash;
+    };
     // Mesh buffers, re-uploaded when the mesh changes (compared by content hash + size).
     std::string mesh_key;
     Buffer positions, normals, indices;
     Buffer uvs, tangents;  // attributes 3 and 4, only for meshes with UVs
     GLsizei index_count = 0;
+    std::size_t vertex_count = 0;
     VertexArray mesh_vao;
     VertexArray empty_vao;  // full-screen passes draw without attributes
-    // AO streams by (mesh key, rays); the live one is attached at location 2.
-    std::map<std::string, Buffer> ao_streams;
     std::map<std::string, FrameTexture> textures;
+    std::map<std::string, VertexStream> streams;
     std::map<std::string, Sampler> samplers;  // by sampler_key
     std::size_t uploads = 0;
     PassReuse reuse;
     bool reuse_enabled = false;
-    std::map<std::string, Program> programs;
+    std::map<std::string, PassProgram> programs;
     std::vector<Query> queries;
-    AmbientOcclusionSource ao_source = [](const Mesh& mesh, int rays) {
-        AoBakeOptions options;
-        options.rays = rays;
-        return load_or_bake_ambient_occlusion(mesh, options);
-    };
+    UploadProducer producer = produce_upload;
 
     void upload_mesh(const Mesh& mesh) {
         const std::string key = mesh.content_hash + "/" +
@@ -170,6 +198,7 @@ struct FrameExecutor::Impl {
             mesh.triangles.data(),
             static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(glm::uvec3)));
         index_count = static_cast<GLsizei>(mesh.triangles.size() * 3);
+        vertex_count = mesh.vertex_count();
         mesh_vao = make_vertex_array();
         const GLuint vao = mesh_vao.id();
         glVertexArrayVertexBuffer(vao, 0, positions.id(), 0, sizeof(glm::vec3));
@@ -179,8 +208,6 @@ struct FrameExecutor::Impl {
             glVertexArrayAttribFormat(vao, i, 3, GL_FLOAT, GL_FALSE, 0);
             glVertexArrayAttribBinding(vao, i, i);
         }
-        glVertexArrayAttribFormat(vao, 2, 1, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(vao, 2, 2);
         if (mesh.has_uvs() && mesh.tangents.size() == mesh.positions.size()) {
             // Texture coordinates (3) and tangents with handedness (4).
             uvs =
@@ -200,27 +227,42 @@ struct FrameExecutor::Impl {
         }
         glVertexArrayElementBuffer(vao, indices.id());
         mesh_key = key;
-        ao_streams.clear();
     }
 
-    GLuint program(const ShaderDesc& shader) {
+    const PassProgram& pass_program(const ShaderDesc& shader) {
         const std::string key = program_key(shader);
         auto it = programs.find(key);
         if (it == programs.end()) {
-            Program linked = link_program(
-                {shader_stage(GL_VERTEX_SHADER, shader.vertex, shader.defines),
-                 shader_stage(GL_FRAGMENT_SHADER, shader.fragment, shader.defines)});
+            const ShaderStage vertex =
+                shader_stage(GL_VERTEX_SHADER, shader.vertex, shader.defines);
+            const ShaderStage fragment =
+                shader_stage(GL_FRAGMENT_SHADER, shader.fragment, shader.defines);
+            PassProgram linked{link_program({vertex, fragment}),
+                               vertex.name + " + " + fragment.name,
+                               declared_uniforms(vertex.source),
+                               declared_input_locations(vertex.source)};
+            linked.uniforms.merge(declared_uniforms(fragment.source));
             it = programs.emplace(key, std::move(linked)).first;
         }
-        return it->second.id();
+        return it->second;
     }
+    GLuint program(const ShaderDesc& shader) { return pass_program(shader).program.id(); }
 
-    // Allocates the plan's textures (reusing ones of the same storage) and frees the
-    // ones it does not name.
+    // Allocates the plan's textures and vertex streams (reusing ones of the same
+    // storage) and frees the ones it does not name.
     void allocate(const FramePlan& plan) {
         std::map<std::string, FrameTexture> kept;
+        std::map<std::string, VertexStream> kept_streams;
         for (const auto& r : plan.resources) {
-            if (r.format == ResourceFormat::vertex_float) continue;
+            if (is_stream(r)) {
+                auto it = streams.find(r.name);
+                if (it != streams.end() && same_storage(it->second.desc, r) &&
+                    it->second.desc.attribute == r.attribute)
+                    kept_streams.emplace(r.name, std::move(it->second));
+                else
+                    kept_streams.emplace(r.name, VertexStream{r, Buffer(), ""});
+                continue;
+            }
             auto it = textures.find(r.name);
             if (it != textures.end() && same_storage(it->second.desc, r)) {
                 kept.emplace(r.name, std::move(it->second));
@@ -235,6 +277,7 @@ struct FrameExecutor::Impl {
             }
         }
         textures = std::move(kept);
+        streams = std::move(kept_streams);
     }
 
     GLuint sampler_for(const Sampling& sampling) {
@@ -253,11 +296,13 @@ struct FrameExecutor::Impl {
     }
 
     // Calls the producer and uploads only when the content hash differs from the last
-    // upload into this texture (a reallocated texture has none).
+    // upload into this texture or stream (a reallocated one has none).
     void upload(const Pass& pass) {
+        if (auto stream = streams.find(pass.writes.at(0)); stream != streams.end())
+            return upload_stream(pass, stream->second);
         FrameTexture& target = textures.at(pass.writes.at(0));
         if (target.uploaded_hash == pass.data.content_hash) return;
-        const TextureData data = pass.data.produce();
+        const TextureData data = producer(pass);
         const std::string problem = check_texture_data(target.desc, data);
         if (!problem.empty())
             throw std::runtime_error("pass '" + pass.name + "': data for '" +
@@ -276,6 +321,54 @@ struct FrameExecutor::Impl {
         }
         target.uploaded_hash = pass.data.content_hash;
         ++uploads;
+    }
+
+    void upload_stream(const Pass& pass, VertexStream& target) {
+        if (target.uploaded_hash == pass.data.content_hash) return;
+        const TextureData data = producer(pass);
+        const std::string problem = check_texture_data(target.desc, data);
+        if (!problem.empty())
+            throw std::runtime_error("pass '" + pass.name + "': data for '" +
+                                     target.desc.name + "': " + problem);
+        const std::vector<float>& values = data.levels[0];
+        target.buffer = make_buffer(
+            values.data(), static_cast<GLsizeiptr>(values.size() * sizeof(float)));
+        target.uploaded_hash = pass.data.content_hash;
+        ++uploads;
+    }
+
+    // Binds the vertex streams `pass` reads at their attribute locations of the mesh's
+    // vertex array; returns the locations, to disable after the draw.
+    std::vector<GLuint> bind_streams(const Pass& pass, const PassProgram& program) {
+        std::vector<GLuint> bound;
+        for (const auto& read : pass.reads) {
+            auto it = streams.find(read.resource);
+            if (it == streams.end()) continue;
+            const VertexStream& stream = it->second;
+            const ResourceDesc& desc = stream.desc;
+            if (!program.vertex_inputs.count(desc.attribute))
+                throw std::logic_error("pass '" + pass.name + "': vertex stream '" +
+                                       desc.name + "' is bound at attribute " +
+                                       std::to_string(desc.attribute) + ", which " +
+                                       pass.shader.vertex + " does not declare");
+            if (static_cast<std::size_t>(desc.size.x) != vertex_count)
+                throw std::runtime_error(
+                    "pass '" + pass.name + "': vertex stream '" + desc.name + "' has " +
+                    std::to_string(desc.size.x) + " vertices, the mesh " +
+                    std::to_string(vertex_count));
+            if (!stream.buffer.id())
+                throw std::logic_error("pass '" + pass.name + "': vertex stream '" +
+                                       desc.name + "' was never uploaded");
+            const GLuint vao = mesh_vao.id(), location = GLuint(desc.attribute);
+            const int channels = format_channels(desc.format);
+            glVertexArrayVertexBuffer(vao, location, stream.buffer.id(), 0,
+                                      static_cast<GLsizei>(channels * sizeof(float)));
+            glVertexArrayAttribFormat(vao, location, channels, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(vao, location, location);
+            glEnableVertexArrayAttrib(vao, location);
+            bound.push_back(location);
+        }
+        return bound;
     }
 
     // Levels 1.. of the written texture, each from the one above: that level alone is
@@ -311,23 +404,6 @@ struct FrameExecutor::Impl {
         glBindSampler(0, 0);
     }
 
-    void bake(const Scene& scene, const Pass& pass) {
-        const std::string key = std::to_string(pass.ao_rays);
-        auto it = ao_streams.find(key);
-        if (it == ao_streams.end()) {
-            const std::vector<float> ao = ao_source(*scene.mesh, pass.ao_rays);
-            if (ao.size() != scene.mesh->vertex_count())
-                throw std::runtime_error(
-                    "ambient occlusion: expected one value per vertex");
-            it = ao_streams
-                     .emplace(key, make_buffer(ao.data(), static_cast<GLsizeiptr>(
-                                                              ao.size() * sizeof(float))))
-                     .first;
-        }
-        glVertexArrayVertexBuffer(mesh_vao.id(), 2, it->second.id(), 0, sizeof(float));
-        glEnableVertexArrayAttrib(mesh_vao.id(), 2);
-    }
-
     void draw(const Pass& pass, const FramePlan& plan) {
         // Attachments: the depth-format write becomes the depth attachment, the others
         // colour attachments in order.
@@ -347,7 +423,8 @@ struct FrameExecutor::Impl {
                 throw std::runtime_error("pass '" + pass.name + "': " + e.what());
             }
         }();
-        const GLuint prog = program(pass.shader);
+        const PassProgram& linked = pass_program(pass.shader);
+        const GLuint prog = linked.program.id();
         if (pass.clear) {
             for (std::size_t i = 0; i < colour.size(); ++i)
                 glClearNamedFramebufferfv(fbo.id(), GL_COLOR, static_cast<GLint>(i),
@@ -397,22 +474,25 @@ struct FrameExecutor::Impl {
             glDisable(GL_DEPTH_TEST);
         }
         glUseProgram(prog);
-        for (const auto& u : pass.uniforms) set_uniform(prog, u);
+        for (const auto& u : pass.uniforms) set_uniform(linked, pass, u);
         GLint unit = 0;
         for (const auto& read : pass.reads) {
             auto it = textures.find(read.resource);
-            if (it == textures.end()) continue;  // a vertex stream, bound by bake()
+            if (it == textures.end()) continue;  // a vertex stream: bind_streams()
             const std::string& sampler =
                 read.sampler.empty() ? read.resource : read.sampler;
             glBindTextureUnit(static_cast<GLuint>(unit), it->second.texture.id());
             glBindSampler(static_cast<GLuint>(unit), sampler_for(read.sampling));
-            const GLint location = glGetUniformLocation(prog, sampler.c_str());
+            const GLint location = uniform_location(linked, pass, sampler, "sampler");
             if (location >= 0) glProgramUniform1i(prog, location, unit);
             ++unit;
         }
         if (pass.kind == PassKind::draw_mesh) {
+            const std::vector<GLuint> bound = bind_streams(pass, linked);
             glBindVertexArray(mesh_vao.id());
             glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
+            for (GLuint location : bound)
+                glDisableVertexArrayAttrib(mesh_vao.id(), location);
         } else {
             glBindVertexArray(empty_vao.id());
             glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -436,10 +516,12 @@ FrameExecutor::FrameExecutor() : impl_(std::make_unique<Impl>()) {
 }
 FrameExecutor::~FrameExecutor() = default;
 
-void FrameExecutor::set_ambient_occlusion_source(AmbientOcclusionSource source) {
-    impl_->ao_source = std::move(source);
-    impl_->reuse.forget();  // the AO stream may differ now
-    impl_->ao_streams.clear();
+void FrameExecutor::set_upload_producer(UploadProducer producer) {
+    impl_->producer = std::move(producer);
+    // What was uploaded may differ from what the new producer gives: upload afresh.
+    impl_->reuse.forget();
+    for (auto& [name, texture] : impl_->textures) texture.uploaded_hash.clear();
+    for (auto& [name, stream] : impl_->streams) stream.uploaded_hash.clear();
 }
 
 void FrameExecutor::set_reuse_unchanged_passes(bool reuse) {
@@ -455,7 +537,6 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
     check_errors("upload of mesh '" + scene.mesh->name + "'");
     try {
         impl_->allocate(plan);
-        glDisableVertexArrayAttrib(impl_->mesh_vao.id(), 2);
         check_errors("allocation of the frame's textures");
     } catch (...) {
         impl_->reuse.forget();  // textures may have been dropped: trust none of them
@@ -481,10 +562,6 @@ void FrameExecutor::execute(const Scene& scene, const FramePlan& plan, bool time
             const bool gpu = runs && time_passes && gpu_timer && !cpu_pass(pass.kind);
             if (gpu) glBeginQuery(GL_TIME_ELAPSED, impl_->queries[index].id());
             switch (pass.kind) {
-                case PassKind::bake_ambient_occlusion:
-                    // The stream is cached; binding it is needed even when reused.
-                    impl_->bake(scene, pass);
-                    break;
                 case PassKind::upload:
                     if (runs) impl_->upload(pass);
                     break;
@@ -606,12 +683,8 @@ Image FrameExecutor::render(const Scene& scene, const FramePlan& plan) {
 std::vector<std::string> FrameExecutor::allocated_resources() const {
     std::vector<std::string> names;
     for (const auto& [name, texture] : impl_->textures) names.push_back(name);
-    if (glIsVertexArray(impl_->mesh_vao.id())) {
-        GLint enabled = 0;
-        glGetVertexArrayIndexediv(impl_->mesh_vao.id(), 2, GL_VERTEX_ATTRIB_ARRAY_ENABLED,
-                                  &enabled);
-        if (enabled) names.push_back("vertex_ao");
-    }
+    for (const auto& [name, stream] : impl_->streams) names.push_back(name);
+    std::sort(names.begin(), names.end());
     return names;
 }
 

@@ -1,10 +1,10 @@
 #pragma once
 // Runs a FramePlan with OpenGL: allocates exactly the resources the plan names (textures
-// of each resource's shape and levels, the AO vertex stream, CPU data), compiles each
-// pass's shader variant once, binds reads to samplers and writes to a framebuffer, and
-// draws. Optional per-pass GPU timer queries feed `lucent bench frame` and the explorer's
-// status bar. Needs a current GL 4.5 context; every GL object is owned by an RAII wrapper
-// held here.
+// of each resource's shape and levels, vertex streams), uploads CPU-made data through an
+// UploadProducer, compiles each pass's shader variant once, binds reads to samplers (and
+// streams to attributes) and writes to a framebuffer, and draws. Optional per-pass GPU
+// timer queries feed `lucent bench frame` and the explorer's status bar. Needs a current
+// GL 4.5 context; every GL object is owned by an RAII wrapper held here.
 #include <functional>
 #include <map>
 #include <memory>
@@ -30,13 +30,9 @@ struct FrameTimings {
     std::vector<PassTiming> passes;
     double total_milliseconds = 0.0;
     // True: GL_TIME_ELAPSED queries; false: wall time around glFinish (no timer queries).
-    // The AO pass is CPU work and always wall time.
+    // Upload passes are CPU work and always wall time.
     bool gpu_timer = false;
 };
-
-// Per-vertex AO for (mesh, rays). Defaults to load_or_bake_ambient_occlusion (disk
-// cache).
-using AmbientOcclusionSource = std::function<std::vector<float>(const Mesh&, int rays)>;
 
 class FrameExecutor {
 public:
@@ -45,7 +41,10 @@ public:
     FrameExecutor(const FrameExecutor&) = delete;
     FrameExecutor& operator=(const FrameExecutor&) = delete;
 
-    void set_ambient_occlusion_source(AmbientOcclusionSource source);
+    // Produces the data of every upload performed (core/frame_plan.h UploadProducer);
+    // the default calls the pass's producer. Forgets what was uploaded, so the next frame
+    // uploads through the new producer.
+    void set_upload_producer(UploadProducer producer);
     // On: a pass whose inputs (description, uniforms, versions of what it reads, upload
     // hash, mesh) are those of its last run, and whose outputs still hold that run's
     // results, is not run again (core/pass_reuse.h); last_timings() marks it cached. For
@@ -55,7 +54,9 @@ public:
     // Runs every pass of `plan` for `scene`. With `time_passes`, last_timings() holds
     // per-pass times afterwards (this waits for the GPU). Throws ShaderError, GlError
     // naming the pass whose GL calls failed (gl/errors.h; checked after every pass,
-    // upload and read-back) or std::runtime_error.
+    // upload and read-back), std::logic_error naming the pass and a uniform, sampler or
+    // vertex stream its shaders do not declare (declared but inactive in the variant is
+    // fine), or std::runtime_error.
     void execute(const Scene& scene, const FramePlan& plan, bool time_passes = false);
     // The plan's output after execute(), top row first.
     Image read_output(const FramePlan& plan) const;

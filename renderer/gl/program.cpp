@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <regex>
 #include <sstream>
 
 namespace lucent::embedded {
@@ -121,6 +122,55 @@ ShaderStage shader_stage(GLenum type, std::string_view relative_path,
         source.insert(at, block + "#line 2\n");
     }
     return ShaderStage{type, std::string(relative_path), std::move(source)};
+}
+
+namespace {
+
+// `source` with // and /* */ comments replaced by a space.
+std::string without_comments(std::string_view source) {
+    std::string out;
+    for (std::size_t i = 0; i < source.size();) {
+        if (source.compare(i, 2, "//") == 0) {
+            i = source.find('\n', i);
+            if (i == std::string_view::npos) break;
+        } else if (source.compare(i, 2, "/*") == 0) {
+            const std::size_t end = source.find("*/", i + 2);
+            if (end == std::string_view::npos) break;
+            out += ' ';
+            i = end + 2;
+        } else {
+            out += source[i++];
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+std::set<std::string> declared_uniforms(std::string_view source) {
+    static const std::regex declaration(R"(\buniform\b([^;{]*)(\{[^}]*\}[^;]*)?;)");
+    static const std::regex identifier(R"([A-Za-z_][A-Za-z0-9_]*)");
+    std::set<std::string> names;
+    const std::string text = without_comments(source);
+    for (std::sregex_iterator it(text.begin(), text.end(), declaration), end; it != end;
+         ++it) {
+        const std::string body = (*it)[0].str();
+        for (std::sregex_iterator id(body.begin(), body.end(), identifier); id != end;
+             ++id)
+            names.insert((*id)[0].str());
+    }
+    return names;
+}
+
+std::set<int> declared_input_locations(std::string_view source) {
+    static const std::regex declaration(
+        R"(\blayout\s*\(\s*location\s*=\s*([0-9]+)\s*\)\s*in\b)");
+    std::set<int> locations;
+    const std::string text = without_comments(source);
+    for (std::sregex_iterator it(text.begin(), text.end(), declaration), end; it != end;
+         ++it)
+        locations.insert(std::stoi((*it)[1].str()));
+    return locations;
 }
 
 }  // namespace lucent::gl

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "renderer/techniques/ambient_occlusion_pass.h"
+
 namespace lucent {
 
 void shade_deferred(PlanBuilder& plan, Pass& lighting, const std::vector<Uniform>& camera,
@@ -20,7 +22,7 @@ void shade_deferred(PlanBuilder& plan, Pass& lighting, const std::vector<Uniform
     surface.writes = {"surface_position", "surface_normal"};
     if (ambient_occlusion) {
         surface.shader.defines.push_back("WITH_AMBIENT");
-        surface.reads.push_back({"vertex_ao", ""});
+        surface.reads.push_back({kAmbientOcclusionStream, ""});
     }
     if (eye_normal) {
         surface.shader.defines.push_back("WITH_EYE_NORMAL");
@@ -36,7 +38,7 @@ void shade_deferred(PlanBuilder& plan, Pass& lighting, const std::vector<Uniform
     lighting.shader.defines.push_back("DEFERRED");
     if (eye_normal) lighting.shader.defines.push_back("WITH_EYE_NORMAL");
     std::erase_if(lighting.reads,
-                  [](const Read& r) { return r.resource == "vertex_ao"; });
+                  [](const Read& r) { return r.resource == kAmbientOcclusionStream; });
     lighting.reads.push_back({"surface_position", ""});
     lighting.reads.push_back({"surface_normal", ""});
     if (eye_normal) lighting.reads.push_back({"surface_normal_eye", ""});

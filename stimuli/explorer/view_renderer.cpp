@@ -94,41 +94,40 @@ std::vector<std::uint8_t> depth_for_display(const std::vector<float>& depth) {
     return out;
 }
 
-gl::FrameExecutor& ViewRenderer::executor(const std::string& key,
-                                          bool ambient_occlusion) {
-    const std::string full = key + (ambient_occlusion ? "" : "/no-ao");
+namespace {
+
+// Whether the explorer bakes `pass` (in the background) rather than showing a stand-in.
+bool baked(const Pass& pass, bool bakes) {
+    return is_bake(pass) && (bakes || !pass.data.stand_in);
+}
+
+}  // namespace
+
+gl::FrameExecutor& ViewRenderer::executor(const std::string& key, bool bakes) {
+    const std::string full = key + (bakes ? "" : "/stand-ins");
     auto& slot = executors_[full];
     if (!slot) {
         slot = std::make_unique<gl::FrameExecutor>();
         // A frame re-runs only the passes whose inputs a slider (or the view) changed.
         slot->set_reuse_unchanged_passes(true);
-        if (ambient_occlusion)
-            // Only executed once find_or_start() returned the bake (see execute()).
-            slot->set_ambient_occlusion_source([this](const Mesh& mesh, int rays) {
-                for (const auto& side : sides_)
-                    if (side.scene.mesh &&
-                        side.scene.mesh->content_hash == mesh.content_hash)
-                        if (const auto* ao = bakes_.find_or_start(side.scene.mesh, rays))
-                            return *ao;
-                throw std::runtime_error(
-                    "ambient occlusion requested before its bake finished");
-            });
-        else
-            slot->set_ambient_occlusion_source([](const Mesh& mesh, int) {
-                return std::vector<float>(mesh.vertex_count(), 1.f);
-            });
+        // Bakes come from the background (execute() runs a plan only once they are
+        // done), or are their stand-ins; other uploads are produced in line.
+        slot->set_upload_producer([this, bakes](const Pass& pass) {
+            if (!is_bake(pass)) return produce_upload(pass);
+            if (!baked(pass, bakes)) return pass.data.stand_in();
+            if (const TextureData* data = bakes_.find(pass.data.content_hash))
+                return *data;
+            throw std::runtime_error("pass '" + pass.name +
+                                     "' uploaded before its bake finished");
+        });
     }
     return *slot;
 }
 
 bool ViewRenderer::execute(gl::FrameExecutor& executor, const Scene& scene,
-                           const FramePlan& plan, bool ambient_occlusion,
-                           bool time_passes) {
-    if (ambient_occlusion)
-        for (const Pass& pass : plan.passes)
-            if (pass.kind == PassKind::bake_ambient_occlusion &&
-                !bakes_.find_or_start(scene.mesh, pass.ao_rays))
-                return false;
+                           const FramePlan& plan, bool bakes, bool time_passes) {
+    for (const Pass& pass : plan.passes)
+        if (baked(pass, bakes) && !bakes_.find_or_start(pass)) return false;
     executor.execute(scene, plan, time_passes);
     return true;
 }
@@ -168,10 +167,11 @@ void ViewRenderer::render_side(const ExplorerSession& session,
     FramePlan plan = make_frame_plan(
         scene, technique, PlanMode::pruned,
         viewed.empty() ? std::vector<std::string>{} : std::vector<std::string>{viewed});
-    // The scene is published first: the AO source looks the mesh up through it.
+    // A frame that waits for a bake keeps showing the last complete one.
     const Scene previous = std::move(side.scene);
     side.scene = scene;
     const std::string key = "side" + std::to_string(index);
+    // The AO checkbox: off previews the stand-ins of bakes (the AO's: every vertex open).
     gl::FrameExecutor& shading = executor(key, session.ambient_occlusion);
     if (!execute(shading, scene, plan, session.ambient_occlusion,
                  session.show_pass_times)) {

@@ -15,14 +15,14 @@
 #include "renderer/core/scene.h"
 #include "renderer/gl/frame_executor.h"
 #include "renderer/gl/objects.h"
-#include "stimuli/explorer/ao_bakes.h"
+#include "stimuli/explorer/background_bakes.h"
 #include "stimuli/explorer/session.h"
 
 namespace lucent::explorer {
 
 // One parameter set's latest frame.
 struct RenderedSide {
-    bool valid = false;  // false until the first frame (e.g. while AO bakes)
+    bool valid = false;  // false until the first frame (e.g. while the AO bakes)
     Scene scene;         // its camera places overlays
     FramePlan plan;
     Image image;               // linear float, as `lucent render` writes it
@@ -44,30 +44,32 @@ class ViewRenderer {
 public:
     ViewRenderer() = default;
     // Renders the shown sets at width x height pixels in all (side by side: half each).
-    // A set whose AO is still baking keeps its previous frame.
+    // A set whose bakes (the AO) are still running keeps its previous frame; with
+    // session.ambient_occlusion off, bakes that have a stand-in show it instead.
     void render(const ExplorerSession& session, const std::shared_ptr<const Mesh>& mesh,
                 int width, int height);
     // The sets shown, in screen order (one, or A then B).
     const std::vector<int>& shown() const { return shown_; }
     const RenderedSide& side(int index) const { return sides_[index]; }
-    AmbientOcclusionBakes& bakes() { return bakes_; }
+    BackgroundBakes& bakes() { return bakes_; }
     // Why the buffer view shows nothing (the buffer is not in the plan), else "".
     const std::string& buffer_message() const { return buffer_message_; }
     // Drops every executor: shaders compile again (read from LUCENT_SHADER_DIR when it
-    // is set) and AO streams are fetched again from the bakes.
+    // is set) and baked data is uploaded again from the bakes.
     void drop_executors() { executors_.clear(); }
 
 private:
-    gl::FrameExecutor& executor(const std::string& key, bool ambient_occlusion);
-    // Executes `scene`; false when its AO is still baking.
+    // `bakes` false: the executor uploads the stand-ins of bakes that have one.
+    gl::FrameExecutor& executor(const std::string& key, bool bakes);
+    // Executes `scene`; false when a bake it uploads is still running.
     bool execute(gl::FrameExecutor& executor, const Scene& scene, const FramePlan& plan,
-                 bool ambient_occlusion, bool time_passes);
+                 bool bakes, bool time_passes);
     void render_side(const ExplorerSession& session,
                      const std::shared_ptr<const Mesh>& mesh, int index, int width,
                      int height);
 
     std::map<std::string, std::unique_ptr<gl::FrameExecutor>> executors_;
-    AmbientOcclusionBakes bakes_;
+    BackgroundBakes bakes_;
     RenderedSide sides_[2];
     std::vector<int> shown_;
     std::string buffer_message_;

@@ -20,6 +20,7 @@
 #include <mutex>
 
 #include "renderer/core/light_view.h"
+#include "renderer/techniques/ambient_occlusion_pass.h"
 #include "renderer/techniques/deferred_surface.h"
 #include "renderer/techniques/dipole/atlas.h"
 #include "renderer/techniques/dipole/dipole.h"
@@ -128,7 +129,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     while (side * side < p.samples) ++side;
     const RingPattern pattern = make_ring_pattern(dipole, split, p.rings, p.ring_samples);
 
-    plan.create("vertex_ao", ResourceFormat::vertex_float);
+    // Ambient occlusion for the ambient term (as the other techniques).
+    add_ambient_occlusion(plan, scene, p.ao_rays, "bake (or load cached) per-vertex AO");
     plan.create(texture_2d("atlas_position", ResourceFormat::rgba32f, atlas, atlas));
     plan.create(texture_2d("atlas_normal", ResourceFormat::rgba32f, atlas, atlas));
     plan.create(
@@ -143,13 +145,6 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     plan.create("colour", ResourceFormat::rgba32f);
     plan.create("shade_depth", ResourceFormat::depth32f);
 
-    // Ambient occlusion for the ambient term (as the other techniques).
-    Pass ao{"ambient_occlusion", "bake (or load cached) per-vertex AO",
-            PassKind::bake_ambient_occlusion};
-    ao.writes = {"vertex_ao"};
-    ao.ao_rays = p.ao_rays;
-    plan.add(ao);
-
     if (subsurface) {
         // Stage 0 (Sec. 3, our atlas): the surfel atlas, uploaded when the mesh, the
         // model size or the resolution changes.
@@ -163,14 +158,14 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                        "surfel atlas: equal-area texels, xyz mm and area mm^2",
                        PassKind::upload};
         positions.writes = {"atlas_position"};
-        positions.data = {atlas_hash + "-p", [lazy, atlas] {
+        positions.data = {atlas_hash + "-p", [lazy, atlas](const ProduceOptions&) {
                               return texels_of(lazy->get().position_area, atlas, atlas);
                           }};
         plan.add(positions);
         Pass normals{"atlas_normals", "surfel atlas: interpolated normals",
                      PassKind::upload};
         normals.writes = {"atlas_normal"};
-        normals.data = {atlas_hash + "-n", [lazy, atlas] {
+        normals.data = {atlas_hash + "-n", [lazy, atlas](const ProduceOptions&) {
                             return texels_of(lazy->get().normal, atlas, atlas);
                         }};
         plan.add(normals);
@@ -257,7 +252,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                       PassKind::upload};
             ring.writes = {"ring_pattern"};
             const int count = int(pattern.offset.size());
-            ring.data = {hash, [texels, count] {
+            ring.data = {hash, [texels, count](const ProduceOptions&) {
                              TextureData data;
                              data.size = {count, 1, 1};
                              data.levels = {texels};
@@ -314,7 +309,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     }
     if (ambient) {
         shade.shader.defines.push_back("WITH_AMBIENT");
-        shade.reads.push_back({"vertex_ao", ""});
+        shade.reads.push_back({kAmbientOcclusionStream, ""});
         const glm::dvec3 colour = p.ambient * glm::dvec3(scene.light.ambient) *
                                   mean_fresnel_transmittance(material.eta) *
                                   dipole.total_reflectance();

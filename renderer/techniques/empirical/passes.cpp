@@ -9,6 +9,7 @@
 // Terms that cannot change the image select a shader variant without them, and the
 // passes that only fed them are culled by PlanBuilder::compile().
 
+#include "renderer/techniques/ambient_occlusion_pass.h"
 #include "renderer/techniques/empirical/empirical.h"
 
 namespace lucent::empirical {
@@ -56,20 +57,15 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                           shading == SurfaceShading::deferred &&
                           p.depth_precision == "32f";
 
-    plan.create("vertex_ao", ResourceFormat::vertex_float);
+    // Step 0 (Sec. 3.1, Eq. 3.5): per-vertex AO; culled unless the ambient term reads it.
+    add_ambient_occlusion(plan, scene, p.ao_rays,
+                          "bake (or load cached) per-vertex AO, Eq. 3.5");
     // By facing, the first layer is `shade`'s own depth buffer (exact floats).
     plan.create("front_depth", by_facing ? ResourceFormat::depth32f : depth);
     plan.create("second_depth", depth);
     plan.create("smoothed_depth", ResourceFormat::r32f);
     plan.create("colour", ResourceFormat::rgba32f);
     plan.create("shade_depth", ResourceFormat::depth32f);
-
-    // Step 0 (Sec. 3.1, Eq. 3.5): per-vertex AO; culled unless the ambient term reads it.
-    Pass ao{"ambient_occlusion", "bake (or load cached) per-vertex AO, Eq. 3.5",
-            PassKind::bake_ambient_occlusion};
-    ao.writes = {"vertex_ao"};
-    ao.ao_rays = p.ao_rays;
-    plan.add(ao);
 
     if (!by_facing) {
         // Step 1 (Sec. 3.1): depth of the nearest surface, read by the peel (and,
@@ -85,7 +81,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
             front.writes = {"front_surface", "front_depth"};
             if (ambient_term) {
                 front.shader.defines.push_back("WITH_AMBIENT_OCCLUSION");
-                front.reads.push_back({"vertex_ao", ""});
+                front.reads.push_back({kAmbientOcclusionStream, ""});
             }
         }
         plan.add(front);
@@ -167,7 +163,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     };
     if (ambient_term) {
         shade.shader.defines.push_back("WITH_AMBIENT_OCCLUSION");
-        if (!deferred) shade.reads.push_back({"vertex_ao", ""});
+        if (!deferred) shade.reads.push_back({kAmbientOcclusionStream, ""});
         u.push_back({"u_ambient", static_cast<float>(p.ambient)});
         u.push_back({"u_light_ambient", light_ambient});
     }

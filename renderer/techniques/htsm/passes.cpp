@@ -66,7 +66,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                     PassKind::upload};
         volume.writes = {"htsm_density"};
         const auto density = scene.density;
-        volume.data = {"density-" + density->content_hash, [density] {
+        volume.data = {"density-" + density->content_hash,
+                       [density](const ProduceOptions&) {
                            TextureData data;
                            data.size = density->size;
                            data.levels = {density->voxels};
@@ -82,7 +83,8 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                             std::to_string(nf) + " entries (Sec. 4.3.4)",
                         PassKind::upload};
         phase_pass.writes = {"htsm_phase"};
-        phase_pass.data = {"hg-" + number(gg) + "-" + std::to_string(nf), [gg, nf] {
+        phase_pass.data = {"hg-" + number(gg) + "-" + std::to_string(nf),
+                           [gg, nf](const ProduceOptions&) {
                                TextureData data;
                                data.size = {nf, 1, 1};
                                std::vector<float> texels(nf);

@@ -106,7 +106,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan) {
         Pass pass{name, purpose, PassKind::upload};
         pass.writes = {name};
         pass.data = {hash + "|" + name + "|k" + std::to_string(bins),
-                     [lazy, texel] { return pyramid_texels(lazy->get(), texel); }};
+                     [lazy, texel](const ProduceOptions&) {
+                         return pyramid_texels(lazy->get(), texel);
+                     }};
         plan.add(pass);
     };
     upload("albedo",

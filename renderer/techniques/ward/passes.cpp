@@ -4,6 +4,7 @@
 // A zero diffuse weight or zero specular reflectance compiles that term out of the
 // shader; no AO term culls the bake.
 
+#include "renderer/techniques/ambient_occlusion_pass.h"
 #include "renderer/techniques/ward/ward.h"
 
 namespace lucent::ward {
@@ -15,17 +16,11 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
         plan.full() || (p.diffuse != 0.0 && scene.light.diffuse != glm::vec3(0.0f));
     const bool specular_term = plan.full() || has_specular_term(p, scene.light);
 
-    plan.create("vertex_ao", ResourceFormat::vertex_float);
+    // Per-vertex AO for the ambient term; culled when the shader does not read it.
+    add_ambient_occlusion(plan, scene, p.ao_rays,
+                          "bake (or load cached) per-vertex AO for the ambient term");
     plan.create("colour", ResourceFormat::rgba32f);
     plan.create("shade_depth", ResourceFormat::depth32f);
-
-    // Per-vertex AO for the ambient term; culled when the shader does not read it.
-    Pass ao{"ambient_occlusion",
-            "bake (or load cached) per-vertex AO for the ambient term",
-            PassKind::bake_ambient_occlusion};
-    ao.writes = {"vertex_ao"};
-    ao.ao_rays = p.ao_rays;
-    plan.add(ao);
 
     const glm::mat4 view = scene.camera.view();
     Pass shade{
@@ -42,7 +37,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
                        {"u_light_direction", scene.light.direction}});
     if (ambient_term) {
         shade.shader.defines.push_back("WITH_AMBIENT_OCCLUSION");
-        shade.reads.push_back({"vertex_ao", ""});
+        shade.reads.push_back({kAmbientOcclusionStream, ""});
         shade.uniforms.push_back({"u_ambient", static_cast<float>(p.ambient)});
         shade.uniforms.push_back({"u_light_ambient", scene.light.ambient});
     }

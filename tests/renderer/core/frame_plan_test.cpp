@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 
 #include "renderer/core/recording_executor.h"
 #include "renderer/core/technique.h"
@@ -271,22 +272,40 @@ TEST(PlanBuilder, CullsUnreadPassesTransitivelyAndNeverVisitsThem) {
     EXPECT_EQ(pass_names(full.compile()).size(), 4u);
 }
 
+// Names are checked where they are declared: add() rejects the pass (one line naming it
+// and the name), so such a plan never compiles either.
 TEST(PlanBuilder, RejectsReadsBeforeWritesAndUndeclaredResources) {
+    const auto message = [](const std::function<void()>& f) -> std::string {
+        try {
+            f();
+        } catch (const std::logic_error& e) {
+            return e.what();
+        }
+        return "(accepted)";
+    };
     PlanBuilder builder(PlanMode::pruned, 8, 8);
     builder.create("out", ResourceFormat::rgba32f);
+    builder.create("unwritten", ResourceFormat::r32f);
     Pass reader{"reader"};
     reader.reads = {{"missing", ""}};
     reader.writes = {"out"};
-    builder.add(reader);
+    EXPECT_EQ(message([&] { builder.add(reader); }),
+              "frame plan: pass 'reader' reads 'missing', which no create() declared");
+    reader.reads = {{"unwritten", ""}};
+    EXPECT_EQ(message([&] { builder.add(reader); }),
+              "frame plan: pass 'reader' reads 'unwritten' before any pass writes it");
     builder.set_output("out");
     EXPECT_THROW(builder.compile(), std::logic_error);
 
     PlanBuilder undeclared(PlanMode::pruned, 8, 8);
     Pass writer{"writer"};
     writer.writes = {"nowhere"};
-    undeclared.add(writer);
+    EXPECT_EQ(message([&] { undeclared.add(writer); }),
+              "frame plan: pass 'writer' writes undeclared 'nowhere'");
     undeclared.set_output("nowhere");
     EXPECT_THROW(undeclared.compile(), std::logic_error);
+    undeclared.create("nowhere", ResourceFormat::r32f);
+    undeclared.add(writer);
     EXPECT_THROW(undeclared.add(writer), std::logic_error);  // duplicate pass name
 }
 
@@ -302,7 +321,7 @@ Pass pass_writing(std::string name, std::vector<std::string> writes,
 }
 
 DataSource constant_data(std::string hash, glm::ivec3 size, int channels) {
-    return {std::move(hash), [size, channels] {
+    return {std::move(hash), [size, channels](const ProduceOptions&) {
                 return TextureData{
                     size,
                     {std::vector<float>(std::size_t(size.x) * size.y * size.z * channels,
@@ -400,7 +419,7 @@ TEST(PlanBuilder, RejectsMalformedUploadsMipsLevelsAndFeedback) {
     Pass no_hash{"table"};
     no_hash.kind = PassKind::upload;
     no_hash.writes = {"out"};
-    no_hash.data.produce = [] { return TextureData{}; };
+    no_hash.data.produce = [](const ProduceOptions&) { return TextureData{}; };
     EXPECT_THROW(compile_with({out}, {no_hash}, "out"), std::logic_error);
     Pass one_level_mips{"mips"};
     one_level_mips.kind = PassKind::build_mips;
@@ -473,7 +492,7 @@ TEST(PlanBuilder, NewPassKindsAreCulledWhenUnreadAndKeptInFullMode) {
         builder.create(frame_texture("out", ResourceFormat::rgba32f));
         Pass table{"unused_table", "", PassKind::upload};
         table.writes = {"unused_table"};
-        table.data = {"h", [&produced] {
+        table.data = {"h", [&produced](const ProduceOptions&) {
                           ++produced;
                           return TextureData{{4, 1, 1}, {std::vector<float>(4, 0.5f)}};
                       }};
@@ -504,6 +523,87 @@ TEST(PlanBuilder, NewPassKindsAreCulledWhenUnreadAndKeptInFullMode) {
     EXPECT_NE(full.explain().find("resource unused_mips: 8x8 r32f, 4 levels"),
               std::string::npos)
         << full.explain();
+}
+
+// A vertex stream is described once (format, vertex count, attribute), filled by an
+// ordinary upload (here a bake, as the AO) and read by mesh passes only; executors hand
+// every upload they perform to the UploadProducer, which sees what it is only through
+// its DataSource.
+TEST(PlanBuilder, VertexStreamsAreUploadedResourcesReadByMeshPasses) {
+    const auto message = [](const std::function<void()>& f) -> std::string {
+        try {
+            f();
+        } catch (const std::logic_error& e) {
+            return e.what();
+        }
+        return "(accepted)";
+    };
+    int produced = 0;
+    const auto build = [&](ResourceDesc stream, PassKind reader, std::string hash) {
+        PlanBuilder builder(PlanMode::pruned, 8, 8);
+        builder.create(stream);
+        builder.create(frame_texture("out", ResourceFormat::rgba32f));
+        Pass upload{"per_vertex", "", PassKind::upload};
+        upload.writes = {stream.name};
+        upload.data.content_hash = std::move(hash);
+        upload.data.cost = ProductionCost::bake;
+        upload.data.produce = [&produced](const ProduceOptions&) {
+            ++produced;
+            return TextureData{{5, 1, 1}, {std::vector<float>(10, 0.5f)}};
+        };
+        builder.add(upload);
+        Pass draw = pass_writing("draw", {"out"}, {{stream.name, ""}});
+        draw.kind = reader;
+        builder.add(draw);
+        builder.set_output("out");
+        return builder.compile();
+    };
+    const ResourceDesc stream = vertex_stream("pairs", ResourceFormat::rg32f, 5, 6);
+    const FramePlan plan = build(stream, PassKind::draw_mesh, "h1");
+    EXPECT_EQ(pass_names(plan), (std::vector<std::string>{"per_vertex", "draw"}));
+    EXPECT_TRUE(is_bake(plan.passes[0]));
+    EXPECT_FALSE(is_bake(plan.passes[1]));
+    EXPECT_NE(plan.explain().find("resource pairs: 5 vertices x rg32f at attribute 6"),
+              std::string::npos)
+        << plan.explain();
+
+    RecordingExecutor recorder;
+    std::vector<std::string> seen;
+    recorder.set_upload_producer([&](const Pass& pass) {
+        seen.push_back(pass.name + " " + pass.data.content_hash);
+        return produce_upload(pass);
+    });
+    recorder.execute(plan);
+    recorder.execute(plan);  // the same hash: nothing produced
+    recorder.execute(build(stream, PassKind::draw_mesh, "h2"));
+    EXPECT_EQ(seen, (std::vector<std::string>{"per_vertex h1", "per_vertex h2"}));
+    EXPECT_EQ(produced, 2);
+    // Another mesh (key) with the same data re-runs the stream's upload, as mesh passes.
+    EXPECT_EQ(recorder.execute(build(stream, PassKind::draw_mesh, "h2"), "another"),
+              (std::vector<std::string>{"per_vertex", "draw"}));
+
+    EXPECT_EQ(
+        message([&] { build(stream, PassKind::fullscreen, "h"); }),
+        "frame plan: pass 'draw' reads the vertex stream 'pairs' but draws no mesh");
+    EXPECT_EQ(message([&] {
+                  build(vertex_stream("pairs", ResourceFormat::rg32f, 5, 1),
+                        PassKind::draw_mesh, "h");
+              }),
+              "frame plan: resource 'pairs': attribute 1 is not a free vertex attribute "
+              "location");
+    EXPECT_EQ(message([&] {
+                  build(vertex_stream("pairs", ResourceFormat::rgba8, 5, 2),
+                        PassKind::draw_mesh, "h");
+              }),
+              "frame plan: resource 'pairs': a vertex stream is r32f, rg32f or rgba32f, "
+              "not rgba8");
+    PlanBuilder drawn_into(PlanMode::pruned, 8, 8);
+    drawn_into.create(stream);
+    drawn_into.add(pass_writing("draw", {"pairs"}));
+    drawn_into.set_output("pairs");
+    EXPECT_EQ(message([&] { drawn_into.compile(); }),
+              "frame plan: pass 'draw' draws into the vertex stream 'pairs'; streams are "
+              "uploaded");
 }
 
 TEST(TextureData, ChecksSizeLevelsAndTexelCounts) {

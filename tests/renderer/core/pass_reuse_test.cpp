@@ -33,7 +33,7 @@ struct SyntheticPlan {
         Pass table{"table", "", PassKind::upload};
         table.writes = {"table"};
         int* counter = produced;
-        table.data = {table_hash, [counter] {
+        table.data = {table_hash, [counter](const ProduceOptions&) {
                           if (counter) ++*counter;
                           return TextureData{{4, 1, 1}, {std::vector<float>(4, 1.0f)}};
                       }};

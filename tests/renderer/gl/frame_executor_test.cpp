@@ -53,7 +53,8 @@ Pass upload_pass(std::string name, std::string resource, std::string hash,
     Pass pass{std::move(name)};
     pass.kind = PassKind::upload;
     pass.writes = {std::move(resource)};
-    pass.data = {std::move(hash), [data = std::move(data)] { return data; }};
+    pass.data = {std::move(hash),
+                 [data = std::move(data)](const ProduceOptions&) { return data; }};
     return pass;
 }
 
@@ -133,7 +134,7 @@ TEST_F(FrameExecutorGl, UploadsOnlyWhenTheContentHashChanges) {
         Pass pass{"table"};
         pass.kind = PassKind::upload;
         pass.writes = {"table"};
-        pass.data = {hash, [&produced, width, value] {
+        pass.data = {hash, [&produced, width, value](const ProduceOptions&) {
                          ++produced;
                          return TextureData{
                              {width, 1, 1},
@@ -309,6 +310,135 @@ TEST_F(FrameExecutorGl, CompositingPassesBlendOntoKeptContents) {
     const glm::vec4 half_dst{0.1f, 0.2f, 0.3f, 0.5f}, near_src{0.4f, 0.4f, 0.4f, 0.8f};
     expect_vec4(composite(half_dst, near_src, Blend::premultiplied_under),
                 0.5f * near_src + half_dst);
+}
+
+// One triangle whose positions are clip coordinates covering the whole viewport.
+Scene clip_triangle_scene() {
+    auto triangle = std::make_shared<Mesh>();
+    triangle->name = "clip-space triangle";
+    triangle->positions = {
+        {-1.0f, -1.0f, 0.0f}, {3.0f, -1.0f, 0.0f}, {-1.0f, 3.0f, 0.0f}};
+    triangle->normals.assign(3, glm::vec3(0.0f, 0.0f, 1.0f));
+    triangle->triangles = {{0u, 1u, 2u}};
+    triangle->content_hash = "triangle";
+    Scene scene;
+    scene.mesh = triangle;
+    return scene;
+}
+
+// A vertex stream is a CPU-made resource like any texture: uploaded by an `upload` pass
+// (through the executor's UploadProducer, once per content hash) and bound at its
+// attribute by the mesh passes that read it.
+TEST_F(FrameExecutorGl, VertexStreamsAreUploadedAndBoundAtTheirAttribute) {
+    const Scene scene = clip_triangle_scene();
+    const auto plan_with = [](std::string hash, float value, float scale) {
+        PlanBuilder builder(PlanMode::pruned, 4, 4);
+        builder.create(vertex_stream("values", ResourceFormat::r32f, 3, 2));
+        builder.create(texture_2d("out", ResourceFormat::rgba32f, 2, 2));
+        Pass upload{"values", "", PassKind::upload};
+        upload.writes = {"values"};
+        upload.data = {hash, [value](const ProduceOptions&) {
+                           return TextureData{{3, 1, 1}, {std::vector<float>(3, value)}};
+                       }};
+        builder.add(upload);
+        Pass draw{"draw",
+                  "",
+                  PassKind::draw_mesh,
+                  {"test_shaders/stream.vert", "test_shaders/stream.frag", {}}};
+        draw.reads = {{"values", ""}};
+        draw.writes = {"out"};
+        draw.uniforms = {{"u_scale", scale}};
+        builder.add(draw);
+        builder.set_output("out");
+        return builder.compile();
+    };
+    gl::FrameExecutor executor;
+    std::vector<std::string> produced;
+    executor.set_upload_producer([&](const Pass& pass) {
+        produced.push_back(pass.data.content_hash);
+        return produce_upload(pass);
+    });
+    const auto red = [&] {  // of every texel of `out`
+        const std::vector<float> texels = executor.read_texture("out").levels[0];
+        std::vector<float> r;
+        for (std::size_t i = 0; i < texels.size(); i += 4) r.push_back(texels[i]);
+        return r;
+    };
+    executor.execute(scene, plan_with("a", 0.25f, 2.0f));
+    EXPECT_EQ(red(), std::vector<float>(4, 0.5f));
+    executor.execute(scene, plan_with("a", 0.25f, 4.0f));  // same data: no upload
+    EXPECT_EQ(red(), std::vector<float>(4, 1.0f));
+    executor.execute(scene, plan_with("b", 0.125f, 4.0f));
+    EXPECT_EQ(red(), std::vector<float>(4, 0.5f));
+    EXPECT_EQ(produced, (std::vector<std::string>{"a", "b"}));
+    EXPECT_EQ(executor.uploads_performed(), 2u);
+    EXPECT_EQ(executor.allocated_resources(),
+              (std::vector<std::string>{"out", "values"}));
+}
+
+// A uniform, sampler or vertex stream whose name the pass's shaders do not declare fails
+// the pass in one line naming both; one they declare but this variant compiles out (or
+// the compiler optimises away) is fine.
+TEST_F(FrameExecutorGl, NamesTheShadersLackFailThePass) {
+    const Scene scene = clip_triangle_scene();
+    const auto failure = [&](const FramePlan& plan) -> std::string {
+        gl::FrameExecutor executor;
+        try {
+            executor.execute(scene, plan);
+        } catch (const std::logic_error& e) {
+            return e.what();
+        }
+        return "(ran)";
+    };
+    const auto draw_plan = [](std::vector<Uniform> uniforms,
+                              std::vector<std::string> defines, int attribute) {
+        PlanBuilder builder(PlanMode::pruned, 4, 4);
+        builder.create(vertex_stream("values", ResourceFormat::r32f, 3, attribute));
+        builder.create(texture_2d("out", ResourceFormat::rgba32f, 2, 2));
+        Pass upload{"values", "", PassKind::upload};
+        upload.writes = {"values"};
+        upload.data = {"v", [](const ProduceOptions&) {
+                           return TextureData{{3, 1, 1}, {std::vector<float>(3, 1.0f)}};
+                       }};
+        builder.add(upload);
+        Pass draw{"draw",
+                  "",
+                  PassKind::draw_mesh,
+                  {"test_shaders/stream.vert", "test_shaders/stream.frag", defines}};
+        draw.reads = {{"values", ""}};
+        draw.writes = {"out"};
+        draw.uniforms = std::move(uniforms);
+        builder.add(draw);
+        builder.set_output("out");
+        return builder.compile();
+    };
+    EXPECT_EQ(failure(draw_plan({{"u_scale", 1.0f}}, {}, 2)), "(ran)");
+    EXPECT_EQ(failure(draw_plan({{"u_scael", 1.0f}}, {}, 2)),
+              "pass 'draw': uniform 'u_scael' is not declared in "
+              "test_shaders/stream.vert + test_shaders/stream.frag");
+    // u_offset is declared, in the variant without WITH_OFFSET compiled out.
+    EXPECT_EQ(failure(draw_plan({{"u_scale", 1.0f}, {"u_offset", 0.5f}}, {}, 2)),
+              "(ran)");
+    EXPECT_EQ(
+        failure(draw_plan({{"u_scale", 1.0f}, {"u_offset", 0.5f}}, {"WITH_OFFSET"}, 2)),
+        "(ran)");
+    EXPECT_EQ(failure(draw_plan({{"u_scale", 1.0f}}, {}, 5)),
+              "pass 'draw': vertex stream 'values' is bound at attribute 5, which "
+              "test_shaders/stream.vert does not declare");
+
+    PlanBuilder sampled(PlanMode::pruned, 4, 4);
+    sampled.create(texture_2d("pair", ResourceFormat::r32f, 2, 1));
+    sampled.create(texture_2d("out", ResourceFormat::rgba32f, 1, 1));
+    sampled.add(upload_pass("data", "pair", "fixed", {{2, 1, 1}, {{0.0f, 1.0f}}}));
+    Pass read = fullscreen("read", "test_shaders/sample.frag", {"out"});
+    read.reads = {{"pair", "sorce"}};
+    read.uniforms = {
+        {"origin", glm::vec3(0.0f)}, {"step", glm::vec3(0.0f)}, {"lod", 0.0f}};
+    sampled.add(read);
+    sampled.set_output("out");
+    EXPECT_EQ(failure(sampled.compile()),
+              "pass 'read': sampler 'sorce' is not declared in "
+              "gl/shaders/fullscreen.vert + test_shaders/sample.frag");
 }
 
 // Reuse on: a second identical frame runs no pass, a changed uniform re-runs its pass
