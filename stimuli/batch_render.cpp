@@ -22,6 +22,7 @@
 #include <optional>
 #include <thread>
 
+#include "common/content_hash.h"
 #include "lucent/version.h"
 #include "renderer/core/density_volume.h"
 #include "renderer/core/mesh.h"
@@ -102,9 +103,9 @@ ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mes
 
 std::string files_hash(const std::filesystem::path& dir, const StimulusSet& set,
                        const Stimulus& s) {
-    Hasher hasher;
+    common::ContentHash hasher;
     for (const auto format : set.formats)
-        hasher.add_field(hash_file(dir / file_of(s, format)));
+        hasher.field(common::hash_file(dir / file_of(s, format)));
     return hasher.hex();
 }
 
@@ -207,16 +208,16 @@ private:
 
 std::string input_hash(const StimulusSet& set, const Stimulus& stimulus,
                        const std::string& mesh_hash) {
-    Hasher hasher;
-    hasher.add_field(version_string()).add_field(build_hash());
-    hasher.add_field(stimulus.technique).add_field(mesh_hash);
-    hasher.add_field(std::to_string(set.width)).add_field(std::to_string(set.height));
-    for (const auto format : set.formats) hasher.add_field(extension(format));
+    common::ContentHash hasher;
+    hasher.field(version_string()).field(build_hash());
+    hasher.field(stimulus.technique).field(mesh_hash);
+    hasher.field(std::to_string(set.width)).field(std::to_string(set.height));
+    for (const auto format : set.formats) hasher.field(extension(format));
     for (const auto& [name, value] : stimulus.parameters.all())
-        hasher.add_field(name).add_field(format_knob_value(value));
+        hasher.field(name).field(format_knob_value(value));
     // A density file can change under the same spec: its content decides.
     if (const auto density = density_from_knobs(stimulus.parameters))
-        hasher.add_field("density_hash").add_field(density->content_hash);
+        hasher.field("density_hash").field(density->content_hash);
     return hasher.hex();
 }
 

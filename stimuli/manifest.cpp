@@ -65,35 +65,6 @@ void write_atomically(const std::filesystem::path& path, const std::string& text
 
 }  // namespace
 
-Hasher& Hasher::add(std::string_view bytes) {
-    for (unsigned char byte : bytes) {
-        state_ ^= byte;
-        state_ *= 0x100000001b3ull;
-    }
-    return *this;
-}
-
-Hasher& Hasher::add_field(std::string_view text) {
-    add(std::to_string(text.size()) + ":");
-    return add(text);
-}
-
-std::string Hasher::hex() const {
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(state_));
-    return text;
-}
-
-std::string hash_file(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path.string() + ": cannot read");
-    Hasher hasher;
-    char buffer[1 << 16];
-    while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
-        hasher.add(std::string_view(buffer, std::size_t(in.gcount())));
-    return hasher.hex();
-}
-
 std::vector<ManifestField> statistics_fields(const ImageStatistics& stats) {
     std::vector<ManifestField> fields = {
         {"object_pixels", std::to_string(stats.object_pixels), true},

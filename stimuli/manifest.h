@@ -3,7 +3,6 @@
 // stimulus (id, file, technique, every parameter value, mesh hash, image statistics,
 // software version, input and content hashes). The CSV is also read back so a second
 // run can skip stimuli whose inputs did not change.
-#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <span>
@@ -14,21 +13,6 @@
 #include "stimuli/image_statistics.h"
 
 namespace lucent::stimuli {
-
-// 64-bit FNV-1a, as 16 hex digits: detects changed inputs and files (not cryptographic).
-class Hasher {
-public:
-    Hasher& add(std::string_view bytes);
-    Hasher& add_field(
-        std::string_view text);  // length-prefixed, so fields never run together
-    std::uint64_t value() const { return state_; }
-    std::string hex() const;
-
-private:
-    std::uint64_t state_ = 0xcbf29ce484222325ull;
-};
-// Hash of a file's bytes; throws std::runtime_error naming the file when unreadable.
-std::string hash_file(const std::filesystem::path& path);
 
 // One manifest cell; numbers are written bare in JSON, text quoted, empty cells as null.
 struct ManifestField {

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "analysis/data/decimal.h"
+#include "common/content_hash.h"
 
 namespace lucent::analysis {
 namespace {
@@ -177,7 +178,7 @@ public:
     Label operator()(std::string_view text) {
         if (has_previous_ && text == previous_.str()) return previous_;
         if (4 * (used_ + 1) > 3 * slots_.size()) grow();
-        const std::uint64_t hash = fnv1a(text);
+        const std::uint64_t hash = common::fnv1a_64(text);
         std::size_t at = hash & (slots_.size() - 1);
         while (slots_[at].used && !(slots_[at].hash == hash && slots_[at].label == text))
             at = (at + 1) & (slots_.size() - 1);
@@ -196,12 +197,6 @@ private:
         Label label;
         bool used = false;
     };
-    static std::uint64_t fnv1a(std::string_view text) {
-        std::uint64_t hash = 0xcbf29ce484222325ULL;
-        for (const char c : text)
-            hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
-        return hash;
-    }
     void grow() {
         std::vector<Slot> old(std::max<std::size_t>(64, 2 * slots_.size()));
         old.swap(slots_);

@@ -21,6 +21,7 @@
 #include "analysis/report/html_page.h"
 #include "analysis/report/report.h"
 #include "analysis/report/svg_plot.h"
+#include "common/content_hash.h"
 #include "common/output_file.h"
 #include "renderer/core/image.h"
 #include "renderer/core/progress.h"
@@ -140,10 +141,10 @@ std::vector<fs::path> checked_files(const fs::path& directory,
     if (files.empty())
         fail(manifest + ": stimulus '" + cell(row, "id") + "' lists no files");
     // The content hash as the batch renderer computes it: each file's hash as a field.
-    Hasher hasher;
+    common::ContentHash hasher;
     for (const auto& path : files) {
         try {
-            hasher.add_field(hash_file(path));
+            hasher.field(common::hash_file(path));
         } catch (const std::runtime_error& e) {
             fail(e.what());  // "PATH: cannot read"
         }
@@ -220,12 +221,9 @@ Displayed decode(const fs::path& file, const std::string& background) {
         }
         out.mask[i] = linear_with_alpha ? image.rgba[i * 4 + 3] > 0.5f : object;
     }
-    Hasher hasher;
-    hasher.add_field(std::to_string(out.width) + "x" + std::to_string(out.height));
-    for (float v : out.rgb) {
-        const auto q = std::uint32_t(std::lround(double(v) * 65535.0));
-        hasher.add(std::string_view(reinterpret_cast<const char*>(&q), sizeof q));
-    }
+    common::ContentHash hasher;
+    hasher.field(std::to_string(out.width) + "x" + std::to_string(out.height));
+    for (float v : out.rgb) hasher.word(std::uint32_t(std::lround(double(v) * 65535.0)));
     out.pixel_hash = hasher.hex();
     return out;
 }

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 
+#include "common/content_hash.h"
 #include "lucent/version.h"
 #include "renderer/core/density_volume.h"
 #include "renderer/core/mesh.h"
@@ -72,7 +73,7 @@ void check_against_manifest(StimulusProvenance& resolved, const std::vector<Knob
         if (listed != value) differs("parameter '" + name + "'", field(row, name), value);
     }
     // The content hash covers every format's file, as the batch renderer computed it.
-    stimuli::Hasher files;
+    common::ContentHash files;
     bool shown_is_listed = false;
     std::string listed_files = field(row, "files");
     for (size_t start = 0; start <= listed_files.size();) {
@@ -83,7 +84,7 @@ void check_against_manifest(StimulusProvenance& resolved, const std::vector<Knob
         const fs::path path = dir / name;
         shown_is_listed |= fs::path(file).filename() == name;
         try {
-            files.add_field(stimuli::hash_file(path));
+            files.field(common::hash_file(path));
         } catch (const std::exception&) {
             fail("cannot read " + path.string() + ", listed with it in " + manifest_name);
         }
@@ -121,7 +122,7 @@ std::vector<ResolvedProtocolStimulus> resolve_protocol_stimuli(
             p.file = spec.image;
             try {
                 p.content_hash =
-                    stimuli::Hasher().add_field(stimuli::hash_file(spec.image)).hex();
+                    common::ContentHash().field(common::hash_file(spec.image)).hex();
             } catch (const std::exception& e) {
                 throw StimulusError(where + e.what());
             }

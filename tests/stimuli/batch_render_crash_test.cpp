@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/content_hash.h"
 #include "renderer/core/image.h"
 #include "renderer/core/mesh.h"
 #include "renderer/gl/program.h"
@@ -57,9 +58,9 @@ std::size_t check_manifest_matches_files(const std::filesystem::path& dir,
     const auto rows = read_manifest_csv(dir);
     const Mesh mesh = load_mesh("sphere:1k");
     for (const auto& [id, row] : rows) {
-        Hasher files;
+        common::ContentHash files;
         for (const auto& name : split_files(row.at("files")))
-            files.add_field(hash_file(dir / name));
+            files.field(common::hash_file(dir / name));
         EXPECT_EQ(row.at("content_hash"), files.hex()) << id << " in " << dir;
         const auto stimulus =
             std::find_if(set.stimuli.begin(), set.stimuli.end(),

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <thread>
 
+#include "common/content_hash.h"
 #include "lucent/version.h"
 #include "renderer/core/image.h"
 #include "renderer/core/mesh.h"
@@ -72,10 +73,10 @@ TEST(BatchRender, WritesImagesAndACompleteManifest) {
         EXPECT_EQ(row.at("ao_rays"), "8");
         EXPECT_EQ(row.at("input_hash").size(), 16u);
         // The content hash covers the files as written.
-        Hasher files;
-        files.add_field(hash_file(dir / (std::string(id) + ".exr")));
-        files.add_field(hash_file(dir / (std::string(id) + ".png")));
-        files.add_field(hash_file(dir / (std::string(id) + ".tif")));
+        common::ContentHash files;
+        files.field(common::hash_file(dir / (std::string(id) + ".exr")));
+        files.field(common::hash_file(dir / (std::string(id) + ".png")));
+        files.field(common::hash_file(dir / (std::string(id) + ".tif")));
         EXPECT_EQ(row.at("content_hash"), files.hex());
         // Statistics agree with the EXR read back (float, lossless).
         const Image image = read_image(dir / (std::string(id) + ".exr"));

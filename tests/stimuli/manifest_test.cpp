@@ -1,4 +1,4 @@
-// Manifest pieces: hashing, CSV quoting, and writing then reading a manifest back.
+// Manifest pieces: CSV quoting, and writing then reading a manifest back.
 #include "stimuli/manifest.h"
 
 #include <gtest/gtest.h>
@@ -12,23 +12,6 @@
 
 namespace lucent::stimuli {
 namespace {
-
-TEST(Manifest, HasherIsFnv1a64) {
-    // Published FNV-1a 64-bit test vectors.
-    EXPECT_EQ(Hasher().hex(), "cbf29ce484222325");
-    EXPECT_EQ(Hasher().add("a").hex(), "af63dc4c8601ec8c");
-    EXPECT_EQ(Hasher().add("foobar").hex(), "85944171f73967e8");
-    // Length-prefixed fields never run together.
-    EXPECT_NE(Hasher().add_field("ab").add_field("c").hex(),
-              Hasher().add_field("a").add_field("bc").hex());
-}
-
-TEST(Manifest, HashFileMatchesHashOfBytes) {
-    const auto dir = test::scratch_dir("manifest_hash");
-    std::ofstream(dir / "f.bin", std::ios::binary) << "foobar";
-    EXPECT_EQ(hash_file(dir / "f.bin"), "85944171f73967e8");
-    EXPECT_THROW(hash_file(dir / "absent"), std::runtime_error);
-}
 
 TEST(Manifest, CsvQuotingRoundTrips) {
     for (std::string text : {"plain", "0.8,0.5,0.3", "say \"hi\"", "", "a,\"b\",c"}) {

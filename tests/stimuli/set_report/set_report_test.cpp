@@ -11,6 +11,7 @@
 #include <iostream>
 #include <set>
 
+#include "common/content_hash.h"
 #include "renderer/core/image.h"
 #include "stimuli/image_statistics.h"
 #include "stimuli/manifest.h"
@@ -61,8 +62,10 @@ ManifestRow stimulus(const fs::path& dir, const std::string& id,
     row.push_back({"software_version", "test", false});
     row.push_back({"build_hash", "test", false});
     row.push_back({"input_hash", "0", false});
-    row.push_back({"content_hash",
-                   Hasher().add_field(hash_file(dir / (id + ".png"))).hex(), false});
+    row.push_back(
+        {"content_hash",
+         common::ContentHash().field(common::hash_file(dir / (id + ".png"))).hex(),
+         false});
     return row;
 }
 
@@ -266,7 +269,7 @@ TEST_F(SmallSet, AnImageChangedSinceTheManifestIsNamed) {
 
 TEST_F(SmallSet, AnUndecodableImageListedWithItsHashIsNamed) {
     const auto hash = [&] {
-        return Hasher().add_field(hash_file(dir_ / "white.png")).hex();
+        return common::ContentHash().field(common::hash_file(dir_ / "white.png")).hex();
     };
     const std::string before = hash();
     std::ofstream(dir_ / "white.png", std::ios::trunc) << "not a picture";
@@ -334,7 +337,9 @@ void write_grid(const fs::path& dir, int side, int rows, int columns) {
             row.push_back({"build_hash", "test", false});
             row.push_back({"input_hash", "0", false});
             row.push_back({"content_hash",
-                           Hasher().add_field(hash_file(dir / (id + ".png"))).hex(),
+                           common::ContentHash()
+                               .field(common::hash_file(dir / (id + ".png")))
+                               .hex(),
                            false});
             manifest.push_back(std::move(row));
         }

@@ -16,6 +16,7 @@
 #include <random>
 #include <thread>
 
+#include "common/content_hash.h"
 #include "lucent/version.h"
 #include "stimuli/manifest.h"
 #include "study/postgres/local_server.h"
@@ -104,7 +105,7 @@ void write_manifest_for(const fs::path& dir, const Protocol& protocol) {
         row.push_back({"software_version", version_string(), false});
         row.push_back({"build_hash", build_hash(), false});
         row.push_back({"content_hash",
-                       stimuli::Hasher().add_field(stimuli::hash_file(dir / file)).hex(),
+                       common::ContentHash().field(common::hash_file(dir / file)).hex(),
                        false});
         rows.push_back(std::move(row));
     }
