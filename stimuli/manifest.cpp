@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/csv.h"
 #include "lucent/version.h"
 
 namespace lucent::stimuli {
@@ -83,38 +84,6 @@ std::vector<ManifestField> statistics_fields(const ImageStatistics& stats) {
     return fields;
 }
 
-std::string csv_escape(std::string_view text) {
-    if (text.find_first_of(",\"\n\r") == std::string_view::npos) return std::string(text);
-    std::string out = "\"";
-    for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return out + "\"";
-}
-
-std::vector<std::string> csv_split(std::string_view line) {
-    std::vector<std::string> fields(1);
-    bool quoted = false;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-        const char c = line[i];
-        if (quoted) {
-            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-                fields.back() += '"';
-                ++i;
-            } else if (c == '"') {
-                quoted = false;
-            } else {
-                fields.back() += c;
-            }
-        } else if (c == '"') {
-            quoted = true;
-        } else if (c == ',') {
-            fields.emplace_back();
-        } else if (c != '\r') {
-            fields.back() += c;
-        }
-    }
-    return fields;
-}
-
 void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
                     std::span<const ManifestRow> rows) {
     // The header: every column in first-seen order.
@@ -126,13 +95,13 @@ void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
 
     std::ostringstream csv;
     for (std::size_t c = 0; c < columns.size(); ++c)
-        csv << (c ? "," : "") << csv_escape(columns[c]);
+        csv << (c ? "," : "") << common::csv_field(columns[c]);
     csv << "\n";
     for (const auto& row : rows) {
         for (std::size_t c = 0; c < columns.size(); ++c) {
             if (c) csv << ",";
             for (const auto& field : row)
-                if (field.column == columns[c]) csv << csv_escape(field.text);
+                if (field.column == columns[c]) csv << common::csv_field(field.text);
         }
         csv << "\n";
     }
@@ -168,9 +137,9 @@ std::map<std::string, std::map<std::string, std::string>> read_manifest_csv(
     std::ifstream in(dir / "manifest.csv");
     std::string line;
     if (!in || !std::getline(in, line)) return rows;
-    const auto header = csv_split(line);
+    const auto header = common::split_csv_line(line);
     while (std::getline(in, line)) {
-        const auto cells = csv_split(line);
+        const auto cells = common::split_csv_line(line);
         if (cells.size() != header.size()) continue;  // a damaged row: render it again
         std::map<std::string, std::string> row;
         for (std::size_t c = 0; c < header.size(); ++c) row[header[c]] = cells[c];

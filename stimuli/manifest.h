@@ -37,8 +37,4 @@ void write_manifest(const std::filesystem::path& dir, std::string_view set_name,
 std::map<std::string, std::map<std::string, std::string>> read_manifest_csv(
     const std::filesystem::path& dir);
 
-// CSV quoting (RFC 4180) and its inverse for one line of fields.
-std::string csv_escape(std::string_view text);
-std::vector<std::string> csv_split(std::string_view line);
-
 }  // namespace lucent::stimuli

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "common/csv.h"
 #include "common/output_file.h"
 #include "study/question_scales.h"
 #include "study/sqlite/database.h"
@@ -74,13 +75,6 @@ std::string format_number(double v) {
 
 }  // namespace
 
-std::string csv_cell(const std::string& value) {
-    if (value.find_first_of(",\"\r\n") == std::string::npos) return value;
-    std::string out = "\"";
-    for (char c : value) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return out + "\"";
-}
-
 int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out,
                std::vector<std::string>* notes) {
     Database db = open_read_only(db_path);
@@ -96,7 +90,7 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
 
     if (format == ExportFormat::Long) {
         out << "participant,session,trial_position,block,stimulus,technique,mesh";
-        for (const std::string& n : names) out << "," << csv_cell(n);
+        for (const std::string& n : names) out << "," << common::csv_field(n);
         out << ",mesh_hash,stimulus_source,image_file,image_hash,renderer_version,"
                "renderer_build";
         out << ",question,rating,rt_ms,changes,practice,catch,expected_rating,catch_"
@@ -124,8 +118,9 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
             const auto known = s.is_null(15) ? resolved.end() : resolved.find(s.text(4));
             const bool recorded = known != resolved.end();
             without_provenance += recorded ? 0 : 1;
-            for (int c = 0; c < 6; ++c) out << (c ? "," : "") << csv_cell(s.text(c));
-            out << "," << csv_cell(recorded ? known->second.mesh : s.text(6));
+            for (int c = 0; c < 6; ++c)
+                out << (c ? "," : "") << common::csv_field(s.text(c));
+            out << "," << common::csv_field(recorded ? known->second.mesh : s.text(6));
             const auto it = params.find(s.text(4));
             for (const std::string& n : names) {
                 std::string v;
@@ -134,16 +129,16 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
                 } else if (it != params.end() && it->second.count(n)) {
                     v = it->second.at(n);
                 }
-                out << "," << csv_cell(v);
+                out << "," << common::csv_field(v);
             }
-            out << "," << csv_cell(recorded ? known->second.mesh_hash : "");
-            for (int c = 15; c < 20; ++c) out << "," << csv_cell(s.text(c));
+            out << "," << common::csv_field(recorded ? known->second.mesh_hash : "");
+            for (int c = 15; c < 20; ++c) out << "," << common::csv_field(s.text(c));
             const bool is_catch = s.integer(12) != 0;
             std::string passed;
             if (is_catch)
                 passed =
                     std::abs(s.integer(8) - s.integer(13)) <= s.integer(14) ? "1" : "0";
-            out << "," << csv_cell(s.text(7)) << "," << s.integer(8) << ","
+            out << "," << common::csv_field(s.text(7)) << "," << s.integer(8) << ","
                 << format_number(s.real(9)) << "," << s.integer(10) << ","
                 << s.integer(11) << "," << s.integer(12) << ","
                 << (is_catch ? s.text(13) : "") << "," << passed << "\n";
@@ -187,11 +182,11 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
         while (c.step()) sessions[c.text(0)] = static_cast<int>(c.integer(1));
     }
     out << "participant,sessions,catch_failed";
-    for (const std::string& c : columns) out << "," << csv_cell(c);
+    for (const std::string& c : columns) out << "," << common::csv_field(c);
     out << "\n";
     for (const auto& [participant, n_sessions] : sessions) {
         const auto f = failed.find(participant);
-        out << csv_cell(participant) << "," << n_sessions << ","
+        out << common::csv_field(participant) << "," << n_sessions << ","
             << (f == failed.end() ? 0 : f->second);
         const auto& row = cells[participant];
         for (const std::string& c : columns) {
@@ -375,9 +370,9 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
 void write_long_table_csv(const LongTable& table, std::ostream& out) {
     out << "participant,stimulus,factor,level,question,rating\n";
     for (const LongRow& r : table.rows)
-        out << csv_cell(r.participant) << "," << csv_cell(r.stimulus) << ","
-            << csv_cell(r.factor) << "," << csv_cell(r.level) << ","
-            << csv_cell(r.question) << "," << r.rating << "\n";
+        out << common::csv_field(r.participant) << "," << common::csv_field(r.stimulus)
+            << "," << common::csv_field(r.factor) << "," << common::csv_field(r.level)
+            << "," << common::csv_field(r.question) << "," << r.rating << "\n";
 }
 
 }  // namespace lucent::study

@@ -129,7 +129,4 @@ MergeReport merge_databases(const std::vector<std::string>& inputs,
                             const std::string& out_path,
                             const std::vector<std::string>& names = {});
 
-// One CSV cell, quoted when it holds a comma, quote or line break.
-std::string csv_cell(const std::string& value);
-
 }  // namespace lucent::study

@@ -19,6 +19,7 @@
 
 #include "analysis/data/decimal.h"
 #include "common/content_hash.h"
+#include "common/csv.h"
 
 namespace lucent::analysis {
 namespace {
@@ -95,37 +96,14 @@ void split_record(std::string_view line, LineCursor& lines, const std::string& s
     }
     const std::size_t first_line = lines.line_no();
     std::vector<std::string>& fields = decoded;
-    fields.assign(1, std::string());
-    bool quoted = false;
     std::string joined(line);
-    for (std::size_t i = 0;; ++i) {
-        if (i == joined.size()) {
-            if (!quoted) break;
-            const auto more = lines.next();
-            if (!more)
-                throw InputError(location(source, first_line) +
-                                 ": unterminated quoted field");
-            joined += '\n';
-            joined += *more;
-        }
-        if (i == joined.size()) break;
-        const char c = joined[i];
-        if (quoted) {
-            if (c == '"' && i + 1 < joined.size() && joined[i + 1] == '"') {
-                fields.back() += '"';
-                ++i;
-            } else if (c == '"') {
-                quoted = false;
-            } else {
-                fields.back() += c;
-            }
-        } else if (c == '"') {
-            quoted = true;
-        } else if (c == ',') {
-            fields.emplace_back();
-        } else {
-            fields.back() += c;
-        }
+    while (!common::decode_csv_record(joined, fields, common::BareCarriageReturn::keep)) {
+        const auto more = lines.next();
+        if (!more)
+            throw InputError(location(source, first_line) +
+                             ": unterminated quoted field");
+        joined += '\n';
+        joined += *more;
     }
     for (const std::string& field : fields) views.emplace_back(field);
 }
@@ -501,17 +479,12 @@ LongTable read_long_csv(const std::filesystem::path& path, const RatingScale& sc
 }
 
 void write_long_csv(std::ostream& out, const LongTable& table) {
-    auto quote = [](const std::string& s) {
-        if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-        std::string q = "\"";
-        for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-        return q + "\"";
-    };
     out << "participant,stimulus,factor,level,question,rating\n";
     for (const RatingRow& row : table.rows) {
-        out << quote(row.participant) << ',' << quote(row.stimulus) << ','
-            << quote(row.factor) << ',' << quote(row.level) << ',' << quote(row.question)
-            << ',';
+        out << common::csv_field(row.participant) << ','
+            << common::csv_field(row.stimulus) << ',' << common::csv_field(row.factor)
+            << ',' << common::csv_field(row.level) << ','
+            << common::csv_field(row.question) << ',';
         if (row.rating) out << format_exact(table.origin + *row.rating);
         out << '\n';
     }

@@ -11,6 +11,7 @@
 #include "analysis/report/format.h"
 #include "analysis/report/html_page.h"
 #include "analysis/report/svg_plot.h"
+#include "common/csv.h"
 #include "common/output_file.h"
 
 namespace lucent::analysis {
@@ -33,13 +34,6 @@ struct Block {
     };
     std::vector<Image> images;  // kImages: thumbnails in a row
 };
-
-std::string csv_field(const std::string& s) {
-    if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-    std::string q = "\"";
-    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
-}
 
 std::string html_escape(const std::string& s) {
     std::string out;
@@ -491,7 +485,8 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
     friedman << "question,factor,n_participants,chi_sq,df,p,kendall_w\n";
     paired << "question,factor,level_a,level_b,diff,t,df,p,p_holm\n";
     for (const OneWayAnalysis& a : analyses) {
-        const std::string key = csv_field(a.question) + ',' + csv_field(a.factor) + ',';
+        const std::string key =
+            common::csv_field(a.question) + ',' + common::csv_field(a.factor) + ',';
         const AnovaResult& r = a.anova;
         anova << key << format_full(r.ss_between) << ',' << format_full(r.ss_within)
               << ',' << format_full(r.df_between) << ',' << format_full(r.df_within)
@@ -499,19 +494,20 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
               << ',' << format_full(r.f) << ',' << format_p_full(r.p) << ','
               << format_full(r.eta_sq) << ',' << format_full(r.omega_sq) << '\n';
         for (const TukeyPair& p : a.tukey.pairs)
-            tukey << key << csv_field(p.level_a) << ',' << csv_field(p.level_b) << ','
-                  << format_full(p.diff) << ',' << format_full(p.se) << ','
-                  << format_full(p.q) << ',' << format_p_full(p.p_adj) << ','
-                  << format_full(p.lower) << ',' << format_full(p.upper) << '\n';
+            tukey << key << common::csv_field(p.level_a) << ','
+                  << common::csv_field(p.level_b) << ',' << format_full(p.diff) << ','
+                  << format_full(p.se) << ',' << format_full(p.q) << ','
+                  << format_p_full(p.p_adj) << ',' << format_full(p.lower) << ','
+                  << format_full(p.upper) << '\n';
         kruskal << key << format_full(a.kruskal.h) << ',' << format_full(a.kruskal.df)
                 << ',' << format_p_full(a.kruskal.p) << '\n';
         welch << key << format_full(a.welch.f) << ',' << format_full(a.welch.df1) << ','
               << format_full(a.welch.df2) << ',' << format_p_full(a.welch.p) << '\n';
         for (const Descriptives& d : a.descriptives)
-            desc << key << csv_field(d.level) << ',' << d.n << ',' << format_full(d.mean)
-                 << ',' << format_full(d.sd) << ',' << format_full(d.se) << ','
-                 << format_full(d.median) << ',' << format_full(d.ci_low) << ','
-                 << format_full(d.ci_high) << '\n';
+            desc << key << common::csv_field(d.level) << ',' << d.n << ','
+                 << format_full(d.mean) << ',' << format_full(d.sd) << ','
+                 << format_full(d.se) << ',' << format_full(d.median) << ','
+                 << format_full(d.ci_low) << ',' << format_full(d.ci_high) << '\n';
         const WithinSubjectAnalysis& w = a.within;
         if (!w.computed) continue;  // no row: not a within-subject layout
         const RepeatedMeasuresAnova& rm = w.anova;
@@ -527,10 +523,10 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
                  << format_full(f.df) << ',' << format_p_full(f.p) << ','
                  << format_full(f.kendall_w) << '\n';
         for (const PairedComparison& c : w.paired)
-            paired << key << csv_field(c.level_a) << ',' << csv_field(c.level_b) << ','
-                   << format_full(c.diff) << ',' << format_full(c.t) << ','
-                   << format_full(c.df) << ',' << format_p_full(c.p) << ','
-                   << format_p_full(c.p_holm) << '\n';
+            paired << key << common::csv_field(c.level_a) << ','
+                   << common::csv_field(c.level_b) << ',' << format_full(c.diff) << ','
+                   << format_full(c.t) << ',' << format_full(c.df) << ','
+                   << format_p_full(c.p) << ',' << format_p_full(c.p_holm) << '\n';
     }
     files.emplace_back("anova.csv", anova.str());
     files.emplace_back("tukey.csv", tukey.str());

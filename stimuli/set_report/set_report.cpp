@@ -22,6 +22,7 @@
 #include "analysis/report/report.h"
 #include "analysis/report/svg_plot.h"
 #include "common/content_hash.h"
+#include "common/csv.h"
 #include "common/output_file.h"
 #include "renderer/core/image.h"
 #include "renderer/core/progress.h"
@@ -95,7 +96,7 @@ ManifestTable read_manifest_strictly(const fs::path& directory) {
     std::string line;
     if (!in || !std::getline(in, line)) fail(file.string() + ": cannot read, or empty");
     ManifestTable table;
-    table.header = csv_split(line);
+    table.header = common::split_csv_line(line);
     for (const char* required : {"id", "file", "files", "technique", "width", "height",
                                  "object_pixels", "content_hash", "software_version"})
         if (std::find(table.header.begin(), table.header.end(), required) ==
@@ -105,7 +106,7 @@ ManifestTable read_manifest_strictly(const fs::path& directory) {
     std::set<std::string> ids;
     for (int number = 2; std::getline(in, line); ++number) {
         if (line.empty() || line == "\r") continue;
-        const auto cells = csv_split(line);
+        const auto cells = common::split_csv_line(line);
         if (cells.size() != table.header.size())
             fail(file.string() + ":" + std::to_string(number) + ": " +
                  std::to_string(cells.size()) + " fields, the header has " +

@@ -1,4 +1,4 @@
-// Manifest pieces: CSV quoting, and writing then reading a manifest back.
+// Manifests: writing then reading a manifest back.
 #include "stimuli/manifest.h"
 
 #include <gtest/gtest.h>
@@ -12,16 +12,6 @@
 
 namespace lucent::stimuli {
 namespace {
-
-TEST(Manifest, CsvQuotingRoundTrips) {
-    for (std::string text : {"plain", "0.8,0.5,0.3", "say \"hi\"", "", "a,\"b\",c"}) {
-        const auto fields = csv_split(csv_escape(text) + "," + csv_escape("next"));
-        ASSERT_EQ(fields.size(), 2u) << text;
-        EXPECT_EQ(fields[0], text);
-        EXPECT_EQ(fields[1], "next");
-    }
-    EXPECT_EQ(csv_escape("0.8,0.5,0.3"), "\"0.8,0.5,0.3\"");
-}
 
 TEST(Manifest, WritesUnionOfColumnsAndReadsBack) {
     const auto dir = test::scratch_dir("manifest_roundtrip");

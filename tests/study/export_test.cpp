@@ -20,7 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 using lucent::test::small_protocol;
 
-// Minimal CSV reader (quotes, doubled quotes), independent of csv_cell.
+// Minimal CSV reader (quotes, doubled quotes), independent of common/csv.h.
 std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
     std::vector<std::vector<std::string>> rows(1, std::vector<std::string>(1));
     bool quoted = false;
@@ -51,13 +51,6 @@ int column(const std::vector<std::string>& header, const std::string& name) {
         if (header[i] == name) return static_cast<int>(i);
     ADD_FAILURE() << "no column " << name;
     return 0;
-}
-
-TEST(CsvCell, QuotesOnlyWhenNeeded) {
-    EXPECT_EQ(csv_cell("plain"), "plain");
-    EXPECT_EQ(csv_cell("a,b"), "\"a,b\"");
-    EXPECT_EQ(csv_cell("say \"hi\""), "\"say \"\"hi\"\"\"");
-    EXPECT_EQ(parse_csv(csv_cell("x,\"y\"\nz") + "\n")[0][0], "x,\"y\"\nz");
 }
 
 class ExportTest : public ::testing::Test {
