@@ -5,9 +5,9 @@
 #include <iostream>
 #include <stdexcept>
 
-#include "analysis/data/decimal.h"
 #include "analysis/stats/studentized_range.h"
 #include "app/commands.h"
+#include "common/number_text.h"
 
 namespace lucent::app {
 namespace {
@@ -16,13 +16,13 @@ namespace {
 double parse_df(const std::string& text) {
     if (text == "inf" || text == "infinity" || text == "Inf")
         return analysis::kInfiniteDf;
-    const auto value = analysis::parse_finite_number(text);
+    const auto value = common::parse_finite_number(text);
     if (!value)
         throw std::domain_error("--df: expected a number or 'inf', got '" + text + "'");
     return *value;
 }
 
-void print_full(double x) { std::printf("%.17g\n", x); }
+void print_full(double x) { std::printf("%s\n", common::full_precision_text(x).c_str()); }
 
 int guarded(const char* name, const std::function<void()>& body) {
     try {

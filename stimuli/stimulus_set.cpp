@@ -17,6 +17,8 @@
 #include <set>
 #include <sstream>
 
+#include "common/number_text.h"
+
 namespace lucent::stimuli {
 namespace {
 
@@ -77,10 +79,7 @@ std::string as_string(const toml::node& node, const std::string& key,
 
 std::string number_text(const toml::node& node) {
     if (node.is_integer()) return std::to_string(node.as_integer()->get());
-    std::ostringstream out;
-    out.precision(17);
-    out << node.as_floating_point()->get();
-    return out.str();
+    return common::full_precision_text(node.as_floating_point()->get());
 }
 
 // One TOML value for `knob` as a validated KnobValue. Numbers for scalars, integers for

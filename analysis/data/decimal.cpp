@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 
 namespace lucent::analysis {
@@ -19,27 +20,6 @@ std::string_view trim(std::string_view text) {
         text.remove_suffix(1);
     return text;
 }
-
-}  // namespace
-
-std::optional<double> parse_finite_number(std::string_view text) {
-    text = trim(text);
-    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-    if (text.empty()) return std::nullopt;
-    // Only digits, one point, an exponent and signs: from_chars would accept "inf"/"nan".
-    for (char c : text)
-        if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' ||
-              c == 'E' || c == '-' || c == '+'))
-            return std::nullopt;
-    double value = 0.0;
-    const auto [end, error] =
-        std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
-        return std::nullopt;
-    return value;
-}
-
-namespace {
 
 // A plain decimal ([-]digits[.digits], no exponent) of at most 17 digits as an integer
 // and its count of fraction digits: value = integer / 10^fraction_digits, exactly.

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <map>
 
-#include "analysis/data/decimal.h"
+#include "common/number_text.h"
 
 namespace lucent::analysis {
 
@@ -46,14 +46,16 @@ std::vector<FactorData> split_by_question_and_factor(const LongTable& table,
     }
     for (FactorData& pair : pairs) {
         auto& groups = pair.data.groups;
-        const bool numeric = std::all_of(
-            groups.begin(), groups.end(),
-            [](const Group& g) { return parse_finite_number(g.level).has_value(); });
+        const bool numeric =
+            std::all_of(groups.begin(), groups.end(), [](const Group& g) {
+                return common::parse_finite_number(g.level).has_value();
+            });
         if (numeric)
-            std::stable_sort(
-                groups.begin(), groups.end(), [](const Group& a, const Group& b) {
-                    return *parse_finite_number(a.level) < *parse_finite_number(b.level);
-                });
+            std::stable_sort(groups.begin(), groups.end(),
+                             [](const Group& a, const Group& b) {
+                                 return *common::parse_finite_number(a.level) <
+                                        *common::parse_finite_number(b.level);
+                             });
     }
     return pairs;
 }

@@ -20,6 +20,7 @@
 #include "analysis/data/decimal.h"
 #include "common/content_hash.h"
 #include "common/csv.h"
+#include "common/number_text.h"
 
 namespace lucent::analysis {
 namespace {
@@ -29,12 +30,6 @@ constexpr std::array<const char*, 6> kColumns{"participant", "stimulus", "factor
 
 std::string location(const std::string& source, std::size_t line) {
     return source + ":" + std::to_string(line);
-}
-
-std::string format_exact(double value) {
-    char buffer[32];
-    const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
-    return error == std::errc() ? std::string(buffer, end) : std::to_string(value);
 }
 
 // The CSV text, walked line by line without copying: a million rows cost no per-line
@@ -257,7 +252,7 @@ void parse_rows(LineCursor& lines, const std::string& source,
         const std::string_view rating_text = trimmed(fields[column[5]]);
         if (rating_text.empty() || rating_text == "NA") continue;
         if (origin.text.empty()) {
-            const auto value = parse_finite_number(rating_text);
+            const auto value = common::parse_finite_number(rating_text);
             if (!value) refuse_rating(source, line_no, column[5], rating_text);
             origin.text = rating_text;
             origin.value = *value;
@@ -269,7 +264,7 @@ void parse_rows(LineCursor& lines, const std::string& source,
             row.rating = static_cast<double>(rating_text[0] - origin.text[0]);
             continue;
         }
-        if (!parse_finite_number(rating_text))
+        if (!common::parse_finite_number(rating_text))
             refuse_rating(source, line_no, column[5], rating_text);
         row.rating = exact_difference(rating_text, origin.text);
         if (!std::isfinite(*row.rating))  // 1e308 after -1e308: no double holds the gap
@@ -412,7 +407,8 @@ LongTable parse_long_csv(std::string_view text, const std::string& source,
     // The origin is the first rating rounded to double; the stored differences are exact
     // relative to its text, so add back what that rounding dropped.
     if (!origin.text.empty()) {
-        const double rounding = exact_difference(origin.text, format_exact(table.origin));
+        const double rounding =
+            exact_difference(origin.text, common::shortest_text(table.origin));
         if (rounding != 0.0)
             for (RatingRow& row : table.rows)
                 if (row.rating) *row.rating += rounding;
@@ -429,8 +425,8 @@ RatingScale parse_scale(std::string_view text) {
     const auto dots = text.find("..");
     std::optional<double> low, high;
     if (dots != std::string_view::npos) {
-        low = parse_finite_number(text.substr(0, dots));
-        high = parse_finite_number(text.substr(dots + 2));
+        low = common::parse_finite_number(text.substr(0, dots));
+        high = common::parse_finite_number(text.substr(dots + 2));
     }
     if (!low || !high || !(*low < *high))
         throw InputError(
@@ -441,7 +437,7 @@ RatingScale parse_scale(std::string_view text) {
 
 std::string describe_scale(const RatingScale& scale) {
     if (scale.any) return "any finite number";
-    return format_exact(scale.min) + ".." + format_exact(scale.max);
+    return common::shortest_text(scale.min) + ".." + common::shortest_text(scale.max);
 }
 
 void check_scale(const LongTable& table, const RatingScale& scale,
@@ -455,7 +451,7 @@ void check_scale(const LongTable& table, const RatingScale& scale,
         if (scale.any) continue;
         if (value < scale.min || value > scale.max)
             throw InputError(location(source, row.source_line) + ": rating " +
-                             format_exact(value) + " is outside the scale " +
+                             common::shortest_text(value) + " is outside the scale " +
                              describe_scale(scale) +
                              " (set it with --scale MIN..MAX, or --scale any)");
     }
@@ -485,7 +481,7 @@ void write_long_csv(std::ostream& out, const LongTable& table) {
             << common::csv_field(row.stimulus) << ',' << common::csv_field(row.factor)
             << ',' << common::csv_field(row.level) << ','
             << common::csv_field(row.question) << ',';
-        if (row.rating) out << format_exact(table.origin + *row.rating);
+        if (row.rating) out << common::shortest_text(table.origin + *row.rating);
         out << '\n';
     }
 }

@@ -2,21 +2,33 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
+
+#include "common/number_text.h"
 
 namespace lucent::analysis {
 namespace {
 
-std::string format_with(const Statistic& value, const char* pattern) {
+std::string format_with(const Statistic& value,
+                        const std::function<std::string(double)>& text) {
     if (!value || std::isnan(*value)) return "undefined";
     if (std::isinf(*value)) return *value > 0 ? "inf" : "-inf";
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, pattern, *value);
-    return buffer;
+    return text(*value);
+}
+
+std::string format_with(const Statistic& value, const char* pattern) {
+    return format_with(value, [pattern](double v) {
+        char buffer[64];
+        std::snprintf(buffer, sizeof buffer, pattern, v);
+        return std::string(buffer);
+    });
 }
 
 }  // namespace
 
-std::string format_full(const Statistic& value) { return format_with(value, "%.17g"); }
+std::string format_full(const Statistic& value) {
+    return format_with(value, common::full_precision_text);
+}
 std::string format_short(const Statistic& value) { return format_with(value, "%.4g"); }
 
 std::string format_p_full(const Statistic& p) {

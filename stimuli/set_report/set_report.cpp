@@ -23,6 +23,7 @@
 #include "analysis/report/svg_plot.h"
 #include "common/content_hash.h"
 #include "common/csv.h"
+#include "common/number_text.h"
 #include "common/output_file.h"
 #include "renderer/core/image.h"
 #include "renderer/core/progress.h"
@@ -44,16 +45,6 @@ std::string cell(const std::map<std::string, std::string>& row,
                  const std::string& column) {
     const auto it = row.find(column);
     return it == row.end() ? std::string() : it->second;
-}
-
-std::optional<double> number(const std::string& text) {
-    double value = 0.0;
-    const auto [end, error] =
-        std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size() || text.empty() ||
-        !std::isfinite(value))
-        return std::nullopt;
-    return value;
 }
 
 std::string fixed(double value, int decimals) {
@@ -203,7 +194,7 @@ Displayed decode(const fs::path& file, const std::string& background) {
     const auto parts = split(background, ',');
     for (int c = 0; c < 3; ++c)
         if (parts.size() == 3)
-            if (const auto v = number(parts[std::size_t(c)]))
+            if (const auto v = common::parse_finite(parts[std::size_t(c)]))
                 encoded_background[c] = srgb_encode(float(*v));
     Displayed out;
     out.width = image.width;
@@ -283,14 +274,16 @@ void build_series(SetReport& report, const std::vector<std::string>& header) {
             const std::string& column = series.varying.front();
             bool numeric = true;
             for (std::size_t m : series.members)
-                numeric &= number(cell(report.stimuli[m].cells, column)).has_value();
+                numeric &= common::parse_finite(cell(report.stimuli[m].cells, column))
+                               .has_value();
             if (numeric)
-                std::stable_sort(
-                    series.members.begin(), series.members.end(),
-                    [&](std::size_t a, std::size_t b) {
-                        return *number(cell(report.stimuli[a].cells, column)) <
-                               *number(cell(report.stimuli[b].cells, column));
-                    });
+                std::stable_sort(series.members.begin(), series.members.end(),
+                                 [&](std::size_t a, std::size_t b) {
+                                     return *common::parse_finite(
+                                                cell(report.stimuli[a].cells, column)) <
+                                            *common::parse_finite(
+                                                cell(report.stimuli[b].cells, column));
+                                 });
         }
         for (std::size_t m : series.members) {
             std::string level;
@@ -335,16 +328,17 @@ std::vector<std::pair<std::size_t, std::size_t>> neighbour_pairs(
             for (auto& [key, line] : lines) {
                 bool numeric = true;
                 for (std::size_t position : line)
-                    numeric &= number(cell(report.stimuli[series.members[position]].cells,
-                                           column))
-                                   .has_value();
+                    numeric &=
+                        common::parse_finite(
+                            cell(report.stimuli[series.members[position]].cells, column))
+                            .has_value();
                 if (numeric)
                     std::stable_sort(
                         line.begin(), line.end(), [&](std::size_t a, std::size_t b) {
-                            return *number(cell(report.stimuli[series.members[a]].cells,
-                                                column)) <
-                                   *number(cell(report.stimuli[series.members[b]].cells,
-                                                column));
+                            return *common::parse_finite(cell(
+                                       report.stimuli[series.members[a]].cells, column)) <
+                                   *common::parse_finite(cell(
+                                       report.stimuli[series.members[b]].cells, column));
                         });
                 for (std::size_t k = 0; k + 1 < line.size(); ++k)
                     pairs.emplace(std::min(line[k], line[k + 1]),
@@ -563,7 +557,7 @@ std::vector<std::pair<std::string, std::vector<std::size_t>>> sheet_groups(
 }
 
 double statistic(const ReportStimulus& s, const std::string& column) {
-    return number(cell(s.cells, column)).value_or(NAN);
+    return common::parse_finite(cell(s.cells, column)).value_or(NAN);
 }
 
 // The luminance histogram as shares of the object's pixels.
@@ -573,7 +567,7 @@ std::vector<double> histogram_shares(const ReportStimulus& s) {
         char column[16];
         std::snprintf(column, sizeof column, "hist_%02d", bin);
         if (!s.cells.count(column)) break;
-        counts.push_back(number(cell(s.cells, column)).value_or(0.0));
+        counts.push_back(common::parse_finite(cell(s.cells, column)).value_or(0.0));
     }
     const double total = std::accumulate(counts.begin(), counts.end(), 0.0);
     for (double& c : counts) c = total > 0.0 ? c / total : 0.0;
