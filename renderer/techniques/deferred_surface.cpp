@@ -16,9 +16,7 @@ void shade_deferred(PlanBuilder& plan, Pass& lighting, const std::vector<Uniform
                      (ambient_occlusion ? ", AO" : "") +
                      (eye_normal ? ", eye normal" : ""),
                  PassKind::draw_mesh,
-                 {"techniques/dipole/shaders/mesh.vert",
-                  "techniques/dipole/shaders/surface.frag",
-                  {}}};
+                 {"techniques/shaders/mesh.vert", "techniques/shaders/surface.frag", {}}};
     surface.writes = {"surface_position", "surface_normal"};
     if (ambient_occlusion) {
         surface.shader.defines.push_back("WITH_AMBIENT");

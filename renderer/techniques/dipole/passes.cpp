@@ -93,7 +93,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const glm::mat4 view = scene.camera.view();
     const std::vector<Uniform> camera =
         mesh_transform_uniforms(view, scene.camera.projection());
-    const std::string mesh_vert = "techniques/dipole/shaders/mesh.vert";
+    const std::string mesh_vert = "techniques/shaders/mesh.vert";
     const glm::vec3 light_object = glm::vec3(light_in_object_space(scene));
 
     // The profile's constants per channel (dipole.glsl); zr = zv = 1 where nothing

@@ -37,9 +37,12 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const ResourceFormat depth = depth_format(p.depth_precision);
     const auto camera =
         mesh_transform_uniforms(scene.camera.view(), scene.camera.projection());
-    const std::string mesh_vert = "techniques/empirical/shaders/mesh.vert";
+    // Every mesh pass draws its vertices at bit-identical depths (`invariant`), which the
+    // peel's comparison of layers relies on.
+    const std::string mesh_vert = "techniques/shaders/mesh.vert";
+    const std::string invariant = "INVARIANT_POSITION";
     const ShaderDesc depth_only{
-        mesh_vert, "techniques/empirical/shaders/depth_only.frag", {}};
+        mesh_vert, "techniques/empirical/shaders/depth_only.frag", {invariant}};
     // A closed mesh facing out, seen from outside: the nearest surface of every pixel is
     // a front face and the one behind it a back face (the first exit). The second layer
     // is then the nearest back face, rasterised with front faces culled and without
@@ -104,7 +107,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
             Pass peel{"second_layer",
                       "depth peeling: nearest depth behind front + epsilon",
                       PassKind::draw_mesh,
-                      {mesh_vert, "techniques/empirical/shaders/peel.frag", {}}};
+                      {mesh_vert, "techniques/empirical/shaders/peel.frag", {invariant}}};
             peel.reads = {{"front_depth", ""}};
             peel.writes = {"second_depth"};
             peel.uniforms = with_uniforms(
@@ -142,7 +145,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     Pass shade{"shade",
                "Eq. 3.6: ambient*AO + diffuse + specular + backlight(thickness)",
                PassKind::draw_mesh,
-               {mesh_vert, "techniques/empirical/shaders/shade.frag", {}}};
+               {mesh_vert, "techniques/empirical/shaders/shade.frag", {invariant}}};
     if (deferred) {
         shade.purpose += ", once per pixel of the front layer";
         shade.kind = PassKind::fullscreen;

@@ -39,7 +39,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
     const bool mips = transport && coarse;
     const int wl = p.light_map_size;
 
-    const std::string mesh_vert = "techniques/dipole/shaders/mesh.vert";
+    const std::string mesh_vert = "techniques/shaders/mesh.vert";
     const glm::mat4 view = scene.camera.view();
     const LightView& light = g.light;
     const std::vector<Uniform> box = {{"u_box_min", glm::vec3(g.box_min)},

@@ -29,7 +29,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, Variant variant) {
                                  : "Eq. 15: ambient*AO + reversed diffuse Id*chroma*(1 - "
                                    "Y(Kd)*N.L) + Ward specular",
         PassKind::draw_mesh,
-        {"techniques/ward/shaders/mesh.vert", "techniques/ward/shaders/shade.frag", {}}};
+        {"techniques/shaders/mesh.vert", "techniques/ward/shaders/shade.frag", {}}};
     shade.uniforms =
         with_uniforms(mesh_transform_uniforms(view, scene.camera.projection()),
                       {{"u_albedo", glm::vec3(p.albedo)},

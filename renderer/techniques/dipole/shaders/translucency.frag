@@ -12,7 +12,7 @@
 // rasterised fragment (llvmpipe shades whole 4x4 blocks of small triangles); the inputs
 // are the same floats, so is the colour.
 #include "techniques/dipole/shaders/dipole.glsl"
-#include "techniques/dipole/shaders/surface_inputs.glsl"
+#include "techniques/shaders/surface_inputs.glsl"
 uniform vec3 u_light_direction;  // eye space, towards the light
 uniform vec3 u_eye_object;       // camera position, object space
 uniform vec3 u_background;

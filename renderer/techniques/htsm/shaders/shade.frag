@@ -8,7 +8,7 @@
 // The same equations as renderer/techniques/htsm/reference.cpp (exact footprints there).
 // DEFERRED: a full-screen pass over the surface a `surface` pass stored, each covered
 // pixel lit once instead of every rasterised fragment (the same floats, the same colour).
-#include "techniques/dipole/shaders/surface_inputs.glsl"
+#include "techniques/shaders/surface_inputs.glsl"
 uniform vec3 u_light_direction;  // eye space, towards the light
 uniform vec3 u_background;
 layout(location = 0) out vec4 o_colour;

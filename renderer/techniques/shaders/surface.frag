@@ -1,5 +1,6 @@
 #version 450 core
-// What `translucency` shades, once per pixel (deferred): the nearest surface's
+// What a deferred lighting pass (techniques/deferred_surface.h: the dipole's translucency,
+// the htsm's shade) lights, once per pixel: the nearest surface's
 // interpolated object-space position (w = 1 marks a covered pixel) and normal (w = AO),
 // and its eye-space normal (WITH_EYE_NORMAL), stored exactly in rgba32f, so shading them
 // gives the floats shading each fragment would (surface_inputs.glsl reads them back).
