@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/srgb.h"
 #include "renderer/core/image.h"
 
 namespace lucent::stimuli {
@@ -23,11 +24,6 @@ constexpr int kLineHeight = 16;
 constexpr int kLabelLines = 4;
 constexpr int kHeadingHeight = 30;
 constexpr float kSheetGrey = 0.16f;  // sRGB-encoded: dark enough to see black backgrounds
-
-float srgb_decode(float encoded) {
-    const float v = std::clamp(encoded, 0.0f, 1.0f);
-    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
 
 // An RGB ImageBuf of the sheet's grey.
 OIIO::ImageBuf grey_buffer(int width, int height) {
@@ -146,7 +142,7 @@ void write_contact_sheet(const std::filesystem::path& file,
                      pixels.data());
     for (std::size_t i = 0, n = std::size_t(width) * height; i < n; ++i) {
         for (int c = 0; c < 3; ++c)
-            image.rgba[i * 4 + c] = srgb_decode(pixels[i * 3 + c]);
+            image.rgba[i * 4 + c] = common::srgb_decode(pixels[i * 3 + c]);
         image.rgba[i * 4 + 3] = 1.0f;
     }
     write_image(file, image);
@@ -161,7 +157,7 @@ std::string thumbnail_png(const Thumbnail& thumbnail) {
     for (std::size_t i = 0, n = std::size_t(thumbnail.width) * thumbnail.height; i < n;
          ++i) {
         for (int c = 0; c < 3; ++c)
-            image.rgba[i * 4 + c] = srgb_decode(thumbnail.rgb[i * 3 + c]);
+            image.rgba[i * 4 + c] = common::srgb_decode(thumbnail.rgb[i * 3 + c]);
         image.rgba[i * 4 + 3] = 1.0f;
     }
     write_image(file, image);

@@ -25,6 +25,7 @@
 #include "common/csv.h"
 #include "common/number_text.h"
 #include "common/output_file.h"
+#include "common/srgb.h"
 #include "renderer/core/image.h"
 #include "renderer/core/progress.h"
 #include "stimuli/manifest.h"
@@ -165,11 +166,6 @@ fs::path displayed_file(const std::vector<fs::path>& files) {
 
 // ---- [SECTION] measuring -----------------------------------------------------------
 
-float srgb_decode(float encoded) {
-    const float v = std::clamp(encoded, 0.0f, 1.0f);
-    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
-
 // One stimulus as displayed: sRGB-encoded RGB, its object mask and a hash of the pixels.
 struct Displayed {
     int width = 0, height = 0;
@@ -233,9 +229,9 @@ Measured measure(Displayed displayed, const SrgbToLab& to_lab) {
     const std::size_t n = displayed.mask.size();
     m.luminance.resize(n);
     for (std::size_t i = 0; i < n; ++i)
-        m.luminance[i] = 0.2126 * srgb_decode(displayed.rgb[i * 3]) +
-                         0.7152 * srgb_decode(displayed.rgb[i * 3 + 1]) +
-                         0.0722 * srgb_decode(displayed.rgb[i * 3 + 2]);
+        m.luminance[i] = 0.2126 * common::srgb_decode(displayed.rgb[i * 3]) +
+                         0.7152 * common::srgb_decode(displayed.rgb[i * 3 + 1]) +
+                         0.0722 * common::srgb_decode(displayed.rgb[i * 3 + 2]);
     m.displayed = std::move(displayed);
     return m;
 }

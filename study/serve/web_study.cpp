@@ -12,6 +12,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "common/srgb.h"
 #include "study/session/session_flow.h"
 #include "study/sha256.h"
 #include "study/sqlite/sqlite_store.h"
@@ -129,10 +130,9 @@ int64_t random_seed() {
 
 std::string css_colour(const float rgb[3]) {
     // The protocol's background is linear; the page takes sRGB.
+    // In double (as the page always had it), rounded to 8 bits.
     auto encode = [](float c) {
-        const double s =
-            c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
-        return static_cast<int>(std::lround(std::clamp(s, 0.0, 1.0) * 255));
+        return static_cast<int>(std::lround(common::srgb_encode(double(c)) * 255));
     };
     char out[8];
     std::snprintf(out, sizeof out, "#%02x%02x%02x", encode(rgb[0]), encode(rgb[1]),
