@@ -4,8 +4,9 @@
 
 namespace lucent {
 
-// Each technique folder defines one accessor; adding a technique adds one line to each
-// list below.
+// Each technique defines one accessor (ward/technique.cpp defines ward's and
+// contrast_reversed's: one class, two variants); adding a technique adds one line to
+// each list below.
 const Technique& empirical_technique();
 const Technique& ward_technique();
 const Technique& contrast_reversed_technique();
