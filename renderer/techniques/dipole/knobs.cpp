@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "renderer/core/common_knobs.h"
+#include "renderer/cpu/blinn_phong.h"
 #include "renderer/techniques/dipole/dipole.h"
 
 namespace lucent::dipole {
@@ -157,13 +158,7 @@ double tone_map_average(const Params& p, const Scene& scene, double flux_per_id,
 glm::dvec3 blinn_phong(const Params& p, const Light& light, glm::dvec3 n) {
     const glm::dvec3 l = light.direction;
     if (!(glm::dot(n, l) > 0.0)) return glm::dvec3(0.0);
-    const glm::dvec3 half_sum = l + glm::dvec3(0.0, 0.0, 1.0);
-    const double length2 = glm::dot(half_sum, half_sum);
-    const double n_dot_h =
-        length2 > 1e-30 ? std::max(glm::dot(n, half_sum / std::sqrt(length2)), 0.0) : 0.0;
-    // 0^0 = 1: shininess 0 is a constant lobe, as in the empirical technique.
-    const double lobe = p.shininess == 0.0 ? 1.0 : std::pow(n_dot_h, p.shininess);
-    return p.specular * glm::dvec3(light.specular) * lobe;
+    return p.specular * glm::dvec3(light.specular) * blinn_phong_lobe(n, l, p.shininess);
 }
 
 glm::dvec3 ambient_term(const Params& p, const Light& light, double n_dot_v, double ao) {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "renderer/core/ambient_occlusion.h"
+#include "renderer/cpu/blinn_phong.h"
 #include "renderer/cpu/pixel_rays.h"
 #include "renderer/cpu/ray_caster.h"
 #include "renderer/techniques/empirical/empirical.h"
@@ -134,7 +135,6 @@ Image render_reference(const Scene& scene) {
     const glm::dvec3 kd = p.albedo, ia = light.ambient, id = light.diffuse,
                      is = light.specular;
     const glm::dvec3 l = light.direction;
-    const glm::dvec3 half_sum = l + glm::dvec3(0.0, 0.0, 1.0);  // viewer at infinity
 
     Image image(w, h);
     for (int y = 0; y < h; ++y)
@@ -155,14 +155,8 @@ Image render_reference(const Scene& scene) {
             const double n_dot_l = glm::dot(normal, l);
             if (n_dot_l > 0.0) {
                 colour += p.diffuse_contribution * kd * id * n_dot_l;
-                const double half_length2 = glm::dot(half_sum, half_sum);
-                const double n_dot_h =
-                    half_length2 > 1e-30
-                        ? std::max(glm::dot(normal, half_sum / std::sqrt(half_length2)),
-                                   0.0)
-                        : 0.0;
                 colour += p.specular_contribution * p.specular * is *
-                          power(n_dot_h, p.shininess);
+                          blinn_phong_lobe(normal, l, p.shininess);
             }
             // Thickness term (Eq. 3.10); no second layer counts as the full diameter.
             if (p.backlight != 0.0) {

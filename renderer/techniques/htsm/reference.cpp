@@ -9,6 +9,7 @@
 #include <cmath>
 #include <optional>
 
+#include "renderer/cpu/blinn_phong.h"
 #include "renderer/cpu/pixel_rays.h"
 #include "renderer/cpu/ray_caster.h"
 #include "renderer/techniques/htsm/htsm.h"
@@ -121,7 +122,6 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
     const double fine_per_plane = light ? light->size() / plane : 0.0;
 
     const glm::dvec3 l_eye = scene.light.direction;
-    const glm::dvec3 half = glm::normalize(l_eye + glm::dvec3(0, 0, 1));
     const int w = scene.width, h = scene.height;
     const PixelRays rays(scene.camera, w, h);
     Image image(w, h);
@@ -188,11 +188,7 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
                     const glm::dvec3 origin = point + 1e-4 * g.phi * geometric;
                     if (!caster.occluded(glm::vec3(origin), glm::vec3(g.to_light), 0.0f,
                                          1e30f)) {
-                        const double lobe =
-                            p.shininess == 0.0
-                                ? 1.0
-                                : std::pow(std::max(glm::dot(n_eye, half), 0.0),
-                                           p.shininess);
+                        const double lobe = blinn_phong_lobe(n_eye, l_eye, p.shininess);
                         colour += p.diffuse * p.albedo * glm::dvec3(scene.light.diffuse) *
                                       n_dot_l +
                                   p.specular * glm::dvec3(scene.light.specular) * lobe;

@@ -13,6 +13,7 @@
 // are the same floats, so is the colour.
 #include "techniques/dipole/shaders/dipole.glsl"
 #include "techniques/shaders/surface_inputs.glsl"
+#include "techniques/shaders/blinn_phong.glsl"
 uniform vec3 u_light_direction;  // eye space, towards the light
 uniform vec3 u_eye_object;       // camera position, object space
 uniform vec3 u_background;
@@ -117,12 +118,9 @@ void main() {
 #endif
 #ifdef WITH_SPECULAR
     vec3 ne = normalize(normal_eye);
-    if (dot(ne, u_light_direction) > 0.0) {
-        vec3 h = u_light_direction + vec3(0.0, 0.0, 1.0);
-        float n_dot_h = dot(h, h) > 1e-30 ? max(dot(ne, normalize(h)), 0.0) : 0.0;
-        float lobe = u_shininess == 0.0 ? 1.0 : pow(n_dot_h, u_shininess);
-        colour += u_specular * u_light_specular * lobe;
-    }
+    if (dot(ne, u_light_direction) > 0.0)
+        colour += u_specular * u_light_specular *
+                  blinn_phong_lobe(ne, u_light_direction, u_shininess);
 #endif
     o_colour = vec4(colour, 1.0);
 }

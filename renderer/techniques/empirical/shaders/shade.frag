@@ -25,6 +25,7 @@ float power(float x, float e) {
     if (e == 0.0) return 1.0;
     return x <= 0.0 ? 0.0 : pow(x, e);
 }
+#include "techniques/shaders/blinn_phong.glsl"
 
 #ifdef WITH_BACKLIGHT
 uniform float u_near;
@@ -105,11 +106,8 @@ void main() {
     float n_dot_l = dot(n, l);
     if (n_dot_l > 0.0) {
         colour += u_diffuse_contribution * u_albedo * u_light_diffuse * n_dot_l;
-        vec3 h = l + vec3(0.0, 0.0, 1.0);
-        float h_length2 = dot(h, h);
-        float n_dot_h = h_length2 > 1e-30 ? max(dot(n, h * inversesqrt(h_length2)), 0.0) : 0.0;
         colour += u_specular_contribution * u_specular * u_light_specular *
-                  power(n_dot_h, u_shininess);
+                  blinn_phong_lobe(n, l, u_shininess);
     }
 
 #ifdef WITH_BACKLIGHT

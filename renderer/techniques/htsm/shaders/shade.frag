@@ -9,6 +9,7 @@
 // DEFERRED: a full-screen pass over the surface a `surface` pass stored, each covered
 // pixel lit once instead of every rasterised fragment (the same floats, the same colour).
 #include "techniques/shaders/surface_inputs.glsl"
+#include "techniques/shaders/blinn_phong.glsl"
 uniform vec3 u_light_direction;  // eye space, towards the light
 uniform vec3 u_background;
 layout(location = 0) out vec4 o_colour;
@@ -108,8 +109,7 @@ void main() {
         vec3 w = clip.xyz / clip.w * 0.5 + 0.5;
         float stored = texture(light_depth, w.xy).r;
         if (w.z - u_depth_bias <= stored) {
-            vec3 h = normalize(u_light_direction + vec3(0.0, 0.0, 1.0));
-            float lobe = u_shininess == 0.0 ? 1.0 : pow(max(dot(n_eye, h), 0.0), u_shininess);
+            float lobe = blinn_phong_lobe(n_eye, u_light_direction, u_shininess);
             colour += u_diffuse_colour * n_dot_l + u_specular * lobe;
         }
     }
