@@ -53,4 +53,28 @@ ImageErrorStats compare_images(const Image& a, const Image& b, int band) {
     return stats;
 }
 
+ReferenceError reference_error(const Image& coarse, const Image& fine) {
+    double sum2 = 0.0, ref2 = 0.0, worst = 0.0;
+    std::size_t count = 0;
+    for (int y = 0; y < fine.height; ++y)
+        for (int x = 0; x < fine.width; ++x) {
+            const glm::vec4 a = coarse.at(x, y), b = fine.at(x, y);
+            if (a.a == 0.0f || b.a == 0.0f) continue;
+            for (int c = 0; c < 3; ++c) {
+                const double d = double(a[c]) - double(b[c]);
+                sum2 += d * d;
+                ref2 += double(b[c]) * double(b[c]);
+                worst = std::max(worst, std::abs(d));
+            }
+            ++count;
+        }
+    ReferenceError error;
+    if (count > 0) {
+        error.rms = std::sqrt(sum2 / (3.0 * count));
+        error.max = worst;
+        error.relative_rms = ref2 > 0.0 ? std::sqrt(sum2 / ref2) : 0.0;
+    }
+    return error;
+}
+
 }  // namespace lucent

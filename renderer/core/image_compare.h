@@ -19,4 +19,12 @@ struct ImageErrorStats {
 // Throws std::invalid_argument when the sizes differ.
 ImageErrorStats compare_images(const Image& a, const Image& b, int band = 1);
 
+// A CPU reference's estimate of its own error: the rgb differences between its images of
+// one scene at two qualities, over the pixels both cover (alpha != 0). relative_rms is
+// rms over the root mean square of the finer image's values (0 when that is 0).
+struct ReferenceError {
+    double rms = 0.0, max = 0.0, relative_rms = 0.0;
+};
+ReferenceError reference_error(const Image& coarse, const Image& fine);
+
 }  // namespace lucent

@@ -66,4 +66,21 @@ void for_each_row_parallel(int height, const std::function<void(int)>& row) {
     for (auto& thread : pool) thread.join();
 }
 
+Image shade_front_hits(const PixelRays& rays, const RayCaster& caster,
+                       glm::vec3 background, const HitShader& shade) {
+    Image image(rays.width(), rays.height());
+    for_each_row_parallel(rays.height(), [&](int row) {
+        for (int x = 0; x < rays.width(); ++x) {
+            const glm::dvec3 direction = rays.direction(x, row);
+            const std::optional<RayHit> front = rays.front_hit(caster, direction);
+            if (!front) {
+                image.set(x, row, glm::vec4(background, 0.0f));
+                continue;
+            }
+            image.set(x, row, glm::vec4(glm::vec3(shade(direction, *front)), 1.0f));
+        }
+    });
+    return image;
+}
+
 }  // namespace lucent

@@ -1,14 +1,15 @@
 #pragma once
 // What every CPU reference renderer needs to sample a scene as the GL rasteriser does:
 // one ray per pixel centre through the scene's camera (image rows top first), the
-// eye-space depth of a hit, vertex attributes interpolated at a hit, and rows rendered
-// in parallel.
+// eye-space depth of a hit, vertex attributes interpolated at a hit, rows rendered in
+// parallel, and the pixel loop of the references that shade the nearest surface.
 #include <functional>
 #include <glm/glm.hpp>
 #include <optional>
 #include <vector>
 
 #include "renderer/core/camera.h"
+#include "renderer/core/image.h"
 #include "renderer/core/mesh.h"
 #include "renderer/cpu/ray_caster.h"
 
@@ -17,6 +18,9 @@ namespace lucent {
 class PixelRays {
 public:
     PixelRays(const Camera& camera, int width, int height);
+
+    int width() const { return width_; }
+    int height() const { return height_; }
 
     glm::dvec3 eye() const { return eye_; }
     const glm::dmat4& view() const { return view_; }
@@ -57,5 +61,12 @@ SurfaceSample interpolate_at(const Mesh& mesh, const RayHit& hit,
 
 // Calls `row(y)` for every y in [0, height), spread over the hardware threads.
 void for_each_row_parallel(int height, const std::function<void(int)>& row);
+
+// The reference pixel loop (ward, contrast_reversed, dipole, htsm): every pixel ray's
+// front hit (PixelRays::front_hit, rows in parallel) gets the rgb `shade(direction,
+// hit)` with alpha 1; a pixel without one is `background` with alpha 0, as GL's clear.
+using HitShader = std::function<glm::dvec3(glm::dvec3 direction, const RayHit& hit)>;
+Image shade_front_hits(const PixelRays& rays, const RayCaster& caster,
+                       glm::vec3 background, const HitShader& shade);
 
 }  // namespace lucent

@@ -8,6 +8,7 @@
 
 #include "renderer/core/frame_plan.h"
 #include "renderer/core/image.h"
+#include "renderer/core/image_compare.h"
 #include "renderer/core/knobs.h"
 #include "renderer/core/scene.h"
 #include "renderer/techniques/deferred_surface.h"
@@ -77,11 +78,8 @@ struct ReferenceStats {
 };
 Image render_reference(const Scene& scene, const IntegratorQuality& quality,
                        ReferenceStats* stats = nullptr);
-// The reference's own error: RMS and max abs difference (linear rgb, object pixels)
-// between quality and quality.halved(); returns the halved image.
-struct ReferenceError {
-    double rms = 0.0, max = 0.0, relative_rms = 0.0;
-};
+// The reference's own error (core/image_compare.h reference_error) between quality and
+// quality.halved(); returns the halved image.
 Image render_reference_with_error(const Scene& scene, const IntegratorQuality& quality,
                                   ReferenceError& error);
 

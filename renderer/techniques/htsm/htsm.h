@@ -11,6 +11,7 @@
 
 #include "renderer/core/frame_plan.h"
 #include "renderer/core/image.h"
+#include "renderer/core/image_compare.h"
 #include "renderer/core/knobs.h"
 #include "renderer/core/light_view.h"
 #include "renderer/core/scene.h"
@@ -82,11 +83,8 @@ struct ReferenceQuality {
     ReferenceQuality halved() const { return {oversample / 2, steps / 2}; }
 };
 Image render_reference(const Scene& scene, const ReferenceQuality& quality);
-struct ReferenceError {
-    double rms = 0.0, max = 0.0;
-};
 // Renders at `quality` and at quality.halved(): the difference is the reference's own
-// error estimate; returns the finer image.
+// error estimate (core/image_compare.h reference_error); returns the finer image.
 Image render_reference_with_error(const Scene& scene, const ReferenceQuality& quality,
                                   ReferenceError& error);
 

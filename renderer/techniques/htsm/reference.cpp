@@ -122,19 +122,11 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
     const double fine_per_plane = light ? light->size() / plane : 0.0;
 
     const glm::dvec3 l_eye = scene.light.direction;
-    const int w = scene.width, h = scene.height;
-    const PixelRays rays(scene.camera, w, h);
-    Image image(w, h);
-    for_each_row_parallel(h, [&](int row) {
-        for (int x = 0; x < w; ++x) {
-            const glm::dvec3 direction = rays.direction(x, row);
-            const std::optional<RayHit> front = rays.front_hit(caster, direction);
-            if (!front) {
-                image.set(x, row, glm::vec4(scene.background, 0.0f));
-                continue;
-            }
-            const glm::dvec3 point = rays.eye() + double(front->distance) * direction;
-            const glm::dvec3 normal_raw = interpolate_at(mesh, *front, {}).normal;
+    const PixelRays rays(scene.camera, scene.width, scene.height);
+    return shade_front_hits(
+        rays, caster, scene.background, [&](glm::dvec3 direction, const RayHit& front) {
+            const glm::dvec3 point = rays.eye() + double(front.distance) * direction;
+            const glm::dvec3 normal_raw = interpolate_at(mesh, front, {}).normal;
             const double n_length = glm::length(normal_raw);
             const glm::dvec3 n =
                 n_length > 0.0 ? normal_raw / n_length : glm::dvec3(0, 0, 1);
@@ -183,7 +175,7 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
                 const glm::dvec3 n_eye = glm::normalize(rays.normal_matrix() * n);
                 const double n_dot_l = glm::dot(n_eye, l_eye);
                 if (n_dot_l > 0.0) {
-                    glm::dvec3 geometric(front->geometric_normal);
+                    glm::dvec3 geometric(front.geometric_normal);
                     if (glm::dot(geometric, g.to_light) < 0.0) geometric = -geometric;
                     const glm::dvec3 origin = point + 1e-4 * g.phi * geometric;
                     if (!caster.occluded(glm::vec3(origin), glm::vec3(g.to_light), 0.0f,
@@ -195,34 +187,15 @@ Image render_reference(const Scene& scene, const ReferenceQuality& quality) {
                     }
                 }
             }
-            image.set(x, row, glm::vec4(glm::vec3(colour), 1.0f));
-        }
-    });
-    return image;
+            return colour;
+        });
 }
 
 Image render_reference_with_error(const Scene& scene, const ReferenceQuality& quality,
                                   ReferenceError& error) {
     const Image coarse = render_reference(scene, quality.halved());
     Image fine = render_reference(scene, quality);
-    double sum2 = 0.0, worst = 0.0;
-    std::size_t count = 0;
-    for (int y = 0; y < fine.height; ++y)
-        for (int x = 0; x < fine.width; ++x) {
-            const glm::vec4 a = coarse.at(x, y), b = fine.at(x, y);
-            if (a.a == 0.0f || b.a == 0.0f) continue;
-            for (int c = 0; c < 3; ++c) {
-                const double d = double(a[c]) - double(b[c]);
-                sum2 += d * d;
-                worst = std::max(worst, std::abs(d));
-            }
-            ++count;
-        }
-    error = {};
-    if (count > 0) {
-        error.rms = std::sqrt(sum2 / (3.0 * count));
-        error.max = worst;
-    }
+    error = reference_error(coarse, fine);
     return fine;
 }
 

@@ -49,21 +49,12 @@ Image render_reference(const Scene& scene, Variant variant) {
         options.rays = p.ao_rays;
         vertex_ao = load_or_bake_ambient_occlusion(mesh, options);
     }
-    const int w = scene.width, h = scene.height;
-    const PixelRays rays(scene.camera, w, h);
+    const PixelRays rays(scene.camera, scene.width, scene.height);
     const RayCaster caster(mesh);
-
-    Image image(w, h);
-    auto render_row = [&](int row) {
-        for (int x = 0; x < w; ++x) {
-            const glm::dvec3 direction = rays.direction(x, row);
-            const std::optional<RayHit> front = rays.front_hit(caster, direction);
-            if (!front) {
-                image.set(x, row, glm::vec4(scene.background, 0.0f));
-                continue;
-            }
+    return shade_front_hits(
+        rays, caster, scene.background, [&](glm::dvec3 direction, const RayHit& front) {
             // Interpolated normal and AO (barycentric, as the rasteriser), eye space.
-            const SurfaceSample surface = interpolate_at(mesh, *front, vertex_ao);
+            const SurfaceSample surface = interpolate_at(mesh, front, vertex_ao);
             const glm::dvec3 normal = rays.normal_matrix() * surface.normal;
             const double n2 = glm::dot(normal, normal);
             const glm::dvec3 n =
@@ -71,13 +62,8 @@ Image render_reference(const Scene& scene, Variant variant) {
             const double ao = surface.ao;
             // View vector: from the hit point back to the eye, in eye space.
             const glm::dvec3 to_eye = glm::dmat3(rays.view()) * -direction;
-            image.set(x, row,
-                      glm::vec4(glm::vec3(shade(p, scene.light, variant, n, to_eye, ao)),
-                                1.0f));
-        }
-    };
-    for_each_row_parallel(h, render_row);
-    return image;
+            return shade(p, scene.light, variant, n, to_eye, ao);
+        });
 }
 
 }  // namespace lucent::ward
