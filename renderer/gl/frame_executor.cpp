@@ -295,6 +295,16 @@ struct FrameExecutor::Impl {
         return it->second.id();
     }
 
+    // The upload's data from the producer, checked against the resource it fills.
+    TextureData produce(const Pass& pass, const ResourceDesc& target) {
+        TextureData data = producer(pass);
+        const std::string problem = check_texture_data(target, data);
+        if (!problem.empty())
+            throw std::runtime_error("pass '" + pass.name + "': data for '" +
+                                     target.name + "': " + problem);
+        return data;
+    }
+
     // Calls the producer and uploads only when the content hash differs from the last
     // upload into this texture or stream (a reallocated one has none).
     void upload(const Pass& pass) {
@@ -302,11 +312,7 @@ struct FrameExecutor::Impl {
             return upload_stream(pass, stream->second);
         FrameTexture& target = textures.at(pass.writes.at(0));
         if (target.uploaded_hash == pass.data.content_hash) return;
-        const TextureData data = producer(pass);
-        const std::string problem = check_texture_data(target.desc, data);
-        if (!problem.empty())
-            throw std::runtime_error("pass '" + pass.name + "': data for '" +
-                                     target.desc.name + "': " + problem);
+        const TextureData data = produce(pass, target.desc);
         const bool three_d = target.desc.shape == ResourceShape::fixed_3d;
         const GLenum format = pixel_format(target.desc.format);
         for (std::size_t l = 0; l < data.levels.size(); ++l) {
@@ -325,11 +331,7 @@ struct FrameExecutor::Impl {
 
     void upload_stream(const Pass& pass, VertexStream& target) {
         if (target.uploaded_hash == pass.data.content_hash) return;
-        const TextureData data = producer(pass);
-        const std::string problem = check_texture_data(target.desc, data);
-        if (!problem.empty())
-            throw std::runtime_error("pass '" + pass.name + "': data for '" +
-                                     target.desc.name + "': " + problem);
+        const TextureData data = produce(pass, target.desc);
         const std::vector<float>& values = data.levels[0];
         target.buffer = make_buffer(
             values.data(), static_cast<GLsizeiptr>(values.size() * sizeof(float)));

@@ -272,27 +272,29 @@ TEST(PlanBuilder, CullsUnreadPassesTransitivelyAndNeverVisitsThem) {
     EXPECT_EQ(pass_names(full.compile()).size(), 4u);
 }
 
+// The message of the std::logic_error `f` throws, or "(accepted)".
+std::string logic_error_of(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const std::logic_error& e) {
+        return e.what();
+    }
+    return "(accepted)";
+}
+
 // Names are checked where they are declared: add() rejects the pass (one line naming it
 // and the name), so such a plan never compiles either.
 TEST(PlanBuilder, RejectsReadsBeforeWritesAndUndeclaredResources) {
-    const auto message = [](const std::function<void()>& f) -> std::string {
-        try {
-            f();
-        } catch (const std::logic_error& e) {
-            return e.what();
-        }
-        return "(accepted)";
-    };
     PlanBuilder builder(PlanMode::pruned, 8, 8);
     builder.create("out", ResourceFormat::rgba32f);
     builder.create("unwritten", ResourceFormat::r32f);
     Pass reader{"reader"};
     reader.reads = {{"missing", ""}};
     reader.writes = {"out"};
-    EXPECT_EQ(message([&] { builder.add(reader); }),
+    EXPECT_EQ(logic_error_of([&] { builder.add(reader); }),
               "frame plan: pass 'reader' reads 'missing', which no create() declared");
     reader.reads = {{"unwritten", ""}};
-    EXPECT_EQ(message([&] { builder.add(reader); }),
+    EXPECT_EQ(logic_error_of([&] { builder.add(reader); }),
               "frame plan: pass 'reader' reads 'unwritten' before any pass writes it");
     builder.set_output("out");
     EXPECT_THROW(builder.compile(), std::logic_error);
@@ -300,7 +302,7 @@ TEST(PlanBuilder, RejectsReadsBeforeWritesAndUndeclaredResources) {
     PlanBuilder undeclared(PlanMode::pruned, 8, 8);
     Pass writer{"writer"};
     writer.writes = {"nowhere"};
-    EXPECT_EQ(message([&] { undeclared.add(writer); }),
+    EXPECT_EQ(logic_error_of([&] { undeclared.add(writer); }),
               "frame plan: pass 'writer' writes undeclared 'nowhere'");
     undeclared.set_output("nowhere");
     EXPECT_THROW(undeclared.compile(), std::logic_error);
@@ -530,14 +532,6 @@ TEST(PlanBuilder, NewPassKindsAreCulledWhenUnreadAndKeptInFullMode) {
 // every upload they perform to the UploadProducer, which sees what it is only through
 // its DataSource.
 TEST(PlanBuilder, VertexStreamsAreUploadedResourcesReadByMeshPasses) {
-    const auto message = [](const std::function<void()>& f) -> std::string {
-        try {
-            f();
-        } catch (const std::logic_error& e) {
-            return e.what();
-        }
-        return "(accepted)";
-    };
     int produced = 0;
     const auto build = [&](ResourceDesc stream, PassKind reader, std::string hash) {
         PlanBuilder builder(PlanMode::pruned, 8, 8);
@@ -583,15 +577,15 @@ TEST(PlanBuilder, VertexStreamsAreUploadedResourcesReadByMeshPasses) {
               (std::vector<std::string>{"per_vertex", "draw"}));
 
     EXPECT_EQ(
-        message([&] { build(stream, PassKind::fullscreen, "h"); }),
+        logic_error_of([&] { build(stream, PassKind::fullscreen, "h"); }),
         "frame plan: pass 'draw' reads the vertex stream 'pairs' but draws no mesh");
-    EXPECT_EQ(message([&] {
+    EXPECT_EQ(logic_error_of([&] {
                   build(vertex_stream("pairs", ResourceFormat::rg32f, 5, 1),
                         PassKind::draw_mesh, "h");
               }),
               "frame plan: resource 'pairs': attribute 1 is not a free vertex attribute "
               "location");
-    EXPECT_EQ(message([&] {
+    EXPECT_EQ(logic_error_of([&] {
                   build(vertex_stream("pairs", ResourceFormat::rgba8, 5, 2),
                         PassKind::draw_mesh, "h");
               }),
@@ -601,7 +595,7 @@ TEST(PlanBuilder, VertexStreamsAreUploadedResourcesReadByMeshPasses) {
     drawn_into.create(stream);
     drawn_into.add(pass_writing("draw", {"pairs"}));
     drawn_into.set_output("pairs");
-    EXPECT_EQ(message([&] { drawn_into.compile(); }),
+    EXPECT_EQ(logic_error_of([&] { drawn_into.compile(); }),
               "frame plan: pass 'draw' draws into the vertex stream 'pairs'; streams are "
               "uploaded");
 }
