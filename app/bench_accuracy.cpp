@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "common/html/html_page.h"
 #include "renderer/core/image_compare.h"
 #include "renderer/gl/context.h"
 #include "renderer/render.h"
@@ -117,12 +118,6 @@ std::string sweep_label(const QualitySweep& sweep) {
     return fixed.empty() ? label : label + " (" + fixed + ")";
 }
 
-std::string escape(const std::string& text) {
-    std::string out;
-    for (char c : text) out += c == '<' ? "&lt;" : c == '&' ? "&amp;" : std::string(1, c);
-    return out;
-}
-
 // One panel per knob: RMSE (y) against the cost that varies along the sweep (x): the
 // precomputation when it varies, otherwise the GPU frame time.
 void write_svg(const std::string& path, const std::vector<Row>& rows,
@@ -137,7 +132,7 @@ void write_svg(const std::string& path, const std::vector<Row>& rows,
         << "' height='" << panel_h + 40 << "' font-family='sans-serif' font-size='11'>\n"
         << "<rect width='100%' height='100%' fill='white'/>\n<text x='10' y='16' "
            "font-size='13'>"
-        << escape(title) << "</text>\n";
+        << common::text_escape(title) << "</text>\n";
     for (std::size_t k = 0; k < knobs.size(); ++k) {
         std::vector<const Row*> series;
         for (const auto& r : rows)
@@ -160,7 +155,7 @@ void write_svg(const std::string& path, const std::vector<Row>& rows,
         const auto px = [&](double x) { return ox + x / max_x * w; };
         const auto py = [&](double y) { return oy - y / max_y * h; };
         svg << "<text x='" << ox << "' y='" << oy - h - 6 << "' font-weight='bold'>"
-            << escape(knobs[k]) << "</text>\n"
+            << common::text_escape(knobs[k]) << "</text>\n"
             << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox + w << "' y2='"
             << oy << "' stroke='black'/>\n"
             << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox << "' y2='"
@@ -183,7 +178,7 @@ void write_svg(const std::string& path, const std::vector<Row>& rows,
             svg << "<circle cx='" << px(x_of(r)) << "' cy='" << py(r->error.rmse)
                 << "' r='3' fill='steelblue'/>"
                 << "<text x='" << px(x_of(r)) + 5 << "' y='" << py(r->error.rmse) - 5
-                << "'>" << escape(r->value) << "</text>\n";
+                << "'>" << common::text_escape(r->value) << "</text>\n";
     }
     svg << "</svg>\n";
     if (!svg) throw std::runtime_error(path + ": cannot write the SVG plot");

@@ -1,17 +1,15 @@
 #include "analysis/report/report.h"
 
 #include <algorithm>
-#include <boost/archive/iterators/base64_from_binary.hpp>
-#include <boost/archive/iterators/transform_width.hpp>
 #include <cctype>
 #include <fstream>
 #include <sstream>
 
 #include "analysis/data/long_table.h"
 #include "analysis/report/format.h"
-#include "analysis/report/html_page.h"
 #include "analysis/report/svg_plot.h"
 #include "common/csv.h"
+#include "common/html/html_page.h"
 #include "common/output_file.h"
 
 namespace lucent::analysis {
@@ -34,21 +32,6 @@ struct Block {
     };
     std::vector<Image> images;  // kImages: thumbnails in a row
 };
-
-std::string html_escape(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        if (c == '<')
-            out += "&lt;";
-        else if (c == '>')
-            out += "&gt;";
-        else if (c == '&')
-            out += "&amp;";
-        else
-            out += c;
-    }
-    return out;
-}
 
 std::string md_cell(const std::string& s) {
     std::string out;
@@ -419,19 +402,19 @@ void render_html(const std::vector<Block>& doc, const ReportOptions& options,
            "title>\n<style>body{font-family:sans-serif;max-width:60em;margin:auto}"
            "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 8px;"
            "text-align:right}</style>"
-        << images_drawn_script() << "</head><body>\n";
+        << common::images_drawn_script() << "</head><body>\n";
     for (const Block& b : doc) {
         switch (b.kind) {
             case Block::kHeading:
-                out << "<h" << b.level << '>' << html_escape(b.text) << "</h" << b.level
-                    << ">\n";
+                out << "<h" << b.level << '>' << common::text_escape(b.text) << "</h"
+                    << b.level << ">\n";
                 break;
             case Block::kParagraph:
-                out << "<p>" << html_escape(b.text) << "</p>\n";
+                out << "<p>" << common::text_escape(b.text) << "</p>\n";
                 break;
             case Block::kPlot:
                 out << "<figure>" << b.svg << "<figcaption>saved as "
-                    << html_escape(b.text) << "</figcaption></figure>\n";
+                    << common::text_escape(b.text) << "</figcaption></figure>\n";
                 break;
             case Block::kImages:
                 out << "<div class=\"thumbnails\">";
@@ -439,13 +422,14 @@ void render_html(const std::vector<Block>& doc, const ReportOptions& options,
                     out << "<figure style=\"display:inline-block;margin:4px\">";
                     const std::string png = embedded_picture(image.path, options);
                     if (!png.empty())
-                        out << "<img width=\"128\" alt=\"" << html_escape(image.caption)
-                            << "\" src=\"data:image/png;base64," << base64_encode(png)
-                            << "\">";
+                        out << "<img width=\"128\" alt=\""
+                            << common::text_escape(image.caption)
+                            << "\" src=\"data:image/png;base64,"
+                            << common::base64_encode(png) << "\">";
                     else
-                        out << "(image unreadable: " << html_escape(image.path.string())
-                            << ")";
-                    out << "<figcaption>" << html_escape(image.caption)
+                        out << "(image unreadable: "
+                            << common::text_escape(image.path.string()) << ")";
+                    out << "<figcaption>" << common::text_escape(image.caption)
                         << "</figcaption></figure>";
                 }
                 out << "</div>\n";
@@ -453,12 +437,12 @@ void render_html(const std::vector<Block>& doc, const ReportOptions& options,
             case Block::kTable:
                 out << "<table><tr>";
                 for (const auto& h : b.table.header)
-                    out << "<th>" << html_escape(h) << "</th>";
+                    out << "<th>" << common::text_escape(h) << "</th>";
                 out << "</tr>\n";
                 for (const auto& row : b.table.rows) {
                     out << "<tr>";
                     for (const auto& cell : row)
-                        out << "<td>" << html_escape(cell) << "</td>";
+                        out << "<td>" << common::text_escape(cell) << "</td>";
                     out << "</tr>\n";
                 }
                 out << "</table>\n";
@@ -590,14 +574,6 @@ level_images_from_directory(const LongTable& table,
             images[key] = {row.stimulus, png};
     }
     return images;
-}
-
-std::string base64_encode(std::string_view bytes) {
-    using namespace boost::archive::iterators;
-    using Encoder = base64_from_binary<transform_width<const char*, 6, 8>>;
-    std::string out(Encoder(bytes.data()), Encoder(bytes.data() + bytes.size()));
-    out.append((3 - bytes.size() % 3) % 3, '=');
-    return out;
 }
 
 std::string figure_file_name(const std::string& factor) {

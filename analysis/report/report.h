@@ -47,9 +47,6 @@ std::map<std::pair<std::string, std::string>,
 level_images_from_directory(const LongTable& table,
                             const std::filesystem::path& directory);
 
-// RFC 4648 base64 of `bytes` (for images embedded in the HTML report).
-std::string base64_encode(std::string_view bytes);
-
 // "md,csv,html" (any subset, comma-separated); throws InputError naming a bad entry.
 void parse_formats(const std::string& list, ReportOptions& options);
 

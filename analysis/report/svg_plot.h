@@ -24,22 +24,3 @@ std::string factor_figure_svg(const std::string& factor,
                               const std::vector<QuestionPanel>& panels);
 
 }  // namespace lucent::analysis
-
-namespace lucent::analysis {
-
-// Text safe inside HTML or SVG markup and attribute values (& < > ").
-std::string markup_escape(const std::string& text);
-
-// Small plots for stimulus-set reports (a few hundred pixels wide):
-// a histogram of `shares` (one bar per equal-width bin over [0, 1], heights are fractions
-// of the pixels), titled, with the bins' range under the axis;
-std::string histogram_svg(const std::string& title, const std::vector<double>& shares,
-                          const std::string& x_label = "luminance");
-// one value per level, as dots joined by a line, on an axis spanning the values; the
-// levels' names under the axis, `x_label` (e.g. the factor) below them.
-std::string level_values_svg(const std::string& title,
-                             const std::vector<std::string>& levels,
-                             const std::vector<double>& values,
-                             const std::string& x_label = "");
-
-}  // namespace lucent::analysis

@@ -18,11 +18,10 @@
 #include <set>
 #include <sstream>
 
-#include "analysis/report/html_page.h"
-#include "analysis/report/report.h"
-#include "analysis/report/svg_plot.h"
 #include "common/content_hash.h"
 #include "common/csv.h"
+#include "common/html/html_page.h"
+#include "common/html/svg_plot.h"
 #include "common/number_text.h"
 #include "common/output_file.h"
 #include "common/srgb.h"
@@ -36,7 +35,7 @@ namespace lucent::stimuli {
 namespace {
 
 namespace fs = std::filesystem;
-using analysis::markup_escape;
+using common::markup_escape;
 
 constexpr int kThumbnailSide = 160;
 
@@ -582,7 +581,7 @@ void write_html(std::ostream& out, const SetReport& r) {
            ".5em;text-align:right}td:first-child,th:first-child{text-align:left}"
         << ".warn{color:#a00}.plots svg{margin:.2em}</style>\n"
         // Marks the page once every picture has decoded, for headless-browser checks.
-        << analysis::images_drawn_script() << "</head><body>\n";
+        << common::images_drawn_script() << "</head><body>\n";
     out << "<h1>Stimulus set " << markup_escape(r.set_name) << "</h1>\n<p>"
         << r.stimuli.size() << " stimuli from <code>"
         << markup_escape((r.directory / "manifest.csv").string())
@@ -614,8 +613,7 @@ void write_html(std::ostream& out, const SetReport& r) {
             out << "<figure><img width=\"" << s.thumbnail.width << "\" height=\""
                 << s.thumbnail.height << "\" alt=\"" << markup_escape(s.id)
                 << "\" src=\"data:image/png;base64,"
-                << analysis::base64_encode(thumbnail_png(s.thumbnail))
-                << "\"><figcaption>";
+                << common::base64_encode(thumbnail_png(s.thumbnail)) << "\"><figcaption>";
             const auto lines = label_of(s);
             for (std::size_t k = 0; k < lines.size(); ++k)
                 out << (k ? "<br>" : "<b>") << markup_escape(lines[k])
@@ -684,7 +682,7 @@ void write_html(std::ostream& out, const SetReport& r) {
             std::vector<double> values;
             for (std::size_t m : series.members)
                 values.push_back(statistic(r.stimuli[m], column));
-            out << analysis::level_values_svg(title, levels, values, axis);
+            out << common::level_values_svg(title, levels, values, axis);
         }
         out << "</div>\n";
     }
@@ -701,7 +699,7 @@ void write_html(std::ostream& out, const SetReport& r) {
         for (const char* column : {"mean_luminance", "rms_contrast", "skewness",
                                    "saturation_intensity_correlation"})
             out << "<td>" << fixed(statistic(s, column), 3) << "</td>";
-        out << "<td>" << analysis::histogram_svg(s.id, histogram_shares(s))
+        out << "<td>" << common::histogram_svg(s.id, histogram_shares(s))
             << "</td></tr>\n";
     }
     out << "</table>\n</body></html>\n";

@@ -12,6 +12,7 @@
 #include "analysis/analyze.h"
 #include "analysis/data/long_table.h"
 #include "analysis/report/svg_plot.h"
+#include "common/html/html_page.h"
 #include "tests/support/test_paths.h"
 
 namespace lucent::analysis {
@@ -346,18 +347,6 @@ TEST(Report, FactorFigurePutsQuestionsSideBySideOnOneScale) {
     EXPECT_FALSE(std::regex_search(svg, std::regex("nan|inf", std::regex::icase)));
 }
 
-TEST(Report, Base64MatchesRfc4648TestVectors) {
-    // RFC 4648 section 10.
-    EXPECT_EQ(base64_encode(""), "");
-    EXPECT_EQ(base64_encode("f"), "Zg==");
-    EXPECT_EQ(base64_encode("fo"), "Zm8=");
-    EXPECT_EQ(base64_encode("foo"), "Zm9v");
-    EXPECT_EQ(base64_encode("foob"), "Zm9vYg==");
-    EXPECT_EQ(base64_encode("fooba"), "Zm9vYmE=");
-    EXPECT_EQ(base64_encode("foobar"), "Zm9vYmFy");
-    EXPECT_EQ(base64_encode(std::string("\xff\x00\xfe", 3)), "/wD+");
-}
-
 TEST(Report, LevelPicturesAreEmbeddedBesideTheirDescriptives) {
     const auto dir = test::scratch_dir("report_thumbnails");
     const auto images = dir / "stimuli";
@@ -377,12 +366,12 @@ TEST(Report, LevelPicturesAreEmbeddedBesideTheirDescriptives) {
     options.csv = false;
     write_report(analyze_table(table, AnalysisRequest{}).pairs, dir / "out", options);
     const std::string html = slurp(dir / "out" / "report.html");
-    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thin")),
+    EXPECT_NE(html.find("data:image/png;base64," + common::base64_encode("PNG-thin")),
               std::string::npos);
-    EXPECT_NE(html.find("data:image/png;base64," + base64_encode("PNG-thick")),
+    EXPECT_NE(html.find("data:image/png;base64," + common::base64_encode("PNG-thick")),
               std::string::npos);
-    EXPECT_LT(html.find(base64_encode("PNG-thin")),
-              html.find(base64_encode("PNG-thick")));
+    EXPECT_LT(html.find(common::base64_encode("PNG-thin")),
+              html.find(common::base64_encode("PNG-thick")));
     EXPECT_NE(html.find("r 30 (thick)"), std::string::npos);
     EXPECT_THROW(level_images_from_directory(table, dir / "missing"), InputError);
 }

@@ -1,13 +1,15 @@
 // The stimulus-set report's small plots: bar heights proportional to the shares, one dot
-// per defined value, and no NaN or Inf in the SVG text.
+// per defined value, and no NaN or Inf in the SVG text; the pieces every chart uses.
+#include "common/html/svg_plot.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <regex>
 
-#include "analysis/report/svg_plot.h"
+#include "common/html/html_page.h"
 
-namespace lucent::analysis {
+namespace lucent::common {
 namespace {
 
 std::size_t count(const std::string& text, const std::string& what) {
@@ -47,5 +49,26 @@ TEST(SmallPlots, LevelValuesSkipUndefinedValuesAndNameTheAxis) {
     EXPECT_EQ(markup_escape("a<b & \"c\""), "a&lt;b &amp; &quot;c&quot;");
 }
 
+TEST(SvgPieces, NumbersHaveTwoDecimalsAndRangesCanBeDrawn) {
+    EXPECT_EQ(svg_number(12.5), "12.50");
+    EXPECT_EQ(svg_number(-0.004), "-0.00");
+    double lo = 2, hi = 4;  // padded by 5% of 2 on each side
+    padded_range(lo, hi);
+    EXPECT_DOUBLE_EQ(lo, 1.9);
+    EXPECT_DOUBLE_EQ(hi, 4.1);
+    lo = 3, hi = 3;  // one value: a unit range around it, padded
+    padded_range(lo, hi);
+    EXPECT_DOUBLE_EQ(lo, 2.45);
+    EXPECT_DOUBLE_EQ(hi, 3.55);
+    lo = INFINITY, hi = -INFINITY;  // nothing defined: [0, 1], padded
+    padded_range(lo, hi);
+    EXPECT_DOUBLE_EQ(lo, -0.05);
+    EXPECT_DOUBLE_EQ(hi, 1.05);
+    const std::string header = svg_header(200, 120);
+    EXPECT_EQ(header.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"200\"", 0),
+              0u);
+    EXPECT_NE(header.find("viewBox=\"0 0 200 120\""), std::string::npos);
+}
+
 }  // namespace
-}  // namespace lucent::analysis
+}  // namespace lucent::common
