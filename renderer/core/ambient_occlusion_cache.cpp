@@ -19,6 +19,7 @@
 #include <random>
 #include <string>
 
+#include "common/content_hash.h"
 #include "renderer/core/ambient_occlusion.h"
 #include "renderer/core/progress.h"
 
@@ -45,11 +46,7 @@ static_assert(sizeof(CacheHeader) == 56);
 
 template <typename T>
 std::uint64_t checksum(const std::vector<T>& values) {  // FNV-1a over the bytes
-    std::uint64_t hash = 0xcbf29ce484222325ull;
-    const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-    for (std::size_t i = 0; i < values.size() * sizeof(T); ++i)
-        hash = (hash ^ bytes[i]) * 0x100000001b3ull;
-    return hash;
+    return common::ContentHash().bytes(values.data(), values.size() * sizeof(T)).result();
 }
 
 CacheHeader header_for(const Mesh& mesh, int rays, const std::vector<float>& values) {

@@ -14,6 +14,9 @@
 #include <mutex>
 #include <sstream>
 
+#include "common/content_hash.h"
+#include "common/number_text.h"
+
 namespace lucent {
 namespace {
 
@@ -54,14 +57,6 @@ std::string list_of(const std::vector<std::string>& names) {
     std::string text;
     for (const auto& n : names) text += (text.empty() ? "" : ", ") + n;
     return text;
-}
-
-bool parse_number(std::string_view text, double& value) {
-    if (text.empty()) return false;
-    const auto [end, error] =
-        std::from_chars(text.data(), text.data() + text.size(), value);
-    return error == std::errc() && end == text.data() + text.size() &&
-           std::isfinite(value);
 }
 
 bool ends_with(std::string_view text, std::string_view suffix) {
@@ -241,23 +236,10 @@ std::vector<float> read_nrrd(const std::string& path, glm::ivec3& size) {
 }
 
 std::string hash_of(glm::ivec3 size, const std::vector<float>& voxels) {
-    std::uint64_t hash = 0xcbf29ce484222325ull;
-    const auto mix = [&hash](std::uint32_t word) {
-        for (int byte = 0; byte < 4; ++byte) {
-            hash ^= (word >> (8 * byte)) & 0xffu;
-            hash *= 0x100000001b3ull;
-        }
-    };
-    for (int a = 0; a < 3; ++a) mix(std::uint32_t(size[a]));
-    for (float v : voxels) {
-        std::uint32_t bits = 0;
-        const float value = v == 0.0f ? 0.0f : v;
-        std::memcpy(&bits, &value, sizeof bits);
-        mix(bits);
-    }
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
-    return text;
+    common::ContentHash hash;
+    for (int a = 0; a < 3; ++a) hash.word(std::uint32_t(size[a]));
+    for (float v : voxels) hash.float_bits(v);  // -0 and +0 hash alike
+    return hash.hex();
 }
 
 }  // namespace
@@ -310,8 +292,10 @@ DensitySpec parse_density_spec(std::string_view text) {
         if (key == "axis" && value_text.size() == 1 && value_text[0] >= 'x' &&
             value_text[0] <= 'z')
             value = value_text[0] - 'x';
-        else if (!parse_number(value_text, value) || value < range->min ||
-                 value > range->max)
+        else if (const auto number = common::parse_finite(value_text);
+                 number && *number >= range->min && *number <= range->max)
+            value = *number;
+        else
             fail(spec.generator + ": " + key + " '" + std::string(value_text) +
                  "' is not a number in [" + std::to_string(range->min) + ", " +
                  std::to_string(range->max) + "]");

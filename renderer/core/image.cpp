@@ -60,15 +60,6 @@ std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
 constexpr const char* kPngStrategy = "rle";
 constexpr int kPngFilterPaeth = 0x80;  // libpng's PNG_FILTER_PAETH
 
-}  // namespace
-
-float srgb_encode(float linear) {
-    const float v = std::clamp(linear, 0.0f, 1.0f);
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-
-namespace {
-
 // The 8-bit sRGB encoding by table: threshold[k] is the smallest float whose
 // lround(srgb_encode(v) * 255) is at least k (binary search over the float bit
 // patterns, as the encoding is monotone), and bucket[] the code at the start of each

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "common/number_text.h"
+
 namespace lucent {
 namespace {
 
@@ -25,12 +27,10 @@ std::string_view trim(std::string_view text) {
 // Whole-string parse of a finite real number; nullopt-like failure through `ok`.
 bool parse_real(std::string_view text, double& value) {
     text = trim(text);
-    if (text.empty()) return false;
-    if (text.front() == '+') text.remove_prefix(1);
-    const auto [end, error] =
-        std::from_chars(text.data(), text.data() + text.size(), value);
-    return error == std::errc() && end == text.data() + text.size() &&
-           std::isfinite(value);
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    const auto number = common::parse_finite(text);
+    if (number) value = *number;
+    return number.has_value();
 }
 
 std::vector<std::string_view> split_commas(std::string_view text) {

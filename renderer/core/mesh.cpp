@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <unordered_map>
 
+#include "common/content_hash.h"
 #include "renderer/core/mesh_sources.h"
 
 namespace lucent {
@@ -72,38 +73,20 @@ BoundingSphere Mesh::bounding_sphere() const {
 std::string compute_content_hash(const std::vector<glm::vec3>& positions,
                                  const std::vector<glm::uvec3>& triangles,
                                  const std::vector<glm::vec2>& uvs) {
-    std::uint64_t hash = 0xcbf29ce484222325ull;
-    auto mix = [&hash](std::uint32_t word) {
-        for (int byte = 0; byte < 4; ++byte) {
-            hash ^= (word >> (8 * byte)) & 0xffu;
-            hash *= 0x100000001b3ull;
-        }
-    };
+    common::ContentHash hash;
     // Counts first, so (positions, triangles) splits cannot collide by concatenation.
-    mix(static_cast<std::uint32_t>(positions.size()));
-    mix(static_cast<std::uint32_t>(triangles.size()));
+    hash.word(static_cast<std::uint32_t>(positions.size()));
+    hash.word(static_cast<std::uint32_t>(triangles.size()));
     for (const glm::vec3& p : positions)
-        for (int k = 0; k < 3; ++k) {
-            const float value = p[k] == 0.0f ? 0.0f : p[k];  // -0 and +0 hash alike
-            std::uint32_t bits = 0;
-            std::memcpy(&bits, &value, sizeof bits);
-            mix(bits);
-        }
+        for (int k = 0; k < 3; ++k) hash.float_bits(p[k]);  // -0 and +0 hash alike
     for (const glm::uvec3& t : triangles)
-        for (int k = 0; k < 3; ++k) mix(t[k]);
+        for (int k = 0; k < 3; ++k) hash.word(t[k]);
     if (!uvs.empty()) {
-        mix(static_cast<std::uint32_t>(uvs.size()));
+        hash.word(static_cast<std::uint32_t>(uvs.size()));
         for (const glm::vec2& uv : uvs)
-            for (int k = 0; k < 2; ++k) {
-                const float value = uv[k] == 0.0f ? 0.0f : uv[k];
-                std::uint32_t bits = 0;
-                std::memcpy(&bits, &value, sizeof bits);
-                mix(bits);
-            }
+            for (int k = 0; k < 2; ++k) hash.float_bits(uv[k]);
     }
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
-    return text;
+    return hash.hex();
 }
 
 std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& positions,

@@ -17,6 +17,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "common/content_hash.h"
 #include "renderer/core/mesh.h"
 #include "renderer/core/mesh_sources.h"
 
@@ -88,9 +89,8 @@ struct PositionKey {
 };
 struct PositionKeyHash {
     std::size_t operator()(const PositionKey& k) const {
-        std::uint64_t h = 1469598103934665603ull;
-        for (std::uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
-        return static_cast<std::size_t>(h);
+        return static_cast<std::size_t>(
+            common::ContentHash().bytes(k.bits, sizeof k.bits).result());
     }
 };
 

@@ -2,33 +2,14 @@
 
 #include <cstring>
 
+#include "common/content_hash.h"
+
 namespace lucent {
 namespace {
 
-// FNV-1a, 64 bit, over bytes; values are fed with their size so fields cannot run into
-// each other.
-class Hasher {
-public:
-    void bytes(const void* data, std::size_t size) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        for (std::size_t i = 0; i < size; ++i) {
-            hash_ ^= p[i];
-            hash_ *= 0x100000001b3ull;
-        }
-    }
-    template <typename T>
-    void value(const T& v) {
-        bytes(&v, sizeof v);
-    }
-    void text(const std::string& s) {
-        value(s.size());
-        bytes(s.data(), s.size());
-    }
-    std::uint64_t result() const { return hash_; }
-
-private:
-    std::uint64_t hash_ = 0xcbf29ce484222325ull;
-};
+// FNV-1a, 64 bit, over the values' bytes (in-process keys); texts are fed with their
+// size so fields cannot run into each other.
+using Hasher = common::ContentHash;
 
 bool same_storage(const ResourceDesc& a, const ResourceDesc& b) {
     return a.format == b.format && a.shape == b.shape && a.size == b.size &&

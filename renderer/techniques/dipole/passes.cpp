@@ -19,6 +19,7 @@
 #include <memory>
 #include <mutex>
 
+#include "common/number_text.h"
 #include "renderer/core/light_view.h"
 #include "renderer/techniques/ambient_occlusion_pass.h"
 #include "renderer/techniques/deferred_surface.h"
@@ -61,12 +62,6 @@ double surface_area_mm2(const Mesh& mesh, double scale) {
         area += 0.5 * glm::length(glm::cross(b - a, c - a));
     }
     return area * scale * scale;
-}
-
-std::string number(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.17g", value);
-    return text;
 }
 
 }  // namespace
@@ -152,8 +147,9 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
         lazy->mesh = scene.mesh;
         lazy->scale = scale;
         lazy->resolution = atlas;
-        const std::string atlas_hash =
-            mesh.content_hash + "-s" + number(scale) + "-a" + std::to_string(atlas);
+        const std::string atlas_hash = mesh.content_hash + "-s" +
+                                       common::full_precision_text(scale) + "-a" +
+                                       std::to_string(atlas);
         Pass positions{"atlas_positions",
                        "surfel atlas: equal-area texels, xyz mm and area mm^2",
                        PassKind::upload};
@@ -245,7 +241,7 @@ void add_passes(const Scene& scene, PlanBuilder& plan, SurfaceShading shading) {
                 return t;
             }();
             std::string hash = "ring";
-            for (float v : texels) hash += "," + number(v);
+            for (float v : texels) hash += "," + common::full_precision_text(v);
             Pass ring{"ring_pattern",
                       "local pattern: " + std::to_string(pattern.offset.size()) +
                           " equal-mass samples on the light plane",

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "common/srgb.h"
 #include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
@@ -72,11 +73,6 @@ double uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b = 0) {
            0x1.0p-53;
 }
 
-float srgb_decode(float encoded) {
-    const float c = std::clamp(encoded, 0.0f, 1.0f);
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
 TexelGrid from_file(const std::string& spec) {
     std::error_code error;
     if (!std::filesystem::is_regular_file(spec, error))
@@ -107,7 +103,8 @@ TexelGrid from_file(const std::string& spec) {
             grid.opaque[k] = c.a >= 0.5f ? 1 : 0;
             grid.colour[k] =
                 linear ? glm::clamp(glm::vec3(c), 0.0f, 1.0f)
-                       : glm::vec3(srgb_decode(c.r), srgb_decode(c.g), srgb_decode(c.b));
+                       : glm::vec3(common::srgb_decode(c.r), common::srgb_decode(c.g),
+                                   common::srgb_decode(c.b));
         }
     return grid;
 }
