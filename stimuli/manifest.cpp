@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "common/csv.h"
+#include "common/output_file.h"
 #include "lucent/version.h"
 
 namespace lucent::stimuli {
@@ -53,15 +54,7 @@ std::string json_escape(std::string_view text) {
 }
 
 void write_atomically(const std::filesystem::path& path, const std::string& text) {
-    const auto temporary =
-        path.parent_path() / ("." + path.filename().string() + ".partial");
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        out << text;
-        out.flush();
-        if (!out) throw std::runtime_error(temporary.string() + ": cannot write");
-    }
-    std::filesystem::rename(temporary, path);
+    common::write_file_atomically(path, true, [&](std::ostream& out) { out << text; });
 }
 
 }  // namespace

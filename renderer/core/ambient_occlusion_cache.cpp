@@ -6,7 +6,6 @@
 // but other normals rebakes instead of reusing the file.
 // A file is trusted only if every header field matches, its size is exact, the
 // checksum matches and every value is in [0, 1]; otherwise the bake is redone.
-#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -16,10 +15,10 @@
 #include <cstring>
 #include <fstream>
 #include <optional>
-#include <random>
 #include <string>
 
 #include "common/content_hash.h"
+#include "common/output_file.h"
 #include "renderer/core/ambient_occlusion.h"
 #include "renderer/core/progress.h"
 
@@ -87,8 +86,8 @@ std::optional<std::vector<float>> read_cache(const std::filesystem::path& path,
     return values;
 }
 
-// Writes to a unique temporary file in the same directory, then renames it over the
-// target: readers see the old file or the complete new one, never a partial one.
+// Written atomically (common/output_file.h: a unique temporary sibling, renamed over the
+// target): readers see the old file or the complete new one, never a partial one.
 bool write_cache(const std::filesystem::path& path, const Mesh& mesh, int rays,
                  const std::vector<float>& values, std::string& reason) {
     std::error_code error;
@@ -97,27 +96,15 @@ bool write_cache(const std::filesystem::path& path, const Mesh& mesh, int rays,
         reason = error.message();
         return false;
     }
-    std::random_device entropy;
-    const auto temporary =
-        std::filesystem::path(path.string() + ".tmp-" + std::to_string(getpid()) + "-" +
-                              std::to_string(entropy()));
-    {
-        std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-        const CacheHeader header = header_for(mesh, rays, values);
-        file.write(reinterpret_cast<const char*>(&header), sizeof header);
-        file.write(reinterpret_cast<const char*>(values.data()),
-                   static_cast<std::streamsize>(values.size() * sizeof(float)));
-        file.close();
-        if (!file) {
-            reason = "cannot write " + temporary.string();
-            std::filesystem::remove(temporary, error);
-            return false;
-        }
-    }
-    std::filesystem::rename(temporary, path, error);
-    if (error) {
-        reason = error.message();
-        std::filesystem::remove(temporary, error);
+    try {
+        common::write_file_atomically(path, true, [&](std::ostream& file) {
+            const CacheHeader header = header_for(mesh, rays, values);
+            file.write(reinterpret_cast<const char*>(&header), sizeof header);
+            file.write(reinterpret_cast<const char*>(values.data()),
+                       static_cast<std::streamsize>(values.size() * sizeof(float)));
+        });
+    } catch (const common::OutputError& e) {
+        reason = e.what();
         return false;
     }
     return true;

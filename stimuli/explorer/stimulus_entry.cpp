@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "common/output_file.h"
 #include "renderer/techniques/registry.h"
 #include "stimuli/stimulus_set.h"
 
@@ -21,18 +22,9 @@ std::string read_text(const std::filesystem::path& path) {
     return text.str();
 }
 
-// Temporary file + rename: the config is never seen half written.
+// Temporary file + rename (common/output_file.h): the config is never seen half written.
 void write_text(const std::filesystem::path& path, const std::string& text) {
-    const std::filesystem::path temporary = path.string() + ".explore-tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        if (!(out << text) || !out.flush())
-            throw std::runtime_error(temporary.string() + ": cannot write");
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, path, error);
-    if (error)
-        throw std::runtime_error(path.string() + ": cannot replace: " + error.message());
+    common::write_file_atomically(path, true, [&](std::ostream& out) { out << text; });
 }
 
 std::string quoted(const std::string& text) {
