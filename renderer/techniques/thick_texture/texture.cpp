@@ -1,9 +1,9 @@
 // Binary textures of the thick_texture technique: procedural patterns (no files needed)
 // and image files through OpenImageIO (alpha < 0.5 = hole).
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 
+#include "common/number_text.h"
 #include "common/srgb.h"
 #include "renderer/techniques/thick_texture/thick_texture.h"
 
@@ -25,13 +25,9 @@ std::vector<double> arguments(const std::string& spec, const std::string& text,
     while (start <= text.size()) {
         const std::size_t comma = std::min(text.find(',', start), text.size());
         const std::string part = text.substr(start, comma - start);
-        double value = 0.0;
-        const auto [end, error] =
-            std::from_chars(part.data(), part.data() + part.size(), value);
-        if (part.empty() || error != std::errc() || end != part.data() + part.size() ||
-            !std::isfinite(value))
-            fail(spec, "has '" + part + "', not a number");
-        values.push_back(value);
+        const auto value = common::parse_finite(part);
+        if (!value) fail(spec, "has '" + part + "', not a number");
+        values.push_back(*value);
         start = comma + 1;
     }
     if (values.size() != count)
