@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "renderer/techniques/registry.h"
 #include "study/embedded_study_files.h"
 #include "study/sha256.h"
 
@@ -230,14 +231,11 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
             r.fail(nullptr, "technique",
                    "stimulus '" + s.id +
                        "' needs exactly one of technique (live) or image (pre-rendered)");
-        // The renderer's registry (lucent_study stays GL-free, so it is listed here).
-        static const std::set<std::string> techniques = {
-            "empirical", "ward", "contrast_reversed", "dipole", "htsm", "thick_texture"};
-        if (!s.technique.empty() && !techniques.count(s.technique))
+        // The renderer's one list of techniques (its GL-free core).
+        if (!s.technique.empty() && !is_technique_name(s.technique))
             r.fail(r.raw().get("technique"), "technique",
                    "unknown technique '" + s.technique +
-                       "' (valid: empirical, ward, contrast_reversed, dipole, htsm, "
-                       "thick_texture)");
+                       "' (valid: " + technique_names_listed() + ")");
         if (!s.image.empty() && !base_dir.empty() &&
             std::filesystem::path(s.image).is_relative())
             s.image = (std::filesystem::path(base_dir) / s.image).string();

@@ -1,6 +1,8 @@
 #pragma once
 // Linear float RGBA images, top row first (as image files store them). Alpha is coverage:
-// 1 where the object is, 0 on the background.
+// 1 where the object is, 0 on the background. The struct is the core's; the functions
+// below that read, write or encode files are defined in lucent_renderer_io
+// (renderer/io/image_files.cpp, OpenImageIO), which every program that renders links.
 #include <cstdint>
 #include <filesystem>
 #include <glm/glm.hpp>
@@ -66,6 +68,8 @@ struct ImageWriteOptions {
 void write_image(const std::filesystem::path& path, const Image& image,
                  const ImageWriteOptions& options = {});
 // Reads any image OpenImageIO can; channels beyond 4 are dropped, missing alpha is 1.
+// Callable from the core (file textures): it goes through the CPU backend
+// (core/cpu_backend.h) to lucent_renderer_io.
 Image read_image(const std::filesystem::path& path);
 // True when write_image() accepts the extension of `path`.
 bool is_supported_image_path(const std::filesystem::path& path);

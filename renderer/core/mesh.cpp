@@ -1,5 +1,5 @@
 // Mesh helpers shared by the built-in shapes and the file loader: bounding sphere,
-// content hash, smooth normals, and the spec dispatch of load_mesh().
+// content hash and smooth normals (load_mesh() itself is in renderer/io).
 #include "renderer/core/mesh.h"
 
 #include <algorithm>
@@ -10,7 +10,6 @@
 #include <unordered_map>
 
 #include "common/content_hash.h"
-#include "renderer/core/mesh_sources.h"
 
 namespace lucent {
 
@@ -236,18 +235,6 @@ void finalize_mesh(Mesh& mesh) {
             compute_tangents(mesh.positions, mesh.normals, mesh.uvs, mesh.triangles);
     mesh.content_hash = compute_content_hash(mesh.positions, mesh.triangles, mesh.uvs);
     mesh.closed_facing_out = bounds_solid_facing_out(mesh.positions, mesh.triangles);
-}
-
-Mesh load_mesh(const std::string& spec) {
-    if (spec.empty())
-        throw MeshError(
-            "(empty mesh spec): give a built-in name (sphere, torus, torus_knot, "
-            "hand, square, wave, drape) or a mesh file path");
-    // A built-in name wins unless a regular file of that exact name exists.
-    std::error_code error;
-    if (is_builtin_mesh_spec(spec) && !std::filesystem::is_regular_file(spec, error))
-        return build_builtin_mesh(spec);
-    return load_mesh_file(spec);
 }
 
 }  // namespace lucent

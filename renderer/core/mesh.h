@@ -50,7 +50,8 @@ struct Mesh {
 
 // Builds a mesh from a spec: a built-in name with an optional face budget
 // ("sphere", "torus_knot:240k", "hand:30000"), or a path to a file Assimp reads
-// (OBJ, PLY, glTF, STL, OFF, ...). Throws MeshError.
+// (OBJ, PLY, glTF, STL, OFF, ...). Throws MeshError. Defined in lucent_mesh_io
+// (renderer/io/), so that the core links no importer.
 Mesh load_mesh(const std::string& spec);
 
 // The built-in procedural mesh names, for help text and error messages.

@@ -14,6 +14,8 @@
 //               triangles, the thesis's Wave1; wave:12800 is Wave2)
 //   drape       doubly curved z = 0.2 sin(pi x) sin(pi y), uv = ((x, y) + 1) / 2: not
 //               developable, so its texels are not square (a robustness case)
+#include "renderer/core/mesh_builtin.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -21,7 +23,6 @@
 #include <numbers>
 
 #include "renderer/core/mesh.h"
-#include "renderer/core/mesh_sources.h"
 #include "renderer/core/polygonise.h"
 
 namespace lucent {

@@ -18,6 +18,7 @@
 
 #include "renderer/core/ambient_occlusion.h"
 #include "renderer/cpu/ambient_occlusion_directions.h"
+#include "renderer/cpu/embree_backend.h"
 #include "renderer/cpu/occlusion_counter.h"
 
 namespace lucent {
@@ -95,8 +96,8 @@ void AoDirections::generate(std::size_t vertex, glm::vec3 n,
     }
 }
 
-std::vector<float> bake_ambient_occlusion(const Mesh& mesh,
-                                          const AoBakeOptions& options) {
+std::vector<float> embree_bake_ambient_occlusion(const Mesh& mesh,
+                                                 const AoBakeOptions& options) {
     const AoDirections lattice(options.rays);  // throws for rays < 1
     const std::size_t total = mesh.vertex_count();
     std::vector<float> result(total, 1.0f);

@@ -1,6 +1,7 @@
 #pragma once
-// Embree ray casting over a Mesh for the CPU reference renderers (the AO bake counts
-// escaping rays with cpu/occlusion_counter.h).
+// Ray casting over a Mesh for the CPU reference renderers (the AO bake counts escaping
+// rays with cpu/occlusion_counter.h). GL-free and Embree-free: the queries go to the CPU
+// backend (core/cpu_backend.h), Embree in every program that renders.
 #include <glm/glm.hpp>
 #include <memory>
 #include <optional>
@@ -16,6 +17,8 @@ struct RayHit {
     glm::vec2 barycentric{0.0f};       // Embree's (u, v) for vertices 1 and 2
     glm::vec3 geometric_normal{0.0f};  // unit, as wound (counter-clockwise = front)
 };
+
+class RayQueries;  // core/cpu_backend.h
 
 // Builds an Embree BVH once (robust mode: rays through shared edges or vertices never
 // slip between triangles); all queries are const and thread-safe. Directions need not
@@ -42,8 +45,8 @@ public:
     float layer_epsilon() const;
 
 private:
-    struct Impl;
-    std::unique_ptr<Impl> impl_;
+    std::unique_ptr<RayQueries> queries_;
+    float epsilon_ = 0.0f;
 };
 
 }  // namespace lucent

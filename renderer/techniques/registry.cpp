@@ -22,14 +22,24 @@ const std::vector<const Technique*>& all_techniques() {
     return techniques;
 }
 
+bool is_technique_name(std::string_view name) {
+    for (const Technique* technique : all_techniques())
+        if (technique->name() == name) return true;
+    return false;
+}
+
+std::string technique_names_listed() {
+    std::string names;
+    for (const Technique* technique : all_techniques())
+        names += (names.empty() ? "" : ", ") + std::string(technique->name());
+    return names;
+}
+
 const Technique& find_technique(std::string_view name) {
-    std::string valid;
-    for (const Technique* technique : all_techniques()) {
+    for (const Technique* technique : all_techniques())
         if (technique->name() == name) return *technique;
-        valid += (valid.empty() ? "" : ", ") + std::string(technique->name());
-    }
-    throw KnobError("technique: '" + std::string(name) + "' is unknown (valid: " + valid +
-                    ")");
+    throw KnobError("technique: '" + std::string(name) +
+                    "' is unknown (valid: " + technique_names_listed() + ")");
 }
 
 std::vector<Knob> knobs_for(const Technique& technique) {

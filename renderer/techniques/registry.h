@@ -1,5 +1,6 @@
 #pragma once
 // The one list of techniques Lucent knows, and the knobs each one accepts.
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -10,6 +11,10 @@ namespace lucent {
 
 // Every technique, in registry order.
 const std::vector<const Technique*>& all_techniques();
+// True when `name` is a registered technique.
+bool is_technique_name(std::string_view name);
+// "empirical, ward, ...": every technique's name in registry order, for messages.
+std::string technique_names_listed();
 // Throws KnobError "technique: 'x' is unknown (valid: empirical, ...)".
 const Technique& find_technique(std::string_view name);
 // scene_knobs() followed by the technique's own knobs: everything `--set` accepts.

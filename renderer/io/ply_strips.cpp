@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "renderer/core/mesh.h"
-#include "renderer/core/mesh_sources.h"
+#include "renderer/io/mesh_sources.h"
 
 namespace lucent {
 

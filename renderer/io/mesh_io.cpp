@@ -19,7 +19,8 @@
 
 #include "common/content_hash.h"
 #include "renderer/core/mesh.h"
-#include "renderer/core/mesh_sources.h"
+#include "renderer/core/mesh_builtin.h"
+#include "renderer/io/mesh_sources.h"
 
 namespace lucent {
 
@@ -168,6 +169,18 @@ Mesh load_mesh_file(const std::string& path) {
     if (std::optional<RawMesh> strips = read_ply_triangle_strips(path))
         return clean(path, std::move(*strips));
     return clean(path, read_with_assimp(path));
+}
+
+Mesh load_mesh(const std::string& spec) {
+    if (spec.empty())
+        throw MeshError(
+            "(empty mesh spec): give a built-in name (sphere, torus, torus_knot, "
+            "hand, square, wave, drape) or a mesh file path");
+    // A built-in name wins unless a regular file of that exact name exists.
+    std::error_code error;
+    if (is_builtin_mesh_spec(spec) && !std::filesystem::is_regular_file(spec, error))
+        return build_builtin_mesh(spec);
+    return load_mesh_file(spec);
 }
 
 }  // namespace lucent

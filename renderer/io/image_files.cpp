@@ -1,4 +1,6 @@
-#include "renderer/core/image.h"
+// Image files through OpenImageIO, and the sRGB encodings they use (core/image.h
+// declares them; lucent_renderer_io defines them, so the core links no image library).
+#include "renderer/io/image_files.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -8,6 +10,8 @@
 #include <cstdint>
 #include <limits>
 #include <system_error>
+
+#include "renderer/core/image.h"
 
 namespace lucent {
 namespace {
@@ -197,7 +201,7 @@ void write_image(const std::filesystem::path& path, const Image& input,
         fail(path, "cannot rename temporary file: " + rename_error.message());
 }
 
-Image read_image(const std::filesystem::path& path) {
+Image read_image_file(const std::filesystem::path& path) {
     auto in = OIIO::ImageInput::open(path.string());
     if (!in) fail(path, "cannot read: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();

@@ -1,5 +1,6 @@
 #pragma once
-// Internal to lucent_renderer: the two sources load_mesh() dispatches to.
+// Internal to lucent_mesh_io: reading mesh files (load_mesh() dispatches built-in names
+// to core/mesh_builtin.h and the rest here).
 #include <optional>
 #include <string>
 #include <vector>
@@ -8,11 +9,6 @@
 
 namespace lucent {
 
-// True when the text before any ':' is a built-in mesh name.
-bool is_builtin_mesh_spec(const std::string& spec);
-// "name" or "name:budget" (budget: digits with an optional k or m suffix). Throws
-// MeshError.
-Mesh build_builtin_mesh(const std::string& spec);
 // Reads a file through Assimp and cleans it. Throws MeshError "PATH: reason".
 Mesh load_mesh_file(const std::string& path);
 
