@@ -15,7 +15,9 @@ namespace {
 
 struct RenderOptions {
     std::string mesh;
-    std::string density;  // a density spec (htsm), the same as --set density=SPEC
+    // Knob-declared scene inputs (Knob::input_hash): --NAME VALUE, the same as --set
+    // NAME=VALUE, by knob name.
+    std::map<std::string, std::string> inputs;
     std::string technique = "empirical";
     std::vector<std::string> settings;
     std::string size = "512x512";
@@ -54,8 +56,8 @@ int run_render(const RenderOptions& options) {
         parse_size(options.size, request.width, request.height);
         request.mesh = options.mesh;
         request.technique = options.technique;
-        if (!options.density.empty())
-            request.settings.push_back({"density", options.density});
+        for (const auto& [name, value] : options.inputs)
+            if (!value.empty()) request.settings.push_back({name, value});
         for (const auto& s : options.settings)
             request.settings.push_back(parse_assignment(s));
         if (options.plan == "full")
@@ -157,10 +159,20 @@ void register_render(CLI::App& app, int& exit_code) {
                     "stimulus sets: parallel workers (default 1)");
     cmd->add_flag("--force", options->force,
                   "stimulus sets: re-render unchanged stimuli too");
-    cmd->add_option(
-        "--density", options->density,
-        "density volume over the mesh's box for techniques with one (htsm): "
-        "constant, cube, spheres, marble, layers[:name=value,...] or FILE.nrrd");
+    // A scene input a knob declares (a density volume) gets an option of its own.
+    std::map<std::string, std::string> input_users;
+    for (const Technique* t : all_techniques())
+        for (const Knob& k : t->knobs())
+            if (k.input_hash) {
+                std::string& users = input_users[k.name];
+                if (users.empty())
+                    users = k.description + " (the same as --set " + k.name + "=...; ";
+                else
+                    users += ", ";
+                users += std::string(t->name());
+            }
+    for (const auto& [name, help] : input_users)
+        cmd->add_option("--" + name, options->inputs[name], help + ")");
     cmd->add_option("--technique", options->technique, "technique (" + techniques + ")");
     cmd->add_option(
         "--set", options->settings,

@@ -1,16 +1,5 @@
 // lucent-full: every subcommand. Users run `lucent` (main_dispatch.cpp), which hands
 // everything but the analysis subcommands to this program.
-#include "app/cli_main.h"
-#include "app/level_thumbnail.h"
-#include "app/light_commands.h"
+#include "app/full_cli.h"
 
-int main(int argc, char** argv) {
-    using namespace lucent::app;
-    set_analyze_thumbnail_maker(level_thumbnail_png);
-    std::vector<Registration> subcommands = {
-        register_info,    register_render, register_run,  register_explore,
-        register_stimuli, register_serve,  register_bench};
-    for (const LightCommand& light : light_commands())
-        subcommands.push_back(light.registration);
-    return run_cli(argc, argv, subcommands);
-}
+int main(int argc, char** argv) { return lucent::app::run_full_cli(argc, argv); }

@@ -24,7 +24,6 @@
 
 #include "common/content_hash.h"
 #include "lucent/version.h"
-#include "renderer/core/density_volume.h"
 #include "renderer/core/mesh.h"
 #include "renderer/core/technique.h"
 #include "renderer/gl/context.h"
@@ -53,11 +52,10 @@ std::vector<ManifestField> parameter_fields(const Stimulus& stimulus) {
         const bool numeric =
             std::holds_alternative<double>(value) || std::holds_alternative<int>(value);
         fields.push_back({knob.name, format_knob_value(value), numeric});
-        // A density volume's content hash follows its spec, as mesh_hash follows mesh.
-        if (knob.name == "density")
-            fields.push_back({"density_hash",
-                              density_from_knobs(stimulus.parameters)->content_hash,
-                              false});
+        // An input's content hash follows its spec, as mesh_hash follows mesh.
+        if (knob.input_hash)
+            fields.push_back(
+                {input_hash_column(knob), knob.input_hash(stimulus.parameters), false});
     }
     return fields;
 }
@@ -70,7 +68,7 @@ std::vector<std::string> parameter_columns(const StimulusSet& set) {
         for (const Knob& knob : knobs_for(find_technique(s.technique)))
             if (std::find(columns.begin(), columns.end(), knob.name) == columns.end()) {
                 columns.push_back(knob.name);
-                if (knob.name == "density") columns.push_back("density_hash");
+                if (knob.input_hash) columns.push_back(input_hash_column(knob));
             }
     return columns;
 }
@@ -215,9 +213,10 @@ std::string input_hash(const StimulusSet& set, const Stimulus& stimulus,
     for (const auto format : set.formats) hasher.field(extension(format));
     for (const auto& [name, value] : stimulus.parameters.all())
         hasher.field(name).field(format_knob_value(value));
-    // A density file can change under the same spec: its content decides.
-    if (const auto density = density_from_knobs(stimulus.parameters))
-        hasher.field("density_hash").field(density->content_hash);
+    // An input file can change under the same spec: its content decides.
+    for (const auto& [column, hash] :
+         input_hashes(knobs_for(find_technique(stimulus.technique)), stimulus.parameters))
+        hasher.field(column).field(hash);
     return hasher.hex();
 }
 

@@ -268,4 +268,15 @@ KnobValues resolve_knob_values(std::span<const Knob> knobs,
     return values;
 }
 
+std::string input_hash_column(const Knob& knob) { return knob.name + "_hash"; }
+
+std::vector<std::pair<std::string, std::string>> input_hashes(std::span<const Knob> knobs,
+                                                              const KnobValues& values) {
+    std::vector<std::pair<std::string, std::string>> hashes;
+    for (const Knob& knob : knobs)
+        if (knob.input_hash)
+            hashes.emplace_back(input_hash_column(knob), knob.input_hash(values));
+    return hashes;
+}
+
 }  // namespace lucent

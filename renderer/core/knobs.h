@@ -33,6 +33,7 @@ enum class KnobKind {
 // double for scalar, glm::dvec3 for rgb and vec3, int for integer, std::string for
 // choice.
 using KnobValue = std::variant<double, glm::dvec3, int, std::string>;
+class KnobValues;
 
 struct Knob {
     std::string name;         // canonical name, used in CLI, configs and the database
@@ -45,6 +46,20 @@ struct Knob {
     // KnobKind::text only: why the text is not accepted, "" when it is (may be empty).
     std::function<std::string(std::string_view)> check;
     std::string accepted;  // KnobKind::text only: what is accepted, for messages
+
+    // A knob that names an input read from outside its own text (a density volume from
+    // a generator or a file) gives that input's content hash for resolved values.
+    // Manifests and study databases record it in input_hash_column(), beside the knob,
+    // so a changed file under the same spec is noticed. Empty for other knobs.
+    std::function<std::string(const KnobValues&)> input_hash;
+    // One line on that input for resolved values (its size and statistics), or empty.
+    std::function<std::string(const KnobValues&)> describe_input;
+    // Where the explorer shows the knob: "" with the technique's other knobs, else a
+    // panel of this name holding every knob that names it (a volume, its resolution and
+    // contrast).
+    std::string panel;
+    // Values the explorer offers as one-click buttons (a volume's built-in generators).
+    std::vector<std::string> suggestions;
 };
 
 // Named, validated values; lookups of a missing name or the wrong type are logic errors
@@ -87,6 +102,12 @@ std::string format_knob_value(const KnobValue& value);
 std::string accepted_range(const Knob& knob);
 
 const Knob* find_knob(std::span<const Knob> knobs, std::string_view name);
+
+// "<name>_hash": the column a knob's input hash is recorded in (Knob::input_hash).
+std::string input_hash_column(const Knob& knob);
+// {input_hash_column, hash} for each knob of `knobs` that names an input, in knob order.
+std::vector<std::pair<std::string, std::string>> input_hashes(std::span<const Knob> knobs,
+                                                              const KnobValues& values);
 // Every knob at its default, then `assignments` applied in order (later wins). An
 // unknown key throws KnobError listing the valid ones.
 KnobValues resolve_knob_values(std::span<const Knob> knobs,

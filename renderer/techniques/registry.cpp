@@ -1,5 +1,7 @@
 #include "renderer/techniques/registry.h"
 
+#include <stdexcept>
+
 #include "renderer/core/common_knobs.h"
 
 namespace lucent {
@@ -14,13 +16,29 @@ const Technique& dipole_technique();
 const Technique& htsm_technique();
 const Technique& thick_texture_technique();
 
-const std::vector<const Technique*>& all_techniques() {
-    static const std::vector<const Technique*> techniques = {
+namespace {
+
+std::vector<const Technique*>& registered() {
+    static std::vector<const Technique*> techniques = {
         &empirical_technique(), &ward_technique(), &contrast_reversed_technique(),
         &dipole_technique(),    &htsm_technique(), &thick_texture_technique(),
     };
     return techniques;
 }
+
+}  // namespace
+
+const std::vector<const Technique*>& all_techniques() { return registered(); }
+
+TechniqueRegistration::TechniqueRegistration(const Technique& technique)
+    : technique_(&technique) {
+    if (is_technique_name(technique.name()))
+        throw std::logic_error("technique '" + std::string(technique.name()) +
+                               "' is registered already");
+    registered().push_back(technique_);
+}
+
+TechniqueRegistration::~TechniqueRegistration() { std::erase(registered(), technique_); }
 
 bool is_technique_name(std::string_view name) {
     for (const Technique* technique : all_techniques())

@@ -9,8 +9,25 @@
 
 namespace lucent {
 
-// Every technique, in registry order.
+// Every technique, in registry order: the built-in ones (registry.cpp), then any
+// registered by a TechniqueRegistration.
 const std::vector<const Technique*>& all_techniques();
+
+// Adds `technique` after the others while this object lives, so every layer that asks
+// the registry (render, stimulus sets, protocols, the explorer, the benches) sees it: a
+// technique from outside the renderer, such as one a test defines. Register before
+// rendering starts (lookups are not locked); a name taken already throws
+// std::logic_error.
+class TechniqueRegistration {
+public:
+    explicit TechniqueRegistration(const Technique& technique);
+    ~TechniqueRegistration();
+    TechniqueRegistration(const TechniqueRegistration&) = delete;
+    TechniqueRegistration& operator=(const TechniqueRegistration&) = delete;
+
+private:
+    const Technique* technique_;
+};
 // True when `name` is a registered technique.
 bool is_technique_name(std::string_view name);
 // "empirical, ward, ...": every technique's name in registry order, for messages.

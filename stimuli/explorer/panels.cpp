@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "renderer/core/density_volume.h"
 #include "renderer/techniques/registry.h"
 #include "stimuli/explorer/pass_times.h"
 
@@ -112,36 +111,46 @@ void group_widgets(ExplorerSession& session, KnobGroup group,
         if (knob_group(knob) == group) knob_widget(set, knob, session, widgets);
 }
 
-bool has_group(ExplorerSession& session, KnobGroup group) {
+// The panels knobs name for themselves (Knob::panel), in knob order: "Density" holds
+// htsm's volume, its resolution, contrast and scale.
+std::vector<std::string> own_panels(ExplorerSession& session) {
+    std::vector<std::string> panels;
     for (const Knob& knob : knobs_for(find_technique(session.current().technique())))
-        if (knob_group(knob) == group) return true;
-    return false;
+        if (!knob.panel.empty() &&
+            std::find(panels.begin(), panels.end(), knob.panel) == panels.end())
+            panels.push_back(knob.panel);
+    return panels;
 }
 
-// The density volume (htsm): one button per built-in generator, the spec field, then
-// resolution, contrast and scale; the volume's size and hash show what is rendered.
-void density_panel(ExplorerSession& session, std::map<std::string, WidgetRect>& widgets) {
+// One such panel: a button per suggested value (a volume's generators), the knobs'
+// widgets, then a line on each input (its size and hash: what is rendered).
+void own_panel(ExplorerSession& session, const std::string& panel,
+               std::map<std::string, WidgetRect>& widgets) {
     ParameterSet& set = session.current();
-    for (const std::string& generator : density_generator_names()) {
-        if (button(generator.c_str(), widgets)) {
-            try {
-                set.set("density", generator);
-            } catch (const KnobError& e) {
-                session.message = e.what();
+    const std::vector<Knob> knobs = knobs_for(find_technique(set.technique()));
+    for (const Knob& knob : knobs) {
+        if (knob.panel != panel || knob.suggestions.empty()) continue;
+        for (const std::string& value : knob.suggestions) {
+            if (button(value.c_str(), widgets)) {
+                try {
+                    set.set(knob.name, value);
+                } catch (const KnobError& e) {
+                    session.message = e.what();
+                }
             }
+            ImGui::SameLine();
         }
-        ImGui::SameLine();
+        ImGui::NewLine();
     }
-    ImGui::NewLine();
-    group_widgets(session, KnobGroup::density, widgets);
-    try {
-        if (const auto volume = density_from_knobs(set.values()))
-            ImGui::TextDisabled("%dx%dx%d voxels, mean %.3f, range [%.3f, %.3f], hash %s",
-                                volume->size.x, volume->size.y, volume->size.z,
-                                double(volume->mean), double(volume->min),
-                                double(volume->max), volume->content_hash.c_str());
-    } catch (const KnobError& e) {
-        ImGui::TextDisabled("%s", e.what());
+    for (const Knob& knob : knobs)
+        if (knob.panel == panel) knob_widget(set, knob, session, widgets);
+    for (const Knob& knob : knobs) {
+        if (knob.panel != panel || !knob.describe_input) continue;
+        try {
+            ImGui::TextDisabled("%s", knob.describe_input(set.values()).c_str());
+        } catch (const KnobError& e) {
+            ImGui::TextDisabled("%s", e.what());
+        }
     }
 }
 
@@ -286,9 +295,9 @@ PanelRequests draw_panels(ExplorerSession& session, const PanelInfo& info,
         actions_panel(session, requests, widgets);
     if (ImGui::CollapsingHeader("Technique", ImGuiTreeNodeFlags_DefaultOpen))
         group_widgets(session, KnobGroup::technique, widgets);
-    if (has_group(session, KnobGroup::density) &&
-        ImGui::CollapsingHeader("Density", ImGuiTreeNodeFlags_DefaultOpen))
-        density_panel(session, widgets);
+    for (const std::string& panel : own_panels(session))
+        if (ImGui::CollapsingHeader(panel.c_str(), ImGuiTreeNodeFlags_DefaultOpen))
+            own_panel(session, panel, widgets);
     if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen))
         group_widgets(session, KnobGroup::material, widgets);
     if (ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -124,8 +124,8 @@ KnobGroup knob_group(const Knob& knob) {
          {albedo_knob(), ambient_knob(), specular_knob(), shininess_knob()})
         if (material.name == knob.name) return KnobGroup::material;
     if (knob.name == ao_rays_knob().name) return KnobGroup::ambient_occlusion;
-    // The density volume and its contrast/scale (htsm): the explorer's density panel.
-    if (knob.name.rfind("density", 0) == 0) return KnobGroup::density;
+    // A knob that names its panel (an input and its settings: htsm's density volume).
+    if (!knob.panel.empty()) return KnobGroup::own_panel;
     return KnobGroup::technique;
 }
 

@@ -95,7 +95,8 @@ RenderRequest render_request(const ExplorerSession& session, int side, int width
 
 // The panel a knob belongs to: scene knobs by their group, shared material knobs,
 // ao_rays under AO, and everything else under the technique.
-enum class KnobGroup { light, camera, material, ambient_occlusion, density, technique };
+// `own_panel`: a knob that names its panel (Knob::panel, e.g. a volume and its settings).
+enum class KnobGroup { light, camera, material, ambient_occlusion, own_panel, technique };
 KnobGroup knob_group(const Knob& knob);
 
 }  // namespace lucent::explorer

@@ -8,7 +8,6 @@
 
 #include "common/content_hash.h"
 #include "lucent/version.h"
-#include "renderer/core/density_volume.h"
 #include "renderer/core/mesh.h"
 #include "renderer/core/technique.h"
 #include "renderer/render.h"
@@ -158,10 +157,11 @@ std::vector<ResolvedProtocolStimulus> resolve_protocol_stimuli(
         for (const Knob& knob : *knobs) {
             p.values.emplace_back(knob.name,
                                   format_knob_value(scene->values.get(knob.name)));
-            // The density volume's content hash beside its spec, like mesh_hash beside
-            // the mesh: a changed file under the same spec is noticed.
-            if (knob.name == "density" && scene->density)
-                p.values.emplace_back("density_hash", scene->density->content_hash);
+            // An input's content hash beside its spec, like mesh_hash beside the mesh:
+            // a changed file under the same spec is noticed.
+            if (knob.input_hash)
+                p.values.emplace_back(input_hash_column(knob),
+                                      knob.input_hash(scene->values));
         }
         p.mesh_hash = scene->mesh->content_hash;
         if (!file.empty()) {

@@ -2,6 +2,7 @@
 // geometry (box, Phi, light view), the hierarchical pattern, Fresnel, phase, weight.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "renderer/core/common_knobs.h"
 #include "renderer/core/density_volume.h"
@@ -45,6 +46,27 @@ const std::vector<Knob>& knobs() {
         };
         density.accepted =
             "constant|cube|spheres|marble|layers[:name=value,...] or FILE.nrrd";
+        // The volume is an input beyond the spec's text (a file can change under the same
+        // name): its content hash is recorded beside the spec, like mesh_hash.
+        density.input_hash = [](const KnobValues& values) {
+            return density_from_knobs(values)->content_hash;
+        };
+        density.describe_input = [](const KnobValues& values) {
+            const auto volume = density_from_knobs(values);
+            char line[256];
+            std::snprintf(line, sizeof line,
+                          "%dx%dx%d voxels, mean %.3f, range [%.3f, %.3f], hash %s",
+                          volume->size.x, volume->size.y, volume->size.z,
+                          double(volume->mean), double(volume->min), double(volume->max),
+                          volume->content_hash.c_str());
+            return std::string(line);
+        };
+        density.panel = "Density";
+        density.suggestions = density_generator_names();
+        const auto in_density_panel = [](Knob knob) {
+            knob.panel = "Density";
+            return knob;
+        };
         return std::vector<Knob>{
             choice("rays", "n: rays per pixel in the hierarchical pattern (1 + 4 rings)",
                    d.samples, {"1", "5", "9", "13"}),
@@ -61,15 +83,17 @@ const std::vector<Knob>& knobs() {
                  std::string("on"),
                  {"off", "on"}},
             density,
-            choice("density_resolution",
-                   "R: voxels per axis of a generated density volume",
-                   d.density_resolution, {"16", "32", "64", "128"}),
-            {"density_contrast",
-             "c: rho = clamp(mean + c (rho - mean), 0, 1); 0 = homogeneous at the mean",
-             KnobKind::scalar, 0.0, 4.0, 1.0},
-            {"density_scale",
-             "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
-             KnobKind::scalar, 0.0, 1000.0, d.density_scale},
+            in_density_panel(choice("density_resolution",
+                                    "R: voxels per axis of a generated density volume",
+                                    d.density_resolution, {"16", "32", "64", "128"})),
+            in_density_panel({"density_contrast",
+                              "c: rho = clamp(mean + c (rho - mean), 0, 1); 0 = "
+                              "homogeneous at the mean",
+                              KnobKind::scalar, 0.0, 4.0, 1.0}),
+            in_density_panel(
+                {"density_scale",
+                 "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
+                 KnobKind::scalar, 0.0, 1000.0, d.density_scale}),
             choice("phase_table_size", "N_f: entries of the phase-function table",
                    d.phase_table_size, {"16", "64", "256", "1024"}),
             {"pattern_radius",

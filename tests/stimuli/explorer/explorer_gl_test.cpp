@@ -11,8 +11,10 @@
 #include <iostream>
 #include <sstream>
 
+#include "renderer/techniques/registry.h"
 #include "stimuli/explorer/explorer.h"
 #include "tests/support/display.h"
+#include "tests/support/flat_test_technique.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -358,6 +360,26 @@ TEST_F(ExplorerTest, AddToStimulusSetButtonWritesAConfigLucentRenderRenders) {
                 b = read_image(dir / "single.exr");
     ASSERT_EQ(a.rgba.size(), b.rgba.size());
     for (std::size_t i = 0; i < a.rgba.size(); ++i) ASSERT_EQ(a.rgba[i], b.rgba[i]) << i;
+}
+
+// A technique that exists only in this test, registered here, is seen by the explorer:
+// it can be chosen, its own panel is drawn with its knob and suggested values, and the
+// view shows its picture (issue 27 item 2).
+TEST_F(ExplorerTest, ATechniqueRegisteredByATestGetsItsPanelsAndItsPicture) {
+    const test::FlatTestTechnique flat;
+    const TechniqueRegistration registration(flat);
+    ExplorerSession session;
+    session.current().set_technique(test::FlatTestTechnique::kName);
+    session.current().set("levels", 5);
+    auto explorer = open(session);
+    const Image& shown = settle(*explorer);
+    EXPECT_TRUE(explorer->widget("flat_colour")) << "its knob in its own panel";
+    EXPECT_TRUE(explorer->widget("levels")) << "its quality knob with the technique's";
+    EXPECT_TRUE(explorer->widget("0.25")) << "a suggested value's button";
+    ASSERT_GT(shown.width, 0);
+    const glm::vec4 centre = shown.at(shown.width / 2, shown.height / 2);
+    EXPECT_FLOAT_EQ(centre.r, test::FlatTestTechnique::quantised(0.3, 5));
+    EXPECT_FLOAT_EQ(centre.b, test::FlatTestTechnique::quantised(0.7, 5));
 }
 
 }  // namespace
