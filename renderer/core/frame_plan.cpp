@@ -313,12 +313,14 @@ void PlanBuilder::also_keep(std::string resource) {
     also_keep_.push_back(std::move(resource));
 }
 
-FramePlan PlanBuilder::compile() const {
-    // Resolve every resource's size and level count.
-    std::vector<ResourceDesc> resolved = resources_;
+namespace {
+
+// compile(), stage 1: every resource's size and level count resolved and checked.
+std::vector<ResourceDesc> resolve_resources(std::vector<ResourceDesc> resolved, int width,
+                                            int height) {
     for (auto& r : resolved) {
         const std::string where = "frame plan: resource '" + r.name + "'";
-        if (r.shape == ResourceShape::frame) r.size = {width_, height_, 1};
+        if (r.shape == ResourceShape::frame) r.size = {width, height, 1};
         if (r.shape == ResourceShape::fixed_2d) r.size.z = 1;
         if (is_stream(r)) {
             r.size = {r.size.x, 1, 1};
@@ -354,95 +356,111 @@ FramePlan PlanBuilder::compile() const {
         if (is_3d(r) && is_depth_format(r.format))
             throw std::logic_error(where + ": a depth format cannot be 3D");
     }
-    const auto find = [&](const std::string& name) -> const ResourceDesc* {
-        for (const auto& r : resolved)
-            if (r.name == name) return &r;
-        return nullptr;
-    };
+    return resolved;
+}
 
-    // Validate what add() could not: attachments agree, special passes write one
-    // fitting resource, vertex streams are uploaded and read by mesh passes. (add()
-    // checked that every name is created and that reads follow writes.)
-    for (const auto& pass : passes_) {
-        const std::string where = "frame plan: pass '" + pass.name + "'";
-        for (const auto& read : pass.reads)
-            if (is_stream(*find(read.resource)) && pass.kind != PassKind::draw_mesh)
-                throw std::logic_error(where + " reads the vertex stream '" +
-                                       read.resource + "' but draws no mesh");
-        glm::ivec3 attachment_size{0};
-        std::string first_attachment;
-        int depth_attachments = 0;
-        for (const auto& w : pass.writes) {
-            const ResourceDesc* desc = find(w);
-            if (is_stream(*desc)) {
-                if (pass.kind != PassKind::upload)
-                    throw std::logic_error(where + " draws into the vertex stream '" + w +
-                                           "'; streams are uploaded");
-                continue;
-            }
-            if (pass.level < 0 || pass.level >= desc->levels)
-                throw std::logic_error(where + " writes level " +
-                                       std::to_string(pass.level) + " of '" + w +
-                                       "', which has " + std::to_string(desc->levels));
-            if (is_depth_format(desc->format)) ++depth_attachments;
-            const glm::ivec3 size = mip_size(desc->size, pass.level, is_3d(*desc));
-            if (first_attachment.empty()) {
-                attachment_size = size;
-                first_attachment = w;
-            } else if (size != attachment_size) {
-                throw std::logic_error(where + " writes '" + first_attachment + "' (" +
-                                       size_text(attachment_size, true) + ") and '" + w +
-                                       "' (" + size_text(size, true) +
-                                       "): attachments differ in size");
-            }
-            if (is_3d(*desc) && pass.kind != PassKind::upload)
-                throw std::logic_error(where + " renders into the 3D resource '" + w +
-                                       "'; volumes are uploaded");
+// compile(), stage 2: what add() could not check of one pass: attachments agree, special
+// passes write one fitting resource, vertex streams are uploaded and read by mesh passes.
+// (add() checked that every name is created and that reads follow writes.)
+void check_pass(const Pass& pass,
+                const std::function<const ResourceDesc*(const std::string&)>& find) {
+    const std::string where = "frame plan: pass '" + pass.name + "'";
+    for (const auto& read : pass.reads)
+        if (is_stream(*find(read.resource)) && pass.kind != PassKind::draw_mesh)
+            throw std::logic_error(where + " reads the vertex stream '" + read.resource +
+                                   "' but draws no mesh");
+    glm::ivec3 attachment_size{0};
+    std::string first_attachment;
+    int depth_attachments = 0;
+    for (const auto& w : pass.writes) {
+        const ResourceDesc* desc = find(w);
+        if (is_stream(*desc)) {
+            if (pass.kind != PassKind::upload)
+                throw std::logic_error(where + " draws into the vertex stream '" + w +
+                                       "'; streams are uploaded");
+            continue;
         }
-        if (depth_attachments > 1)
-            throw std::logic_error(where + " writes " +
-                                   std::to_string(depth_attachments) +
-                                   " depth attachments");
-        if (pass.kind == PassKind::upload || pass.kind == PassKind::build_mips) {
-            const ResourceDesc* desc =
-                pass.writes.size() == 1 ? find(pass.writes[0]) : nullptr;
-            if (!desc || is_depth_format(desc->format) ||
-                (is_stream(*desc) && pass.kind != PassKind::upload))
-                throw std::logic_error(where + " (" + pass_kind_name(pass.kind) +
-                                       ") must write exactly one colour resource");
-            if (!pass.reads.empty())
-                throw std::logic_error(where + " (" + pass_kind_name(pass.kind) +
-                                       ") reads nothing");
-            if (pass.kind == PassKind::upload &&
-                (pass.data.content_hash.empty() || !pass.data.produce))
-                throw std::logic_error(
-                    where + " uploads data without a content hash or producer");
-            if (pass.kind == PassKind::build_mips &&
-                (desc->levels < 2 || is_3d(*desc) || pass.level != 0))
-                throw std::logic_error(where + " builds mips of '" + desc->name +
-                                       "', which needs a 2D resource of several levels");
+        if (pass.level < 0 || pass.level >= desc->levels)
+            throw std::logic_error(where + " writes level " + std::to_string(pass.level) +
+                                   " of '" + w + "', which has " +
+                                   std::to_string(desc->levels));
+        if (is_depth_format(desc->format)) ++depth_attachments;
+        const glm::ivec3 size = mip_size(desc->size, pass.level, is_3d(*desc));
+        if (first_attachment.empty()) {
+            attachment_size = size;
+            first_attachment = w;
+        } else if (size != attachment_size) {
+            throw std::logic_error(where + " writes '" + first_attachment + "' (" +
+                                   size_text(attachment_size, true) + ") and '" + w +
+                                   "' (" + size_text(size, true) +
+                                   "): attachments differ in size");
         }
+        if (is_3d(*desc) && pass.kind != PassKind::upload)
+            throw std::logic_error(where + " renders into the 3D resource '" + w +
+                                   "'; volumes are uploaded");
     }
-    if (output_.empty() ||
-        std::find(written_.begin(), written_.end(), output_) == written_.end())
-        throw std::logic_error("frame plan: no pass writes the output '" + output_ + "'");
+    if (depth_attachments > 1)
+        throw std::logic_error(where + " writes " + std::to_string(depth_attachments) +
+                               " depth attachments");
+    if (pass.kind == PassKind::upload || pass.kind == PassKind::build_mips) {
+        const ResourceDesc* desc =
+            pass.writes.size() == 1 ? find(pass.writes[0]) : nullptr;
+        if (!desc || is_depth_format(desc->format) ||
+            (is_stream(*desc) && pass.kind != PassKind::upload))
+            throw std::logic_error(where + " (" + pass_kind_name(pass.kind) +
+                                   ") must write exactly one colour resource");
+        if (!pass.reads.empty())
+            throw std::logic_error(where + " (" + pass_kind_name(pass.kind) +
+                                   ") reads nothing");
+        if (pass.kind == PassKind::upload &&
+            (pass.data.content_hash.empty() || !pass.data.produce))
+            throw std::logic_error(where +
+                                   " uploads data without a content hash or producer");
+        if (pass.kind == PassKind::build_mips &&
+            (desc->levels < 2 || is_3d(*desc) || pass.level != 0))
+            throw std::logic_error(where + " builds mips of '" + desc->name +
+                                   "', which needs a 2D resource of several levels");
+    }
+}
 
-    // Cull: walk backwards from the output, keeping a pass only when something needed
-    // later reads one of its writes; a kept pass makes its reads needed.
-    std::set<std::string> needed{output_};
-    needed.insert(also_keep_.begin(), also_keep_.end());
-    std::vector<bool> keep(passes_.size(), false);
-    for (std::size_t i = passes_.size(); i-- > 0;) {
-        const Pass& pass = passes_[i];
+// compile(), stage 3: walk backwards from the output, keeping a pass only when something
+// needed later reads one of its writes; a kept pass makes its reads needed.
+std::vector<bool> passes_to_keep(const std::vector<Pass>& passes,
+                                 const std::string& output,
+                                 const std::vector<std::string>& also_keep, bool full) {
+    std::set<std::string> needed{output};
+    needed.insert(also_keep.begin(), also_keep.end());
+    std::vector<bool> keep(passes.size(), false);
+    for (std::size_t i = passes.size(); i-- > 0;) {
+        const Pass& pass = passes[i];
         const bool used =
             std::any_of(pass.writes.begin(), pass.writes.end(),
                         [&](const std::string& w) { return needed.count(w) > 0; });
-        keep[i] = used || full();
+        keep[i] = used || full;
         if (!keep[i]) continue;
         for (const auto& read : pass.reads) needed.insert(read.resource);
         if (reads_own_writes(pass))
             for (const auto& w : pass.writes) needed.insert(w);
     }
+
+    return keep;
+}
+
+}  // namespace
+
+FramePlan PlanBuilder::compile() const {
+    const std::vector<ResourceDesc> resolved =
+        resolve_resources(resources_, width_, height_);
+    const auto find = [&](const std::string& name) -> const ResourceDesc* {
+        for (const auto& r : resolved)
+            if (r.name == name) return &r;
+        return nullptr;
+    };
+    for (const auto& pass : passes_) check_pass(pass, find);
+    if (output_.empty() ||
+        std::find(written_.begin(), written_.end(), output_) == written_.end())
+        throw std::logic_error("frame plan: no pass writes the output '" + output_ + "'");
+    const std::vector<bool> keep = passes_to_keep(passes_, output_, also_keep_, full());
 
     FramePlan plan;
     plan.width = width_;
