@@ -147,7 +147,15 @@ PostgresStore::PostgresStore(const std::string& uri, const StoreOptions& options
     });
 }
 
-PostgresStore::~PostgresStore() = default;  // closing the connection releases claims
+// Claims are released before the connection closes, not left to the server: a backend
+// frees its session locks only when it has noticed the disconnect, so a browser or a
+// station claiming the same participant right after this store closed could still be
+// refused (seen on a fresh machine). Failures are ignored: a closed connection holds
+// nothing.
+PostgresStore::~PostgresStore() {
+    const std::set<std::string> claimed = claimed_;
+    for (const std::string& code : claimed) release_participant(code);
+}
 
 PostgresStore::Connection& PostgresStore::connection() {
     if (conn_ && conn_->is_open()) return *conn_;
