@@ -1,6 +1,6 @@
 // Stimulus-set loader: TOML -> validated, expanded list of stimuli.
 // [SECTION] ErrorReporter: "file:line:column: key: reason" from toml++ source regions
-// [SECTION] knob_value(): one TOML value -> a validated KnobValue (type, then range)
+// [SECTION] knob_value(): the renderer's TOML knob reader, errors at file:line:column
 // [SECTION] Loader: top-level keys, meshes, shared parameter tables, each [[stimuli]]
 //           entry with its [stimuli.vary] expansion and ids
 // [SECTION] public entry points
@@ -17,7 +17,7 @@
 #include <set>
 #include <sstream>
 
-#include "common/number_text.h"
+#include "renderer/core/knob_toml.h"
 
 namespace lucent::stimuli {
 namespace {
@@ -77,69 +77,14 @@ std::string as_string(const toml::node& node, const std::string& key,
     errors.fail(node, key, "expected a string");
 }
 
-std::string number_text(const toml::node& node) {
-    if (node.is_integer()) return std::to_string(node.as_integer()->get());
-    return common::full_precision_text(node.as_floating_point()->get());
-}
-
-// One TOML value for `knob` as a validated KnobValue. Numbers for scalars, integers for
-// integers, a number / [r, g, b] / "r,g,b" for rgb, [x, y, z] / "x,y,z" for vectors,
-// a string (or an integer) for choices.
+// One TOML value for `knob` through the renderer's one TOML knob reader, its error placed
+// at the value's file:line:column.
 KnobValue knob_value(const Knob& knob, const toml::node& node, const std::string& key,
                      const ErrorReporter& errors) {
-    std::string text;
-    auto wrong_type = [&](const char* expected) {
-        errors.fail(node, key,
-                    std::string("wrong type: expected ") + expected +
-                        " (accepted: " + accepted_range(knob) + ")");
-    };
-    switch (knob.kind) {
-        case KnobKind::scalar:
-            if (!node.is_number()) wrong_type("a number");
-            text = number_text(node);
-            break;
-        case KnobKind::integer:
-            if (!node.is_integer()) wrong_type("an integer");
-            text = number_text(node);
-            break;
-        case KnobKind::rgb:
-        case KnobKind::vec3:
-            if (const auto* array = node.as_array()) {
-                if (array->size() != 3) wrong_type("3 numbers");
-                for (const auto& element : *array) {
-                    if (!element.is_number()) wrong_type("3 numbers");
-                    text += (text.empty() ? "" : ",") + number_text(element);
-                }
-            } else if (node.is_string()) {
-                text = node.as_string()->get();
-            } else if (node.is_number() && knob.kind == KnobKind::rgb) {
-                text = number_text(node);
-            } else {
-                wrong_type(knob.kind == KnobKind::rgb ? "a number, [r, g, b] or \"r,g,b\""
-                                                      : "[x, y, z] or \"x,y,z\"");
-            }
-            break;
-        case KnobKind::text:
-            if (!node.is_string()) wrong_type("a string");
-            text = node.as_string()->get();
-            break;
-        case KnobKind::choice:
-            if (node.is_string())
-                text = node.as_string()->get();
-            else if (node.is_integer())
-                text = number_text(node);
-            else
-                wrong_type("a string");
-            break;
-    }
     try {
-        return parse_knob_value(knob, text);
+        return read_knob_value(knob, node);
     } catch (const KnobError& e) {
-        // The knob's message starts with its name, which `key` already gives.
-        std::string message = e.what();
-        if (message.rfind(knob.name + ": ", 0) == 0)
-            message.erase(0, knob.name.size() + 2);
-        errors.fail(node, key, message);
+        errors.fail(node, key, e.what());
     }
 }
 

@@ -55,7 +55,8 @@ std::optional<Protocol> stored_protocol(Database& db) {
     Statement s = db.prepare("SELECT protocol_text, name FROM studies LIMIT 1");
     if (!s.step()) return std::nullopt;
     try {
-        return parse_protocol(s.text(0), db.path() + " (stored protocol)");
+        return parse_protocol(s.text(0), db.path() + " (stored protocol)", "",
+                              KnobCheck::lenient);
     } catch (const ProtocolError&) {
         return std::nullopt;
     }

@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "common/number_text.h"
+#include "renderer/core/knob_toml.h"
 #include "renderer/techniques/registry.h"
 #include "study/embedded_study_files.h"
 #include "study/sha256.h"
@@ -113,21 +115,17 @@ private:
     std::set<std::string> used_;
 };
 
-// Canonical text of a parameter value: numbers as written by the shortest round trip,
-// arrays (rgb) as "r,g,b", so equal values compare equal as factor levels.
-std::string parameter_text(const toml::node& node, TableReader& reader,
-                           const std::string& key) {
-    auto number_text = [](double v) {
-        std::ostringstream out;
-        out.precision(12);
-        out << v;
-        return out.str();
+// A pre-rendered image's parameter is a label, not a knob: its text, with numbers in the
+// shortest form that reads back to the same double and arrays as "a,b,c", so equal
+// values compare equal as factor levels.
+std::string label_text(const toml::node& node, TableReader& reader,
+                       const std::string& key) {
+    auto number = [&](const toml::node& item) {
+        const double v = *item.value<double>();
+        if (!std::isfinite(v)) reader.fail(&item, key, "must be finite");
+        return common::shortest_text(v);
     };
-    if (node.is_integer() || node.is_floating_point()) {
-        double v = *node.value<double>();
-        if (!std::isfinite(v)) reader.fail(&node, key, "must be finite");
-        return number_text(v);
-    }
+    if (node.is_integer() || node.is_floating_point()) return number(node);
     if (node.is_string()) return std::string(*node.value<std::string>());
     if (node.is_boolean()) return *node.value<bool>() ? "true" : "false";
     if (const toml::array* array = node.as_array()) {
@@ -135,11 +133,33 @@ std::string parameter_text(const toml::node& node, TableReader& reader,
         for (const toml::node& item : *array) {
             if (!(item.is_integer() || item.is_floating_point()))
                 reader.fail(&item, key, "array values must be numbers (r,g,b)");
-            out += (out.empty() ? "" : ",") + number_text(*item.value<double>());
+            out += (out.empty() ? "" : ",") + number(item);
         }
         return out;
     }
     reader.fail(&node, key, "must be a number, string, boolean or array of numbers");
+}
+
+// A live stimulus's parameter: a knob of its technique, read by the renderer's one TOML
+// knob reader (as stimulus sets read it) and kept as the text of that exact value, which
+// parse_knob_value() reads back bit for bit. See KnobCheck for what a refusal does.
+std::string knob_text(const std::vector<Knob>& knobs, const StimulusSpec& stimulus,
+                      const toml::node& node, TableReader& reader, const std::string& key,
+                      KnobCheck check) {
+    const Knob* knob = find_knob(knobs, key);
+    const std::string where = "stimulus '" + stimulus.id + "': ";
+    try {
+        if (!knob) {
+            std::string valid;
+            for (const Knob& k : knobs) valid += (valid.empty() ? "" : ", ") + k.name;
+            throw KnobError("'" + key + "' is not a parameter of technique '" +
+                            stimulus.technique + "' (valid: " + valid + ")");
+        }
+        return format_knob_value(read_knob_value(*knob, node));
+    } catch (const KnobError& e) {
+        if (check == KnobCheck::lenient) return label_text(node, reader, key);
+        reader.fail(&node, key, where + e.what());
+    }
 }
 
 const toml::table& as_table(const toml::node& node, TableReader& parent,
@@ -216,7 +236,8 @@ void read_questions(Protocol& p, TableReader& root) {
     }
 }
 
-void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
+void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir,
+                  KnobCheck check) {
     const toml::array* stimuli = root.array("stimuli");
     if (!stimuli || stimuli->empty())
         root.fail(stimuli, "stimuli", "at least one [[stimuli]] entry is required");
@@ -241,9 +262,14 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir) {
             s.image = (std::filesystem::path(base_dir) / s.image).string();
         if (const toml::table* params = r.table("params")) {
             TableReader pr(*params, "stimuli.params", p.source);
-            for (const auto& [key, value] : *params)
-                s.parameters[std::string(key.str())] =
-                    parameter_text(value, pr, std::string(key.str()));
+            const std::vector<Knob> knobs =
+                s.live() ? knobs_for(find_technique(s.technique)) : std::vector<Knob>{};
+            for (const auto& [key, value] : *params) {
+                const std::string name(key.str());
+                s.parameters[name] = s.live()
+                                         ? knob_text(knobs, s, value, pr, name, check)
+                                         : label_text(value, pr, name);
+            }
         }
         s.varies = r.strings("varies");
         // A factor is a parameter, "technique", or "series:NAME": a comparison series
@@ -422,7 +448,7 @@ std::string Protocol::level_of(const StimulusSpec& stimulus,
 }
 
 Protocol parse_protocol(std::string_view text, const std::string& source,
-                        const std::string& base_dir) {
+                        const std::string& base_dir, KnobCheck check) {
     toml::table root_table;
     try {
         root_table = toml::parse(text, source);
@@ -439,7 +465,7 @@ Protocol parse_protocol(std::string_view text, const std::string& source,
     read_study(p, root);
     read_screens(p, root);
     read_questions(p, root);
-    read_stimuli(p, root, base_dir);
+    read_stimuli(p, root, base_dir, check);
     read_trials(p, root);
     read_randomisation(p, root);
     read_analysis_plan(p, root);

@@ -23,8 +23,9 @@ struct StimulusSpec {
     std::string technique;  // "empirical", "ward", "contrast_reversed"; "" for images
     std::string mesh;       // built-in mesh name or path (live stimuli)
     std::string image;      // image path (pre-rendered stimuli), relative to the protocol
-    // Technique parameters in canonical names (issue 3 / 5), values as written ("25",
-    // "1.2", "0.8,0.6,0.5"), ordered by name. They become analysis factors.
+    // Technique parameters by knob name, ordered by name; they become analysis factors.
+    // A live stimulus's values are its knobs' values as text that reads back bit for bit
+    // ("25", "1.2", "0.8,0.6,0.5"); an image's are labels with numbers in shortest form.
     std::map<std::string, std::string> parameters;
     // Which parameters this stimulus was designed to vary (its factor series); empty
     // means every parameter is a factor. "technique" may be listed too, and
@@ -126,10 +127,23 @@ struct Protocol {
     static std::string picture_key(const StimulusSpec& stimulus);
 };
 
+// How a live stimulus's parameters are held to its technique's knobs.
+enum class KnobCheck {
+    // A protocol being set up (a file, a preset): every parameter must be a knob of the
+    // technique with a value the knob accepts, else ProtocolError at its line.
+    strict,
+    // A protocol read back from a database: the study already ran with it, so a value
+    // today's knobs refuse (a renamed knob, a moved density file) keeps its text.
+    lenient,
+};
+
 // Parses and validates a protocol. `source` names the file in error messages; image
-// paths are resolved relative to `base_dir` when given. Unknown keys are errors.
+// paths are resolved relative to `base_dir` when given. Unknown keys are errors. A live
+// stimulus's parameters are read as stimulus sets read them (renderer/core/knob_toml.h)
+// and kept as the text of the exact value (format_knob_value).
 Protocol parse_protocol(std::string_view text, const std::string& source,
-                        const std::string& base_dir = "");
+                        const std::string& base_dir = "",
+                        KnobCheck check = KnobCheck::strict);
 Protocol load_protocol_file(const std::string& path);
 // Built-in protocols by name ("thesis"); throws ProtocolError listing valid names.
 Protocol builtin_protocol(std::string_view name);

@@ -15,8 +15,9 @@ QuestionPoints stored_question_points(Database& db, int64_t study_id) {
     s.bind(1, study_id);
     if (!s.step()) throw StoreError(db.path() + ": no study " + std::to_string(study_id));
     try {
-        return question_points(
-            parse_protocol(s.text(1), db.path() + " (study '" + s.text(0) + "')"));
+        return question_points(parse_protocol(s.text(1),
+                                              db.path() + " (study '" + s.text(0) + "')",
+                                              "", KnobCheck::lenient));
     } catch (const ProtocolError& e) {
         throw StoreError(db.path() +
                          ": the stored protocol no longer parses: " + e.what());

@@ -9,7 +9,8 @@
 namespace lucent {
 namespace {
 
-std::string number_text(double value) {
+// Numbers in messages (ranges, a refused value): 9 digits read easily.
+std::string message_number(double value) {
     std::ostringstream out;
     out.precision(9);
     out << value;
@@ -120,7 +121,7 @@ KnobAssignment parse_assignment(std::string_view key_equals_value) {
 
 std::string accepted_range(const Knob& knob) {
     const std::string range =
-        "[" + number_text(knob.min) + ", " + number_text(knob.max) + "]";
+        "[" + message_number(knob.min) + ", " + message_number(knob.max) + "]";
     switch (knob.kind) {
         case KnobKind::scalar:
             return "a number in " + range;
@@ -200,7 +201,7 @@ void validate_knob_value(const Knob& knob, const KnobValue& value) {
         case KnobKind::scalar: {
             const double* v = std::get_if<double>(&value);
             if (!v) wrong_type();
-            check_range(knob, *v, number_text(*v));
+            check_range(knob, *v, message_number(*v));
             return;
         }
         case KnobKind::integer: {
@@ -238,11 +239,14 @@ void validate_knob_value(const Knob& knob, const KnobValue& value) {
 }
 
 std::string format_knob_value(const KnobValue& value) {
-    if (const double* v = std::get_if<double>(&value)) return number_text(*v);
+    // Every bit: manifests, databases and protocols record the double the renderer
+    // received, and parse_knob_value() reads the text back to that same double.
+    using common::shortest_text;
+    if (const double* v = std::get_if<double>(&value)) return shortest_text(*v);
     if (const int* v = std::get_if<int>(&value)) return std::to_string(*v);
     if (const auto* v = std::get_if<std::string>(&value)) return *v;
     const auto& c = std::get<glm::dvec3>(value);
-    return number_text(c.x) + "," + number_text(c.y) + "," + number_text(c.z);
+    return shortest_text(c.x) + "," + shortest_text(c.y) + "," + shortest_text(c.z);
 }
 
 const Knob* find_knob(std::span<const Knob> knobs, std::string_view name) {

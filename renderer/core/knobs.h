@@ -95,7 +95,8 @@ KnobAssignment parse_assignment(std::string_view key_equals_value);
 KnobValue parse_knob_value(const Knob& knob, std::string_view text);
 // Checks type and range of an already typed value (for TOML and the explorer).
 void validate_knob_value(const Knob& knob, const KnobValue& value);
-// The value written back as text that parse_knob_value() accepts ("0.8,0.5,0.3").
+// The value written back as text that parse_knob_value() reads back to the same value,
+// each number in its shortest such form ("0.8,0.5,0.3", "0.123456789012345").
 std::string format_knob_value(const KnobValue& value);
 // "a number in [0, 10]", "r,g,b (or one grey value) with each in [0, 1]", "one of 1, 3,
 // 5".

@@ -658,7 +658,8 @@ PostgresStore::SessionCache& PostgresStore::session_cache(int64_t session_id) {
         try {
             c.points = question_points(
                 parse_protocol(r[0][2].as<std::string>(),
-                               name_ + " (study '" + r[0][1].as<std::string>() + "')"));
+                               name_ + " (study '" + r[0][1].as<std::string>() + "')", "",
+                               KnobCheck::lenient));
         } catch (const ProtocolError& e) {
             throw StoreError(name_ +
                              ": the stored protocol no longer parses: " + e.what());

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <fstream>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "study/sha256.h"
 #include "tests/study/study_fixtures.h"
@@ -179,6 +181,54 @@ TEST(ProtocolErrors, EachKindIsOneLineNamingTheKey) {
         EXPECT_EQ(e.find('\n'), std::string::npos) << e;
         EXPECT_EQ(e.rfind("bad.toml:", 0), 0u) << e;
     }
+}
+
+// Issue 27 item 1: a live stimulus's parameters are read as stimulus sets read them and
+// held to its technique's knobs when the protocol is read, at the value's line, not
+// later when a session resolves them.
+TEST(ProtocolParameters, AreHeldToTheTechniquesKnobsAtTheirLine) {
+    struct Case {
+        std::string to;
+        std::vector<std::string> expect;
+    };
+    // kSmallProtocol starts with a newline: stimulus 'p''s params are on line 39.
+    const Case cases[] = {
+        {"roughness = -3", {"bad.toml:39:", "stimuli.params.roughness", "stimulus 'p'",
+                            "accepted: a number in ["}},
+        {"roughness = \"rough\"", {"bad.toml:39:", "wrong type: expected a number"}},
+        {"sparkle = 3",
+         {"bad.toml:39:", "stimuli.params.sparkle",
+          "'sparkle' is not a parameter of technique 'ward'", "roughness"}},
+    };
+    for (const Case& c : cases) {
+        std::string text = lucent::test::kSmallProtocol;
+        text.replace(text.find("roughness = 0.2"), 15, c.to);
+        const std::string e = error_of(text);
+        for (const std::string& part : c.expect)
+            EXPECT_NE(e.find(part), std::string::npos) << c.to << " got: " << e;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    }
+}
+
+TEST(ProtocolParameters, KeepEveryDigitOfTheValue) {
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("roughness = 0.2"), 15, "roughness = 0.123456789012345678");
+    const Protocol p = parse_protocol(text, "digits.toml");
+    const std::string& kept = p.find_stimulus("p")->parameters.at("roughness");
+    // The double nearest 0.123456789012345678, as TOML and C++ both read it; 12 digits
+    // (0.123456789012) would be a different double.
+    EXPECT_EQ(std::stod(kept), 0.123456789012345678) << kept;
+}
+
+TEST(ProtocolParameters, AStoredProtocolWhoseKnobIsGoneStillReads) {
+    // A study run by a build whose ward had a 'sparkle' knob: its stored protocol must
+    // still give its questions and factor levels to the store and the export.
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("roughness = 0.2"), 15, "roughness = 0.25, sparkle = 3");
+    EXPECT_THROW(parse_protocol(text, "stored"), ProtocolError);
+    const Protocol stored = parse_protocol(text, "stored", "", KnobCheck::lenient);
+    EXPECT_EQ(stored.find_stimulus("p")->parameters.at("sparkle"), "3");
+    EXPECT_EQ(stored.find_stimulus("p")->parameters.at("roughness"), "0.25");
 }
 
 TEST(Protocol, AnalysisPlanNamesThePrimaryDesign) {
