@@ -2,11 +2,19 @@
 // The rows the study store reads and writes, shared by every backend (study_store.h).
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace lucent::study {
+
+// Any storage failure, from every backend; what() is one line naming the store (its
+// file or its server).
+class StoreError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
 
 // What one stimulus is, as the renderer resolved it and as a segment shows it.
 struct StimulusProvenance {

@@ -9,6 +9,7 @@
 #include <pqxx/pqxx>
 
 #include "study/sqlite/sqlite_store.h"
+#include "study/store_rules.h"
 #include "study/withdrawal.h"
 
 namespace lucent::study {
@@ -859,9 +860,7 @@ PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict,
             "question",
             trial_id);
         if (!held.empty()) {
-            if (strict)
-                throw StoreError(name_ + ": trial " + std::to_string(trial_id) +
-                                 " already has ratings; refusing to record it twice");
+            if (strict) refuse_second_answer(name_, trial_id);
             // A resend of a commit whose reply was lost: the same ratings confirm it.
             std::map<std::string, int> mine, theirs;
             for (const Response& r : j.outcome.responses) mine[r.question] = r.rating;
@@ -899,24 +898,16 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
                                  const TrialOutcome& outcome) {
     SessionCache& cache = session_cache(session_id);
     const auto uuid = cache.trial_uuid.find(trial_id);
-    if (uuid == cache.trial_uuid.end())
-        throw StoreError(name_ + ": trial " + std::to_string(trial_id) +
-                         " is not part of session " + std::to_string(session_id));
-    if (uuid->second.empty())
-        throw StoreError(name_ + ": trial " + std::to_string(trial_id) +
-                         " has no UUID (planned before schema 4); cannot journal it");
+    const bool part_of_session = uuid != cache.trial_uuid.end();
+    check_trial_answer(name_, session_id, trial_id,
+                       {.part_of_session = part_of_session,
+                        .answered = part_of_session && (cache.answered.count(trial_id) ||
+                                                        journal_.contains(uuid->second))},
+                       cache.points, outcome);
     const std::string where = name_ + ": trial " + std::to_string(trial_id);
-    if (cache.answered.count(trial_id) || journal_.contains(uuid->second))
-        throw StoreError(where + " already has ratings; refusing to record it twice");
-    for (const Response& r : outcome.responses)
-        check_rating_on_scale(cache.points, r.question, r.rating, where);
-    std::set<std::string> questions;
-    for (const Response& r : outcome.responses) questions.insert(r.question);
-    if (outcome.responses.size() != cache.points.size() ||
-        questions.size() != cache.points.size())
-        throw StoreError(where + " has " + std::to_string(outcome.responses.size()) +
-                         " ratings for " + std::to_string(cache.points.size()) +
-                         " questions");
+    if (uuid->second.empty())
+        throw StoreError(where +
+                         " has no UUID (planned before schema 4); cannot journal it");
 
     // Durable on this machine first; only then the network.
     const JournaledTrial journaled{uuid->second, cache.uuid, utc_now_iso8601(), outcome};
@@ -1013,10 +1004,9 @@ void PostgresStore::set_status(int64_t session_id, const std::string& status,
             pqxx::work tx(connection());
             const pqxx::result current = tx.exec_params(
                 "SELECT status, uuid FROM sessions WHERE id = $1 FOR UPDATE", session_id);
-            if (!current.empty() && current[0][0].as<std::string>() == "completed" &&
-                status != "completed")
-                throw StoreError(name_ + ": session " + current[0][1].as<std::string>() +
-                                 " is completed; refusing to set it " + status);
+            if (!current.empty())
+                check_status_change(name_, current[0][1].as<std::string>(),
+                                    current[0][0].as<std::string>(), status);
             if (ended)
                 tx.exec_params(
                     "UPDATE sessions SET status = $1, ended_utc = $2 WHERE id = $3",

@@ -9,13 +9,9 @@
 #include <string>
 #include <string_view>
 
-namespace lucent::study {
+#include "study/store_types.h"  // StoreError
 
-// Any storage failure; what() is one line naming the database file.
-class StoreError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
+namespace lucent::study {
 
 class Statement;
 

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "study/store_rules.h"
 #include "study/withdrawal.h"
 
 namespace lucent::study {
@@ -876,28 +877,15 @@ bool Store::has_consent(int64_t session_id) {
 bool Store::record_trial(int64_t session_id, int64_t trial_id,
                          const TrialOutcome& outcome) {
     Transaction tx(db_);
-    {
-        Statement check = db_.prepare(
-            "SELECT (SELECT count(*) FROM trials WHERE id = ? AND session_id = ?), "
-            "(SELECT count(*) FROM responses WHERE trial_id = ?)");
-        check.bind(1, trial_id).bind(2, session_id).bind(3, trial_id);
-        check.step();
-        if (check.integer(0) != 1)
-            throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) +
-                             " is not part of session " + std::to_string(session_id));
-        if (check.integer(1) != 0)
-            throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) +
-                             " already has ratings; refusing to record it twice");
-    }
-    // Each rating on its own question's scale: the schema's CHECK only knows 1..7.
-    const QuestionPoints& points = question_points_of_session(session_id);
-    for (const Response& r : outcome.responses)
-        check_rating_on_scale(points, r.question, r.rating,
-                              db_.path() + ": trial " + std::to_string(trial_id));
-    if (outcome.responses.size() != points.size())  // with UNIQUE: each question once
-        throw StoreError(db_.path() + ": trial " + std::to_string(trial_id) + " has " +
-                         std::to_string(outcome.responses.size()) + " ratings for " +
-                         std::to_string(points.size()) + " questions");
+    Statement facts = db_.prepare(
+        "SELECT (SELECT count(*) FROM trials WHERE id = ? AND session_id = ?), "
+        "(SELECT count(*) FROM responses WHERE trial_id = ?)");
+    facts.bind(1, trial_id).bind(2, session_id).bind(3, trial_id);
+    facts.step();
+    check_trial_answer(
+        db_.path(), session_id, trial_id,
+        {.part_of_session = facts.integer(0) == 1, .answered = facts.integer(1) != 0},
+        question_points_of_session(session_id), outcome);
     Statement insert = db_.prepare(
         "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
         "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
@@ -961,9 +949,8 @@ void Store::set_status(int64_t session_id, const std::string& status, bool ended
     {
         Statement current = db_.prepare("SELECT status, uuid FROM sessions WHERE id = ?");
         current.bind(1, session_id);
-        if (current.step() && current.text(0) == "completed" && status != "completed")
-            throw StoreError(db_.path() + ": session " + current.text(1) +
-                             " is completed; refusing to set it " + status);
+        if (current.step())
+            check_status_change(db_.path(), current.text(1), current.text(0), status);
     }
     if (ended) {
         db_.prepare("UPDATE sessions SET status = ?, ended_utc = ? WHERE id = ?")

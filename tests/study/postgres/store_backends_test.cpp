@@ -132,6 +132,53 @@ TEST_P(Backend, RecordsEachTrialOnceAndRefusesDuplicatesAndBadRatings) {
     EXPECT_FALSE(seen[1].answered);
 }
 
+// Issue 27 item 6: the rules are written once above the backends (study/store_rules.h),
+// so every backend refuses the same answers with the same line.
+TEST_P(Backend, EveryBackendRefusesWithTheSameLines) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    const int64_t pid = store->ensure_participant(study, "anna", nullptr);
+    const SessionRow s = store->create_session(study, pid, plan_trials(p, 1, 1), 1, {});
+    const std::vector<TrialRow> trials = store->trials(s.id);
+    const auto refusal = [&](const std::function<void()>& call) {
+        try {
+            call();
+        } catch (const StoreError& e) {
+            return std::string(e.what());
+        }
+        return std::string("(accepted)");
+    };
+    const std::string trial0 = store->name() + ": trial " + std::to_string(trials[0].id);
+    TrialOutcome same_question_twice = lucent::test::outcome_for(p, trials[0]);
+    same_question_twice.responses[1].question = same_question_twice.responses[0].question;
+    EXPECT_EQ(
+        refusal([&] { store->record_trial(s.id, trials[0].id, same_question_twice); }),
+        trial0 + " rates question '" + same_question_twice.responses[0].question +
+            "' twice");
+    const int64_t other_pid = store->ensure_participant(study, "ben", nullptr);
+    const SessionRow other =
+        store->create_session(study, other_pid, plan_trials(p, 2, 2), 2, {});
+    EXPECT_EQ(refusal([&] {
+                  store->record_trial(other.id, trials[0].id,
+                                      lucent::test::outcome_for(p, trials[0]));
+              }),
+              trial0 + " is not part of session " + std::to_string(other.id));
+    store->record_trial(s.id, trials[0].id, lucent::test::outcome_for(p, trials[0]));
+    EXPECT_EQ(refusal([&] {
+                  store->record_trial(s.id, trials[0].id,
+                                      lucent::test::outcome_for(p, trials[0]));
+              }),
+              trial0 + " already has ratings; refusing to record it twice");
+    for (const TrialRow& t : store->trials(s.id))
+        if (!t.answered) store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
+    EXPECT_EQ(refusal([&] { store->set_status(s.id, "paused", false); }),
+              store->name() + ": session " + s.uuid +
+                  " is completed; refusing to set it paused");
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"),
+              static_cast<int64_t>(trials.size() * p.questions.size()));
+}
+
 TEST_P(Backend, ResumeFindsTheUnfinishedSessionAndTheLastTrialCompletesIt) {
     const Protocol p = lucent::test::small_protocol();
     int64_t session_id = 0;
