@@ -1,6 +1,6 @@
 #include "study/session/live_stimuli.h"
 
-#include <cmath>
+#include <algorithm>
 
 #include "renderer/core/image.h"
 #include "renderer/gl/frame_executor.h"
@@ -10,11 +10,9 @@ namespace lucent::study {
 
 const std::vector<ResolvedProtocolStimulus>& LiveOrPrerenderedStimuli::resolved(
     const Protocol& protocol) const {
-    if (!is_resolved_) {
+    if (resolved_for_ != protocol.text) {
         resolved_ = resolve_protocol_stimuli(protocol, images_.images_dir());
-        for (const ResolvedProtocolStimulus& r : resolved_)
-            if (r.scene) scenes_[r.provenance.stimulus] = r.scene;
-        is_resolved_ = true;
+        resolved_for_ = protocol.text;
     }
     return resolved_;
 }
@@ -38,8 +36,10 @@ std::vector<StimulusProvenance> LiveOrPrerenderedStimuli::provenance(
 StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int width,
                                                  int height) {
     if (!images_.path_for(spec).empty()) return images_.render(spec, width, height);
-    const auto resolved_scene = scenes_.find(spec.id);
-    if (resolved_scene == scenes_.end())
+    const auto resolved_scene = std::find_if(
+        resolved_.begin(), resolved_.end(),
+        [&](const auto& r) { return r.provenance.stimulus == spec.id && r.scene; });
+    if (resolved_scene == resolved_.end())
         throw StimulusError(
             "stimulus '" + spec.id +
             "': not resolved before rendering (check() the protocol first)");
@@ -47,7 +47,7 @@ StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int w
     try {
         // The resolved scene at the window's size: same mesh, density and values, the
         // camera refitted.
-        Scene scene = *resolved_scene->second;
+        Scene scene = *resolved_scene->scene;
         fit_scene_camera(scene, width, height);
         if (on_render) on_render(scene);
         // One executor per stimulus: its GL objects are gone before the window closes.
@@ -67,8 +67,7 @@ StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int w
                  std::vector<uint8_t>(size_t(image.width) * image.height * 4)};
     for (size_t i = 0; i < size_t(image.width) * image.height; ++i) {
         for (int c = 0; c < 3; ++c)  // as write_image encodes PNG stimuli
-            out.rgba[i * 4 + c] = static_cast<uint8_t>(
-                std::lround(srgb_encode(image.rgba[i * 4 + c]) * 255.f));
+            out.rgba[i * 4 + c] = srgb_encode_8bit(image.rgba[i * 4 + c]);
         out.rgba[i * 4 + 3] = 255;  // opaque, like the RGB PNG of the same stimulus
     }
     return upload_texture(out, "stimulus '" + spec.id + "'");

@@ -3,8 +3,8 @@
 // path as `lucent render` and the stimulus batch), or taken from a pre-rendered image
 // when one exists (an `image` stimulus, or <id>.png|.tif|.exr in the images directory).
 #include <functional>
-#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "renderer/core/scene.h"
@@ -32,13 +32,16 @@ public:
     std::function<void(const Scene&)> on_render;
 
 private:
+    // The resolution of `protocol`'s stimuli, made on first use and again only for
+    // another protocol (another text), so a station never shows one protocol's scenes
+    // for another's stimuli.
     const std::vector<ResolvedProtocolStimulus>& resolved(const Protocol& protocol) const;
 
     PrerenderedStimuli images_;
-    // The one resolution of the protocol's stimuli, and each live scene by stimulus id.
+    // The one resolution of the protocol's stimuli (each live one with its scene), and
+    // the text of the protocol it was made for.
     mutable std::vector<ResolvedProtocolStimulus> resolved_;
-    mutable std::map<std::string, std::shared_ptr<const Scene>> scenes_;
-    mutable bool is_resolved_ = false;
+    mutable std::optional<std::string> resolved_for_;
 };
 
 }  // namespace lucent::study

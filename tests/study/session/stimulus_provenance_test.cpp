@@ -145,6 +145,22 @@ TEST(ResolveStimuli, AProtocolSettingOneParameterStoresEveryParameterOfTheTechni
     EXPECT_EQ(cells["stimulus_source"], "live");
 }
 
+// A station resolves a protocol once, and a second protocol anew: its rows are never the
+// first protocol's (the old cache ignored which protocol it was asked about).
+TEST(ResolveStimuli, AnotherProtocolIsResolvedAnew) {
+    LiveOrPrerenderedStimuli stimuli("");
+    stimuli.check(parse_protocol(kOneParameter, "one.toml"));
+    std::string text = kOneParameter;
+    text.replace(text.find("backlight = 1.5"), 15, "backlight = 0.75");
+    const std::vector<StimulusProvenance> rows =
+        stimuli.provenance(parse_protocol(text, "other.toml"));
+    ASSERT_EQ(rows.size(), 1u);
+    EXPECT_EQ(values_of(rows[0]).at("backlight"), "0.75");
+    EXPECT_EQ(values_of(stimuli.provenance(parse_protocol(kOneParameter, "one.toml"))[0])
+                  .at("backlight"),
+              "1.5");
+}
+
 TEST(ResolveStimuli, AChangedDefaultChangesTheStoredValuesAndMergeRefusesThem) {
     const Protocol p = parse_protocol(kOneParameter, "one.toml");
     const auto today = resolve_stimuli(p, "");
