@@ -1,5 +1,6 @@
 #include "study/store_rules.h"
 
+#include <cctype>
 #include <set>
 
 namespace lucent::study {
@@ -33,6 +34,71 @@ void check_status_change(const std::string& store, const std::string& session_uu
     if (current_status == "completed" && new_status != "completed")
         throw StoreError(store + ": session " + session_uuid +
                          " is completed; refusing to set it " + new_status);
+}
+
+int participant_number_from_code(const std::string& code) {
+    size_t end = code.size(), begin = end;
+    while (begin > 0 && std::isdigit(static_cast<unsigned char>(code[begin - 1])))
+        --begin;
+    if (begin == end || end - begin > 9) return -1;
+    return std::stoi(code.substr(begin));
+}
+
+std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int number,
+                                        const std::string& active_since_utc) {
+    const int cells = static_cast<int>(counts.size());
+    const int first = ((number % cells) + cells) % cells;
+    int best = first;
+    for (int k = 0; k < cells; ++k) {
+        const int c = (first + k) % cells;
+        if (counts[c] < counts[best]) best = c;
+    }
+    std::string per_cell;
+    for (int64_t n : counts)
+        per_cell += (per_cell.empty() ? "" : ",") + std::to_string(n);
+    return {best, "online arrival " + std::to_string(number) + ": cell " +
+                      std::to_string(best) + " of " + std::to_string(cells) +
+                      ", the fewest completed + active sessions (per cell " + per_cell +
+                      "; active = activity since " + active_since_utc + ")"};
+}
+
+// One word for a segment's pictures: the common source, "mixed", or NULL when unknown.
+std::optional<std::string> segment_source(
+    const std::vector<StimulusProvenance>& stimuli) {
+    std::set<std::string> sources;
+    for (const StimulusProvenance& p : stimuli) sources.insert(p.source);
+    if (sources.empty()) return std::nullopt;
+    return sources.size() == 1 ? *sources.begin() : std::string("mixed");
+}
+
+ResolvedStimulus resolved_of(const StimulusProvenance& p) {
+    ResolvedStimulus r{p.technique, p.mesh, p.mesh_hash, {}};
+    for (const auto& [name, value] : p.values) r.values[name] = value;
+    return r;
+}
+
+std::string resolved_difference(const std::string& stimulus, const ResolvedStimulus& a,
+                                const std::string& a_name, const ResolvedStimulus& b,
+                                const std::string& b_name) {
+    auto differs = [&](const std::string& name, const std::string& x,
+                       const std::string& y) {
+        return "stimulus '" + stimulus + "': parameter '" + name + "' is " +
+               (x.empty() ? "(none)" : x) + " in " + a_name + " but " +
+               (y.empty() ? "(none)" : y) + " in " + b_name;
+    };
+    if (a.technique != b.technique) return differs("technique", a.technique, b.technique);
+    if (a.mesh != b.mesh) return differs("mesh", a.mesh, b.mesh);
+    if (a.mesh_hash != b.mesh_hash) return differs("mesh_hash", a.mesh_hash, b.mesh_hash);
+    std::set<std::string> names;
+    for (const auto& [name, value] : a.values) names.insert(name);
+    for (const auto& [name, value] : b.values) names.insert(name);
+    for (const std::string& name : names) {
+        const auto x = a.values.find(name), y = b.values.find(name);
+        const std::string vx = x == a.values.end() ? "" : x->second;
+        const std::string vy = y == b.values.end() ? "" : y->second;
+        if (vx != vy) return differs(name, vx, vy);
+    }
+    return "";
 }
 
 }  // namespace lucent::study

@@ -4,7 +4,10 @@
 // and only then writes; so SQLite and PostgreSQL refuse the same things with the same
 // one-line StoreError, and a backend is its SQL.
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "study/question_scales.h"
 #include "study/store_types.h"
@@ -31,5 +34,25 @@ void check_trial_answer(const std::string& store, int64_t session_id, int64_t tr
 void check_status_change(const std::string& store, const std::string& session_uuid,
                          const std::string& current_status,
                          const std::string& new_status);
+
+// A later session, or a database merged in, shows each stimulus as the first session
+// recorded it: "" when `a` and `b` are equal, else "stimulus 'ID': parameter 'NAME' is A
+// in <a_name> but B in <b_name>" for the first difference (technique, mesh, mesh_hash or
+// a knob value).
+std::string resolved_difference(const std::string& stimulus, const ResolvedStimulus& a,
+                                const std::string& a_name, const ResolvedStimulus& b,
+                                const std::string& b_name);
+// A provenance row as stored.
+ResolvedStimulus resolved_of(const StimulusProvenance& p);
+// One word for a segment's pictures: the common source, "mixed", or nullopt when unknown.
+std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli);
+
+// A participant's number: a lab code's trailing digits (-1 when none or over 9 digits).
+int participant_number_from_code(const std::string& code);
+// Online allocation (enrol_online): given each cell's completed + active sessions, the
+// cell with the fewest (ties: the first from number mod cells) and the allocation text
+// sessions.allocation records.
+std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int number,
+                                        const std::string& active_since_utc);
 
 }  // namespace lucent::study

@@ -1,6 +1,7 @@
 #pragma once
 // The rows the study store reads and writes, shared by every backend (study_store.h).
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,15 @@ namespace lucent::study {
 class StoreError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
+};
+
+// The resolved description of a stimulus as stored (technique, mesh, mesh hash, every
+// knob value); compared between sessions and between databases being merged.
+struct ResolvedStimulus {
+    std::string technique;
+    std::string mesh;
+    std::string mesh_hash;
+    std::map<std::string, std::string> values;
 };
 
 // What one stimulus is, as the renderer resolved it and as a segment shows it.

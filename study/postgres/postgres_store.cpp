@@ -8,8 +8,10 @@
 #include <chrono>
 #include <pqxx/pqxx>
 
-#include "study/sqlite/sqlite_store.h"
+#include "study/schema.h"
+#include "study/sqlite/sqlite_store.h"  // snapshot_to_sqlite writes a study file
 #include "study/store_rules.h"
+#include "study/time_and_ids.h"
 #include "study/withdrawal.h"
 
 namespace lucent::study {

@@ -20,40 +20,20 @@
 
 #include "study/protocol.h"
 #include "study/question_scales.h"
+#include "study/schema.h"
 #include "study/sqlite/database.h"
+#include "study/sqlite/database_file.h"
+#include "study/store_rules.h"
 #include "study/store_types.h"
 #include "study/study_store.h"
+#include "study/time_and_ids.h"
 #include "study/trial_plan.h"
 
 namespace lucent::study {
 
-inline constexpr int32_t kApplicationId = 0x4C55434E;  // "LUCN"
-inline constexpr int kSchemaVersion = 5;
-
-// Checks, without writing a byte, that `path` is a Lucent study database this build can
-// use (or absent/empty). Throws StoreError with one line: not SQLite, corrupt, another
-// application's database, or a newer schema.
-void check_database_file(const std::string& path);
-
-// Applies schema migrations 1..target to an open connection (tests build old versions).
-void migrate(Database& db, int target = kSchemaVersion);
-
-// The resolved description of a stimulus as stored (technique, mesh, mesh hash, every
-// knob value); compared between sessions and between databases being merged.
-struct ResolvedStimulus {
-    std::string technique;
-    std::string mesh;
-    std::string mesh_hash;
-    std::map<std::string, std::string> values;
-};
 // Stimulus key -> its resolved description, for stimuli that have one (schema 3 and a
 // session that recorded it); older databases give an empty map.
 std::map<std::string, ResolvedStimulus> read_resolved_stimuli(Database& db);
-// "" when equal, else "stimulus 'ID': parameter 'NAME' is A in <a_name> but B in
-// <b_name>" for the first difference (technique, mesh, mesh_hash or a knob value).
-std::string resolved_difference(const std::string& stimulus, const ResolvedStimulus& a,
-                                const std::string& a_name, const ResolvedStimulus& b,
-                                const std::string& b_name);
 
 // The SQLite backend of StudyStore (study_store.h documents each operation).
 class Store : public StudyStore {
@@ -120,27 +100,5 @@ private:
     int claim_fd_ = -1;  // the participant lock file, once something is claimed
     std::map<std::string, int64_t> claimed_;  // code -> its locked byte
 };
-
-// Migration steps 1..kSchemaVersion in SQLite's dialect (the server backend translates
-// the same text, so both schemas stay one).
-const std::vector<std::string>& schema_migrations();
-
-// Shared by the backends: a code's trailing digits as its number (-1 when none or over
-// 9 digits); a provenance row as stored; one word for a segment's picture source.
-int participant_number_from_code(const std::string& code);
-// Online allocation (enrol_online): the SQL giving (cell, completed + active sessions) of
-// study ?1/$1 with activity since ?2/$2, in SQLite's or PostgreSQL's dialect; the cell
-// with the fewest (ties: the first from number mod cells) and the allocation text.
-std::string online_cell_counts_sql(bool postgres);
-std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int number,
-                                        const std::string& active_since_utc);
-ResolvedStimulus resolved_of(const StimulusProvenance& p);
-std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli);
-
-// UTC as 2026-12-02T16:56:02.123Z (milliseconds), the form every stored time uses.
-std::string utc_iso8601(std::chrono::system_clock::time_point t);
-std::string utc_now_iso8601();
-std::string new_uuid_v4();
-std::string machine_id();
 
 }  // namespace lucent::study

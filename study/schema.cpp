@@ -1,0 +1,194 @@
+// The schema's text, one migration step at a time.
+#include "study/schema.h"
+
+#include <iterator>
+
+namespace lucent::study {
+namespace {
+
+// Migration i (1-based) brings user_version from i-1 to i. Never edit a released step:
+// add a new one.
+const char* const kMigrations[] = {
+    // 1: the core tables.
+    R"sql(
+CREATE TABLE studies (
+    id INTEGER PRIMARY KEY,
+    name TEXT NOT NULL,
+    protocol_text TEXT NOT NULL,
+    protocol_hash TEXT NOT NULL UNIQUE,
+    created_utc TEXT NOT NULL);
+CREATE TABLE stimuli (
+    id INTEGER PRIMARY KEY,
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    stimulus_key TEXT NOT NULL,
+    technique TEXT NOT NULL,
+    mesh TEXT NOT NULL,
+    image TEXT NOT NULL,
+    varies TEXT NOT NULL,
+    UNIQUE (study_id, stimulus_key));
+CREATE TABLE stimulus_parameters (
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id) ON DELETE CASCADE,
+    name TEXT NOT NULL,
+    value TEXT NOT NULL,
+    PRIMARY KEY (stimulus_id, name));
+CREATE TABLE participants (
+    id INTEGER PRIMARY KEY,
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    code TEXT NOT NULL UNIQUE,
+    number INTEGER NOT NULL,
+    created_utc TEXT NOT NULL);
+CREATE TABLE sessions (
+    id INTEGER PRIMARY KEY,
+    uuid TEXT NOT NULL UNIQUE,
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    participant_id INTEGER NOT NULL REFERENCES participants(id) ON DELETE CASCADE,
+    machine_id TEXT NOT NULL,
+    seed TEXT NOT NULL,
+    cell INTEGER NOT NULL,
+    block_order TEXT NOT NULL,
+    status TEXT NOT NULL CHECK (status IN ('running', 'paused', 'completed', 'aborted')),
+    started_utc TEXT NOT NULL,
+    ended_utc TEXT,
+    consent_utc TEXT,
+    software_version TEXT NOT NULL,
+    build_hash TEXT NOT NULL,
+    gl_vendor TEXT,
+    gl_renderer TEXT,
+    display_mode TEXT,
+    display_refresh_hz REAL,
+    measured_refresh_hz REAL);
+CREATE TABLE trials (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+    position INTEGER NOT NULL,
+    block TEXT NOT NULL,
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id),
+    practice INTEGER NOT NULL CHECK (practice IN (0, 1)),
+    catch INTEGER NOT NULL CHECK (catch IN (0, 1)),
+    catch_id TEXT,
+    prompt TEXT,
+    expected_rating INTEGER,
+    tolerance INTEGER,
+    break_before INTEGER NOT NULL CHECK (break_before IN (0, 1)),
+    onset_ns INTEGER,
+    confirm_ns INTEGER,
+    answered_utc TEXT,
+    UNIQUE (session_id, position));
+CREATE TABLE responses (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+    trial_id INTEGER NOT NULL REFERENCES trials(id) ON DELETE CASCADE,
+    question TEXT NOT NULL,
+    rating INTEGER NOT NULL CHECK (rating BETWEEN 1 AND 7),
+    rt_ms REAL NOT NULL CHECK (rt_ms >= 0),
+    changes INTEGER NOT NULL CHECK (changes >= 0),
+    first_choice_ns INTEGER NOT NULL,
+    final_choice_ns INTEGER NOT NULL,
+    UNIQUE (trial_id, question));
+CREATE INDEX responses_by_session ON responses(session_id);
+CREATE INDEX trials_by_session ON trials(session_id);
+)sql",
+    // 2: frame timing (why a refresh is unknown; dropped frames per trial).
+    R"sql(
+ALTER TABLE sessions ADD COLUMN refresh_note TEXT;
+ALTER TABLE trials ADD COLUMN dropped_frames INTEGER;
+)sql",
+    // 3: provenance: every resolved value per stimulus, one environment row per session
+    // segment (start, each resume) and where each picture of a segment came from.
+    // Existing sessions get their first segment from the session row; trials answered
+    // before keep segment_id NULL (nothing was recorded about what they showed).
+    R"sql(
+ALTER TABLE stimuli ADD COLUMN resolved_mesh TEXT;
+ALTER TABLE stimuli ADD COLUMN mesh_hash TEXT;
+CREATE TABLE stimulus_values (
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id) ON DELETE CASCADE,
+    name TEXT NOT NULL,
+    value TEXT NOT NULL,
+    PRIMARY KEY (stimulus_id, name));
+CREATE TABLE session_segments (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+    segment INTEGER NOT NULL,
+    started_utc TEXT NOT NULL,
+    machine_id TEXT NOT NULL,
+    software_version TEXT NOT NULL,
+    build_hash TEXT NOT NULL,
+    gl_vendor TEXT,
+    gl_renderer TEXT,
+    display_mode TEXT,
+    display_refresh_hz REAL,
+    measured_refresh_hz REAL,
+    refresh_note TEXT,
+    stimulus_source TEXT CHECK (stimulus_source IN ('live', 'images', 'image', 'mixed')),
+    UNIQUE (session_id, segment));
+INSERT INTO session_segments (session_id, segment, started_utc, machine_id,
+    software_version, build_hash, gl_vendor, gl_renderer, display_mode, display_refresh_hz,
+    measured_refresh_hz, refresh_note)
+SELECT id, 1, started_utc, machine_id, software_version, build_hash, gl_vendor,
+    gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, refresh_note
+FROM sessions;
+CREATE TABLE segment_stimuli (
+    segment_id INTEGER NOT NULL REFERENCES session_segments(id) ON DELETE CASCADE,
+    stimulus_id INTEGER NOT NULL REFERENCES stimuli(id) ON DELETE CASCADE,
+    source TEXT NOT NULL CHECK (source IN ('live', 'images', 'image')),
+    file TEXT,
+    content_hash TEXT,
+    software_version TEXT NOT NULL,
+    build_hash TEXT NOT NULL,
+    PRIMARY KEY (segment_id, stimulus_id));
+ALTER TABLE trials ADD COLUMN segment_id INTEGER REFERENCES session_segments(id);
+CREATE INDEX segments_by_session ON session_segments(session_id);
+-- Enrolment numbers of withdrawn participants (the number only, nothing personal): a
+-- number, and with it a Latin-square row, is never handed out twice.
+CREATE TABLE retired_participant_numbers (number INTEGER PRIMARY KEY);
+)sql",
+    // 4: a UUID per planned trial, so a station's journal can resend a trial to a server
+    // idempotently and a merge can tell one trial from another. Earlier trials keep NULL.
+    R"sql(
+ALTER TABLE trials ADD COLUMN uuid TEXT;
+CREATE UNIQUE INDEX trials_by_uuid ON trials(uuid);
+)sql",
+    // 5: withdrawals that survive merges, imports and syncs (tombstones: the withdrawn
+    // sessions' UUIDs, and each (code, machine) as a salted SHA-256 so the code itself is
+    // gone); how a session's counterbalancing cell was allocated; declined consents as
+    // an anonymous count per study (nothing else of a decline is kept).
+    R"sql(
+CREATE TABLE withdrawn_sessions (
+    uuid TEXT PRIMARY KEY,
+    withdrawn_utc TEXT NOT NULL);
+CREATE TABLE withdrawn_codes (
+    salt TEXT NOT NULL,
+    code_hash TEXT NOT NULL,
+    withdrawn_utc TEXT NOT NULL,
+    PRIMARY KEY (salt, code_hash));
+ALTER TABLE sessions ADD COLUMN allocation TEXT;
+CREATE TABLE consent_declines (
+    study_id INTEGER NOT NULL PRIMARY KEY REFERENCES studies(id) ON DELETE CASCADE,
+    declined INTEGER NOT NULL CHECK (declined >= 0));
+)sql",
+};
+static_assert(std::size(kMigrations) == kSchemaVersion);
+
+}  // namespace
+
+const std::vector<std::string>& schema_migrations() {
+    static const std::vector<std::string> steps(std::begin(kMigrations),
+                                                std::end(kMigrations));
+    return steps;
+}
+
+std::string online_cell_counts_sql(bool postgres) {
+    const std::string latest = postgres ? "greatest" : "max";
+    const std::string study = postgres ? "$1" : "?1", since = postgres ? "$2" : "?2";
+    return "SELECT s.cell, count(*) FROM sessions s WHERE s.study_id = " + study +
+           " AND (s.status = 'completed' OR (s.status IN ('running', 'paused') AND " +
+           latest +
+           "(s.started_utc, coalesce((SELECT max(g.started_utc) FROM session_segments g "
+           "WHERE "
+           "g.session_id = s.id), ''), coalesce((SELECT max(t.answered_utc) FROM trials "
+           "t "
+           "WHERE t.session_id = s.id), '')) >= " +
+           since + ")) GROUP BY s.cell";
+}
+
+}  // namespace lucent::study
