@@ -220,255 +220,364 @@ std::string input_hash(const StimulusSet& set, const Stimulus& stimulus,
     return hasher.hex();
 }
 
-BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& options) {
-    const auto wall_start = Clock::now();
-    const auto& dir = options.out_dir;
-    BatchResult result;
+namespace {
 
-    // Meshes, once per spec (MeshError propagates before anything is written).
-    std::map<std::string, std::shared_ptr<const Mesh>> meshes;
+using MeshesBySpec = std::map<std::string, std::shared_ptr<const Mesh>>;
+
+// Meshes, once per spec (MeshError propagates before anything is written).
+MeshesBySpec load_meshes(const StimulusSet& set) {
+    MeshesBySpec meshes;
     for (const auto& s : set.stimuli)
         if (!meshes.count(s.mesh_spec))
             meshes[s.mesh_spec] = std::make_shared<const Mesh>(load_mesh(s.mesh_spec));
+    return meshes;
+}
 
-    std::filesystem::create_directories(dir);
-    const auto previous = read_manifest_csv(dir);
+// What this run renders, and the rows it keeps from the previous run.
+struct RenderPlan {
+    std::vector<ManifestRow> rows;     // empty until the stimulus is complete
+    std::vector<std::string> inputs;   // input_hash() of each stimulus, in set order
+    std::vector<std::size_t> pending;  // the stimuli to render (indices into set.stimuli)
+    std::size_t reused = 0;
+};
 
-    // Decide what to render; reused rows keep the previous run's measurements verbatim.
+// The row of a reused stimulus, with the previous run's measurements (`old`) verbatim.
+ManifestRow reused_row(const StimulusSet& set, const Stimulus& s, const Mesh& mesh,
+                       const std::map<std::string, std::string>& old,
+                       const std::string& inputs, const std::string& content) {
+    ManifestRow row = identity_fields(set, s, mesh);
+    ImageStatistics columns;
+    columns.luminance_histogram.resize(kHistogramBins);
+    for (const auto& field : measured_fields(columns, 0)) {
+        const auto found = old.find(field.column);
+        row.push_back({field.column, found == old.end() ? "0" : found->second, true});
+    }
+    append_provenance(row, inputs, content);
+    return row;
+}
+
+// Decide what to render; reused rows keep the previous run's measurements verbatim.
+RenderPlan plan_renders(
+    const StimulusSet& set, const BatchOptions& options, const MeshesBySpec& meshes,
+    const std::map<std::string, std::map<std::string, std::string>>& previous) {
+    const auto& dir = options.out_dir;
     const std::size_t count = set.stimuli.size();
-    std::vector<ManifestRow> rows(count);  // empty until the stimulus is complete
-    std::vector<std::string> inputs(count);
-    std::vector<std::size_t> pending;
+    RenderPlan plan;
+    plan.rows.resize(count);
+    plan.inputs.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
         const auto& s = set.stimuli[i];
         const Mesh& mesh = *meshes.at(s.mesh_spec);
-        inputs[i] = input_hash(set, s, mesh.content_hash);
+        plan.inputs[i] = input_hash(set, s, mesh.content_hash);
         const auto it = previous.find(s.id);
         const auto* old = it == previous.end() ? nullptr : &it->second;
         const std::string content =
             options.force ? std::string()
-                          : reusable_content_hash(old, inputs[i], dir, set, s);
+                          : reusable_content_hash(old, plan.inputs[i], dir, set, s);
         if (!content.empty()) {
-            rows[i] = identity_fields(set, s, mesh);
-            ImageStatistics columns;
-            columns.luminance_histogram.resize(kHistogramBins);
-            for (const auto& field : measured_fields(columns, 0)) {
-                const auto found = old->find(field.column);
-                rows[i].push_back(
-                    {field.column, found == old->end() ? "0" : found->second, true});
-            }
-            append_provenance(rows[i], inputs[i], content);
-            ++result.reused;
+            plan.rows[i] = reused_row(set, s, mesh, *old, plan.inputs[i], content);
+            ++plan.reused;
         } else {
-            pending.push_back(i);
+            plan.pending.push_back(i);
         }
     }
-    // Drop the rows of everything about to be re-rendered before any file is replaced.
-    write_complete_rows(dir, set, rows);
+    return plan;
+}
 
-    // Produce the bakes (ProductionCost::bake uploads: the AO) the pending plans upload
-    // once each, here, by content hash, so parallel workers never bake the same data
-    // twice and a bake's own progress bar is not interleaved; workers are handed the
-    // results (see render_worker).
-    double prebake_seconds = 0.0;
-    std::map<std::string, TextureData> baked;  // read-only once the workers start
-    {
-        std::map<std::string, Pass> bakes;
-        for (const std::size_t i : pending) {
-            const Stimulus& s = set.stimuli[i];
-            const Technique& technique = find_technique(s.technique);
-            const Scene scene = make_scene(meshes.at(s.mesh_spec), technique,
-                                           s.parameters, set.width, set.height);
-            for (const Pass& pass : make_frame_plan(scene, technique).passes)
-                if (is_bake(pass)) bakes.emplace(pass.data.content_hash, pass);
-        }
-        const auto start = Clock::now();
-        for (const auto& [hash, pass] : bakes) baked.emplace(hash, produce_upload(pass));
-        prebake_seconds = seconds_since(start);
-    }
+// The pre-bake's results, by content hash, and the time it took.
+struct Prebaked {
+    std::map<std::string, TextureData> by_hash;  // read-only once the workers start
+    double seconds = 0.0;
+};
 
-    // Render the pending stimuli on `jobs` render workers, each with its own GL context,
-    // and encode them on `jobs` encode workers, so files are written while the next
-    // image renders. A bounded queue between them holds at most `jobs` images. The first
-    // failure anywhere (GL, I/O, after_stimulus) stops both sides: rendered but not yet
-    // encoded images are dropped, so the manifest lists only finished stimuli.
-    struct RenderedStimulus {
-        std::size_t index;  // into set.stimuli
-        RenderedImage rendered;
-    };
-    std::mutex mutex;  // guards everything below and the manifest rows
-    std::condition_variable finished_signal, queue_changed;
-    std::size_t finished = 0;
-    std::atomic<std::size_t> next{0};
-    std::string failure;
-    std::vector<std::string> finished_ids;
-    std::deque<RenderedStimulus> queue;
-    const int jobs =
-        std::clamp(options.jobs, 1, int(std::max<std::size_t>(pending.size(), 1)));
-    int rendering = jobs;  // render workers still running; 0 closes the queue
-    std::vector<BatchTimings> render_timings(static_cast<std::size_t>(jobs)),
-        encode_timings(static_cast<std::size_t>(jobs));
-    const auto fail = [&](const std::string& what) {  // caller holds `mutex`
-        if (failure.empty()) failure = what;
-        finished_signal.notify_all();
-        queue_changed.notify_all();
-    };
-
-    // Files, statistics and the manifest row of one rendered stimulus; false when the run
-    // has stopped meanwhile (the row is then not written). Throws on I/O failure.
-    const auto finish_stimulus = [&](const RenderedStimulus& item,
-                                     BatchTimings& timings) {
-        const std::size_t i = item.index;
+// Produce the bakes (ProductionCost::bake uploads: the AO) the pending plans upload
+// once each, here, by content hash, so parallel workers never bake the same data
+// twice and a bake's own progress bar is not interleaved; workers are handed the
+// results (see RenderWorkers::render_worker).
+Prebaked prebake(const StimulusSet& set, const MeshesBySpec& meshes,
+                 const std::vector<std::size_t>& pending) {
+    Prebaked baked;
+    std::map<std::string, Pass> bakes;
+    for (const std::size_t i : pending) {
         const Stimulus& s = set.stimuli[i];
-        const Image& image = item.rendered.image;
-
-        auto start = Clock::now();
-        for (const auto format : set.formats)
-            write_image(dir / file_of(s, format), image, {.png = options.png});
-        timings.encode_seconds += seconds_since(start);
-
-        start = Clock::now();
-        ManifestRow row = identity_fields(set, s, *meshes.at(s.mesh_spec));
-        const auto stats = compute_image_statistics(
-            FloatImageView{image.width, image.height, 4, image.rgba}, kHistogramBins);
-        const auto measured = measured_fields(stats, item.rendered.non_finite_pixels);
-        row.insert(row.end(), measured.begin(), measured.end());
-        append_provenance(row, inputs[i], files_hash(dir, set, s));
-        timings.statistics_seconds += seconds_since(start);
-
-        std::size_t done = 0;
-        {
-            std::lock_guard lock(mutex);
-            if (!failure.empty()) return false;  // another worker failed meanwhile
-            rows[i] = std::move(row);
-            write_complete_rows(dir, set, rows);
-            finished_ids.push_back(s.id);
-            done = ++finished;
-            finished_signal.notify_one();
-        }
-        if (options.after_stimulus) options.after_stimulus(s.id, done);
-        return true;
-    };
-
-    auto render_worker = [&](int index) {
-        BatchTimings& timings = render_timings[std::size_t(index)];
-        try {
-            auto context = gl::create_headless_context();
-            gl::FrameExecutor executor;
-            // Bakes come from the pre-bake above; their time (and that of any bake it
-            // missed) counts as bake time, not GL time.
-            executor.set_upload_producer([&timings, &baked](const Pass& pass) {
-                if (!is_bake(pass)) return produce_upload(pass);
-                const auto start = Clock::now();
-                const auto it = baked.find(pass.data.content_hash);
-                TextureData data = it != baked.end() ? it->second : produce_upload(pass);
-                timings.ao_seconds += seconds_since(start);
-                return data;
-            });
-            for (std::size_t k; (k = next++) < pending.size();) {
-                {
-                    std::lock_guard lock(mutex);
-                    if (!failure.empty()) break;
-                }
-                const std::size_t i = pending[k];
-                const Stimulus& s = set.stimuli[i];
-                const Technique& technique = find_technique(s.technique);
-
-                // The single-image path of `lucent render --mesh`.
-                const auto start = Clock::now();
-                const double ao_before = timings.ao_seconds;
-                const Scene scene = make_scene(meshes.at(s.mesh_spec), technique,
-                                               s.parameters, set.width, set.height);
-                RenderedStimulus item{i, render_image_counted(executor, scene)};
-                timings.gl_seconds +=
-                    seconds_since(start) - (timings.ao_seconds - ao_before);
-
-                if (!options.overlap_encode) {  // encode here, before the next render
-                    if (!finish_stimulus(item, timings)) break;
-                    continue;
-                }
-                std::unique_lock lock(mutex);
-                queue_changed.wait(lock, [&] {
-                    return queue.size() < std::size_t(jobs) || !failure.empty();
-                });
-                if (!failure.empty()) break;
-                queue.push_back(std::move(item));
-                queue_changed.notify_all();
-            }
-        } catch (const std::exception& e) {
-            std::lock_guard lock(mutex);
-            fail(e.what());
-        }
-        std::lock_guard lock(mutex);
-        --rendering;
-        queue_changed.notify_all();
-    };
-
-    auto encode_worker = [&](int index) {
-        BatchTimings& timings = encode_timings[std::size_t(index)];
-        try {
-            for (;;) {
-                std::optional<RenderedStimulus> item;
-                {
-                    std::unique_lock lock(mutex);
-                    queue_changed.wait(lock, [&] {
-                        return !queue.empty() || rendering == 0 || !failure.empty();
-                    });
-                    if (!failure.empty() || queue.empty()) return;
-                    item = std::move(queue.front());
-                    queue.pop_front();
-                    queue_changed.notify_all();
-                }
-                if (!finish_stimulus(*item, timings)) return;
-            }
-        } catch (const std::exception& e) {
-            std::lock_guard lock(mutex);
-            fail(e.what());
-        }
-    };
-    std::vector<std::thread> workers;
-    for (int w = 0; w < jobs && !pending.empty(); ++w) {
-        workers.emplace_back(render_worker, w);
-        if (options.overlap_encode) workers.emplace_back(encode_worker, w);
+        const Technique& technique = find_technique(s.technique);
+        const Scene scene = make_scene(meshes.at(s.mesh_spec), technique, s.parameters,
+                                       set.width, set.height);
+        for (const Pass& pass : make_frame_plan(scene, technique).passes)
+            if (is_bake(pass)) bakes.emplace(pass.data.content_hash, pass);
     }
+    const auto start = Clock::now();
+    for (const auto& [hash, pass] : bakes)
+        baked.by_hash.emplace(hash, produce_upload(pass));
+    baked.seconds = seconds_since(start);
+    return baked;
+}
 
-    BatchProgress progress(pending.size(), options.progress);
+// An image rendered and not yet encoded.
+struct RenderedStimulus {
+    std::size_t index;  // into set.stimuli
+    RenderedImage rendered;
+};
+
+// Render the pending stimuli on `jobs` render workers, each with its own GL context,
+// and encode them on `jobs` encode workers, so files are written while the next
+// image renders. A bounded queue between them holds at most `jobs` images. The first
+// failure anywhere (GL, I/O, after_stimulus) stops both sides: rendered but not yet
+// encoded images are dropped, so the manifest lists only finished stimuli.
+class RenderWorkers {
+public:
+    // Renders plan.pending and fills plan.rows; everything passed must outlive this.
+    RenderWorkers(const StimulusSet& set, const BatchOptions& options,
+                  const MeshesBySpec& meshes,
+                  const std::map<std::string, TextureData>& baked, RenderPlan& plan)
+        : set_(set),
+          options_(options),
+          meshes_(meshes),
+          baked_(baked),
+          rows_(plan.rows),
+          inputs_(plan.inputs),
+          pending_(plan.pending),
+          jobs_(std::clamp(options.jobs, 1,
+                           int(std::max<std::size_t>(pending_.size(), 1)))),
+          rendering_(jobs_),
+          render_timings_(static_cast<std::size_t>(jobs_)),
+          encode_timings_(static_cast<std::size_t>(jobs_)) {}
+
+    // Starts the workers, shows progress until every pending stimulus is finished or one
+    // failed, and joins them; throws std::runtime_error with the first failure.
+    void run();
+    const std::vector<BatchTimings>& render_timings() const { return render_timings_; }
+    const std::vector<BatchTimings>& encode_timings() const { return encode_timings_; }
+
+private:
+    void fail(const std::string& what);
+    bool finish_stimulus(const RenderedStimulus& item, BatchTimings& timings);
+    void render_worker(int index);
+    void encode_worker(int index);
+    void show_progress();
+
+    const StimulusSet& set_;
+    const BatchOptions& options_;
+    const MeshesBySpec& meshes_;
+    const std::map<std::string, TextureData>& baked_;
+    std::vector<ManifestRow>& rows_;
+    const std::vector<std::string>& inputs_;
+    const std::vector<std::size_t>& pending_;
+    const int jobs_;
+    std::mutex mutex_;  // guards everything below and the manifest rows
+    std::condition_variable finished_signal_, queue_changed_;
+    std::size_t finished_ = 0;
+    std::atomic<std::size_t> next_{0};
+    std::string failure_;
+    std::vector<std::string> finished_ids_;
+    std::deque<RenderedStimulus> queue_;
+    int rendering_;  // render workers still running; 0 closes the queue
+    std::vector<BatchTimings> render_timings_, encode_timings_;
+};
+
+void RenderWorkers::fail(const std::string& what) {  // caller holds `mutex_`
+    if (failure_.empty()) failure_ = what;
+    finished_signal_.notify_all();
+    queue_changed_.notify_all();
+}
+
+// Files, statistics and the manifest row of one rendered stimulus; false when the run
+// has stopped meanwhile (the row is then not written). Throws on I/O failure.
+bool RenderWorkers::finish_stimulus(const RenderedStimulus& item, BatchTimings& timings) {
+    const auto& dir = options_.out_dir;
+    const std::size_t i = item.index;
+    const Stimulus& s = set_.stimuli[i];
+    const Image& image = item.rendered.image;
+
+    auto start = Clock::now();
+    for (const auto format : set_.formats)
+        write_image(dir / file_of(s, format), image, {.png = options_.png});
+    timings.encode_seconds += seconds_since(start);
+
+    start = Clock::now();
+    ManifestRow row = identity_fields(set_, s, *meshes_.at(s.mesh_spec));
+    const auto stats = compute_image_statistics(
+        FloatImageView{image.width, image.height, 4, image.rgba}, kHistogramBins);
+    const auto measured = measured_fields(stats, item.rendered.non_finite_pixels);
+    row.insert(row.end(), measured.begin(), measured.end());
+    append_provenance(row, inputs_[i], files_hash(dir, set_, s));
+    timings.statistics_seconds += seconds_since(start);
+
+    std::size_t done = 0;
     {
-        std::unique_lock lock(mutex);
-        std::size_t shown = 0;
-        while (shown < pending.size() && failure.empty()) {
-            finished_signal.wait(lock,
-                                 [&] { return finished > shown || !failure.empty(); });
-            while (shown < finished) {
-                const std::string id = finished_ids[shown++];
-                lock.unlock();
-                progress.done(shown, id);
-                lock.lock();
+        std::lock_guard lock(mutex_);
+        if (!failure_.empty()) return false;  // another worker failed meanwhile
+        rows_[i] = std::move(row);
+        write_complete_rows(dir, set_, rows_);
+        finished_ids_.push_back(s.id);
+        done = ++finished_;
+        finished_signal_.notify_one();
+    }
+    if (options_.after_stimulus) options_.after_stimulus(s.id, done);
+    return true;
+}
+
+void RenderWorkers::render_worker(int index) {
+    BatchTimings& timings = render_timings_[std::size_t(index)];
+    try {
+        auto context = gl::create_headless_context();
+        gl::FrameExecutor executor;
+        // Bakes come from the pre-bake (prebake()); their time (and that of any bake it
+        // missed) counts as bake time, not GL time.
+        executor.set_upload_producer([&timings, &baked = baked_](const Pass& pass) {
+            if (!is_bake(pass)) return produce_upload(pass);
+            const auto start = Clock::now();
+            const auto it = baked.find(pass.data.content_hash);
+            TextureData data = it != baked.end() ? it->second : produce_upload(pass);
+            timings.ao_seconds += seconds_since(start);
+            return data;
+        });
+        for (std::size_t k; (k = next_++) < pending_.size();) {
+            {
+                std::lock_guard lock(mutex_);
+                if (!failure_.empty()) break;
             }
+            const std::size_t i = pending_[k];
+            const Stimulus& s = set_.stimuli[i];
+            const Technique& technique = find_technique(s.technique);
+
+            // The single-image path of `lucent render --mesh`.
+            const auto start = Clock::now();
+            const double ao_before = timings.ao_seconds;
+            const Scene scene = make_scene(meshes_.at(s.mesh_spec), technique,
+                                           s.parameters, set_.width, set_.height);
+            RenderedStimulus item{i, render_image_counted(executor, scene)};
+            timings.gl_seconds += seconds_since(start) - (timings.ao_seconds - ao_before);
+
+            if (!options_.overlap_encode) {  // encode here, before the next render
+                if (!finish_stimulus(item, timings)) break;
+                continue;
+            }
+            std::unique_lock lock(mutex_);
+            queue_changed_.wait(lock, [&] {
+                return queue_.size() < std::size_t(jobs_) || !failure_.empty();
+            });
+            if (!failure_.empty()) break;
+            queue_.push_back(std::move(item));
+            queue_changed_.notify_all();
+        }
+    } catch (const std::exception& e) {
+        std::lock_guard lock(mutex_);
+        fail(e.what());
+    }
+    std::lock_guard lock(mutex_);
+    --rendering_;
+    queue_changed_.notify_all();
+}
+
+void RenderWorkers::encode_worker(int index) {
+    BatchTimings& timings = encode_timings_[std::size_t(index)];
+    try {
+        for (;;) {
+            std::optional<RenderedStimulus> item;
+            {
+                std::unique_lock lock(mutex_);
+                queue_changed_.wait(lock, [&] {
+                    return !queue_.empty() || rendering_ == 0 || !failure_.empty();
+                });
+                if (!failure_.empty() || queue_.empty()) return;
+                item = std::move(queue_.front());
+                queue_.pop_front();
+                queue_changed_.notify_all();
+            }
+            if (!finish_stimulus(*item, timings)) return;
+        }
+    } catch (const std::exception& e) {
+        std::lock_guard lock(mutex_);
+        fail(e.what());
+    }
+}
+
+// The progress line, redrawn as stimuli finish, until all are done or one failed.
+void RenderWorkers::show_progress() {
+    BatchProgress progress(pending_.size(), options_.progress);
+    std::unique_lock lock(mutex_);
+    std::size_t shown = 0;
+    while (shown < pending_.size() && failure_.empty()) {
+        finished_signal_.wait(lock,
+                              [&] { return finished_ > shown || !failure_.empty(); });
+        while (shown < finished_) {
+            const std::string id = finished_ids_[shown++];
+            lock.unlock();
+            progress.done(shown, id);
+            lock.lock();
         }
     }
-    for (auto& thread : workers) thread.join();
-    if (!failure.empty()) throw std::runtime_error(failure);
-    result.rendered = pending.size();
+}
 
-    for (std::size_t i = 0; i < count; ++i) {
+void RenderWorkers::run() {
+    std::vector<std::thread> workers;
+    for (int w = 0; w < jobs_ && !pending_.empty(); ++w) {
+        workers.emplace_back(&RenderWorkers::render_worker, this, w);
+        if (options_.overlap_encode)
+            workers.emplace_back(&RenderWorkers::encode_worker, this, w);
+    }
+    show_progress();
+    for (auto& thread : workers) thread.join();
+    if (!failure_.empty()) throw std::runtime_error(failure_);
+}
+
+// The stimuli whose image had NaN or Inf pixels, with the count, in set order.
+std::vector<std::pair<std::string, std::size_t>> non_finite_stimuli(
+    const StimulusSet& set, const std::vector<ManifestRow>& rows) {
+    std::vector<std::pair<std::string, std::size_t>> non_finite;
+    for (std::size_t i = 0; i < set.stimuli.size(); ++i) {
         const auto& row = rows[i];
         const auto it = std::find_if(row.begin(), row.end(), [](const ManifestField& f) {
             return f.column == "non_finite_pixels";
         });
         const auto pixels = it == row.end() ? std::nullopt : parse_count(it->text);
-        if (pixels && *pixels > 0)
-            result.non_finite.push_back({set.stimuli[i].id, *pixels});
+        if (pixels && *pixels > 0) non_finite.push_back({set.stimuli[i].id, *pixels});
     }
-    result.rows = std::move(rows);
-    result.timings.ao_seconds = prebake_seconds;
+    return non_finite;
+}
+
+// The stage times summed over the pre-bake and every worker (wall time not included).
+BatchTimings summed_timings(double prebake_seconds,
+                            const std::vector<BatchTimings>& render_timings,
+                            const std::vector<BatchTimings>& encode_timings) {
+    BatchTimings sum;
+    sum.ao_seconds = prebake_seconds;
     for (const auto* timings : {&render_timings, &encode_timings})
         for (const auto& t : *timings) {
-            result.timings.ao_seconds += t.ao_seconds;
-            result.timings.gl_seconds += t.gl_seconds;
-            result.timings.encode_seconds += t.encode_seconds;
-            result.timings.statistics_seconds += t.statistics_seconds;
+            sum.ao_seconds += t.ao_seconds;
+            sum.gl_seconds += t.gl_seconds;
+            sum.encode_seconds += t.encode_seconds;
+            sum.statistics_seconds += t.statistics_seconds;
         }
+    return sum;
+}
+
+}  // namespace
+
+BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& options) {
+    const auto wall_start = Clock::now();
+    const auto& dir = options.out_dir;
+    BatchResult result;
+
+    const MeshesBySpec meshes = load_meshes(set);
+    std::filesystem::create_directories(dir);
+    const auto previous = read_manifest_csv(dir);
+
+    RenderPlan plan = plan_renders(set, options, meshes, previous);
+    result.reused = plan.reused;
+    // Drop the rows of everything about to be re-rendered before any file is replaced.
+    write_complete_rows(dir, set, plan.rows);
+
+    const Prebaked baked = prebake(set, meshes, plan.pending);
+    RenderWorkers workers(set, options, meshes, baked.by_hash, plan);
+    workers.run();
+    result.rendered = plan.pending.size();
+
+    result.non_finite = non_finite_stimuli(set, plan.rows);
+    result.rows = std::move(plan.rows);
+    result.timings =
+        summed_timings(baked.seconds, workers.render_timings(), workers.encode_timings());
     result.timings.wall_seconds = seconds_since(wall_start);
     return result;
 }
