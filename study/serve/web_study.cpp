@@ -414,10 +414,19 @@ WebStudy::Live& WebStudy::load(const std::string& code, const SessionRow& sessio
     return out;
 }
 
-WebReply WebStudy::start(const json& body) {
-    // Who: ?participant=ID, or Prolific's PROLIFIC_PID (with STUDY_ID and SESSION_ID).
-    std::string code = text_field(body, "participant", kMaxCodeLength + 1, false);
+namespace {
+
+// Who a page is: its participant code and, from Prolific, the study and session.
+struct Participant {
+    std::string code;
     std::string prolific_study, prolific_session;
+};
+
+// Who: ?participant=ID, or Prolific's PROLIFIC_PID (with STUDY_ID and SESSION_ID).
+Participant participant_of(const json& body) {
+    Participant who;
+    std::string& code = who.code;
+    code = text_field(body, "participant", kMaxCodeLength + 1, false);
     if (const json* prolific = field(body, "prolific")) {
         if (!prolific->is_object())
             throw RequestError(400, "field 'prolific' must be an object");
@@ -428,20 +437,26 @@ WebReply WebStudy::start(const json& body) {
             throw RequestError(
                 400, "participant '" + code + "' and PROLIFIC_PID '" + pid + "' differ");
         code = pid;
-        prolific_study = text_field(*prolific, "STUDY_ID", kMaxCodeLength + 1, false);
-        prolific_session = text_field(*prolific, "SESSION_ID", kMaxCodeLength + 1, false);
-        if (!prolific_study.empty()) check_code(prolific_study, "STUDY_ID");
-        if (!prolific_session.empty()) check_code(prolific_session, "SESSION_ID");
+        who.prolific_study = text_field(*prolific, "STUDY_ID", kMaxCodeLength + 1, false);
+        who.prolific_session =
+            text_field(*prolific, "SESSION_ID", kMaxCodeLength + 1, false);
+        if (!who.prolific_study.empty()) check_code(who.prolific_study, "STUDY_ID");
+        if (!who.prolific_session.empty()) check_code(who.prolific_session, "SESSION_ID");
     }
     if (code.empty())
         throw RequestError(400,
                            "no participant code (the link needs ?participant=ID or "
                            "Prolific's PROLIFIC_PID)");
     check_code(code, "participant code");
-    const std::string token = text_field(body, "token", kMaxTokenLength, false);
-    const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+    return who;
+}
 
-    Live browser;  // what this page says about itself
+}  // namespace
+
+// What this page says about itself: the request's `client` fields (Prolific's ids are
+// the caller's to add).
+WebStudy::Live WebStudy::browser_of(const json& body) {
+    Live browser;
     if (const json* client = field(body, "client")) {
         if (!client->is_object())
             throw RequestError(400, "field 'client' must be an object");
@@ -459,24 +474,26 @@ WebReply WebStudy::start(const json& body) {
             number_field(*client, "device_pixel_ratio", 0.05, 16, false).value_or(0);
         browser.refresh_hz = number_field(*client, "refresh_hz", 1, 1000, false);
     }
-    browser.prolific_study = prolific_study;
-    browser.prolific_session = prolific_session;
-    auto take_browser = [&](Live& live) {
-        live.user_agent = browser.user_agent;
-        live.window_width = browser.window_width;
-        live.window_height = browser.window_height;
-        live.screen_width = browser.screen_width;
-        live.screen_height = browser.screen_height;
-        live.device_pixel_ratio = browser.device_pixel_ratio;
-        live.refresh_hz = browser.refresh_hz;
-        live.prolific_study = browser.prolific_study;
-        live.prolific_session = browser.prolific_session;
-    };
-    const std::string in_progress =
-        "participant '" + code +
-        "' has a session in progress in another browser; continue "
-        "it there (the study link in that browser holds its key)";
+    return browser;
+}
 
+void WebStudy::take_browser(Live& live, const Live& browser) {
+    live.user_agent = browser.user_agent;
+    live.window_width = browser.window_width;
+    live.window_height = browser.window_height;
+    live.screen_width = browser.screen_width;
+    live.screen_height = browser.screen_height;
+    live.device_pixel_ratio = browser.device_pixel_ratio;
+    live.refresh_hz = browser.refresh_hz;
+    live.prolific_study = browser.prolific_study;
+    live.prolific_session = browser.prolific_session;
+}
+
+// The participant's session in progress in the store, if any; a loaded page whose
+// session ended is forgotten first, and a session whose every trial is answered is
+// completed instead.
+std::optional<SessionRow> WebStudy::unfinished_session_of(const std::string& code,
+                                                          const std::string& token) {
     std::optional<SessionRow> unfinished = store_.unfinished_session(code);
     if (const auto it = live_.find(code);
         it != live_.end() && !it->second->pending &&
@@ -493,35 +510,40 @@ WebReply WebStudy::start(const json& body) {
         drop(code);
         unfinished.reset();
     }
-    // A page (re)loaded for a session in progress: from the first unanswered trial, as
-    // `lucent run --resume` does; a new segment only once the last one has an answer.
-    if (unfinished) {
-        const std::string expected =
-            session_token(options_.secret, code, unfinished->uuid);
-        if (!same_secret_text(token, expected)) throw RequestError(403, in_progress);
-        store_.claim_participant(code);
-        Live probe;
-        take_browser(probe);
-        const SessionEnvironment env = environment_for(probe);
-        store_.set_status(unfinished->id, "running", false);
-        store_.resume_segment(unfinished->id, env);
-        Live& live = load(code, *unfinished, expected);
-        take_browser(live);
-        live.trials = store_.trials(unfinished->id);
-        live.flow.emplace(protocol_, store_, unfinished->id, live.trials,
-                          store_.has_consent(unfinished->id), ms_to_ns(t_ms));
-        json reply = state(live);
-        reply["token"] = live.token;
-        return {200, to_text(reply)};
-    }
-    if (store_.has_completed_session(code)) {
-        drop(code);
-        json reply = done_state();
-        reply["already_completed"] = true;
-        return {200, to_text(reply)};
-    }
-    // A new participant: the consent screen, nothing stored (the same page reloaded
-    // keeps its pending session; another page without its token starts a new one).
+    return unfinished;
+}
+
+// A page (re)loaded for a session in progress: from the first unanswered trial, as
+// `lucent run --resume` does; a new segment only once the last one has an answer.
+WebReply WebStudy::resume(const std::string& code, const std::string& token,
+                          const SessionRow& unfinished, const Live& browser,
+                          double t_ms) {
+    const std::string in_progress =
+        "participant '" + code +
+        "' has a session in progress in another browser; continue "
+        "it there (the study link in that browser holds its key)";
+    const std::string expected = session_token(options_.secret, code, unfinished.uuid);
+    if (!same_secret_text(token, expected)) throw RequestError(403, in_progress);
+    store_.claim_participant(code);
+    Live probe;
+    take_browser(probe, browser);
+    const SessionEnvironment env = environment_for(probe);
+    store_.set_status(unfinished.id, "running", false);
+    store_.resume_segment(unfinished.id, env);
+    Live& live = load(code, unfinished, expected);
+    take_browser(live, browser);
+    live.trials = store_.trials(unfinished.id);
+    live.flow.emplace(protocol_, store_, unfinished.id, live.trials,
+                      store_.has_consent(unfinished.id), ms_to_ns(t_ms));
+    json reply = state(live);
+    reply["token"] = live.token;
+    return {200, to_text(reply)};
+}
+
+// A new participant: the consent screen, nothing stored (the same page reloaded
+// keeps its pending session; another page without its token starts a new one).
+WebReply WebStudy::show_consent(const std::string& code, const std::string& token,
+                                const Live& browser, double t_ms) {
     const auto it = live_.find(code);
     if (it == live_.end() || !it->second->pending ||
         !same_secret_text(token, it->second->token)) {
@@ -543,7 +565,7 @@ WebReply WebStudy::start(const json& body) {
         live.seed = static_cast<uint64_t>(random_seed());
     }
     Live& live = *live_.at(code);
-    take_browser(live);
+    take_browser(live, browser);
     live.seen = now();
     if (protocol_.screens.consent.empty()) {
         // No consent screen in the protocol: the session starts at once.
@@ -558,6 +580,27 @@ WebReply WebStudy::start(const json& body) {
     json reply = pending_state(live);
     reply["token"] = live.token;
     return {200, to_text(reply)};
+}
+
+WebReply WebStudy::start(const json& body) {
+    const Participant who = participant_of(body);
+    const std::string& code = who.code;
+    const std::string token = text_field(body, "token", kMaxTokenLength, false);
+    const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+
+    Live browser = browser_of(body);  // what this page says about itself
+    browser.prolific_study = who.prolific_study;
+    browser.prolific_session = who.prolific_session;
+
+    if (const std::optional<SessionRow> unfinished = unfinished_session_of(code, token))
+        return resume(code, token, *unfinished, browser, t_ms);
+    if (store_.has_completed_session(code)) {
+        drop(code);
+        json reply = done_state();
+        reply["already_completed"] = true;
+        return {200, to_text(reply)};
+    }
+    return show_consent(code, token, browser, t_ms);
 }
 
 // The answer on a pending page's consent screen. Declined: one more in the study's count,
@@ -625,10 +668,9 @@ json WebStudy::pending_state(const Live& live) const {
 
 // ---- [SECTION] actions
 // -------------------------------------------------------------------
-WebReply WebStudy::act(std::string_view endpoint, const json& body) {
-    const std::string token = text_field(body, "token", kMaxTokenLength, true);
-    const size_t dot = token.rfind('.');
-    const std::string code = token.substr(0, dot == std::string::npos ? 0 : dot);
+// The page a token names: loaded here, and the token its own.
+WebStudy::Live& WebStudy::page_of_token(const std::string& code,
+                                        const std::string& token) {
     const auto it = live_.find(code);
     if (participant_code_problem(code).empty() && it == live_.end()) {
         // Not loaded here (the server restarted, the page was idle, or the session
@@ -640,33 +682,84 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
     }
     if (it == live_.end() || !same_secret_text(token, it->second->token))
         throw RequestError(403, "unknown session token");
-    Live& live = *it->second;
+    return *it->second;
+}
+
+// An action of a pending page: only its consent screen is shown (the answer agrees or
+// declines).
+WebReply WebStudy::act_pending(std::string_view endpoint, Live& live, const json& body) {
+    if (endpoint == "state") return {200, to_text(pending_state(live))};
+    if (endpoint == "environment") {
+        live.refresh_hz =
+            number_field(body, "refresh_hz", 1, 1000, true);  // kept in memory
+        return {200, to_text(pending_state(live))};
+    }
+    if (endpoint == "answer")
+        throw RequestError(409, "the consent screen is shown; no trial yet");
+    const double view = *number_field(body, "view", 0, 1e9, true);
+    const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
+    const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+    if (static_cast<int>(view) != kConsentView)
+        throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
+                                    " is no longer shown (now view " +
+                                    std::to_string(kConsentView) + ")");
+    if (t_ms < shown_ms)
+        throw RequestError(400,
+                           "the key came before the screen was shown (t_ms < shown_ms)");
+    return consent(live, endpoint == "decline", shown_ms, t_ms);
+}
+
+// continue / decline: Enter (or N on the consent screen) on the view shown.
+WebReply WebStudy::continue_or_decline(std::string_view endpoint, Live& live,
+                                       const std::string& code, const json& body) {
+    SessionFlow& flow = *live.flow;
+    const double view = *number_field(body, "view", 0, 1e9, true);
+    const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
+    const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+    if (static_cast<int>(view) != flow.serial())
+        throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
+                                    " is no longer shown (now view " +
+                                    std::to_string(flow.serial()) + ")");
+    const Screen screen = flow.screen();
+    const bool decline = endpoint == "decline";
+    if (decline && screen != Screen::Consent)
+        throw RequestError(409, "declining is possible only on the consent screen");
+    if (screen == Screen::Blank || screen == Screen::Trial || screen == Screen::Done)
+        throw RequestError(409, std::string("the ") + screen_name(screen) +
+                                    " screen is not continued with Enter");
+    SessionFlow next = flow;  // changes kept only when the key was taken
+    next.presented(next.serial(), ms_to_ns(shown_ms));
+    next.key({decline ? Key::Decline : Key::Enter, 0, ms_to_ns(t_ms)});
+    if (next.serial() == flow.serial() && !next.finished())
+        throw RequestError(400,
+                           "the key came before the screen was shown (t_ms < shown_ms)");
+    if (decline) {
+        // A session stored before consent (by a lab station, or an older lucent
+        // serve) is left 'aborted', as a lab decline leaves it.
+        drop(code);
+        return {200, to_text(json{{"screen", "declined"},
+                                  {"text",
+                                   "You did not agree to take part. You may close this "
+                                   "window."}})};
+    }
+    live.flow.emplace(next);
+    if (next.screen() == Screen::Done) {
+        drop(code);
+        return {200, to_text(done_state())};
+    }
+    return {200, to_text(state(live))};
+}
+
+WebReply WebStudy::act(std::string_view endpoint, const json& body) {
+    const std::string token = text_field(body, "token", kMaxTokenLength, true);
+    const size_t dot = token.rfind('.');
+    const std::string code = token.substr(0, dot == std::string::npos ? 0 : dot);
+    Live& live = page_of_token(code, token);
     live.seen = now();
 
-    if (live.pending) {
-        if (endpoint == "state") return {200, to_text(pending_state(live))};
-        if (endpoint == "environment") {
-            live.refresh_hz =
-                number_field(body, "refresh_hz", 1, 1000, true);  // kept in memory
-            return {200, to_text(pending_state(live))};
-        }
-        if (endpoint == "answer")
-            throw RequestError(409, "the consent screen is shown; no trial yet");
-        const double view = *number_field(body, "view", 0, 1e9, true);
-        const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
-        const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
-        if (static_cast<int>(view) != kConsentView)
-            throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
-                                        " is no longer shown (now view " +
-                                        std::to_string(kConsentView) + ")");
-        if (t_ms < shown_ms)
-            throw RequestError(
-                400, "the key came before the screen was shown (t_ms < shown_ms)");
-        return consent(live, endpoint == "decline", shown_ms, t_ms);
-    }
+    if (live.pending) return act_pending(endpoint, live, body);
 
     try {
-        SessionFlow& flow = *live.flow;
         if (endpoint == "state") return {200, to_text(state(live))};
         if (endpoint == "environment") {
             live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);
@@ -680,44 +773,7 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
                     code);  // completed: the debrief writes nothing
             return reply;
         }
-
-        // continue / decline: Enter (or N on the consent screen) on the view shown.
-        const double view = *number_field(body, "view", 0, 1e9, true);
-        const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
-        const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
-        if (static_cast<int>(view) != flow.serial())
-            throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
-                                        " is no longer shown (now view " +
-                                        std::to_string(flow.serial()) + ")");
-        const Screen screen = flow.screen();
-        const bool decline = endpoint == "decline";
-        if (decline && screen != Screen::Consent)
-            throw RequestError(409, "declining is possible only on the consent screen");
-        if (screen == Screen::Blank || screen == Screen::Trial || screen == Screen::Done)
-            throw RequestError(409, std::string("the ") + screen_name(screen) +
-                                        " screen is not continued with Enter");
-        SessionFlow next = flow;  // changes kept only when the key was taken
-        next.presented(next.serial(), ms_to_ns(shown_ms));
-        next.key({decline ? Key::Decline : Key::Enter, 0, ms_to_ns(t_ms)});
-        if (next.serial() == flow.serial() && !next.finished())
-            throw RequestError(
-                400, "the key came before the screen was shown (t_ms < shown_ms)");
-        if (decline) {
-            // A session stored before consent (by a lab station, or an older lucent
-            // serve) is left 'aborted', as a lab decline leaves it.
-            drop(code);
-            return {200,
-                    to_text(json{{"screen", "declined"},
-                                 {"text",
-                                  "You did not agree to take part. You may close this "
-                                  "window."}})};
-        }
-        live.flow.emplace(next);
-        if (next.screen() == Screen::Done) {
-            drop(code);
-            return {200, to_text(done_state())};
-        }
-        return {200, to_text(state(live))};
+        return continue_or_decline(endpoint, live, code, body);
     } catch (const StoreError&) {
         // Refused by the store: when because the participant was withdrawn while the page
         // was open, the page is told so (and forgotten) instead of the store's words.
@@ -729,15 +785,26 @@ WebReply WebStudy::act(std::string_view endpoint, const json& body) {
     }
 }
 
-WebReply WebStudy::answer(Live& live, const json& body) {
-    SessionFlow& flow = *live.flow;
-    const std::string trial_uuid = text_field(body, "trial", 64, true);
+namespace {
+
+// One input event of an answer, checked, as the lab's RatingInput takes it.
+struct AnswerEvent {
+    enum class Kind { Key, Point, Next } kind;
+    Key key = Key::Enter;
+    int digit = 0, question = 0, value = 0;
+    int64_t t_ns = 0;
+};
+
+// The trial an answer names must be the one on screen: 404 when it is none of the
+// session's, 409 when answered already or not shown.
+void check_trial_on_screen(const SessionFlow& flow, const std::vector<TrialRow>& trials,
+                           const std::string& trial_uuid) {
     const TrialRow* current = flow.trial();
     if (!current || current->uuid != trial_uuid) {
         const auto it =
-            std::find_if(live.trials.begin(), live.trials.end(),
+            std::find_if(trials.begin(), trials.end(),
                          [&](const TrialRow& t) { return t.uuid == trial_uuid; });
-        if (it == live.trials.end())
+        if (it == trials.end())
             throw RequestError(
                 404, "trial '" + trial_uuid + "' is not one of this session's trials");
         if (it->answered)
@@ -746,12 +813,65 @@ WebReply WebStudy::answer(Live& live, const json& body) {
         throw RequestError(409, "trial " + std::to_string(it->position + 1) +
                                     " is not the one on screen");
     }
-    const double view = *number_field(body, "view", 0, 1e9, true);
-    if (static_cast<int>(view) != flow.serial())
-        throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
-                                    " is no longer shown (now view " +
-                                    std::to_string(flow.serial()) + ")");
-    const double onset_ms = *number_field(body, "onset_ms", 0, kMaxPageMs, true);
+}
+
+// One of an answer's events, checked: a key the scales (at most `max_points`) or the
+// lab know, a rating inside its question's scale, or Next.
+AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
+                     int max_points) {
+    if (!e.is_object()) throw RequestError(400, "each event must be an object");
+    AnswerEvent ev{AnswerEvent::Kind::Key};
+    ev.t_ns = ms_to_ns(*number_field(e, "t_ms", 0, kMaxPageMs, true));
+    const std::string type = text_field(e, "type", 16, true);
+    if (type == "key") {
+        const std::string key = text_field(e, "key", 16, true);
+        if (key.size() == 1 && key[0] >= '1' && key[0] <= '9') {
+            ev.key = Key::Digit;
+            ev.digit = key[0] - '0';
+            if (ev.digit > max_points)
+                throw RequestError(400, "key '" + key + "' is outside every scale (1.." +
+                                            std::to_string(max_points) + ")");
+        } else if (key == "Enter") {
+            ev.key = Key::Enter;
+        } else if (key == "ArrowLeft") {
+            ev.key = Key::Left;
+        } else if (key == "ArrowRight") {
+            ev.key = Key::Right;
+        } else if (key == "ArrowUp") {
+            ev.key = Key::Up;
+        } else if (key == "ArrowDown") {
+            ev.key = Key::Down;
+        } else {
+            throw RequestError(400, "unknown key '" + one_line(key) + "'");
+        }
+    } else if (type == "point") {
+        ev.kind = AnswerEvent::Kind::Point;
+        const double q = *number_field(e, "question", 0, 1e6, true);
+        if (q != std::floor(q) || q >= static_cast<double>(questions.size()))
+            throw RequestError(400, "question index " + json(q).dump() +
+                                        " is not one of the " +
+                                        std::to_string(questions.size()) + " questions");
+        ev.question = static_cast<int>(q);
+        const Question& question = questions[ev.question];
+        const json* v = field(e, "value");
+        if (!v || !v->is_number_integer() || v->get<int64_t>() < 1 ||
+            v->get<int64_t>() > question.points())
+            throw RequestError(400, "rating " + (v ? v->dump() : std::string("(none)")) +
+                                        " is outside 1.." +
+                                        std::to_string(question.points()) +
+                                        " of question '" + question.id + "'");
+        ev.value = static_cast<int>(v->get<int64_t>());
+    } else if (type == "next") {
+        ev.kind = AnswerEvent::Kind::Next;
+    } else {
+        throw RequestError(400, "unknown event type '" + one_line(type) + "'");
+    }
+    return ev;
+}
+
+// The answer's `events`, bounded in number.
+std::vector<AnswerEvent> events_of(const json& body,
+                                   const std::vector<Question>& questions) {
     const json* events = field(body, "events");
     if (!events || !events->is_array())
         throw RequestError(400, "field 'events' must be an array");
@@ -761,90 +881,35 @@ WebReply WebStudy::answer(Live& live, const json& body) {
 
     // Every event checked before any is replayed.
     int max_points = 0;
-    for (const Question& q : protocol_.questions)
-        max_points = std::max(max_points, q.points());
-    struct Event {
-        enum class Kind { Key, Point, Next } kind;
-        Key key = Key::Enter;
-        int digit = 0, question = 0, value = 0;
-        int64_t t_ns = 0;
-    };
-    std::vector<Event> replay;
-    for (const json& e : *events) {
-        if (!e.is_object()) throw RequestError(400, "each event must be an object");
-        Event ev{Event::Kind::Key};
-        ev.t_ns = ms_to_ns(*number_field(e, "t_ms", 0, kMaxPageMs, true));
-        const std::string type = text_field(e, "type", 16, true);
-        if (type == "key") {
-            const std::string key = text_field(e, "key", 16, true);
-            if (key.size() == 1 && key[0] >= '1' && key[0] <= '9') {
-                ev.key = Key::Digit;
-                ev.digit = key[0] - '0';
-                if (ev.digit > max_points)
-                    throw RequestError(400, "key '" + key +
-                                                "' is outside every scale (1.." +
-                                                std::to_string(max_points) + ")");
-            } else if (key == "Enter") {
-                ev.key = Key::Enter;
-            } else if (key == "ArrowLeft") {
-                ev.key = Key::Left;
-            } else if (key == "ArrowRight") {
-                ev.key = Key::Right;
-            } else if (key == "ArrowUp") {
-                ev.key = Key::Up;
-            } else if (key == "ArrowDown") {
-                ev.key = Key::Down;
-            } else {
-                throw RequestError(400, "unknown key '" + one_line(key) + "'");
-            }
-        } else if (type == "point") {
-            ev.kind = Event::Kind::Point;
-            const double q = *number_field(e, "question", 0, 1e6, true);
-            if (q != std::floor(q) ||
-                q >= static_cast<double>(protocol_.questions.size()))
-                throw RequestError(
-                    400, "question index " + json(q).dump() + " is not one of the " +
-                             std::to_string(protocol_.questions.size()) + " questions");
-            ev.question = static_cast<int>(q);
-            const Question& question = protocol_.questions[ev.question];
-            const json* v = field(e, "value");
-            if (!v || !v->is_number_integer() || v->get<int64_t>() < 1 ||
-                v->get<int64_t>() > question.points())
-                throw RequestError(
-                    400, "rating " + (v ? v->dump() : std::string("(none)")) +
-                             " is outside 1.." + std::to_string(question.points()) +
-                             " of question '" + question.id + "'");
-            ev.value = static_cast<int>(v->get<int64_t>());
-        } else if (type == "next") {
-            ev.kind = Event::Kind::Next;
-        } else {
-            throw RequestError(400, "unknown event type '" + one_line(type) + "'");
-        }
-        replay.push_back(ev);
-    }
+    for (const Question& q : questions) max_points = std::max(max_points, q.points());
+    std::vector<AnswerEvent> replay;
+    for (const json& e : *events) replay.push_back(event_of(e, questions, max_points));
+    return replay;
+}
 
-    // Replayed on a copy: the blank gives way to the picture at its onset, then the keys
-    // and clicks as the lab's RatingInput takes them; the copy commits the trial.
+// Replayed on a copy: the blank gives way to the picture at its onset, then the keys
+// and clicks as the lab's RatingInput takes them; the copy commits the trial.
+SessionFlow replayed(const SessionFlow& flow, double onset_ms,
+                     const std::vector<AnswerEvent>& replay, int inter_trial_ms) {
     SessionFlow next = flow;
     const int64_t onset_ns = ms_to_ns(onset_ms);
     next.tick(onset_ns);
     if (next.screen() != Screen::Trial)
         throw RequestError(400, "the picture was shown before the " +
-                                    std::to_string(protocol_.inter_trial_ms) +
-                                    " ms blank ended");
+                                    std::to_string(inter_trial_ms) + " ms blank ended");
     next.presented(next.serial(), onset_ns);
     const size_t answered_before = next.answered_trials();
-    for (const Event& ev : replay) {
+    for (const AnswerEvent& ev : replay) {
         if (next.answered_trials() != answered_before)
             break;  // confirmed: the rest is late
         switch (ev.kind) {
-            case Event::Kind::Key:
+            case AnswerEvent::Kind::Key:
                 next.key({ev.key, ev.digit, ev.t_ns});
                 break;
-            case Event::Kind::Point:
+            case AnswerEvent::Kind::Point:
                 next.click_point(ev.question, ev.value, ev.t_ns);
                 break;
-            case Event::Kind::Next:
+            case AnswerEvent::Kind::Next:
                 next.click_next(ev.t_ns);
                 break;
         }
@@ -853,6 +918,24 @@ WebReply WebStudy::answer(Live& live, const json& body) {
         throw RequestError(400,
                            "the events do not rate every question and confirm it "
                            "(Enter or Next) after the picture's onset");
+    return next;
+}
+
+}  // namespace
+
+WebReply WebStudy::answer(Live& live, const json& body) {
+    SessionFlow& flow = *live.flow;
+    const std::string trial_uuid = text_field(body, "trial", 64, true);
+    check_trial_on_screen(flow, live.trials, trial_uuid);
+    const double view = *number_field(body, "view", 0, 1e9, true);
+    if (static_cast<int>(view) != flow.serial())
+        throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
+                                    " is no longer shown (now view " +
+                                    std::to_string(flow.serial()) + ")");
+    const double onset_ms = *number_field(body, "onset_ms", 0, kMaxPageMs, true);
+    const std::vector<AnswerEvent> replay = events_of(body, protocol_.questions);
+
+    SessionFlow next = replayed(flow, onset_ms, replay, protocol_.inter_trial_ms);
     for (TrialRow& t : live.trials)
         if (t.uuid == trial_uuid) t.answered = true;
     live.flow.emplace(next);

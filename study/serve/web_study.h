@@ -100,7 +100,24 @@ public:
 private:
     struct Live;
     WebReply start(const nlohmann::json& body);
+    // start()'s stages: what the browser says, the participant's session in progress,
+    // resuming it, or a new participant's consent screen.
+    static Live browser_of(const nlohmann::json& body);
+    static void take_browser(Live& live, const Live& browser);
+    std::optional<SessionRow> unfinished_session_of(const std::string& code,
+                                                    const std::string& token);
+    WebReply resume(const std::string& code, const std::string& token,
+                    const SessionRow& unfinished, const Live& browser, double t_ms);
+    WebReply show_consent(const std::string& code, const std::string& token,
+                          const Live& browser, double t_ms);
     WebReply act(std::string_view endpoint, const nlohmann::json& body);
+    // act()'s stages: the page a token names, a pending page's actions, Enter or N on a
+    // loaded session's screen.
+    Live& page_of_token(const std::string& code, const std::string& token);
+    WebReply act_pending(std::string_view endpoint, Live& live,
+                         const nlohmann::json& body);
+    WebReply continue_or_decline(std::string_view endpoint, Live& live,
+                                 const std::string& code, const nlohmann::json& body);
     WebReply answer(Live& live, const nlohmann::json& body);
     nlohmann::json state(const Live& live) const;
     nlohmann::json done_state() const;
