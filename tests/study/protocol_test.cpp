@@ -193,8 +193,9 @@ TEST(ProtocolParameters, AreHeldToTheTechniquesKnobsAtTheirLine) {
     };
     // kSmallProtocol starts with a newline: stimulus 'p''s params are on line 39.
     const Case cases[] = {
-        {"roughness = -3", {"bad.toml:39:", "stimuli.params.roughness", "stimulus 'p'",
-                            "accepted: a number in ["}},
+        {"roughness = -3",
+         {"bad.toml:39:", "stimuli.params.roughness", "stimulus 'p'",
+          "accepted: a number in ["}},
         {"roughness = \"rough\"", {"bad.toml:39:", "wrong type: expected a number"}},
         {"sparkle = 3",
          {"bad.toml:39:", "stimuli.params.sparkle",
