@@ -25,6 +25,38 @@ namespace {
 
 int64_t first_int(Statement& s) { return s.step() ? s.integer(0) : 0; }
 
+// A segment's environment: its columns (the session row repeats the first segment's), in
+// the order bind_environment() binds them.
+constexpr int kEnvironmentColumnCount = 9;
+constexpr const char* kEnvironmentColumns =
+    "machine_id, software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
+    "display_refresh_hz, measured_refresh_hz, refresh_note";
+constexpr const char* kEnvironmentValues = "?, ?, ?, ?, ?, ?, ?, ?, ?";
+
+// "machine_id = ?, software_version = ?, ...": the columns as an UPDATE sets them.
+std::string environment_assignments() {
+    std::string out, columns = kEnvironmentColumns;
+    for (size_t start = 0; start < columns.size();) {
+        const size_t end = std::min(columns.find(", ", start), columns.size());
+        out += (out.empty() ? "" : ", ") + columns.substr(start, end - start) + " = ?";
+        start = end + 2;
+    }
+    return out;
+}
+
+// Binds `env` to the environment columns' parameters, the first at index `first`.
+Statement& bind_environment(Statement& s, int first, const SessionEnvironment& env) {
+    return s.bind(first, env.machine_id)
+        .bind(first + 1, env.software_version)
+        .bind(first + 2, env.build_hash)
+        .bind(first + 3, env.gl_vendor)
+        .bind(first + 4, env.gl_renderer)
+        .bind(first + 5, env.display_mode)
+        .bind(first + 6, env.display_refresh_hz)
+        .bind(first + 7, env.measured_refresh_hz)
+        .bind(first + 8, env.refresh_note);
+}
+
 }  // namespace
 
 std::map<std::string, ResolvedStimulus> read_resolved_stimuli(Database& db) {
@@ -153,33 +185,21 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
     std::string order;
     for (const std::string& b : plan.block_order) order += (order.empty() ? "" : ",") + b;
 
-    db_.prepare(
-           "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, seed, "
-           "cell, "
-           "block_order, status, started_utc, software_version, build_hash, gl_vendor, "
-           "gl_renderer, display_mode, display_refresh_hz, measured_refresh_hz, "
-           "refresh_note, "
-           "allocation) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, "
-           "?, ?)")
-        .bind(1, row.uuid)
+    Statement session = db_.prepare(
+        "INSERT INTO sessions (uuid, study_id, participant_id, seed, cell, block_order, "
+        "status, started_utc, allocation, " +
+        std::string(kEnvironmentColumns) +
+        ") VALUES (?, ?, ?, ?, ?, ?, 'running', ?, ?, " + kEnvironmentValues + ")");
+    session.bind(1, row.uuid)
         .bind(2, study_id)
         .bind(3, participant_id)
-        .bind(4, env.machine_id)
-        .bind(5, std::to_string(seed))
-        .bind(6, plan.cell)
-        .bind(7, order)
-        .bind(8, utc_now_iso8601())
-        .bind(9, env.software_version)
-        .bind(10, env.build_hash)
-        .bind(11, env.gl_vendor)
-        .bind(12, env.gl_renderer)
-        .bind(13, env.display_mode)
-        .bind(14, env.display_refresh_hz)
-        .bind(15, env.measured_refresh_hz)
-        .bind(16, env.refresh_note)
-        .bind(17,
-              allocation.empty() ? std::nullopt : std::optional<std::string>(allocation))
-        .run();
+        .bind(4, std::to_string(seed))
+        .bind(5, plan.cell)
+        .bind(6, order)
+        .bind(7, utc_now_iso8601())
+        .bind(8,
+              allocation.empty() ? std::nullopt : std::optional<std::string>(allocation));
+    bind_environment(session, 9, env).run();
     row.id = db_.last_insert_id();
     Statement code = db_.prepare("SELECT code FROM participants WHERE id = ?");
     if (code.bind(1, participant_id).step()) row.participant = code.text(0);
@@ -357,25 +377,16 @@ void Store::insert_segment(int64_t session_id, int segment,
             value.bind(1, study_id).bind(2, p.stimulus).bind(3, name).bind(4, text).run();
         }
     }
-    db_.prepare(
-           "INSERT INTO session_segments (session_id, segment, started_utc, machine_id, "
-           "software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
-           "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) "
-           "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
-        .bind(1, session_id)
+    Statement segment_row = db_.prepare(
+        "INSERT INTO session_segments (session_id, segment, started_utc, "
+        "stimulus_source, " +
+        std::string(kEnvironmentColumns) + ") VALUES (?, ?, ?, ?, " + kEnvironmentValues +
+        ")");
+    segment_row.bind(1, session_id)
         .bind(2, segment)
         .bind(3, utc_now_iso8601())
-        .bind(4, env.machine_id)
-        .bind(5, env.software_version)
-        .bind(6, env.build_hash)
-        .bind(7, env.gl_vendor)
-        .bind(8, env.gl_renderer)
-        .bind(9, env.display_mode)
-        .bind(10, env.display_refresh_hz)
-        .bind(11, env.measured_refresh_hz)
-        .bind(12, env.refresh_note)
-        .bind(13, segment_source(env.stimuli))
-        .run();
+        .bind(4, segment_source(env.stimuli));
+    bind_environment(segment_row, 5, env).run();
     const int64_t segment_id = db_.last_insert_id();
     Statement shown = db_.prepare(
         "INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, "
@@ -435,41 +446,17 @@ int Store::resume_segment(int64_t session_id, const SessionEnvironment& env) {
 // The session row keeps the first segment's environment (what older readers show).
 void Store::copy_environment_to_session_row(int64_t session_id,
                                             const SessionEnvironment& env) {
-    db_.prepare(
-           "UPDATE sessions SET machine_id = ?, software_version = ?, build_hash = ?, "
-           "gl_vendor = ?, gl_renderer = ?, display_mode = ?, display_refresh_hz = ?, "
-           "measured_refresh_hz = ?, refresh_note = ? WHERE id = ?")
-        .bind(1, env.machine_id)
-        .bind(2, env.software_version)
-        .bind(3, env.build_hash)
-        .bind(4, env.gl_vendor)
-        .bind(5, env.gl_renderer)
-        .bind(6, env.display_mode)
-        .bind(7, env.display_refresh_hz)
-        .bind(8, env.measured_refresh_hz)
-        .bind(9, env.refresh_note)
-        .bind(10, session_id)
-        .run();
+    Statement update =
+        db_.prepare("UPDATE sessions SET " + environment_assignments() + " WHERE id = ?");
+    bind_environment(update, 1, env).bind(kEnvironmentColumnCount + 1, session_id).run();
 }
 
 void Store::update_environment(int64_t session_id, const SessionEnvironment& env) {
     Transaction tx(db_);
-    db_.prepare(
-           "UPDATE session_segments SET machine_id = ?, software_version = ?, "
-           "build_hash = ?, gl_vendor = ?, gl_renderer = ?, display_mode = ?, "
-           "display_refresh_hz = ?, measured_refresh_hz = ?, refresh_note = ? "
-           "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = ?)")
-        .bind(1, env.machine_id)
-        .bind(2, env.software_version)
-        .bind(3, env.build_hash)
-        .bind(4, env.gl_vendor)
-        .bind(5, env.gl_renderer)
-        .bind(6, env.display_mode)
-        .bind(7, env.display_refresh_hz)
-        .bind(8, env.measured_refresh_hz)
-        .bind(9, env.refresh_note)
-        .bind(10, session_id)
-        .run();
+    Statement update = db_.prepare(
+        "UPDATE session_segments SET " + environment_assignments() +
+        " WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = ?)");
+    bind_environment(update, 1, env).bind(kEnvironmentColumnCount + 1, session_id).run();
     if (first_int(
             db_.prepare("SELECT count(*) FROM session_segments WHERE session_id = ?")
                 .bind(1, session_id)) > 1) {
