@@ -181,6 +181,225 @@ void withdraw_on_server(pqxx::work& tx, Database& m,
     }
 }
 
+// A code the server holds must keep its name: a rename would split a server
+// participant.
+void refuse_renamed_server_codes(Database& m, const std::string& uri) {
+    Statement renamed = m.prepare(
+        "SELECT p.code FROM srv.participants p WHERE p.code NOT IN "
+        "(SELECT code FROM main.participants) AND EXISTS (SELECT 1 FROM srv.sessions "
+        "s "
+        "WHERE s.participant_id = p.id AND s.uuid IN (SELECT uuid FROM "
+        "main.sessions))");
+    if (renamed.step())
+        throw StoreError("refusing to merge into " + uri + ": participant code " +
+                         renamed.text(0) +
+                         " on the server is several people once the inputs are added "
+                         "(another machine, or another file's completed session); merge "
+                         "into a file instead");
+}
+
+// The merged file's sessions the server lacks (temp.new_sessions), and those it holds
+// that a file's copy extends (temp.extended, with their new segments and newly answered
+// trials).
+void classify_sessions(Database& m) {
+    m.exec(
+        "CREATE TEMP TABLE new_sessions AS SELECT id FROM main.sessions "
+        "WHERE uuid NOT IN (SELECT uuid FROM srv.sessions)");
+    // Sessions the server holds that a file's copy extends (more answers, a later
+    // status).
+    m.exec(
+        "CREATE TEMP TABLE extended AS SELECT m.id, m.uuid FROM main.sessions m "
+        "JOIN srv.sessions s ON s.uuid = m.uuid WHERE m.status <> s.status "
+        "OR (SELECT count(*) FROM main.responses WHERE session_id = m.id) <> "
+        "(SELECT count(*) FROM srv.responses WHERE session_id = s.id) "
+        "OR (SELECT count(*) FROM main.session_segments WHERE session_id = m.id) <> "
+        "(SELECT count(*) FROM srv.session_segments WHERE session_id = s.id)");
+    m.exec(
+        "CREATE TEMP TABLE ext_segments AS SELECT g.id FROM main.session_segments g "
+        "JOIN temp.extended e ON e.id = g.session_id WHERE NOT EXISTS (SELECT 1 FROM "
+        "srv.session_segments sg JOIN srv.sessions ss ON ss.id = sg.session_id "
+        "WHERE ss.uuid = e.uuid AND sg.segment = g.segment)");
+    m.exec(
+        "CREATE TEMP TABLE ext_trials AS SELECT t.id FROM main.trials t "
+        "JOIN temp.extended e ON e.id = t.session_id "
+        "WHERE EXISTS (SELECT 1 FROM main.responses r WHERE r.trial_id = t.id) "
+        "AND NOT EXISTS (SELECT 1 FROM srv.responses r JOIN srv.trials st ON st.id = "
+        "r.trial_id "
+        "JOIN srv.sessions ss ON ss.id = st.session_id WHERE ss.uuid = e.uuid "
+        "AND st.position = t.position)");
+}
+
+// Sessions the server holds that a withdrawal in an input covers: the merge left
+// them out, and the server drops them too.
+std::vector<std::string> sessions_withdrawn_on_server(Database& m) {
+    std::vector<std::string> withdrawn_on_server;
+    Statement w = m.prepare(
+        "SELECT uuid FROM srv.sessions WHERE uuid NOT IN "
+        "(SELECT uuid FROM main.sessions) ORDER BY id");
+    while (w.step()) withdrawn_on_server.push_back(w.text(0));
+    return withdrawn_on_server;
+}
+
+// What the merge adds to the server, as reported before anything is stored.
+MergeReport report_of(Database& m, const MergeReport& merged,
+                      const std::vector<std::string>& files,
+                      const std::vector<std::string>& withdrawn_on_server) {
+    MergeReport report;
+    report.notes = merged.notes;
+    report.sessions_added =
+        static_cast<int>(m.scalar_int("SELECT count(*) FROM temp.new_sessions"));
+    report.sessions_extended =
+        static_cast<int>(m.scalar_int("SELECT count(*) FROM temp.extended"));
+    report.sessions_withdrawn = merged.sessions_withdrawn;
+    int offered = 0;  // the files' copies of sessions the merge kept
+    for (const std::string& f : files) {
+        Database in(f, SQLITE_OPEN_READONLY);
+        if (!in.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'sessions'"))
+            continue;
+        Statement uuids = in.prepare("SELECT uuid FROM sessions");
+        Statement kept = m.prepare("SELECT count(*) FROM main.sessions WHERE uuid = ?");
+        while (uuids.step()) {
+            kept.reset();
+            kept.bind(1, uuids.text(0));
+            if (kept.step() && kept.integer(0) > 0) ++offered;
+        }
+    }
+    report.sessions_already_present =
+        std::max(0, offered - report.sessions_added - report.sessions_extended);
+    if (!withdrawn_on_server.empty())
+        report.notes.push_back(
+            std::to_string(withdrawn_on_server.size()) + " session" +
+            (withdrawn_on_server.size() == 1 ? "" : "s") +
+            " of withdrawn participants removed from the server (withdrawn in an input)");
+    return report;
+}
+
+// The server's ids of the merged file's studies and stimuli.
+struct StudyIds {
+    IdMap studies, stimuli;
+};
+
+// The study and its stimuli on the server: looked up when the server holds the study
+// (with the stimulus values it has not recorded yet), copied otherwise.
+StudyIds study_on_server(pqxx::work& tx, Database& m) {
+    StudyIds study;
+    IdMap& studies = study.studies;
+    IdMap& stimuli = study.stimuli;
+    const bool server_has_study = m.scalar_int("SELECT count(*) FROM srv.studies") > 0;
+    if (server_has_study) {
+        Statement s = m.prepare("SELECT id, protocol_hash FROM main.studies");
+        while (s.step())
+            studies[s.integer(0)] =
+                tx.exec_params1("SELECT id FROM studies WHERE protocol_hash = $1",
+                                s.text(1))[0]
+                    .as<int64_t>();
+        Statement st = m.prepare("SELECT id, study_id, stimulus_key FROM main.stimuli");
+        while (st.step())
+            stimuli[st.integer(0)] = tx.exec_params1(
+                                           "SELECT id FROM stimuli WHERE study_id = $1 "
+                                           "AND stimulus_key = $2",
+                                           studies.at(st.integer(1)), st.text(2))[0]
+                                         .as<int64_t>();
+        // Values the server has not recorded yet (the merge checked they agree).
+        Statement first = m.prepare(
+            "SELECT id, resolved_mesh, mesh_hash FROM main.stimuli WHERE "
+            "resolved_mesh IS NOT "
+            "NULL AND stimulus_key IN (SELECT stimulus_key FROM srv.stimuli WHERE "
+            "resolved_mesh IS NULL)");
+        std::string ids;
+        while (first.step()) {
+            tx.exec_params(
+                "UPDATE stimuli SET resolved_mesh = $1, mesh_hash = $2 WHERE id = $3 "
+                "AND resolved_mesh IS NULL",
+                first.text(1),
+                first.is_null(2) ? std::optional<std::string>() : first.text(2),
+                stimuli.at(first.integer(0)));
+            ids += (ids.empty() ? "" : ",") + std::to_string(first.integer(0));
+        }
+        if (!ids.empty())
+            copy_rows(tx, m, "stimulus_values", "stimulus_id IN (" + ids + ")",
+                      {{"stimulus_id", &stimuli}}, false);
+    } else {
+        studies = copy_rows(tx, m, "studies", "1", {}, true);
+        stimuli = copy_rows(tx, m, "stimuli", "1", {{"study_id", &studies}}, true);
+        copy_rows(tx, m, "stimulus_parameters", "1", {{"stimulus_id", &stimuli}}, false);
+        copy_rows(tx, m, "stimulus_values", "1", {{"stimulus_id", &stimuli}}, false);
+    }
+    return study;
+}
+
+// The server's ids of the merged file's participants: those the server knows by code,
+// the others added.
+IdMap participants_on_server(pqxx::work& tx, Database& m, const IdMap& studies) {
+    IdMap participants;
+    Statement known = m.prepare(
+        "SELECT id, code FROM main.participants WHERE code IN "
+        "(SELECT code FROM srv.participants)");
+    while (known.step())
+        participants[known.integer(0)] =
+            tx.exec_params1("SELECT id FROM participants WHERE code = $1",
+                            known.text(1))[0]
+                .as<int64_t>();
+    const IdMap added = copy_rows(tx, m, "participants",
+                                  "code NOT IN (SELECT code FROM srv.participants)",
+                                  {{"study_id", &studies}}, true);
+    participants.insert(added.begin(), added.end());
+    return participants;
+}
+
+// The sessions the server lacks (temp.new_sessions), with their segments, trials and
+// responses.
+void copy_new_sessions(pqxx::work& tx, Database& m, const StudyIds& study,
+                       const IdMap& participants) {
+    const IdMap& studies = study.studies;
+    const IdMap& stimuli = study.stimuli;
+    const IdMap sessions =
+        copy_rows(tx, m, "sessions", "id IN (SELECT id FROM temp.new_sessions)",
+                  {{"study_id", &studies}, {"participant_id", &participants}}, true);
+    const IdMap segments = copy_rows(tx, m, "session_segments",
+                                     "session_id IN (SELECT id FROM temp.new_sessions)",
+                                     {{"session_id", &sessions}}, true);
+    copy_rows(
+        tx, m, "segment_stimuli",
+        "segment_id IN (SELECT g.id FROM session_segments g JOIN temp.new_sessions n "
+        "ON n.id = g.session_id)",
+        {{"segment_id", &segments}, {"stimulus_id", &stimuli}}, false);
+    const IdMap trials = copy_rows(
+        tx, m, "trials", "session_id IN (SELECT id FROM temp.new_sessions)",
+        {{"session_id", &sessions}, {"stimulus_id", &stimuli}, {"segment_id", &segments}},
+        true);
+    copy_rows(tx, m, "responses", "session_id IN (SELECT id FROM temp.new_sessions)",
+              {{"session_id", &sessions}, {"trial_id", &trials}}, false);
+}
+
+// Everything the merged file adds, onto the server in one transaction: stored whole or
+// not at all.
+void store_on_server(Database& m, const std::string& uri,
+                     const std::vector<std::string>& withdrawn_on_server) {
+    try {
+        pqxx::connection c(checked_server_uri(uri));
+        pqxx::work tx(c);
+        // The same locks stations take: no study row or participant number is created
+        // meanwhile.
+        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", 0x4C55, 1);
+        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", 0x4C55, 2);
+        const StudyIds study = study_on_server(tx, m);
+        const IdMap participants = participants_on_server(tx, m, study.studies);
+        copy_rows(tx, m, "retired_participant_numbers", "1", {}, false,
+                  " ON CONFLICT DO NOTHING");
+        copy_new_sessions(tx, m, study, participants);
+        extend_server_sessions(tx, m, study.stimuli);
+        withdraw_on_server(tx, m, withdrawn_on_server);
+        tx.commit();
+    } catch (const StoreError&) {
+        throw;
+    } catch (const std::exception& e) {
+        std::string why = e.what();
+        throw StoreError(uri + ": merge not stored (nothing changed): " +
+                         why.substr(0, why.find('\n')));
+    }
+}
+
 }  // namespace
 
 MergeReport merge_into_server(const std::vector<std::string>& files,
@@ -214,182 +433,11 @@ MergeReport merge_into_server(const std::vector<std::string>& files,
     m.prepare("ATTACH DATABASE ? AS srv")
         .bind(1, file_uri(server_snapshot.path(), "mode=ro"))
         .run();
-    // A code the server holds must keep its name: a rename would split a server
-    // participant.
-    {
-        Statement renamed = m.prepare(
-            "SELECT p.code FROM srv.participants p WHERE p.code NOT IN "
-            "(SELECT code FROM main.participants) AND EXISTS (SELECT 1 FROM srv.sessions "
-            "s "
-            "WHERE s.participant_id = p.id AND s.uuid IN (SELECT uuid FROM "
-            "main.sessions))");
-        if (renamed.step())
-            throw StoreError(
-                "refusing to merge into " + uri + ": participant code " +
-                renamed.text(0) +
-                " on the server is several people once the inputs are added "
-                "(another machine, or another file's completed session); merge "
-                "into a file instead");
-    }
-    m.exec(
-        "CREATE TEMP TABLE new_sessions AS SELECT id FROM main.sessions "
-        "WHERE uuid NOT IN (SELECT uuid FROM srv.sessions)");
-    // Sessions the server holds that a file's copy extends (more answers, a later
-    // status).
-    m.exec(
-        "CREATE TEMP TABLE extended AS SELECT m.id, m.uuid FROM main.sessions m "
-        "JOIN srv.sessions s ON s.uuid = m.uuid WHERE m.status <> s.status "
-        "OR (SELECT count(*) FROM main.responses WHERE session_id = m.id) <> "
-        "(SELECT count(*) FROM srv.responses WHERE session_id = s.id) "
-        "OR (SELECT count(*) FROM main.session_segments WHERE session_id = m.id) <> "
-        "(SELECT count(*) FROM srv.session_segments WHERE session_id = s.id)");
-    m.exec(
-        "CREATE TEMP TABLE ext_segments AS SELECT g.id FROM main.session_segments g "
-        "JOIN temp.extended e ON e.id = g.session_id WHERE NOT EXISTS (SELECT 1 FROM "
-        "srv.session_segments sg JOIN srv.sessions ss ON ss.id = sg.session_id "
-        "WHERE ss.uuid = e.uuid AND sg.segment = g.segment)");
-    m.exec(
-        "CREATE TEMP TABLE ext_trials AS SELECT t.id FROM main.trials t "
-        "JOIN temp.extended e ON e.id = t.session_id "
-        "WHERE EXISTS (SELECT 1 FROM main.responses r WHERE r.trial_id = t.id) "
-        "AND NOT EXISTS (SELECT 1 FROM srv.responses r JOIN srv.trials st ON st.id = "
-        "r.trial_id "
-        "JOIN srv.sessions ss ON ss.id = st.session_id WHERE ss.uuid = e.uuid "
-        "AND st.position = t.position)");
-    // Sessions the server holds that a withdrawal in an input covers: the merge left
-    // them out, and the server drops them too.
-    std::vector<std::string> withdrawn_on_server;
-    {
-        Statement w = m.prepare(
-            "SELECT uuid FROM srv.sessions WHERE uuid NOT IN "
-            "(SELECT uuid FROM main.sessions) ORDER BY id");
-        while (w.step()) withdrawn_on_server.push_back(w.text(0));
-    }
-    MergeReport report;
-    report.notes = merged.notes;
-    report.sessions_added =
-        static_cast<int>(m.scalar_int("SELECT count(*) FROM temp.new_sessions"));
-    report.sessions_extended =
-        static_cast<int>(m.scalar_int("SELECT count(*) FROM temp.extended"));
-    report.sessions_withdrawn = merged.sessions_withdrawn;
-    int offered = 0;  // the files' copies of sessions the merge kept
-    for (const std::string& f : files) {
-        Database in(f, SQLITE_OPEN_READONLY);
-        if (!in.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'sessions'"))
-            continue;
-        Statement uuids = in.prepare("SELECT uuid FROM sessions");
-        Statement kept = m.prepare("SELECT count(*) FROM main.sessions WHERE uuid = ?");
-        while (uuids.step()) {
-            kept.reset();
-            kept.bind(1, uuids.text(0));
-            if (kept.step() && kept.integer(0) > 0) ++offered;
-        }
-    }
-    report.sessions_already_present =
-        std::max(0, offered - report.sessions_added - report.sessions_extended);
-    if (!withdrawn_on_server.empty())
-        report.notes.push_back(
-            std::to_string(withdrawn_on_server.size()) + " session" +
-            (withdrawn_on_server.size() == 1 ? "" : "s") +
-            " of withdrawn participants removed from the server (withdrawn in an input)");
-
-    try {
-        pqxx::connection c(checked_server_uri(uri));
-        pqxx::work tx(c);
-        // The same locks stations take: no study row or participant number is created
-        // meanwhile.
-        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", 0x4C55, 1);
-        tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", 0x4C55, 2);
-        IdMap studies, stimuli, participants, sessions, segments, trials;
-        const bool server_has_study =
-            m.scalar_int("SELECT count(*) FROM srv.studies") > 0;
-        if (server_has_study) {
-            Statement s = m.prepare("SELECT id, protocol_hash FROM main.studies");
-            while (s.step())
-                studies[s.integer(0)] =
-                    tx.exec_params1("SELECT id FROM studies WHERE protocol_hash = $1",
-                                    s.text(1))[0]
-                        .as<int64_t>();
-            Statement st =
-                m.prepare("SELECT id, study_id, stimulus_key FROM main.stimuli");
-            while (st.step())
-                stimuli[st.integer(0)] =
-                    tx.exec_params1(
-                          "SELECT id FROM stimuli WHERE study_id = $1 "
-                          "AND stimulus_key = $2",
-                          studies.at(st.integer(1)), st.text(2))[0]
-                        .as<int64_t>();
-            // Values the server has not recorded yet (the merge checked they agree).
-            Statement first = m.prepare(
-                "SELECT id, resolved_mesh, mesh_hash FROM main.stimuli WHERE "
-                "resolved_mesh IS NOT "
-                "NULL AND stimulus_key IN (SELECT stimulus_key FROM srv.stimuli WHERE "
-                "resolved_mesh IS NULL)");
-            std::string ids;
-            while (first.step()) {
-                tx.exec_params(
-                    "UPDATE stimuli SET resolved_mesh = $1, mesh_hash = $2 WHERE id = $3 "
-                    "AND resolved_mesh IS NULL",
-                    first.text(1),
-                    first.is_null(2) ? std::optional<std::string>() : first.text(2),
-                    stimuli.at(first.integer(0)));
-                ids += (ids.empty() ? "" : ",") + std::to_string(first.integer(0));
-            }
-            if (!ids.empty())
-                copy_rows(tx, m, "stimulus_values", "stimulus_id IN (" + ids + ")",
-                          {{"stimulus_id", &stimuli}}, false);
-        } else {
-            studies = copy_rows(tx, m, "studies", "1", {}, true);
-            stimuli = copy_rows(tx, m, "stimuli", "1", {{"study_id", &studies}}, true);
-            copy_rows(tx, m, "stimulus_parameters", "1", {{"stimulus_id", &stimuli}},
-                      false);
-            copy_rows(tx, m, "stimulus_values", "1", {{"stimulus_id", &stimuli}}, false);
-        }
-        {
-            Statement known = m.prepare(
-                "SELECT id, code FROM main.participants WHERE code IN "
-                "(SELECT code FROM srv.participants)");
-            while (known.step())
-                participants[known.integer(0)] =
-                    tx.exec_params1("SELECT id FROM participants WHERE code = $1",
-                                    known.text(1))[0]
-                        .as<int64_t>();
-            const IdMap added = copy_rows(
-                tx, m, "participants", "code NOT IN (SELECT code FROM srv.participants)",
-                {{"study_id", &studies}}, true);
-            participants.insert(added.begin(), added.end());
-        }
-        copy_rows(tx, m, "retired_participant_numbers", "1", {}, false,
-                  " ON CONFLICT DO NOTHING");
-        sessions =
-            copy_rows(tx, m, "sessions", "id IN (SELECT id FROM temp.new_sessions)",
-                      {{"study_id", &studies}, {"participant_id", &participants}}, true);
-        segments = copy_rows(tx, m, "session_segments",
-                             "session_id IN (SELECT id FROM temp.new_sessions)",
-                             {{"session_id", &sessions}}, true);
-        copy_rows(
-            tx, m, "segment_stimuli",
-            "segment_id IN (SELECT g.id FROM session_segments g JOIN temp.new_sessions n "
-            "ON n.id = g.session_id)",
-            {{"segment_id", &segments}, {"stimulus_id", &stimuli}}, false);
-        trials =
-            copy_rows(tx, m, "trials", "session_id IN (SELECT id FROM temp.new_sessions)",
-                      {{"session_id", &sessions},
-                       {"stimulus_id", &stimuli},
-                       {"segment_id", &segments}},
-                      true);
-        copy_rows(tx, m, "responses", "session_id IN (SELECT id FROM temp.new_sessions)",
-                  {{"session_id", &sessions}, {"trial_id", &trials}}, false);
-        extend_server_sessions(tx, m, stimuli);
-        withdraw_on_server(tx, m, withdrawn_on_server);
-        tx.commit();
-    } catch (const StoreError&) {
-        throw;
-    } catch (const std::exception& e) {
-        std::string why = e.what();
-        throw StoreError(uri + ": merge not stored (nothing changed): " +
-                         why.substr(0, why.find('\n')));
-    }
+    refuse_renamed_server_codes(m, uri);
+    classify_sessions(m);
+    const std::vector<std::string> withdrawn_on_server = sessions_withdrawn_on_server(m);
+    MergeReport report = report_of(m, merged, files, withdrawn_on_server);
+    store_on_server(m, uri, withdrawn_on_server);
     return report;
 }
 
