@@ -115,9 +115,9 @@ private:
     std::set<std::string> used_;
 };
 
-// A pre-rendered image's parameter is a label, not a knob: its text, with numbers in the
-// shortest form that reads back to the same double and arrays as "a,b,c", so equal
-// values compare equal as factor levels.
+// A parameter's text as the database and the factor levels hold it: as written, numbers
+// in the shortest form that reads back to the same double ("25" for 25.0), arrays as
+// "a,b,c". A pre-rendered image's parameters are only this: labels, not knobs.
 std::string label_text(const toml::node& node, TableReader& reader,
                        const std::string& key) {
     auto number = [&](const toml::node& item) {
@@ -140,9 +140,11 @@ std::string label_text(const toml::node& node, TableReader& reader,
     reader.fail(&node, key, "must be a number, string, boolean or array of numbers");
 }
 
-// A live stimulus's parameter: a knob of its technique, read by the renderer's one TOML
-// knob reader (as stimulus sets read it) and kept as the text of that exact value, which
-// parse_knob_value() reads back bit for bit. See KnobCheck for what a refusal does.
+// A live stimulus's parameter: a knob of its technique, checked by the renderer's one
+// TOML knob reader (as stimulus sets read it), and kept in the form it was written (a
+// grey "0.6" stays one number, as the database and the factor levels always had it) with
+// each number in the shortest text that parse_knob_value() reads back to the same double
+// as that reader. See KnobCheck for what a refusal does.
 std::string knob_text(const std::vector<Knob>& knobs, const StimulusSpec& stimulus,
                       const toml::node& node, TableReader& reader, const std::string& key,
                       KnobCheck check) {
@@ -155,7 +157,8 @@ std::string knob_text(const std::vector<Knob>& knobs, const StimulusSpec& stimul
             throw KnobError("'" + key + "' is not a parameter of technique '" +
                             stimulus.technique + "' (valid: " + valid + ")");
         }
-        return format_knob_value(read_knob_value(*knob, node));
+        read_knob_value(*knob, node);
+        return label_text(node, reader, key);
     } catch (const KnobError& e) {
         if (check == KnobCheck::lenient) return label_text(node, reader, key);
         reader.fail(&node, key, where + e.what());

@@ -24,8 +24,9 @@ struct StimulusSpec {
     std::string mesh;       // built-in mesh name or path (live stimuli)
     std::string image;      // image path (pre-rendered stimuli), relative to the protocol
     // Technique parameters by knob name, ordered by name; they become analysis factors.
-    // A live stimulus's values are its knobs' values as text that reads back bit for bit
-    // ("25", "1.2", "0.8,0.6,0.5"); an image's are labels with numbers in shortest form.
+    // Values as written ("25", "1.2", "0.8,0.6,0.5", a grey "0.6"), each number in the
+    // shortest text that reads back to the same double; a live stimulus's are checked
+    // against its technique's knobs when the protocol is read.
     std::map<std::string, std::string> parameters;
     // Which parameters this stimulus was designed to vary (its factor series); empty
     // means every parameter is a factor. "technique" may be listed too, and
@@ -139,8 +140,8 @@ enum class KnobCheck {
 
 // Parses and validates a protocol. `source` names the file in error messages; image
 // paths are resolved relative to `base_dir` when given. Unknown keys are errors. A live
-// stimulus's parameters are read as stimulus sets read them (renderer/core/knob_toml.h)
-// and kept as the text of the exact value (format_knob_value).
+// stimulus's parameters are checked as stimulus sets read them
+// (renderer/core/knob_toml.h) and kept as written, at full precision.
 Protocol parse_protocol(std::string_view text, const std::string& source,
                         const std::string& base_dir = "",
                         KnobCheck check = KnobCheck::strict);
