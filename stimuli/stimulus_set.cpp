@@ -257,41 +257,89 @@ private:
         return &it->second;
     }
 
+    // One [[stimuli]] entry: who it is, its values in precedence order, then its
+    // [stimuli.vary] expansion into one or several stimuli.
     void read_stimulus(const toml::table& table, const std::string& prefix,
                        StimulusSet& set) {
+        const EntryIdentity entry = read_identity(table, prefix);
+        const KnobValues base =
+            base_values(table, prefix, entry, read_own_parameters(table, prefix, entry));
+        const Axes axes = read_vary(table, prefix, entry);
+        const std::string expand = read_expand(table, prefix);
+        const std::size_t count = expansion_count(table, prefix, axes, expand);
+        // The factor series: named, or the id pattern of an entry with several stimuli.
+        std::string series = count > 1 ? entry.id : std::string();
+        if (const auto* node = table.get("series")) {
+            series = as_string(*node, prefix + "series", errors_);
+            if (!is_safe_name(series))
+                errors_.fail(
+                    *node, prefix + "series",
+                    "'" + series + "' is not a valid name (letters, digits, _ - . only)");
+        }
         const int line = int(table.source().begin.line);
-        // Identity: id, technique, mesh.
-        const auto* id_node = table.get("id");
-        if (!id_node) errors_.fail(table.source(), prefix + "id", "missing");
-        const std::string id = as_string(*id_node, prefix + "id", errors_);
+        for (std::size_t index = 0; index < count; ++index) {
+            Stimulus stimulus{entry.id,
+                              entry.technique,
+                              entry.mesh_name,
+                              meshes_.at(entry.mesh_name),
+                              base,
+                              line};
+            std::size_t rest = index;
+            for (auto axis = axes.rbegin(); axis != axes.rend(); ++axis) {
+                const std::size_t n = axis->second.size();
+                const std::size_t pick = expand == "zip" ? index : rest % n;
+                rest /= n;
+                stimulus.parameters.set(axis->first, axis->second[pick]);
+            }
+            stimulus.id = expanded_id(entry.id, stimulus.parameters, index, count);
+            stimulus.series = series;
+            check_id(stimulus.id, *entry.id_node, prefix + "id");
+            set.stimuli.push_back(std::move(stimulus));
+        }
+    }
+
+    // An entry's identity: id, technique (with its knobs), mesh.
+    struct EntryIdentity {
+        const toml::node* id_node = nullptr;
+        std::string id, technique, mesh_name;
+        std::vector<Knob> knobs;
+    };
+    EntryIdentity read_identity(const toml::table& table, const std::string& prefix) {
+        EntryIdentity entry;
+        entry.id_node = table.get("id");
+        if (!entry.id_node) errors_.fail(table.source(), prefix + "id", "missing");
+        entry.id = as_string(*entry.id_node, prefix + "id", errors_);
         const auto* technique_node = table.get("technique");
         if (!technique_node)
             errors_.fail(table.source(), prefix + "technique", "missing");
-        const std::string technique =
-            as_string(*technique_node, prefix + "technique", errors_);
-        const auto knobs = catalog_.knobs_of(technique);
+        entry.technique = as_string(*technique_node, prefix + "technique", errors_);
+        auto knobs = catalog_.knobs_of(entry.technique);
         if (!knobs)
             errors_.fail(*technique_node, prefix + "technique",
-                         "unknown technique '" + technique +
+                         "unknown technique '" + entry.technique +
                              "' (valid: " + join(catalog_.technique_names) + ")");
-        std::string mesh_name;
+        entry.knobs = std::move(*knobs);
         if (const auto* node = table.get("mesh")) {
-            mesh_name = as_string(*node, prefix + "mesh", errors_);
-            if (!meshes_.count(mesh_name)) {
+            entry.mesh_name = as_string(*node, prefix + "mesh", errors_);
+            if (!meshes_.count(entry.mesh_name)) {
                 std::vector<std::string> names;
-                for (const auto& entry : meshes_) names.push_back(entry.first);
+                for (const auto& mesh : meshes_) names.push_back(mesh.first);
                 errors_.fail(*node, prefix + "mesh",
-                             "missing mesh '" + mesh_name +
+                             "missing mesh '" + entry.mesh_name +
                                  "' (defined in [meshes]: " + join(names) + ")");
             }
         } else if (meshes_.size() == 1) {
-            mesh_name = meshes_.begin()->first;
+            entry.mesh_name = meshes_.begin()->first;
         } else {
             errors_.fail(table.source(), prefix + "mesh",
                          "missing: several meshes are defined");
         }
+        return entry;
+    }
 
-        // Own parameters (every other key must be a knob of this technique).
+    // Own parameters (every other key must be a knob of this technique).
+    Assignments read_own_parameters(const toml::table& table, const std::string& prefix,
+                                    const EntryIdentity& entry) {
         Assignments own;
         for (auto&& [key, value] : table) {
             const std::string name(key.str());
@@ -299,23 +347,27 @@ private:
                 name == "light" || name == "material" || name == "vary" ||
                 name == "expand" || name == "series")
                 continue;
-            const Knob* knob = find_knob(*knobs, name);
+            const Knob* knob = find_knob(entry.knobs, name);
             if (!knob)
-                errors_.fail(
-                    key.source(), prefix + name,
-                    "unknown key (not a parameter of technique '" + technique + "')");
+                errors_.fail(key.source(), prefix + name,
+                             "unknown key (not a parameter of technique '" +
+                                 entry.technique + "')");
             knob_value(*knob, value, prefix + name, errors_);
             own.push_back({name, &value});
         }
+        return own;
+    }
+
+    // Base values in precedence order; keys a technique lacks are skipped here.
+    KnobValues base_values(const toml::table& table, const std::string& prefix,
+                           const EntryIdentity& entry, const Assignments& own) {
         const auto* light = lookup(table, "light", lights_, prefix);
         const auto* material = lookup(table, "material", materials_, prefix);
-
-        // Base values in precedence order; keys a technique lacks are skipped here.
         KnobValues base;
-        for (const auto& knob : *knobs) base.set(knob.name, knob.default_value);
+        for (const auto& knob : entry.knobs) base.set(knob.name, knob.default_value);
         auto apply = [&](const Assignments& assignments) {
             for (const auto& a : assignments)
-                if (const Knob* knob = find_knob(*knobs, a.key))
+                if (const Knob* knob = find_knob(entry.knobs, a.key))
                     base.set(a.key, knob_value(*knob, *a.node, a.key, errors_));
         };
         apply(defaults_);
@@ -323,39 +375,49 @@ private:
         if (light) apply(*light);
         if (material) apply(*material);
         apply(own);
+        return base;
+    }
 
-        // Expansion: [stimuli.vary] lists, as a grid (every combination) or zipped.
-        std::vector<std::pair<std::string, std::vector<KnobValue>>> axes;
-        if (const auto* vary_node = table.get("vary")) {
-            // toml++ keeps keys sorted; restore the order they are written in, so the
-            // first listed parameter varies slowest.
-            std::vector<std::pair<const toml::key*, const toml::node*>> entries;
-            for (auto&& [key, value] : as_table(*vary_node, prefix + "vary", errors_))
-                entries.emplace_back(&key, &value);
-            std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
-                const auto& pa = a.first->source().begin;
-                const auto& pb = b.first->source().begin;
-                return pa.line != pb.line ? pa.line < pb.line : pa.column < pb.column;
-            });
-            for (const auto& [key_ptr, value_ptr] : entries) {
-                const toml::key& key = *key_ptr;
-                const toml::node& value = *value_ptr;
-                const std::string name(key.str()), full = prefix + "vary." + name;
-                const Knob* knob = find_knob(*knobs, name);
-                if (!knob)
-                    errors_.fail(
-                        key.source(), full,
-                        "unknown key (not a parameter of technique '" + technique + "')");
-                const auto* list = value.as_array();
-                if (!list || list->empty())
-                    errors_.fail(value, full,
-                                 "wrong type: expected a non-empty list of values");
-                std::vector<KnobValue> values;
-                for (const auto& element : *list)
-                    values.push_back(knob_value(*knob, element, full, errors_));
-                axes.emplace_back(name, std::move(values));
-            }
+    // Expansion: [stimuli.vary] lists, each a knob with its values.
+    using Axes = std::vector<std::pair<std::string, std::vector<KnobValue>>>;
+    Axes read_vary(const toml::table& table, const std::string& prefix,
+                   const EntryIdentity& entry) {
+        Axes axes;
+        const auto* vary_node = table.get("vary");
+        if (!vary_node) return axes;
+        // toml++ keeps keys sorted; restore the order they are written in, so the first
+        // listed parameter varies slowest.
+        std::vector<std::pair<const toml::key*, const toml::node*>> entries;
+        for (auto&& [key, value] : as_table(*vary_node, prefix + "vary", errors_))
+            entries.emplace_back(&key, &value);
+        std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+            const auto& pa = a.first->source().begin;
+            const auto& pb = b.first->source().begin;
+            return pa.line != pb.line ? pa.line < pb.line : pa.column < pb.column;
+        });
+        for (const auto& [key_ptr, value_ptr] : entries) {
+            const toml::key& key = *key_ptr;
+            const toml::node& value = *value_ptr;
+            const std::string name(key.str()), full = prefix + "vary." + name;
+            const Knob* knob = find_knob(entry.knobs, name);
+            if (!knob)
+                errors_.fail(key.source(), full,
+                             "unknown key (not a parameter of technique '" +
+                                 entry.technique + "')");
+            const auto* list = value.as_array();
+            if (!list || list->empty())
+                errors_.fail(value, full,
+                             "wrong type: expected a non-empty list of values");
+            std::vector<KnobValue> values;
+            for (const auto& element : *list)
+                values.push_back(knob_value(*knob, element, full, errors_));
+            axes.emplace_back(name, std::move(values));
         }
+        return axes;
+    }
+
+    // "grid" (every combination of the vary lists) or "zip" (the i-th of each).
+    std::string read_expand(const toml::table& table, const std::string& prefix) {
         std::string expand = "grid";
         if (const auto* node = table.get("expand")) {
             expand = as_string(*node, prefix + "expand", errors_);
@@ -363,6 +425,12 @@ private:
                 errors_.fail(*node, prefix + "expand",
                              "'" + expand + "' is out of range (valid: grid, zip)");
         }
+        return expand;
+    }
+
+    // How many stimuli the entry expands into (zip: lists of equal length).
+    std::size_t expansion_count(const toml::table& table, const std::string& prefix,
+                                const Axes& axes, const std::string& expand) {
         std::size_t count = 1;
         for (const auto& axis : axes) {
             if (expand == "zip" && axis.second.size() != axes.front().second.size())
@@ -376,32 +444,7 @@ private:
                 errors_.fail(*table.get("vary"), prefix + "vary",
                              "expands to too many stimuli");
         }
-
-        // The factor series: named, or the id pattern of an entry with several stimuli.
-        std::string series = count > 1 ? id : std::string();
-        if (const auto* node = table.get("series")) {
-            series = as_string(*node, prefix + "series", errors_);
-            if (!is_safe_name(series))
-                errors_.fail(
-                    *node, prefix + "series",
-                    "'" + series + "' is not a valid name (letters, digits, _ - . only)");
-        }
-
-        for (std::size_t index = 0; index < count; ++index) {
-            Stimulus stimulus{id,   technique, mesh_name, meshes_.at(mesh_name),
-                              base, line};
-            std::size_t rest = index;
-            for (auto axis = axes.rbegin(); axis != axes.rend(); ++axis) {
-                const std::size_t n = axis->second.size();
-                const std::size_t pick = expand == "zip" ? index : rest % n;
-                rest /= n;
-                stimulus.parameters.set(axis->first, axis->second[pick]);
-            }
-            stimulus.id = expanded_id(id, stimulus.parameters, index, count);
-            stimulus.series = series;
-            check_id(stimulus.id, *id_node, prefix + "id");
-            set.stimuli.push_back(std::move(stimulus));
-        }
+        return count;
     }
 
     // "{key}" placeholders take the value's text; without any, expanded ids get "_N".
