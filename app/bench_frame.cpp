@@ -131,6 +131,21 @@ int finish_csv(const FrameBenchOptions& options,
     return kExitOk;
 }
 
+// The --set assignments every row shares; nullopt, after saying why, when one is not
+// key=value.
+std::optional<std::vector<KnobAssignment>> fixed_settings(
+    const FrameBenchOptions& options) {
+    std::vector<KnobAssignment> fixed;
+    try {
+        for (const auto& setting : options.settings)
+            fixed.push_back(parse_assignment(setting));
+    } catch (const std::exception& e) {
+        std::cerr << "lucent bench frame: --set: " << e.what() << "\n";
+        return std::nullopt;
+    }
+    return fixed;
+}
+
 // --sweep KNOB=V1,V2,... (or the technique's first quality knob): rows of mesh x value.
 int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
                     gl::Context& context) {
@@ -174,14 +189,8 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
     }
     const bool per_unit =
         knob->kind == KnobKind::integer || knob->kind == KnobKind::scalar;
-    std::vector<KnobAssignment> fixed;
-    try {
-        for (const auto& setting : options.settings)
-            fixed.push_back(parse_assignment(setting));
-    } catch (const std::exception& e) {
-        std::cerr << "lucent bench frame: --set: " << e.what() << "\n";
-        return kExitUsage;
-    }
+    const auto fixed = fixed_settings(options);
+    if (!fixed) return kExitUsage;
     std::ostringstream table, breakdowns;
     std::vector<std::vector<std::string>> csv = {{"mesh", "faces", knob_name, "total_ms",
                                                   "fps", "costliest_pass", "pass_ms",
@@ -196,7 +205,7 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
         request.mesh = options.mesh + ":" + faces;
         std::shared_ptr<const Mesh> mesh;
         for (const auto& value : values) {
-            request.settings = fixed;
+            request.settings = *fixed;
             request.settings.push_back({knob_name, value});
             Scene scene;
             try {
@@ -249,14 +258,8 @@ int run_sweep_bench(const FrameBenchOptions& options, RenderRequest request,
 int run_comparison_bench(const FrameBenchOptions& options,
                          const FrameComparison& comparison, RenderRequest request,
                          gl::Context& context) {
-    std::vector<KnobAssignment> fixed;
-    try {
-        for (const auto& setting : options.settings)
-            fixed.push_back(parse_assignment(setting));
-    } catch (const std::exception& e) {
-        std::cerr << "lucent bench frame: --set: " << e.what() << "\n";
-        return kExitUsage;
-    }
+    const auto fixed = fixed_settings(options);
+    if (!fixed) return kExitUsage;
     const auto& variants = comparison.variants;
     const std::string& baseline = variants.back().label;
     std::ostringstream table, breakdowns;
@@ -287,7 +290,7 @@ int run_comparison_bench(const FrameBenchOptions& options,
         std::vector<Scene> scenes;
         try {
             for (const auto& v : variants) {
-                request.settings = fixed;
+                request.settings = *fixed;
                 request.settings.insert(request.settings.end(), v.settings.begin(),
                                         v.settings.end());
                 scenes.push_back(build_scene(request));

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -61,7 +62,34 @@ struct WriterTimes {
     std::vector<std::vector<double>> latencies;
     std::vector<Clock::time_point> first_start, last_end;
     std::vector<std::string> errors;
+
+    // Writer w's commit that started at t0 and was confirmed at t1.
+    void record(int w, Clock::time_point t0, Clock::time_point t1) {
+        first_start[w] = std::min(first_start[w], t0);
+        last_end[w] = std::max(last_end[w], t1);
+        latencies[w].push_back(
+            std::chrono::duration<double, std::milli>(t1 - t0).count());
+    }
 };
+
+// Runs writer(w, times) for every w at once, one thread each; a writer that throws
+// stops there with its message in times.errors[w].
+WriterTimes time_writers(int writers,
+                         const std::function<void(int w, WriterTimes& times)>& writer) {
+    WriterTimes times(writers);
+    std::vector<std::thread> threads;
+    for (int w = 0; w < writers; ++w) {
+        threads.emplace_back([&, w] {
+            try {
+                writer(w, times);
+            } catch (const std::exception& e) {
+                times.errors[w] = e.what();
+            }
+        });
+    }
+    for (std::thread& t : threads) t.join();
+    return times;
+}
 
 // One row of the table: commits per second over the span of all writers, p50/p99.
 BenchRow summarise(const std::string& backend, const WriterTimes& times) {
@@ -94,52 +122,35 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
         store->ensure_study(protocol);
     }
     using Clock = WriterTimes::Clock;
-    WriterTimes times(writers);
-    auto& [latencies, first_start, last_end, errors] = times;
-    std::vector<std::thread> threads;
-    for (int w = 0; w < writers; ++w) {
-        threads.emplace_back([&, w] {
-            try {
-                study::StoreOptions options;
-                options.journal_path =
-                    journal_dir + "/journal-" + std::to_string(w) + ".db";
-                auto store = study::open_study_store(db, options);
-                const int64_t study_id = store->ensure_study(protocol);
-                const std::string code =
-                    "bench" + std::to_string(writers) + "w" + std::to_string(w);
-                int number = 0;
-                const int64_t pid = store->ensure_participant(study_id, code, &number);
-                const study::SessionRow s = store->create_session(
-                    study_id, pid, study::plan_trials(protocol, 1000 + w, number),
-                    1000 + w, {});
-                const std::vector<study::TrialRow> rows = store->trials(s.id);
-                const int n = std::min<int>(trials, static_cast<int>(rows.size()));
-                for (int i = 0; i < n; ++i) {
-                    study::TrialOutcome o;
-                    o.onset_ns = 1;
-                    o.confirm_ns = 2;
-                    for (const study::Question& q : protocol.questions)
-                        o.responses.push_back(
-                            {q.id,
-                             rows[i].is_catch ? rows[i].expected : 1 + (i % q.points()),
-                             500.0, 0, 1, 2});
-                    const auto t0 = Clock::now();
-                    store->record_trial(s.id, rows[i].id, o);
-                    const auto t1 = Clock::now();
-                    first_start[w] = std::min(first_start[w], t0);
-                    last_end[w] = std::max(last_end[w], t1);
-                    latencies[w].push_back(
-                        std::chrono::duration<double, std::milli>(t1 - t0).count());
-                }
-                if (store->pending_trials() != 0)
-                    errors[w] =
-                        std::to_string(store->pending_trials()) + " trials unconfirmed";
-            } catch (const std::exception& e) {
-                errors[w] = e.what();
-            }
-        });
-    }
-    for (std::thread& t : threads) t.join();
+    const WriterTimes times = time_writers(writers, [&](int w, WriterTimes& measured) {
+        study::StoreOptions options;
+        options.journal_path = journal_dir + "/journal-" + std::to_string(w) + ".db";
+        auto store = study::open_study_store(db, options);
+        const int64_t study_id = store->ensure_study(protocol);
+        const std::string code =
+            "bench" + std::to_string(writers) + "w" + std::to_string(w);
+        int number = 0;
+        const int64_t pid = store->ensure_participant(study_id, code, &number);
+        const study::SessionRow s = store->create_session(
+            study_id, pid, study::plan_trials(protocol, 1000 + w, number), 1000 + w, {});
+        const std::vector<study::TrialRow> rows = store->trials(s.id);
+        const int n = std::min<int>(trials, static_cast<int>(rows.size()));
+        for (int i = 0; i < n; ++i) {
+            study::TrialOutcome o;
+            o.onset_ns = 1;
+            o.confirm_ns = 2;
+            for (const study::Question& q : protocol.questions)
+                o.responses.push_back(
+                    {q.id, rows[i].is_catch ? rows[i].expected : 1 + (i % q.points()),
+                     500.0, 0, 1, 2});
+            const auto t0 = Clock::now();
+            store->record_trial(s.id, rows[i].id, o);
+            measured.record(w, t0, Clock::now());
+        }
+        if (store->pending_trials() != 0)
+            measured.errors[w] =
+                std::to_string(store->pending_trials()) + " trials unconfirmed";
+    });
     return summarise(backend, times);
 }
 
@@ -170,74 +181,55 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
     std::thread server([&] { http.listen_after_bind(); });
 
     using Clock = WriterTimes::Clock;
-    WriterTimes times(writers);
-    auto& [latencies, first_start, last_end, errors] = times;
-    std::vector<std::thread> threads;
-    for (int w = 0; w < writers; ++w) {
-        threads.emplace_back([&, w] {
-            httplib::Client client("127.0.0.1", port);
-            client.set_keep_alive(true);
-            client.set_tcp_nodelay(true);  // as browsers do
-            client.set_read_timeout(60);
-            double now = 10;  // the simulated page's performance.now()
-            auto post = [&](const std::string& endpoint, const json& body) {
-                const auto r = client.Post(("/api/" + endpoint).c_str(), body.dump(),
-                                           "application/json");
-                if (!r)
-                    throw std::runtime_error(endpoint + ": " +
-                                             httplib::to_string(r.error()));
-                if (r->status != 200) throw std::runtime_error(endpoint + ": " + r->body);
-                return json::parse(r->body);
-            };
-            try {
-                json state =
-                    post("session", {{"participant", "web" + std::to_string(writers) +
-                                                         "w" + std::to_string(w)},
-                                     {"t_ms", now}});
-                const std::string token = state["token"];
-                int answered = 0;
-                while (state["screen"] != "done" && answered < trials) {
-                    if (state["screen"] != "trial") {
-                        now += 100;
-                        state = post("continue", {{"token", token},
-                                                  {"view", state["view"]},
-                                                  {"shown_ms", now - 50},
-                                                  {"t_ms", now}});
-                        continue;
-                    }
-                    const double onset =
-                        now + state["trial"]["blank_ms"].get<double>() + 10;
-                    json events = json::array();
-                    const bool is_catch =
-                        !state["trial"]["prompt"].get<std::string>().empty();
-                    for (size_t q = 0; q < protocol.questions.size(); ++q)
-                        events.push_back(
-                            {{"t_ms", onset + 100.0 * (q + 1)},
-                             {"type", "point"},
-                             {"question", q},
-                             {"value", is_catch ? protocol.catch_trials[0].expected
-                                                : 1 + (answered + int(q)) % 7}});
-                    events.push_back({{"t_ms", onset + 400}, {"type", "next"}});
-                    now = onset + 1000;
-                    const auto t0 = Clock::now();
-                    state = post("answer", {{"token", token},
-                                            {"trial", state["trial"]["id"]},
-                                            {"view", state["view"]},
-                                            {"onset_ms", onset},
-                                            {"events", events}});
-                    const auto t1 = Clock::now();
-                    ++answered;
-                    first_start[w] = std::min(first_start[w], t0);
-                    last_end[w] = std::max(last_end[w], t1);
-                    latencies[w].push_back(
-                        std::chrono::duration<double, std::milli>(t1 - t0).count());
-                }
-            } catch (const std::exception& e) {
-                errors[w] = e.what();
+    const WriterTimes times = time_writers(writers, [&](int w, WriterTimes& measured) {
+        httplib::Client client("127.0.0.1", port);
+        client.set_keep_alive(true);
+        client.set_tcp_nodelay(true);  // as browsers do
+        client.set_read_timeout(60);
+        double now = 10;  // the simulated page's performance.now()
+        auto post = [&](const std::string& endpoint, const json& body) {
+            const auto r = client.Post(("/api/" + endpoint).c_str(), body.dump(),
+                                       "application/json");
+            if (!r)
+                throw std::runtime_error(endpoint + ": " + httplib::to_string(r.error()));
+            if (r->status != 200) throw std::runtime_error(endpoint + ": " + r->body);
+            return json::parse(r->body);
+        };
+        json state = post("session", {{"participant", "web" + std::to_string(writers) +
+                                                          "w" + std::to_string(w)},
+                                      {"t_ms", now}});
+        const std::string token = state["token"];
+        int answered = 0;
+        while (state["screen"] != "done" && answered < trials) {
+            if (state["screen"] != "trial") {
+                now += 100;
+                state = post("continue", {{"token", token},
+                                          {"view", state["view"]},
+                                          {"shown_ms", now - 50},
+                                          {"t_ms", now}});
+                continue;
             }
-        });
-    }
-    for (std::thread& t : threads) t.join();
+            const double onset = now + state["trial"]["blank_ms"].get<double>() + 10;
+            json events = json::array();
+            const bool is_catch = !state["trial"]["prompt"].get<std::string>().empty();
+            for (size_t q = 0; q < protocol.questions.size(); ++q)
+                events.push_back({{"t_ms", onset + 100.0 * (q + 1)},
+                                  {"type", "point"},
+                                  {"question", q},
+                                  {"value", is_catch ? protocol.catch_trials[0].expected
+                                                     : 1 + (answered + int(q)) % 7}});
+            events.push_back({{"t_ms", onset + 400}, {"type", "next"}});
+            now = onset + 1000;
+            const auto t0 = Clock::now();
+            state = post("answer", {{"token", token},
+                                    {"trial", state["trial"]["id"]},
+                                    {"view", state["view"]},
+                                    {"onset_ms", onset},
+                                    {"events", events}});
+            measured.record(w, t0, Clock::now());
+            ++answered;
+        }
+    });
     http.stop();
     server.join();
     if (store->pending_trials() > 0) store->sync();

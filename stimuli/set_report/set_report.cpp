@@ -742,7 +742,7 @@ std::vector<fs::path> write_set_report(const SetReport& report) {
 
 int run_stimuli_report(const fs::path& directory, const SetReportOptions& options,
                        const std::string& command) {
-    SetReport report;
+    // Measuring and writing share one try: an error in either is said the same way.
     try {
         // Progress: one line first when the comparisons are many (logs see it too), then
         // the shared bar on a terminal once the work has run half a second.
@@ -759,18 +759,10 @@ int run_stimuli_report(const fs::path& directory, const SetReportOptions& option
             bar->update(done);
             if (done == total) bar->finish();
         };
-        report = measure_stimulus_set(directory, with_progress);
+        const SetReport report = measure_stimulus_set(directory, with_progress);
         bar.reset();
-    } catch (const SetReportError& e) {
-        std::cerr << command << ": " << e.what() << "\n";
-        return 2;
-    } catch (const std::exception& e) {
-        std::cerr << command << ": " << e.what() << "\n";
-        return 1;
-    }
-    for (const auto& warning : report.warnings)
-        std::cerr << command << ": warning: " << warning << "\n";
-    try {
+        for (const auto& warning : report.warnings)
+            std::cerr << command << ": warning: " << warning << "\n";
         for (const auto& file : write_set_report(report))
             std::cout << "wrote " << file.string() << "\n";
     } catch (const SetReportError& e) {
