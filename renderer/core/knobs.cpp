@@ -108,6 +108,12 @@ const std::string& KnobValues::choice(std::string_view name) const {
     throw std::logic_error("knob '" + std::string(name) + "' is not a choice");
 }
 
+Knob choice_knob(std::string name, std::string description, std::string value,
+                 std::vector<std::string> choices) {
+    return Knob{std::move(name),  std::move(description), KnobKind::choice, 0.0, 0.0,
+                std::move(value), std::move(choices)};
+}
+
 KnobAssignment parse_assignment(std::string_view key_equals_value) {
     const std::size_t equals = key_equals_value.find('=');
     if (equals == std::string_view::npos)

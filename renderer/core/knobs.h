@@ -62,6 +62,10 @@ struct Knob {
     std::vector<std::string> suggestions;
 };
 
+// A KnobKind::choice knob: one of `choices` (as text), `value` by default.
+Knob choice_knob(std::string name, std::string description, std::string value,
+                 std::vector<std::string> choices);
+
 // Named, validated values; lookups of a missing name or the wrong type are logic errors
 // (the planner asked for a knob its technique never declared).
 class KnobValues {

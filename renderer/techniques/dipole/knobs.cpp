@@ -19,14 +19,8 @@ const std::vector<Knob>& knobs() {
         specular.default_value = d.specular;
         shininess.default_value = d.shininess;
         rays.default_value = d.ao_rays;
-        const auto choice = [](std::string name, std::string description,
-                               std::string value, std::vector<std::string> choices) {
-            return Knob{
-                std::move(name),  std::move(description), KnobKind::choice, 0.0, 0.0,
-                std::move(value), std::move(choices)};
-        };
         return std::vector<Knob>{
-            choice(
+            choice_knob(
                 "material",
                 "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta 1.3), or "
                 "custom: sigma_a, sigma_s_prime and eta",
@@ -42,12 +36,14 @@ const std::vector<Knob>& knobs() {
              KnobKind::scalar, 0.1, 1000.0, d.model_size},
             {"samples", "N: texture-space importance samples shared by every pixel",
              KnobKind::integer, 1.0, 65536.0, d.samples},
-            choice("atlas_resolution", "side of the surfel atlas of irradiance (texels)",
-                   std::to_string(d.atlas_resolution), {"256", "512", "1024", "2048"}),
-            choice("hybrid",
-                   "Sec. 4 hybrid: local part from the light view (L rings x C + 1), "
-                   "global part by texture-space sampling",
-                   d.hybrid ? "on" : "off", {"off", "on"}),
+            choice_knob(
+                "atlas_resolution", "side of the surfel atlas of irradiance (texels)",
+                std::to_string(d.atlas_resolution), {"256", "512", "1024", "2048"}),
+            choice_knob(
+                "hybrid",
+                "Sec. 4 hybrid: local part from the light view (L rings x C + 1), "
+                "global part by texture-space sampling",
+                d.hybrid ? "on" : "off", {"off", "on"}),
             {"rings", "L: rings of the local pattern (hybrid)", KnobKind::integer, 1.0,
              32.0, d.rings},
             {"ring_samples", "C: samples per ring of the local pattern (hybrid)",
@@ -57,14 +53,14 @@ const std::vector<Knob>& knobs() {
              KnobKind::scalar, 0.001, 10.0, d.importance_bound},
             {"hybrid_k", "K: steepness of the local weight around Rp (mm^-1; hybrid)",
              KnobKind::scalar, 0.01, 100.0, d.hybrid_k},
-            choice(
+            choice_knob(
                 "light_map_resolution",
                 "side of the light-view depth/flux maps (visibility, hybrid local part)",
                 std::to_string(d.light_map_resolution), {"256", "512", "1024"}),
             {"sample_seed", "stratification offset xi = frac(0.5 + seed * 0.618...)",
              KnobKind::integer, 0.0, 1000000.0, d.sample_seed},
-            choice("tone_map", "none (linear radiance) or reinhard s/(1+s)", d.tone_map,
-                   {"none", "reinhard"}),
+            choice_knob("tone_map", "none (linear radiance) or reinhard s/(1+s)",
+                        d.tone_map, {"none", "reinhard"}),
             {"tone_key", "a: Reinhard key, s = a L / L_avg", KnobKind::scalar, 0.001,
              100.0, d.tone_key},
             specular,

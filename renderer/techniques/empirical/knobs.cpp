@@ -39,21 +39,16 @@ const std::vector<Knob>& knobs() {
              5.0,
              std::to_string(d.blur_kernel),
              {"1", "3", "5"}},
-            {"depth_precision",
-             "bits of the front/second depth-layer textures: 16, 24 or 32f (float)",
-             KnobKind::choice,
-             0.0,
-             0.0,
-             d.depth_precision,
-             {"16", "24", "32f"}},
-            {"layer_method",
-             "how the two depth layers are found: auto (a closed mesh: nearest front and "
-             "back faces by culling; otherwise peeling) or peel (always depth peeling)",
-             KnobKind::choice,
-             0.0,
-             0.0,
-             d.layer_method,
-             {"auto", "peel"}},
+            choice_knob(
+                "depth_precision",
+                "bits of the front/second depth-layer textures: 16, 24 or 32f (float)",
+                d.depth_precision, {"16", "24", "32f"}),
+            choice_knob(
+                "layer_method",
+                "how the two depth layers are found: auto (a closed mesh: nearest front "
+                "and back faces by culling; otherwise peeling) or peel (always depth "
+                "peeling)",
+                d.layer_method, {"auto", "peel"}),
         };
     }();
     return list;

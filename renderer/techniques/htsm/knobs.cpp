@@ -18,12 +18,6 @@ const std::vector<Knob>& knobs() {
         albedo.default_value = d.albedo;
         specular.default_value = d.specular;
         shininess.default_value = d.shininess;
-        const auto choice = [](std::string name, std::string description, int value,
-                               std::vector<std::string> choices) {
-            return Knob{
-                std::move(name),       std::move(description), KnobKind::choice, 0.0, 0.0,
-                std::to_string(value), std::move(choices)};
-        };
         Knob density{"density",
                      "the density volume over the mesh's bounding box: a generator "
                      "(constant, cube, spheres, marble, layers; e.g. marble:frequency=3) "
@@ -68,24 +62,23 @@ const std::vector<Knob>& knobs() {
             return knob;
         };
         return std::vector<Knob>{
-            choice("rays", "n: rays per pixel in the hierarchical pattern (1 + 4 rings)",
-                   d.samples, {"1", "5", "9", "13"}),
+            choice_knob("rays",
+                        "n: rays per pixel in the hierarchical pattern (1 + 4 rings)",
+                        std::to_string(d.samples), {"1", "5", "9", "13"}),
             {"steps", "S: midpoint steps through the density per ray", KnobKind::integer,
              1.0, 64.0, d.steps},
-            choice("light_map_size", "W_L: side of the light-view images (texels)",
-                   d.light_map_size, {"64", "128", "256", "512", "1024"}),
-            Knob{"light_mips",
-                 "on: each ring reads the mip level of its footprint (Sec. 4.3.1); off: "
-                 "every ray reads level 0 (point samples, no prefiltering)",
-                 KnobKind::choice,
-                 0.0,
-                 0.0,
-                 std::string("on"),
-                 {"off", "on"}},
+            choice_knob("light_map_size", "W_L: side of the light-view images (texels)",
+                        std::to_string(d.light_map_size),
+                        {"64", "128", "256", "512", "1024"}),
+            choice_knob(
+                "light_mips",
+                "on: each ring reads the mip level of its footprint (Sec. 4.3.1); "
+                "off: every ray reads level 0 (point samples, no prefiltering)",
+                "on", {"off", "on"}),
             density,
-            in_density_panel(choice("density_resolution",
-                                    "R: voxels per axis of a generated density volume",
-                                    d.density_resolution, {"16", "32", "64", "128"})),
+            in_density_panel(choice_knob(
+                "density_resolution", "R: voxels per axis of a generated density volume",
+                std::to_string(d.density_resolution), {"16", "32", "64", "128"})),
             in_density_panel({"density_contrast",
                               "c: rho = clamp(mean + c (rho - mean), 0, 1); 0 = "
                               "homogeneous at the mean",
@@ -94,8 +87,8 @@ const std::vector<Knob>& knobs() {
                 {"density_scale",
                  "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
                  KnobKind::scalar, 0.0, 1000.0, d.density_scale}),
-            choice("phase_table_size", "N_f: entries of the phase-function table",
-                   d.phase_table_size, {"16", "64", "256", "1024"}),
+            choice_knob("phase_table_size", "N_f: entries of the phase-function table",
+                        std::to_string(d.phase_table_size), {"16", "64", "256", "1024"}),
             {"pattern_radius",
              "r1: radius of the first ring, fraction of Phi (ring k: r1 2^(k-1))",
              KnobKind::scalar, 0.0, 0.5, d.pattern_radius},

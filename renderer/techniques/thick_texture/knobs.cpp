@@ -12,12 +12,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Knob choice(std::string name, std::string description, std::string value,
-            std::vector<std::string> choices) {
-    return Knob{std::move(name),  std::move(description), KnobKind::choice, 0.0, 0.0,
-                std::move(value), std::move(choices)};
-}
-
 }  // namespace
 
 const std::vector<Knob>& knobs() {
@@ -51,16 +45,16 @@ const std::vector<Knob>& knobs() {
              KnobKind::scalar, 0.0, 89.0, d.tilt},
             {"azimuth", "sheet rotation about its own normal before the tilt, degrees",
              KnobKind::scalar, -180.0, 180.0, d.azimuth},
-            choice("filter",
-                   "texture filtering (Fig. 4.6): nearest texel and level, linear = "
-                   "nearest texel blended across levels, bilinear, trilinear",
-                   d.filter, {"nearest", "linear", "bilinear", "trilinear"}),
-            choice(
+            choice_knob("filter",
+                        "texture filtering (Fig. 4.6): nearest texel and level, linear = "
+                        "nearest texel blended across levels, bilinear, trilinear",
+                        d.filter, {"nearest", "linear", "bilinear", "trilinear"}),
+            choice_knob(
                 "fetch_path",
                 "hardware: normalised averages, hardware filtering, 3 fetches; thesis: "
                 "Algorithm 3.1 on 8 texels, 32 fetches (Sec. 3.5)",
                 d.fetch_path, {"hardware", "thesis"}),
-            choice(
+            choice_knob(
                 "wide_hole_bins",
                 "K: 1 = the thesis's neighbour walls only; 4 or 8 = run-length bins per "
                 "direction (the future-work fix for holes wider than a texel)",
@@ -72,11 +66,13 @@ const std::vector<Knob>& knobs() {
              KnobKind::rgb, 0.0, 1.0, d.top_colour},
             {"wall_colour", "c2: colour of the hole walls (linear rgb)", KnobKind::rgb,
              0.0, 1.0, d.wall_colour},
-            choice("colour_source",
-                   "c1 from the texture's colours (weave, curtain, files) or top_colour",
-                   d.colour_source, {"texture", "knob"}),
-            choice("backdrop", "opaque plane behind the sheet, perpendicular to the view",
-                   d.backdrop, {"checker", "stripes", "plain"}),
+            choice_knob(
+                "colour_source",
+                "c1 from the texture's colours (weave, curtain, files) or top_colour",
+                d.colour_source, {"texture", "knob"}),
+            choice_knob("backdrop",
+                        "opaque plane behind the sheet, perpendicular to the view",
+                        d.backdrop, {"checker", "stripes", "plain"}),
             {"backdrop_a", "first backdrop colour (linear rgb)", KnobKind::rgb, 0.0, 1.0,
              d.backdrop_a},
             {"backdrop_b", "second backdrop colour (linear rgb)", KnobKind::rgb, 0.0, 1.0,
