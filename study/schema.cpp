@@ -1,6 +1,7 @@
 // The schema's text, one migration step at a time.
 #include "study/schema.h"
 
+#include <algorithm>
 #include <iterator>
 
 namespace lucent::study {
@@ -189,6 +190,37 @@ std::string online_cell_counts_sql(bool postgres) {
            "t "
            "WHERE t.session_id = s.id), '')) >= " +
            since + ")) GROUP BY s.cell";
+}
+
+namespace {
+// Parameter `n`: SQLite's positional "?" or PostgreSQL's "$n".
+std::string parameter(bool postgres, int n) {
+    if (!postgres) return "?";
+    std::string out = "$";  // appended to: GCC 12's -Wrestrict misfires on "$" + ...
+    return out += std::to_string(n);
+}
+}  // namespace
+
+std::string environment_values(bool postgres, int first) {
+    std::string out;
+    for (int i = 0; i < kEnvironmentColumnCount; ++i) {
+        if (i > 0) out += ", ";
+        out += parameter(postgres, first + i);
+    }
+    return out;
+}
+
+std::string environment_assignments(bool postgres) {
+    std::string out;
+    const std::string columns = kEnvironmentColumns;
+    int n = 1;
+    for (size_t start = 0; start < columns.size(); ++n) {
+        const size_t end = std::min(columns.find(", ", start), columns.size());
+        if (!out.empty()) out += ", ";
+        out += columns.substr(start, end - start) + " = " + parameter(postgres, n);
+        start = end + 2;
+    }
+    return out;
 }
 
 }  // namespace lucent::study

@@ -3,6 +3,8 @@
 #include <cctype>
 #include <set>
 
+#include "study/trial_plan.h"
+
 namespace lucent::study {
 
 void refuse_second_answer(const std::string& store, int64_t trial_id) {
@@ -60,6 +62,26 @@ std::pair<int, std::string> online_cell(const std::vector<int64_t>& counts, int 
                       std::to_string(best) + " of " + std::to_string(cells) +
                       ", the fewest completed + active sessions (per cell " + per_cell +
                       "; active = activity since " + active_since_utc + ")"};
+}
+
+SessionRow new_session_row(const std::string& uuid, int64_t participant_id, uint64_t seed,
+                           const TrialPlan& plan) {
+    SessionRow row;
+    row.uuid = uuid;
+    row.participant_id = participant_id;
+    row.seed = seed;
+    row.cell = plan.cell;
+    row.status = "running";
+    return row;
+}
+
+std::string block_order_text(const TrialPlan& plan) {
+    std::string out;
+    for (const std::string& b : plan.block_order) {
+        if (!out.empty()) out += ',';
+        out += b;
+    }
+    return out;
 }
 
 // One word for a segment's pictures: the common source, "mixed", or NULL when unknown.

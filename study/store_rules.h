@@ -14,6 +14,15 @@
 
 namespace lucent::study {
 
+struct TrialPlan;
+
+// A new session's row as both backends fill it before the insert (the id and the
+// participant's code come from the store): running, in the plan's cell.
+SessionRow new_session_row(const std::string& uuid, int64_t participant_id, uint64_t seed,
+                           const TrialPlan& plan);
+// sessions.block_order: the plan's block names, comma-separated.
+std::string block_order_text(const TrialPlan& plan);
+
 // What a store holds about a trial it is asked to record.
 struct TrialAnswerFacts {
     bool part_of_session = false;  // a planned trial of the session named

@@ -157,6 +157,32 @@ int64_t PostgresStore::ensure_study(const Protocol& protocol) {
     });
 }
 
+namespace {
+
+// Enrolment order: one past the highest number held, not the count, which falls after a
+// withdrawal and would hand out a number (a Latin-square row) still in use. The caller
+// holds the number lock until the number is taken.
+int next_participant_number(pqxx::work& tx) {
+    return tx.exec_params1(
+                 "SELECT greatest(coalesce((SELECT max(number) FROM participants), 0), "
+                 "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")[0]
+               .as<int>() +
+           1;
+}
+
+// The participant's row, enrolled now; its id.
+int64_t insert_participant(pqxx::work& tx, int64_t study_id, const std::string& code,
+                           int number) {
+    return tx
+        .exec_params1(
+            "INSERT INTO participants (study_id, code, number, created_utc) "
+            "VALUES ($1, $2, $3, $4) RETURNING id",
+            study_id, code, number, utc_now_iso8601())[0]
+        .as<int64_t>();
+}
+
+}  // namespace
+
 int64_t PostgresStore::ensure_participant(int64_t study_id, const std::string& code,
                                           int* number) {
     return guarded("enrolling the participant", [&]() -> int64_t {
@@ -171,20 +197,8 @@ int64_t PostgresStore::ensure_participant(int64_t study_id, const std::string& c
             return found[0][0].as<int64_t>();
         }
         int n = participant_number_from_code(code);
-        if (n < 0)
-            n = tx.exec_params1(
-                      "SELECT greatest(coalesce((SELECT max(number) FROM participants), "
-                      "0), "
-                      "coalesce((SELECT max(number) FROM retired_participant_numbers), "
-                      "0))")[0]
-                    .as<int>() +
-                1;
-        const int64_t id =
-            tx.exec_params1(
-                  "INSERT INTO participants (study_id, code, number, created_utc) "
-                  "VALUES ($1, $2, $3, $4) RETURNING id",
-                  study_id, code, n, utc_now_iso8601())[0]
-                .as<int64_t>();
+        if (n < 0) n = next_participant_number(tx);
+        const int64_t id = insert_participant(tx, study_id, code, n);
         tx.commit();
         if (number) *number = n;
         return id;
@@ -259,6 +273,25 @@ void PostgresStore::check_stimulus_values(
 
 namespace {
 
+// `sql` run with the environment's values as $1..$9 (schema.h: kEnvironmentColumns), then
+// `more` from $10 on.
+template <class... More>
+pqxx::result exec_with_environment(pqxx::work& tx, const std::string& sql,
+                                   const SessionEnvironment& env, const More&... more) {
+    return tx.exec_params(sql, env.machine_id, env.software_version, env.build_hash,
+                          env.gl_vendor, env.gl_renderer, env.display_mode,
+                          env.display_refresh_hz, env.measured_refresh_hz,
+                          env.refresh_note, more...);
+}
+
+// The session row keeps the first segment's environment (what older readers show).
+void copy_environment_to_session_row(pqxx::work& tx, int64_t session_id,
+                                     const SessionEnvironment& env) {
+    exec_with_environment(
+        tx, "UPDATE sessions SET " + environment_assignments(true) + " WHERE id = $10",
+        env, session_id);
+}
+
 // The segment rows and (first time) the study's resolved values, inside `tx`.
 void insert_segment(pqxx::work& tx, int64_t session_id, int segment,
                     const SessionEnvironment& env) {
@@ -282,17 +315,14 @@ void insert_segment(pqxx::work& tx, int64_t session_id, int segment,
                 study_id, p.stimulus, name, text);
     }
     const int64_t segment_id =
-        tx.exec_params1(
-              "INSERT INTO session_segments (session_id, segment, started_utc, "
-              "machine_id, "
-              "software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
-              "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) "
-              "VALUES "
-              "($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13) RETURNING id",
-              session_id, segment, utc_now_iso8601(), env.machine_id,
-              env.software_version, env.build_hash, env.gl_vendor, env.gl_renderer,
-              env.display_mode, env.display_refresh_hz, env.measured_refresh_hz,
-              env.refresh_note, segment_source(env.stimuli))[0]
+        exec_with_environment(
+            tx,
+            "INSERT INTO session_segments (" + std::string(kEnvironmentColumns) +
+                ", session_id, segment, started_utc, stimulus_source) "
+                "VALUES (" +
+                environment_values(true, 1) + ", $10, $11, $12, $13) RETURNING id",
+            env, session_id, segment, utc_now_iso8601(),
+            segment_source(env.stimuli))[0][0]
             .as<int64_t>();
     for (const StimulusProvenance& p : env.stimuli)
         tx.exec_params(
@@ -324,29 +354,19 @@ SessionRow insert_session(pqxx::work& tx, int64_t study_id, int64_t participant_
                           const TrialPlan& plan, uint64_t seed,
                           const SessionEnvironment& env, const std::string& uuid,
                           const std::optional<std::string>& allocation) {
-    SessionRow row;
-    row.uuid = uuid;
-    row.participant_id = participant_id;
-    row.seed = seed;
-    row.cell = plan.cell;
-    row.status = "running";
+    SessionRow row = new_session_row(uuid, participant_id, seed, plan);
     {
         row.id =
-            tx.exec_params1(
-                  "INSERT INTO sessions (uuid, study_id, participant_id, machine_id, "
-                  "seed, "
-                  "cell, block_order, status, started_utc, software_version, build_hash, "
-                  "gl_vendor, gl_renderer, display_mode, display_refresh_hz, "
-                  "measured_refresh_hz, refresh_note, allocation) VALUES ($1, $2, $3, "
-                  "$4, "
-                  "$5, $6, $7, 'running', $8, $9, $10, $11, $12, $13, $14, $15, $16, "
-                  "$17) "
-                  "RETURNING id",
-                  row.uuid, study_id, participant_id, env.machine_id,
-                  std::to_string(seed), plan.cell, flag_list(plan.block_order),
-                  utc_now_iso8601(), env.software_version, env.build_hash, env.gl_vendor,
-                  env.gl_renderer, env.display_mode, env.display_refresh_hz,
-                  env.measured_refresh_hz, env.refresh_note, allocation)[0]
+            exec_with_environment(
+                tx,
+                "INSERT INTO sessions (" + std::string(kEnvironmentColumns) +
+                    ", uuid, study_id, participant_id, seed, cell, block_order, "
+                    "status, started_utc, allocation) VALUES (" +
+                    environment_values(true, 1) +
+                    ", $10, $11, $12, $13, $14, $15, 'running', $16, $17) "
+                    "RETURNING id",
+                env, row.uuid, study_id, participant_id, std::to_string(seed), plan.cell,
+                block_order_text(plan), utc_now_iso8601(), allocation)[0][0]
                 .as<int64_t>();
         row.participant = tx.exec_params1("SELECT code FROM participants WHERE id = $1",
                                           participant_id)[0]
@@ -413,18 +433,8 @@ OnlineSession PostgresStore::enrol_online(int64_t study_id, const std::string& c
             participant_id = found[0][0].as<int64_t>();
             out.number = found[0][1].as<int>();
         } else {
-            out.number =
-                tx.exec_params1(
-                      "SELECT greatest(coalesce((SELECT max(number) FROM participants), "
-                      "0), coalesce((SELECT max(number) FROM "
-                      "retired_participant_numbers), 0))")[0]
-                    .as<int>() +
-                1;
-            participant_id = tx.exec_params1(
-                                   "INSERT INTO participants (study_id, code, number, "
-                                   "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
-                                   study_id, code, out.number, utc_now_iso8601())[0]
-                                 .as<int64_t>();
+            out.number = next_participant_number(tx);
+            participant_id = insert_participant(tx, study_id, code, out.number);
         }
         std::vector<int64_t> counts(static_cast<size_t>(how.cells), 0);
         for (const pqxx::row& r : tx.exec_params(online_cell_counts_sql(true), study_id,
@@ -581,15 +591,7 @@ int PostgresStore::resume_segment(int64_t session_id, const SessionEnvironment& 
             segment = newest[0][1].as<int>();
             tx.exec_params("DELETE FROM session_segments WHERE id = $1",
                            newest[0][0].as<int64_t>());
-            if (segment == 1)
-                tx.exec_params(
-                    "UPDATE sessions SET machine_id = $1, software_version = $2, "
-                    "build_hash = $3, gl_vendor = $4, gl_renderer = $5, "
-                    "display_mode = $6, display_refresh_hz = $7, "
-                    "measured_refresh_hz = $8, refresh_note = $9 WHERE id = $10",
-                    env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
-                    env.gl_renderer, env.display_mode, env.display_refresh_hz,
-                    env.measured_refresh_hz, env.refresh_note, session_id);
+            if (segment == 1) copy_environment_to_session_row(tx, session_id, env);
         } else if (!newest.empty()) {
             segment = newest[0][1].as<int>() + 1;
         }
@@ -603,25 +605,16 @@ void PostgresStore::update_environment(int64_t session_id,
                                        const SessionEnvironment& env) {
     guarded("updating the environment", [&] {
         pqxx::work tx(connection());
-        tx.exec_params(
-            "UPDATE session_segments SET machine_id = $1, software_version = $2, "
-            "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
-            "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
-            "WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = $10)",
-            env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
-            env.gl_renderer, env.display_mode, env.display_refresh_hz,
-            env.measured_refresh_hz, env.refresh_note, session_id);
+        exec_with_environment(tx,
+                              "UPDATE session_segments SET " +
+                                  environment_assignments(true) +
+                                  " WHERE id = (SELECT max(id) FROM session_segments "
+                                  "WHERE session_id = $10)",
+                              env, session_id);
         if (tx.exec_params1("SELECT count(*) FROM session_segments WHERE session_id = $1",
                             session_id)[0]
                 .as<int64_t>() == 1)
-            tx.exec_params(
-                "UPDATE sessions SET machine_id = $1, software_version = $2, "
-                "build_hash = $3, gl_vendor = $4, gl_renderer = $5, display_mode = $6, "
-                "display_refresh_hz = $7, measured_refresh_hz = $8, refresh_note = $9 "
-                "WHERE id = $10",
-                env.machine_id, env.software_version, env.build_hash, env.gl_vendor,
-                env.gl_renderer, env.display_mode, env.display_refresh_hz,
-                env.measured_refresh_hz, env.refresh_note, session_id);
+            copy_environment_to_session_row(tx, session_id, env);
         tx.commit();
         return 0;
     });

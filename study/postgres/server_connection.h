@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <pqxx/pqxx>
 #include <string>
-#include <vector>
 
 #include "study/postgres/postgres_store.h"
 
@@ -42,12 +41,6 @@ inline int64_t steady_ns() {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
                std::chrono::steady_clock::now().time_since_epoch())
         .count();
-}
-
-inline std::string flag_list(const std::vector<std::string>& items) {
-    std::string out;
-    for (const std::string& v : items) out += (out.empty() ? "" : ",") + v;
-    return out;
 }
 
 }  // namespace postgres_internal

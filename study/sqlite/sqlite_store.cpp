@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 
+#include "study/schema.h"
 #include "study/store_rules.h"
 #include "study/withdrawal.h"
 
@@ -25,26 +26,8 @@ namespace {
 
 int64_t first_int(Statement& s) { return s.step() ? s.integer(0) : 0; }
 
-// A segment's environment: its columns (the session row repeats the first segment's), in
-// the order bind_environment() binds them.
-constexpr int kEnvironmentColumnCount = 9;
-constexpr const char* kEnvironmentColumns =
-    "machine_id, software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
-    "display_refresh_hz, measured_refresh_hz, refresh_note";
-constexpr const char* kEnvironmentValues = "?, ?, ?, ?, ?, ?, ?, ?, ?";
-
-// "machine_id = ?, software_version = ?, ...": the columns as an UPDATE sets them.
-std::string environment_assignments() {
-    std::string out, columns = kEnvironmentColumns;
-    for (size_t start = 0; start < columns.size();) {
-        const size_t end = std::min(columns.find(", ", start), columns.size());
-        out += (out.empty() ? "" : ", ") + columns.substr(start, end - start) + " = ?";
-        start = end + 2;
-    }
-    return out;
-}
-
-// Binds `env` to the environment columns' parameters, the first at index `first`.
+// Binds `env` to the environment columns' parameters (schema.h: kEnvironmentColumns),
+// the first at index `first`.
 Statement& bind_environment(Statement& s, int first, const SessionEnvironment& env) {
     return s.bind(first, env.machine_id)
         .bind(first + 1, env.software_version)
@@ -55,6 +38,30 @@ Statement& bind_environment(Statement& s, int first, const SessionEnvironment& e
         .bind(first + 6, env.display_refresh_hz)
         .bind(first + 7, env.measured_refresh_hz)
         .bind(first + 8, env.refresh_note);
+}
+
+// Enrolment order: one past the highest number held, not the count, which falls after a
+// withdrawal and would hand out a number (a Latin-square row) still in use. The caller
+// holds the write lock until the number is taken.
+int next_participant_number(Database& db) {
+    return static_cast<int>(db.scalar_int(
+               "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
+               "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) +
+           1;
+}
+
+// The participant's row, enrolled now; its id.
+int64_t insert_participant(Database& db, int64_t study_id, const std::string& code,
+                           int number) {
+    db.prepare(
+          "INSERT INTO participants (study_id, code, number, created_utc) "
+          "VALUES (?, ?, ?, ?)")
+        .bind(1, study_id)
+        .bind(2, code)
+        .bind(3, number)
+        .bind(4, utc_now_iso8601())
+        .run();
+    return db.last_insert_id();
 }
 
 }  // namespace
@@ -141,22 +148,8 @@ int64_t Store::ensure_participant(int64_t study_id, const std::string& code,
         return find.integer(0);  // nothing written: the rollback is a no-op
     }
     int n = participant_number_from_code(code);
-    // Enrolment order: one past the highest number held, not the count, which falls
-    // after a withdrawal and would hand out a number (a Latin-square row) still in use.
-    if (n < 0)
-        n = static_cast<int>(db_.scalar_int(
-                "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
-                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) +
-            1;
-    db_.prepare(
-           "INSERT INTO participants (study_id, code, number, created_utc) "
-           "VALUES (?, ?, ?, ?)")
-        .bind(1, study_id)
-        .bind(2, code)
-        .bind(3, n)
-        .bind(4, utc_now_iso8601())
-        .run();
-    const int64_t id = db_.last_insert_id();
+    if (n < 0) n = next_participant_number(db_);
+    const int64_t id = insert_participant(db_, study_id, code, n);
     tx.commit();
     if (number) *number = n;
     return id;
@@ -176,26 +169,19 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
                                  const TrialPlan& plan, uint64_t seed,
                                  const SessionEnvironment& env, const std::string& uuid,
                                  const std::string& allocation) {
-    SessionRow row;
-    row.uuid = uuid;
-    row.participant_id = participant_id;
-    row.seed = seed;
-    row.cell = plan.cell;
-    row.status = "running";
-    std::string order;
-    for (const std::string& b : plan.block_order) order += (order.empty() ? "" : ",") + b;
-
+    SessionRow row = new_session_row(uuid, participant_id, seed, plan);
     Statement session = db_.prepare(
         "INSERT INTO sessions (uuid, study_id, participant_id, seed, cell, block_order, "
         "status, started_utc, allocation, " +
         std::string(kEnvironmentColumns) +
-        ") VALUES (?, ?, ?, ?, ?, ?, 'running', ?, ?, " + kEnvironmentValues + ")");
+        ") VALUES (?, ?, ?, ?, ?, ?, 'running', ?, ?, " + environment_values(false, 1) +
+        ")");
     session.bind(1, row.uuid)
         .bind(2, study_id)
         .bind(3, participant_id)
         .bind(4, std::to_string(seed))
         .bind(5, plan.cell)
-        .bind(6, order)
+        .bind(6, block_order_text(plan))
         .bind(7, utc_now_iso8601())
         .bind(8,
               allocation.empty() ? std::nullopt : std::optional<std::string>(allocation));
@@ -246,20 +232,8 @@ OnlineSession Store::enrol_online(int64_t study_id, const std::string& code,
         participant_id = find.integer(0);
         out.number = static_cast<int>(find.integer(1));
     } else {
-        out.number =
-            static_cast<int>(db_.scalar_int(
-                "SELECT max(coalesce((SELECT max(number) FROM participants), 0), "
-                "coalesce((SELECT max(number) FROM retired_participant_numbers), 0))")) +
-            1;
-        db_.prepare(
-               "INSERT INTO participants (study_id, code, number, created_utc) "
-               "VALUES (?, ?, ?, ?)")
-            .bind(1, study_id)
-            .bind(2, code)
-            .bind(3, out.number)
-            .bind(4, utc_now_iso8601())
-            .run();
-        participant_id = db_.last_insert_id();
+        out.number = next_participant_number(db_);
+        participant_id = insert_participant(db_, study_id, code, out.number);
     }
     std::vector<int64_t> counts(static_cast<size_t>(how.cells), 0);
     Statement per_cell = db_.prepare(online_cell_counts_sql(false));
@@ -380,8 +354,8 @@ void Store::insert_segment(int64_t session_id, int segment,
     Statement segment_row = db_.prepare(
         "INSERT INTO session_segments (session_id, segment, started_utc, "
         "stimulus_source, " +
-        std::string(kEnvironmentColumns) + ") VALUES (?, ?, ?, ?, " + kEnvironmentValues +
-        ")");
+        std::string(kEnvironmentColumns) + ") VALUES (?, ?, ?, ?, " +
+        environment_values(false, 1) + ")");
     segment_row.bind(1, session_id)
         .bind(2, segment)
         .bind(3, utc_now_iso8601())
@@ -446,15 +420,15 @@ int Store::resume_segment(int64_t session_id, const SessionEnvironment& env) {
 // The session row keeps the first segment's environment (what older readers show).
 void Store::copy_environment_to_session_row(int64_t session_id,
                                             const SessionEnvironment& env) {
-    Statement update =
-        db_.prepare("UPDATE sessions SET " + environment_assignments() + " WHERE id = ?");
+    Statement update = db_.prepare("UPDATE sessions SET " +
+                                   environment_assignments(false) + " WHERE id = ?");
     bind_environment(update, 1, env).bind(kEnvironmentColumnCount + 1, session_id).run();
 }
 
 void Store::update_environment(int64_t session_id, const SessionEnvironment& env) {
     Transaction tx(db_);
     Statement update = db_.prepare(
-        "UPDATE session_segments SET " + environment_assignments() +
+        "UPDATE session_segments SET " + environment_assignments(false) +
         " WHERE id = (SELECT max(id) FROM session_segments WHERE session_id = ?)");
     bind_environment(update, 1, env).bind(kEnvironmentColumnCount + 1, session_id).run();
     if (first_int(
