@@ -1,10 +1,17 @@
 #include "study/session/frame_timing.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
 namespace lucent::study {
+
+int64_t steady_now_ns() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
 
 RefreshEstimate estimate_refresh(int mode_refresh_hz,
                                  const std::vector<int64_t>& swaps_ns) {

@@ -8,6 +8,10 @@
 
 namespace lucent::study {
 
+// Now on the steady clock, in ns: what swaps and key presses are stamped with (the
+// runner and XKeyEvents' thread), so that the two compare.
+int64_t steady_now_ns();
+
 struct RefreshEstimate {
     std::optional<double> mode_hz;      // the video mode's rate; none when it reports 0
     std::optional<double> measured_hz;  // 1 / median swap interval; none when unknown

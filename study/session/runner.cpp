@@ -31,12 +31,6 @@
 namespace lucent::study {
 namespace {
 
-int64_t now_ns() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-}
-
 // ---- [SECTION] keys
 // -------------------------------------------------------------------- Keys come from
 // XKeyEvents (stamped by its thread when the X server sends them). Only without X11 (GLFW
@@ -82,7 +76,7 @@ void on_glfw_key(GLFWwindow* window, int key, int scancode, int action, int mods
     int digit = 0;
     if (action == GLFW_PRESS)
         if (const auto k = key_for_glfw(key, &digit))
-            log->presses.push_back({*k, digit, now_ns()});
+            log->presses.push_back({*k, digit, steady_now_ns()});
     if (log->chained) log->chained(window, key, scancode, action, mods);
 }
 
@@ -333,7 +327,7 @@ void Session::draw_rating_panel(const ScreenLayout& layout) {
                                                        ? ImVec4(0.9f, 0.6f, 0.1f, 1)
                                                        : ImVec4(0.25f, 0.25f, 0.3f, 1));
             if (ImGui::Button(std::to_string(v).c_str(), ImVec2(button, 0))) {
-                const int64_t t_ns = now_ns();
+                const int64_t t_ns = steady_now_ns();
                 ui_actions_.push_back(
                     [this, q, v, t_ns] { flow_->click_point(int(q), v, t_ns); });
             }
@@ -347,7 +341,7 @@ void Session::draw_rating_panel(const ScreenLayout& layout) {
     ImGui::SetCursorPosX(layout.panel.width * 0.5f - 60);
     if (!ready) ImGui::BeginDisabled();
     if (ImGui::Button("Next", ImVec2(120, 0))) {
-        const int64_t t_ns = now_ns();
+        const int64_t t_ns = steady_now_ns();
         ui_actions_.push_back([this, t_ns] { flow_->click_next(t_ns); });
     }
     if (!ready) ImGui::EndDisabled();
@@ -357,7 +351,7 @@ void Session::draw_rating_panel(const ScreenLayout& layout) {
 void Session::draw(int w, int h) {
     auto button_key = [this](const char* label, Key key) {
         if (ImGui::Button(label)) {
-            const int64_t t_ns = now_ns();
+            const int64_t t_ns = steady_now_ns();
             ui_actions_.push_back([this, key, t_ns] { flow_->key({key, 0, t_ns}); });
         }
     };
@@ -451,7 +445,7 @@ void Session::present(int w, int h) {
     }
     window_->swap();
     if (first) gl::wait_for_gpu();
-    const int64_t swapped = now_ns();
+    const int64_t swapped = steady_now_ns();
     for (const auto& action : ui_actions_) action();
     ui_actions_.clear();
     flow_->presented(serial, swapped);
@@ -510,18 +504,18 @@ RunResult Session::run() {
     // The first screen's clock starts now; keys pressed while preparing count for
     // nothing.
     flow_.emplace(p_, *store_, session_.id, store_->trials(session_.id),
-                  store_->has_consent(session_.id), now_ns());
+                  store_->has_consent(session_.id), steady_now_ns());
     if (x_keys_) x_keys_->take();
     glfw_keys_.presses.clear();
 
-    int64_t last_swap = now_ns();
+    int64_t last_swap = steady_now_ns();
     while (!flow_->finished()) {
         window_->begin_frame();
         if (glfwWindowShouldClose(window_->glfw())) {  // closed by the window manager
             flow_->window_closed();
             break;
         }
-        const int64_t now = now_ns();
+        const int64_t now = steady_now_ns();
         if (autopilot_ && autopilot_->scripted() && !script_sent_) {
             x_keyboard_->play(
                 autopilot_->script());  // the whole script, timed by the server
@@ -534,19 +528,19 @@ RunResult Session::run() {
         }
         feed_keys();
         if (flow_->finished()) break;
-        flow_->tick(now_ns());
+        flow_->tick(steady_now_ns());
 
         int w = 0, h = 0;
         window_->framebuffer_size(w, h);
         present(w, h);
         // Without a paced display (Xvfb), cap the loop near 60 Hz instead of spinning.
-        const int64_t swapped = now_ns();
+        const int64_t swapped = steady_now_ns();
         if (mode_refresh_hz_ <= 0) {
             const int64_t next = last_swap + 16'666'667;
             if (next > swapped)
                 std::this_thread::sleep_for(std::chrono::nanoseconds(next - swapped));
         }
-        last_swap = now_ns();
+        last_swap = steady_now_ns();
     }
     const RunResult result = flow_->result();
     if (result == RunResult::SavedAndQuit) {

@@ -12,7 +12,6 @@
 #include <unistd.h>
 
 #include <bitset>
-#include <chrono>
 #include <optional>
 #include <stdexcept>
 
@@ -22,12 +21,6 @@ extern "C" Window glfwGetX11Window(GLFWwindow* window);
 
 namespace lucent::study {
 namespace {
-
-int64_t now_ns() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-}
 
 std::optional<TimedKey> press_for(XKeyEvent& event, int64_t t_ns) {
     KeySym sym = XLookupKeysym(&event, 0);
@@ -117,7 +110,7 @@ void XKeyEvents::loop() {
             if (fds[1].revents) return;
             if (XEventsQueued(dpy, QueuedAfterReading) == 0) continue;
         }
-        const int64_t t = now_ns();  // as soon as the server's bytes are here
+        const int64_t t = steady_now_ns();  // as soon as the server's bytes are here
         XEvent event;
         XNextEvent(dpy, &event);
         if (event.type == FocusIn || event.type == FocusOut) {
