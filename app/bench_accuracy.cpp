@@ -27,7 +27,7 @@ namespace lucent::app {
 namespace {
 
 struct AccuracyBenchOptions {
-    std::string technique = "empirical";
+    std::string technique = default_technique_name();
     std::string mesh = "torus_knot:30k";
     std::string size = "256x256";
     std::vector<std::string> settings;

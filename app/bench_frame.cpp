@@ -22,7 +22,7 @@ namespace lucent::app {
 namespace {
 
 struct FrameBenchOptions {
-    std::string technique = "empirical";
+    std::string technique = default_technique_name();
     std::string sweep;                  // KNOB=V1,V2,...: one row per mesh and value
     std::vector<std::string> settings;  // key=value for every row
     std::string mesh;                   // default: the technique's comparison, or sphere

@@ -18,7 +18,7 @@ struct RenderOptions {
     // Knob-declared scene inputs (Knob::input_hash): --NAME VALUE, the same as --set
     // NAME=VALUE, by knob name.
     std::map<std::string, std::string> inputs;
-    std::string technique = "empirical";
+    std::string technique = default_technique_name();
     std::vector<std::string> settings;
     std::string size = "512x512";
     std::string out;

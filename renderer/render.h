@@ -9,12 +9,13 @@
 #include "renderer/core/knobs.h"
 #include "renderer/core/scene.h"
 #include "renderer/gl/frame_executor.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent {
 
 struct RenderRequest {
-    std::string mesh = "torus_knot";      // built-in name (optionally ":faces") or a file
-    std::string technique = "empirical";  // registry name
+    std::string mesh = "torus_knot";  // built-in name (optionally ":faces") or a file
+    std::string technique = default_technique_name();  // registry name
     std::vector<KnobAssignment> settings;  // applied over the defaults, in order
     int width = 512;
     int height = 512;

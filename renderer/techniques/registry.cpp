@@ -40,6 +40,10 @@ TechniqueRegistration::TechniqueRegistration(const Technique& technique)
 
 TechniqueRegistration::~TechniqueRegistration() { std::erase(registered(), technique_); }
 
+std::string default_technique_name() {
+    return std::string(all_techniques().front()->name());
+}
+
 bool is_technique_name(std::string_view name) {
     for (const Technique* technique : all_techniques())
         if (technique->name() == name) return true;

@@ -28,6 +28,9 @@ public:
 private:
     const Technique* technique_;
 };
+// The technique used where none is named (`lucent render`, the benches, the explorer's
+// first view): the registry's first, the thesis's empirical shader.
+std::string default_technique_name();
 // True when `name` is a registered technique.
 bool is_technique_name(std::string_view name);
 // "empirical, ward, ...": every technique's name in registry order, for messages.

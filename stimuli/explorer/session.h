@@ -11,6 +11,7 @@
 
 #include "renderer/core/knobs.h"
 #include "renderer/render.h"
+#include "renderer/techniques/registry.h"
 
 namespace lucent::explorer {
 
@@ -18,7 +19,7 @@ namespace lucent::explorer {
 // technique and back restores what was set before.
 class ParameterSet {
 public:
-    ParameterSet() : ParameterSet("empirical") {}
+    ParameterSet() : ParameterSet(default_technique_name()) {}
     explicit ParameterSet(std::string technique);
     const std::string& technique() const { return technique_; }
     // Switches technique (throws KnobError for an unknown name).
