@@ -19,8 +19,7 @@
 namespace lucent::study {
 using namespace postgres_internal;
 
-// ---- [1] connection
-// ----------------------------------------------------------------------
+// ---- [1] connection -------------------------------------------------------------------
 
 std::string checked_server_uri(const std::string& uri) {
     const size_t scheme_end = uri.find("://");
@@ -268,8 +267,7 @@ void PostgresStore::check_stimulus_values(
     });
 }
 
-// ---- [3] sessions, segments
-// ------------------------------------------------------------
+// ---- [3] sessions, segments -----------------------------------------------------------
 
 namespace {
 

@@ -23,8 +23,7 @@ using nlohmann::json;
 
 namespace {
 
-// ---- [SECTION] tokens and names
-// ----------------------------------------------------------
+// ---- [SECTION] tokens and names -------------------------------------------------------
 std::string bytes_of_hex(const std::string& hex) {
     std::string out;
     for (size_t i = 0; i + 1 < hex.size(); i += 2)
@@ -47,9 +46,8 @@ int hex_digit(char c) {
     return -1;
 }
 
-// ---- [SECTION] request fields
-// ------------------------------------------------------------ A refused request: HTTP
-// status and one line.
+// ---- [SECTION] request fields ---------------------------------------------------------
+// A refused request: HTTP status and one line.
 struct RequestError : std::runtime_error {
     RequestError(int status, const std::string& what)
         : std::runtime_error(what), status(status) {}
@@ -222,12 +220,11 @@ std::optional<std::string> image_of_target(
     return id;
 }
 
-// ---- [SECTION] sessions
-// ----------------------------------------------------------------- A page is `pending`
-// from its first request until the participant agrees on the consent screen: held in
-// memory only (the session UUID and so its token, the seed, what the browser said),
-// nothing stored. Agreeing enrols it (StudyStore::enrol_online), and from then on it is a
-// session like a lab station's.
+// ---- [SECTION] sessions ---------------------------------------------------------------
+// A page is `pending` from its first request until the participant agrees on the consent
+// screen: held in memory only (the session UUID and so its token, the seed, what the
+// browser said), nothing stored. Agreeing enrols it (StudyStore::enrol_online), and from
+// then on it is a session like a lab station's.
 struct WebStudy::Live {
     std::string code;
     bool pending = false;
@@ -666,8 +663,7 @@ json WebStudy::pending_state(const Live& live) const {
     return out;
 }
 
-// ---- [SECTION] actions
-// -------------------------------------------------------------------
+// ---- [SECTION] actions ----------------------------------------------------------------
 // The page a token names: loaded here, and the token its own.
 WebStudy::Live& WebStudy::page_of_token(const std::string& code,
                                         const std::string& token) {
@@ -942,8 +938,7 @@ WebReply WebStudy::answer(Live& live, const json& body) {
     return {200, to_text(state(live))};
 }
 
-// ---- [SECTION] the state a page shows
-// ---------------------------------------------------
+// ---- [SECTION] the state a page shows -------------------------------------------------
 json WebStudy::done_state() const {
     json out{{"screen", "done"},
              {"text", "Thank you: the study is complete and your answers are saved."}};

@@ -31,11 +31,10 @@
 namespace lucent::study {
 namespace {
 
-// ---- [SECTION] keys
-// -------------------------------------------------------------------- Keys come from
-// XKeyEvents (stamped by its thread when the X server sends them). Only without X11 (GLFW
-// on Wayland) do they come from GLFW's callback, stamped when glfwPollEvents delivers
-// them, up to a frame late; the runner says so in the log.
+// ---- [SECTION] keys -------------------------------------------------------------------
+// Keys come from XKeyEvents (stamped by its thread when the X server sends them). Only
+// without X11 (GLFW on Wayland) do they come from GLFW's callback, stamped when
+// glfwPollEvents delivers them, up to a frame late; the runner says so in the log.
 struct GlfwKeyLog {
     std::vector<TimedKey> presses;
     GLFWkeyfun chained = nullptr;  // ImGui's callback, called after logging
@@ -96,8 +95,7 @@ void centred_text_window(const char* id, const std::string& text, int w, int h) 
 
 }  // namespace
 
-// ---- [SECTION] the session
-// -------------------------------------------------------------
+// ---- [SECTION] the session ------------------------------------------------------------
 class Session {
 public:
     Session(const RunOptions& o, StimulusRenderer& s, std::ostream& log)
@@ -287,8 +285,7 @@ void Session::feed_keys() {
     }
 }
 
-// ---- [SECTION] drawing
-// ------------------------------------------------------------------
+// ---- [SECTION] drawing ----------------------------------------------------------------
 void Session::draw_rating_panel(const ScreenLayout& layout) {
     const TrialRow& t = *flow_->trial();
     const RatingInput* input = flow_->rating();
@@ -419,11 +416,10 @@ void Session::draw(int w, int h) {
     }
 }
 
-// ---- [SECTION] the frame loop
-// ----------------------------------------------------------- Draws and presents one
-// frame, and tells the flow when it reached the display. A screen's first frame is
-// finished on the GPU before and after the swap, so its time is when it appeared (on a
-// trial: the stimulus onset).
+// ---- [SECTION] the frame loop ---------------------------------------------------------
+// Draws and presents one frame, and tells the flow when it reached the display. A
+// screen's first frame is finished on the GPU before and after the swap, so its time is
+// when it appeared (on a trial: the stimulus onset).
 void Session::present(int w, int h) {
     const int serial = flow_->serial();
     const bool first = flow_->awaiting_presentation();

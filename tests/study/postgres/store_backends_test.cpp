@@ -467,8 +467,7 @@ TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
     EXPECT_NO_THROW(store->check_stimulus_values(provenance_for(p, "0.8,0.55,0.35")));
 }
 
-// ---- stations driven by the simulated participant
-// --------------------------------------
+// ---- stations driven by the simulated participant -------------------------------------
 
 Key key_of(const std::string& name, int* digit) {
     *digit = 0;
@@ -718,8 +717,7 @@ TEST_P(Backend, AResumeSegmentReplacesASegmentWithoutAnswersAndAddsOneAfterAnAns
 INSTANTIATE_TEST_SUITE_P(Stores, Backend, ::testing::Values("sqlite", "postgresql"),
                          param_name);
 
-// ---- the server alone: schema, URI, outages
-// ----------------------------------------------
+// ---- the server alone: schema, URI, outages -------------------------------------------
 
 class Server : public ::testing::Test {
 protected:

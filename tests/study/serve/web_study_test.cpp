@@ -470,8 +470,7 @@ TEST_P(Serve, FiftyParticipantsAtOnceLoseAndDuplicateNothing) {
     for (int i = 0; i < kPages; ++i) EXPECT_EQ(static_cast<int64_t>(shown[i].size()), n);
 }
 
-// ---- issue 26: consent first, claims that end, arrival-order cells, bounded rows
-// --------
+// ---- issue 26: consent first, claims that end, arrival-order cells, bounded rows ------
 
 // Item 5: before consent nothing of the person is stored; a decline leaves only a count.
 TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
@@ -821,8 +820,7 @@ TEST_P(Serve, ANumberBeyondADoubleIsA400NamingTheField) {
 INSTANTIATE_TEST_SUITE_P(Stores, Serve, ::testing::Values("sqlite", "postgresql"),
                          param_name);
 
-// ---- names, tokens, image paths (no store)
-// ------------------------------------------------
+// ---- names, tokens, image paths (no store) --------------------------------------------
 TEST(ServeNames, HmacMatchesRfc4231) {
     // RFC 4231 test cases 1 and 2.
     EXPECT_EQ(hmac_sha256_hex(std::string(20, '\x0b'), "Hi There"),
