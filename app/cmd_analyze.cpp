@@ -36,8 +36,9 @@ int run_analyze(const AnalyzeArgs& args) {
         if (!(args.within_share > 0.0 && args.within_share <= 1.0))
             throw InputError("--within-share must lie in (0, 1]");
         std::optional<Design> plan_design;
-        const LongTable table = read_ratings(args.input, parse_scale(args.scale),
-                                             &plan_design, &options.input_notes);
+        options.scale = parse_scale(args.scale);
+        const LongTable table =
+            read_ratings(args.input, options.scale, &plan_design, &options.input_notes);
         if (!args.images.empty()) {
             options.level_images = level_images_from_directory(table, args.images);
             if (thumbnail_maker) options.thumbnail_png = thumbnail_maker;

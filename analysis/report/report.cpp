@@ -7,7 +7,7 @@
 
 #include "analysis/data/long_table.h"
 #include "analysis/report/format.h"
-#include "analysis/report/svg_plot.h"
+#include "analysis/report/rating_figures.h"
 #include "common/csv.h"
 #include "common/html/html_page.h"
 #include "common/output_file.h"
@@ -244,15 +244,15 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         for (const OneWayAnalysis& a : analyses)
             if (a.factor == factor) panels.push_back({a.question, a.descriptives});
         Block figure{Block::kPlot, figure_file_name(factor), {}, {}};
-        figure.svg = factor_figure_svg(factor, panels);
+        figure.svg = factor_figure_svg(factor, panels, options.scale);
         doc.push_back(figure);
     }
 
     for (const OneWayAnalysis& a : analyses) {
         doc.push_back({Block::kHeading, configuration(a), {}, {}, 2});
         Block plot{Block::kPlot, plot_file_name(a.question, a.factor), {}, {}};
-        plot.svg =
-            mean_ci_plot_svg(configuration(a), a.question, a.descriptives, a.factor);
+        plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives,
+                                    a.factor, options.scale);
         doc.push_back(plot);
         Block thumbnails{Block::kImages, "", {}, {}};
         for (const Descriptives& d : a.descriptives) {
@@ -401,7 +401,7 @@ void render_html(const std::vector<Block>& doc, const ReportOptions& options,
            "report</"
            "title>\n<style>body{font-family:sans-serif;max-width:60em;margin:auto}"
            "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 8px;"
-           "text-align:right}</style>"
+           "text-align:right}figure{margin:1em 0}svg{max-width:100%;height:auto}</style>"
         << common::images_drawn_script() << "</head><body>\n";
     for (const Block& b : doc) {
         switch (b.kind) {

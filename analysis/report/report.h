@@ -29,6 +29,8 @@ struct ReportOptions {
     // Paragraphs after the input line: what the input reader left out and why (sessions
     // not completed, failed catch trials, withdrawn).
     std::vector<std::string> input_notes;
+    // The rating scale: the plots' y axis (ticks at integers); "any": the data's range.
+    RatingScale scale;
     // A picture of each level's stimulus, shown beside its descriptives (HTML embeds the
     // PNG, so the report stays one file): (factor, level) -> (stimulus id, PNG path).
     std::map<std::pair<std::string, std::string>,

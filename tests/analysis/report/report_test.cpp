@@ -11,7 +11,7 @@
 
 #include "analysis/analyze.h"
 #include "analysis/data/long_table.h"
-#include "analysis/report/svg_plot.h"
+#include "analysis/report/rating_figures.h"
 #include "common/html/html_page.h"
 #include "tests/support/test_paths.h"
 
