@@ -5,6 +5,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "renderer/techniques/dipole/scattering.h"
+
 namespace lucent::dipole {
 namespace {
 
@@ -80,6 +82,13 @@ SurfaceAtlas build_surface_atlas(const Mesh& mesh, double scale_mm, int resoluti
         if (j + 1 == faces) end = texels;  // rounding: the last triangle takes the rest
         const std::size_t n = end - k;
         const glm::uvec3 t = mesh.triangles[j];
+        // The facet's normal, on its vertex normals' side: the irradiance pass's cosine
+        // and shadow offset, as the CPU reference (scattering.h facet_normal).
+        const glm::dvec3 normal =
+            facet_normal(glm::dvec3(mesh.positions[t.x]), glm::dvec3(mesh.positions[t.y]),
+                         glm::dvec3(mesh.positions[t.z]),
+                         glm::dvec3(mesh.normals[t.x]) + glm::dvec3(mesh.normals[t.y]) +
+                             glm::dvec3(mesh.normals[t.z]));
         for (std::size_t i = 0; i < n; ++i, ++k) {
             const double u = (double(i) + 0.5) / double(n);
             double v = std::fmod(0.5 + double(i) * kGoldenConjugate, 1.0);
@@ -90,11 +99,7 @@ SurfaceAtlas build_surface_atlas(const Mesh& mesh, double scale_mm, int resoluti
                           w1 * glm::dvec3(mesh.positions[t.y]) +
                           w2 * glm::dvec3(mesh.positions[t.z])) *
                          scale_mm;
-            const glm::dvec3 nn = w0 * glm::dvec3(mesh.normals[t.x]) +
-                                  w1 * glm::dvec3(mesh.normals[t.y]) +
-                                  w2 * glm::dvec3(mesh.normals[t.z]);
-            const double len = glm::length(nn);
-            s.normal = len > 1e-30 ? nn / len : glm::dvec3(0.0, 0.0, 1.0);
+            s.normal = normal;
             lo = glm::min(lo, s.position);
             hi = glm::max(hi, s.position);
         }

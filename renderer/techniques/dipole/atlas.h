@@ -20,7 +20,7 @@ namespace lucent::dipole {
 struct SurfaceAtlas {
     int resolution = 0;                    // A, a power of two
     std::vector<glm::vec4> position_area;  // A*A, row-major: xyz in mm, w = area mm^2
-    std::vector<glm::vec4> normal;         // A*A: unit interpolated normal, w = 0
+    std::vector<glm::vec4> normal;         // A*A: unit facet normal (facet_normal), w = 0
     double total_area = 0.0;               // mm^2, = sum of w
     std::string content_hash;              // of mesh hash, scale and resolution
 };

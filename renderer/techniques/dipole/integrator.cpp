@@ -64,6 +64,10 @@ ScatteringIntegrator::ScatteringIntegrator(const Mesh& mesh, double scale_mm,
                                  glm::dvec3(mesh.normals[t.y]),
                                  glm::dvec3(mesh.normals[t.z])};
         const glm::dvec3 geometric = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+        // Eq. 4's cosine from the flat facet (its vertex normals give only the side):
+        // the same flux whichever way a shape is tessellated (scattering.h).
+        const double mu = glm::dot(facet_normal(p[0], p[1], p[2], n[0] + n[1] + n[2]), l);
+        if (!(mu > 0.0)) continue;  // unlit: no cells
         const int level = level_for(longest_edge(p[0], p[1], p[2]) * scale_mm, h);
         const int steps = 1 << level;
         // Uniform subdivision of the barycentric square into steps^2 sub-triangles.
@@ -81,10 +85,7 @@ ScatteringIntegrator::ScatteringIntegrator(const Mesh& mesh, double scale_mm,
             cell.c = at(q2, p) * scale_mm;
             cell.centroid = (cell.a + cell.b + cell.c) / 3.0;
             cell.area = 0.5 * glm::length(glm::cross(cell.b - cell.a, cell.c - cell.a));
-            const glm::dvec3 normal = at(g, n);
-            const double len = glm::length(normal);
-            const double mu = len > 1e-30 ? glm::dot(normal / len, l) : 0.0;
-            if (!(mu > 0.0) || !(cell.area > 0.0)) return;
+            if (!(cell.area > 0.0)) return;
             if (visibility) {
                 const glm::dvec3 origin = at(g, p) + double(ray_offset) * l +
                                           double(ray_offset) *

@@ -2,7 +2,8 @@
 // The CPU reference's scattering integral B(xo) = integral_A E(xi) Rd(|xi - xo|) dA
 // (Chang et al. Eq. 3), independent of the GL path: the mesh's triangles are subdivided
 // into cells no wider than `cell_size`, each cell gets E = pi Id Ft(eta, N.L) max(N.L, 0)
-// V at its centroid (V by an Embree shadow ray), and the sum runs over a Barnes-Hut
+// V at its centroid (N its triangle's facet normal, scattering.h facet_normal; V by an
+// Embree shadow ray), and the sum runs over a Barnes-Hut
 // octree (a node far enough away, size / distance < opening_angle, counts as its flux at
 // its flux-weighted centroid plus the second-order (quadrupole) term of its spread; JB02
 // uses the monopole with 0.3). Cells near xo are subdivided

@@ -192,7 +192,7 @@ void add_atlas_uploads(PlanBuilder& plan, const FrameInputs& f) {
                           return texels_of(lazy->get().position_area, atlas, atlas);
                       }};
     plan.add(positions);
-    Pass normals{"atlas_normals", "surfel atlas: interpolated normals", PassKind::upload};
+    Pass normals{"atlas_normals", "surfel atlas: facet normals", PassKind::upload};
     normals.writes = {"atlas_normal"};
     normals.data = {atlas_hash + "-n", [lazy, atlas](const ProduceOptions&) {
                         return texels_of(lazy->get().normal, atlas, atlas);

@@ -55,6 +55,19 @@ double mean_fresnel_transmittance(double eta) {
     return sum / (3.0 * n);
 }
 
+glm::dvec3 facet_normal(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2,
+                        const glm::dvec3& shading) {
+    const glm::dvec3 cross = glm::cross(p1 - p0, p2 - p0);
+    const double length = glm::length(cross);
+    const double shading_length = glm::length(shading);
+    if (!(length > 0.0) || !std::isfinite(length))
+        return shading_length > 0.0 && std::isfinite(shading_length)
+                   ? shading / shading_length
+                   : glm::dvec3(0.0, 0.0, 1.0);
+    const glm::dvec3 n = cross / length;
+    return glm::dot(n, shading) < 0.0 ? -n : n;
+}
+
 double diffuse_fresnel_reflectance(double eta) {
     return -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta;
 }

@@ -43,6 +43,17 @@ double mean_fresnel_transmittance(double eta);
 // eta >= 1.
 double diffuse_fresnel_reflectance(double eta);
 
+// The normal of Eq. 4's cosine N.L on the triangle (p0, p1, p2): its geometric (facet)
+// normal, turned to the side of `shading` (the mean of its vertex normals), so a
+// mesh wound either way faces out where its normals say. The flux into a flat facet
+// is its area times E(N_facet), whatever normals its vertices carry: interpolated
+// vertex normals smoothed across a sharp edge (an OBJ without normals, a shared rim
+// vertex) tilt whole triangles, and the flux would depend on how the shape is
+// tessellated (README.md, "Irradiance"). Falls back to `shading` (normalised, or +z)
+// for a degenerate triangle.
+glm::dvec3 facet_normal(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2,
+                        const glm::dvec3& shading);
+
 // The dipole of one channel, with its constants precomputed. A channel with
 // sigma_a + sigma_s' = 0 (nothing scatters) has Rd == 0.
 class Dipole {

@@ -19,7 +19,12 @@ layout(location = 1) out vec4 o_position;
 
 void main() {
 #ifdef WITH_LOCAL
-    vec3 n = normalize(v_normal_object);
+    // The facet's normal (the plane of the triangle's positions), on the side of the
+    // interpolated one, as the atlas and the CPU reference (scattering.h facet_normal).
+    vec3 n = cross(dFdx(v_position_object), dFdy(v_position_object));
+    float len = length(n);
+    n = len > 0.0 ? n / len : normalize(v_normal_object);
+    if (dot(n, v_normal_object) < 0.0) n = -n;
     float mu = dot(n, u_light_object);
     float phi = mu > 0.0 ? 3.14159265358979 * fresnel_transmittance(u_eta, mu) : 0.0;
     o_flux = vec4(phi, 0.0, 0.0, 1.0);

@@ -95,4 +95,55 @@ inline Mesh puck(float radius, float thickness, int segments, int rings) {
     return b.done("puck");
 }
 
+// The same cylinder as puck(), its vertices shared and without normals, as an OBJ of
+// `v` and `f` lines loads: finalize_mesh() gives each vertex the angle-weighted mean of
+// its faces' normals, so the rim's vertices point 45 degrees out of both caps. rings = 1
+// makes each cap a fan of `segments` long thin triangles from its centre.
+inline Mesh puck_with_shared_vertices(float radius, float thickness, int segments,
+                                      int rings) {
+    Mesh mesh;
+    const unsigned per_cap = 1 + unsigned(rings * segments);
+    const auto index = [&](int s, int ring, int cap) {  // cap 0: top; ring 0: centre
+        return cap * per_cap +
+               (ring == 0 ? 0u : 1 + unsigned((ring - 1) * segments + s % segments));
+    };
+    for (int cap = 0; cap < 2; ++cap) {
+        const float z = cap == 0 ? thickness : 0.0f;
+        mesh.positions.push_back({0, 0, z});
+        for (int ring = 1; ring <= rings; ++ring)
+            for (int s = 0; s < segments; ++s) {
+                const double phi = 2 * M_PI * s / segments,
+                             r = radius * double(ring) / rings;
+                mesh.positions.push_back(
+                    {float(r * std::cos(phi)), float(r * std::sin(phi)), z});
+            }
+    }
+    for (int cap = 0; cap < 2; ++cap)
+        for (int s = 0; s < segments; ++s)
+            for (int ring = 0; ring < rings; ++ring) {
+                // Counter-clockwise seen from +z; reversed for the bottom.
+                const unsigned q0 = index(s, ring, cap), q1 = index(s, ring + 1, cap),
+                               q2 = index(s + 1, ring + 1, cap),
+                               q3 = index(s + 1, ring, cap);
+                if (ring == 0)
+                    mesh.triangles.push_back(cap == 0 ? glm::uvec3{q0, q1, q2}
+                                                      : glm::uvec3{q0, q2, q1});
+                else if (cap == 0)
+                    mesh.triangles.push_back({q0, q1, q2}),
+                        mesh.triangles.push_back({q0, q2, q3});
+                else
+                    mesh.triangles.push_back({q0, q3, q2}),
+                        mesh.triangles.push_back({q0, q2, q1});
+            }
+    for (int s = 0; s < segments; ++s) {
+        const unsigned i = index(s, rings, 1), j = index(s + 1, rings, 1),
+                       k = index(s + 1, rings, 0), l = index(s, rings, 0);
+        mesh.triangles.push_back({i, j, k});
+        mesh.triangles.push_back({i, k, l});
+    }
+    mesh.name = "puck";
+    finalize_mesh(mesh);
+    return mesh;
+}
+
 }  // namespace lucent::dipole::test
