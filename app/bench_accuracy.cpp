@@ -10,14 +10,16 @@
 // values.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <map>
 #include <sstream>
 
 #include "app/commands.h"
-#include "common/html/html_page.h"
+#include "common/html/svg_plot.h"
 #include "renderer/core/image_compare.h"
 #include "renderer/gl/context.h"
 #include "renderer/render.h"
@@ -118,70 +120,102 @@ std::string sweep_label(const QualitySweep& sweep) {
     return fixed.empty() ? label : label + " (" + fixed + ")";
 }
 
-// One panel per knob: RMSE (y) against the cost that varies along the sweep (x): the
+// One panel per knob, wrapping three to a row: RMSE (y, a log axis where the errors span
+// more than a decade) against the cost that varies along the sweep (x): the
 // precomputation when it varies, otherwise the GPU frame time.
 void write_svg(const std::string& path, const std::vector<Row>& rows,
                const std::string& title) {
-    std::vector<std::string> knobs;
+    std::vector<common::PlotPanel> panels;
     for (const auto& r : rows)
-        if (std::find(knobs.begin(), knobs.end(), r.knob) == knobs.end())
-            knobs.push_back(r.knob);
-    const int panel_w = 320, panel_h = 260, margin = 50;
-    std::ofstream svg(path);
-    svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << panel_w * knobs.size()
-        << "' height='" << panel_h + 40 << "' font-family='sans-serif' font-size='11'>\n"
-        << "<rect width='100%' height='100%' fill='white'/>\n<text x='10' y='16' "
-           "font-size='13'>"
-        << common::text_escape(title) << "</text>\n";
-    for (std::size_t k = 0; k < knobs.size(); ++k) {
+        if (std::none_of(panels.begin(), panels.end(),
+                         [&](const auto& p) { return p.title == r.knob; }))
+            panels.emplace_back().title = r.knob;
+    for (auto& panel : panels) {
         std::vector<const Row*> series;
         for (const auto& r : rows)
-            if (r.knob == knobs[k]) series.push_back(&r);
+            if (r.knob == panel.title) series.push_back(&r);
         double min_pre = 1e300, max_pre = 0;
         for (const Row* r : series)
             min_pre = std::min(min_pre, r->precompute_s),
             max_pre = std::max(max_pre, r->precompute_s);
         const bool by_precompute = max_pre > 1.5 * std::max(min_pre, 1e-9);
-        const auto x_of = [&](const Row* r) {
-            return by_precompute ? r->precompute_s : r->frame_ms;
-        };
-        double max_x = 0, max_y = 0;
-        for (const Row* r : series)
-            max_x = std::max(max_x, x_of(r)), max_y = std::max(max_y, r->error.rmse);
-        max_x = max_x > 0 ? max_x * 1.15 : 1;
-        max_y = max_y > 0 ? max_y * 1.15 : 1;
-        const int ox = static_cast<int>(k) * panel_w + margin, oy = 30 + panel_h - margin;
-        const int w = panel_w - margin - 20, h = panel_h - margin - 20;
-        const auto px = [&](double x) { return ox + x / max_x * w; };
-        const auto py = [&](double y) { return oy - y / max_y * h; };
-        svg << "<text x='" << ox << "' y='" << oy - h - 6 << "' font-weight='bold'>"
-            << common::text_escape(knobs[k]) << "</text>\n"
-            << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox + w << "' y2='"
-            << oy << "' stroke='black'/>\n"
-            << "<line x1='" << ox << "' y1='" << oy << "' x2='" << ox << "' y2='"
-            << oy - h << "' stroke='black'/>\n"
-            << "<text x='" << ox + w / 2 << "' y='" << oy + 30
-            << "' text-anchor='middle'>"
-            << (by_precompute ? "bake time (s)" : "GPU frame time (ms)") << ", max "
-            << max_x / 1.15 << "</text>\n"
-            << "<text x='" << ox - 8 << "' y='" << oy - h / 2
-            << "' text-anchor='middle' transform='rotate(-90 " << ox - 36 << " "
-            << oy - h / 2 << ")'>RMSE vs CPU reference (max " << max_y / 1.15
-            << ")</text>\n";
-        std::string points;
-        for (const Row* r : series)
-            points += std::to_string(px(x_of(r))) + "," +
-                      std::to_string(py(r->error.rmse)) + " ";
-        svg << "<polyline fill='none' stroke='steelblue' stroke-width='1.5' points='"
-            << points << "'/>\n";
-        for (const Row* r : series)
-            svg << "<circle cx='" << px(x_of(r)) << "' cy='" << py(r->error.rmse)
-                << "' r='3' fill='steelblue'/>"
-                << "<text x='" << px(x_of(r)) + 5 << "' y='" << py(r->error.rmse) - 5
-                << "'>" << common::text_escape(r->value) << "</text>\n";
+        for (const Row* r : series) {
+            panel.x.push_back(by_precompute ? r->precompute_s : r->frame_ms);
+            panel.y.push_back(r->error.rmse);
+            panel.point_labels.push_back(r->value);
+        }
+        panel.x_label = by_precompute ? "bake time (s)" : "GPU frame time (ms)";
+        panel.y_label = "RMSE vs CPU reference";
+        panel.x_axis.include_zero = panel.y_axis.include_zero = true;
+        panel.y_axis.log_ratio = 10.0;  // errors over more than a decade: log
     }
-    svg << "</svg>\n";
+    std::ofstream svg(path);
+    svg << common::figure_svg(title, panels);
     if (!svg) throw std::runtime_error(path + ": cannot write the SVG plot");
+}
+
+std::string size_text(const Scene& scene) {
+    return std::to_string(scene.width) + "x" + std::to_string(scene.height);
+}
+
+// The technique's CPU reference of `scene`. A reference larger than 64x64 says first
+// how long it should take: the same scene at 16 pixels wide (a warm-up: the first call
+// pays one-off costs), then timed at 32 and 64 wide, time ~ pixels^p with p fitted to
+// those two (kept within [1, 3]: the dipole's reference grows faster than its pixels);
+// then its elapsed time every 15 s while it runs, and its time at the end.
+Image timed_reference(const Technique& technique, const Scene& scene,
+                      const std::string& what) {
+    const std::string size = size_text(scene);
+    const double pixels = double(scene.width) * double(scene.height);
+    if (pixels <= 64.0 * 64.0) {
+        std::cerr << what << " at " << size << "...\n";
+        return technique.render_reference(scene);
+    }
+    struct SmallRun {
+        std::string size;
+        double pixels, seconds;
+    };
+    const auto small_run = [&](int width) {
+        Scene small = scene;
+        fit_scene_camera(
+            small, width,
+            std::max(1, int(std::lround(double(width) * scene.height / scene.width))));
+        const auto t0 = std::chrono::steady_clock::now();
+        technique.render_reference(small);
+        return SmallRun{size_text(small), double(small.width) * small.height,
+                        seconds_since(t0)};
+    };
+    small_run(16);
+    const SmallRun a = small_run(32), b = small_run(64);
+    const double power =
+        std::clamp(a.seconds > 0 && b.seconds > 0
+                       ? std::log(b.seconds / a.seconds) / std::log(b.pixels / a.pixels)
+                       : 1.0,
+                   1.0, 3.0);
+    const double expected = b.seconds * std::pow(pixels / b.pixels, power);
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "%s at %s: expected ~%.1f s (from %s and %s runs in %.3f s and %.3f "
+                  "s: time ~ pixels^%.2f)\n",
+                  what.c_str(), size.c_str(), expected, a.size.c_str(), b.size.c_str(),
+                  a.seconds, b.seconds, power);
+    std::cerr << line;
+    const auto start = std::chrono::steady_clock::now();
+    auto pending =
+        std::async(std::launch::async, [&] { return technique.render_reference(scene); });
+    while (pending.wait_for(std::chrono::seconds(15)) != std::future_status::ready) {
+        const double elapsed = seconds_since(start);
+        std::snprintf(line, sizeof line,
+                      "%s at %s: %.0f s elapsed of ~%.0f s expected%s\n", what.c_str(),
+                      size.c_str(), elapsed, expected,
+                      elapsed > expected ? " (taking longer)" : "");
+        std::cerr << line;
+    }
+    Image image = pending.get();
+    std::snprintf(line, sizeof line, "%s at %s: done in %.1f s (expected ~%.1f s)\n",
+                  what.c_str(), size.c_str(), seconds_since(start), expected);
+    std::cerr << line;
+    return image;
 }
 
 int run_accuracy_bench(const AccuracyBenchOptions& options) {
@@ -243,9 +277,8 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
         return is_bake(pass) ? bake(pass).first : produce_upload(pass);
     });
 
-    std::cerr << "CPU reference...\n";
     const auto reference_start = std::chrono::steady_clock::now();
-    const Image reference = technique.render_reference(reference_scene);
+    const Image reference = timed_reference(technique, reference_scene, "CPU reference");
     const double reference_s = seconds_since(reference_start);
 
     std::vector<Row> rows;
@@ -267,9 +300,9 @@ int run_accuracy_bench(const AccuracyBenchOptions& options) {
                 // knobs at their reference values.
                 Image row_reference;
                 if (sweep.per_value_reference) {
-                    std::cerr << "CPU reference at " << sweep.knob << "="
-                              << format_knob_value(value) << "...\n";
-                    row_reference = technique.render_reference(scene);
+                    row_reference = timed_reference(technique, scene,
+                                                    "CPU reference for " + sweep.knob +
+                                                        "=" + format_knob_value(value));
                 }
                 const Image& truth =
                     sweep.per_value_reference ? row_reference : reference;
