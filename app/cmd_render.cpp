@@ -1,7 +1,9 @@
 // lucent render: one image of a mesh under a technique, with parameters from --set.
 // The work itself is lucent::build_scene + render_image + write_image
 // (renderer/render.h), the same path batch rendering and the explorer use.
+#include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "app/commands.h"
 #include "renderer/core/technique.h"
@@ -12,6 +14,8 @@
 
 namespace lucent::app {
 namespace {
+
+constexpr const char* technique_progress_label = "sample passes ";
 
 struct RenderOptions {
     std::string mesh;
@@ -99,9 +103,35 @@ int run_render(const RenderOptions& options) {
         if (options.out.empty()) return kExitOk;
     }
     std::size_t non_finite = 0;
+    std::string error_file;
     try {
         RenderedImage rendered;
-        if (options.reference) {
+        // A Monte Carlo technique (path) renders its estimate with the per-pixel standard
+        // error, written beside the image; its GL plan only uploads the same mean.
+        std::optional<EstimatedImage> estimate;
+        if (mode == PlanMode::pruned) {
+            ProduceOptions produce;
+            produce.progress = [](std::size_t done, std::size_t total) {
+                std::cerr << "\r" << technique_progress_label << done << "/" << total
+                          << (done == total ? "\n" : "") << std::flush;
+            };
+            estimate = technique.render_estimate(scene, produce);
+        }
+        if (estimate) {
+            rendered.image = std::move(estimate->mean);
+            rendered.non_finite_pixels =
+                count_non_finite_pixels(rendered.image) +
+                count_non_finite_pixels(estimate->standard_error);
+            replace_non_finite(rendered.image);
+            replace_non_finite(estimate->standard_error);
+            std::filesystem::path errors(options.out);
+            errors.replace_extension(".stderr.exr");
+            error_file = errors.string();
+            ImageWriteOptions linear;
+            linear.linear = true;
+            write_image(error_file, estimate->standard_error, linear);
+            std::cout << estimate->summary << "\n";
+        } else if (options.reference) {
             // The same scene, knobs and outputs; the ground truth a GL render is
             // measured against (no GL context needed).
             rendered.image = technique.render_reference(scene);
@@ -121,6 +151,7 @@ int run_render(const RenderOptions& options) {
         return kExitFailure;
     }
     std::cout << "wrote " << options.out << (options.reference ? " (CPU reference)" : "")
+              << (error_file.empty() ? "" : " and its standard error " + error_file)
               << "\n";
     // The file is valid (values replaced), but NaN/Inf means a rendering bug: say so and
     // fail, so scripts notice.

@@ -28,6 +28,7 @@ void register_merge(CLI::App& app, int& exit_code);
 void register_explore(CLI::App& app, int& exit_code);
 void register_store(CLI::App& app, int& exit_code);
 void register_stimuli(CLI::App& app, int& exit_code);
+void register_truth(CLI::App& app, int& exit_code);
 
 // `lucent analyze --images`: how a level's picture becomes a thumbnail (PNG bytes).
 // lucent-full sets it (it links the image library); unset, the picture itself is

@@ -48,6 +48,14 @@ struct FrameComparison {
     std::function<std::string(const Scene&)> detail = {};
 };
 
+// A Monte Carlo image with its per-pixel standard error (rgb per pixel, alpha 0) and a
+// one-line summary (samples, time, events), from a technique that estimates its image.
+struct EstimatedImage {
+    Image mean;
+    Image standard_error;
+    std::string summary;
+};
+
 class Technique {
 public:
     virtual ~Technique() = default;
@@ -71,6 +79,13 @@ public:
     // How an interactive view refines this technique's image over frames (none by
     // default): see core/progressive.h.
     virtual ProgressiveRefinement progressive_refinement() const { return {}; }
+    // A technique whose image is a Monte Carlo estimate made on the CPU (the path
+    // tracer) renders it with its standard error here, so `lucent render` can write the
+    // error beside the image; nullopt for the others (their image is the GL plan's).
+    virtual std::optional<EstimatedImage> render_estimate(
+        const Scene& /*scene*/, const ProduceOptions& /*options*/) const {
+        return std::nullopt;
+    }
     // The cost comparison of `lucent bench frame --technique NAME`; none: the bench
     // sweeps the first quality knob instead.
     virtual std::optional<FrameComparison> frame_comparison() const {

@@ -15,6 +15,7 @@ const Technique& contrast_reversed_technique();
 const Technique& dipole_technique();
 const Technique& htsm_technique();
 const Technique& thick_texture_technique();
+const Technique& path_technique();
 
 namespace {
 
@@ -22,6 +23,7 @@ std::vector<const Technique*>& registered() {
     static std::vector<const Technique*> techniques = {
         &empirical_technique(), &ward_technique(), &contrast_reversed_technique(),
         &dipole_technique(),    &htsm_technique(), &thick_texture_technique(),
+        &path_technique(),
     };
     return techniques;
 }

@@ -18,45 +18,8 @@ const std::vector<Knob>& knobs() {
         albedo.default_value = d.albedo;
         specular.default_value = d.specular;
         shininess.default_value = d.shininess;
-        Knob density{"density",
-                     "the density volume over the mesh's bounding box: a generator "
-                     "(constant, cube, spheres, marble, layers; e.g. marble:frequency=3) "
-                     "or an .nrrd file",
-                     KnobKind::text,
-                     0.0,
-                     0.0,
-                     std::string("marble")};
-        density.check = [](std::string_view text) -> std::string {
-            try {
-                // A file is read here too, so a bad one is refused where it is named
-                // (command line, config, explorer field), not later while rendering.
-                if (!parse_density_spec(text).file.empty())
-                    make_density_volume(text, 1, 1.0);
-                return "";
-            } catch (const DensityError& e) {
-                std::string why = e.what();
-                return why.rfind("density: ", 0) == 0 ? why.substr(9) : why;
-            }
-        };
-        density.accepted =
-            "constant|cube|spheres|marble|layers[:name=value,...] or FILE.nrrd";
-        // The volume is an input beyond the spec's text (a file can change under the same
-        // name): its content hash is recorded beside the spec, like mesh_hash.
-        density.input_hash = [](const KnobValues& values) {
-            return density_from_knobs(values)->content_hash;
-        };
-        density.describe_input = [](const KnobValues& values) {
-            const auto volume = density_from_knobs(values);
-            char line[256];
-            std::snprintf(line, sizeof line,
-                          "%dx%dx%d voxels, mean %.3f, range [%.3f, %.3f], hash %s",
-                          volume->size.x, volume->size.y, volume->size.z,
-                          double(volume->mean), double(volume->min), double(volume->max),
-                          volume->content_hash.c_str());
-            return std::string(line);
-        };
-        density.panel = "Density";
-        density.suggestions = density_generator_names();
+        const std::vector<Knob> volume =
+            density_volume_knobs("marble", d.density_resolution);
         const auto in_density_panel = [](Knob knob) {
             knob.panel = "Density";
             return knob;
@@ -75,14 +38,9 @@ const std::vector<Knob>& knobs() {
                 "on: each ring reads the mip level of its footprint (Sec. 4.3.1); "
                 "off: every ray reads level 0 (point samples, no prefiltering)",
                 "on", {"off", "on"}),
-            density,
-            in_density_panel(choice_knob(
-                "density_resolution", "R: voxels per axis of a generated density volume",
-                std::to_string(d.density_resolution), {"16", "32", "64", "128"})),
-            in_density_panel({"density_contrast",
-                              "c: rho = clamp(mean + c (rho - mean), 0, 1); 0 = "
-                              "homogeneous at the mean",
-                              KnobKind::scalar, 0.0, 4.0, 1.0}),
+            volume[0],
+            volume[1],
+            volume[2],
             in_density_panel(
                 {"density_scale",
                  "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
