@@ -351,8 +351,9 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
         for (std::size_t i = 0; i < n; ++i)
             if (defined(i))
                 points += svg_number(px(i)) + "," + svg_number(py(p.y[i])) + " ";
-        svg << "<polyline points=\"" << points << "\" fill=\"none\" stroke=\"" << kBlue
-            << "\" stroke-width=\"1.5\"/>\n";
+        if (!points.empty())  // no empty <polyline> where nothing is defined
+            svg << "<polyline points=\"" << points << "\" fill=\"none\" stroke=\""
+                << kBlue << "\" stroke-width=\"1.5\"/>\n";
     }
     for (std::size_t i = 0; i < n; ++i) {
         if (!defined(i)) continue;
