@@ -18,6 +18,9 @@ pkg_check_modules(SQLITE3 REQUIRED IMPORTED_TARGET sqlite3)
 pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
 # littleCMS: sRGB -> Lab and CIEDE2000 for the stimulus-set report.
 pkg_check_modules(LCMS2 REQUIRED IMPORTED_TARGET lcms2)
+# NLopt's C++ API (libnlopt-cxx-dev): the bounded derivative-free optimiser (BOBYQA) of
+# `lucent bench fidelity`'s fits.
+pkg_check_modules(NLOPT_CXX REQUIRED IMPORTED_TARGET nlopt_cxx)
 
 if(LUCENT_BUILD_TESTS)
   find_package(GTest REQUIRED)

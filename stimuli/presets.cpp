@@ -11,7 +11,9 @@ std::optional<std::string_view> stimuli_preset_file(std::string_view relative_pa
 
 namespace lucent::stimuli {
 
-std::vector<std::string> preset_names() { return {"thesis", "heterogeneous", "fabrics"}; }
+std::vector<std::string> preset_names() {
+    return {"thesis", "heterogeneous", "fabrics", "physical"};
+}
 
 std::optional<std::string_view> preset_text(std::string_view name) {
     for (const auto& known : preset_names())

@@ -228,6 +228,48 @@ double widest_label(const Axis& axis, double font_size) {
 constexpr double kTickFont = 10, kLabelFont = 11, kTitleFont = 13, kNoteFont = 9;
 constexpr const char* kBlue = "#1f77b4";
 
+// Tableau's ten colours (as matplotlib's default cycle), the first being kBlue.
+constexpr const char* kSeriesColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728",
+                                          "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+                                          "#bcbd22", "#17becf"};
+
+// Each series as a line through its points with dots, then a legend (panel x0..x1, from
+// legend_top down, two columns).
+void draw_series(std::ostringstream& svg, const std::vector<PlotSeries>& series,
+                 const Axis& xa, const Axis& ya, double left, double right, double top,
+                 double bottom, double x0, double x1, double legend_top) {
+    if (series.empty()) return;
+    const double plot_w = right - left, plot_h = bottom - top;
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        const PlotSeries& s = series[k];
+        const char* colour = kSeriesColours[k % std::size(kSeriesColours)];
+        std::string points, dots;
+        for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+            const double fx = xa.fraction(s.x[i]), fy = ya.fraction(s.y[i]);
+            if (!std::isfinite(fx) || !std::isfinite(fy)) continue;
+            const std::string x = svg_number(left + plot_w * fx),
+                              y = svg_number(bottom - plot_h * fy);
+            points += x + "," + y + " ";
+            dots += "<circle cx=\"" + x + "\" cy=\"" + y + "\" r=\"3\" fill=\"" + colour +
+                    "\"/>";
+        }
+        svg << "<polyline points=\"" << points << "\" fill=\"none\" stroke=\"" << colour
+            << "\" stroke-width=\"1.5\"/>" << dots << '\n';
+    }
+    // The legend in two columns under the x axis's label, in the room draw_panel left.
+    const double row = 12, column_w = (x1 - x0 - 8) / 2;
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        const double x = x0 + 4 + column_w * double(k % 2),
+                     y = legend_top + row * double(k / 2);
+        svg << "<rect x=\"" << svg_number(x) << "\" y=\"" << svg_number(y + 2)
+            << "\" width=\"10\" height=\"8\" fill=\""
+            << kSeriesColours[k % std::size(kSeriesColours)] << "\"/>";
+        put_text(svg, x + 14, y + 9.5, series[k].label, "start", kTickFont,
+                 column_w - 16);
+    }
+    svg << '\n';
+}
+
 void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double h,
                 const PlotPanel& p) {
     const bool categorical = !p.categories.empty();
@@ -243,6 +285,11 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
             if (std::isfinite(e)) ys.push_back(e);
         if (!categorical) xs.push_back(p.x[i]);
     }
+    for (const PlotSeries& series : p.series)
+        for (std::size_t i = 0; i < std::min(series.x.size(), series.y.size()); ++i) {
+            xs.push_back(series.x[i]);
+            ys.push_back(series.y[i]);
+        }
     const Axis ya = p.fixed_y ? *p.fixed_y : choose_axis(ys, p.y_axis);
     const Axis xa = categorical ? Axis{} : choose_axis(xs, p.x_axis);
     std::string note = ya.note;
@@ -264,8 +311,9 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
                                     : text_width(xa.labels.back(), kTickFont) / 2;
     const double right = x0 + w - std::max(14.0, last_x_label + 4);
     const double top = y0 + (p.title.empty() ? 12.0 : 30.0);
-    const double bottom =
-        y0 + h - 18 - (p.x_label.empty() ? 0.0 : 16.0) - (note.empty() ? 0.0 : 13.0);
+    const double legend_h = 12.0 * double((p.series.size() + 1) / 2);
+    const double bottom = y0 + h - 18 - (p.x_label.empty() ? 0.0 : 16.0) -
+                          (note.empty() ? 0.0 : 13.0) - legend_h;
     const double plot_w = right - left, plot_h = bottom - top;
     const auto py = [&](double v) { return bottom - plot_h * ya.fraction(v); };
     const auto px = [&](std::size_t i) {
@@ -369,6 +417,8 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
         }
         svg << '\n';
     }
+    draw_series(svg, p.series, xa, ya, left, right, top, bottom, x0, x0 + w,
+                bottom + (p.x_label.empty() ? 18.0 : 34.0));
 }
 
 }  // namespace

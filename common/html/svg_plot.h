@@ -68,6 +68,13 @@ double nice_step(double raw);
 // non-empty: x is ignored), optionally with an interval [y_low, y_high] per point (a
 // 95% CI: drawn as a bar with caps; where the y axis ends inside it, the bar stops at
 // the axis with a triangle pointing on). NaN values are not drawn.
+// One labelled curve among several in a panel (every technique's error against time),
+// drawn in its own colour and named in the panel's legend.
+struct PlotSeries {
+    std::string label;
+    std::vector<double> x, y;
+};
+
 struct PlotPanel {
     std::string title, x_label, y_label;
     std::vector<double> x, y;
@@ -77,6 +84,9 @@ struct PlotPanel {
     bool join = true;                       // a line through the points in order
     AxisOptions x_axis, y_axis;
     std::optional<Axis> fixed_y;  // this y axis instead of one chosen from the data
+    // Further curves on the same numeric axes (the axes cover them too), each a line
+    // through its points in order, with a legend.
+    std::vector<PlotSeries> series;
 };
 
 struct FigureLayout {

@@ -56,6 +56,14 @@ struct EstimatedImage {
     std::string summary;
 };
 
+// A knob `lucent bench fidelity` fits to the path-traced truth, for a technique whose
+// knobs are appearance, not physics: the range searched (narrower than the knob's own
+// where that is wide; an rgb knob fits each channel in it).
+struct FitRange {
+    std::string knob;
+    double lo = 0.0, hi = 1.0;
+};
+
 class Technique {
 public:
     virtual ~Technique() = default;
@@ -86,6 +94,9 @@ public:
         const Scene& /*scene*/, const ProduceOptions& /*options*/) const {
         return std::nullopt;
     }
+    // The knobs `lucent bench fidelity` fits to the truth; none: the technique takes the
+    // truth's material and scene knobs of the same names directly (the dipole).
+    virtual std::vector<FitRange> fidelity_fit() const { return {}; }
     // The cost comparison of `lucent bench frame --technique NAME`; none: the bench
     // sweeps the first quality knob instead.
     virtual std::optional<FrameComparison> frame_comparison() const {

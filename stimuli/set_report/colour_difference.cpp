@@ -85,13 +85,15 @@ DeltaEStatistics delta_e_statistics(std::span<const Lab> first,
     DeltaEStatistics stats;
     stats.pixels = differences.size();
     if (differences.empty()) return stats;
-    double sum = 0.0;
+    double sum = 0.0, squares = 0.0;
     std::size_t above = 0;
     for (double d : differences) {
         sum += d;
+        squares += d * d;
         above += d > 1.0;
     }
     stats.mean = sum / double(differences.size());
+    stats.root_mean_square = std::sqrt(squares / double(differences.size()));
     stats.share_above_1 = double(above) / double(differences.size());
     // Nearest rank: the smallest value with at least 95% of the pixels at or below it.
     const std::size_t rank = std::size_t(std::ceil(0.95 * double(differences.size())));

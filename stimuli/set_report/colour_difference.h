@@ -38,10 +38,11 @@ private:
 
 // Delta E00 over the pixels where `mask` is non-zero (both images the same size).
 struct DeltaEStatistics {
-    std::size_t pixels = 0;      // pixels compared
-    double mean = 0.0;           // mean Delta E00 (0 without pixels)
-    double percentile_95 = 0.0;  // nearest-rank 95th percentile
-    double share_above_1 = 0.0;  // fraction of pixels with Delta E00 > 1
+    std::size_t pixels = 0;         // pixels compared
+    double mean = 0.0;              // mean Delta E00 (0 without pixels)
+    double root_mean_square = 0.0;  // sqrt of the mean squared Delta E00
+    double percentile_95 = 0.0;     // nearest-rank 95th percentile
+    double share_above_1 = 0.0;     // fraction of pixels with Delta E00 > 1
     double max = 0.0;
 };
 // Throws std::invalid_argument when the sizes disagree.

@@ -209,3 +209,42 @@ TEST(PlotsInBrowser, AnalysisReportStaysOnTheRatingScaleAndInsideThePage) {
 
 }  // namespace
 }  // namespace lucent
+
+namespace lucent {
+namespace {
+
+// `lucent bench fidelity`'s figure as the command writes it (a tiny run: one case, two
+// techniques, a few renders): every technique a labelled curve, the text inside the SVG
+// and the page, the CSV beside it with the fitted technique's error.
+TEST(PlotsInBrowser, BenchFidelityFigureHasACurvePerTechniqueInsideThePage) {
+    const fs::path dir =
+        fs::path(LUCENT_BINARY_DIR) / "test-scratch" / "plot_browser_fidelity";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string command =
+        std::string("'") + LUCENT_EXECUTABLE +
+        "' bench fidelity --case thin --size 20 --paths 8 --evaluations 4 "
+        "--techniques ward,dipole --csv '" +
+        (dir / "fidelity.csv").string() + "' --svg '" + (dir / "fidelity.svg").string() +
+        "' > '" + (dir / "bench.log").string() + "' 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << read_file(dir / "bench.log");
+    const std::string svg = read_file(dir / "fidelity.svg");
+    for (const char* label : {">ward (ao_rays)<", ">dipole (", ">path (paths)<"})
+        EXPECT_NE(svg.find(label), std::string::npos) << label;
+    EXPECT_EQ(svg.find("nan"), std::string::npos);
+    EXPECT_NE(read_file(dir / "fidelity.csv").find("\"thin ward\",\"mean Delta E00\""),
+              std::string::npos)
+        << read_file(dir / "fidelity.csv");
+    write_file(dir / "page.html",
+               "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\">" +
+                   text_check_script() + "</head><body style=\"margin:0\">\n" + svg +
+                   "</body></html>\n");
+    const test::BrowserPage page =
+        test::open_in_browser(dir / "page.html", dir / "screenshot.png", 1100, 500);
+    ASSERT_TRUE(page.ok) << page.error;
+    const std::string check = attribute(page.dom, "data-text-check");
+    EXPECT_GE(texts_all_inside(check), 10) << check;
+}
+
+}  // namespace
+}  // namespace lucent

@@ -180,3 +180,38 @@ TEST(FabricsPreset, TwoFabricsTwoThicknessesThreeAnglesInFourSeries) {
 
 }  // namespace
 }  // namespace lucent::stimuli
+
+namespace lucent::stimuli {
+namespace {
+
+// The built-in `physical` set (issue 28 section 4): the three materials of the thesis
+// survey's physically based comparison, path-traced on the thesis's knot under its key
+// light, beside the survey's baseline empirical image, as one factor series; and a
+// picture of it renders finite with the object covered (a small size, few paths).
+TEST(PhysicalPreset, ThreePathTracedMaterialsBesideTheEmpiricalBaseline) {
+    std::ifstream in(test::source_dir() / "stimuli/presets/physical.toml",
+                     std::ios::binary);
+    std::ostringstream file;
+    file << in.rdbuf();
+    ASSERT_TRUE(preset_text("physical").has_value());
+    EXPECT_EQ(std::string(*preset_text("physical")), file.str());
+    const auto set = load_preset("physical", default_catalog());
+    ASSERT_EQ(set.stimuli.size(), 4u);
+    std::vector<std::string> materials;
+    for (const auto& s : set.stimuli) {
+        EXPECT_EQ(s.series, "physical") << s.id;
+        EXPECT_EQ(s.mesh_spec, "torus_knot:30k");
+        EXPECT_EQ(s.parameters.vec3("light_direction"), glm::dvec3(0.4, 0.6, 1.0));
+        if (s.technique == "path") {
+            materials.push_back(s.parameters.choice("material"));
+            EXPECT_EQ(s.parameters.scalar("model_size"), 30.0);
+        } else {
+            EXPECT_EQ(s.id, "empirical_row_1");
+            EXPECT_EQ(s.parameters.scalar("thickness_exponent"), 25.0);
+        }
+    }
+    EXPECT_EQ(materials, (std::vector<std::string>{"skin1", "marble", "skimmilk"}));
+}
+
+}  // namespace
+}  // namespace lucent::stimuli

@@ -39,6 +39,17 @@ public:
              std::string("peel")},
         };
     }
+    // Eq. 3.6's appearance knobs, fitted to the path-traced truth by `bench fidelity`
+    // (the exponent up to 50: Table 4.3 uses 5-25).
+    std::vector<FitRange> fidelity_fit() const override {
+        return {{"albedo", 0.0, 1.0},
+                {"ambient", 0.0, 2.0},
+                {"diffuse_contribution", 0.0, 2.0},
+                {"specular", 0.0, 2.0},
+                {"backlight", 0.0, 5.0},
+                {"thickness_exponent", 0.5, 50.0},
+                {"diffuse_weight", 0.0, 1.0}};
+    }
     // The thesis's Table 4.2: the full shader against direct light only (no peeling or
     // smoothing), per mesh size.
     std::optional<FrameComparison> frame_comparison() const override {

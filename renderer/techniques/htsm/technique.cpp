@@ -48,6 +48,13 @@ public:
              true},
         };
     }
+    // Shopf's coefficients have no physical units, so `bench fidelity` fits them to the
+    // truth; the density volume is the truth's own (the same knob names).
+    std::vector<FitRange> fidelity_fit() const override {
+        return {{"transport_colour", 0.0, 4.0}, {"transport_distance", 0.01, 2.0},
+                {"density_scale", 0.0, 20.0},   {"diffuse", 0.0, 2.0},
+                {"albedo", 0.0, 1.0},           {"specular", 0.0, 2.0}};
+    }
     // Shopf's Fig. 5.9: the frame at n = 13, 9 and 5 rays against n = 1 (three GPUs:
     // 8.8-11.5x for n = 13), with the texture fetches each pixel makes.
     std::optional<FrameComparison> frame_comparison() const override {

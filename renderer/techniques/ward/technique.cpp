@@ -28,6 +28,16 @@ public:
         // The only approximation the GL path adds: the AO bake's ray count.
         return {{"ao_rays", {16, 40, 80, 160, 320}, 1024}};
     }
+    // Appearance knobs, fitted to the path-traced truth by `bench fidelity`.
+    std::vector<FitRange> fidelity_fit() const override {
+        return {
+            {"albedo", 0.0, 1.0},
+            {"ambient", 0.0, 2.0},
+            {variant_ == ward::Variant::ward ? "diffuse_reflectance" : "reversed_diffuse",
+             0.0, 1.0},
+            {"specular_reflectance", 0.0, 0.5},
+            {"roughness", 0.01, 0.5}};
+    }
 
 private:
     ward::Variant variant_;

@@ -217,5 +217,27 @@ TEST(Figures, PanelsWrapIntoRowsOfThreeAndLongTitlesAreSqueezedIntoTheWidth) {
     EXPECT_EQ(clipped.find("nan"), std::string::npos);
 }
 
+// Several labelled curves in one panel (bench fidelity: every technique's error against
+// time): each its own colour and polyline, named in the legend, and the axes cover every
+// curve's points.
+TEST(Figures, SeriesShareThePanelsAxesWithALegend) {
+    PlotPanel panel;
+    panel.x_axis.scale = AxisScale::log;
+    panel.series = {{"empirical", {2.0, 3.0}, {12.0, 11.0}},
+                    {"dipole", {40.0, 900.0}, {6.0, 5.5}},
+                    {"path", {1500.0, 30000.0}, {4.0, NAN}}};
+    const std::string svg = figure_svg("", {panel});
+    EXPECT_EQ(count(svg, "<polyline"), 3u);
+    EXPECT_EQ(count(svg, "<circle"), 5u);  // the NaN point is not drawn
+    for (const char* label : {">empirical<", ">dipole<", ">path<"})
+        EXPECT_EQ(count(svg, label), 1u) << label;
+    for (const char* colour : {"#1f77b4", "#ff7f0e", "#2ca02c"})
+        EXPECT_NE(svg.find(colour), std::string::npos) << colour;
+    // The log x axis runs from the decade below 2 to the one above 30000.
+    EXPECT_NE(svg.find(">1<"), std::string::npos);
+    EXPECT_NE(svg.find(">1e5<"), std::string::npos) << svg;
+    EXPECT_EQ(svg.find("nan"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace lucent::common
