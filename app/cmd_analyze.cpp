@@ -38,7 +38,8 @@ int run_analyze(const AnalyzeArgs& args) {
         std::optional<Design> plan_design;
         options.scale = parse_scale(args.scale);
         const LongTable table =
-            read_ratings(args.input, options.scale, &plan_design, &options.input_notes);
+            read_ratings(args.input, options.scale, &plan_design, &options.input_notes,
+                         &options.question_scales);
         if (!args.images.empty()) {
             options.level_images = level_images_from_directory(table, args.images);
             if (thumbnail_maker) options.thumbnail_png = thumbnail_maker;

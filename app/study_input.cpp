@@ -18,10 +18,10 @@ bool is_sqlite_file(const std::string& path) {
            std::string(magic, 16) == std::string("SQLite format 3\0", 16);
 }
 
-analysis::LongTable read_ratings(const std::string& path,
-                                 const analysis::RatingScale& scale,
-                                 std::optional<analysis::Design>* plan_design,
-                                 std::vector<std::string>* notes) {
+analysis::LongTable read_ratings(
+    const std::string& path, const analysis::RatingScale& scale,
+    std::optional<analysis::Design>* plan_design, std::vector<std::string>* notes,
+    std::map<std::string, analysis::RatingScale>* question_scales) {
     const bool server = study::is_server_uri(path);
     if (!server && !is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
     study::LongTable rows;
@@ -29,8 +29,10 @@ analysis::LongTable read_ratings(const std::string& path,
     try {
         const study::ReadableStudyFile source(path);  // a server: one snapshot of it
         read_path = source.path();
-        study::check_stored_ratings(
-            source.path());  // each rating on its own question's scale
+        // Each rating on its own question's scale, which the report's plots then use.
+        for (const auto& [question, points] : study::check_stored_ratings(source.path()))
+            if (question_scales)
+                (*question_scales)[question] = {false, 1.0, double(points)};
         rows = study::analysis_long_table(source.path());
     } catch (const study::StoreError& e) {
         throw analysis::InputError(e.what());

@@ -1,6 +1,7 @@
 #pragma once
 // `lucent analyze` input: a long CSV, or a study database read through study/ (each
 // stimulus's parameters as factors; practice, catch and excluded participants dropped).
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,10 +15,12 @@ namespace lucent::app {
 bool is_sqlite_file(const std::string& path);
 // Reads either kind; throws analysis::InputError (one line) on bad input. For a study
 // database, `plan_design` receives the stored protocol's primary design, and `notes` the
-// line saying how many sessions were analysed and left out, by reason (also on stderr).
-analysis::LongTable read_ratings(const std::string& path,
-                                 const analysis::RatingScale& scale,
-                                 std::optional<analysis::Design>* plan_design = nullptr,
-                                 std::vector<std::string>* notes = nullptr);
+// line saying how many sessions were analysed and left out, by reason (also on stderr),
+// and `question_scales` each rated question's scale (1..points) from its protocol.
+analysis::LongTable read_ratings(
+    const std::string& path, const analysis::RatingScale& scale,
+    std::optional<analysis::Design>* plan_design = nullptr,
+    std::vector<std::string>* notes = nullptr,
+    std::map<std::string, analysis::RatingScale>* question_scales = nullptr);
 
 }  // namespace lucent::app

@@ -1,5 +1,7 @@
 #include "study/question_scales.h"
 
+#include <algorithm>
+
 #include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
@@ -36,8 +38,9 @@ void check_rating_on_scale(const QuestionPoints& points, const std::string& ques
                          std::to_string(it->second));
 }
 
-void check_stored_ratings(Database& db) {
+QuestionPoints check_stored_ratings(Database& db) {
     std::map<int64_t, QuestionPoints> by_study;
+    QuestionPoints rated;
     Statement s = db.prepare(
         "SELECT se.study_id, p.code, se.uuid, t.position, r.question, r.rating "
         "FROM responses r JOIN trials t ON t.id = r.trial_id "
@@ -52,15 +55,18 @@ void check_stored_ratings(Database& db) {
         check_rating_on_scale(it->second, s.text(4), static_cast<int>(s.integer(5)),
                               db.path() + ": participant '" + s.text(1) + "', session " +
                                   s.text(2) + ", trial " + std::to_string(s.integer(3)));
+        int& points = rated[s.text(4)];
+        points = std::max(points, it->second.at(s.text(4)));
     }
+    return rated;
 }
 
-void check_stored_ratings(const std::string& path) {
+QuestionPoints check_stored_ratings(const std::string& path) {
     check_database_file(path);
     Database db(path, SQLITE_OPEN_READONLY);
     if (db.scalar_int("SELECT count(*) FROM sqlite_schema WHERE name = 'responses'") == 0)
-        return;
-    check_stored_ratings(db);
+        return {};
+    return check_stored_ratings(db);
 }
 
 }  // namespace lucent::study

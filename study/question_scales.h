@@ -22,9 +22,10 @@ void check_rating_on_scale(const QuestionPoints& points, const std::string& ques
                            int rating, const std::string& where);
 // Checks every stored rating against its question's scale; throws StoreError naming the
 // first impossible one (participant, session, trial position, question, rating, scale).
-void check_stored_ratings(Database& db);
+// Returns the scale of each rated question (the longest, where studies differ).
+QuestionPoints check_stored_ratings(Database& db);
 // The same for the database file at `path`, opened read-only (check_database_file
-// first); a database without ratings passes.
-void check_stored_ratings(const std::string& path);
+// first); a database without ratings passes (and returns no scale).
+QuestionPoints check_stored_ratings(const std::string& path);
 
 }  // namespace lucent::study

@@ -56,6 +56,27 @@ Statistic within_summary_p(const WithinSubjectAnalysis& w) {
     return w.anova.p_gg ? w.anova.p_gg : w.anova.p;
 }
 
+// The y axis of `question`'s plots: its own scale where the input gave one, else the
+// report's.
+RatingScale scale_of(const ReportOptions& options, const std::string& question) {
+    const auto own = options.question_scales.find(question);
+    return own != options.question_scales.end() ? own->second : options.scale;
+}
+
+// One axis for several questions' panels: the widest of their scales.
+RatingScale shared_scale(const ReportOptions& options,
+                         const std::vector<QuestionPanel>& panels) {
+    RatingScale shared = options.scale;
+    for (std::size_t i = 0; i < panels.size(); ++i) {
+        const RatingScale s = scale_of(options, panels[i].question);
+        if (i == 0) shared = s;
+        shared.any = shared.any || s.any;
+        shared.min = std::min(shared.min, s.min);
+        shared.max = std::max(shared.max, s.max);
+    }
+    return shared;
+}
+
 // Every participant who rated the pair, complete or not.
 int participants_of(const OneWayAnalysis& a) {
     return a.within.participants +
@@ -244,7 +265,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         for (const OneWayAnalysis& a : analyses)
             if (a.factor == factor) panels.push_back({a.question, a.descriptives});
         Block figure{Block::kPlot, figure_file_name(factor), {}, {}};
-        figure.svg = factor_figure_svg(factor, panels, options.scale);
+        figure.svg = factor_figure_svg(factor, panels, shared_scale(options, panels));
         doc.push_back(figure);
     }
 
@@ -252,7 +273,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         doc.push_back({Block::kHeading, configuration(a), {}, {}, 2});
         Block plot{Block::kPlot, plot_file_name(a.question, a.factor), {}, {}};
         plot.svg = mean_ci_plot_svg(configuration(a), a.question, a.descriptives,
-                                    a.factor, options.scale);
+                                    a.factor, scale_of(options, a.question));
         doc.push_back(plot);
         Block thumbnails{Block::kImages, "", {}, {}};
         for (const Descriptives& d : a.descriptives) {

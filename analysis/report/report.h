@@ -31,6 +31,9 @@ struct ReportOptions {
     std::vector<std::string> input_notes;
     // The rating scale: the plots' y axis (ticks at integers); "any": the data's range.
     RatingScale scale;
+    // A question's own scale where the input says it (a study database's protocol:
+    // 1..points), in place of `scale` on its plots.
+    std::map<std::string, RatingScale> question_scales;
     // A picture of each level's stimulus, shown beside its descriptives (HTML embeds the
     // PNG, so the report stays one file): (factor, level) -> (stimulus id, PNG path).
     std::map<std::pair<std::string, std::string>,

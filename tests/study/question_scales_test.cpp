@@ -77,7 +77,10 @@ TEST(QuestionScales, StoredImpossibleRatingsAreFoundAndNamed) {
         Store store(m.path);
         store.record_trial(m.session.id, m.trials[0].id, outcome(7, 5));
         Database& db = store.db();
-        check_stored_ratings(db);  // all on their scales
+        // All on their scales; each rated question's scale comes back (the mixed study
+        // asks 'translucent' on 7 points and 'realistic' on 5).
+        EXPECT_EQ(check_stored_ratings(db),
+                  (QuestionPoints{{"realistic", 5}, {"translucent", 7}}));
         // What a build before per-question scales could store: 7 on the 5-point scale.
         db.exec("UPDATE responses SET rating = 7 WHERE question = 'realistic'");
     }

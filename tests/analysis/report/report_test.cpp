@@ -347,6 +347,50 @@ TEST(Report, FactorFigurePutsQuestionsSideBySideOnOneScale) {
     EXPECT_FALSE(std::regex_search(svg, std::regex("nan|inf", std::regex::icase)));
 }
 
+// The y tick labels (right-aligned text) of an SVG plot.
+std::vector<std::string> y_ticks(const std::string& svg) {
+    std::vector<std::string> ticks;
+    const std::regex tick("<text [^>]*text-anchor=\"end\"[^>]*>([^<]*)</text>");
+    for (std::sregex_iterator it(svg.begin(), svg.end(), tick), end; it != end; ++it)
+        ticks.push_back((*it)[1]);
+    return ticks;
+}
+
+TEST(Report, PlotsRunOverTheRatingScaleOfTheirQuestion) {
+    // Each plot's y axis is its question's scale where the input knows it (a study
+    // database: 'realistic' on 5 points), else the report's (1..7); the factor's figure
+    // spans both. Ratings that disagree put the 95% intervals past both ends.
+    std::istringstream csv(
+        "participant,stimulus,factor,level,question,rating\n"
+        "P1,a,r,18,translucent,1\nP2,a,r,18,translucent,7\nP3,a,r,18,translucent,4\n"
+        "P1,a,r,18,realistic,1\nP2,a,r,18,realistic,5\nP3,a,r,18,realistic,3\n"
+        "P1,b,r,25,translucent,2\nP2,b,r,25,translucent,6\nP3,b,r,25,translucent,3\n"
+        "P1,b,r,25,realistic,2\nP2,b,r,25,realistic,5\nP3,b,r,25,realistic,1\n");
+    const LongTable table = read_long_csv(csv, "scales.csv", RatingScale{});
+    const AnalysisResult result = analyze_table(table, AnalysisRequest{});
+    const auto dir = test::scratch_dir("report_scales");
+    ReportOptions options;
+    options.question_scales["realistic"] = RatingScale{false, 1, 5};
+    write_report(result.pairs, dir, options);
+    using Ticks = std::vector<std::string>;
+    EXPECT_EQ(y_ticks(slurp(dir / plot_file_name("realistic", "r"))),
+              (Ticks{"1", "2", "3", "4", "5"}));
+    EXPECT_EQ(y_ticks(slurp(dir / plot_file_name("translucent", "r"))),
+              (Ticks{"1", "2", "3", "4", "5", "6", "7"}));
+    const std::string figure = slurp(dir / figure_file_name("r"));
+    EXPECT_EQ(y_ticks(figure), (Ticks{"1", "2", "3", "4", "5", "6", "7", "1", "2", "3",
+                                      "4", "5", "6", "7"}));
+    EXPECT_NE(figure.find("<path"), std::string::npos);  // intervals cut at the scale
+    EXPECT_NE(figure.find("the interval goes on past the axis"), std::string::npos);
+    // "any": the data's range at round steps.
+    options.scale.any = true;
+    options.question_scales.clear();
+    write_report(result.pairs, dir, options);
+    const Ticks any = y_ticks(slurp(dir / plot_file_name("translucent", "r")));
+    ASSERT_GE(any.size(), 2u);
+    EXPECT_LT(std::stod(any.front()), 1.0);  // the intervals reach below 1
+}
+
 TEST(Report, LevelPicturesAreEmbeddedBesideTheirDescriptives) {
     const auto dir = test::scratch_dir("report_thumbnails");
     const auto images = dir / "stimuli";
