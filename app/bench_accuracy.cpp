@@ -161,8 +161,9 @@ std::string size_text(const Scene& scene) {
 // The technique's CPU reference of `scene`. A reference larger than 64x64 says first
 // how long it should take: the same scene at 16 pixels wide (a warm-up: the first call
 // pays one-off costs), then timed at 32 and 64 wide, time ~ pixels^p with p fitted to
-// those two (kept within [1, 3]: the dipole's reference grows faster than its pixels);
-// then its elapsed time every 15 s while it runs, and its time at the end.
+// those two (kept within [1, 3]: a reference may grow faster than its pixel count);
+// then every 15 s while it runs its elapsed time and what is left, and its time at the
+// end.
 Image timed_reference(const Technique& technique, const Scene& scene,
                       const std::string& what) {
     const std::string size = size_text(scene);
@@ -205,10 +206,15 @@ Image timed_reference(const Technique& technique, const Scene& scene,
         std::async(std::launch::async, [&] { return technique.render_reference(scene); });
     while (pending.wait_for(std::chrono::seconds(15)) != std::future_status::ready) {
         const double elapsed = seconds_since(start);
-        std::snprintf(line, sizeof line,
-                      "%s at %s: %.0f s elapsed of ~%.0f s expected%s\n", what.c_str(),
-                      size.c_str(), elapsed, expected,
-                      elapsed > expected ? " (taking longer)" : "");
+        if (elapsed < expected)
+            std::snprintf(line, sizeof line,
+                          "%s at %s: %.0f s elapsed, ~%.0f s left of ~%.0f s expected\n",
+                          what.c_str(), size.c_str(), elapsed, expected - elapsed,
+                          expected);
+        else
+            std::snprintf(line, sizeof line,
+                          "%s at %s: %.0f s elapsed, longer than the ~%.0f s expected\n",
+                          what.c_str(), size.c_str(), elapsed, expected);
         std::cerr << line;
     }
     Image image = pending.get();
