@@ -15,6 +15,7 @@
 
 #include "app/bench_results.h"
 #include "app/commands.h"
+#include "common/cpu_time.h"
 #include "renderer/core/ambient_occlusion.h"
 #include "renderer/core/progress.h"
 #include "renderer/cpu/ambient_occlusion_directions.h"
@@ -37,11 +38,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
         .count();
 }
 
-double thread_cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
+using common::thread_cpu_seconds;
 
 // Rays per CPU-second of each query type on the bake's own rays for every `sample`th
 // vertex, on this thread, in both scene layouts; the escape counts must agree (same rays,

@@ -8,6 +8,7 @@ void register_bench_families(CLI::App& bench, int& exit_code) {
     register_bench_accuracy(bench, exit_code);
     register_bench_ao(bench, exit_code);
     register_bench_fidelity(bench, exit_code);
+    register_bench_truth(bench, exit_code);
     register_bench_stats(bench, exit_code);
     register_bench_render(bench, exit_code);
     register_bench_store(bench, exit_code);

@@ -45,5 +45,6 @@ void register_bench_stats(CLI::App& bench, int& exit_code);
 void register_bench_render(CLI::App& bench, int& exit_code);
 void register_bench_store(CLI::App& bench, int& exit_code);
 void register_bench_fidelity(CLI::App& bench, int& exit_code);
+void register_bench_truth(CLI::App& bench, int& exit_code);
 
 }  // namespace lucent::app

@@ -55,9 +55,19 @@ struct TraceOptions {
     ProduceOptions produce;
 };
 
+// What a render did, for `lucent bench truth`: the walks' events and the CPU time the
+// tracing threads used (their sum over threads).
+struct TraceStatistics {
+    WalkCounters counters;
+    double cpu_seconds = 0.0;
+    double wall_seconds = 0.0;
+    int paths_done = 0;
+};
+
 // Renders the scene's estimate: the mean per pixel (rows top first, alpha = coverage of
 // the pixel centre's ray, as the rasteriser's), its standard error, and a summary line.
-EstimatedImage render_path(const Scene& scene, const TraceOptions& options = {});
+EstimatedImage render_path(const Scene& scene, const TraceOptions& options = {},
+                           TraceStatistics* statistics = nullptr);
 
 // The plan: one upload pass whose producer is the tracer (a bake: batch renders run it
 // before their workers, the explorer in the background), the output.

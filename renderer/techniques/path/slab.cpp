@@ -30,12 +30,13 @@ struct SlabBoundary {
         if (direction.z > 0.0) {
             // A semi-infinite slab's far face is at infinity: a walk always collides
             // before it (sigma_t = 1).
-            if (std::isinf(depth)) return BoundaryHit{depth, {0.0, 0.0, 1.0}};
-            return BoundaryHit{std::max(0.0, (depth - origin.z) / direction.z),
-                               {0.0, 0.0, 1.0}};
+            if (std::isinf(depth)) return BoundaryHit{depth, {0.0, 0.0, 1.0}, 1};
+            return BoundaryHit{
+                std::max(0.0, (depth - origin.z) / direction.z), {0.0, 0.0, 1.0}, 1};
         }
         if (direction.z < 0.0)
-            return BoundaryHit{std::max(0.0, -origin.z / direction.z), {0.0, 0.0, -1.0}};
+            return BoundaryHit{
+                std::max(0.0, -origin.z / direction.z), {0.0, 0.0, -1.0}, 0};
         return std::nullopt;  // parallel to the faces: it never leaves (an infinite slab)
     }
 };

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "common/content_hash.h"
+#include "common/cpu_time.h"
 #include "renderer/cpu/pixel_rays.h"
 #include "renderer/cpu/ray_caster.h"
 #include "renderer/techniques/path/path.h"
@@ -34,7 +35,8 @@ struct MeshBoundary {
         const std::optional<RayHit> hit =
             caster.first_hit(glm::vec3(origin), glm::vec3(direction), epsilon, far);
         if (!hit) return std::nullopt;
-        return BoundaryHit{double(hit->distance), glm::dvec3(hit->geometric_normal)};
+        return BoundaryHit{double(hit->distance), glm::dvec3(hit->geometric_normal),
+                           hit->triangle};
     }
 };
 
@@ -98,6 +100,52 @@ struct Tracer {
     WalkShortcuts shortcuts;
     WalkLimits limits;
     bool next_event;  // eta = 1: shadow rays reach the key light
+    // eta != 1: shadow rays reach it through one flat facet (connect_through_facet)
+    bool next_event_through_facet;
+
+    // The path from `x` inside the medium through one facet of the boundary to the
+    // outside direction `out`: the inside direction whose refraction at the facet it
+    // meets is `out`. The facet is found by iteration (aim, see which facet the ray
+    // meets, aim by that facet's normal, ...) and the connection holds once a ray aimed
+    // by a facet's normal meets that facet; nothing after 4 tries. Deterministic in
+    // (x, out), so the phase-sampled side can ask whether this would have found its path.
+    struct FacetConnection {
+        glm::dvec3 direction;  // from x, inside
+        double distance = 0.0;
+        glm::dvec3 outward;
+        std::uint32_t facet = 0;
+        double cos_inside = 1.0, cos_outside = 1.0;
+    };
+    std::optional<FacetConnection> connect_through_facet(glm::dvec3 x,
+                                                         glm::dvec3 out) const {
+        glm::dvec3 aim = out;
+        std::optional<std::uint32_t> aimed_by;
+        double cos_inside = 1.0, cos_outside = 1.0;
+        for (int attempt = 0; attempt < 5; ++attempt) {
+            const std::optional<BoundaryHit> hit =
+                boundary.nearest(x, aim, true, INFINITY);
+            if (!hit) return std::nullopt;
+            if (aimed_by && *aimed_by == hit->facet)
+                return FacetConnection{aim,        hit->distance, hit->outward,
+                                       hit->facet, cos_inside,    cos_outside};
+            const glm::dvec3 n = hit->outward;
+            cos_outside = glm::dot(out, n);
+            if (!(cos_outside > 1e-9) || attempt == 4) return std::nullopt;
+            // Light arriving along -out refracts into the medium along -aim (Snell).
+            const double sin2_inside = (1.0 - cos_outside * cos_outside) / (eta * eta);
+            cos_inside = std::sqrt(std::max(0.0, 1.0 - sin2_inside));
+            aim = glm::normalize(out / eta + (cos_inside - cos_outside / eta) * n);
+            aimed_by = hit->facet;
+        }
+        return std::nullopt;
+    }
+    // The density over inside directions with which next-event estimation through a
+    // facet chooses a connection: uniform over the disc's solid angle outside, times
+    // d omega_out / d omega_in = eta^2 cos_in / cos_out.
+    double facet_connection_pdf(const FacetConnection& c) const {
+        return eta * eta * c.cos_inside /
+               (std::max(c.cos_outside, 1e-12) * light.solid_angle);
+    }
 
     // Transmittance from `origin` (inside the medium) along `direction` to infinity,
     // through every crossing of the index-matched boundary.
@@ -128,7 +176,7 @@ struct Tracer {
         double sum = 0.0;
         const auto on_scatter = [&](glm::dvec3 position, glm::dvec3 incoming,
                                     double weight) {
-            if (!next_event || !light.on) return;
+            if (!(next_event || next_event_through_facet) || !light.on) return;
             if (light.radius == 0.0) {
                 const double phase =
                     henyey_greenstein(medium.g, glm::dot(incoming, light.direction));
@@ -139,6 +187,25 @@ struct Tracer {
             }
             const glm::dvec3 to_light =
                 sample_cone(light, random.uniform(), random.uniform());
+            if (next_event_through_facet) {
+                const std::optional<FacetConnection> c =
+                    connect_through_facet(position, to_light);
+                if (!c) return;
+                const glm::dvec3 exit = position + c->distance * c->direction;
+                if (boundary.nearest(exit + c->outward * boundary.spawn_offset(),
+                                     to_light, false, INFINITY))
+                    return;  // the object is in the way outside
+                const double pdf = facet_connection_pdf(*c);
+                const double phase =
+                    henyey_greenstein(medium.g, glm::dot(incoming, c->direction));
+                const double transmitted =
+                    1.0 - fresnel_dielectric(c->cos_inside, 1.0 / eta);
+                sum += weight * phase * transmitted * light.radiance[channel] / pdf *
+                       power_heuristic(pdf, phase) *
+                       transmittance(medium, position, c->direction, c->distance, random,
+                                     shortcuts, counters);
+                return;
+            }
             const double light_pdf = 1.0 / light.solid_angle;
             const double phase =
                 henyey_greenstein(medium.g, glm::dot(incoming, to_light));
@@ -157,10 +224,17 @@ struct Tracer {
                 // last event a scattering) shares the light by the power heuristic; a
                 // hit no shadow ray could have made (no scattering since the eye, or a
                 // refracting interface on the way) counts whole.
-                const double mis =
-                    next_event && e.phase_pdf > 0.0
-                        ? power_heuristic(e.phase_pdf, 1.0 / light.solid_angle)
-                        : 1.0;
+                double mis = next_event && e.phase_pdf > 0.0
+                                 ? power_heuristic(e.phase_pdf, 1.0 / light.solid_angle)
+                                 : 1.0;
+                // Through one facet: shared with the connection that would have found
+                // this very path (the same facet from the same scattering).
+                if (next_event_through_facet && e.one_refraction_after_scattering)
+                    if (const std::optional<FacetConnection> c =
+                            connect_through_facet(e.scattering_position, e.direction);
+                        c && c->facet == e.exit_facet)
+                        mis = power_heuristic(e.scattering_phase_pdf,
+                                              facet_connection_pdf(*c));
                 seen += light.radiance[channel] * mis;
             }
             sum += e.weight * seen;
@@ -180,7 +254,8 @@ std::uint64_t sample_seed(int seed, int sample) {
 
 }  // namespace
 
-EstimatedImage render_path(const Scene& scene, const TraceOptions& options) {
+EstimatedImage render_path(const Scene& scene, const TraceOptions& options,
+                           TraceStatistics* statistics) {
     const auto start = std::chrono::steady_clock::now();
     const Params p = params(scene);
     const RayCaster caster(*scene.mesh);
@@ -196,8 +271,11 @@ EstimatedImage render_path(const Scene& scene, const TraceOptions& options) {
                   MeshBoundary{caster, caster.layer_epsilon()},
                   options.full ? WalkShortcuts::none() : WalkShortcuts{},
                   WalkLimits{1'000'000, 0.1},
+                  false,
                   false};
     tracer.next_event = tracer.eta == 1.0 && options.light_sampling;
+    tracer.next_event_through_facet =
+        tracer.eta != 1.0 && tracer.light.radius > 0.0 && options.light_sampling;
     // A walk after a path that met a point of the scene with a light only in other
     // channels contributes nothing in this one: with no light in a channel, skip its
     // walks.
@@ -219,6 +297,7 @@ EstimatedImage render_path(const Scene& scene, const TraceOptions& options) {
 
     const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     std::vector<WalkCounters> thread_counters(threads);
+    std::vector<double> thread_cpu(threads, 0.0);
     int samples_done = 0;
     for (int sample = 0; sample < p.paths; ++sample) {
         const std::uint64_t seed = sample_seed(p.seed, sample);
@@ -226,6 +305,7 @@ EstimatedImage render_path(const Scene& scene, const TraceOptions& options) {
         std::vector<std::thread> workers;
         for (unsigned t = 0; t < threads; ++t)
             workers.emplace_back([&, t] {
+                const double cpu_start = common::thread_cpu_seconds();
                 for (int row; (row = next_row.fetch_add(1)) < height;)
                     for (int x = 0; x < width; ++x) {
                         const std::size_t pixel = std::size_t(row) * width + x;
@@ -241,6 +321,7 @@ EstimatedImage render_path(const Scene& scene, const TraceOptions& options) {
                             sum2[pixel * 3 + c] += value * value;
                         }
                     }
+                thread_cpu[t] += common::thread_cpu_seconds() - cpu_start;
             });
         for (std::thread& worker : workers) worker.join();
         samples_done = sample + 1;
@@ -283,6 +364,9 @@ EstimatedImage render_path(const Scene& scene, const TraceOptions& options) {
     for (const WalkCounters& c : thread_counters) counters.add(c);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double cpu_seconds = 0.0;
+    for (const double c : thread_cpu) cpu_seconds += c;
+    if (statistics) *statistics = {counters, cpu_seconds, seconds, samples_done};
     char line[512];
     std::snprintf(
         line, sizeof line,

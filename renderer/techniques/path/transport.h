@@ -138,6 +138,7 @@ double transmittance(const ChannelMedium& medium, glm::dvec3 origin, glm::dvec3 
 struct BoundaryHit {
     double distance = 0.0;
     glm::dvec3 outward{0.0, 0.0, 1.0};
+    std::uint32_t facet = 0;  // which flat piece of the boundary (a triangle, a plane)
 };
 
 }  // namespace lucent::path

@@ -27,6 +27,14 @@ struct Escape {
     // nothing changed it since (eta = 1): what multiple importance sampling against a
     // light sampled at that scattering needs. 0 otherwise.
     double phase_pdf = 0.0;
+    // The walk left by exactly one refraction after its last scattering (nothing else in
+    // between): next-event estimation through that facet (tracer.cpp) could have made
+    // the same path, and its multiple importance sampling weight needs these.
+    bool one_refraction_after_scattering = false;
+    glm::dvec3 scattering_position{0.0};
+    glm::dvec3 scattering_direction{0.0};  // the direction the scattering chose
+    double scattering_phase_pdf = 0.0;
+    std::uint32_t exit_facet = 0;
 };
 
 // Walks from `origin` along unit `direction`, starting inside the medium or outside it,
@@ -50,6 +58,16 @@ void walk(const Boundary& boundary, const ChannelMedium& medium, double medium_e
     constexpr double kNowhere = std::numeric_limits<double>::infinity();
     bool direct = true;
     double phase_pdf = 0.0;
+    Escape last;               // the scattering fields, kept up to date
+    int crossings_since = -1;  // interface crossings since the last scattering (-1: none)
+    const auto escape = [&](bool is_direct) {
+        last.direction = direction;
+        last.weight = weight;
+        last.direct = is_direct;
+        last.phase_pdf = phase_pdf;
+        last.one_refraction_after_scattering = crossings_since == 1;
+        on_escape(last);
+    };
     // Returns false when the walk ends at the collision (absorbed or rouletted).
     const auto scatter_at = [&](double t) {
         origin += t * direction;
@@ -65,6 +83,10 @@ void walk(const Boundary& boundary, const ChannelMedium& medium, double medium_e
         direction = sample_henyey_greenstein(medium.g, incoming, random.uniform(),
                                              random.uniform());
         phase_pdf = henyey_greenstein(medium.g, glm::dot(incoming, direction));
+        last.scattering_position = origin;
+        last.scattering_direction = direction;
+        last.scattering_phase_pdf = phase_pdf;
+        crossings_since = 0;
         return true;
     };
     for (std::uint64_t events = 0;; ++events) {
@@ -85,7 +107,7 @@ void walk(const Boundary& boundary, const ChannelMedium& medium, double medium_e
         }
         if (!hit) {
             if (inside) ++counters.leaks;
-            on_escape(Escape{direction, weight, direct, phase_pdf});
+            escape(direct);
             return;
         }
         direct = false;
@@ -105,19 +127,25 @@ void walk(const Boundary& boundary, const ChannelMedium& medium, double medium_e
             }
         }
         if (!std::isfinite(hit->distance)) {  // a boundary at infinity, never reached
-            on_escape(Escape{direction, weight, false, phase_pdf});
+            escape(false);
             return;
         }
         origin += hit->distance * direction;
         const glm::dvec3 outward = hit->outward;
+        last.exit_facet = hit->facet;
         if (pass_straight) {
             inside = !inside;
+            if (crossings_since >= 0) ++crossings_since;
         } else {
             ++counters.interface_events;
             const InterfaceEvent event =
                 cross_interface(direction, outward, medium_eta, random.uniform());
             if (event.transmitted) inside = !inside;
             if (!(event.transmitted && medium_eta == 1.0)) phase_pdf = 0.0;
+            // A reflection is not a refraction: the connection through one facet no
+            // longer describes this path.
+            if (crossings_since >= 0)
+                crossings_since = event.transmitted ? crossings_since + 1 : 2;
             direction = event.direction;
         }
         // Off the surface to the side the walk goes on in, so that rounding never puts
