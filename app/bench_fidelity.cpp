@@ -19,6 +19,7 @@
 #include "app/commands.h"
 #include "common/html/svg_plot.h"
 #include "common/output_file.h"
+#include "renderer/core/common_knobs.h"
 #include "renderer/gl/context.h"
 #include "renderer/render.h"
 #include "renderer/techniques/registry.h"
@@ -197,9 +198,17 @@ int run_bench_fidelity(const FidelityOptions& options) {
                 std::printf("  %-22s refused: %s\n", name.c_str(), fit.refused.c_str());
                 continue;
             }
-            print_error_row(name.c_str(), fit.error, fit.frame_ms,
-                            fit.fitted.empty() ? "takes the material directly"
-                                               : settings_text(fit.fitted));
+            print_error_row(
+                name.c_str(), fit.error, fit.frame_ms,
+                fit.fitted.empty() ? "nothing to fit" : settings_text(fit.fitted));
+            // What it took from the truth beyond the scene (light, camera): the material.
+            std::vector<KnobAssignment> material;
+            for (const KnobAssignment& a : fit.taken)
+                if (std::none_of(scene_knobs().begin(), scene_knobs().end(),
+                                 [&](const Knob& k) { return k.name == a.key; }))
+                    material.push_back(a);
+            if (!material.empty())
+                std::printf("  %-22s takes %s\n", "", settings_text(material).c_str());
             print_error_row(("  (defaults)"), fit.start_error, NAN, "before the fit");
             const std::string section = c.name + " " + name;
             results.add(section, "mean Delta E00", fit.error.mean_delta_e, "dE00");

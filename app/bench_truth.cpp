@@ -124,9 +124,15 @@ int run_bench_truth(const TruthOptions& options) {
             path::TraceStatistics statistics;
             const EstimatedImage image = path::render_path(sweep, {}, &statistics);
             const Comparison c = compare(image, reference);
-            std::printf("  %8d %10.3f %10.3f %12.5f %12.5f %8.2f\n", paths,
-                        statistics.wall_seconds, statistics.cpu_seconds, c.rmse,
-                        c.reported, c.reported > 0 ? c.rmse / c.reported : 0.0);
+            // One path has no standard error of its own (a variance needs two samples).
+            if (paths > 1)
+                std::printf("  %8d %10.3f %10.3f %12.5f %12.5f %8.2f\n", paths,
+                            statistics.wall_seconds, statistics.cpu_seconds, c.rmse,
+                            c.reported, c.reported > 0 ? c.rmse / c.reported : 0.0);
+            else
+                std::printf("  %8d %10.3f %10.3f %12.5f %12s %8s\n", paths,
+                            statistics.wall_seconds, statistics.cpu_seconds, c.rmse, "-",
+                            "-");
             const std::string name = "paths=" + std::to_string(paths);
             results.add(section, name + " RMSE", c.rmse, "linear");
             results.add(section, name + " reported standard error", c.reported, "linear");

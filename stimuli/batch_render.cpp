@@ -295,7 +295,7 @@ struct Prebaked {
 // twice and a bake's own progress bar is not interleaved; workers are handed the
 // results (see RenderWorkers::render_worker).
 Prebaked prebake(const StimulusSet& set, const MeshesBySpec& meshes,
-                 const std::vector<std::size_t>& pending) {
+                 const std::vector<std::size_t>& pending, bool show_progress) {
     Prebaked baked;
     std::map<std::string, Pass> bakes;
     for (const std::size_t i : pending) {
@@ -307,8 +307,26 @@ Prebaked prebake(const StimulusSet& set, const MeshesBySpec& meshes,
             if (is_bake(pass)) bakes.emplace(pass.data.content_hash, pass);
     }
     const auto start = Clock::now();
-    for (const auto& [hash, pass] : bakes)
-        baked.by_hash.emplace(hash, produce_upload(pass));
+    // A bake may take minutes (a path-traced picture): each says what it is, reports its
+    // own progress where it can (done / total) and its time when finished.
+    const bool tty = isatty(STDERR_FILENO);
+    std::size_t number = 0;
+    for (const auto& [hash, pass] : bakes) {
+        ++number;
+        const auto bake_start = Clock::now();
+        ProduceOptions produce;
+        if (show_progress)
+            produce.progress = [&](std::size_t done, std::size_t total) {
+                if (!tty && done != total) return;
+                std::fprintf(stderr, "%sbake %zu/%zu %s: %zu/%zu, %.1f s%s",
+                             tty ? "\r" : "", number, bakes.size(), pass.name.c_str(),
+                             done, total, seconds_since(bake_start),
+                             tty ? "\033[K" : "\n");
+                std::fflush(stderr);
+            };
+        baked.by_hash.emplace(hash, pass.data.produce(produce));
+        if (show_progress && tty) std::fprintf(stderr, "\n");
+    }
     baked.seconds = seconds_since(start);
     return baked;
 }
@@ -569,7 +587,7 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
     // Drop the rows of everything about to be re-rendered before any file is replaced.
     write_complete_rows(dir, set, plan.rows);
 
-    const Prebaked baked = prebake(set, meshes, plan.pending);
+    const Prebaked baked = prebake(set, meshes, plan.pending, options.progress);
     RenderWorkers workers(set, options, meshes, baked.by_hash, plan);
     workers.run();
     result.rendered = plan.pending.size();

@@ -94,8 +94,9 @@ public:
         const Scene& /*scene*/, const ProduceOptions& /*options*/) const {
         return std::nullopt;
     }
-    // The knobs `lucent bench fidelity` fits to the truth; none: the technique takes the
-    // truth's material and scene knobs of the same names directly (the dipole).
+    // The knobs `lucent bench fidelity` fits to the truth (appearance, not physics: the
+    // truth's material and scene knobs of the same names are taken as they are, as the
+    // dipole takes its material); none: nothing is fitted.
     virtual std::vector<FitRange> fidelity_fit() const { return {}; }
     // The cost comparison of `lucent bench frame --technique NAME`; none: the bench
     // sweeps the first quality knob instead.

@@ -2,10 +2,12 @@
 // pairs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <sstream>
 
+#include "renderer/techniques/registry.h"
 #include "stimuli/stimulus_set.h"
 #include "tests/support/test_paths.h"
 
@@ -126,7 +128,7 @@ TEST(ThesisPreset, RealCatalogRejectsUnknownTechniqueAndKeys) {
         EXPECT_NE(std::string(e.what()).find(
                       "x.toml:5:13: stimuli[0].technique: unknown technique "
                       "'phong' (valid: empirical, ward, contrast_reversed, dipole, htsm, "
-                      "thick_texture)"),
+                      "thick_texture, path)"),
                   std::string::npos)
             << e.what();
     }
@@ -201,13 +203,21 @@ TEST(PhysicalPreset, ThreePathTracedMaterialsBesideTheEmpiricalBaseline) {
     for (const auto& s : set.stimuli) {
         EXPECT_EQ(s.series, "physical") << s.id;
         EXPECT_EQ(s.mesh_spec, "torus_knot:30k");
-        EXPECT_EQ(s.parameters.vec3("light_direction"), glm::dvec3(0.4, 0.6, 1.0));
         if (s.technique == "path") {
+            EXPECT_EQ(s.parameters.vec3("light_direction"), glm::dvec3(0.4, 0.6, 1.0));
             materials.push_back(s.parameters.choice("material"));
             EXPECT_EQ(s.parameters.scalar("model_size"), 30.0);
         } else {
+            // The thesis set's own baseline picture, value for value.
             EXPECT_EQ(s.id, "empirical_row_1");
-            EXPECT_EQ(s.parameters.scalar("thickness_exponent"), 25.0);
+            const auto thesis = load_preset("thesis", default_catalog());
+            const auto row_1 =
+                std::find_if(thesis.stimuli.begin(), thesis.stimuli.end(),
+                             [](const Stimulus& t) { return t.id == "empirical_row_1"; });
+            ASSERT_NE(row_1, thesis.stimuli.end());
+            for (const Knob& knob : knobs_for(find_technique("empirical")))
+                EXPECT_EQ(s.parameters.get(knob.name), row_1->parameters.get(knob.name))
+                    << knob.name;
         }
     }
     EXPECT_EQ(materials, (std::vector<std::string>{"skin1", "marble", "skimmilk"}));

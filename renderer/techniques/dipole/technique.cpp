@@ -27,6 +27,11 @@ public:
     ProgressiveRefinement progressive_refinement() const override {
         return {"samples", "sample_seed", 4};
     }
+    // The material is physics and comes from the truth as it is; the ambient and
+    // Blinn-Phong terms are appearance, so `bench fidelity` fits them.
+    std::vector<FitRange> fidelity_fit() const override {
+        return {{"ambient", 0.0, 2.0}, {"specular", 0.0, 2.0}, {"shininess", 1.0, 200.0}};
+    }
     std::vector<QualitySweep> quality_sweeps() const override {
         // The CPU reference integrates Eq. 3 directly; it uses none of these.
         return {

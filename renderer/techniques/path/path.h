@@ -20,9 +20,10 @@
 namespace lucent::path {
 
 struct Params {
-    std::string material = "skimmilk";  // a Jensen et al. 2001 preset or "custom"
-    glm::dvec3 sigma_a{0.0014, 0.0025, 0.0142};  // custom, mm^-1
-    glm::dvec3 sigma_s_prime{0.70, 1.22, 1.90};  // custom, mm^-1
+    // The dipole's defaults, so that one knob name has one default (docs/parameters.md).
+    std::string material = "skin1";         // a Jensen et al. 2001 preset or "custom"
+    glm::dvec3 sigma_a{0.032, 0.17, 0.48};  // custom, mm^-1
+    glm::dvec3 sigma_s_prime{0.74, 0.88, 1.01};  // custom, mm^-1
     double eta = 1.3;                            // custom: relative index, [1, 2]
     double g = 0.0;             // Henyey-Greenstein asymmetry, [-0.95, 0.95]
     double model_size = 10.0;   // mm: the mesh's bounding-box diagonal

@@ -248,6 +248,24 @@ TEST(PathImage, IsTheSameForASeedAndDiffersForAnother) {
     EXPECT_NE(render_path(sphere(other)).mean.rgba, a.mean.rgba);
 }
 
+// A time budget stops after the pass of paths that exceeds it (at least one), and the
+// summary says how many of the asked-for paths were traced.
+TEST(PathImage, ATimeBudgetStopsEarlyAndSaysSo) {
+    const Scene scene = sphere({{"material", "marble"},
+                                {"model_size", "100"},
+                                {"paths", "100000"},
+                                {"time_budget", "0.05"}},
+                               16);
+    TraceStatistics statistics;
+    const EstimatedImage e = render_path(scene, {}, &statistics);
+    EXPECT_GE(statistics.paths_done, 1);
+    EXPECT_LT(statistics.paths_done, 100000);
+    EXPECT_NE(e.summary.find(std::to_string(statistics.paths_done) + " of 100000"),
+              std::string::npos)
+        << e.summary;
+    for (const float v : e.mean.rgba) ASSERT_TRUE(std::isfinite(v));
+}
+
 TEST(PathImage, RefusesAnOpenMeshAndAnUnreachableDirectionalLight) {
     try {
         test::scene_for("path", {}, "square", 8);
@@ -255,7 +273,7 @@ TEST(PathImage, RefusesAnOpenMeshAndAnUnreachableDirectionalLight) {
     } catch (const MeshError& e) {
         EXPECT_NE(std::string(e.what()).find("closed"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(sphere({{"light_radius", "0"}}), KnobError);  // skim milk: eta 1.3
+    EXPECT_THROW(sphere({{"light_radius", "0"}}), KnobError);  // skin1: eta 1.3
     EXPECT_NO_THROW(
         sphere({{"light_radius", "0"}, {"material", "custom"}, {"eta", "1"}}));
 }
