@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -216,6 +217,28 @@ TEST_F(ExplorerTest, TheDipoleRefinesOverFramesToTheSetsSamples) {
     explorer->step();
     EXPECT_EQ(explorer->shown().refinement_status(), "refining: 4 of 12 samples");
     EXPECT_NE(explorer->shown().image.rgba, converged.rgba);
+}
+
+// The path tracer refines the same way, one path per pixel and channel a frame, each
+// frame's trace a background bake (the view keeps its last complete frame meanwhile and
+// asks for the same seed again until the bake is in): it reaches the set's paths.
+TEST_F(ExplorerTest, ThePathTracerRefinesOverFramesToTheSetsPaths) {
+    ExplorerSession session;
+    session.sets[0].set_technique("path");
+    session.sets[0].set("paths", 3);
+    session.sets[0].set("material", std::string("marble"));
+    auto explorer = open(session, 200, 150);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(180);
+    const auto converged = [&] {
+        const RenderedSide& side = explorer->shown();
+        return side.valid && side.refinement && side.refinement->converged();
+    };
+    while (!converged() && std::chrono::steady_clock::now() < deadline) explorer->step();
+    ASSERT_TRUE(converged());
+    EXPECT_EQ(explorer->shown().refinement->samples(), 3);
+    EXPECT_EQ(explorer->shown().refinement->frames(), 3);
+    EXPECT_GT(covered_pixels(explorer->shown().image), 100u);
+    for (const float v : explorer->shown().image.rgba) ASSERT_TRUE(std::isfinite(v));
 }
 
 TEST_F(ExplorerTest, DragsOnTheViewOrbitAndMoveTheLight) {
