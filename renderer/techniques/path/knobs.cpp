@@ -113,8 +113,11 @@ ChannelMedium channel_medium(const Scene& scene, const Params& p, int channel) {
 std::vector<std::string> shortcuts_taken(const Scene& scene, const Params& p) {
     std::vector<std::string> taken;
     if (medium_eta(p) == 1.0) taken.push_back("no Fresnel events (eta = 1)");
-    bool scatters = false;
-    for (int c = 0; c < 3; ++c) scatters |= channel_medium(scene, p, c).sigma_s > 0.0;
+    // sigma_s = sigma_s' / (1 - g) times a positive scale: zero exactly where sigma_s' is
+    // (asked from the material itself: plan() runs every frame, and channel_medium()
+    // scans every vertex for the mesh's box).
+    const glm::dvec3 reduced = material_of(p).sigma_s_prime;
+    const bool scatters = reduced.x > 0.0 || reduced.y > 0.0 || reduced.z > 0.0;
     if (!scatters) taken.push_back("no collisions (sigma_s = 0: Beer-Lambert weights)");
     if (scene.density && scene.density->constant())
         taken.push_back("no density lookups (constant rho = " +
