@@ -9,6 +9,8 @@ find_package(tomlplusplus REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(Boost 1.74 REQUIRED)              # Math and Multiprecision are header-only
 find_package(Threads REQUIRED)
+# Eigen (libeigen3-dev): the dense and sparse Cholesky factors of the mixed models.
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
@@ -19,7 +21,7 @@ pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
 # littleCMS: sRGB -> Lab and CIEDE2000 for the stimulus-set report.
 pkg_check_modules(LCMS2 REQUIRED IMPORTED_TARGET lcms2)
 # NLopt's C++ API (libnlopt-cxx-dev): the bounded derivative-free optimiser (BOBYQA) of
-# `lucent bench fidelity`'s fits.
+# `lucent bench fidelity`'s fits and the mixed models' variance parameters.
 pkg_check_modules(NLOPT_CXX REQUIRED IMPORTED_TARGET nlopt_cxx)
 
 if(LUCENT_BUILD_TESTS)
