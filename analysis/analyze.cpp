@@ -27,6 +27,8 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
             subject_by_level(table, pair.question, pair.factor, levels);
         analyses.back().within = analyze_within_subject(
             matrix.complete, std::move(matrix.incomplete_participants));
+        analyses.back().models =
+            fit_pair_models(table, pair.question, pair.factor, levels, request.models);
     }
     if (request.primary) {
         result.primary = *request.primary;

@@ -27,6 +27,8 @@ struct AnalysisRequest {
     // this share of the pair's participants rated every level (1: every participant, a
     // truly within-subject design) and at least two did; otherwise between.
     double within_share = 1.0;
+    // The analyses to run besides the one-way ones, and which leads the report.
+    ModelChoice models;
 };
 
 struct AnalysisResult {

@@ -152,7 +152,7 @@ int bench_whole_process(long ratings, int groups, int repeat, Results& results) 
     // shared machine; each column is the median of `repeat` runs.
     const std::string lucent_command = quoted(self) + " analyze " + quoted(csv) +
                                        " --out " + quoted(dir / "report") +
-                                       " --format csv >/dev/null 2>&1";
+                                       " --format csv --model anova >/dev/null 2>&1";
     const bool have_r = std::system("command -v Rscript >/dev/null 2>&1") == 0;
     const fs::path script = dir / "analysis.R";
     if (have_r)

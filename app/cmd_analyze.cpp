@@ -19,6 +19,7 @@ struct AnalyzeArgs {
     std::string input, out_dir, factor, question, formats = "md,csv,html", scale = "1..7";
     std::string design;  // "", "between" or "within"
     std::string images;  // folder of rendered stimuli for thumbnails
+    std::string models = "anova,clmm", primary_model;
     double alpha = 0.10;
     double within_share = 1.0;
 };
@@ -37,9 +38,20 @@ int run_analyze(const AnalyzeArgs& args) {
             throw InputError("--within-share must lie in (0, 1]");
         std::optional<Design> plan_design;
         options.scale = parse_scale(args.scale);
+        std::string plan_model;
         const LongTable table =
             read_ratings(args.input, options.scale, &plan_design, &options.input_notes,
-                         &options.question_scales);
+                         &options.question_scales, &plan_model);
+        RatingModel primary_model = RatingModel::anova;
+        std::string primary_model_source;
+        if (!args.primary_model.empty()) {
+            primary_model = parse_rating_model(args.primary_model, "--primary-model");
+            primary_model_source = "--primary-model " + args.primary_model;
+        } else if (!plan_model.empty()) {
+            primary_model =
+                parse_rating_model(plan_model, "the protocol's primary_model");
+            primary_model_source = "the protocol's [analysis] primary_model";
+        }
         if (!args.images.empty()) {
             options.level_images = level_images_from_directory(table, args.images);
             if (thumbnail_maker) options.thumbnail_png = thumbnail_maker;
@@ -51,6 +63,12 @@ int run_analyze(const AnalyzeArgs& args) {
                                               << factor << " (" << levels << " levels)\n";
                                 }};
         request.within_share = args.within_share;
+        request.models = parse_model_list(args.models, primary_model);
+        if (!args.primary_model.empty() && !request.models.runs(primary_model))
+            throw InputError("--primary-model " + args.primary_model +
+                             " is not among --model " + args.models);
+        if (request.models.primary == primary_model)
+            request.models.primary_source = primary_model_source;
         if (args.design == "within") request.primary = Design::Within;
         if (args.design == "between") request.primary = Design::Between;
         if (request.primary) request.primary_source = "--design " + args.design;
@@ -60,6 +78,7 @@ int run_analyze(const AnalyzeArgs& args) {
         }
         const AnalysisResult result = analyze_table(table, request);
         options.primary = result.primary;
+        options.models = request.models;
         options.primary_reason = result.primary_reason;
         std::cerr << "lucent analyze: primary design " << design_name(result.primary)
                   << ", " << result.primary_reason << "\n";
@@ -80,8 +99,9 @@ void register_analyze(CLI::App& app, int& exit_code) {
     auto args = std::make_shared<AnalyzeArgs>();
     auto* cmd = app.add_subcommand(
         "analyze",
-        "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch per (question, factor), "
-        "with plots, from a study database or a long CSV of ratings");
+        "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch, and ordinal and linear "
+        "mixed models (participants and stimuli random) per (question, factor), with "
+        "plots, from a study database or a long CSV of ratings");
     cmd->add_option("input", args->input,
                     "Study database, or long CSV: "
                     "participant,stimulus,factor,level,question,rating")
@@ -104,6 +124,13 @@ void register_analyze(CLI::App& app, int& exit_code) {
     cmd->add_option("--images", args->images,
                     "Folder of rendered stimuli (lucent render's output): each level's "
                     "picture is shown beside its descriptives, embedded in report.html");
+    cmd->add_option("--model", args->models,
+                    "Analyses to run: a comma-separated subset of anova (the one-way "
+                    "tests), clmm (ordinal mixed model), lmm (linear mixed model)")
+        ->capture_default_str();
+    cmd->add_option("--primary-model", args->primary_model,
+                    "The analysis that leads the report: anova, clmm or lmm (default: "
+                    "the protocol's [analysis] primary_model; for a CSV, anova)");
     cmd->add_option("--scale", args->scale,
                     "Accepted ratings: MIN..MAX, or 'any' for any finite number")
         ->capture_default_str();

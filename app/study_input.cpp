@@ -21,7 +21,8 @@ bool is_sqlite_file(const std::string& path) {
 analysis::LongTable read_ratings(
     const std::string& path, const analysis::RatingScale& scale,
     std::optional<analysis::Design>* plan_design, std::vector<std::string>* notes,
-    std::map<std::string, analysis::RatingScale>* question_scales) {
+    std::map<std::string, analysis::RatingScale>* question_scales,
+    std::string* plan_model) {
     const bool server = study::is_server_uri(path);
     if (!server && !is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
     study::LongTable rows;
@@ -37,6 +38,7 @@ analysis::LongTable read_ratings(
     } catch (const study::StoreError& e) {
         throw analysis::InputError(e.what());
     }
+    if (plan_model) *plan_model = rows.primary_model;
     if (plan_design && !rows.primary_design.empty())
         *plan_design = rows.primary_design == "within" ? analysis::Design::Within
                                                        : analysis::Design::Between;

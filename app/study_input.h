@@ -21,6 +21,7 @@ analysis::LongTable read_ratings(
     const std::string& path, const analysis::RatingScale& scale,
     std::optional<analysis::Design>* plan_design = nullptr,
     std::vector<std::string>* notes = nullptr,
-    std::map<std::string, analysis::RatingScale>* question_scales = nullptr);
+    std::map<std::string, analysis::RatingScale>* question_scales = nullptr,
+    std::string* plan_model = nullptr);
 
 }  // namespace lucent::app

@@ -221,6 +221,7 @@ LongTable analysis_long_table(const std::string& db_path,
     const std::optional<Protocol> protocol = stored_protocol(db);
     if (protocol) {
         table.primary_design = protocol->analysis.primary_design;
+        table.primary_model = protocol->analysis.primary_model;
         table.sessions = protocol->analysis.sessions;
     }
     if (!options.sessions.empty()) table.sessions = options.sessions;

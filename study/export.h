@@ -68,7 +68,8 @@ struct LongTable {
     std::vector<std::string>
         excluded_participants;  // with the reason, "P3 (2 catch failed)"
     std::string
-        primary_design;  // the stored protocol's [analysis] plan; "" if unreadable
+        primary_design;         // the stored protocol's [analysis] plan; "" if unreadable
+    std::string primary_model;  // likewise ("anova", "clmm", "lmm")
     std::string sessions = "completed";  // which sessions were taken
     int sessions_total = 0;              // in the database, withdrawn ones included
     int sessions_analysed = 0;

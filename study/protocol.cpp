@@ -377,6 +377,12 @@ void read_analysis_plan(Protocol& p, TableReader& root) {
         r.fail(
             r.raw().get("primary_design"), "primary_design",
             "must be \"within\" or \"between\", got '" + p.analysis.primary_design + "'");
+    p.analysis.primary_model = r.string("primary_model", "anova");
+    if (p.analysis.primary_model != "anova" && p.analysis.primary_model != "clmm" &&
+        p.analysis.primary_model != "lmm")
+        r.fail(r.raw().get("primary_model"), "primary_model",
+               "must be \"anova\", \"clmm\" or \"lmm\", got '" +
+                   p.analysis.primary_model + "'");
     p.analysis.sessions = r.string("sessions", "completed");
     if (p.analysis.sessions != "completed" && p.analysis.sessions != "all")
         r.fail(r.raw().get("sessions"), "sessions",

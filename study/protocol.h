@@ -72,6 +72,10 @@ struct AnalysisPlan {
     // "within": every participant rates every level (the thesis's survey), so the
     // repeated-measures tests lead the report; "between": independent groups lead.
     std::string primary_design = "within";
+    // The analysis that leads the report: "anova" (the thesis's one-way tests, the
+    // default), "clmm" (the ordinal mixed model with participants and stimuli as random
+    // effects) or "lmm" (its linear cousin).
+    std::string primary_model = "anova";
     // Which sessions enter the analysis (`lucent analyze`, `export --format analysis`):
     // "completed" (the default: a participant who gave up, or quit before the catch
     // trials, is left out as incomplete) or "all" (running, paused and aborted too).

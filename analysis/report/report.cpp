@@ -6,7 +6,9 @@
 #include <sstream>
 
 #include "analysis/data/long_table.h"
+#include "analysis/report/document.h"
 #include "analysis/report/format.h"
+#include "analysis/report/mixed_sections.h"
 #include "analysis/report/rating_figures.h"
 #include "common/csv.h"
 #include "common/html/html_page.h"
@@ -14,24 +16,6 @@
 
 namespace lucent::analysis {
 namespace {
-
-// A tiny document model rendered to both Markdown and HTML, so the two never disagree.
-struct Table {
-    std::vector<std::string> header;
-    std::vector<std::vector<std::string>> rows;
-};
-struct Block {
-    enum Kind { kHeading, kParagraph, kTable, kPlot, kImages } kind;
-    std::string text;  // heading/paragraph text, or plot file name
-    Table table;
-    std::string svg;
-    int level = 2;
-    struct Image {
-        std::string caption;
-        std::filesystem::path path;
-    };
-    std::vector<Image> images;  // kImages: thumbnails in a row
-};
 
 std::string md_cell(const std::string& s) {
     std::string out;
@@ -215,33 +199,73 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                                   const ReportOptions& options) {
     std::vector<Block> doc;
     doc.push_back({Block::kHeading, "Lucent analysis report", {}, {}, 1});
-    doc.push_back({Block::kParagraph, "Input: " + options.source +
-                                          ". One-way ANOVA per (question, factor); " +
-                                          "alpha = " + format_short(options.alpha) +
-                                          ", Tukey HSD intervals at " +
-                                          format_short(1.0 - options.alpha) +
-                                          " confidence, descriptive intervals at 95%."});
+    std::string analyses_run;
+    if (options.models.anova) analyses_run += "One-way ANOVA per (question, factor); ";
+    if (options.models.clmm)
+        analyses_run +=
+            "ordinal mixed model (clmm) per (question, factor) with "
+            "participants and stimuli as random effects; ";
+    if (options.models.lmm) analyses_run += "linear mixed model (lmm) likewise; ";
+    doc.push_back({Block::kParagraph,
+                   "Input: " + options.source + ". " + analyses_run +
+                       "alpha = " + format_short(options.alpha) +
+                       ", Tukey HSD intervals at " + format_short(1.0 - options.alpha) +
+                       " confidence, descriptive intervals and model effects at 95%."});
     for (const std::string& note : options.input_notes)
         doc.push_back({Block::kParagraph, note});
-    // Summary in the layout of the thesis's Table 4.4, both designs, the primary first.
+    // Summary in the layout of the thesis's Table 4.4: both designs of the one-way
+    // ANOVA and each mixed model, the primary analysis first.
     const Design primary = options.primary;
     const Design secondary = primary == Design::Within ? Design::Between : Design::Within;
-    Table summary{
-        {"configuration", "design", "test", "p", "F", "significant at alpha", "used"},
-        {}};
-    for (const OneWayAnalysis& a : analyses)
-        for (Design design : {primary, secondary}) {
-            std::vector<std::string> row{configuration(a),
-                                         std::string(design_name(design)) +
-                                             (design == primary ? " (primary)" : "")};
-            for (std::string& cell : summary_cells(a, design, options.alpha))
-                row.push_back(std::move(cell));
-            summary.rows.push_back(std::move(row));
+    const ModelChoice& models = options.models;
+    Table summary{{"configuration", "analysis", "test", "p", "statistic",
+                   "significant at alpha", "used"},
+                  {}};
+    for (const OneWayAnalysis& a : analyses) {
+        std::vector<std::vector<std::string>> rows;
+        if (models.anova)
+            for (Design design : {primary, secondary}) {
+                const bool leads =
+                    models.primary == RatingModel::anova && design == primary;
+                std::vector<std::string> row{
+                    configuration(a),
+                    std::string(design_name(design)) + (leads ? " (primary)" : "")};
+                for (std::string& cell : summary_cells(a, design, options.alpha))
+                    row.push_back(std::move(cell));
+                rows.push_back(std::move(row));
+            }
+        for (RatingModel model : {RatingModel::clmm, RatingModel::lmm}) {
+            std::vector<std::string> cells = mixed_summary_cells(a, model, options.alpha);
+            if (cells.empty()) continue;
+            const bool leads = models.primary == model;
+            std::vector<std::string> row{
+                configuration(a),
+                std::string(rating_model_name(model)) + (leads ? " (primary)" : "")};
+            for (std::string& cell : cells) row.push_back(std::move(cell));
+            if (leads)
+                rows.insert(rows.begin(), std::move(row));
+            else
+                rows.push_back(std::move(row));
         }
+        summary.rows.insert(summary.rows.end(), rows.begin(), rows.end());
+    }
     doc.push_back({Block::kHeading, "Summary", {}, {}, 2});
+    if (models.primary != RatingModel::anova)
+        doc.push_back(
+            {Block::kParagraph,
+             std::string("Primary analysis: the ") +
+                 (models.primary == RatingModel::clmm ? "ordinal mixed model (clmm)"
+                                                      : "linear mixed model (lmm)") +
+                 (models.primary_source.empty()
+                      ? std::string()
+                      : ", as " + models.primary_source + " states") +
+                 ", with participants and stimuli as random effects."});
     doc.push_back(
         {Block::kParagraph,
-         std::string("Primary design: ") + design_name(primary) +
+         std::string(models.primary == RatingModel::anova
+                         ? "Primary design: "
+                         : "Design of the one-way tests: ") +
+             design_name(primary) +
              (primary == Design::Within
                   ? " (repeated-measures tests on the means of the participants "
                     "who rated every level)"
@@ -284,8 +308,11 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                      image->second.second});
         }
         if (!thumbnails.images.empty()) doc.push_back(thumbnails);
+        const std::vector<Block> mixed = mixed_model_blocks(a);
+        const bool mixed_leads = models.primary != RatingModel::anova;
+        if (mixed_leads) doc.insert(doc.end(), mixed.begin(), mixed.end());
         const std::vector<Block> within = within_subject_blocks(a, options.alpha);
-        if (primary == Design::Within)
+        if (models.anova && primary == Design::Within)
             doc.insert(doc.end(), within.begin(), within.end());
 
         Table desc{{"level", "n", "mean", "SD", "SE", "median", "95% CI"}, {}};
@@ -299,59 +326,63 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         doc.push_back({Block::kHeading, "Descriptives", {}, {}, 3});
         doc.push_back({Block::kTable, "", desc});
 
-        const AnovaResult& an = a.anova;
-        Table anova{{"source", "SS", "df", "MS", "F", "p"}, {}};
-        anova.rows.push_back({"between", format_short(an.ss_between),
-                              format_short(an.df_between), format_short(an.ms_between),
-                              format_short(an.f), format_p_short(an.p)});
-        anova.rows.push_back({"within", format_short(an.ss_within),
-                              format_short(an.df_within), format_short(an.ms_within), "",
-                              ""});
-        anova.rows.push_back({"total", format_short(an.ss_between + an.ss_within),
-                              format_short(an.df_between + an.df_within), "", "", ""});
-        doc.push_back({Block::kHeading, "One-way ANOVA", {}, {}, 3});
-        doc.push_back({Block::kTable, "", anova});
-        doc.push_back(
-            {Block::kParagraph, "eta squared = " + format_short(an.eta_sq) +
-                                    ", omega squared = " + format_short(an.omega_sq) +
-                                    (an.note.empty() ? "" : ". Note: " + an.note)});
+        if (models.anova) {
+            const AnovaResult& an = a.anova;
+            Table anova{{"source", "SS", "df", "MS", "F", "p"}, {}};
+            anova.rows.push_back(
+                {"between", format_short(an.ss_between), format_short(an.df_between),
+                 format_short(an.ms_between), format_short(an.f), format_p_short(an.p)});
+            anova.rows.push_back({"within", format_short(an.ss_within),
+                                  format_short(an.df_within), format_short(an.ms_within),
+                                  "", ""});
+            anova.rows.push_back({"total", format_short(an.ss_between + an.ss_within),
+                                  format_short(an.df_between + an.df_within), "", "",
+                                  ""});
+            doc.push_back({Block::kHeading, "One-way ANOVA", {}, {}, 3});
+            doc.push_back({Block::kTable, "", anova});
+            doc.push_back(
+                {Block::kParagraph, "eta squared = " + format_short(an.eta_sq) +
+                                        ", omega squared = " + format_short(an.omega_sq) +
+                                        (an.note.empty() ? "" : ". Note: " + an.note)});
 
-        const TukeyResult& tk = a.tukey;
-        doc.push_back({Block::kHeading, "Tukey HSD", {}, {}, 3});
-        if (tk.pairs.empty()) {
-            doc.push_back({Block::kParagraph, "Not computed: " + tk.note});
-        } else {
-            Table tukey{{"level a", "level b", "diff (b - a)", "se", "q", "p adj",
-                         "lower", "upper", "p adj < " + format_short(tk.alpha)},
-                        {}};
-            for (const TukeyPair& p : tk.pairs)
-                tukey.rows.push_back(
-                    {p.level_a, p.level_b, format_short(p.diff), format_short(p.se),
-                     format_short(p.q), format_p_short(p.p_adj), format_short(p.lower),
-                     format_short(p.upper), significant_at(p.p_adj, tk.alpha)});
-            doc.push_back({Block::kTable, "", tukey});
-            std::string hsd = "q critical (alpha " + format_short(tk.alpha) +
-                              ") = " + format_short(tk.q_critical);
-            if (tk.hsd_05)
-                hsd += "; HSD[.05] = " + format_short(tk.hsd_05) +
-                       ", HSD[.01] = " + format_short(tk.hsd_01);
-            else
-                hsd += "; groups are unbalanced (Tukey-Kramer), so no single HSD";
-            doc.push_back({Block::kParagraph, hsd});
+            const TukeyResult& tk = a.tukey;
+            doc.push_back({Block::kHeading, "Tukey HSD", {}, {}, 3});
+            if (tk.pairs.empty()) {
+                doc.push_back({Block::kParagraph, "Not computed: " + tk.note});
+            } else {
+                Table tukey{{"level a", "level b", "diff (b - a)", "se", "q", "p adj",
+                             "lower", "upper", "p adj < " + format_short(tk.alpha)},
+                            {}};
+                for (const TukeyPair& p : tk.pairs)
+                    tukey.rows.push_back({p.level_a, p.level_b, format_short(p.diff),
+                                          format_short(p.se), format_short(p.q),
+                                          format_p_short(p.p_adj), format_short(p.lower),
+                                          format_short(p.upper),
+                                          significant_at(p.p_adj, tk.alpha)});
+                doc.push_back({Block::kTable, "", tukey});
+                std::string hsd = "q critical (alpha " + format_short(tk.alpha) +
+                                  ") = " + format_short(tk.q_critical);
+                if (tk.hsd_05)
+                    hsd += "; HSD[.05] = " + format_short(tk.hsd_05) +
+                           ", HSD[.01] = " + format_short(tk.hsd_01);
+                else
+                    hsd += "; groups are unbalanced (Tukey-Kramer), so no single HSD";
+                doc.push_back({Block::kParagraph, hsd});
+            }
+            doc.push_back({Block::kHeading, "Rank and heteroscedastic tests", {}, {}, 3});
+            doc.push_back(
+                {Block::kParagraph,
+                 "Kruskal-Wallis (tie-corrected): H = " + format_short(a.kruskal.h) +
+                     ", df = " + format_short(a.kruskal.df) +
+                     ", p = " + format_p_short(a.kruskal.p) +
+                     (a.kruskal.note.empty() ? "" : " (" + a.kruskal.note + ")")});
+            doc.push_back({Block::kParagraph,
+                           "Welch's ANOVA: F = " + format_short(a.welch.f) +
+                               ", df1 = " + format_short(a.welch.df1) +
+                               ", df2 = " + format_short(a.welch.df2) +
+                               ", p = " + format_p_short(a.welch.p) +
+                               (a.welch.note.empty() ? "" : " (" + a.welch.note + ")")});
         }
-        doc.push_back({Block::kHeading, "Rank and heteroscedastic tests", {}, {}, 3});
-        doc.push_back(
-            {Block::kParagraph,
-             "Kruskal-Wallis (tie-corrected): H = " + format_short(a.kruskal.h) +
-                 ", df = " + format_short(a.kruskal.df) +
-                 ", p = " + format_p_short(a.kruskal.p) +
-                 (a.kruskal.note.empty() ? "" : " (" + a.kruskal.note + ")")});
-        doc.push_back({Block::kParagraph,
-                       "Welch's ANOVA: F = " + format_short(a.welch.f) +
-                           ", df1 = " + format_short(a.welch.df1) +
-                           ", df2 = " + format_short(a.welch.df2) +
-                           ", p = " + format_p_short(a.welch.p) +
-                           (a.welch.note.empty() ? "" : " (" + a.welch.note + ")")});
         std::string notes;
         for (const std::string& level : a.empty_levels)
             notes += "Level '" + level +
@@ -359,8 +390,9 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         if (a.missing_ratings > 0)
             notes += std::to_string(a.missing_ratings) + " missing ratings were skipped.";
         if (!notes.empty()) doc.push_back({Block::kParagraph, notes});
-        if (primary == Design::Between)
+        if (models.anova && primary == Design::Between)
             doc.insert(doc.end(), within.begin(), within.end());
+        if (!mixed_leads) doc.insert(doc.end(), mixed.begin(), mixed.end());
     }
     return doc;
 }
@@ -471,9 +503,6 @@ void render_html(const std::vector<Block>& doc, const ReportOptions& options,
     }
     out << "</body></html>\n";
 }
-
-// The report's files by name, rendered in memory and written once all are checked.
-using ReportFiles = std::vector<std::pair<std::string, std::string>>;
 
 void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& files) {
     std::ostringstream anova, tukey, kruskal, welch, desc;
@@ -634,7 +663,10 @@ std::vector<std::filesystem::path> write_report(
         render_html(doc, options, out);
         files.emplace_back("report.html", out.str());
     }
-    if (options.csv) write_csv_tables(analyses, files);
+    if (options.csv) {
+        write_csv_tables(analyses, files);
+        write_mixed_csv_tables(analyses, files);
+    }
     // Refuse before writing anything: a report file that is the input or a database.
     // Earlier report files are replaced, atomically (readers see the old or the new).
     std::vector<std::filesystem::path> written;

@@ -24,6 +24,9 @@ struct ReportOptions {
     // them, or any SQLite database, is refused before anything is written.
     std::vector<std::filesystem::path> inputs;
     Design primary = Design::Between;  // shown first in the summary and in each section
+    // The analyses that ran (the one-way ones, the mixed models) and which leads: the
+    // summary marks it "(primary)" and puts it first.
+    ModelChoice models;
     std::string
         primary_reason;  // why it leads (AnalysisResult::primary_reason); may be empty
     // Paragraphs after the input line: what the input reader left out and why (sessions

@@ -1,5 +1,6 @@
 #pragma once
 // Everything the report shows for one (question, factor) pair, computed in one place.
+#include "analysis/mixed/rating_models.h"
 #include "analysis/stats/anova.h"
 #include "analysis/stats/descriptives.h"
 #include "analysis/stats/kruskal_wallis.h"
@@ -37,6 +38,7 @@ struct OneWayAnalysis {
     std::vector<std::string> empty_levels;  // levels without observations (left out)
     std::size_t missing_ratings = 0;
     WithinSubjectAnalysis within;
+    PairModels models;  // the mixed models the request asked for
 };
 
 // alpha sets the Tukey intervals' confidence (1 - alpha); descriptives use 95% CIs.

@@ -67,6 +67,21 @@ add_test(NAME app.analyze_simulated_study
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/pipeline
                  -P ${LUCENT_APP_TEST_DIR}/analyze_pipeline.cmake)
+add_test(NAME app.analyze_mixed_models_lead_when_asked
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 -DDATA=${LUCENT_APP_TEST_DIR}/data/wine_long.csv
+                 -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/mixed_report
+                 -P ${LUCENT_APP_TEST_DIR}/analyze_mixed.cmake)
+add_test(NAME app.analyze_bad_model_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/wine_long.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/bad_model;--model;anova,glmm"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=^lucent analyze: --model: 'glmm' is not one of anova, lmm, clmm"
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+add_test(NAME app.analyze_primary_model_must_run_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/wine_long.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/primary_not_run;--model;anova;--primary-model;lmm"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=--primary-model lmm is not among --model anova"
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
 add_test(NAME app.simulate_bad_effects_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=simulate;--out;${CMAKE_CURRENT_BINARY_DIR}/x.csv;--participants;0"

@@ -20,7 +20,10 @@ set(expected_headers
     "welch.csv|question,factor,f,df1,df2,p"
     "rm_anova.csv|question,factor,n_participants,f,df_effect,df_error,p,mauchly_w,mauchly_p,gg_epsilon,p_gg,hf_epsilon,p_hf,partial_eta_sq,generalized_eta_sq"
     "friedman.csv|question,factor,n_participants,chi_sq,df,p,kendall_w"
-    "posthoc_paired.csv|question,factor,level_a,level_b,diff,t,df,p,p_holm")
+    "posthoc_paired.csv|question,factor,level_a,level_b,diff,t,df,p,p_holm"
+    "mixed_tests.csv|question,factor,model,formula,statistic,df,den_df,p,lr_chi_square,lr_df,lr_p,log_likelihood,participants,stimuli,ratings,notes"
+    "mixed_effects.csv|question,factor,model,level,reference,estimate,se,ci_low,ci_high,estimable"
+    "ordinal_probabilities.csv|question,factor,level,rating,predicted,observed")
 foreach(entry IN LISTS expected_headers)
   string(REPLACE "|" ";" entry "${entry}")
   list(GET entry 0 name)

@@ -247,6 +247,20 @@ TEST(Protocol, AnalysisPlanNamesThePrimaryDesign) {
     EXPECT_EQ(e.rfind("bad.toml:", 0), 0u) << e;
 }
 
+TEST(Protocol, AnalysisPlanNamesThePrimaryModel) {
+    EXPECT_EQ(
+        parse_protocol(lucent::test::kSmallProtocol, "p.toml").analysis.primary_model,
+        "anova");  // the thesis's analysis leads unless the plan says otherwise
+    std::string text = lucent::test::kSmallProtocol;
+    text += "\n[analysis]\nprimary_model = \"clmm\"\n";
+    EXPECT_EQ(parse_protocol(text, "p.toml").analysis.primary_model, "clmm");
+    const std::string e = error_of(std::string(lucent::test::kSmallProtocol) +
+                                   "\n[analysis]\nprimary_model = \"glmm\"\n");
+    EXPECT_NE(e.find("analysis.primary_model"), std::string::npos) << e;
+    EXPECT_NE(e.find("'glmm'"), std::string::npos) << e;
+    EXPECT_EQ(e.rfind("bad.toml:", 0), 0u) << e;
+}
+
 TEST(ProtocolErrors, ImpossibleRandomisationIsReportedWhenPlanning) {
     std::string text = lucent::test::kSmallProtocol;
     text += "\n[randomisation]\nfactor = \"backlight\"\nmax_repeat = 1\n";

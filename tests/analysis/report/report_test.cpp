@@ -83,7 +83,8 @@ TEST(Report, WritesEveryFormatWithExactHeaders) {
         EXPECT_FALSE(std::regex_search(text, std::regex("[0-9.]inf|infinity"))) << name;
     }
     const std::string md = slurp(dir / "report.md");
-    EXPECT_NE(md.find("| configuration | design | test | p | F |"), std::string::npos);
+    EXPECT_NE(md.find("| configuration | analysis | test | p | statistic |"),
+              std::string::npos);
     EXPECT_NE(md.find("translucent ~ thickness"), std::string::npos);
     EXPECT_NE(md.find("undefined"), std::string::npos);
     EXPECT_NE(md.find("no observations"), std::string::npos);
