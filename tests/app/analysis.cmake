@@ -98,5 +98,19 @@ add_test(NAME app.power_bad_means_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=power;--means;3"
                  -DEXPECT_CODE=2 -DEXPECT_STDERR=--means -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
+# lucent power --model lmm: pictures per level in a table, each row with the closed form
+# of the balanced mixed-model F; m = 4, lambda = 4 * 0.125 / (0.4^2 + 1.2^2 / 20), df 1
+# and 6: R's 1 - pf(qf(0.95, 1, 6), 1, 6, ncp = 2.1551724137931) = 0.2367055639.
+add_test(NAME app.power_crossed_prints_closed_form_per_stimuli
+         COMMAND lucent power --model lmm --participants 20 --means 4,4.5
+                 --participant-sd 0.7 --stimulus-sd 0.4 --residual-sd 1.2 --alpha 0.05
+                 --simulations 40 --stimuli-list 2,4)
+set_tests_properties(app.power_crossed_prints_closed_form_per_stimuli PROPERTIES
+    PASS_REGULAR_EXPRESSION "\n4 +[0-9.]+ \\+/- [0-9.]+ +[0-9.]+ \\+/- [0-9.]+ +0\\.2367")
+add_test(NAME app.power_crossed_one_stimulus_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=power;--model;clmm;--means;3,4;--stimuli;1"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=--stimuli must lie in \\[2, 1000\\]"
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
 add_test(NAME app.bench_stats_small COMMAND lucent bench stats --ratings 20000 --cdf-seconds 0.02)
 set_tests_properties(app.bench_stats_small PROPERTIES PASS_REGULAR_EXPRESSION "evals/s")
