@@ -23,6 +23,8 @@
 #include "analysis/stats/kruskal_wallis.h"
 #include "analysis/stats/studentized_range.h"
 #include "analysis/stats/tukey.h"
+#include "app/bench_mixed.h"
+#include "app/bench_process.h"
 #include "app/bench_results.h"
 #include "app/commands.h"
 
@@ -83,43 +85,6 @@ void bench_in_process(long ratings, int groups, Results& results) {
                 tukey.pairs.size(), kw.h.value_or(-1));
 }
 
-// CPU time (user + system) of all finished child processes so far.
-double children_cpu_seconds() {
-    rusage usage{};
-    getrusage(RUSAGE_CHILDREN, &usage);
-    auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
-    return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
-
-// Wall and CPU time of a shell command (CPU time is what a loaded machine does not
-// inflate); negative when it fails.
-struct CommandTime {
-    double wall, cpu;
-};
-CommandTime time_command(const std::string& command) {
-    const auto start = Clock::now();
-    const double cpu_start = children_cpu_seconds();
-    const int status = std::system(command.c_str());
-    const CommandTime t{seconds_since(start), children_cpu_seconds() - cpu_start};
-    return status == 0 ? t : CommandTime{-1.0, -1.0};
-}
-
-// The median of each of wall and CPU time over runs (one run: itself).
-CommandTime median_time(std::vector<CommandTime> runs) {
-    const auto median_of = [](std::vector<double> v) {
-        std::sort(v.begin(), v.end());
-        const std::size_t n = v.size();
-        return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    };
-    std::vector<double> wall, cpu;
-    for (const CommandTime& t : runs) wall.push_back(t.wall), cpu.push_back(t.cpu);
-    return {median_of(wall), median_of(cpu)};
-}
-
-std::string quoted(const std::filesystem::path& path) {
-    return "'" + path.string() + "'";
-}
-
 // `lucent analyze` as a whole process on a simulated long CSV (one question, one factor,
 // `groups` levels), and R's read.csv + aov + TukeyHSD + kruskal.test + oneway.test on the
 // same file when Rscript is on the PATH (nothing is installed).
@@ -150,10 +115,10 @@ int bench_whole_process(long ratings, int groups, int repeat, Results& results) 
     const fs::path self = fs::read_symlink("/proc/self/exe").parent_path() / "lucent";
     // The runs alternate between lucent and R, so that both see the same load on a
     // shared machine; each column is the median of `repeat` runs.
-    const std::string lucent_command = quoted(self) + " analyze " + quoted(csv) +
-                                       " --out " + quoted(dir / "report") +
-                                       " --format csv --model anova >/dev/null 2>&1";
-    const bool have_r = std::system("command -v Rscript >/dev/null 2>&1") == 0;
+    const std::vector<std::string> lucent_command{
+        self.string(), "analyze", csv.string(), "--out", (dir / "report").string(),
+        "--format",    "csv",     "--model",    "anova"};
+    const bool have_r = on_path("Rscript");
     const fs::path script = dir / "analysis.R";
     if (have_r)
         std::ofstream(script) << "d <- read.csv(commandArgs(trailingOnly = TRUE)[1])\n"
@@ -163,35 +128,34 @@ int bench_whole_process(long ratings, int groups, int repeat, Results& results) 
                                  "print(TukeyHSD(fit))\n"
                                  "print(kruskal.test(rating ~ level, data = d))\n"
                                  "print(oneway.test(rating ~ level, data = d))\n";
-    const std::string r_command =
-        "Rscript " + quoted(script) + " " + quoted(csv) + " >/dev/null 2>&1";
-    std::vector<CommandTime> lucent_runs, r_runs;
+    const std::vector<std::string> r_command{"Rscript", script.string(), csv.string()};
+    std::vector<ProcessCost> lucent_runs, r_runs;
     bool r_failed = false;
     for (int run = 0; run < repeat; ++run) {
-        lucent_runs.push_back(time_command(lucent_command));
-        if (lucent_runs.back().wall < 0) {
+        lucent_runs.push_back(run_measured(lucent_command));
+        if (!lucent_runs.back().ok) {
             std::fprintf(stderr, "lucent bench stats: lucent analyze failed on %s\n",
                          csv.c_str());
             return kExitFailure;
         }
         if (have_r && !r_failed) {
-            r_runs.push_back(time_command(r_command));
-            r_failed = r_runs.back().wall < 0;
+            r_runs.push_back(run_measured(r_command));
+            r_failed = !r_runs.back().ok;
         }
     }
-    const CommandTime t_lucent = median_time(lucent_runs);
-    const CommandTime t_start =
-        time_command(quoted(self) + " analyze --help >/dev/null 2>&1");
+    const ProcessCost t_lucent = median_cost(lucent_runs);
+    const ProcessCost t_start = run_measured({self.string(), "analyze", "--help"});
     std::printf("  %-40s %10s %10s   (median of %d runs, alternating)\n", "process",
                 "wall s", "CPU s", repeat);
-    std::printf("  %-40s %10.3f %10.3f\n", "lucent analyze --format csv", t_lucent.wall,
-                t_lucent.cpu);
+    std::printf("  %-40s %10.3f %10.3f\n", "lucent analyze --format csv", t_lucent.wall_s,
+                t_lucent.cpu_s);
     std::printf("  %-40s %10.3f %10.3f\n", "  of which starting lucent (analyze --help)",
-                t_start.wall, t_start.cpu);
-    results.add("whole_process", "lucent analyze --format csv (wall)", t_lucent.wall,
+                t_start.wall_s, t_start.cpu_s);
+    results.add("whole_process", "lucent analyze --format csv (wall)", t_lucent.wall_s,
                 "s");
-    results.add("whole_process", "lucent analyze --format csv (cpu)", t_lucent.cpu, "s");
-    results.add("whole_process", "lucent analyze --help (cpu)", t_start.cpu, "s");
+    results.add("whole_process", "lucent analyze --format csv (cpu)", t_lucent.cpu_s,
+                "s");
+    results.add("whole_process", "lucent analyze --help (cpu)", t_start.cpu_s, "s");
     if (!have_r) {
         std::printf(
             "  R comparison skipped: Rscript is not on the PATH (the bench installs "
@@ -199,16 +163,17 @@ int bench_whole_process(long ratings, int groups, int repeat, Results& results) 
     } else if (r_failed) {
         std::printf("  R comparison failed: Rscript exited with an error\n");
     } else {
-        const CommandTime t_r = median_time(r_runs);
+        const ProcessCost t_r = median_cost(r_runs);
         std::printf("  %-40s %10.3f %10.3f\n", "R read.csv+aov+TukeyHSD+kruskal+oneway",
-                    t_r.wall, t_r.cpu);
-        std::printf("  %-40s %9.1fx %9.1fx\n", "R / lucent", t_r.wall / t_lucent.wall,
-                    t_r.cpu / t_lucent.cpu);
-        results.add("whole_process", "R (wall)", t_r.wall, "s");
-        results.add("whole_process", "R (cpu)", t_r.cpu, "s");
-        results.add("whole_process", "R / lucent (wall)", t_r.wall / t_lucent.wall,
+                    t_r.wall_s, t_r.cpu_s);
+        std::printf("  %-40s %9.1fx %9.1fx\n", "R / lucent", t_r.wall_s / t_lucent.wall_s,
+                    t_r.cpu_s / t_lucent.cpu_s);
+        results.add("whole_process", "R (wall)", t_r.wall_s, "s");
+        results.add("whole_process", "R (cpu)", t_r.cpu_s, "s");
+        results.add("whole_process", "R / lucent (wall)", t_r.wall_s / t_lucent.wall_s,
                     "ratio");
-        results.add("whole_process", "R / lucent (cpu)", t_r.cpu / t_lucent.cpu, "ratio");
+        results.add("whole_process", "R / lucent (cpu)", t_r.cpu_s / t_lucent.cpu_s,
+                    "ratio");
     }
     std::error_code ignored;
     fs::remove_all(dir, ignored);
@@ -288,7 +253,8 @@ void bench_distribution(double seconds, Results& results) {
 }
 
 int run_bench_stats(long ratings, int groups, double cdf_seconds, bool whole_process,
-                    int repeat, const std::string& csv_path) {
+                    int repeat, const std::vector<long>& mixed_sizes, int mixed_repeat,
+                    const std::string& csv_path) {
     using namespace lucent::analysis;
     if (repeat < 1) {
         std::fprintf(stderr, "lucent bench stats: --repeat: must be at least 1\n");
@@ -306,6 +272,18 @@ int run_bench_stats(long ratings, int groups, double cdf_seconds, bool whole_pro
         if (status != kExitOk) return status;
     }
     bench_distribution(cdf_seconds, results);
+    if (!mixed_sizes.empty()) {
+        for (long size : mixed_sizes)
+            if (size < 200 || size > 10000000) {
+                std::fprintf(stderr,
+                             "lucent bench stats: --mixed-ratings: %ld is not in "
+                             "[200, 10000000]\n",
+                             size);
+                return kExitUsage;
+            }
+        const int status = bench_mixed_models(mixed_sizes, mixed_repeat, results);
+        if (status != kExitOk) return status;
+    }
     if (!csv_path.empty() && !results.write_csv(csv_path)) {
         std::fprintf(stderr, "lucent bench stats: cannot write %s\n", csv_path.c_str());
         return kExitFailure;
@@ -322,6 +300,9 @@ void register_bench_stats(CLI::App& bench, int& exit_code) {
         double cdf_seconds = 1.0;
         bool no_process = false;
         int repeat = 3;
+        std::vector<long> mixed_ratings{10000, 100000};
+        int mixed_repeat = 1;
+        bool no_mixed = false;
         std::string csv;
     };
     auto args = std::make_shared<Args>();
@@ -341,12 +322,23 @@ void register_bench_stats(CLI::App& bench, int& exit_code) {
         ->capture_default_str();
     cmd->add_flag("--no-process", args->no_process,
                   "Skip the whole-process 'lucent analyze' (and R) timing");
+    cmd->add_option("--mixed-ratings", args->mixed_ratings,
+                    "Study sizes for the mixed models' whole-process comparison with R "
+                    "(lucent analyze --model lmm|clmm), e.g. 10000,100000")
+        ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_option("--mixed-repeat", args->mixed_repeat,
+                    "Runs of each mixed-model process (median reported)")
+        ->capture_default_str();
+    cmd->add_flag("--no-mixed", args->no_mixed, "Skip the mixed models");
     cmd->add_option(
         "--csv", args->csv,
         "Also write every timing as CSV (section,name,value,unit) to this file");
     cmd->callback([args, &exit_code] {
-        exit_code = run_bench_stats(args->ratings, args->groups, args->cdf_seconds,
-                                    !args->no_process, args->repeat, args->csv);
+        exit_code = run_bench_stats(
+            args->ratings, args->groups, args->cdf_seconds, !args->no_process,
+            args->repeat, args->no_mixed ? std::vector<long>{} : args->mixed_ratings,
+            std::max(1, args->mixed_repeat), args->csv);
     });
 }
 

@@ -33,6 +33,10 @@ void register_simulate(CLI::App& app, int& exit_code) {
         ->capture_default_str();
     cmd->add_option("--noise-sd", spec->noise_sd, "SD of per-rating noise")
         ->capture_default_str();
+    cmd->add_option("--stimulus-sd", spec->stimulus_sd,
+                    "SD of each stimulus's own offset (what a mixed model's stimulus "
+                    "term estimates)")
+        ->capture_default_str();
     cmd->add_option("--seed", spec->seed, "Random seed")->capture_default_str();
     cmd->callback([spec, out, &exit_code] {
         try {

@@ -57,6 +57,9 @@ struct LmmSpec {
     std::vector<RandomTerm> random;
     bool reml = true;
     Convergence convergence = Convergence::optimum;
+    // Where the search for theta starts (lme4's start, identity factors, when empty or of
+    // the wrong length): a neighbouring fit's theta saves evaluations.
+    std::vector<double> start_theta;
 };
 
 // lme4's as.data.frame(VarCorr(fit)) rows: a variance (name_b empty) with its standard
@@ -110,7 +113,8 @@ struct LikelihoodRatioTest {
 };
 
 // R's anova(reduced, full) for nested linear mixed models: both refitted by ML (as R
-// refits REML fits before comparing them).
+// refits REML fits before comparing them), the full model from its start_theta (e.g.
+// its REML fit's), the reduced one from the full model's ML theta.
 LikelihoodRatioTest likelihood_ratio(LmmSpec reduced, LmmSpec full);
 
 }  // namespace lucent::analysis::mixed

@@ -160,6 +160,7 @@ RatingModelFit fit_linear(const PairFrame& pair, const RandomStructure& structur
             fit.den_df = test.den_df;
             fit.p = test.p;
         }
+        spec.start_theta = lmm.theta;
         mixed::LmmSpec reduced = spec;
         reduced.fixed = mixed::fixed_design(pair.frame, {}, true);
         const auto lr = mixed::likelihood_ratio(reduced, spec);

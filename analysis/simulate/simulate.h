@@ -20,6 +20,10 @@ struct SimulationSpec {
                                       0.0};  // latent shift per level (sd units)
     double participant_sd = 0.0;  // between-participant spread of the latent mean
     double noise_sd = 1.0;        // per-rating latent noise
+    // Spread of the stimuli's own offsets (one per stimulus and question), the stimulus
+    // variance a mixed model with stimuli as random effects estimates. Drawn from a
+    // stream of its own, so a study without it is the same as before for a seed.
+    double stimulus_sd = 0.0;
     std::uint64_t seed = 1;
 };
 

@@ -103,6 +103,42 @@ TEST(Lmm, PenicillinCrossedInterceptsEqualR) {
     expect_close(fit_lmm(penicillin(false)).log_likelihood, -166.094174334257);
 }
 
+// Penicillin with every 7th row removed: plates no longer see every sample, so the
+// participants-by-stimuli factor (lmm.cpp's TwoInterceptFactor) meets rows of different
+// counts. lmer(diameter ~ 1 + (1|plate) + (1|sample), Penicillin[-seq(1, 144, 7), ],
+// control = kTight)
+TEST(Lmm, UnbalancedCrossedInterceptsEqualR) {
+    LmmSpec full = penicillin(true);
+    std::vector<int> keep;
+    for (int i = 0; i < 144; ++i)
+        if (i % 7 != 0) keep.push_back(i);
+    LmmSpec spec;
+    spec.y.resize(Eigen::Index(keep.size()));
+    spec.fixed.x.resize(Eigen::Index(keep.size()), 1);
+    spec.fixed.names = full.fixed.names;
+    spec.fixed.term_of_column = full.fixed.term_of_column;
+    spec.random = full.random;
+    for (auto& term : spec.random) {
+        term.group.codes.clear();
+        term.z.resize(Eigen::Index(keep.size()), 1);
+    }
+    for (std::size_t r = 0; r < keep.size(); ++r) {
+        spec.y[Eigen::Index(r)] = full.y[keep[r]];
+        spec.fixed.x(Eigen::Index(r), 0) = 1.0;
+        for (std::size_t t = 0; t < spec.random.size(); ++t) {
+            spec.random[t].group.codes.push_back(
+                full.random[t].group.codes[std::size_t(keep[r])]);
+            spec.random[t].z(Eigen::Index(r), 0) = 1.0;
+        }
+    }
+    const LmmFit fit = fit_lmm(spec);
+    expect_close(fit.criterion, 298.753223919908);
+    expect_close(fit.fixed[0].estimate, 22.9664681881068);
+    expect_close(fit.components[0].variance_or_covariance, 0.658561872238840);
+    expect_close(fit.components[1].variance_or_covariance, 3.706950793687259);
+    expect_close(fit.components[2].variance_or_covariance, 0.331146214656449);
+}
+
 // lmer(Reaction ~ Days + (Days|Subject), sleepstudy); summary() and anova() with
 // lmerTest. Stopping where lme4 stops retraces its path here (43 evaluations), so every
 // value issue 29 quotes agrees to 1e-6, and so do lmerTest's.

@@ -2,6 +2,9 @@
 // simulated studies, and Tukey's HSD must declare any pair different in at most 6%.
 #include <gtest/gtest.h>
 
+#include <map>
+#include <set>
+
 #include "analysis/data/grouping.h"
 #include "analysis/simulate/simulate.h"
 #include "analysis/stats/tukey.h"
@@ -23,6 +26,28 @@ TEST(Simulation, SameSeedSameStudy) {
         differing += *a.rows[i].rating != *c.rows[i].rating;
     EXPECT_GT(differing, 10);
     for (const RatingRow& row : a.rows) ASSERT_TRUE(*row.rating >= 1 && *row.rating <= 7);
+}
+
+// A stimulus's own offset is shared by every participant who rates it: with no noise
+// and no participant spread, each stimulus gets one rating from everyone, and the
+// stimuli of a level differ.
+TEST(Simulation, StimulusSpreadIsSharedAcrossParticipants) {
+    SimulationSpec spec;
+    spec.participants = 5;
+    spec.stimuli_per_level = 8;
+    spec.noise_sd = 0.0;
+    spec.stimulus_sd = 1.5;
+    spec.seed = 3;
+    const LongTable table = simulate_study(spec);
+    std::map<std::string, std::set<double>> ratings_of;
+    for (const RatingRow& row : table.rows)
+        ratings_of[row.stimulus.str()].insert(*row.rating);
+    std::set<double> distinct;
+    for (const auto& [stimulus, ratings] : ratings_of) {
+        EXPECT_EQ(ratings.size(), 1u) << stimulus;
+        distinct.insert(*ratings.begin());
+    }
+    EXPECT_GE(distinct.size(), 3u);
 }
 
 struct NullRates {
