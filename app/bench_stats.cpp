@@ -265,6 +265,14 @@ int run_bench_stats(long ratings, int groups, double cdf_seconds, bool whole_pro
                      "lucent bench stats: need 2..200 groups and 2+ ratings each\n");
         return kExitUsage;
     }
+    for (long size : mixed_sizes)
+        if (size < 200 || size > 10000000) {
+            std::fprintf(
+                stderr,
+                "lucent bench stats: --mixed-ratings: %ld is not in [200, 10000000]\n",
+                size);
+            return kExitUsage;
+        }
     Results results;
     bench_in_process(ratings, groups, results);
     if (whole_process) {
@@ -273,14 +281,6 @@ int run_bench_stats(long ratings, int groups, double cdf_seconds, bool whole_pro
     }
     bench_distribution(cdf_seconds, results);
     if (!mixed_sizes.empty()) {
-        for (long size : mixed_sizes)
-            if (size < 200 || size > 10000000) {
-                std::fprintf(stderr,
-                             "lucent bench stats: --mixed-ratings: %ld is not in "
-                             "[200, 10000000]\n",
-                             size);
-                return kExitUsage;
-            }
         const int status = bench_mixed_models(mixed_sizes, mixed_repeat, results);
         if (status != kExitOk) return status;
     }

@@ -72,6 +72,11 @@ add_test(NAME app.analyze_mixed_models_lead_when_asked
                  -DDATA=${LUCENT_APP_TEST_DIR}/data/wine_long.csv
                  -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/mixed_report
                  -P ${LUCENT_APP_TEST_DIR}/analyze_mixed.cmake)
+add_test(NAME app.readme_analyst_commands_run_as_written
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 -DREADME=${CMAKE_SOURCE_DIR}/README.md
+                 -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/readme_analyst
+                 -P ${LUCENT_APP_TEST_DIR}/readme_analyst.cmake)
 add_test(NAME app.analyze_bad_model_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/wine_long.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/bad_model;--model;anova,glmm"
@@ -112,5 +117,12 @@ add_test(NAME app.power_crossed_one_stimulus_exits_2
                  "-DARGS=power;--model;clmm;--means;3,4;--stimuli;1"
                  -DEXPECT_CODE=2 "-DEXPECT_STDERR=--stimuli must lie in \\[2, 1000\\]"
                  -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
-add_test(NAME app.bench_stats_small COMMAND lucent bench stats --ratings 20000 --cdf-seconds 0.02)
-set_tests_properties(app.bench_stats_small PROPERTIES PASS_REGULAR_EXPRESSION "evals/s")
+add_test(NAME app.bench_stats_small COMMAND lucent bench stats --ratings 20000 --cdf-seconds 0.02
+                                           --mixed-ratings 1200)
+set_tests_properties(app.bench_stats_small PROPERTIES PASS_REGULAR_EXPRESSION
+                     "evals/s.*clmm, 1260 ratings.*lucent +[0-9.]+ +[0-9.]+ +[0-9]+")
+add_test(NAME app.bench_stats_bad_mixed_size_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=bench;stats;--ratings;2000;--cdf-seconds;0.01;--no-process;--mixed-ratings;50"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=--mixed-ratings: 50 is not in"
+                 -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
