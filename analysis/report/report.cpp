@@ -504,7 +504,9 @@ void render_html(const std::vector<Block>& doc, const ReportOptions& options,
     out << "</body></html>\n";
 }
 
-void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& files) {
+// The one-way tests' tables only when they ran (--model); descriptives always.
+void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, bool one_way_tests,
+                      ReportFiles& files) {
     std::ostringstream anova, tukey, kruskal, welch, desc;
     anova << "question,factor,ss_between,ss_within,df_between,df_within,ms_between,"
              "ms_within,f,p,eta_sq,omega_sq\n";
@@ -562,11 +564,12 @@ void write_csv_tables(const std::vector<OneWayAnalysis>& analyses, ReportFiles& 
                    << format_full(c.t) << ',' << format_full(c.df) << ','
                    << format_p_full(c.p) << ',' << format_p_full(c.p_holm) << '\n';
     }
+    files.emplace_back("descriptives.csv", desc.str());
+    if (!one_way_tests) return;
     files.emplace_back("anova.csv", anova.str());
     files.emplace_back("tukey.csv", tukey.str());
     files.emplace_back("kruskal.csv", kruskal.str());
     files.emplace_back("welch.csv", welch.str());
-    files.emplace_back("descriptives.csv", desc.str());
     files.emplace_back("rm_anova.csv", rm_anova.str());
     files.emplace_back("friedman.csv", friedman.str());
     files.emplace_back("posthoc_paired.csv", paired.str());
@@ -664,7 +667,7 @@ std::vector<std::filesystem::path> write_report(
         files.emplace_back("report.html", out.str());
     }
     if (options.csv) {
-        write_csv_tables(analyses, files);
+        write_csv_tables(analyses, options.models.anova, files);
         write_mixed_csv_tables(analyses, files);
     }
     // Refuse before writing anything: a report file that is the input or a database.
