@@ -128,11 +128,6 @@ Statistic by_participant_p(const CrossedPowerSpec& spec, const SimulatedStudy& s
     return repeated_measures_anova(matrix).p;
 }
 
-PowerEstimate estimate_of(long hits, int runs) {
-    const double p = double(hits) / runs;
-    return {p, std::sqrt(p * (1.0 - p) / runs)};
-}
-
 }  // namespace
 
 void check_crossed_power_spec(const CrossedPowerSpec& spec) {
@@ -209,8 +204,8 @@ CrossedPowerResult estimate_crossed_power(const CrossedPowerSpec& spec,
         naive_hits += naive && *naive < spec.alpha;
         if (progress) progress(run + 1, spec.simulations);
     }
-    result.model_test = estimate_of(model_hits, spec.simulations);
-    result.by_participant = estimate_of(naive_hits, spec.simulations);
+    result.model_test = power_estimate(model_hits, spec.simulations);
+    result.by_participant = power_estimate(naive_hits, spec.simulations);
     return result;
 }
 

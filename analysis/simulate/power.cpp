@@ -13,11 +13,6 @@
 namespace lucent::analysis {
 namespace {
 
-PowerEstimate estimate_of(long hits, int runs) {
-    const double p = static_cast<double>(hits) / runs;
-    return {p, std::sqrt(p * (1.0 - p) / runs)};
-}
-
 bool rejects(const Statistic& p, double alpha) { return p && *p < alpha; }
 
 double response(const PowerSpec& spec, double latent) {
@@ -26,6 +21,11 @@ double response(const PowerSpec& spec, double latent) {
 }
 
 }  // namespace
+
+PowerEstimate power_estimate(long hits, int runs) {
+    const double p = static_cast<double>(hits) / runs;
+    return {p, std::sqrt(p * (1.0 - p) / runs)};
+}
 
 void check_power_spec(const PowerSpec& spec) {
     if (spec.participants < 2)
@@ -131,14 +131,14 @@ PowerResult estimate_power(const PowerSpec& spec) {
         }
         any_pair_hits += any;
     }
-    result.one_way_anova = estimate_of(one_way_hits, spec.simulations);
+    result.one_way_anova = power_estimate(one_way_hits, spec.simulations);
     if (within) {
-        result.rm_anova = estimate_of(rm_hits, spec.simulations);
-        result.rm_anova_gg = estimate_of(rm_gg_hits, spec.simulations);
+        result.rm_anova = power_estimate(rm_hits, spec.simulations);
+        result.rm_anova_gg = power_estimate(rm_gg_hits, spec.simulations);
     }
-    result.any_pair = estimate_of(any_pair_hits, spec.simulations);
+    result.any_pair = power_estimate(any_pair_hits, spec.simulations);
     for (std::size_t c = 0; c < result.pairs.size(); ++c)
-        result.pairs[c].estimate = estimate_of(pair_hits[c], spec.simulations);
+        result.pairs[c].estimate = power_estimate(pair_hits[c], spec.simulations);
     return result;
 }
 

@@ -38,6 +38,8 @@ struct PowerEstimate {
     double power = 0.0;
     double mc_error = 0.0;  // standard error of the estimate, sqrt(p (1 - p) / runs)
 };
+// The share of `runs` simulated studies that rejected, with its Monte Carlo error.
+PowerEstimate power_estimate(long hits, int runs);
 
 struct PairPower {
     std::string level_a, level_b;
