@@ -20,6 +20,7 @@ struct AnalyzeArgs {
     std::string design;  // "", "between" or "within"
     std::string images;  // folder of rendered stimuli for thumbnails
     std::string models = "anova,clmm", primary_model;
+    bool random_slopes = false;
     double alpha = 0.10;
     double within_share = 1.0;
 };
@@ -64,6 +65,7 @@ int run_analyze(const AnalyzeArgs& args) {
                                 }};
         request.within_share = args.within_share;
         request.models = parse_model_list(args.models, primary_model);
+        request.models.random_slopes = args.random_slopes;
         if (!args.primary_model.empty() && !request.models.runs(primary_model))
             throw InputError("--primary-model " + args.primary_model +
                              " is not among --model " + args.models);
@@ -131,6 +133,9 @@ void register_analyze(CLI::App& app, int& exit_code) {
     cmd->add_option("--primary-model", args->primary_model,
                     "The analysis that leads the report: anova, clmm or lmm (default: "
                     "the protocol's [analysis] primary_model; for a CSV, anova)");
+    cmd->add_flag("--random-slopes", args->random_slopes,
+                  "lmm: random slopes for the level within participant, where the design "
+                  "identifies them (the report says when it does not)");
     cmd->add_option("--scale", args->scale,
                     "Accepted ratings: MIN..MAX, or 'any' for any finite number")
         ->capture_default_str();

@@ -116,7 +116,29 @@ Statistic finite(double value) {
     return std::isfinite(value) ? Statistic(value) : std::nullopt;
 }
 
-RatingModelFit fit_linear(const PairFrame& pair, const RandomStructure& structure) {
+// Whether (1 + level | participant) is identified, and if not, why not.
+std::string why_slopes_not_identified(const PairFrame& pair) {
+    std::map<std::string, std::map<std::string, int>> ratings_of;
+    const auto& participant = pair.frame.text("participant");
+    const auto& level = pair.frame.text("level");
+    for (std::size_t i = 0; i < participant.size(); ++i)
+        ++ratings_of[participant[i]][level[i]];
+    for (const auto& [who, per_level] : ratings_of) {
+        if (per_level.size() < pair.levels.size())
+            return "participant " + who + " did not rate every level";
+        for (const auto& [l, count] : per_level)
+            if (count < 2) return "participant " + who + " rated level " + l + " once";
+    }
+    const std::size_t k = pair.levels.size(), parameters = k * (k + 1) / 2;
+    if (ratings_of.size() <= parameters)
+        return std::to_string(ratings_of.size()) + " participants for a " +
+               std::to_string(k) + " x " + std::to_string(k) + " covariance (" +
+               std::to_string(parameters) + " parameters)";
+    return "";
+}
+
+RatingModelFit fit_linear(const PairFrame& pair, const RandomStructure& structure,
+                          bool random_slopes) {
     RatingModelFit fit = empty_fit(RatingModel::lmm, pair, structure);
     if (!structure.participant && !structure.stimulus) {
         fit.notes.push_back(
@@ -128,8 +150,27 @@ RatingModelFit fit_linear(const PairFrame& pair, const RandomStructure& structur
     spec.y = Eigen::Map<const Eigen::VectorXd>(pair.ratings.data(),
                                                Eigen::Index(pair.ratings.size()));
     spec.fixed = mixed::fixed_design(pair.frame, {{"level", true, pair.levels}}, true);
-    if (structure.participant)
-        spec.random.push_back(mixed::random_intercept(pair.frame.factor("participant")));
+    bool slopes = false;
+    if (structure.participant && random_slopes) {
+        const std::string why_not = why_slopes_not_identified(pair);
+        slopes = why_not.empty();
+        if (slopes)
+            fit.formula = "rating ~ level + (1 + level | participant)" +
+                          std::string(structure.stimulus ? " + (1 | stimulus)" : "");
+        else
+            fit.notes.push_back(
+                "Random slopes for level within participant are not "
+                "identified (" +
+                why_not + "), so the participants get intercepts only.");
+    }
+    if (structure.participant) {
+        std::vector<std::string> level_columns(spec.fixed.names.begin() + 1,
+                                               spec.fixed.names.end());
+        const FactorColumn participant = pair.frame.factor("participant");
+        spec.random.push_back(
+            slopes ? mixed::random_slopes(participant, spec.fixed, level_columns)
+                   : mixed::random_intercept(participant));
+    }
     if (structure.stimulus)
         spec.random.push_back(mixed::random_intercept(pair.frame.factor("stimulus")));
     try {
@@ -152,7 +193,12 @@ RatingModelFit fit_linear(const PairFrame& pair, const RandomStructure& structur
         }
         for (const auto& component : lmm.components)
             if (component.name_b.empty())
-                fit.random_sds.emplace_back(component.group, component.sd_or_correlation);
+                fit.random_sds.emplace_back(
+                    component.group +
+                        (component.name_a.empty() || component.name_a == "(Intercept)"
+                             ? ""
+                             : " " + component.name_a),
+                    component.sd_or_correlation);
         if (!lmm.anova.empty()) {
             const auto& test = lmm.anova.front();
             fit.statistic = test.f;
@@ -351,7 +397,7 @@ PairModels fit_pair_models(const LongTable& table, const std::string& question,
         if (choice.clmm) models.clmm = empty_fit(RatingModel::clmm, pair, structure);
         return models;
     }
-    if (choice.lmm) models.lmm = fit_linear(pair, structure);
+    if (choice.lmm) models.lmm = fit_linear(pair, structure, choice.random_slopes);
     if (choice.clmm) models.clmm = fit_ordinal(pair, structure);
     return models;
 }

@@ -26,6 +26,10 @@ const char* rating_model_name(RatingModel model);
 // Which analyses a report runs (`--model anova,clmm`) and which one leads it.
 struct ModelChoice {
     bool anova = true, lmm = false, clmm = true;
+    // lmm: random slopes for the level within participant, (1 + level | participant),
+    // where the design identifies them (every participant rated every level at least
+    // twice, and more participants than the slopes' covariance has parameters).
+    bool random_slopes = false;
     RatingModel primary = RatingModel::anova;
     std::string primary_source;  // who chose `primary`, for the report
     bool runs(RatingModel model) const;

@@ -116,6 +116,37 @@ TEST(RatingModels, WineAsARatingStudyEqualsR) {
     expect_all_finite(lmm);
 }
 
+// Every judge rated four wines at each temperature: random slopes are identified.
+// lmer(rating ~ temp + (temp|judge) + (1|bottle), wine, control = tight); anova(m);
+// anova(update(m, ~ . - temp), m)
+TEST(RatingModels, RandomSlopesWhereIdentifiedEqualR) {
+    ModelChoice choice = both();
+    choice.random_slopes = true;
+    const PairModels models =
+        fit_pair_models(wine_table(), "bitterness", "temp", {"cold", "warm"}, choice);
+    ASSERT_TRUE(models.lmm && models.lmm->fitted);
+    const RatingModelFit& lmm = *models.lmm;
+    EXPECT_EQ(lmm.formula, "rating ~ level + (1 + level | participant) + (1 | stimulus)");
+    expect_close(lmm.log_likelihood, -179.974252736021 / 2);
+    expect_close(lmm.statistic, 14.4294475145931);
+    expect_close(lmm.den_df, 6.28625777728131);
+    expect_close(lmm.lr_chi_square, 9.57277480750213);
+    ASSERT_EQ(lmm.random_sds.size(), 4u);
+    EXPECT_EQ(lmm.random_sds[1].first, "participant levelwarm");
+    EXPECT_NEAR(lmm.random_sds[1].second, std::sqrt(0.0804398157834378), 1e-6);
+    // One judge: not identified, said, and intercepts only.
+    const LongTable one =
+        wine_table([](std::string& judge, std::string&, std::string&, double&) {
+            return judge == "J1" || judge == "J2";
+        });
+    const PairModels few =
+        fit_pair_models(one, "bitterness", "temp", {"cold", "warm"}, choice);
+    ASSERT_TRUE(few.lmm);
+    EXPECT_TRUE(
+        has_note(*few.lmm, "not identified (2 participants for a 2 x 2 covariance"));
+    EXPECT_EQ(few.lmm->formula, "rating ~ level + (1 | participant) + (1 | stimulus)");
+}
+
 // One bottle per temperature: stimulus and level confounded; clmm(rating ~ temp +
 // (1|judge), wine) is what remains.
 TEST(RatingModels, OneStimulusPerLevelDropsTheStimulusTermAndSaysSo) {
