@@ -9,6 +9,7 @@
 #include <limits>
 #include <nlopt.hpp>
 #include <numeric>
+#include <thread>
 
 #include "analysis/data/long_table.h"  // InputError
 
@@ -55,7 +56,7 @@ BoundTerms bound_terms(Link link, double z) {
         return b;
     }
     const double e = std::exp(-std::abs(z));  // no overflow on either side
-    const double near = 1.0 / (1.0 + e), far = e / (1.0 + e);
+    const double near = 1.0 / (1.0 + e), far = e * near;
     b.cdf = z >= 0 ? near : far;
     b.upper_tail = z >= 0 ? far : near;
     b.pdf = b.cdf * b.upper_tail;
@@ -69,14 +70,24 @@ bool observation_terms(Link link, double lower, double upper, ObservationTerms& 
     // Through the upper tails when both bounds are far right (no cancellation).
     const double p = lower > 0 ? lo.upper_tail - hi.upper_tail : hi.cdf - lo.cdf;
     if (!(p > 0)) return false;
-    const double a = hi.pdf / p, b = lo.pdf / p;
+    const double inverse = 1.0 / p;
+    const double a = hi.pdf * inverse, b = lo.pdf * inverse;
     t.log_p = std::log(p);
     t.d_upper = a;
     t.d_lower = -b;
-    t.d2_upper = hi.pdf_slope / p - a * a;
-    t.d2_lower = -lo.pdf_slope / p - b * b;
+    t.d2_upper = hi.pdf_slope * inverse - a * a;
+    t.d2_lower = -lo.pdf_slope * inverse - b * b;
     t.d2_both = a * b;
     return true;
+}
+
+// Neumaier's compensated sum: the log-likelihood of thousands of observations to
+// rounding level (plain summation leaves ~1e-11 of noise, which finite differences of
+// the objective amplify by 1 / step^2).
+inline void add_compensated(double& sum, double& compensation, double x) {
+    const double t = sum + x;
+    compensation += std::abs(sum) >= std::abs(x) ? (sum - t) + x : (x - t) + sum;
+    sum = t;
 }
 
 double max_abs(const VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
@@ -95,6 +106,7 @@ struct Grouping {
 struct Problem {
     Link link = Link::Logit;
     ClmmModes modes = ClmmModes::AsR;
+    bool precise_standard_errors = true;
     bool lagged_log_det = false;          // as clmm with a single random term (see as_r)
     std::vector<std::string> categories;  // used response levels
     std::vector<int> y;                   // 0 .. categories - 1
@@ -440,6 +452,9 @@ public:
             q_b_ = levels_of(active_[1]);
             index_cells();
         }
+        // A factor of nothing, so that copying the objective (one per thread) never
+        // copies Eigen's uninitialised status of a factor not computed yet (UBSan).
+        schur_factor_.compute(MatrixXd());
     }
 
     int modes() const { return q_a_ + q_b_; }
@@ -532,35 +547,134 @@ private:
         cell_weight_.resize(Eigen::Index(cell_b_.size()));
     }
 
+    // Observations first .. first + count - 1 (a block that stays in cache): each one's
+    // log-probability, first derivative d and weight w = -second derivative in eta at the
+    // modes `u`, into log_p_, d_, w_ [0, count). False when a probability underflows.
+    bool observation_derivatives(const VectorXd& par, const VectorXd& u, int first,
+                                 int count) {
+        const int k_thr = problem_.thresholds();
+        if (problem_.link != Link::Logit) {
+            ObservationTerms t;
+            for (int j = 0; j < count; ++j) {
+                const int i = first + j, k = problem_.y[std::size_t(i)];
+                const double eta = linear_predictor(i, u);
+                const double upper = k < k_thr ? par[k] - eta : kInfinity;
+                const double lower = k > 0 ? par[k - 1] - eta : -kInfinity;
+                if (!observation_terms(problem_.link, lower, upper, t)) return false;
+                log_p_[j] = t.log_p;
+                d_[j] = t.d_eta();
+                w_[j] = -t.d2_eta();
+            }
+            return true;
+        }
+        // Logit, vectorised over the block: observation_terms' arithmetic, with a missing
+        // bound (lowest or highest category) at 0 and masked out.
+        for (int j = 0; j < count; ++j) {
+            const int i = first + j, k = problem_.y[std::size_t(i)];
+            const double eta = linear_predictor(i, u);
+            upper_[j] = k < k_thr ? par[k] - eta : 0.0;
+            lower_[j] = k > 0 ? par[k - 1] - eta : 0.0;
+        }
+        const auto has_upper = has_upper_.segment(first, count);
+        const auto has_lower = has_lower_.segment(first, count);
+        const auto upper = upper_.head(count), lower = lower_.head(count);
+        auto e = e_.head(count), r = r_.head(count);
+        auto cdf_hi = cdf_hi_.head(count), tail_hi = tail_hi_.head(count),
+             pdf_hi = pdf_hi_.head(count), slope_hi = slope_hi_.head(count);
+        auto cdf_lo = cdf_lo_.head(count), tail_lo = tail_lo_.head(count),
+             pdf_lo = pdf_lo_.head(count), slope_lo = slope_lo_.head(count);
+        // Upper bound: F, 1 - F, f, f'.
+        e = (-upper.abs()).exp();
+        r = (1.0 + e).inverse();
+        split_tails(upper_, count, cdf_hi_, tail_hi_);
+        pdf_hi = has_upper * cdf_hi * tail_hi;
+        slope_hi = pdf_hi * (tail_hi - cdf_hi);
+        cdf_hi = has_upper * cdf_hi + (1.0 - has_upper);
+        tail_hi = has_upper * tail_hi;
+        // Lower bound.
+        e = (-lower.abs()).exp();
+        r = (1.0 + e).inverse();
+        split_tails(lower_, count, cdf_lo_, tail_lo_);
+        pdf_lo = has_lower * cdf_lo * tail_lo;
+        slope_lo = pdf_lo * (tail_lo - cdf_lo);
+        cdf_lo = has_lower * cdf_lo;
+        tail_lo = has_lower * tail_lo + (1.0 - has_lower);
+        // p, through the upper tails when both bounds are far right (no cancellation).
+        for (int j = 0; j < count; ++j)  // plain loops: the compiler vectorises them
+            e_[j] = lower_[j] > 0 && has_lower_[first + j] > 0 ? tail_lo_[j] - tail_hi_[j]
+                                                               : cdf_hi_[j] - cdf_lo_[j];
+        if (!(e > 0).all()) return false;
+        log_p_.head(count) = e.log();
+        r = e.inverse();
+        cdf_hi = pdf_hi * r;  // a = d log p / d upper
+        cdf_lo = pdf_lo * r;  // b = -d log p / d lower
+        d_.head(count) = cdf_lo - cdf_hi;
+        w_.head(count) = -(slope_hi * r - cdf_hi.square() + 2.0 * cdf_hi * cdf_lo -
+                           slope_lo * r - cdf_lo.square());
+        return true;
+    }
+
+    double linear_predictor(int i, const VectorXd& u) const {
+        const int a = (*codes_a_)[std::size_t(i)];
+        return offset_[i] + tau_a_ * u[a] +
+               (q_b_ ? tau_b_ * u[q_a_ + (*codes_b_)[std::size_t(i)]] : 0.0);
+    }
+
+    static constexpr int kBlock = 256;
+
+    // F and 1 - F from e = exp(-|z|) and r = 1 / (1 + e) (in e_, r_).
+    void split_tails(const Eigen::ArrayXd& z, int count, Eigen::ArrayXd& cdf,
+                     Eigen::ArrayXd& tail) const {
+        for (int j = 0; j < count; ++j) {
+            const double near = r_[j], far = e_[j] * r_[j];
+            cdf[j] = z[j] >= 0 ? near : far;
+            tail[j] = z[j] >= 0 ? far : near;
+        }
+    }
+
+    void prepare_blocks() {
+        const int n = problem_.n(), k_thr = problem_.thresholds();
+        has_upper_.resize(n);
+        has_lower_.resize(n);
+        for (int i = 0; i < n; ++i) {
+            const int k = problem_.y[std::size_t(i)];
+            has_upper_[i] = k < k_thr ? 1.0 : 0.0;
+            has_lower_[i] = k > 0 ? 1.0 : 0.0;
+        }
+        for (Eigen::ArrayXd* block :
+             {&log_p_, &d_, &w_, &upper_, &lower_, &e_, &r_, &cdf_hi_, &tail_hi_,
+              &pdf_hi_, &slope_hi_, &cdf_lo_, &tail_lo_, &pdf_lo_, &slope_lo_})
+            block->resize(kBlock);
+    }
+
     // The penalised deviance -log p(y|u) + u'u/2, its gradient in u and the Hessian's
     // pieces (diagonal blocks, cell weights) at `u`. False when a probability underflows.
     bool accumulate(const VectorXd& par, const VectorXd& u) {
-        const int k_thr = problem_.thresholds(), n = problem_.n();
+        const int n = problem_.n();
         gradient_ = u;
-        diag_ = VectorXd::Ones(modes());
+        diag_.setOnes(modes());
         if (q_b_) cell_weight_.setZero();
-        double sum = 0;
-        ObservationTerms t;
-        for (int i = 0; i < n; ++i) {
-            const int a = (*codes_a_)[std::size_t(i)];
-            const int b = q_b_ ? (*codes_b_)[std::size_t(i)] : 0;
-            const double eta =
-                offset_[i] + tau_a_ * u[a] + (q_b_ ? tau_b_ * u[q_a_ + b] : 0.0);
-            const int k = problem_.y[std::size_t(i)];
-            const double upper = k < k_thr ? par[k] - eta : kInfinity;
-            const double lower = k > 0 ? par[k - 1] - eta : -kInfinity;
-            if (!observation_terms(problem_.link, lower, upper, t)) return false;
-            sum += t.log_p;
-            const double d = t.d_eta(), w = -t.d2_eta();
-            gradient_[a] -= tau_a_ * d;
-            diag_[a] += tau_a_ * tau_a_ * w;
-            if (q_b_) {
-                gradient_[q_a_ + b] -= tau_b_ * d;
-                diag_[q_a_ + b] += tau_b_ * tau_b_ * w;
-                cell_weight_[cell_of_[std::size_t(i)]] += tau_a_ * tau_b_ * w;
+        if (has_upper_.size() != n) prepare_blocks();
+        double sum = 0, compensation = 0;
+        for (int first = 0; first < n; first += kBlock) {
+            const int count = std::min(kBlock, n - first);
+            if (!observation_derivatives(par, u, first, count)) return false;
+            for (int j = 0; j < count; ++j) {
+                const int i = first + j;
+                const int a = (*codes_a_)[std::size_t(i)];
+                const int b = q_b_ ? (*codes_b_)[std::size_t(i)] : 0;
+                add_compensated(sum, compensation, log_p_[j]);
+                const double d = d_[j], w = w_[j];
+                gradient_[a] -= tau_a_ * d;
+                diag_[a] += tau_a_ * tau_a_ * w;
+                if (q_b_) {
+                    gradient_[q_a_ + b] -= tau_b_ * d;
+                    diag_[q_a_ + b] += tau_b_ * tau_b_ * w;
+                    cell_weight_[cell_of_[std::size_t(i)]] += tau_a_ * tau_b_ * w;
+                }
             }
         }
-        penalised_ = -sum + 0.5 * u.squaredNorm();
+        penalised_ = -(sum + compensation) + 0.5 * u.squaredNorm();
         if (q_b_) factor_schur();
         return std::isfinite(penalised_);
     }
@@ -631,6 +745,8 @@ private:
     int q_a_ = 0, q_b_ = 0;
     std::vector<int> cell_of_, cell_b_, cell_start_;
     VectorXd cell_weight_, offset_, gradient_, diag_;
+    Eigen::ArrayXd log_p_, d_, w_, has_upper_, has_lower_, upper_, lower_, e_, r_,
+        cdf_hi_, tail_hi_, pdf_hi_, slope_hi_, cdf_lo_, tail_lo_, pdf_lo_, slope_lo_;
     MatrixXd schur_, scaled_cells_;
     Eigen::LLT<MatrixXd> schur_factor_;
     double tau_a_ = 0, tau_b_ = 0, penalised_ = 0;
@@ -639,38 +755,64 @@ private:
 // Central differences at steps h and h/2, Richardson-extrapolated (error O(h^4)), over
 // the parameters marked free. f must be smooth: the inner solve is at rounding level.
 // With `extrapolate` false: one level (step h/2), error O(h^2), half the evaluations.
+// Mixed second derivatives use the diagonal points x +- h_i e_i, x +- h_j e_j and the two
+// points x +- (h_i e_i + h_j e_j) (even in h, so the extrapolation holds): 2 evaluations
+// per pair instead of 4. `f_all` evaluates a list of points (in parallel).
 template <class F>
-void finite_difference_derivatives(F& f, const VectorXd& x, const std::vector<int>& free,
-                                   VectorXd& gradient, MatrixXd& hessian,
-                                   bool with_hessian, bool extrapolate = true) {
+void finite_difference_derivatives(F& f_all, const VectorXd& x,
+                                   const std::vector<int>& free, VectorXd& gradient,
+                                   MatrixXd& hessian, bool with_hessian,
+                                   bool extrapolate = true) {
     const int m = int(free.size());
-    const double f0 = with_hessian ? f(x) : 0.0;
+    const int first_level = extrapolate ? 0 : 1;
+    MatrixXd step(2, m);
+    std::vector<VectorXd> points;
+    if (with_hessian) points.push_back(x);
+    auto add = [&](int level, int i, double si, int j, double sj) {
+        VectorXd y = x;
+        y[free[i]] += si * step(level, i);
+        if (j >= 0) y[free[j]] += sj * step(level, j);
+        points.push_back(std::move(y));
+    };
+    for (int level = first_level; level < 2; ++level) {
+        for (int j = 0; j < m; ++j)
+            step(level, j) = (level ? 1e-3 : 2e-3) * std::max(1.0, std::abs(x[free[j]]));
+        for (int j = 0; j < m; ++j) {
+            add(level, j, 1, -1, 0);
+            add(level, j, -1, -1, 0);
+        }
+        if (with_hessian)
+            for (int j = 0; j < m; ++j)
+                for (int i = 0; i < j; ++i) {
+                    add(level, i, 1, j, 1);
+                    add(level, i, -1, j, -1);
+                }
+    }
+    const std::vector<double> values = f_all(points);
+    std::size_t next = 0;
+    const double f0 = with_hessian ? values[next++] : 0.0;
     VectorXd g[2];
     MatrixXd h[2];
-    for (int level = extrapolate ? 0 : 1; level < 2; ++level) {
+    for (int level = first_level; level < 2; ++level) {
         g[level] = VectorXd::Zero(m);
         h[level] = MatrixXd::Zero(m, m);
-        VectorXd step(m);
-        for (int j = 0; j < m; ++j)
-            step[j] = (level ? 1e-3 : 2e-3) * std::max(1.0, std::abs(x[free[j]]));
-        auto at = [&](int i, double si, int j, double sj) {
-            VectorXd y = x;
-            y[free[i]] += si * step[i];
-            if (j >= 0) y[free[j]] += sj * step[j];
-            return f(y);
-        };
+        VectorXd plus(m), minus(m);
         for (int j = 0; j < m; ++j) {
-            const double plus = at(j, 1, -1, 0), minus = at(j, -1, -1, 0);
-            g[level][j] = (plus - minus) / (2 * step[j]);
-            h[level](j, j) = (plus - 2 * f0 + minus) / (step[j] * step[j]);
-            if (!with_hessian) continue;
+            plus[j] = values[next++];
+            minus[j] = values[next++];
+            const double hj = step(level, j);
+            g[level][j] = (plus[j] - minus[j]) / (2 * hj);
+            h[level](j, j) = (plus[j] - 2 * f0 + minus[j]) / (hj * hj);
+        }
+        if (!with_hessian) continue;
+        for (int j = 0; j < m; ++j)
             for (int i = 0; i < j; ++i) {
-                const double v = (at(i, 1, j, 1) - at(i, 1, j, -1) - at(i, -1, j, 1) +
-                                  at(i, -1, j, -1)) /
-                                 (4 * step[i] * step[j]);
+                const double both_plus = values[next++], both_minus = values[next++];
+                const double v = (both_plus + both_minus - plus[i] - minus[i] - plus[j] -
+                                  minus[j] + 2 * f0) /
+                                 (2 * step(level, i) * step(level, j));
                 h[level](i, j) = h[level](j, i) = v;
             }
-        }
     }
     gradient = extrapolate ? VectorXd((4 * g[1] - g[0]) / 3) : g[1];
     if (with_hessian) hessian = extrapolate ? MatrixXd((4 * h[1] - h[0]) / 3) : h[1];
@@ -738,7 +880,7 @@ void bobyqa_search(LaplaceObjective& objective, const Problem& problem, VectorXd
     optimiser.set_lower_bounds(lower);
     optimiser.set_upper_bounds(upper);
     optimiser.set_initial_step(0.25);
-    optimiser.set_xtol_rel(1e-6);
+    optimiser.set_xtol_rel(1e-3);  // the Newton polish takes it from there
     optimiser.set_ftol_abs(1e-12);
     optimiser.set_maxeval(20000);
     double value = 0;
@@ -757,27 +899,58 @@ void bobyqa_search(LaplaceObjective& objective, const Problem& problem, VectorXd
 // Hessian (one-level differences) is computed once, the gradient (extrapolated) at each
 // step; the final, extrapolated Hessian gives the standard errors.
 bool newton_polish(LaplaceObjective& objective, VectorXd& par, VectorXd& modes,
-                   const std::vector<int>& free, MatrixXd& hessian) {
+                   const std::vector<int>& free, MatrixXd& hessian,
+                   bool precise_hessian) {
     const VectorXd start_modes = modes;
     auto f = [&](const VectorXd& p) {
         VectorXd u = start_modes;
         return objective(p, u);
     };
+    // The difference points are independent: two threads (the machines this runs on have
+    // few cores; the values do not depend on which thread computes them).
+    auto f_all = [&](const std::vector<VectorXd>& points) {
+        std::vector<double> values(points.size());
+        const bool parallel =
+            std::thread::hardware_concurrency() > 1 && points.size() > 8;
+        LaplaceObjective helper = objective;
+        helper.evaluations = 0;
+        auto run = [&](LaplaceObjective& o, std::size_t first) {
+            for (std::size_t k = first; k < points.size(); k += parallel ? 2 : 1) {
+                VectorXd u = start_modes;
+                values[k] = o(points[k], u);
+            }
+        };
+        if (!parallel) {
+            run(objective, 0);
+            return values;
+        }
+        std::thread other([&] { run(helper, 1); });
+        run(objective, 0);
+        other.join();
+        objective.evaluations += helper.evaluations;
+        return values;
+    };
     VectorXd gradient;
     MatrixXd newton_matrix;
-    finite_difference_derivatives(f, par, free, gradient, newton_matrix, true, false);
+    finite_difference_derivatives(f_all, par, free, gradient, newton_matrix, true, false);
     Eigen::LLT<MatrixXd> chol(newton_matrix);
     bool converged = false;
+    double f_par = f(par);
     for (int iteration = 0; iteration < 30 && chol.info() == Eigen::Success;
          ++iteration) {
-        finite_difference_derivatives(f, par, free, gradient, hessian, false);
+        finite_difference_derivatives(f_all, par, free, gradient, hessian, false);
         const VectorXd step = chol.solve(gradient);
         VectorXd next = par;
         for (std::size_t k = 0; k < free.size(); ++k)
             next[free[k]] -= step[Eigen::Index(k)];
-        if (!(f(next) <= f(par) + 1e-9 * (1 + std::abs(f(par))))) break;
+        const double f_next = f(next);
+        if (!(f_next <= f_par + 1e-9 * (1 + std::abs(f_par)))) break;
         par = next;
-        if (max_abs(step) < 1e-9) {
+        f_par = f_next;
+        // The Newton matrix is exact to about 1e-5 (relative), so after a step below 1e-5
+        // the point is within ~1e-10 of the maximum: one more gradient would only
+        // confirm.
+        if (max_abs(step) < 1e-5) {
             converged = true;
             break;
         }
@@ -785,16 +958,26 @@ bool newton_polish(LaplaceObjective& objective, VectorXd& par, VectorXd& modes,
     VectorXd u = start_modes;
     objective(par, u);
     modes = u;
-    finite_difference_derivatives(f, par, free, gradient, hessian, true);
+    if (precise_hessian)
+        finite_difference_derivatives(f_all, par, free, gradient, hessian, true);
+    else
+        hessian = newton_matrix;
     return converged && Eigen::LLT<MatrixXd>(hessian).info() == Eigen::Success;
 }
 
+// `start_sd`: a starting sd per grouping (problem order; 1 where none is given).
 LaplaceResult fit_laplace(const Problem& problem, const std::vector<int>& active,
-                          const VectorXd& clm_par, const std::vector<bool>& fixed) {
+                          const VectorXd& clm_par, const std::vector<bool>& fixed,
+                          const std::vector<double>& start_sd) {
     LaplaceObjective objective(problem, active, problem.modes, problem.lagged_log_det);
     LaplaceResult r;
     r.par.resize(problem.fixed_parameters() + Eigen::Index(active.size()));
     r.par << clm_par, VectorXd::Constant(Eigen::Index(active.size()), 1.0);
+    for (std::size_t k = 0; k < active.size(); ++k)
+        if (std::size_t(active[k]) < start_sd.size() &&
+            start_sd[std::size_t(active[k])] > 0)
+            r.par[problem.fixed_parameters() + Eigen::Index(k)] =
+                std::min(start_sd[std::size_t(active[k])], kTauMax / 2);
     // The objective orders its groupings (larger first): tau follows that order.
     for (int j = 0; j < int(r.par.size()); ++j)
         if (j >= problem.fixed_parameters() || !fixed[std::size_t(j)])
@@ -809,7 +992,8 @@ LaplaceResult fit_laplace(const Problem& problem, const std::vector<int>& active
     for (int j = problem.fixed_parameters(); j < r.par.size(); ++j)
         interior = interior && r.par[j] > 1e-4;
     if (interior)
-        r.converged = newton_polish(objective, r.par, r.modes, r.free, r.hessian);
+        r.converged = newton_polish(objective, r.par, r.modes, r.free, r.hessian,
+                                    problem.precise_standard_errors);
     VectorXd u = r.modes;
     r.log_likelihood = -objective(r.par, u);
     r.evaluations = objective.evaluations;
@@ -835,6 +1019,7 @@ Prepared prepare(const ClmmSpec& spec) {
     Problem& problem = prep.problem;
     problem.link = spec.link;
     problem.modes = spec.modes;
+    problem.precise_standard_errors = spec.precise_standard_errors;
     problem.lagged_log_det = spec.random_intercepts.size() == 1;
     drop_unused_categories(spec, problem, prep.notes);
     const MatrixXd basis =
@@ -907,10 +1092,11 @@ void fill_estimates(const Problem& problem, const VectorXd& par, const VectorXd&
 // The random-effects fit over `active` groupings; a variance estimated at zero is
 // removed and the rest refitted (the likelihood at tau = 0 is that without the grouping).
 void fit_random(const Problem& problem, std::vector<int> active, const ClmResult& clm,
-                const std::vector<bool>& infinite, ClmmFit& fit) {
+                const std::vector<bool>& infinite, const std::vector<double>& start_sd,
+                ClmmFit& fit) {
     while (!active.empty()) {
         active = elimination_order(problem, active);
-        LaplaceResult r = fit_laplace(problem, active, clm.par, infinite);
+        LaplaceResult r = fit_laplace(problem, active, clm.par, infinite, start_sd);
         fit.iterations += r.evaluations;
         auto tau_of = [&](std::size_t k) {
             return r.par[problem.fixed_parameters() + Eigen::Index(k)];
@@ -981,7 +1167,12 @@ void fit_random(const Problem& problem, std::vector<int> active, const ClmResult
 
 }  // namespace
 
-ClmmFit fit_clmm(const ClmmSpec& spec) {
+namespace {
+
+// `start`: a fit of a model with the same groupings whose sds start the search (the full
+// model's, for the reduced one of a likelihood-ratio test); null: sds start at 1. Only
+// the optimiser's path depends on it: it ends at the same maximum.
+ClmmFit fit_clmm_from(const ClmmSpec& spec, const ClmmFit* start) {
     Prepared prep = prepare(spec);
     const Problem& problem = prep.problem;
     ClmmFit fit;
@@ -1005,7 +1196,13 @@ ClmmFit fit_clmm(const ClmmSpec& spec) {
     std::iota(active.begin(), active.end(), 0);
     fit.log_likelihood = 0;
     fit.converged = false;
-    if (!active.empty()) fit_random(problem, active, clm, infinite, fit);
+    std::vector<double> start_sd;  // per identifiable grouping (problem order)
+    if (start && start->groupings.size() == spec.random_intercepts.size())
+        for (int source : problem.grouping_source) {
+            const ClmmGrouping& g = start->groupings[std::size_t(source)];
+            start_sd.push_back(g.identifiable && !g.at_boundary ? g.sd : 0.0);
+        }
+    if (!active.empty()) fit_random(problem, active, clm, infinite, start_sd, fit);
     if (!fit.thresholds.empty()) return fit;
 
     // clm: no groupings, or every variance at zero.
@@ -1025,6 +1222,10 @@ ClmmFit fit_clmm(const ClmmSpec& spec) {
     fill_estimates(problem, clm.par, se, infinite, fit);
     return fit;
 }
+
+}  // namespace
+
+ClmmFit fit_clmm(const ClmmSpec& spec) { return fit_clmm_from(spec, nullptr); }
 
 double clmm_log_likelihood_at(const ClmmSpec& spec, const std::vector<double>& thresholds,
                               const std::vector<double>& coefficients,
@@ -1063,16 +1264,11 @@ double clmm_log_likelihood_at(const ClmmSpec& spec, const std::vector<double>& t
     return -value;
 }
 
-ClmmLikelihoodRatioTest clmm_likelihood_ratio_test(const ClmmSpec& spec,
-                                                   const ClmmFit& full,
-                                                   const std::string& term) {
-    ClmmLikelihoodRatioTest test;
-    test.term = term;
-    test.log_likelihood_full = full.log_likelihood;
-    test.parameters_full = full.parameters;
+ClmmSpec clmm_without_term(const ClmmSpec& spec, const std::string& term) {
     const std::vector<int> columns = columns_of_term(spec.fixed, term);
     if (columns.empty()) throw InputError("clmm: no fixed term '" + term + "'");
     ClmmSpec reduced = spec;
+    reduced.precise_standard_errors = false;  // the test needs only its log-likelihood
     std::vector<int> keep;
     for (int c = 0; c < int(spec.fixed.x.cols()); ++c)
         if (std::find(columns.begin(), columns.end(), c) == columns.end())
@@ -1086,7 +1282,23 @@ ClmmLikelihoodRatioTest clmm_likelihood_ratio_test(const ClmmSpec& spec,
         reduced.fixed.term_of_column.push_back(
             spec.fixed.term_of_column[std::size_t(keep[k])]);
     }
-    const ClmmFit without = fit_clmm(reduced);
+    return reduced;
+}
+
+ClmmLikelihoodRatioTest clmm_likelihood_ratio_test(const ClmmSpec& spec,
+                                                   const ClmmFit& full,
+                                                   const std::string& term) {
+    const ClmmFit without = fit_clmm_from(clmm_without_term(spec, term), &full);
+    return clmm_likelihood_ratio_test(full, without, term);
+}
+
+ClmmLikelihoodRatioTest clmm_likelihood_ratio_test(const ClmmFit& full,
+                                                   const ClmmFit& without,
+                                                   const std::string& term) {
+    ClmmLikelihoodRatioTest test;
+    test.term = term;
+    test.log_likelihood_full = full.log_likelihood;
+    test.parameters_full = full.parameters;
     test.log_likelihood_reduced = without.log_likelihood;
     test.parameters_reduced = without.parameters;
     test.df = full.parameters - without.parameters;

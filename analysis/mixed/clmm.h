@@ -18,7 +18,9 @@
 // BOBYQA and then polished by Newton steps on Richardson-extrapolated central
 // differences, whose Hessian also gives the standard errors (clmm: nlminb, then a
 // finite-difference Hessian). Cost per evaluation is O(observations + cells of the
-// participant x stimulus incidence).
+// participant x stimulus incidence); the log-likelihood is summed with compensation (the
+// differences would otherwise be rounding-noise limited), and the difference points are
+// evaluated on two threads.
 //
 // Hard cases never give NaN or infinity: they are handled and said in `notes` (unused
 // rating categories are dropped, zero or collinear fixed columns are dropped, a grouping
@@ -52,6 +54,11 @@ struct ClmmSpec {
     std::vector<FactorColumn> random_intercepts;  // 0 (= clm), 1, or 2 crossed groupings
     Link link = Link::Logit;
     ClmmModes modes = ClmmModes::AsR;
+    // False: the maximum only, without the extrapolated finite-difference Hessian of the
+    // standard errors (a third of a fit's work); they then come from the Newton polish's
+    // one-level Hessian at the optimiser's point (relative error up to ~1e-3). For the
+    // reduced model of a likelihood-ratio test, which needs only its log-likelihood.
+    bool precise_standard_errors = true;
 };
 
 // A threshold ("1|2") or an effect ("tempwarm").
@@ -113,6 +120,16 @@ struct ClmmLikelihoodRatioTest {
 
 ClmmLikelihoodRatioTest clmm_likelihood_ratio_test(const ClmmSpec& spec,
                                                    const ClmmFit& full,
+                                                   const std::string& term);
+
+// The reduced model's spec: `spec` without the term's columns, and without
+// precise_standard_errors. Throws InputError when there is no such term.
+ClmmSpec clmm_without_term(const ClmmSpec& spec, const std::string& term);
+
+// The same test with the reduced model already fitted, `reduced` =
+// fit_clmm(clmm_without_term(spec, term)) (so that both fits can run at the same time).
+ClmmLikelihoodRatioTest clmm_likelihood_ratio_test(const ClmmFit& full,
+                                                   const ClmmFit& reduced,
                                                    const std::string& term);
 
 }  // namespace lucent::analysis::mixed

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
+#include <future>
 #include <map>
 #include <set>
 
@@ -301,6 +302,15 @@ RatingModelFit fit_ordinal(const PairFrame& pair, const RandomStructure& structu
     if (structure.stimulus)
         spec.random_intercepts.push_back(pair.frame.factor("stimulus"));
     try {
+        // The reduced model of the likelihood-ratio test is fitted on another thread at
+        // the same time as the full one (the two fits are independent).
+        std::future<mixed::ClmmFit> reduced;
+        if (!mixed::columns_of_term(spec.fixed, "level").empty())
+            reduced =
+                std::async(std::launch::async,
+                           [reduced_spec = mixed::clmm_without_term(spec, "level")] {
+                               return mixed::fit_clmm(reduced_spec);
+                           });
         const mixed::ClmmFit clmm = mixed::fit_clmm(spec);
         fit.fitted = true;
         fit.log_likelihood = finite(clmm.log_likelihood);
@@ -321,7 +331,10 @@ RatingModelFit fit_ordinal(const PairFrame& pair, const RandomStructure& structu
         for (const auto& grouping : clmm.groupings)
             if (grouping.identifiable)
                 fit.random_sds.emplace_back(grouping.name, grouping.sd);
-        const auto test = mixed::clmm_likelihood_ratio_test(spec, clmm, "level");
+        const auto test =
+            reduced.valid()
+                ? mixed::clmm_likelihood_ratio_test(clmm, reduced.get(), "level")
+                : mixed::clmm_likelihood_ratio_test(spec, clmm, "level");
         for (const auto& note : test.notes)
             if (std::find(fit.notes.begin(), fit.notes.end(), note) == fit.notes.end())
                 fit.notes.push_back(note);
