@@ -459,7 +459,7 @@ Optimum minimise(ProfiledDeviance& deviance, Convergence convergence,
         optimiser.set_xtol_abs(1e-8);
         optimiser.set_xtol_rel(1e-4);
     } else {
-        optimiser.set_xtol_rel(1e-10);
+        optimiser.set_xtol_rel(convergence == Convergence::likelihood ? 1e-7 : 1e-10);
         optimiser.set_ftol_rel(1e-15);
     }
     optimiser.set_maxeval(100000);
@@ -703,8 +703,18 @@ LmmFit fit_lmm(const LmmSpec& spec) {
     const Eigen::VectorXd beta = deviance.beta();
     fit.fixed_covariance = deviance.beta_covariance(fit.theta, fit.sigma);
     fit.components = variance_components(spec, fit.theta, fit.sigma);
-    const Satterthwaite satterthwaite(deviance, fit.theta, fit.sigma, fit.notes);
     const auto p = beta.size();
+    if (!spec.satterthwaite_tests) {
+        for (Eigen::Index j = 0; j < p; ++j)
+            fit.fixed.push_back({spec.fixed.names[std::size_t(j)],
+                                 beta[j],
+                                 std::sqrt(fit.fixed_covariance(j, j)),
+                                 {},
+                                 {},
+                                 {}});
+        return fit;
+    }
+    const Satterthwaite satterthwaite(deviance, fit.theta, fit.sigma, fit.notes);
     for (Eigen::Index j = 0; j < p; ++j) {
         FixedEffect effect;
         effect.name = spec.fixed.names[std::size_t(j)];
@@ -732,6 +742,11 @@ LmmFit fit_lmm(const LmmSpec& spec) {
 LikelihoodRatioTest likelihood_ratio(LmmSpec reduced, LmmSpec full) {
     reduced.reml = false;
     full.reml = false;
+    for (LmmSpec* spec : {&reduced, &full}) {
+        spec->satterthwaite_tests = false;
+        if (spec->convergence == Convergence::optimum)
+            spec->convergence = Convergence::likelihood;
+    }
     const LmmFit large = fit_lmm(full);
     reduced.start_theta = large.theta;
     const LmmFit small = fit_lmm(reduced);

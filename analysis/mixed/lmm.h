@@ -46,9 +46,12 @@ RandomTerm random_slopes(FactorColumn group, const FixedDesign& design,
                          const std::vector<std::string>& slopes);
 
 enum class Convergence {
-    optimum,       // theta to 1e-10 relative
-    lme4_default,  // lme4's nloptwrap settings: xtol_abs 1e-8, ftol_abs 1e-8, xtol_rel
-                   // 1e-4
+    optimum,  // theta to 1e-10 relative
+    // lme4's nloptwrap settings: xtol_abs 1e-8, ftol_abs 1e-8, xtol_rel 1e-4
+    lme4_default,
+    // theta to 1e-7 relative: the deviance is then within ~1e-13 of its minimum (it is
+    // flat there), all a likelihood-ratio test reads from a fit
+    likelihood,
 };
 
 struct LmmSpec {
@@ -60,6 +63,9 @@ struct LmmSpec {
     // Where the search for theta starts (lme4's start, identity factors, when empty or of
     // the wrong length): a neighbouring fit's theta saves evaluations.
     std::vector<double> start_theta;
+    // Satterthwaite's t and F tests (numerical derivatives: most of a small fit's cost);
+    // a fit for its likelihood alone (likelihood_ratio's refits) goes without them.
+    bool satterthwaite_tests = true;
 };
 
 // lme4's as.data.frame(VarCorr(fit)) rows: a variance (name_b empty) with its standard
