@@ -413,7 +413,10 @@ std::vector<bool> runs_to_infinity(const Problem& problem, const VectorXd& par,
     const VectorXd values = eigen.eigenvalues();
     const double largest = std::max(values.cwiseAbs().maxCoeff(), 1e-300);
     for (int e = 0; e < m; ++e) {
-        if (values[e] > 1e-7 * largest) continue;  // a well-determined direction
+        // A well-determined direction, relative to the best one and in itself: when
+        // every parameter runs off (a saturated model, one rating per level) the whole
+        // information matrix is tiny, and only the absolute test sees it.
+        if (values[e] > 1e-7 * largest && values[e] > 1e-8) continue;
         const VectorXd direction = eigen.eigenvectors().col(e);
         for (int j = 0; j < m; ++j)
             if (std::abs(direction[j]) > 0.1 && std::abs(par[j]) * scale[j] > 5)

@@ -401,6 +401,21 @@ PairModels fit_pair_models(const LongTable& table, const std::string& question,
     if (!choice.lmm && !choice.clmm) return models;
     const PairFrame pair = pair_frame(table, question, factor, levels);
     RandomStructure structure = random_structure(pair);
+    std::map<std::string, int> ratings_per_level;
+    for (const auto& level : pair.frame.text("level")) ++ratings_per_level[level];
+    const bool one_rating_each =
+        std::all_of(ratings_per_level.begin(), ratings_per_level.end(),
+                    [](const auto& entry) { return entry.second < 2; });
+    if (pair.levels.size() >= 2 && one_rating_each) {
+        structure.notes.insert(
+            structure.notes.begin(),
+            "Needs at least 2 ratings in some level (each level has 1): "
+            "a model with a parameter per level fits them exactly, so "
+            "no model is fitted.");
+        if (choice.lmm) models.lmm = empty_fit(RatingModel::lmm, pair, structure);
+        if (choice.clmm) models.clmm = empty_fit(RatingModel::clmm, pair, structure);
+        return models;
+    }
     if (pair.levels.size() < 2) {
         structure.notes.insert(structure.notes.begin(),
                                std::to_string(pair.levels.size()) +

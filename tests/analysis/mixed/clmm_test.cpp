@@ -308,6 +308,25 @@ TEST(ClmmHardCases, CompleteSeparationIsReportedNotNaN) {
     EXPECT_NEAR(fit.log_likelihood, 20 * std::log(0.2), 1e-6);
 }
 
+// Three ratings, one per level, all different: a parameter per level fits them exactly,
+// so every threshold and effect runs off together and the whole information matrix is
+// tiny (no direction stands out against a better one). Before the absolute test this
+// reported effects of +-65 with standard errors of 2e7 as estimable.
+TEST(ClmmHardCases, SaturatedModelIsNotEstimable) {
+    DataFrame frame;
+    frame.set("y", {"5", "4", "6"});
+    frame.set("level", {"a", "b", "c"});
+    ClmmSpec spec;
+    spec.response = frame.factor("y");
+    spec.fixed = fixed_design(frame, {{"level", true, {}}}, false);
+    const ClmmFit fit = fit_clmm(spec);
+    expect_all_finite(fit);
+    ASSERT_EQ(fit.coefficients.size(), 2u);
+    EXPECT_FALSE(fit.coefficients[0].estimable);
+    EXPECT_FALSE(fit.coefficients[1].estimable);
+    EXPECT_TRUE(has_note(fit, "complete separation"));
+}
+
 TEST(ClmmHardCases, CompleteSeparationWithRandomIntercepts) {
     const DataFrame frame = separated_frame(3);
     ClmmSpec spec;

@@ -264,6 +264,30 @@ TEST(RatingModels, ASingleParticipantDropsTheParticipantTerm) {
     expect_all_finite(*models.lmm);
 }
 
+// One participant rating one stimulus per level (scripts/run-default's first study): a
+// parameter per level fits the three ratings exactly, so a likelihood-ratio test would
+// report a "significant" 6.6 on 2 df from three numbers. Nothing is fitted, and why.
+TEST(RatingModels, OneRatingPerLevelFitsNothingAndSaysWhy) {
+    LongTable table;
+    const double ratings[3] = {5, 4, 6};
+    for (int level = 0; level < 3; ++level) {
+        RatingRow row;
+        row.participant = "p1";
+        row.stimulus = "s" + std::to_string(level);
+        row.factor = "temp";
+        row.level = std::to_string(level + 1);
+        row.question = "bitterness";
+        row.rating = ratings[level];
+        table.rows.push_back(row);
+    }
+    const PairModels models = fit(table, {"1", "2", "3"});
+    ASSERT_TRUE(models.clmm && models.lmm);
+    EXPECT_FALSE(models.clmm->fitted);
+    EXPECT_FALSE(models.clmm->p.has_value());
+    EXPECT_TRUE(has_note(*models.clmm, "Needs at least 2 ratings in some level"));
+    EXPECT_FALSE(models.lmm->fitted);
+}
+
 TEST(RatingModels, OneLevelFitsNothingAndSaysWhy) {
     const PairModels models = fit(wine_table(), {"cold"});
     ASSERT_TRUE(models.clmm);
