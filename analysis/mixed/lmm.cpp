@@ -165,10 +165,10 @@ public:
         n_ = spec.y.size();
         p_ = spec.fixed.x.cols();
         build_z();
-        zt_ = z_.transpose();
-        ztz_ = zt_ * z_;
-        ztx_ = zt_ * spec.fixed.x;
-        zty_ = zt_ * spec.y;
+        const SparseMatrix zt = z_.transpose();
+        ztz_ = zt * z_;
+        ztx_ = zt * spec.fixed.x;
+        zty_ = zt * spec.y;
         xtx_ = spec.fixed.x.transpose() * spec.fixed.x;
         xty_ = spec.fixed.x.transpose() * spec.y;
         for (const auto& term : spec.random) {
@@ -281,10 +281,16 @@ private:
         pattern_nonzeros_ = scaled_.nonZeros();
     }
 
-    void fill_scalar(const std::vector<double>& theta, Eigen::VectorXd& lambda_diagonal) {
-        lambda_diagonal.resize(z_.cols());
+    // Random intercepts only: Lambda's diagonal, each column's term's theta.
+    Eigen::VectorXd lambda_diagonal_of(const std::vector<double>& theta) const {
+        Eigen::VectorXd diagonal(z_.cols());
         for (Eigen::Index c = 0; c < z_.cols(); ++c)
-            lambda_diagonal[c] = theta[std::size_t(column_theta_[std::size_t(c)])];
+            diagonal[c] = theta[std::size_t(column_theta_[std::size_t(c)])];
+        return diagonal;
+    }
+
+    void fill_scalar(const std::vector<double>& theta, Eigen::VectorXd& lambda_diagonal) {
+        lambda_diagonal = lambda_diagonal_of(theta);
         const double* from = ztz_.valuePtr();
         double* to = scaled_.valuePtr();
         for (Eigen::Index c = 0; c < ztz_.outerSize(); ++c)
@@ -347,9 +353,7 @@ private:
         TwoInterceptFactor& factor = *two_intercepts_;
         factor.factorize(theta[0], theta[1]);
         log_det_l2_ = factor.log_det();
-        Eigen::VectorXd lambda_diagonal(z_.cols());
-        for (Eigen::Index c = 0; c < z_.cols(); ++c)
-            lambda_diagonal[c] = theta[std::size_t(column_theta_[std::size_t(c)])];
+        const Eigen::VectorXd lambda_diagonal = lambda_diagonal_of(theta);
         Eigen::MatrixXd rhs(z_.cols(), p_ + 1);
         rhs.col(0) = lambda_diagonal.cwiseProduct(zty_);
         rhs.rightCols(p_) = lambda_diagonal.asDiagonal() * ztx_;
@@ -383,7 +387,7 @@ private:
     const LmmSpec& spec_;
     bool reml_;
     Eigen::Index n_ = 0, p_ = 0;
-    SparseMatrix z_, zt_, ztz_;
+    SparseMatrix z_, ztz_;
     Eigen::MatrixXd ztx_, xtx_;
     Eigen::VectorXd zty_, xty_;
     std::vector<double> lower_bound_;
