@@ -12,7 +12,7 @@ std::optional<std::string_view> stimuli_preset_file(std::string_view relative_pa
 namespace lucent::stimuli {
 
 std::vector<std::string> preset_names() {
-    return {"thesis", "heterogeneous", "fabrics", "physical"};
+    return {"thesis", "heterogeneous", "fabrics", "physical", "scaling"};
 }
 
 std::optional<std::string_view> preset_text(std::string_view name) {
