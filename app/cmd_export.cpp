@@ -1,4 +1,5 @@
-// lucent export: a study database as CSV (long, wide, or the analysis long table).
+// lucent export: a study database as CSV (long, wide, the analysis long table, or the
+// forced choices).
 #include <iostream>
 
 #include "app/commands.h"
@@ -15,7 +16,8 @@ void register_export(CLI::App& app, int& exit_code) {
     auto format = std::make_shared<std::string>("long");
     auto out = std::make_shared<std::string>();
     auto force = std::make_shared<bool>(false);
-    auto* cmd = app.add_subcommand("export", "Write a study database's ratings as CSV");
+    auto* cmd = app.add_subcommand("export",
+                                   "Write a study database's ratings or choices as CSV");
     cmd->add_option("db", *db,
                     "Study database: FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
         ->required()
@@ -23,8 +25,10 @@ void register_export(CLI::App& app, int& exit_code) {
     cmd->add_option(
            "--format", *format,
            "long: one row per rating; wide: one row per participant; analysis: "
-           "participant,stimulus,factor,level,question,rating for lucent analyze")
-        ->check(CLI::IsMember({"long", "wide", "analysis"}));
+           "participant,stimulus,factor,level,question,rating for lucent analyze; "
+           "choices: one row per paired-comparison or MLDS choice (the stimuli in "
+           "screen order, the choice, RT)")
+        ->check(CLI::IsMember({"long", "wide", "analysis", "choices"}));
     cmd->add_option("--out", *out,
                     "CSV file to write (never a database; written to a temporary file in "
                     "its folder, then renamed)")

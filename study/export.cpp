@@ -12,6 +12,7 @@
 #include "study/question_scales.h"
 #include "study/sqlite/database.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/store_rules.h"
 
 namespace lucent::study {
 namespace {
@@ -67,11 +68,110 @@ int max_failed_catch(Database& db) {
     return protocol ? protocol->max_failed_catch : 0;
 }
 
+// SQL condition on trials `t` keeping ratings only: forced choices (schema 6) are their
+// own table (export_choices). Older databases hold nothing else.
+std::string rating_trials(Database& db) {
+    return db.scalar_int("PRAGMA user_version") >= 6
+               ? " AND (t.task IS NULL OR t.task = 'rating') "
+               : " ";
+}
+
 std::string format_number(double v) {
     std::ostringstream out;
     out.precision(10);
     out << v;
     return out.str();
+}
+
+// The sessions an analysis reads (withdrawn never; "completed" or "all" by status),
+// the participants excluded for failed catch trials, and the note saying so.
+struct SessionSelection {
+    std::map<std::int64_t, std::string> taken;  // session id -> participant code
+    std::set<std::string> excluded;             // participant codes
+    std::vector<std::string> excluded_participants;
+    SessionsLeftOut left_out;
+    int total = 0, analysed = 0;
+    std::string note;
+};
+
+SessionSelection select_sessions(Database& db, const std::string& db_path,
+                                 const std::string& sessions, bool exclude_failed_catch) {
+    SessionSelection out;
+    // Which sessions are read: never a withdrawn one (a tombstone's UUID; its rows are
+    // normally gone already), and with "completed" only completed ones.
+    std::set<std::string> withdrawn;
+    if (db.scalar_int(
+            "SELECT count(*) FROM sqlite_schema WHERE name = 'withdrawn_sessions'") > 0) {
+        Statement w = db.prepare("SELECT uuid FROM withdrawn_sessions");
+        while (w.step()) withdrawn.insert(w.text(0));
+    }
+    out.left_out.withdrawn = static_cast<int>(withdrawn.size());
+    out.total = out.left_out.withdrawn;
+    {
+        Statement q = db.prepare(
+            "SELECT se.id, se.uuid, se.status, p.code FROM sessions se "
+            "JOIN participants p ON p.id = se.participant_id ORDER BY se.id");
+        while (q.step()) {
+            if (withdrawn.count(q.text(1))) continue;  // counted with the tombstones
+            ++out.total;
+            const std::string status = q.text(2);
+            if (sessions == "completed" && status != "completed") {
+                ++out.left_out.incomplete;
+                ++out.left_out.incomplete_by_status[status];
+                continue;
+            }
+            out.taken[q.integer(0)] = q.text(3);
+        }
+    }
+
+    // Catch trials failed in the sessions taken, per participant.
+    if (exclude_failed_catch) {
+        const int allowed = max_failed_catch(db);
+        std::map<std::string, int> failed;
+        Statement f = db.prepare(
+            "SELECT r.session_id, count(DISTINCT t.id) FROM responses r "
+            "JOIN trials t ON t.id = r.trial_id "
+            "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > "
+            "coalesce(t.tolerance, 0) "
+            "GROUP BY r.session_id");
+        while (f.step()) {
+            const auto it = out.taken.find(f.integer(0));
+            if (it != out.taken.end())
+                failed[it->second] += static_cast<int>(f.integer(1));
+        }
+        for (const auto& [participant, n] : failed)
+            if (n > allowed) {
+                out.excluded.insert(participant);
+                out.excluded_participants.push_back(
+                    participant + " (" + std::to_string(n) + " catch trials failed)");
+            }
+        for (const auto& [id, participant] : out.taken)
+            if (out.excluded.count(participant)) ++out.left_out.failed_catch;
+    }
+    out.analysed = static_cast<int>(out.taken.size()) - out.left_out.failed_catch;
+    {
+        const SessionsLeftOut& l = out.left_out;
+        std::string note = db_path + ": " + std::to_string(out.analysed) + " of " +
+                           std::to_string(out.total) + " sessions analysed (" +
+                           (sessions == "completed"
+                                ? "completed sessions only, the analysis plan's default"
+                                : "sessions of every status, as the analysis plan says") +
+                           "); left out: " + std::to_string(l.incomplete) + " incomplete";
+        if (!l.incomplete_by_status.empty()) {
+            note += " (";
+            bool first = true;
+            for (const auto& [status, n] : l.incomplete_by_status) {
+                note += (first ? "" : ", ") + std::to_string(n) + " " + status;
+                first = false;
+            }
+            note += ")";
+        }
+        note += ", " + std::to_string(l.failed_catch) + " failed catch trials, " +
+                std::to_string(l.withdrawn) + " withdrawn";
+        out.note = note;
+    }
+
+    return out;
 }
 
 }  // namespace
@@ -113,7 +213,7 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
             (has_provenance ? "LEFT JOIN segment_stimuli shown ON shown.segment_id = "
                               "t.segment_id AND shown.stimulus_id = t.stimulus_id "
                             : "") +
-            "ORDER BY p.code, se.id, t.position, r.id");
+            "WHERE 1" + rating_trials(db) + "ORDER BY p.code, se.id, t.position, r.id");
         int without_provenance = 0;
         while (s.step()) {
             const auto known = s.is_null(15) ? resolved.end() : resolved.find(s.text(4));
@@ -168,7 +268,8 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
             "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
             "JOIN participants p ON p.id = se.participant_id "
             "JOIN stimuli st ON st.id = t.stimulus_id "
-            "WHERE t.practice = 0 AND t.catch = 0 ORDER BY st.id, r.id");
+            "WHERE t.practice = 0 AND t.catch = 0" +
+            rating_trials(db) + "ORDER BY st.id, r.id");
         while (s.step()) {
             const std::string column = s.text(1) + "." + s.text(2);
             if (seen.insert(column).second) columns.push_back(column);
@@ -229,89 +330,23 @@ LongTable analysis_long_table(const std::string& db_path,
         throw StoreError("analysis sessions: expected \"completed\" or \"all\", got '" +
                          table.sessions + "'");
 
-    // Which sessions are read: never a withdrawn one (a tombstone's UUID; its rows are
-    // normally gone already), and with "completed" only completed ones.
-    std::set<std::string> withdrawn;
-    if (db.scalar_int(
-            "SELECT count(*) FROM sqlite_schema WHERE name = 'withdrawn_sessions'") > 0) {
-        Statement w = db.prepare("SELECT uuid FROM withdrawn_sessions");
-        while (w.step()) withdrawn.insert(w.text(0));
-    }
-    table.left_out.withdrawn = static_cast<int>(withdrawn.size());
-    table.sessions_total = table.left_out.withdrawn;
-    std::map<std::int64_t, std::string> taken;  // session id -> participant code
-    {
-        Statement q = db.prepare(
-            "SELECT se.id, se.uuid, se.status, p.code FROM sessions se "
-            "JOIN participants p ON p.id = se.participant_id ORDER BY se.id");
-        while (q.step()) {
-            if (withdrawn.count(q.text(1))) continue;  // counted with the tombstones
-            ++table.sessions_total;
-            const std::string status = q.text(2);
-            if (table.sessions == "completed" && status != "completed") {
-                ++table.left_out.incomplete;
-                ++table.left_out.incomplete_by_status[status];
-                continue;
-            }
-            taken[q.integer(0)] = q.text(3);
-        }
-    }
-
-    // Catch trials failed in the sessions taken, per participant.
-    std::set<std::string> excluded;
-    if (options.exclude_failed_catch) {
-        const int allowed = max_failed_catch(db);
-        std::map<std::string, int> failed;
-        Statement f = db.prepare(
-            "SELECT r.session_id, count(DISTINCT t.id) FROM responses r "
-            "JOIN trials t ON t.id = r.trial_id "
-            "WHERE t.catch = 1 AND abs(r.rating - t.expected_rating) > "
-            "coalesce(t.tolerance, 0) "
-            "GROUP BY r.session_id");
-        while (f.step()) {
-            const auto it = taken.find(f.integer(0));
-            if (it != taken.end()) failed[it->second] += static_cast<int>(f.integer(1));
-        }
-        for (const auto& [participant, n] : failed)
-            if (n > allowed) {
-                excluded.insert(participant);
-                table.excluded_participants.push_back(
-                    participant + " (" + std::to_string(n) + " catch trials failed)");
-            }
-        for (const auto& [id, participant] : taken)
-            if (excluded.count(participant)) ++table.left_out.failed_catch;
-    }
-    table.sessions_analysed =
-        static_cast<int>(taken.size()) - table.left_out.failed_catch;
-    {
-        const SessionsLeftOut& l = table.left_out;
-        std::string note = db_path + ": " + std::to_string(table.sessions_analysed) +
-                           " of " + std::to_string(table.sessions_total) +
-                           " sessions analysed (" +
-                           (table.sessions == "completed"
-                                ? "completed sessions only, the analysis plan's default"
-                                : "sessions of every status, as the analysis plan says") +
-                           "); left out: " + std::to_string(l.incomplete) + " incomplete";
-        if (!l.incomplete_by_status.empty()) {
-            note += " (";
-            bool first = true;
-            for (const auto& [status, n] : l.incomplete_by_status) {
-                note += (first ? "" : ", ") + std::to_string(n) + " " + status;
-                first = false;
-            }
-            note += ")";
-        }
-        note += ", " + std::to_string(l.failed_catch) + " failed catch trials, " +
-                std::to_string(l.withdrawn) + " withdrawn";
-        table.sessions_note = note;
-    }
+    const SessionSelection selected =
+        select_sessions(db, db_path, table.sessions, options.exclude_failed_catch);
+    const std::map<std::int64_t, std::string>& taken = selected.taken;
+    const std::set<std::string>& excluded = selected.excluded;
+    table.excluded_participants = selected.excluded_participants;
+    table.left_out = selected.left_out;
+    table.sessions_total = selected.total;
+    table.sessions_analysed = selected.analysed;
+    table.sessions_note = selected.note;
 
     Statement s = db.prepare(
         "SELECT p.code, st.stimulus_key, r.question, r.rating, se.id FROM responses r "
         "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
         "JOIN participants p ON p.id = se.participant_id "
         "JOIN stimuli st ON st.id = t.stimulus_id "
-        "WHERE t.practice = 0 AND t.catch = 0 ORDER BY p.code, se.id, t.position, r.id");
+        "WHERE t.practice = 0 AND t.catch = 0" +
+        rating_trials(db) + "ORDER BY p.code, se.id, t.position, r.id");
     while (s.step()) {
         const std::string participant = s.text(0);
         if (!taken.count(s.integer(4)) || excluded.count(participant)) continue;
@@ -341,6 +376,70 @@ LongTable analysis_long_table(const std::string& db_path,
     return table;
 }
 
+ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
+                            const ChoiceExportOptions& options) {
+    Database db = open_read_only(db_path);
+    ChoiceExport result;
+    out << "participant,session,trial,block,task,question,practice,catch,expected,"
+           "shown_1,shown_2,shown_3,shown_4,value_1,value_2,value_3,value_4,choice,"
+           "rt_ms\n";
+    if (db.scalar_int("PRAGMA user_version") < 6) return result;  // ratings only then
+    const std::optional<Protocol> protocol = stored_protocol(db);
+    std::string sessions = options.sessions;
+    if (sessions.empty())
+        sessions = protocol ? protocol->analysis.sessions : std::string("completed");
+    if (sessions != "completed" && sessions != "all")
+        throw StoreError("analysis sessions: expected \"completed\" or \"all\", got '" +
+                         sessions + "'");
+    const SessionSelection selected = select_sessions(
+        db, db_path, options.analysis ? sessions : "all", options.analysis);
+    if (options.analysis) {
+        result.excluded_participants = selected.excluded_participants;
+        result.notes.push_back(selected.note);
+    }
+    const auto params = stimulus_parameters(db);
+    // The series value of a stimulus in a block: its parameter named by the block's
+    // `series` (the stored protocol's), as written.
+    auto series_value = [&](const std::string& block, const std::string& stimulus) {
+        const Block* b = protocol ? protocol->find_block(block) : nullptr;
+        if (!b || b->series.empty()) return std::string();
+        const auto it = params.find(stimulus);
+        if (it == params.end() || !it->second.count(b->series)) return std::string();
+        return it->second.at(b->series);
+    };
+    Statement s = db.prepare(
+        "SELECT p.code, se.uuid, t.position, t.block, t.task, r.question, t.practice, "
+        "t.catch, t.expected_rating, t.shown, r.rating, r.rt_ms, se.id FROM responses r "
+        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
+        "JOIN participants p ON p.id = se.participant_id "
+        "WHERE t.task IN ('pair', 'triad', 'quadruple') "
+        "ORDER BY p.code, se.id, t.position, r.id");
+    while (s.step()) {
+        const std::string participant = s.text(0);
+        const bool practice = s.integer(6) != 0;
+        if (options.analysis && (practice || !selected.taken.count(s.integer(12)) ||
+                                 selected.excluded.count(participant)))
+            continue;
+        if (!selected.taken.count(s.integer(12))) continue;  // withdrawn
+        const std::string block = s.text(3);
+        const std::vector<std::string> shown = shown_from_text(s.text(9));
+        out << common::csv_field(participant) << "," << common::csv_field(s.text(1))
+            << "," << s.integer(2) << "," << common::csv_field(block) << ","
+            << common::csv_field(s.text(4)) << "," << common::csv_field(s.text(5)) << ","
+            << (practice ? 1 : 0) << "," << s.integer(7) << ","
+            << (s.is_null(8) ? std::string() : std::to_string(s.integer(8)));
+        for (size_t k = 0; k < 4; ++k)
+            out << "," << common::csv_field(k < shown.size() ? shown[k] : "");
+        for (size_t k = 0; k < 4; ++k)
+            out << ","
+                << common::csv_field(k < shown.size() ? series_value(block, shown[k])
+                                                      : "");
+        out << "," << s.integer(10) << "," << format_number(s.real(11)) << "\n";
+        ++result.rows;
+    }
+    return result;
+}
+
 ExportFileResult export_file(const std::string& db_path, const std::string& format,
                              const std::string& out_path, bool force) {
     ExportFileResult result;
@@ -354,13 +453,16 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                 result.rows = static_cast<int>(table.rows.size());
                 result.excluded_participants = table.excluded_participants;
                 result.notes.push_back(table.sessions_note);
+            } else if (format == "choices") {
+                const ChoiceExport choices = export_choices(db_path, out);
+                result.rows = choices.rows;
             } else if (format == "long" || format == "wide") {
                 result.rows = export_csv(
                     db_path, format == "long" ? ExportFormat::Long : ExportFormat::Wide,
                     out, &result.notes);
             } else {
                 throw StoreError("export: unknown format '" + format +
-                                 "' (valid: long, wide, analysis)");
+                                 "' (valid: long, wide, analysis, choices)");
             }
         });
     } catch (const common::OutputError& e) {

@@ -27,10 +27,11 @@ struct ExportFileResult {
     std::vector<std::string> notes;
 };
 
-// Writes format "long", "wide" or "analysis" of `db_path` to the CSV file `out_path`:
-// never the database itself (by inode: symlinks, hard links and relative paths
-// included) nor any other database; an existing file only with `force`. Written to a
-// temporary file in the same folder and renamed into place. Throws StoreError (one line).
+// Writes format "long", "wide", "analysis" or "choices" of `db_path` to the CSV file
+// `out_path`: never the database itself (by inode: symlinks, hard links and relative
+// paths included) nor any other database; an existing file only with `force`. Written to
+// a temporary file in the same folder and renamed into place. Throws StoreError (one
+// line).
 ExportFileResult export_file(const std::string& db_path, const std::string& format,
                              const std::string& out_path, bool force);
 
@@ -87,6 +88,28 @@ struct LongTable {
 LongTable analysis_long_table(const std::string& db_path,
                               const LongTableOptions& options = {});
 void write_long_table_csv(const LongTable& table, std::ostream& out);
+
+// Forced choices (issue 30): one row per answered pair, triad or quadruple trial, as
+// `lucent export --format choices` writes them and the scaling reads them
+// (analysis/data/choice_table.h): participant,session,trial,block,task,question,
+// practice,catch,expected,shown_1..shown_4 (the stimuli in screen order),value_1..
+// value_4 (each one's value of the block's series parameter),choice (1 or 2, as
+// PlannedTrial::shown says),rt_ms.
+struct ChoiceExportOptions {
+    // The analysis's view: practice trials left out, only the sessions `sessions` (or
+    // the stored plan) names, participants failing more catch trials than the protocol
+    // allows left out. Otherwise every answered choice, with its practice and catch
+    // flags.
+    bool analysis = false;
+    std::string sessions;  // analysis: "completed" or "all"; empty: the stored plan's
+};
+struct ChoiceExport {
+    int rows = 0;
+    std::vector<std::string> excluded_participants;  // analysis only
+    std::vector<std::string> notes;  // analysis: the sessions left out, by reason
+};
+ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
+                            const ChoiceExportOptions& options = {});
 
 struct MergeReport {
     int sessions_added = 0;

@@ -215,9 +215,10 @@ void read_screens(Protocol& p, TableReader& root) {
 }
 
 void read_questions(Protocol& p, TableReader& root) {
+    // Required (at least one entry) once the blocks say whether anything is rated:
+    // check_questions_needed.
     const toml::array* questions = root.array("questions");
-    if (!questions || questions->empty())
-        root.fail(questions, "questions", "at least one [[questions]] entry is required");
+    if (!questions) return;
     for (const toml::node& node : *questions) {
         TableReader r(as_table(node, root, "questions"), "questions", p.source);
         Question q;
@@ -297,6 +298,125 @@ void check_stimulus_ref(const Protocol& p, TableReader& r, const std::string& ke
         r.fail(r.raw().get(key), key, "no stimulus with id '" + id + "'");
 }
 
+// A stimulus's value of the block's series parameter, as a number.
+std::optional<double> series_value(const Protocol& p, const std::string& stimulus,
+                                   const std::string& parameter) {
+    const StimulusSpec* s = p.find_stimulus(stimulus);
+    const auto it = s ? s->parameters.find(parameter) : decltype(s->parameters.end()){};
+    if (!s || it == s->parameters.end()) return std::nullopt;
+    char* end = nullptr;
+    const double v = std::strtod(it->second.c_str(), &end);
+    if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v))
+        return std::nullopt;
+    return v;
+}
+
+// The keys of a pair, triad or quadruple block (design notes: Block in protocol.h).
+void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
+    const std::string task = r.string("task", "rating");
+    const std::optional<Task> parsed = parse_task(task);
+    if (!parsed)
+        r.fail(r.raw().get("task"), "task",
+               "must be \"rating\", \"pair\", \"triad\" or \"quadruple\", got '" + task +
+                   "'");
+    b.task = *parsed;
+    if (!b.is_choice()) return;
+    const int n = static_cast<int>(b.stimuli.size());
+    const int shown = pictures_per_trial(b.task);
+    if (n < shown)
+        r.fail(r.raw().get("stimuli"), "stimuli",
+               "a " + task + " block needs at least " + std::to_string(shown) +
+                   " stimuli, got " + std::to_string(n));
+    for (const std::string& id : b.stimuli)
+        if (id.find_first_of(" \t\r\n") != std::string::npos)
+            r.fail(r.raw().get("stimuli"), "stimuli",
+                   "stimulus id '" + id +
+                       "' holds whitespace: a choice trial stores its "
+                       "stimuli space-separated");
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < i; ++j)
+            if (b.stimuli[i] == b.stimuli[j])
+                r.fail(r.raw().get("stimuli"), "stimuli",
+                       "stimulus '" + b.stimuli[i] + "' is listed twice in block '" +
+                           b.id + "'");
+    b.question = r.string("question", "", true);
+    b.question_id = r.string("question_id", b.id);
+    for (const Question& q : p.questions)
+        if (q.id == b.question_id)
+            r.fail(r.raw().get("question_id"), "question_id",
+                   "'" + b.question_id + "' is already a [[questions]] id");
+    for (const Block& other : p.blocks)
+        if (other.is_choice() && other.question_id == b.question_id)
+            r.fail(
+                r.raw().get("question_id"), "question_id",
+                "'" + b.question_id + "' is already block '" + other.id + "'s question");
+    b.labels = r.strings("labels");
+    if (b.labels.empty())
+        b.labels = b.task == Task::pair
+                       ? std::vector<std::string>{"left", "right"}
+                       : std::vector<std::string>{"first pair", "second pair"};
+    if (b.labels.size() != 2)
+        r.fail(r.raw().get("labels"), "labels", "needs exactly two answers");
+    b.design = r.string("design", "all");
+    if (b.design != "all" && !(b.task == Task::pair && b.design == "cyclic"))
+        r.fail(r.raw().get("design"), "design",
+               b.task == Task::pair
+                   ? "must be \"all\" or \"cyclic\", got '" + b.design + "'"
+                   : "must be \"all\" for a " + task + " block, got '" + b.design + "'");
+    b.neighbours = r.integer("neighbours", 0, 0, 100000);
+    if (b.design == "cyclic") {
+        // (i, i+d) and (i, i+n-d) are the same pairs: d up to n/2 gives every pair once.
+        if (b.neighbours < 1 || b.neighbours > n / 2)
+            r.fail(r.raw().get("neighbours"), "neighbours",
+                   "a cyclic design needs 1 <= neighbours <= " + std::to_string(n / 2) +
+                       " for " + std::to_string(n) + " stimuli");
+    } else if (r.raw().get("neighbours")) {
+        r.fail(r.raw().get("neighbours"), "neighbours", "only a cyclic design has them");
+    }
+    const std::string presentation = r.string("presentation", "side_by_side");
+    if (presentation == "sequential")
+        b.presentation = Presentation::sequential;
+    else if (presentation != "side_by_side")
+        r.fail(r.raw().get("presentation"), "presentation",
+               "must be \"side_by_side\" or \"sequential\", got '" + presentation + "'");
+    b.duration_ms = r.integer("duration_ms", 1000, 50, 60000);
+    b.blank_ms = r.integer("blank_ms", 500, 0, 60000);
+    b.identical_catch = r.integer("identical_catch", 0, 0, 1000);
+    if (b.identical_catch > 0 && b.task != Task::pair)
+        r.fail(r.raw().get("identical_catch"), "identical_catch",
+               "only pair blocks have identical-pair catch trials");
+    b.obvious_catch = r.strings("obvious_catch");
+    if (!b.obvious_catch.empty()) {
+        if (b.obvious_catch.size() != 2 || b.obvious_catch[0] == b.obvious_catch[1])
+            r.fail(r.raw().get("obvious_catch"), "obvious_catch",
+                   "must name two different stimuli: [low, high]");
+        for (const std::string& id : b.obvious_catch)
+            check_stimulus_ref(p, r, "obvious_catch", id);
+    }
+    b.obvious_catch_repeats =
+        r.integer("obvious_catch_repeats", b.obvious_catch.empty() ? 0 : 1, 0, 1000);
+    if (b.obvious_catch.empty() && b.obvious_catch_repeats > 0)
+        r.fail(r.raw().get("obvious_catch_repeats"), "obvious_catch_repeats",
+               "needs obvious_catch");
+    b.series = r.string("series", "");
+    if (!b.series.empty()) {
+        std::optional<double> previous;
+        for (const std::string& id : b.stimuli) {
+            const std::optional<double> v = series_value(p, id, b.series);
+            if (!v)
+                r.fail(
+                    r.raw().get("series"), "series",
+                    "stimulus '" + id + "' has no numeric parameter '" + b.series + "'");
+            if (b.task != Task::pair && previous && !(*v > *previous))
+                r.fail(r.raw().get("stimuli"), "stimuli",
+                       "an MLDS series must be listed in increasing '" + b.series +
+                           "': '" + id + "' does not follow its predecessor");
+            previous = v;
+        }
+    }
+    b.practice = r.integer("practice", 0, 0, 100);
+}
+
 void read_trials(Protocol& p, TableReader& root) {
     if (const toml::table* practice = root.table("practice")) {
         TableReader r(*practice, "practice", p.source);
@@ -316,6 +436,7 @@ void read_trials(Protocol& p, TableReader& root) {
             r.fail(nullptr, "stimuli", "block '" + b.id + "' has no stimuli");
         for (const std::string& id : b.stimuli) check_stimulus_ref(p, r, "stimuli", id);
         b.repeats = r.integer("repeats", 1, 1, 1000);
+        read_choice_block(p, r, b);
         for (const Block& other : p.blocks)
             if (other.id == b.id)
                 r.fail(r.raw().get("id"), "id", "duplicate block id '" + b.id + "'");
@@ -330,10 +451,15 @@ void read_trials(Protocol& p, TableReader& root) {
             c.stimulus = r.string("stimulus", "", true);
             check_stimulus_ref(p, r, "stimulus", c.stimulus);
             c.block = r.string("block", p.blocks.front().id);
-            if (std::none_of(p.blocks.begin(), p.blocks.end(),
-                             [&](const Block& b) { return b.id == c.block; }))
+            const Block* block = p.find_block(c.block);
+            if (!block)
                 r.fail(r.raw().get("block"), "block",
                        "no block with id '" + c.block + "'");
+            if (block->is_choice())
+                r.fail(r.raw().get("block"), "block",
+                       "block '" + c.block +
+                           "' is a forced choice: its catch trials are its own "
+                           "identical_catch and obvious_catch");
             c.prompt = r.string("prompt", "", true);
             int max_points = 7;
             for (const Question& q : p.questions)
@@ -344,6 +470,13 @@ void read_trials(Protocol& p, TableReader& root) {
             p.catch_trials.push_back(std::move(c));
         }
     }
+}
+
+void check_questions_needed(const Protocol& p, TableReader& root) {
+    if (p.has_rating_trials() && p.questions.empty())
+        root.fail(root.raw().get("questions"), "questions",
+                  "at least one [[questions]] entry is required (the study rates "
+                  "pictures)");
 }
 
 void read_randomisation(Protocol& p, TableReader& root) {
@@ -411,6 +544,52 @@ void read_online(Protocol& p, TableReader& root) {
 
 }  // namespace
 
+const char* task_name(Task task) {
+    switch (task) {
+        case Task::rating:
+            return "rating";
+        case Task::pair:
+            return "pair";
+        case Task::triad:
+            return "triad";
+        case Task::quadruple:
+            return "quadruple";
+    }
+    return "rating";
+}
+
+std::optional<Task> parse_task(std::string_view text) {
+    for (Task t : {Task::rating, Task::pair, Task::triad, Task::quadruple})
+        if (text == task_name(t)) return t;
+    return std::nullopt;
+}
+
+int pictures_per_trial(Task task) {
+    switch (task) {
+        case Task::rating:
+            return 1;
+        case Task::pair:
+            return 2;
+        case Task::triad:
+            return 3;
+        case Task::quadruple:
+            return 4;
+    }
+    return 1;
+}
+
+const Block* Protocol::find_block(std::string_view id) const {
+    for (const Block& b : blocks)
+        if (b.id == id) return &b;
+    return nullptr;
+}
+
+bool Protocol::has_rating_trials() const {
+    return !practice.empty() ||
+           std::any_of(blocks.begin(), blocks.end(),
+                       [](const Block& b) { return !b.is_choice(); });
+}
+
 const StimulusSpec* Protocol::find_stimulus(std::string_view id) const {
     for (const StimulusSpec& s : stimuli)
         if (s.id == id) return &s;
@@ -476,6 +655,7 @@ Protocol parse_protocol(std::string_view text, const std::string& source,
     read_questions(p, root);
     read_stimuli(p, root, base_dir, check);
     read_trials(p, root);
+    check_questions_needed(p, root);
     read_randomisation(p, root);
     read_analysis_plan(p, root);
     read_online(p, root);

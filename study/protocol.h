@@ -52,10 +52,52 @@ struct CatchTrial {
     int tolerance = 0;     // |rating - expected| <= tolerance passes
 };
 
+// What a block's trials ask. `rating`: one picture rated on every [[questions]] entry.
+// The forced choices (issue 30): `pair`, which of two pictures is more X (paired
+// comparisons: Bradley-Terry, Thurstone); `triad` and `quadruple`, which of two pairs of
+// an ordered series differs more (Maximum Likelihood Difference Scaling).
+enum class Task { rating, pair, triad, quadruple };
+const char* task_name(Task task);
+std::optional<Task> parse_task(std::string_view text);
+// The pictures one trial of the task shows: 1, 2, 3 or 4.
+int pictures_per_trial(Task task);
+
+// How a choice block's pictures are shown: all at once, side by side (a triad in a row,
+// a quadruple's pairs as two groups), or one after another (a pair's pictures, an MLDS
+// trial's pairs) with a blank between.
+enum class Presentation { side_by_side, sequential };
+
 struct Block {
     std::string id;
-    std::vector<std::string> stimuli;  // stimulus ids, each shown `repeats` times
+    // Rating: stimulus ids, each shown `repeats` times. Choice blocks: the series, in
+    // its physical order for triads and quadruples.
+    std::vector<std::string> stimuli;
     int repeats = 1;
+    Task task = Task::rating;
+    // Choice blocks only.
+    std::string question;     // the text shown, e.g. "Which looks more translucent?"
+    std::string question_id;  // stored in responses.question (default: the block id)
+    std::vector<std::string> labels;  // the two answers' names (left/right, pairs)
+    // Which pairs or groups: "all" (every unordered pair; every triad a<b<c; every
+    // quadruple a<b<c<d, MLDS's non-overlapping ones) or, for pairs, "cyclic" (a
+    // balanced incomplete design: (i, i+d mod n) for d = 1..neighbours, every stimulus
+    // in 2 * neighbours pairs, the comparison graph connected).
+    std::string design = "all";
+    int neighbours = 0;
+    Presentation presentation = Presentation::side_by_side;
+    int duration_ms = 1000;   // sequential: each picture (pair) or pair (MLDS) on screen
+    int blank_ms = 500;       // sequential: the blank between them
+    int identical_catch = 0;  // pair blocks: trials showing one stimulus twice
+    // Catch trials with a right answer: {low, high}. A pair block shows them and the
+    // answer is `high`; an MLDS block shows (low, low) against (low, high) and the
+    // answer is the differing pair.
+    std::vector<std::string> obvious_catch;
+    int obvious_catch_repeats = 0;
+    // The stimulus parameter whose value places each stimulus on the series (the
+    // report's axis; MLDS blocks: numeric and increasing along `stimuli`); "" = none.
+    std::string series;
+    int practice = 0;  // practice trials of this task (from its design) before block 1
+    bool is_choice() const { return task != Task::rating; }
 };
 
 // Randomisation within blocks, and block order across participants.
@@ -118,6 +160,10 @@ struct Protocol {
     OnlineSettings online;
 
     const StimulusSpec* find_stimulus(std::string_view id) const;
+    const Block* find_block(std::string_view id) const;
+    // True when some trial rates a picture on [[questions]] (a rating block or
+    // [practice] stimuli); a study of forced choices only needs no [[questions]].
+    bool has_rating_trials() const;
     // Level of `factor` for a stimulus ("stimulus", "technique" or a parameter); empty
     // when the stimulus has no such parameter. The level of "stimulus" is the picture:
     // the id of the first stimulus with the same picture_key, so ids that show the same

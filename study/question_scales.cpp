@@ -9,21 +9,46 @@ namespace lucent::study {
 QuestionPoints question_points(const Protocol& protocol) {
     QuestionPoints out;
     for (const Question& q : protocol.questions) out[q.id] = q.points();
+    for (const Block& b : protocol.blocks)
+        if (b.is_choice()) out[b.question_id] = 2;
     return out;
 }
 
-QuestionPoints stored_question_points(Database& db, int64_t study_id) {
+StudyQuestions study_questions(const Protocol& protocol) {
+    StudyQuestions out;
+    for (const Question& q : protocol.questions) out.rating[q.id] = q.points();
+    for (const Block& b : protocol.blocks)
+        if (b.is_choice()) out.choice_question[b.id] = b.question_id;
+    return out;
+}
+
+QuestionPoints StudyQuestions::of_block(const std::string& block) const {
+    const auto it = choice_question.find(block);
+    if (it == choice_question.end()) return rating;
+    return {{it->second, 2}};
+}
+
+namespace {
+Protocol stored_protocol(Database& db, int64_t study_id) {
     Statement s = db.prepare("SELECT name, protocol_text FROM studies WHERE id = ?");
     s.bind(1, study_id);
     if (!s.step()) throw StoreError(db.path() + ": no study " + std::to_string(study_id));
     try {
-        return question_points(parse_protocol(s.text(1),
-                                              db.path() + " (study '" + s.text(0) + "')",
-                                              "", KnobCheck::lenient));
+        return parse_protocol(s.text(1), db.path() + " (study '" + s.text(0) + "')", "",
+                              KnobCheck::lenient);
     } catch (const ProtocolError& e) {
         throw StoreError(db.path() +
                          ": the stored protocol no longer parses: " + e.what());
     }
+}
+}  // namespace
+
+QuestionPoints stored_question_points(Database& db, int64_t study_id) {
+    return question_points(stored_protocol(db, study_id));
+}
+
+StudyQuestions stored_study_questions(Database& db, int64_t study_id) {
+    return study_questions(stored_protocol(db, study_id));
 }
 
 void check_rating_on_scale(const QuestionPoints& points, const std::string& question,

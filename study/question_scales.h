@@ -13,10 +13,23 @@ namespace lucent::study {
 
 using QuestionPoints = std::map<std::string, int>;  // question id -> points
 
+// Every question a study asks: its [[questions]] and each forced-choice block's
+// question (2 points: the first or the second alternative).
 QuestionPoints question_points(const Protocol& protocol);
+
+// Which questions one trial answers: a forced choice its block's question, a rating
+// every [[questions]] entry.
+struct StudyQuestions {
+    QuestionPoints rating;
+    std::map<std::string, std::string> choice_question;  // choice block id -> question
+    QuestionPoints of_block(const std::string& block) const;
+};
+StudyQuestions study_questions(const Protocol& protocol);
+
 // The scales of study `study_id`, parsed from its stored protocol text. Throws
 // StoreError (one line, naming the database) when that text no longer parses.
 QuestionPoints stored_question_points(Database& db, int64_t study_id);
+StudyQuestions stored_study_questions(Database& db, int64_t study_id);
 // Throws StoreError naming the question when `rating` is not within its scale.
 void check_rating_on_scale(const QuestionPoints& points, const std::string& question,
                            int rating, const std::string& where);

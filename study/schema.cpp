@@ -167,6 +167,15 @@ CREATE TABLE consent_declines (
     study_id INTEGER NOT NULL PRIMARY KEY REFERENCES studies(id) ON DELETE CASCADE,
     declined INTEGER NOT NULL CHECK (declined >= 0));
 )sql",
+    // 6: forced-choice trials (issue 30): the block's task, and the stimuli a pair,
+    // triad or quadruple shows in screen order (stimulus keys, space-separated;
+    // trials.stimulus_id is the first). The choice itself is a response to the block's
+    // question with rating 1 or 2, so copies, merges and withdrawals carry it as they
+    // carry ratings. Earlier trials keep NULL: ratings.
+    R"sql(
+ALTER TABLE trials ADD COLUMN task TEXT CHECK (task IN ('rating', 'pair', 'triad', 'quadruple'));
+ALTER TABLE trials ADD COLUMN shown TEXT;
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 

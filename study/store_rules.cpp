@@ -123,4 +123,37 @@ std::string resolved_difference(const std::string& stimulus, const ResolvedStimu
     return "";
 }
 
+std::string shown_text(const std::vector<std::string>& shown) {
+    std::string out;
+    for (const std::string& id : shown) out += (out.empty() ? "" : " ") + id;
+    return out;
+}
+
+std::vector<std::string> shown_from_text(const std::string& text) {
+    std::vector<std::string> out;
+    size_t start = 0;
+    while (start < text.size()) {
+        size_t end = text.find(' ', start);
+        if (end == std::string::npos) end = text.size();
+        if (end > start) out.push_back(text.substr(start, end - start));
+        start = end + 1;
+    }
+    return out;
+}
+
+std::optional<std::string> shown_column(const PlannedTrial& trial) {
+    if (trial.shown.empty()) return std::nullopt;
+    return shown_text(trial.shown);
+}
+
+std::optional<int> expected_rating_column(const PlannedTrial& trial) {
+    if (trial.task != Task::rating && trial.expected == 0) return std::nullopt;
+    return trial.expected;
+}
+
+Task task_column(const std::optional<std::string>& text) {
+    if (!text) return Task::rating;
+    return parse_task(*text).value_or(Task::rating);
+}
+
 }  // namespace lucent::study

@@ -15,6 +15,7 @@
 namespace lucent::study {
 
 struct TrialPlan;
+struct PlannedTrial;
 
 // A new session's row as both backends fill it before the insert (the id and the
 // participant's code come from the store): running, in the plan's cell.
@@ -55,6 +56,18 @@ std::string resolved_difference(const std::string& stimulus, const ResolvedStimu
 ResolvedStimulus resolved_of(const StimulusProvenance& p);
 // One word for a segment's pictures: the common source, "mixed", or nullopt when unknown.
 std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli);
+
+// trials.shown: a forced choice's stimulus keys in screen order, space-separated (keys
+// hold no whitespace: the protocol refuses them in choice blocks); "" for a rating.
+std::string shown_text(const std::vector<std::string>& shown);
+std::vector<std::string> shown_from_text(const std::string& text);
+// The columns of a planned trial as both backends write them: trials.shown (NULL for a
+// rating) and trials.expected_rating of a catch trial (NULL for an identical pair,
+// which has no right answer).
+std::optional<std::string> shown_column(const PlannedTrial& trial);
+std::optional<int> expected_rating_column(const PlannedTrial& trial);
+// trials.task as read back (NULL: a rating, planned before schema 6).
+Task task_column(const std::optional<std::string>& text);
 
 // A participant's number: a lab code's trailing digits (-1 when none or over 9 digits).
 int participant_number_from_code(const std::string& code);

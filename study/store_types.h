@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "study/protocol.h"
+
 namespace lucent::study {
 
 // Any storage failure, from every backend; what() is one line naming the store (its
@@ -79,6 +81,8 @@ struct TrialRow {
     bool break_before = false;
     bool answered = false;
     std::string uuid;  // schema 4: the trial's identity across stores (resends, merges)
+    Task task = Task::rating;        // schema 6 (NULL before: rating)
+    std::vector<std::string> shown;  // forced choices: stimulus ids in screen order
 };
 
 // One rating as the runner collected it.

@@ -3,6 +3,7 @@
 #include "study/trial_plan.h"
 
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <unordered_map>
 
@@ -16,6 +17,14 @@ uint64_t uniform_below(std::mt19937_64& rng, uint64_t n) {
     do x = rng();
     while (x >= limit);
     return x % n;
+}
+
+// Fisher-Yates with uniform_below: the same order from the same seed on every standard
+// library (std::shuffle's draws are implementation-defined).
+template <class T>
+void portable_shuffle(std::vector<T>& items, std::mt19937_64& rng) {
+    for (size_t i = items.size(); i > 1; --i)
+        std::swap(items[i - 1], items[uniform_below(rng, i)]);
 }
 
 // Whether `level` may follow the placed prefix.
@@ -274,6 +283,143 @@ std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,
     return constrained_block_shuffles({levels}, c, rng, max_attempts).front();
 }
 
+namespace {
+
+PlannedTrial choice_trial(const Block& block, std::vector<std::string> shown) {
+    PlannedTrial t;
+    t.block = block.id;
+    t.task = block.task;
+    t.stimulus = shown.front();
+    t.shown = std::move(shown);
+    return t;
+}
+
+// `count` orientations (false: the design's order), half of them flipped; an odd one
+// out is flipped or not at random.
+std::vector<char> balanced_flips(size_t count, std::mt19937_64& rng) {
+    std::vector<char> flips(count);
+    for (size_t i = 0; i < count; ++i) flips[i] = i % 2 == 1;
+    if (count % 2 == 1) flips.back() = rng() % 2 == 1;
+    portable_shuffle(flips, rng);
+    return flips;
+}
+
+}  // namespace
+
+std::vector<PlannedTrial> choice_block_trials(const Block& block, std::mt19937_64& rng) {
+    const std::vector<std::string>& s = block.stimuli;
+    const int n = static_cast<int>(s.size());
+    // The design's groups, as indices into the series in increasing order.
+    std::vector<std::vector<int>> groups;
+    if (block.task == Task::pair && block.design == "cyclic") {
+        for (int d = 1; d <= block.neighbours; ++d)
+            for (int i = 0; i < n; ++i) {
+                // With n even, d = n/2 pairs each stimulus with its opposite once, not
+                // twice.
+                if (2 * d == n && i >= d) continue;
+                const int j = (i + d) % n;
+                groups.push_back({std::min(i, j), std::max(i, j)});
+            }
+    } else {
+        const int k = pictures_per_trial(block.task);
+        std::vector<int> g(k);
+        // Every increasing k-subset, in lexicographic order.
+        std::function<void(int, int)> choose = [&](int from, int depth) {
+            if (depth == k) {
+                groups.push_back(g);
+                return;
+            }
+            for (int i = from; i <= n - (k - depth); ++i) {
+                g[depth] = i;
+                choose(i + 1, depth + 1);
+            }
+        };
+        choose(0, 0);
+    }
+    // Screen order: a pair's order, a triad forwards or backwards, a quadruple's pairs
+    // which first; the two orientations of each group equally often over the repeats
+    // (and over the groups when the repeats are odd).
+    std::vector<PlannedTrial> trials;
+    auto oriented = [&](const std::vector<int>& g, bool flip) {
+        std::vector<std::string> shown;
+        if (block.task == Task::quadruple) {
+            const std::vector<int> order =
+                flip ? std::vector<int>{g[2], g[3], g[0], g[1]} : g;
+            for (int i : order) shown.push_back(s[i]);
+        } else {
+            for (int i : g) shown.push_back(s[i]);
+            if (flip) std::reverse(shown.begin(), shown.end());
+        }
+        return shown;
+    };
+    for (int r = 0; r + 1 < block.repeats; r += 2)
+        for (const std::vector<int>& g : groups) {
+            trials.push_back(choice_trial(block, oriented(g, false)));
+            trials.push_back(choice_trial(block, oriented(g, true)));
+        }
+    if (block.repeats % 2 == 1) {
+        const std::vector<char> flips = balanced_flips(groups.size(), rng);
+        for (size_t i = 0; i < groups.size(); ++i)
+            trials.push_back(choice_trial(block, oriented(groups[i], flips[i])));
+    }
+    // Identical pairs: no right answer (they measure a preference for a side); the
+    // stimuli taken in turn from a random start.
+    const size_t start = n > 0 ? uniform_below(rng, static_cast<uint64_t>(n)) : 0;
+    for (int i = 0; i < block.identical_catch; ++i) {
+        const std::string& id = s[(start + i) % n];
+        PlannedTrial t = choice_trial(block, {id, id});
+        t.is_catch = true;
+        t.catch_id = "identical";
+        trials.push_back(t);
+    }
+    if (!block.obvious_catch.empty()) {
+        const std::string& low = block.obvious_catch[0];
+        const std::string& high = block.obvious_catch[1];
+        const std::vector<char> flips = balanced_flips(block.obvious_catch_repeats, rng);
+        for (char flip : flips) {
+            std::vector<std::string> shown;
+            int expected = 0;
+            switch (block.task) {
+                case Task::pair:
+                    shown = {low, high};
+                    expected = 2;
+                    break;
+                case Task::triad:  // (low, low) against (low, high)
+                    shown = {low, low, high};
+                    expected = 2;
+                    break;
+                default:
+                    shown = {low, low, low, high};
+                    expected = 2;
+                    break;
+            }
+            if (flip) {
+                if (block.task == Task::quadruple)
+                    shown = {shown[2], shown[3], shown[0], shown[1]};
+                else
+                    std::reverse(shown.begin(), shown.end());
+                expected = 1;
+            }
+            PlannedTrial t = choice_trial(block, shown);
+            t.is_catch = true;
+            t.catch_id = "obvious";
+            t.expected = expected;
+            trials.push_back(t);
+        }
+    }
+    return trials;
+}
+
+std::string sequence_level(const PlannedTrial& trial,
+                           const std::map<std::string, std::string>& level_of_stimulus) {
+    if (trial.shown.empty()) return level_of_stimulus.at(trial.stimulus);
+    std::vector<std::string> ids = trial.shown;
+    std::sort(ids.begin(), ids.end());
+    std::string level = "choice";
+    for (const std::string& id : ids) level += " " + id;
+    return level;
+}
+
 TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_number) {
     TrialPlan plan;
     for (const std::string& id : protocol.practice) {
@@ -282,6 +428,23 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
         t.stimulus = id;
         t.practice = true;
         plan.trials.push_back(t);
+    }
+    // Practice of the forced choices: the first trials of each choice block's design
+    // in a random order of its own (a stream apart from the main order's, so adding
+    // practice does not change the main trials).
+    std::mt19937_64 practice_rng(seed ^ 0x9e3779b97f4a7c15ULL);
+    for (const Block& block : protocol.blocks) {
+        if (!block.is_choice() || block.practice == 0) continue;
+        std::vector<PlannedTrial> pool = choice_block_trials(block, practice_rng);
+        pool.erase(std::remove_if(pool.begin(), pool.end(),
+                                  [](const PlannedTrial& t) { return t.is_catch; }),
+                   pool.end());
+        portable_shuffle(pool, practice_rng);
+        for (int i = 0; i < block.practice && !pool.empty(); ++i) {
+            PlannedTrial t = pool[i % pool.size()];
+            t.practice = true;
+            plan.trials.push_back(t);
+        }
     }
 
     const int n_blocks = static_cast<int>(protocol.blocks.size());
@@ -300,6 +463,13 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
         const Block& block = protocol.blocks[b];
         plan.block_order.push_back(block.id);
         std::vector<PlannedTrial>& trials = block_trials.emplace_back();
+        if (block.is_choice()) {
+            // Its own stream per block, so the design of one block does not depend on
+            // the order of the others.
+            std::mt19937_64 design_rng(seed + 0x632be59bd9b4e019ULL * (b + 1));
+            trials = choice_block_trials(block, design_rng);
+            continue;
+        }
         for (int r = 0; r < block.repeats; ++r)
             for (const std::string& id : block.stimuli) {
                 PlannedTrial t;
@@ -326,7 +496,7 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
         std::vector<std::vector<std::string>> levels(block_trials.size());
         for (size_t b = 0; b < block_trials.size(); ++b) {
             for (const PlannedTrial& t : block_trials[b])
-                levels[b].push_back(level_of.at(t.stimulus));
+                levels[b].push_back(sequence_level(t, level_of));
             try {
                 check_feasible(levels[b], constraints);
             } catch (const PlanError& e) {

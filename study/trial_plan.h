@@ -3,6 +3,7 @@
 // number). Pure and GL-free; the store writes the plan before trial 1 so a resumed
 // session continues in the same order.
 #include <cstdint>
+#include <map>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -29,6 +30,14 @@ struct PlannedTrial {
     int expected = 0;
     int tolerance = 0;
     bool break_before = false;  // show the break screen before this trial
+    Task task = Task::rating;   // the block's task (practice ratings: rating)
+    // Forced choices: the stimulus ids in screen order (left to right, or first to last
+    // when shown in sequence); `stimulus` is shown[0]. Empty for ratings. The answer is
+    // one response to the block's question_id, 1 or 2: pair: shown[0] or shown[1] is
+    // more X; triad: (shown[0], shown[1]) or (shown[1], shown[2]) differs more;
+    // quadruple: (shown[0], shown[1]) or (shown[2], shown[3]) differs more. Catch
+    // trials: `expected` is the right answer, 0 when there is none (identical pairs).
+    std::vector<std::string> shown;
 };
 
 struct TrialPlan {
@@ -86,6 +95,17 @@ std::vector<std::vector<int>> exact_block_shuffles(
 std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,
                                      const SequenceConstraints& c, uint64_t seed,
                                      int max_attempts = kMaxShuffleAttempts);
+
+// The trials of a forced-choice block in design order, before shuffling: every pair or
+// group of block.design, `repeats` times, its screen order counterbalanced (a pair's two
+// orders, a triad forwards and backwards, a quadruple's pairs either first, each equally
+// often over the block, odd counts split at random), then the catch trials.
+std::vector<PlannedTrial> choice_block_trials(const Block& block, std::mt19937_64& rng);
+
+// A trial's level for the sequence constraints: a rating's level of the protocol's
+// factor; a forced choice's unordered set of stimuli (the same pair is one level).
+std::string sequence_level(const PlannedTrial& trial,
+                           const std::map<std::string, std::string>& level_of_stimulus);
 
 // Practice trials first, in protocol order; then the blocks in Latin-square order,
 // shuffled by constrained_block_shuffles with the protocol's constraints on the whole

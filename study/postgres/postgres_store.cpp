@@ -376,18 +376,19 @@ SessionRow insert_session(pqxx::work& tx, int64_t study_id, int64_t participant_
             if (t.is_catch) {
                 catch_id = t.catch_id;
                 prompt = t.prompt;
-                expected = t.expected;
+                expected = expected_rating_column(t);
                 tolerance = t.tolerance;
             }
             tx.exec_params(
                 "INSERT INTO trials (session_id, position, block, stimulus_id, "
                 "practice, catch, catch_id, prompt, expected_rating, tolerance, "
-                "break_before, uuid) VALUES ($1, $2, $3, (SELECT id FROM stimuli "
-                "WHERE study_id = $4 AND stimulus_key = $5), $6, $7, $8, $9, $10, "
-                "$11, $12, $13)",
+                "break_before, uuid, task, shown) VALUES ($1, $2, $3, (SELECT id FROM "
+                "stimuli WHERE study_id = $4 AND stimulus_key = $5), $6, $7, $8, $9, "
+                "$10, $11, $12, $13, $14, $15)",
                 row.id, t.position, t.block, study_id, t.stimulus, t.practice ? 1 : 0,
                 t.is_catch ? 1 : 0, catch_id, prompt, expected, tolerance,
-                t.break_before ? 1 : 0, new_uuid_v4());
+                t.break_before ? 1 : 0, new_uuid_v4(), std::string(task_name(t.task)),
+                shown_column(t));
         }
     }
     return row;
@@ -490,8 +491,8 @@ std::vector<TrialRow> PostgresStore::trials(int64_t session_id) {
                 "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
                 "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
                 "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), "
-                "coalesce(t.uuid, '') FROM trials t JOIN stimuli st ON st.id = "
-                "t.stimulus_id "
+                "coalesce(t.uuid, ''), t.task, coalesce(t.shown, '') FROM trials t "
+                "JOIN stimuli st ON st.id = t.stimulus_id "
                 "WHERE t.session_id = $1 ORDER BY t.position",
                 session_id)) {
             TrialRow t;
@@ -506,6 +507,8 @@ std::vector<TrialRow> PostgresStore::trials(int64_t session_id) {
             t.break_before = r[8].as<int>() != 0;
             t.answered = r[9].as<bool>();
             t.uuid = r[10].as<std::string>();
+            t.task = task_column(r[11].as<std::optional<std::string>>());
+            t.shown = shown_from_text(r[12].as<std::string>());
             rows.push_back(std::move(t));
         }
         return rows;
@@ -536,7 +539,7 @@ PostgresStore::SessionCache& PostgresStore::session_cache(int64_t session_id) {
         SessionCache c;
         c.uuid = r[0][0].as<std::string>();
         try {
-            c.points = question_points(
+            c.questions = study_questions(
                 parse_protocol(r[0][2].as<std::string>(),
                                name_ + " (study '" + r[0][1].as<std::string>() + "')", "",
                                KnobCheck::lenient));
@@ -547,9 +550,11 @@ PostgresStore::SessionCache& PostgresStore::session_cache(int64_t session_id) {
         for (const pqxx::row& t :
              tx.exec_params("SELECT t.id, coalesce(t.uuid, ''), EXISTS (SELECT 1 FROM "
                             "responses x WHERE "
-                            "x.trial_id = t.id) FROM trials t WHERE t.session_id = $1",
+                            "x.trial_id = t.id), t.block FROM trials t WHERE "
+                            "t.session_id = $1",
                             session_id)) {
             c.trial_uuid[t[0].as<int64_t>()] = t[1].as<std::string>();
+            c.trial_block[t[0].as<int64_t>()] = t[3].as<std::string>();
             if (t[2].as<bool>()) c.answered.insert(t[0].as<int64_t>());
         }
         return c;

@@ -82,8 +82,9 @@ private:
     // while the server is away.
     struct SessionCache {
         std::string uuid;
-        QuestionPoints points;
-        std::map<int64_t, std::string> trial_uuid;  // trial id -> uuid
+        StudyQuestions questions;
+        std::map<int64_t, std::string> trial_uuid;   // trial id -> uuid
+        std::map<int64_t, std::string> trial_block;  // trial id -> block
         std::set<int64_t> answered;
     };
     enum class Sent { Stored, AlreadyThere, Withdrawn };

@@ -94,11 +94,14 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
     SessionCache& cache = session_cache(session_id);
     const auto uuid = cache.trial_uuid.find(trial_id);
     const bool part_of_session = uuid != cache.trial_uuid.end();
-    check_trial_answer(name_, session_id, trial_id,
-                       {.part_of_session = part_of_session,
-                        .answered = part_of_session && (cache.answered.count(trial_id) ||
-                                                        journal_.contains(uuid->second))},
-                       cache.points, outcome);
+    check_trial_answer(
+        name_, session_id, trial_id,
+        {.part_of_session = part_of_session,
+         .answered = part_of_session &&
+                     (cache.answered.count(trial_id) || journal_.contains(uuid->second))},
+        part_of_session ? cache.questions.of_block(cache.trial_block[trial_id])
+                        : cache.questions.rating,
+        outcome);
     const std::string where = name_ + ": trial " + std::to_string(trial_id);
     if (uuid->second.empty())
         throw StoreError(where +

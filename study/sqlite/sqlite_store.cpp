@@ -192,9 +192,9 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
     insert_segment(row.id, 1, env);
     Statement insert = db_.prepare(
         "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, "
-        "catch_id, prompt, expected_rating, tolerance, break_before, uuid) VALUES "
-        "(?, ?, ?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = ?), "
-        "?, ?, ?, ?, ?, ?, ?, ?)");
+        "catch_id, prompt, expected_rating, tolerance, break_before, uuid, task, shown) "
+        "VALUES (?, ?, ?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = "
+        "?), ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     for (const PlannedTrial& t : plan.trials) {
         insert.reset();
         insert.bind(1, row.id)
@@ -207,10 +207,14 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
         if (t.is_catch) {
             insert.bind(8, t.catch_id)
                 .bind(9, t.prompt)
-                .bind(10, t.expected)
+                .bind(10, expected_rating_column(t))
                 .bind(11, t.tolerance);
         }
-        insert.bind(12, t.break_before ? 1 : 0).bind(13, new_uuid_v4()).run();
+        insert.bind(12, t.break_before ? 1 : 0)
+            .bind(13, new_uuid_v4())
+            .bind(14, std::string(task_name(t.task)))
+            .bind(15, shown_column(t))
+            .run();
     }
     return row;
 }
@@ -288,7 +292,7 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
         "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
         "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
         "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), coalesce(t.uuid, "
-        "'') "
+        "''), t.task, coalesce(t.shown, '') "
         "FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
         "WHERE t.session_id = ? ORDER BY t.position");
     s.bind(1, session_id);
@@ -306,6 +310,9 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
         t.break_before = s.integer(8) != 0;
         t.answered = s.integer(9) != 0;
         t.uuid = s.text(10);
+        t.task = task_column(s.is_null(11) ? std::nullopt
+                                           : std::optional<std::string>(s.text(11)));
+        t.shown = shown_from_text(s.text(12));
         out.push_back(std::move(t));
     }
     return out;
@@ -490,13 +497,19 @@ bool Store::record_trial(int64_t session_id, int64_t trial_id,
     Transaction tx(db_);
     Statement facts = db_.prepare(
         "SELECT (SELECT count(*) FROM trials WHERE id = ? AND session_id = ?), "
-        "(SELECT count(*) FROM responses WHERE trial_id = ?)");
-    facts.bind(1, trial_id).bind(2, session_id).bind(3, trial_id);
+        "(SELECT count(*) FROM responses WHERE trial_id = ?), "
+        "(SELECT block FROM trials WHERE id = ? AND session_id = ?)");
+    facts.bind(1, trial_id)
+        .bind(2, session_id)
+        .bind(3, trial_id)
+        .bind(4, trial_id)
+        .bind(5, session_id);
     facts.step();
+    const std::string block = facts.is_null(2) ? std::string() : facts.text(2);
     check_trial_answer(
         db_.path(), session_id, trial_id,
         {.part_of_session = facts.integer(0) == 1, .answered = facts.integer(1) != 0},
-        question_points_of_session(session_id), outcome);
+        questions_of_session(session_id).of_block(block), outcome);
     Statement insert = db_.prepare(
         "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
         "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
@@ -544,15 +557,15 @@ bool Store::complete_session_if_answered(int64_t session_id) {
     return s.step() && s.integer(0) != 0;
 }
 
-const QuestionPoints& Store::question_points_of_session(int64_t session_id) {
-    auto it = question_points_by_session_.find(session_id);
-    if (it != question_points_by_session_.end()) return it->second;
+const StudyQuestions& Store::questions_of_session(int64_t session_id) {
+    auto it = questions_by_session_.find(session_id);
+    if (it != questions_by_session_.end()) return it->second;
     Statement s = db_.prepare("SELECT study_id FROM sessions WHERE id = ?");
     s.bind(1, session_id);
     if (!s.step())
         throw StoreError(db_.path() + ": no session " + std::to_string(session_id));
-    return question_points_by_session_
-        .emplace(session_id, stored_question_points(db_, s.integer(0)))
+    return questions_by_session_
+        .emplace(session_id, stored_study_questions(db_, s.integer(0)))
         .first->second;
 }
 

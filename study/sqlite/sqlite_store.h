@@ -93,10 +93,10 @@ private:
                               const SessionEnvironment& env, const std::string& uuid,
                               const std::string& allocation);
 
-    const QuestionPoints& question_points_of_session(int64_t session_id);
+    const StudyQuestions& questions_of_session(int64_t session_id);
 
     Database db_;
-    std::map<int64_t, QuestionPoints> question_points_by_session_;  // parsed once
+    std::map<int64_t, StudyQuestions> questions_by_session_;  // parsed once
     int claim_fd_ = -1;  // the participant lock file, once something is claimed
     std::map<std::string, int64_t> claimed_;  // code -> its locked byte
 };

@@ -112,6 +112,79 @@ prompt = "Choose 7"
 expected = 7
 )toml";
 
+// Forced choices beside ratings: 5 stimuli of a thickness series, a rating block, a
+// pair block (all pairs, repeated twice, 2 identical and 1 obvious catch trials, 1
+// practice trial) and a triad block (MLDS) in sequence.
+inline const char* kChoiceProtocol = R"toml(
+[study]
+name = "choices"
+
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+
+[[stimuli]]
+id = "s1"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 10 }
+
+[[stimuli]]
+id = "s2"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 15 }
+
+[[stimuli]]
+id = "s3"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 20 }
+
+[[stimuli]]
+id = "s4"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 25 }
+
+[[stimuli]]
+id = "s5"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 30 }
+
+[[blocks]]
+id = "ratings"
+stimuli = ["s1", "s3", "s5"]
+
+[[blocks]]
+id = "pairs"
+task = "pair"
+stimuli = ["s1", "s2", "s3", "s4", "s5"]
+question = "Which looks more translucent?"
+question_id = "more_translucent"
+repeats = 2
+identical_catch = 2
+obvious_catch = ["s5", "s1"]
+series = "thickness_exponent"
+practice = 1
+
+[[blocks]]
+id = "mlds"
+task = "triad"
+stimuli = ["s1", "s2", "s3", "s4", "s5"]
+question = "Which pair differs more?"
+series = "thickness_exponent"
+presentation = "sequential"
+duration_ms = 800
+blank_ms = 300
+obvious_catch = ["s1", "s5"]
+)toml";
+
+inline study::Protocol choice_protocol() {
+    return study::parse_protocol(kChoiceProtocol, "choices.toml");
+}
+
 inline study::Protocol small_protocol() {
     return study::parse_protocol(kSmallProtocol, "small.toml");
 }
@@ -138,11 +211,24 @@ inline int rating_for(int position, int question) {
     return 1 + (position * 3 + question * 2) % 7;
 }
 
+// Deterministic choice (1 or 2) of a forced-choice trial at `position`.
+inline int choice_for(int position) { return 1 + (position * 5 + 1) % 3 % 2; }
+
 inline study::TrialOutcome outcome_for(const study::Protocol& p, const study::TrialRow& t,
                                        int catch_rating = 7) {
     study::TrialOutcome o;
     o.onset_ns = 1000000LL * (t.position + 1);
     o.confirm_ns = o.onset_ns + 900000000LL;
+    if (t.task != study::Task::rating) {
+        study::Response r;
+        r.question = p.find_block(t.block)->question_id;
+        r.rating = t.is_catch && t.expected > 0 ? t.expected : choice_for(t.position);
+        r.rt_ms = 700.0 + t.position;
+        r.first_choice_ns = o.onset_ns + 100;
+        r.final_choice_ns = o.onset_ns + 200;
+        o.responses.push_back(r);
+        return o;
+    }
     for (int q = 0; q < static_cast<int>(p.questions.size()); ++q) {
         study::Response r;
         r.question = p.questions[q].id;
