@@ -672,7 +672,9 @@ Protocol load_protocol_file(const std::string& path) {
                           std::filesystem::absolute(path).parent_path().string());
 }
 
-std::vector<std::string> builtin_protocol_names() { return {"thesis", "fabrics"}; }
+std::vector<std::string> builtin_protocol_names() {
+    return {"thesis", "fabrics", "scaling"};
+}
 
 Protocol builtin_protocol(std::string_view name) {
     std::optional<std::string_view> text =

@@ -1,0 +1,114 @@
+#include "study/simulated_observer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+namespace lucent::study {
+
+ObserverModel ObserverModel::parse(const std::string& text) {
+    ObserverModel m;
+    std::vector<double> parts;
+    std::istringstream in(text);
+    for (std::string item; std::getline(in, item, ',');) {
+        char* end = nullptr;
+        const double v = std::strtod(item.c_str(), &end);
+        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v))
+            throw std::invalid_argument("observer '" + text + "': '" + item +
+                                        "' is not a number (expected EXPONENT,SIGMA"
+                                        "[,LAPSE])");
+        parts.push_back(v);
+    }
+    if (parts.size() < 2 || parts.size() > 3)
+        throw std::invalid_argument("observer '" + text +
+                                    "': expected EXPONENT,SIGMA[,LAPSE]");
+    m.exponent = parts[0];
+    m.sigma = parts[1];
+    m.lapse = parts.size() == 3 ? parts[2] : 0.0;
+    if (!(m.exponent > 0 && m.exponent <= 10))
+        throw std::invalid_argument("observer '" + text +
+                                    "': EXPONENT must be in (0, 10]");
+    if (!(m.sigma >= 0 && m.sigma <= 10))
+        throw std::invalid_argument("observer '" + text + "': SIGMA must be in [0, 10]");
+    if (!(m.lapse >= 0 && m.lapse <= 1))
+        throw std::invalid_argument("observer '" + text + "': LAPSE must be in [0, 1]");
+    return m;
+}
+
+std::string ObserverModel::describe() const {
+    std::ostringstream out;
+    out << "psi = x^" << exponent << ", sigma " << sigma << ", lapse " << lapse;
+    return out.str();
+}
+
+double ObserverModel::scale(double value, double lo, double hi) const {
+    if (!(hi > lo)) return 0.0;
+    const double x = std::clamp((value - lo) / (hi - lo), 0.0, 1.0);
+    return std::pow(x, exponent);
+}
+
+ChoiceStimuli choice_stimuli(const Protocol& protocol, const std::string& block,
+                             const std::vector<std::string>& shown) {
+    ChoiceStimuli out;
+    const Block* b = protocol.find_block(block);
+    if (!b) return out;
+    out.task = b->task;
+    if (b->series.empty()) return out;
+    auto value_of = [&](const std::string& id) -> std::optional<double> {
+        const StimulusSpec* s = protocol.find_stimulus(id);
+        if (!s) return std::nullopt;
+        const auto it = s->parameters.find(b->series);
+        if (it == s->parameters.end()) return std::nullopt;
+        char* end = nullptr;
+        const double v = std::strtod(it->second.c_str(), &end);
+        if (end == it->second.c_str() || !std::isfinite(v)) return std::nullopt;
+        return v;
+    };
+    std::vector<double> values;
+    for (const std::string& id : shown) {
+        const std::optional<double> v = value_of(id);
+        if (!v) return out;
+        values.push_back(*v);
+    }
+    std::optional<double> lo, hi;
+    for (const std::string& id : b->stimuli)
+        if (const std::optional<double> v = value_of(id)) {
+            lo = lo ? std::min(*lo, *v) : *v;
+            hi = hi ? std::max(*hi, *v) : *v;
+        }
+    if (!lo || !hi) return out;
+    out.values = std::move(values);
+    out.lo = *lo;
+    out.hi = *hi;
+    return out;
+}
+
+int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
+                     std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    std::normal_distribution<double> noise(0.0, observer.sigma);
+    const bool lapse = observer.lapse > 0 && uniform(rng) < observer.lapse;
+    const size_t needed = static_cast<size_t>(pictures_per_trial(trial.task));
+    if (lapse || trial.values.size() != needed) return uniform(rng) < 0.5 ? 1 : 2;
+    std::vector<double> psi;
+    for (double v : trial.values) psi.push_back(observer.scale(v, trial.lo, trial.hi));
+    const double e = observer.sigma > 0 ? noise(rng) : 0.0;
+    switch (trial.task) {
+        case Task::pair: {
+            // Each picture its own noise: the difference has variance 2 sigma^2.
+            const double e2 = observer.sigma > 0 ? noise(rng) : 0.0;
+            return psi[0] + e >= psi[1] + e2 ? 1 : 2;
+        }
+        case Task::triad:
+            return std::abs(psi[1] - psi[0]) - std::abs(psi[2] - psi[1]) + e >= 0 ? 1 : 2;
+        case Task::quadruple:
+            return std::abs(psi[1] - psi[0]) - std::abs(psi[3] - psi[2]) + e >= 0 ? 1 : 2;
+        case Task::rating:
+            break;
+    }
+    return 1;
+}
+
+}  // namespace lucent::study

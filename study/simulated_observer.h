@@ -1,0 +1,54 @@
+#pragma once
+// A simulated observer of forced choices with a known perceptual scale, so a test can
+// check that the scaling recovers it (issue 30): the autopilot of `lucent run`, and the
+// scripted participants of `lucent serve`'s tests, answer pairs, triads and quadruples
+// with it. GL-free.
+//
+// The scale over a block's series is psi(v) = ((v - lo) / (hi - lo))^exponent, 0 at
+// the series' low end and 1 at its high end. A pair is judged as Thurstone's Case V
+// observer judges it: the stimulus with the larger psi + N(0, sigma^2) (each picture
+// its own noise) looks "more"; an MLDS triad or quadruple as Maloney and Yang's
+// observer: the pair whose |psi difference| is larger after adding N(0, sigma^2) to the
+// difference of the two differences. So the fitted MLDS scale (psi_1 = 0, psi_p = 1) is
+// psi at the series' values with the GLM's sigma = `sigma`, and the fitted Thurstone
+// Case V scale is psi / (sigma * sqrt(2)) up to its reference.
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "study/protocol.h"
+
+namespace lucent::study {
+
+struct ObserverModel {
+    double exponent = 0.5;  // the scale's shape (1: linear in the series' value)
+    double sigma = 0.1;     // decision noise, in units of the scale's range
+    double lapse = 0.0;     // share of choices made at random (a coin flip)
+
+    // "EXPONENT,SIGMA" or "EXPONENT,SIGMA,LAPSE" (e.g. "0.5,0.1"); throws
+    // std::invalid_argument naming the bad part.
+    static ObserverModel parse(const std::string& text);
+    std::string describe() const;  // "psi = x^0.5, sigma 0.1, lapse 0"
+
+    // psi of a value on the series [lo, hi] (clamped to it).
+    double scale(double value, double lo, double hi) const;
+};
+
+// The series a choice trial is judged on: the block's `series` parameter of each
+// stimulus shown, and of the block's first and last stimulus (its ends). Empty
+// `values` when the block names no series (the observer then chooses at random).
+struct ChoiceStimuli {
+    Task task = Task::pair;
+    std::vector<double> values;  // one per picture shown, in screen order
+    double lo = 0, hi = 1;
+};
+ChoiceStimuli choice_stimuli(const Protocol& protocol, const std::string& block,
+                             const std::vector<std::string>& shown);
+
+// The observer's answer, 1 or 2 (PlannedTrial::shown says what each means).
+int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
+                     std::mt19937_64& rng);
+
+}  // namespace lucent::study
