@@ -16,10 +16,12 @@ const std::set<std::string> kKeys = {"1",     "2",  "3",    "4",     "5",      "
 
 }  // namespace
 
-Autopilot Autopilot::from_seed(uint64_t seed, double speed) {
+Autopilot Autopilot::from_seed(uint64_t seed, double speed,
+                               const ObserverModel& observer) {
     Autopilot a;
     a.rng_.seed(seed);
     a.speed_ = speed > 0 ? speed : 1.0;
+    a.observer_ = observer;
     return a;
 }
 
@@ -45,9 +47,10 @@ Autopilot Autopilot::from_file(const std::string& path) {
     return a;
 }
 
-Autopilot Autopilot::from_argument(const std::string& argument, double speed) {
+Autopilot Autopilot::from_argument(const std::string& argument, double speed,
+                                   const ObserverModel& observer) {
     if (!argument.empty() && std::all_of(argument.begin(), argument.end(), ::isdigit))
-        return from_seed(std::stoull(argument), speed);
+        return from_seed(std::stoull(argument), speed, observer);
     return from_file(argument);
 }
 
@@ -73,6 +76,13 @@ void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
         case ScreenView::Kind::Pause:
             press(delay_ms(800), "Enter");
             break;
+        case ScreenView::Kind::Choice: {
+            // Look, pick a side with an arrow, confirm.
+            const int choice = simulated_choice(observer_, view.choice, rng_);
+            press(delay_ms(900), choice == 1 ? "Left" : "Right");
+            press(delay_ms(250), "Enter");
+            break;
+        }
         case ScreenView::Kind::Rating: {
             std::bernoulli_distribution change_mind(0.15);
             for (size_t q = 0; q < view.points.size(); ++q) {

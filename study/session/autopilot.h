@@ -2,22 +2,26 @@
 // A simulated participant for end-to-end tests and demos. It decides *which* key to
 // press and *when* (seeded, human-like delays); the runner sends each key as a real X
 // key event through XTest (x_keyboard.h), so it reaches GLFW exactly as a keyboard's.
-// GL-free and X-free, so its timing model is unit-tested.
+// GL-free and X-free, so its timing model is unit-tested. It answers forced choices as a
+// simulated observer with a known perceptual scale.
 #include <cstdint>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "study/simulated_observer.h"
+
 namespace lucent::study {
 
 // What is on screen, as far as a participant can tell.
 struct ScreenView {
-    enum class Kind { Text, Rating, Blank, Pause };
+    enum class Kind { Text, Rating, Choice, Blank, Pause };
     Kind kind = Kind::Blank;
     int serial = 0;           // increases whenever a new screen appears
     std::vector<int> points;  // rating screens: each question's scale length
     bool is_catch = false;    // catch trials: the prompt asks for `expected`
     int expected = 0;
+    ChoiceStimuli choice;  // forced choices: what the observer judges
 };
 
 struct ScheduledKey {
@@ -29,13 +33,17 @@ struct ScheduledKey {
 class Autopilot {
 public:
     // Seeded participant; `speed` divides every delay (1 = human-like, 20 = fast tests).
-    static Autopilot from_seed(uint64_t seed, double speed = 1.0);
+    // Forced choices are answered by `observer` (simulated_observer.h), so a fitted
+    // scale can be checked against the observer's.
+    static Autopilot from_seed(uint64_t seed, double speed = 1.0,
+                               const ObserverModel& observer = {});
     // A script: one "DELAY_MS KEY" per line (# comments), played in order from the
     // session's first frame, whatever is on screen: the runner hands it to the X server
     // at once (XKeyboard::play). Throws std::runtime_error naming file:line.
     static Autopilot from_file(const std::string& path);
     // The argument of --autopilot: digits are a seed, anything else a script file.
-    static Autopilot from_argument(const std::string& argument, double speed);
+    static Autopilot from_argument(const std::string& argument, double speed,
+                                   const ObserverModel& observer = {});
 
     // A seeded participant's keys due at `now_ns` for the screen shown; call once per
     // frame. (A script's keys are not due here: see script().)
@@ -51,6 +59,7 @@ private:
     bool scripted_ = false;
     std::mt19937_64 rng_;
     double speed_ = 1.0;
+    ObserverModel observer_;
     int planned_serial_ = -1;
     std::vector<std::pair<double, std::string>> script_;  // (delay ms, key)
     std::vector<ScheduledKey> queue_;

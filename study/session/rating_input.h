@@ -1,7 +1,8 @@
 #pragma once
 // The rating screen's input rules, GL-free so they are unit-tested: keys 1-7, arrows and
 // Enter, or clicks; no answer is preselected; every change is counted and timed. Each
-// question has its own scale length (2 to 7 points).
+// question has its own scale length (2 to 7 points). A forced choice is one question
+// of two alternatives, picked directly by the arrows.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -17,6 +18,11 @@ class RatingInput {
 public:
     // points[q]: the scale length of question q.
     RatingInput(std::vector<int> points, int64_t onset_ns);
+    // A forced choice (pair, triad, quadruple): one "question" of 2 alternatives; Left
+    // and Right (or 1 and 2) pick the first or the second, Enter confirms, a click on
+    // an alternative picks it (the flow confirms it at once).
+    static RatingInput forced_choice(int64_t onset_ns);
+    bool is_choice() const { return choice_; }
     // `questions` questions on the same `points`-point scale.
     RatingInput(int questions, int points, int64_t onset_ns)
         : RatingInput(std::vector<int>(questions, points), onset_ns) {}
@@ -46,6 +52,7 @@ private:
     std::vector<State> state_;
     std::vector<int> points_;
     int64_t onset_ns_;
+    bool choice_ = false;
     int focus_ = 0;
     bool confirmed_ = false;
     int64_t confirm_ns_ = 0;

@@ -46,6 +46,32 @@ const std::string& SessionFlow::text() const {
     }
 }
 
+const Block* SessionFlow::block() const {
+    const TrialRow* t = trial();
+    return t ? protocol_.find_block(t->block) : nullptr;
+}
+
+bool SessionFlow::choice_trial() const {
+    return current_ < trials_.size() && trials_[current_].task != Task::rating;
+}
+
+std::optional<ChoicePhase> SessionFlow::choice_phase() const {
+    if (screen_ != Screen::Trial || !choice_trial()) return std::nullopt;
+    return phase_;
+}
+
+void SessionFlow::start_trial_presentation() {
+    input_.reset();
+    trial_frames_ns_.clear();
+    trial_onset_ns_.reset();
+    const Block* b = current_ < trials_.size()
+                         ? protocol_.find_block(trials_[current_].block)
+                         : nullptr;
+    phase_ = choice_trial() && b && b->presentation == Presentation::sequential
+                 ? ChoicePhase::First
+                 : ChoicePhase::Answer;
+}
+
 int SessionFlow::main_trials_done() const {
     int n = 0;
     for (size_t i = 0; i < current_; ++i) n += trials_[i].practice ? 0 : 1;
@@ -67,10 +93,16 @@ ScreenView SessionFlow::view() const {
     }
     switch (screen_) {
         case Screen::Trial:
-            v.kind = input_ ? ScreenView::Kind::Rating : ScreenView::Kind::Blank;
-            for (const Question& q : protocol_.questions) v.points.push_back(q.points());
             v.is_catch = trials_[current_].is_catch;
             v.expected = trials_[current_].expected;
+            if (choice_trial()) {
+                v.kind = input_ ? ScreenView::Kind::Choice : ScreenView::Kind::Blank;
+                v.choice = choice_stimuli(protocol_, trials_[current_].block,
+                                          trials_[current_].shown);
+                break;
+            }
+            v.kind = input_ ? ScreenView::Kind::Rating : ScreenView::Kind::Blank;
+            for (const Question& q : protocol_.questions) v.points.push_back(q.points());
             break;
         case Screen::Blank:
         case Screen::Done:
@@ -91,8 +123,7 @@ void SessionFlow::changed() {
 void SessionFlow::enter(Screen screen, int64_t t_ns) {
     screen_ = screen;
     entered_ns_ = t_ns;
-    input_.reset();
-    trial_frames_ns_.clear();
+    start_trial_presentation();
     changed();
 }
 
@@ -101,25 +132,49 @@ void SessionFlow::begin_trial_or_debrief(int64_t t_ns) {
 }
 
 void SessionFlow::tick(int64_t now_ns) {
-    if (finished_ || paused_ || screen_ != Screen::Blank) return;
-    if (now_ns - entered_ns_ >= protocol_.inter_trial_ms * 1'000'000LL)
-        enter(Screen::Trial, now_ns);
+    if (finished_ || paused_) return;
+    if (screen_ == Screen::Blank) {
+        if (now_ns - entered_ns_ >= protocol_.inter_trial_ms * 1'000'000LL)
+            enter(Screen::Trial, now_ns);
+        return;
+    }
+    // A sequence moves on once each part has been on the display for its duration,
+    // counted from the frame that showed it.
+    if (screen_ != Screen::Trial || phase_ == ChoicePhase::Answer || !presented_ns_)
+        return;
+    const Block* b = block();
+    const int ms = phase_ == ChoicePhase::Gap ? b->blank_ms : b->duration_ms;
+    if (now_ns - *presented_ns_ < ms * 1'000'000LL) return;
+    phase_ = static_cast<ChoicePhase>(static_cast<int>(phase_) + 1);
+    changed();
 }
 
 void SessionFlow::presented(int serial, int64_t t_ns) {
     if (finished_ || serial != serial_) return;  // a frame of a screen already left
     if (!presented_ns_) {
         presented_ns_ = t_ns;
-        if (screen_ == Screen::Trial && !paused_) {  // the stimulus onset
-            std::vector<int> points;
-            for (const Question& q : protocol_.questions) points.push_back(q.points());
-            input_.emplace(std::move(points), t_ns);
-            trial_frames_ns_.assign(1, t_ns);
-            ++serial_;  // the rating screen is a new view (same presentation)
+        if (screen_ == Screen::Trial && !paused_) {
+            if (!trial_onset_ns_) {  // the stimulus onset
+                trial_onset_ns_ = t_ns;
+                trial_frames_ns_.assign(1, t_ns);
+            } else {
+                trial_frames_ns_.push_back(t_ns);
+            }
+            if (phase_ != ChoicePhase::Answer) return;  // a sequence: not answerable yet
+            if (choice_trial()) {
+                input_.emplace(RatingInput::forced_choice(t_ns));
+            } else {
+                std::vector<int> points;
+                for (const Question& q : protocol_.questions)
+                    points.push_back(q.points());
+                input_.emplace(std::move(points), t_ns);
+            }
+            ++serial_;  // the answer screen is a new view (same presentation)
         }
         return;
     }
-    if (screen_ == Screen::Trial && input_ && !paused_) trial_frames_ns_.push_back(t_ns);
+    if (screen_ == Screen::Trial && trial_onset_ns_ && !paused_)
+        trial_frames_ns_.push_back(t_ns);
 }
 
 void SessionFlow::key(const TimedKey& press) {
@@ -131,11 +186,9 @@ void SessionFlow::key(const TimedKey& press) {
         if (press.key == Key::Enter || press.key == Key::Resume) {
             paused_ = false;
             changed();
-            // A trial starts again from a new onset, without answers: RTs skip the pause.
-            if (screen_ == Screen::Trial) {
-                input_.reset();
-                trial_frames_ns_.clear();
-            }
+            // A trial starts again from a new onset, without answers: RTs skip the pause
+            // (a sequence is shown again from its first part).
+            if (screen_ == Screen::Trial) start_trial_presentation();
         } else if (press.key == Key::Quit) {
             quit_saving();
         }
@@ -226,6 +279,15 @@ void SessionFlow::click_next(int64_t t_ns) {
     if (input_->confirmed()) finish_trial();
 }
 
+void SessionFlow::click_choice(int alternative, int64_t t_ns) {
+    if (finished_ || paused_ || !input_ || !input_->is_choice() || !presented_ns_ ||
+        t_ns < *presented_ns_)
+        return;
+    input_->click(0, alternative, t_ns);
+    input_->click_next(t_ns);
+    if (input_->confirmed()) finish_trial();
+}
+
 void SessionFlow::window_closed() {
     if (finished_) return;
     if (screen_ == Screen::Debrief || screen_ == Screen::Done) {  // already completed
@@ -244,9 +306,12 @@ void SessionFlow::quit_saving() {
 void SessionFlow::finish_trial() {
     const TrialRow& t = trials_[current_];
     std::vector<std::string> ids;
-    for (const Question& q : protocol_.questions) ids.push_back(q.id);
+    if (choice_trial())
+        ids.push_back(protocol_.find_block(t.block)->question_id);
+    else
+        for (const Question& q : protocol_.questions) ids.push_back(q.id);
     TrialOutcome outcome;
-    outcome.onset_ns = *presented_ns_;
+    outcome.onset_ns = *trial_onset_ns_;
     outcome.confirm_ns = input_->confirm_ns();
     outcome.responses = input_->responses(ids);
     if (refresh_hz_)

@@ -33,6 +33,12 @@ enum class Screen {
     Done
 };
 
+// A forced choice on the Trial screen. Side by side: Answer from the onset (every
+// picture on screen with the two answers). In sequence: the first picture (a pair's
+// first, an MLDS trial's first pair) for the block's duration_ms, a blank for
+// blank_ms, the second for duration_ms, then Answer (the two answers only).
+enum class ChoicePhase { First, Gap, Second, Answer };
+
 // How a session ended, mapped to exit codes by the caller.
 enum class RunResult { Completed, SavedAndQuit, Declined, UsageError, Failure };
 
@@ -58,6 +64,9 @@ public:
     // The mouse on the rating screen: a point on a scale, the "Next" button.
     void click_point(int question, int value, int64_t t_ns);
     void click_next(int64_t t_ns);
+    // A click on a forced choice's alternative (1 or 2: a picture, or a pair's group):
+    // picks it and confirms at once.
+    void click_choice(int alternative, int64_t t_ns);
     void window_closed();  // by the window manager; saves and quits unless completed
     // Time passes: the blank between trials gives way to the stimulus.
     void tick(int64_t now_ns);
@@ -79,6 +88,10 @@ public:
     // The trial on a Blank or Trial screen; the rating input once the stimulus is shown.
     const TrialRow* trial() const;
     const RatingInput* rating() const { return input_ ? &*input_ : nullptr; }
+    // The block of the trial on screen (nullptr between trials).
+    const Block* block() const;
+    // On a forced choice's Trial screen, what it shows now; nullopt otherwise.
+    std::optional<ChoicePhase> choice_phase() const;
     const std::string& text()
         const;  // Consent, Instructions, PracticeDone, Break, Debrief
     size_t answered_trials() const { return current_; }
@@ -93,6 +106,8 @@ private:
     void begin_trial_or_debrief(int64_t t_ns);
     void finish_trial();
     void quit_saving();
+    bool choice_trial() const;
+    void start_trial_presentation();  // phase and input back to the trial's start
 
     const Protocol& protocol_;
     StudyStore& store_;
@@ -107,6 +122,8 @@ private:
     int64_t entered_ns_ = 0;
     std::optional<int64_t> presented_ns_;
     std::optional<RatingInput> input_;
+    ChoicePhase phase_ = ChoicePhase::Answer;
+    std::optional<int64_t> trial_onset_ns_;  // the trial's first picture on the display
     std::vector<int64_t> trial_frames_ns_;
     std::optional<double> refresh_hz_;
 };

@@ -383,5 +383,84 @@ TEST_F(Flow, EachQuestionKeepsItsOwnScale) {
     EXPECT_EQ(count("SELECT rating FROM responses WHERE question = 'realistic'"), 5);
 }
 
+// Forced choices (issue 30): the arrows pick the alternative on their side, Enter
+// confirms, and the stored choice is 1 or 2 of the screen order.
+TEST_F(Flow, APairIsAnsweredWithTheArrowOfItsSideAndStoredAsThatAlternative) {
+    open(lucent::test::kChoiceProtocol, true);
+    // Walk to the first pair trial (the practice pair comes first).
+    frame();
+    press(Key::Enter);  // the (empty) instructions
+    until_rating();
+    const TrialRow* t = flow_->trial();
+    ASSERT_NE(t, nullptr);
+    ASSERT_EQ(t->task, Task::pair);
+    EXPECT_EQ(flow_->choice_phase(), ChoicePhase::Answer);
+    EXPECT_EQ(flow_->view().kind, ScreenView::Kind::Choice);
+    const int64_t trial_id = t->id;
+    press(Key::Left);
+    press(Key::Right);  // a change of mind
+    press(Key::Enter);
+    Database d(db_path_, SQLITE_OPEN_READONLY);
+    Statement s =
+        d.prepare("SELECT question, rating, changes FROM responses WHERE trial_id = ?");
+    s.bind(1, trial_id);
+    ASSERT_TRUE(s.step());
+    EXPECT_EQ(s.text(0), "more_translucent");
+    EXPECT_EQ(s.integer(1), 2);
+    EXPECT_EQ(s.integer(2), 1);
+    EXPECT_FALSE(s.step());
+}
+
+TEST_F(Flow, ASequenceShowsEachPartForItsDurationBeforeItCanBeAnswered) {
+    open(lucent::test::kChoiceProtocol, true);
+    // Answer trials until an MLDS triad (sequential: 800 ms, 300 ms blank, 800 ms).
+    for (int guard = 0; guard < 60; ++guard) {
+        for (int i = 0; i < 200 && flow_->screen() != Screen::Trial; ++i) {
+            if (flow_->screen() != Screen::Blank) press(Key::Enter);
+            frame();
+        }
+        ASSERT_EQ(flow_->screen(), Screen::Trial);
+        if (flow_->trial()->task == Task::triad) break;
+        until_rating();
+        press(Key::Digit, 1);
+        press(Key::Enter);
+    }
+    ASSERT_EQ(flow_->trial()->task, Task::triad);
+    const int64_t first_shown = now_;  // the frame that left the blank showed it
+    EXPECT_EQ(flow_->choice_phase(), ChoicePhase::First);
+    EXPECT_EQ(flow_->rating(), nullptr);
+    press(Key::Left, 0, 10);  // too early: nothing to answer yet
+    std::vector<std::pair<ChoicePhase, int64_t>> changes;
+    for (int i = 0; i < 300 && !flow_->rating(); ++i) {
+        const auto before = flow_->choice_phase();
+        frame();
+        if (flow_->choice_phase() != before)
+            changes.emplace_back(*flow_->choice_phase(), now_);
+    }
+    ASSERT_EQ(changes.size(), 3u);
+    EXPECT_EQ(changes[0].first, ChoicePhase::Gap);
+    EXPECT_EQ(changes[1].first, ChoicePhase::Second);
+    EXPECT_EQ(changes[2].first, ChoicePhase::Answer);
+    // Each part lasted its duration, to within a frame (16 ms) of the fake display.
+    EXPECT_GE(changes[0].second - first_shown, 800 * kMs);
+    EXPECT_LT(changes[0].second - first_shown, (800 + 2 * 16) * kMs);
+    EXPECT_GE(changes[1].second - changes[0].second, 300 * kMs);
+    EXPECT_LT(changes[1].second - changes[0].second, (300 + 2 * 16) * kMs);
+    EXPECT_GE(changes[2].second - changes[1].second, 800 * kMs);
+    ASSERT_NE(flow_->rating(), nullptr);
+    EXPECT_FALSE(flow_->rating()->rating(0).has_value());  // the early key did nothing
+    const int64_t trial_id = flow_->trial()->id;
+    flow_->click_choice(1, now_ + 5 * kMs);  // one click answers
+    Database d(db_path_, SQLITE_OPEN_READONLY);
+    Statement s = d.prepare(
+        "SELECT r.question, r.rating, t.onset_ns FROM responses r JOIN trials t ON "
+        "t.id = r.trial_id WHERE r.trial_id = ?");
+    s.bind(1, trial_id);
+    ASSERT_TRUE(s.step());
+    EXPECT_EQ(s.text(0), "mlds");
+    EXPECT_EQ(s.integer(1), 1);
+    EXPECT_EQ(s.integer(2), first_shown);  // the onset is the first part's
+}
+
 }  // namespace
 }  // namespace lucent::study
