@@ -1,9 +1,19 @@
 #pragma once
-// Where the stimulus and the rating panel go on screen (GL-free, unit-tested).
+// Where the stimulus and the rating panel go on screen, and where a forced choice's
+// pictures, question, answers and click targets go (GL-free, unit-tested).
+#include <array>
+#include <vector>
+
+#include "study/protocol.h"
+
 namespace lucent::study {
 
 struct Rect {
     int x = 0, y = 0, width = 0, height = 0;  // pixels, origin top-left
+    bool contains(int px, int py) const {
+        return px >= x && px < x + width && py >= y && py < y + height;
+    }
+    bool operator==(const Rect&) const = default;
 };
 
 struct ScreenLayout {
@@ -16,5 +26,58 @@ struct ScreenLayout {
 // per question (statement, scale) and the Next button, each `row_height` pixels.
 ScreenLayout compute_layout(int screen_width, int screen_height, int image_width,
                             int image_height, int questions, int row_height);
+
+// ---- forced choices (issue 30) -------------------------------------------------------
+// What a choice trial's screen shows now. Side by side: `all` (every picture with the
+// two answers under them). In sequence: the first part (a pair's first picture, an MLDS
+// trial's first pair), nothing (the blank), the second part, then the two answers.
+enum class ChoiceShow { all, first_part, second_part, nothing, answers };
+
+struct PictureSize {
+    int width = 0, height = 0;
+};
+
+struct ChoiceLayoutInput {
+    int screen_width = 0, screen_height = 0;
+    Task task = Task::pair;  // pair, triad or quadruple
+    ChoiceShow show = ChoiceShow::all;
+    std::vector<PictureSize> pictures;  // every picture of the trial, in screen order
+    int row_height = 32;  // one line of text (the question, an answer's label)
+    int gap = 24;         // between two pictures
+    int group_gap = 96;   // between a quadruple's two pairs
+};
+
+struct ChoiceLayout {
+    // False when the window is too small to show what `show` shows pixel for pixel with
+    // the question and the answers: the trial waits (nothing else below is set).
+    bool fits = true;
+    // The pictures on screen now, pixel for pixel (never scaled): picture[k] shows the
+    // trial's picture index[k] (an index into ChoiceLayoutInput::pictures).
+    std::vector<Rect> picture;
+    std::vector<int> index;
+    Rect question;  // one row above the pictures (or the answer boxes), screen wide
+    // The two answers' names, under what they name: a pair's pictures; an MLDS trial's
+    // pairs (under a bracket spanning each pair); the answer boxes in sequence.
+    std::array<Rect, 2> label;
+    // MLDS side by side: each pair's bracket, its ticks going up at x and x + width from
+    // y + height to y; a triad's two meet at the middle picture's centre. Empty (width
+    // 0) otherwise.
+    std::array<Rect, 2> bracket;
+    // In sequence, the Answer phase's two boxes (the labels sit in them).
+    std::array<Rect, 2> box;
+    // Where a click picks an answer: a pair's pictures; a triad's left and right half
+    // (split at the middle picture's centre); a quadruple's two groups (pictures,
+    // bracket and label); the two boxes in sequence. Empty in the sequence's parts.
+    std::array<Rect, 2> alternative;
+};
+
+// The row of pictures is centred on the screen; the question row sits `row_height / 2`
+// above it, the brackets and labels below it, the whole moved up or down just enough to
+// stay on screen. Too wide or too tall for the screen: fits = false.
+ChoiceLayout compute_choice_layout(const ChoiceLayoutInput& in);
+
+// Which picture indices a sequence's part shows: a pair's {0} or {1}; a triad's {0, 1}
+// or {1, 2}; a quadruple's {0, 1} or {2, 3}. `all`: every one; otherwise none.
+std::vector<int> choice_part(Task task, ChoiceShow show);
 
 }  // namespace lucent::study
