@@ -199,6 +199,13 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                                   const ReportOptions& options) {
     std::vector<Block> doc;
     doc.push_back({Block::kHeading, "Lucent analysis report", {}, {}, 1});
+    if (analyses.empty()) {  // forced choices only: their scales are the report
+        doc.push_back({Block::kParagraph, "Input: " + options.source + "."});
+        for (const std::string& note : options.input_notes)
+            doc.push_back({Block::kParagraph, note});
+        doc.insert(doc.end(), options.extra_blocks.begin(), options.extra_blocks.end());
+        return doc;
+    }
     std::string analyses_run;
     if (options.models.anova) analyses_run += "One-way ANOVA per (question, factor); ";
     if (options.models.clmm)
@@ -394,6 +401,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
             doc.insert(doc.end(), within.begin(), within.end());
         if (!mixed_leads) doc.insert(doc.end(), mixed.begin(), mixed.end());
     }
+    doc.insert(doc.end(), options.extra_blocks.begin(), options.extra_blocks.end());
     return doc;
 }
 
@@ -666,9 +674,16 @@ std::vector<std::filesystem::path> write_report(
         render_html(doc, options, out);
         files.emplace_back("report.html", out.str());
     }
-    if (options.csv) {
+    if (options.csv && !analyses.empty()) {
         write_csv_tables(analyses, options.models.anova, files);
         write_mixed_csv_tables(analyses, files);
+    }
+    // The extra sections' plots are in the document already; their tables are CSV.
+    for (const auto& [name, text] : options.extra_files) {
+        const bool csv = name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0;
+        const bool present = std::any_of(files.begin(), files.end(),
+                                         [&](const auto& f) { return f.first == name; });
+        if (!present && (!csv || options.csv)) files.emplace_back(name, text);
     }
     // Refuse before writing anything: a report file that is the input or a database.
     // Earlier report files are replaced, atomically (readers see the old or the new).

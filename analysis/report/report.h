@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "analysis/data/long_table.h"
+#include "analysis/report/document.h"
 #include "analysis/stats/one_way_analysis.h"
 
 namespace lucent::analysis {
@@ -45,6 +46,11 @@ struct ReportOptions {
     // Makes the PNG bytes of a small thumbnail of a picture file (throws when it cannot
     // be decoded). Unset: the file itself is embedded and the browser scales it.
     std::function<std::string(const std::filesystem::path&)> thumbnail_png;
+    // Sections after the rating analyses (the forced choices' scales,
+    // analysis/scaling/scaling_report.h) and their files (plots always, CSV with `csv`).
+    // With no rating analyses they are the whole report.
+    std::vector<Block> extra_blocks;
+    ReportFiles extra_files;
 };
 
 // The picture of each (factor, level) from a folder of rendered stimuli (`lucent

@@ -427,6 +427,11 @@ std::vector<PairedBlockFits> fit_paired_blocks(
             list.push_back(row);
         }
         block.pooled = fit_paired_comparison(paired_data(rows, block.stimuli), options);
+        PairedOptions other = options;
+        other.link = options.link == BinomialLink::logit ? BinomialLink::probit
+                                                         : BinomialLink::logit;
+        block.pooled_other_link =
+            fit_paired_comparison(paired_data(rows, block.stimuli), other);
         for (const std::string& p : participants)
             block.participants.emplace_back(
                 p, fit_paired_comparison(paired_data(of[p], block.stimuli), options));

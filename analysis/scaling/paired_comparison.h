@@ -98,6 +98,9 @@ struct PairedBlockFits {
     std::vector<std::string> stimuli;           // series order
     std::vector<std::optional<double>> values;  // physical value per stimulus
     PairedFit pooled;
+    // The pooled fit with the other link (Thurstone Case V beside Bradley-Terry, and
+    // the other way round), so the report shows both scales.
+    PairedFit pooled_other_link;
     std::vector<std::pair<std::string, PairedFit>> participants;  // in input order
     std::size_t catch_trials = 0, catch_failed = 0;
 };

@@ -158,16 +158,28 @@ ScalingSection scaling_section(
         if (Block images = pictures_block(b.stimuli, b.values, pictures);
             !images.images.empty())
             section.blocks.push_back(images);
-        Table t{{"stimulus", "value", "ability", "SE", "wins", "comparisons"}, {}};
+        // Both scales: the fit's link and the other (Bradley-Terry and Thurstone).
+        const PairedFit& g = b.pooled_other_link;
+        auto ability_cell = [](const StimulusAbility& a) {
+            return a.unbounded > 0   ? std::string("unbounded above")
+                   : a.unbounded < 0 ? std::string("unbounded below")
+                                     : cell(a.ability);
+        };
+        Table t{
+            {"stimulus", "value", f.model, "SE", g.model, "SE", "wins", "comparisons"},
+            {}};
         for (std::size_t i = 0; i < f.abilities.size(); ++i) {
             const StimulusAbility& a = f.abilities[i];
-            t.rows.push_back({a.stimulus, cell(b.values[i]),
-                              a.unbounded > 0   ? "unbounded above"
-                              : a.unbounded < 0 ? "unbounded below"
-                                                : cell(a.ability),
-                              cell(a.se), format_short(a.wins),
-                              format_short(a.comparisons)});
+            const bool other = i < g.abilities.size();
+            t.rows.push_back({a.stimulus, cell(b.values[i]), ability_cell(a), cell(a.se),
+                              other ? ability_cell(g.abilities[i]) : std::string("-"),
+                              other ? cell(g.abilities[i].se) : std::string("-"),
+                              format_short(a.wins), format_short(a.comparisons)});
         }
+        if (!g.model.empty())
+            section.blocks.push_back(paragraph(
+                g.model + ": deviance " + cell(g.deviance) + " on " +
+                std::to_string(g.df_residual) + " df, AIC " + cell(g.aic) + "."));
         section.blocks.push_back({Block::kTable, "", t, {}});
         Table per{{"participant", "deviance", "df", "AIC", "all-equal p",
                    "first shown chosen", "position p"},
@@ -196,6 +208,8 @@ ScalingSection scaling_section(
             }
         };
         rows_of("(pooled)", f);
+        rows_of("(pooled)", g);
+        rows_of("(pooled)", g);
         for (const auto& [who, pf] : b.participants) rows_of(who, pf);
     }
 
