@@ -79,6 +79,11 @@ ChoiceStimuli choice_stimuli(const Protocol& protocol, const std::string& block,
             hi = hi ? std::max(*hi, *v) : *v;
         }
     if (!lo || !hi) return out;
+    if (b->obvious_catch.size() == 2) {
+        const std::optional<double> less = value_of(b->obvious_catch[0]);
+        const std::optional<double> more = value_of(b->obvious_catch[1]);
+        out.more_is_lower = less && more && *more < *less;
+    }
     out.values = std::move(values);
     out.lo = *lo;
     out.hi = *hi;
@@ -99,7 +104,8 @@ int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
         case Task::pair: {
             // Each picture its own noise: the difference has variance 2 sigma^2.
             const double e2 = observer.sigma > 0 ? noise(rng) : 0.0;
-            return psi[0] + e >= psi[1] + e2 ? 1 : 2;
+            const double sign = trial.more_is_lower ? -1.0 : 1.0;
+            return sign * psi[0] + e >= sign * psi[1] + e2 ? 1 : 2;
         }
         case Task::triad:
             return std::abs(psi[1] - psi[0]) - std::abs(psi[2] - psi[1]) + e >= 0 ? 1 : 2;

@@ -24,7 +24,7 @@ namespace lucent::study {
 
 struct ObserverModel {
     double exponent = 0.5;  // the scale's shape (1: linear in the series' value)
-    double sigma = 0.1;     // decision noise, in units of the scale's range
+    double sigma = 0.2;     // decision noise, in units of the scale's range
     double lapse = 0.0;     // share of choices made at random (a coin flip)
 
     // "EXPONENT,SIGMA" or "EXPONENT,SIGMA,LAPSE" (e.g. "0.5,0.1"); throws
@@ -43,6 +43,10 @@ struct ChoiceStimuli {
     Task task = Task::pair;
     std::vector<double> values;  // one per picture shown, in screen order
     double lo = 0, hi = 1;
+    // A pair's question asks for the end of the series with the lower values (the
+    // block's obvious_catch puts its right answer there: e.g. a lower thickness exponent
+    // looks more translucent): the observer then picks the smaller psi.
+    bool more_is_lower = false;
 };
 ChoiceStimuli choice_stimuli(const Protocol& protocol, const std::string& block,
                              const std::vector<std::string>& shown);

@@ -57,6 +57,12 @@ TEST(SimulatedObserver, ReadsTheBlocksSeriesFromTheProtocol) {
     EXPECT_EQ(t.values, (std::vector<double>{30, 20, 10}));
     EXPECT_EQ(t.lo, 10);
     EXPECT_EQ(t.hi, 30);
+    // The pair block's obvious catch puts "more" at the low end (s1, r 10, over s5).
+    EXPECT_TRUE(choice_stimuli(p, "pairs", {"s1", "s2"}).more_is_lower);
+    EXPECT_FALSE(t.more_is_lower);
+    const ChoiceStimuli lower{Task::pair, {25, 4}, 0, 100, true};
+    EXPECT_NEAR(share_of_first(ObserverModel::parse("0.5,0.2"), lower, 40000),
+                normal_cdf(-0.3 / (0.2 * std::sqrt(2.0))), 0.008);
     // The rating block names no series: no values.
     EXPECT_TRUE(choice_stimuli(p, "ratings", {"s1", "s3"}).values.empty());
 }
