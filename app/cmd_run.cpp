@@ -17,6 +17,7 @@ struct RunArgs {
     std::string preset;
     std::string images_dir;
     int64_t seed = -1;
+    std::string observer = "0.5,0.1";
     study::RunOptions options;
 };
 
@@ -24,6 +25,12 @@ int run_command(RunArgs& args) {
     study::RunOptions& o = args.options;
     if (args.protocol_file.empty() == args.preset.empty()) {
         std::cerr << "lucent run: give a PROTOCOL.toml or --preset NAME (exactly one)\n";
+        return kExitUsage;
+    }
+    try {
+        o.autopilot_observer = study::ObserverModel::parse(args.observer);
+    } catch (const std::invalid_argument& e) {
+        std::cerr << "lucent run: --autopilot-observer: " << e.what() << "\n";
         return kExitUsage;
     }
     try {
@@ -95,8 +102,15 @@ void register_run(CLI::App& app, int& exit_code) {
     cmd->add_option("--autopilot-speed", args->options.autopilot_speed,
                     "Divide the autopilot's human-like delays by this factor")
         ->check(CLI::PositiveNumber);
-    cmd->add_option("--screenshot", args->options.screenshot_path,
-                    "Save the first rating screen as a PNG (for tests)");
+    cmd->add_option(
+           "--autopilot-observer", args->observer,
+           "How a seeded autopilot answers forced choices: EXPONENT,SIGMA[,LAPSE] "
+           "(scale psi = x^EXPONENT over the block's series, decision noise SIGMA "
+           "in units of its range, a share LAPSE of random choices)")
+        ->capture_default_str();
+    cmd->add_option(
+        "--screenshot", args->options.screenshot_path,
+        "Save the first trial screen (rating or choice) as a PNG (for tests)");
     cmd->add_option(
         "--key-trace", args->options.key_trace_path,
         "Write each key press as 'X_EVENT_MS RECEIPT_NS STAMP_NS' (for tests)");

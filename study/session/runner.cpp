@@ -8,6 +8,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <functional>
@@ -110,6 +111,9 @@ private:
     void feed_keys();
     void draw(int w, int h);
     void draw_rating_panel(const ScreenLayout& layout);
+    void draw_choice(int w, int h);
+    std::optional<ChoiceLayout> choice_layout(ChoiceShow show, int w, int h) const;
+    bool waits_for_a_larger_window(int w, int h);
     void present(int w, int h);
     void calibrate(int64_t swapped);
 
@@ -141,6 +145,7 @@ private:
     // screen never changes half way through drawing it.
     std::vector<std::function<void()>> ui_actions_;
     bool screenshot_done_ = false;
+    bool too_small_logged_ = false;
 };
 
 RunResult Session::prepare_store() {
@@ -216,7 +221,8 @@ void Session::open_window() {
     env_.display_refresh_hz =
         mode_refresh_hz_ > 0 ? std::optional<double>(mode_refresh_hz_) : std::nullopt;
     if (!opt_.autopilot.empty()) {
-        autopilot_ = Autopilot::from_argument(opt_.autopilot, opt_.autopilot_speed);
+        autopilot_ = Autopilot::from_argument(opt_.autopilot, opt_.autopilot_speed,
+                                              opt_.autopilot_observer);
         x_keyboard_.emplace(window_->glfw());
         x_keyboard_->focus_window();
     }
@@ -251,9 +257,16 @@ void Session::start_or_resume_session() {
 void Session::prepare_stimuli() {
     const std::vector<TrialRow> trials = store_->trials(session_.id);
     std::vector<std::string> ids;
-    for (const TrialRow& t : trials)
-        if (!t.answered && std::find(ids.begin(), ids.end(), t.stimulus) == ids.end())
-            ids.push_back(t.stimulus);
+    // A choice trial's every picture (`shown`), so a pair or a triad is on screen
+    // complete from its onset.
+    auto add = [&ids](const std::string& id) {
+        if (std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
+    };
+    for (const TrialRow& t : trials) {
+        if (t.answered) continue;
+        add(t.stimulus);
+        for (const std::string& id : t.shown) add(id);
+    }
     for (size_t k = 0; k < ids.size(); ++k) {
         window_->begin_frame();
         int w = 0, h = 0;
@@ -345,6 +358,148 @@ void Session::draw_rating_panel(const ScreenLayout& layout) {
     ImGui::End();
 }
 
+// ---- forced choices (issue 30)
+// ---------------------------------------------------------
+namespace {
+
+ChoiceShow choice_show(const Block& block, std::optional<ChoicePhase> phase) {
+    if (block.presentation == Presentation::side_by_side) return ChoiceShow::all;
+    switch (phase.value_or(ChoicePhase::First)) {
+        case ChoicePhase::First:
+            return ChoiceShow::first_part;
+        case ChoicePhase::Gap:
+            return ChoiceShow::nothing;
+        case ChoicePhase::Second:
+            return ChoiceShow::second_part;
+        case ChoicePhase::Answer:
+            break;
+    }
+    return ChoiceShow::answers;
+}
+
+// The two answers' names on screen. A pair shown in sequence has no left and right: its
+// default names become "first" and "second".
+std::array<std::string, 2> answer_names(const Block& block) {
+    if (block.task == Task::pair && block.presentation == Presentation::sequential &&
+        block.labels == std::vector<std::string>{"left", "right"})
+        return {"first", "second"};
+    return {block.labels.at(0), block.labels.at(1)};
+}
+
+ImU32 colour(float r, float g, float b) {
+    return ImGui::ColorConvertFloat4ToU32(ImVec4(r, g, b, 1));
+}
+
+void centred_text(ImDrawList* list, const Rect& r, ImU32 col, const std::string& text) {
+    const ImVec2 size = ImGui::CalcTextSize(text.c_str());
+    list->AddText(
+        ImVec2(r.x + (r.width - size.x) * 0.5f, r.y + (r.height - size.y) * 0.5f), col,
+        text.c_str());
+}
+
+}  // namespace
+
+// The layout of the current (or, on the blank before it, the next) choice trial.
+std::optional<ChoiceLayout> Session::choice_layout(ChoiceShow show, int w, int h) const {
+    const TrialRow* t = flow_->trial();
+    const Block* b = flow_->block();
+    if (!t || !b || !b->is_choice() || t->shown.empty()) return std::nullopt;
+    ChoiceLayoutInput in;
+    in.screen_width = w;
+    in.screen_height = h;
+    in.task = b->task;
+    in.show = show;
+    for (const std::string& id : t->shown) {
+        const StimulusTexture& texture = textures_.at(id);
+        in.pictures.push_back({texture.width, texture.height});
+    }
+    in.row_height = static_cast<int>(ImGui::GetFrameHeightWithSpacing() * 1.25f);
+    return compute_choice_layout(in);
+}
+
+// Before a choice trial starts (on the blank before it): a window too small for its
+// pictures at their true size keeps it from starting, with a message, until it grows.
+bool Session::waits_for_a_larger_window(int w, int h) {
+    if (flow_->screen() != Screen::Blank || flow_->paused()) return false;
+    const Block* b = flow_->block();
+    if (!b || !b->is_choice()) return false;
+    const std::optional<ChoiceLayout> l =
+        choice_layout(choice_show(*b, std::nullopt), w, h);
+    if (!l || l->fits) {
+        too_small_logged_ = false;
+        return false;
+    }
+    if (!too_small_logged_) {
+        const StimulusTexture& t = textures_.at(flow_->trial()->shown.front());
+        log_ << "lucent run: the window (" << w << " x " << h
+             << ") is too small to show a " << task_name(b->task) << " of " << t.width
+             << " x " << t.height
+             << " pictures at their true size; the trial waits for a larger window\n";
+        too_small_logged_ = true;
+    }
+    return true;
+}
+
+void Session::draw_choice(int w, int h) {
+    const TrialRow& t = *flow_->trial();
+    const Block& b = *flow_->block();
+    const std::optional<ChoiceLayout> l =
+        choice_layout(choice_show(b, flow_->choice_phase()), w, h);
+    if (!l || !l->fits) return;  // a window made smaller mid-trial: nothing half-drawn
+    ImDrawList* list = ImGui::GetBackgroundDrawList();
+    for (size_t k = 0; k < l->picture.size(); ++k) {
+        const Rect& r = l->picture[k];
+        list->AddImage(ui::imgui_texture(textures_.at(t.shown[l->index[k]]).texture),
+                       ImVec2(float(r.x), float(r.y)),
+                       ImVec2(float(r.x + r.width), float(r.y + r.height)));
+    }
+    // The question (no catch prompt: a choice block's catch trials are hidden checks).
+    const ImU32 text = colour(1, 1, 1), dim = colour(0.75f, 0.75f, 0.75f),
+                chosen_colour = colour(0.9f, 0.6f, 0.1f);
+    centred_text(list, l->question, text, b.question);
+    if (t.practice) {
+        Rect above = l->question;
+        above.y -= above.height;
+        centred_text(list, above, dim, "Practice");
+    }
+    // The answers: from the first frame of the Answer phase (the flow's input follows
+    // that frame), none in a sequence's parts and its blank.
+    if (l->alternative[0].width == 0) return;
+    const RatingInput* input = flow_->rating();
+    const std::optional<int> chosen = input ? input->rating(0) : std::nullopt;
+    const std::array<std::string, 2> names = answer_names(b);
+    for (int k = 0; k < 2; ++k) {
+        const bool on = chosen == k + 1;
+        const ImU32 col = on ? chosen_colour : dim;
+        if (const Rect& box = l->box[k]; box.width > 0) {
+            list->AddRectFilled(
+                ImVec2(float(box.x), float(box.y)),
+                ImVec2(float(box.x + box.width), float(box.y + box.height)),
+                on ? chosen_colour : colour(0.25f, 0.25f, 0.3f), 6.f);
+            centred_text(list, box, on ? colour(0, 0, 0) : text, names[k]);
+            continue;
+        }
+        if (const Rect& br = l->bracket[k]; br.width > 0) {
+            const float x0 = br.x + 0.5f, x1 = br.x + br.width - 0.5f, y0 = float(br.y),
+                        y1 = br.y + br.height - 0.5f;
+            const ImVec2 points[4] = {{x0, y0}, {x0, y1}, {x1, y1}, {x1, y0}};
+            list->AddPolyline(points, 4, col, ImDrawFlags_None, on ? 3.f : 1.5f);
+        }
+        centred_text(list, l->label[k], on ? chosen_colour : text, names[k]);
+    }
+    // A click on an alternative picks it and confirms it (the flow's click_choice).
+    if (input && ImGui::IsMouseClicked(ImGuiMouseButton_Left) &&
+        !ImGui::GetIO().WantCaptureMouse) {
+        const ImVec2 m = ImGui::GetIO().MousePos;
+        for (int k = 0; k < 2; ++k)
+            if (l->alternative[k].contains(int(m.x), int(m.y))) {
+                const int64_t t_ns = steady_now_ns();
+                ui_actions_.push_back(
+                    [this, k, t_ns] { flow_->click_choice(k + 1, t_ns); });
+            }
+    }
+}
+
 void Session::draw(int w, int h) {
     auto button_key = [this](const char* label, Key key) {
         if (ImGui::Button(label)) {
@@ -397,6 +552,10 @@ void Session::draw(int w, int h) {
             ImGui::End();
             break;
         case Screen::Trial: {
+            if (flow_->block() && flow_->block()->is_choice()) {
+                draw_choice(w, h);
+                break;
+            }
             const StimulusTexture& texture = textures_.at(flow_->trial()->stimulus);
             const ScreenLayout layout = compute_layout(
                 w, h, texture.width, texture.height,
@@ -411,6 +570,17 @@ void Session::draw(int w, int h) {
             break;
         }
         case Screen::Blank:
+            if (waits_for_a_larger_window(w, h)) {
+                centred_text_window(
+                    "too small",
+                    "This window is too small to show the pictures at their true size "
+                    "(" +
+                        std::to_string(w) + " x " + std::to_string(h) +
+                        " pixels now). Please make it larger (or full screen) to go on.",
+                    w, h);
+                ImGui::End();
+            }
+            break;
         case Screen::Done:
             break;
     }
@@ -524,10 +694,10 @@ RunResult Session::run() {
         }
         feed_keys();
         if (flow_->finished()) break;
-        flow_->tick(steady_now_ns());
-
         int w = 0, h = 0;
         window_->framebuffer_size(w, h);
+        // A choice trial too large for the window does not start (see draw()).
+        if (!waits_for_a_larger_window(w, h)) flow_->tick(steady_now_ns());
         present(w, h);
         // Without a paced display (Xvfb), cap the loop near 60 Hz instead of spinning.
         const int64_t swapped = steady_now_ns();

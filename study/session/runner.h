@@ -9,6 +9,7 @@
 #include "study/protocol.h"
 #include "study/session/session_flow.h"
 #include "study/session/stimulus_source.h"
+#include "study/simulated_observer.h"
 
 namespace lucent::study {
 
@@ -22,6 +23,8 @@ struct RunOptions {
     std::optional<uint64_t> seed;  // session seed (default: random, stored)
     std::string autopilot;         // "" (a person), a seed, or a script file
     double autopilot_speed = 1.0;
+    // How a seeded autopilot answers forced choices (simulated_observer.h).
+    ObserverModel autopilot_observer;
     std::string screenshot_path;  // save the first rating screen as PNG (tests)
     std::string key_trace_path;   // each key press's X event time and stamp (tests)
 };
