@@ -1,11 +1,16 @@
 // lucent analyze: one-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch reports with plots
 // from a study database or a long CSV of ratings
-// (participant,stimulus,factor,level,question,rating).
+// (participant,stimulus,factor,level,question,rating); and the perceptual scales of
+// forced choices (Bradley-Terry, Thurstone, MLDS) from a study database or a choices CSV.
+#include <filesystem>
 #include <iostream>
 
 #include "analysis/analyze.h"
 #include "analysis/data/long_table.h"
 #include "analysis/report/report.h"
+#include "analysis/scaling/mlds.h"
+#include "analysis/scaling/paired_comparison.h"
+#include "analysis/scaling/scaling_report.h"
 #include "analysis/stats/one_way_analysis.h"
 #include "app/commands.h"
 #include "app/study_input.h"
@@ -23,7 +28,41 @@ struct AnalyzeArgs {
     bool random_slopes = false;
     double alpha = 0.10;
     double within_share = 1.0;
+    int bootstrap = 200, six_point = 200;  // MLDS: bootstrap samples, six-point data sets
+    uint64_t seed = 1;
 };
+
+// The forced choices' scales (paired comparisons, MLDS), when the input has any.
+void add_scaling_section(const AnalyzeArgs& args, analysis::ReportOptions& options) {
+    using namespace lucent::analysis;
+    std::map<std::string, std::vector<std::string>> orders;
+    const ChoiceTable choices = read_choices(args.input, &orders);
+    if (choices.rows.empty()) return;
+    std::cerr << "lucent analyze: scaling " << choices.rows.size()
+              << " forced choices (paired comparisons, MLDS)\n";
+    const std::vector<PairedBlockFits> paired = fit_paired_blocks(choices, {}, orders);
+    MldsOptions mlds_options;
+    mlds_options.bootstrap = args.bootstrap;
+    mlds_options.seed = args.seed;
+    mlds_options.six_point_simulations = args.six_point;
+    const std::vector<MldsBlockFits> mlds =
+        fit_mlds_blocks(choices, mlds_options, orders);
+    std::map<std::string, std::filesystem::path> pictures;
+    if (!args.images.empty())
+        for (const ChoiceRow& row : choices.rows)
+            for (int k = 0; k < shown_count(row.task); ++k) {
+                const std::filesystem::path png =
+                    std::filesystem::path(args.images) / (row.shown[k] + ".png");
+                std::error_code error;
+                if (!pictures.count(row.shown[k]) &&
+                    std::filesystem::is_regular_file(png, error))
+                    pictures[row.shown[k]] = png;
+            }
+    ScalingSection section = scaling_section(paired, mlds, pictures);
+    options.extra_blocks = std::move(section.blocks);
+    options.extra_files = std::move(section.files);
+    for (const std::string& note : choices.notes) options.input_notes.push_back(note);
+}
 
 int run_analyze(const AnalyzeArgs& args) {
     using namespace lucent::analysis;
@@ -40,9 +79,15 @@ int run_analyze(const AnalyzeArgs& args) {
         std::optional<Design> plan_design;
         options.scale = parse_scale(args.scale);
         std::string plan_model;
-        const LongTable table =
-            read_ratings(args.input, options.scale, &plan_design, &options.input_notes,
-                         &options.question_scales, &plan_model);
+        // A choices CSV holds no ratings; a study database may hold both.
+        const LongTable table = is_choice_csv(args.input)
+                                    ? LongTable{}
+                                    : read_ratings(args.input, options.scale,
+                                                   &plan_design, &options.input_notes,
+                                                   &options.question_scales, &plan_model);
+        add_scaling_section(args, options);
+        if (table.rows.empty() && options.extra_blocks.empty())
+            throw InputError(args.input + ": holds no ratings and no forced choices");
         RatingModel primary_model = RatingModel::anova;
         std::string primary_model_source;
         if (!args.primary_model.empty()) {
@@ -78,6 +123,11 @@ int run_analyze(const AnalyzeArgs& args) {
             request.primary = plan_design;
             request.primary_source = "the protocol's [analysis] primary_design";
         }
+        if (table.rows.empty()) {  // forced choices only: the scales are the report
+            for (const auto& path : write_report({}, args.out_dir, options))
+                std::cout << path.string() << "\n";
+            return kExitOk;
+        }
         const AnalysisResult result = analyze_table(table, request);
         options.primary = result.primary;
         options.models = request.models;
@@ -103,7 +153,8 @@ void register_analyze(CLI::App& app, int& exit_code) {
         "analyze",
         "One-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch, and ordinal and linear "
         "mixed models (participants and stimuli random) per (question, factor), with "
-        "plots, from a study database or a long CSV of ratings");
+        "plots, from a study database or a long CSV of ratings; paired comparisons and "
+        "MLDS scaled from a study database or a choices CSV");
     cmd->add_option("input", args->input,
                     "Study database, or long CSV: "
                     "participant,stimulus,factor,level,question,rating")
@@ -138,6 +189,17 @@ void register_analyze(CLI::App& app, int& exit_code) {
                   "identifies them (the report says when it does not)");
     cmd->add_option("--scale", args->scale,
                     "Accepted ratings: MIN..MAX, or 'any' for any finite number")
+        ->capture_default_str();
+    cmd->add_option("--bootstrap", args->bootstrap,
+                    "MLDS: parametric bootstrap samples for the scale's intervals "
+                    "(0: none)")
+        ->check(CLI::Range(0, 100000))
+        ->capture_default_str();
+    cmd->add_option("--six-point", args->six_point,
+                    "MLDS: simulated data sets of the six-point test (0: no test)")
+        ->check(CLI::Range(0, 100000))
+        ->capture_default_str();
+    cmd->add_option("--seed", args->seed, "MLDS: the bootstrap's and the test's seed")
         ->capture_default_str();
     cmd->callback([args, &exit_code] { exit_code = run_analyze(*args); });
 }

@@ -1,7 +1,9 @@
 #include "app/study_input.h"
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "study/export.h"
 #include "study/question_scales.h"
@@ -57,6 +59,39 @@ analysis::LongTable read_ratings(
     }
     analysis::check_scale(table, scale, path);
     return table;
+}
+
+bool is_choice_csv(const std::string& path) {
+    if (study::is_server_uri(path) || is_sqlite_file(path)) return false;
+    std::ifstream in(path);
+    std::string header;
+    std::getline(in, header);
+    return header.find("shown_1") != std::string::npos &&
+           header.find("choice") != std::string::npos;
+}
+
+analysis::ChoiceTable read_choices(
+    const std::string& path, std::map<std::string, std::vector<std::string>>* orders) {
+    const bool server = study::is_server_uri(path);
+    if (!server && !is_sqlite_file(path)) {
+        if (!is_choice_csv(path)) return {};
+        return analysis::read_choice_csv(std::filesystem::path(path));
+    }
+    try {
+        const study::ReadableStudyFile source(path);
+        std::stringstream csv;
+        const study::ChoiceExport choices =
+            study::export_choices(source.path(), csv, {.analysis = true});
+        if (orders)
+            for (const auto& [block, stimuli] : study::choice_block_orders(source.path()))
+                (*orders)[block] = stimuli;
+        for (const std::string& p : choices.excluded_participants)
+            std::cerr << "lucent analyze: excluded participant " << p
+                      << " from the scales\n";
+        return analysis::read_choice_csv(csv, path);
+    } catch (const study::StoreError& e) {
+        throw analysis::InputError(e.what());
+    }
 }
 
 }  // namespace lucent::app

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/data/choice_table.h"
 #include "analysis/data/long_table.h"
 #include "analysis/stats/one_way_analysis.h"
 
@@ -23,5 +24,15 @@ analysis::LongTable read_ratings(
     std::vector<std::string>* notes = nullptr,
     std::map<std::string, analysis::RatingScale>* question_scales = nullptr,
     std::string* plan_model = nullptr);
+
+// The forced choices (paired comparisons, MLDS) of a study database, as the analysis
+// reads them (practice left out, the plan's sessions, failed catch trials' participants
+// excluded), or of a `lucent export --format choices` CSV. Empty rows when the input
+// holds none (a database of ratings only, or a ratings CSV). `orders`: each choice
+// block's series as the stored protocol lists it (databases only).
+analysis::ChoiceTable read_choices(
+    const std::string& path, std::map<std::string, std::vector<std::string>>* orders);
+// True when `path` is a CSV whose header names the choices' columns (shown_1, choice).
+bool is_choice_csv(const std::string& path);
 
 }  // namespace lucent::app

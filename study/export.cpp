@@ -440,6 +440,16 @@ ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
     return result;
 }
 
+std::map<std::string, std::vector<std::string>> choice_block_orders(
+    const std::string& db_path) {
+    Database db = open_read_only(db_path);
+    std::map<std::string, std::vector<std::string>> out;
+    if (const std::optional<Protocol> protocol = stored_protocol(db))
+        for (const Block& b : protocol->blocks)
+            if (b.is_choice()) out[b.id] = b.stimuli;
+    return out;
+}
+
 ExportFileResult export_file(const std::string& db_path, const std::string& format,
                              const std::string& out_path, bool force) {
     ExportFileResult result;

@@ -111,6 +111,11 @@ struct ChoiceExport {
 ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
                             const ChoiceExportOptions& options = {});
 
+// Each forced-choice block's stimuli in the stored protocol's order (its series); empty
+// when the protocol cannot be read.
+std::map<std::string, std::vector<std::string>> choice_block_orders(
+    const std::string& db_path);
+
 struct MergeReport {
     int sessions_added = 0;
     // Copies of a session beyond the one kept that hold nothing more (identical).
