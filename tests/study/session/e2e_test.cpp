@@ -801,6 +801,195 @@ TEST_F(SessionE2E, BadLiveParametersAreRefusedBeforeAnyWindow) {
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
 }
 
+// ---- Forced choices (issue 30) ------------------------------------------------------
+// Five live stimuli of the scaling kind (the empirical shader's thickness exponent on a
+// small sphere): a pair block with a practice pair and an obvious catch, a triad block
+// side by side with its catch, and a quadruple block in sequence with short durations.
+// The series 1, 2, 4, 8, 16 keeps every difference and difference of differences of a
+// linear observer at least 1/15 of the range apart, so one with sigma 0.02 errs rarely.
+constexpr const char* kChoiceProtocol = R"(
+[study]
+name = "choice_e2e"
+title = "Forced choices"
+stimulus_size = [128, 128]
+inter_trial_ms = 100
+
+[screens]
+consent = "Do you agree?"
+instructions = "Choose."
+
+[[stimuli]]
+id = "r1"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 1 }
+
+[[stimuli]]
+id = "r2"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 2 }
+
+[[stimuli]]
+id = "r4"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 4 }
+
+[[stimuli]]
+id = "r8"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 8 }
+
+[[stimuli]]
+id = "r16"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 16 }
+
+[[blocks]]
+id = "pairs"
+task = "pair"
+stimuli = ["r1", "r2", "r4", "r8", "r16"]
+series = "thickness_exponent"
+question = "Which looks more translucent?"
+question_id = "more"
+obvious_catch = ["r1", "r16"]
+practice = 1
+
+[[blocks]]
+id = "triads"
+task = "triad"
+stimuli = ["r1", "r2", "r4", "r8", "r16"]
+series = "thickness_exponent"
+question = "Which pair differs more?"
+question_id = "differs"
+obvious_catch = ["r1", "r16"]
+
+[[blocks]]
+id = "quads"
+task = "quadruple"
+stimuli = ["r1", "r2", "r4", "r8", "r16"]
+series = "thickness_exponent"
+question = "Which pair differs more?"
+question_id = "differs4"
+presentation = "sequential"
+duration_ms = 100
+blank_ms = 50
+)";
+
+// A CSV without quoted fields, as rows of column name -> text.
+std::vector<std::map<std::string, std::string>> read_csv_rows(const fs::path& path) {
+    std::ifstream in(path);
+    auto split = [](const std::string& line) {
+        std::vector<std::string> fields;
+        size_t from = 0;
+        for (size_t comma; (comma = line.find(',', from)) != std::string::npos;
+             from = comma + 1)
+            fields.push_back(line.substr(from, comma - from));
+        fields.push_back(line.substr(from));
+        return fields;
+    };
+    std::string line;
+    std::getline(in, line);
+    const std::vector<std::string> header = split(line);
+    std::vector<std::map<std::string, std::string>> rows;
+    while (std::getline(in, line)) {
+        const std::vector<std::string> fields = split(line);
+        std::map<std::string, std::string> row;
+        for (size_t k = 0; k < header.size() && k < fields.size(); ++k)
+            row[header[k]] = fields[k];
+        rows.push_back(std::move(row));
+    }
+    return rows;
+}
+
+TEST_F(SessionE2E, ForcedChoicesAreShownAndAnsweredAsTheSimulatedObserverSeesThem) {
+    LUCENT_REQUIRE_DISPLAY();
+    const fs::path protocol = dir_ / "choice.toml";
+    std::ofstream(protocol) << kChoiceProtocol;
+    const std::string db = (dir_ / "choice.db").string();
+    const fs::path shot = dir_ / "pair_screen.png";
+    const auto start = std::chrono::steady_clock::now();
+    const Process run = start_lucent(
+        {"run", protocol.string(), "--db", db, "--participant", "P1", "--autopilot", "7",
+         "--autopilot-speed", "12", "--autopilot-observer", "1,0.02", "--seed", "77",
+         "--screenshot", shot.string()},
+        dir_);
+    ASSERT_EQ(wait_exit(run), 0) << read_file(run.stderr_path);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    RecordProperty("session_seconds", std::to_string(seconds));
+    std::printf("forced-choice session: %.1f s\n", seconds);
+
+    // 1 practice pair + 10 pairs + 1 catch, 10 triads + 1 catch, 5 quadruples: every
+    // one answered once, on its block's question, 1 or 2.
+    Database d(db, SQLITE_OPEN_READONLY);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials"), 28);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"), 28);
+    EXPECT_EQ(d.scalar_int("SELECT count(DISTINCT trial_id) FROM responses"), 28);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              1);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE onset_ns IS NULL OR "
+                           "confirm_ns <= onset_ns"),
+              0);
+    // A sequence is answered only after its first pair, the blank and its second pair
+    // (100 + 50 + 100 ms from the onset).
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE task = 'quadruple' AND "
+                           "confirm_ns - onset_ns < 250000000"),
+              0);
+
+    const fs::path csv = dir_ / "choices.csv";
+    const Process exported =
+        start_lucent({"export", db, "--format", "choices", "--out", csv.string()}, dir_);
+    ASSERT_EQ(wait_exit(exported), 0) << read_file(exported.stderr_path);
+    const auto rows = read_csv_rows(csv);
+    ASSERT_EQ(rows.size(), 28u);
+    std::map<std::string, int> agree, judged;
+    for (const auto& r : rows) {
+        const std::string& task = r.at("task");
+        const int choice = std::stoi(r.at("choice"));
+        ASSERT_TRUE(choice == 1 || choice == 2) << r.at("choice");
+        if (r.at("catch") == "1") {
+            EXPECT_EQ(r.at("expected"), std::to_string(choice)) << task << " catch";
+            continue;
+        }
+        if (r.at("practice") == "1") continue;
+        auto v = [&r](int k) { return std::stod(r.at("value_" + std::to_string(k))); };
+        // The observer's scale is linear in the series (exponent 1): "more" is the larger
+        // value, a pair differs more when its values differ more.
+        int truth = 0;
+        if (task == "pair")
+            truth = v(1) > v(2) ? 1 : 2;
+        else if (task == "triad")
+            truth = std::abs(v(2) - v(1)) > std::abs(v(3) - v(2)) ? 1 : 2;
+        else
+            truth = std::abs(v(2) - v(1)) > std::abs(v(4) - v(3)) ? 1 : 2;
+        ++judged[task];
+        agree[task] += choice == truth;
+    }
+    EXPECT_EQ(judged["pair"], 10);
+    EXPECT_EQ(judged["triad"], 10);
+    EXPECT_EQ(judged["quadruple"], 5);
+    for (const char* task : {"pair", "triad", "quadruple"})
+        EXPECT_GE(agree[task], 0.9 * judged[task])
+            << task << ": " << agree[task] << " of " << judged[task];
+
+    // The first trial (the practice pair): two 128-pixel pictures 24 pixels apart,
+    // centred; objects in both, background between them.
+    ASSERT_TRUE(fs::exists(shot));
+    const CpuImage screen = load_image_rgba8(shot.string());
+    const int x0 = (screen.width - (128 + 24 + 128)) / 2, y0 = (screen.height - 128) / 2;
+    auto sum = [&](int x, int y) {
+        const uint8_t* c = &screen.rgba[(size_t(y) * screen.width + x) * 4];
+        return c[0] + c[1] + c[2];
+    };
+    EXPECT_GT(sum(x0 + 64, y0 + 64), 0);
+    EXPECT_GT(sum(x0 + 152 + 64, y0 + 64), 0);
+    for (int x = x0 + 128; x < x0 + 152; ++x) EXPECT_EQ(sum(x, y0 + 64), 0) << x;
+}
+
 // ---- The data commands, driven through the CLI (no display needed) ----------------
 class DataCommands : public ::testing::Test {
 protected:
