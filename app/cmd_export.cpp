@@ -27,8 +27,11 @@ void register_export(CLI::App& app, int& exit_code) {
            "long: one row per rating; wide: one row per participant; analysis: "
            "participant,stimulus,factor,level,question,rating for lucent analyze; "
            "choices: one row per paired-comparison or MLDS choice (the stimuli in "
-           "screen order, the choice, RT)")
-        ->check(CLI::IsMember({"long", "wide", "analysis", "choices"}));
+           "screen order, the choice, RT); choice-analysis: the same as lucent analyze "
+           "scales them (no practice, the analysis plan's sessions, participants failing "
+           "catch trials left out)")
+        ->check(
+            CLI::IsMember({"long", "wide", "analysis", "choices", "choice-analysis"}));
     cmd->add_option("--out", *out,
                     "CSV file to write (never a database; written to a temporary file in "
                     "its folder, then renamed)")

@@ -463,16 +463,21 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                 result.rows = static_cast<int>(table.rows.size());
                 result.excluded_participants = table.excluded_participants;
                 result.notes.push_back(table.sessions_note);
-            } else if (format == "choices") {
-                const ChoiceExport choices = export_choices(db_path, out);
+            } else if (format == "choices" || format == "choice-analysis") {
+                const bool analysis = format == "choice-analysis";
+                const ChoiceExport choices =
+                    export_choices(db_path, out, {.analysis = analysis});
                 result.rows = choices.rows;
+                result.excluded_participants = choices.excluded_participants;
+                result.notes = choices.notes;
             } else if (format == "long" || format == "wide") {
                 result.rows = export_csv(
                     db_path, format == "long" ? ExportFormat::Long : ExportFormat::Wide,
                     out, &result.notes);
             } else {
-                throw StoreError("export: unknown format '" + format +
-                                 "' (valid: long, wide, analysis, choices)");
+                throw StoreError(
+                    "export: unknown format '" + format +
+                    "' (valid: long, wide, analysis, choices, choice-analysis)");
             }
         });
     } catch (const common::OutputError& e) {

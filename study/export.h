@@ -27,7 +27,8 @@ struct ExportFileResult {
     std::vector<std::string> notes;
 };
 
-// Writes format "long", "wide", "analysis" or "choices" of `db_path` to the CSV file
+// Writes format "long", "wide", "analysis", "choices" or "choice-analysis" (the choices
+// as the scaling reads them: ChoiceExportOptions::analysis) of `db_path` to the CSV file
 // `out_path`: never the database itself (by inode: symlinks, hard links and relative
 // paths included) nor any other database; an existing file only with `force`. Written to
 // a temporary file in the same folder and renamed into place. Throws StoreError (one

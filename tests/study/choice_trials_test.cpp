@@ -385,6 +385,11 @@ TEST(ChoiceStore, KeepsTheChoicesInScreenOrderAndExportsOneRowEach) {
     std::ostringstream analysis;
     const ChoiceExport view = export_choices(path, analysis, {.analysis = true});
     EXPECT_EQ(view.rows, 34);
+    // The same through export_file, as `lucent export --format ...` writes them.
+    EXPECT_EQ(export_file(path, "choices", (dir / "choices.csv").string(), false).rows, 35);
+    EXPECT_EQ(
+        export_file(path, "choice-analysis", (dir / "analysis.csv").string(), false).rows,
+        34);
     // Ratings stay in the rating exports only.
     const LongTable ratings = analysis_long_table(path);
     EXPECT_EQ(ratings.rows.size(), 3u);  // 3 rated trials x 1 question x 1 factor
