@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <utility>
 
 #include "study/serve/request_fields.h"
 #include "study/serve/web_study.h"  // kMaxEventsPerAnswer
@@ -12,14 +14,11 @@ using nlohmann::json;
 
 namespace {
 
-// One of an answer's events, checked: a key the scales (at most `max_points`) or the
+// One of a rating's events, checked: a key the scales (at most `max_points`) or the
 // lab know, a rating inside its question's scale, or Next.
-AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
-                     int max_points) {
-    if (!e.is_object()) throw RequestError(400, "each event must be an object");
+AnswerEvent rating_event_of(const json& e, const std::string& type,
+                            const std::vector<Question>& questions, int max_points) {
     AnswerEvent ev{AnswerEvent::Kind::Key};
-    ev.t_ns = ms_to_ns(*number_field(e, "t_ms", 0, kMaxPageMs, true));
-    const std::string type = text_field(e, "type", 16, true);
     if (type == "key") {
         const std::string key = text_field(e, "key", 16, true);
         if (key.size() == 1 && key[0] >= '1' && key[0] <= '9') {
@@ -60,10 +59,86 @@ AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
         ev.value = static_cast<int>(v->get<int64_t>());
     } else if (type == "next") {
         ev.kind = AnswerEvent::Kind::Next;
+    } else if (type == "choice") {
+        throw RequestError(400,
+                           "field 'type': a 'choice' event answers a forced choice; this "
+                           "trial is a rating");
     } else {
         throw RequestError(400, "unknown event type '" + one_line(type) + "'");
     }
     return ev;
+}
+
+// One of a forced choice's events, checked: ArrowLeft, ArrowRight, 1, 2 (pick), Enter
+// (confirm), or a click on alternative 1 or 2 (pick and confirm).
+AnswerEvent choice_event_of(const json& e, const std::string& type, Task task) {
+    AnswerEvent ev{AnswerEvent::Kind::Key};
+    if (type == "key") {
+        const std::string key = text_field(e, "key", 16, true);
+        if (key == "1" || key == "2") {
+            ev.key = Key::Digit;
+            ev.digit = key[0] - '0';
+        } else if (key == "Enter") {
+            ev.key = Key::Enter;
+        } else if (key == "ArrowLeft") {
+            ev.key = Key::Left;
+        } else if (key == "ArrowRight") {
+            ev.key = Key::Right;
+        } else {
+            throw RequestError(400, "field 'key': '" + one_line(key) +
+                                        "' does not answer a forced choice (ArrowLeft, "
+                                        "ArrowRight, 1, 2, Enter)");
+        }
+    } else if (type == "choice") {
+        ev.kind = AnswerEvent::Kind::Choice;
+        const json* a = field(e, "alternative");
+        if (!a || !a->is_number_integer() || a->get<int64_t>() < 1 ||
+            a->get<int64_t>() > 2)
+            throw RequestError(400,
+                               "field 'alternative' must be 1 or 2, not " +
+                                   (a ? one_line(to_text(*a)) : std::string("none")));
+        ev.alternative = static_cast<int>(a->get<int64_t>());
+    } else if (type == "point" || type == "next") {
+        throw RequestError(400, "field 'type': a '" + type +
+                                    "' event rates a question; this trial is a forced "
+                                    "choice (" +
+                                    task_name(task) + ")");
+    } else {
+        throw RequestError(400, "unknown event type '" + one_line(type) + "'");
+    }
+    return ev;
+}
+
+AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
+                     int max_points, Task task) {
+    if (!e.is_object()) throw RequestError(400, "each event must be an object");
+    const int64_t t_ns = ms_to_ns(*number_field(e, "t_ms", 0, kMaxPageMs, true));
+    const std::string type = text_field(e, "type", 16, true);
+    AnswerEvent ev = task == Task::rating
+                         ? rating_event_of(e, type, questions, max_points)
+                         : choice_event_of(e, type, task);
+    ev.t_ns = t_ns;
+    return ev;
+}
+
+std::string milliseconds(double ms) {
+    char out[32];
+    std::snprintf(out, sizeof out, "%.1f", ms);
+    return out;
+}
+
+const char* phase_name(ChoicePhase phase) {
+    switch (phase) {
+        case ChoicePhase::First:
+            return "first part";
+        case ChoicePhase::Gap:
+            return "blank";
+        case ChoicePhase::Second:
+            return "second part";
+        case ChoicePhase::Answer:
+            return "answer screen";
+    }
+    return "answer screen";
 }
 
 }  // namespace
@@ -87,7 +162,7 @@ void check_trial_on_screen(const SessionFlow& flow, const std::vector<TrialRow>&
 }
 
 std::vector<AnswerEvent> events_of(const json& body,
-                                   const std::vector<Question>& questions) {
+                                   const std::vector<Question>& questions, Task task) {
     const json* events = field(body, "events");
     if (!events || !events->is_array())
         throw RequestError(400, "field 'events' must be an array");
@@ -99,11 +174,33 @@ std::vector<AnswerEvent> events_of(const json& body,
     int max_points = 0;
     for (const Question& q : questions) max_points = std::max(max_points, q.points());
     std::vector<AnswerEvent> replay;
-    for (const json& e : *events) replay.push_back(event_of(e, questions, max_points));
+    for (const json& e : *events)
+        replay.push_back(event_of(e, questions, max_points, task));
     return replay;
 }
 
+std::optional<SequenceOnsets> sequence_onsets_of(const json& body, bool sequential) {
+    const json* onsets = field(body, "phase_onsets_ms");
+    if (!sequential) {
+        if (onsets)
+            throw RequestError(400,
+                               "field 'phase_onsets_ms' is only for a trial shown in "
+                               "sequence");
+        return std::nullopt;
+    }
+    if (!onsets || !onsets->is_object())
+        throw RequestError(400,
+                           "field 'phase_onsets_ms' ({\"gap\", \"second\", \"answer\"}) "
+                           "is required for a trial shown in sequence");
+    SequenceOnsets out;
+    out.gap_ms = *number_field(*onsets, "gap", 0, kMaxPageMs, true);
+    out.second_ms = *number_field(*onsets, "second", 0, kMaxPageMs, true);
+    out.answer_ms = *number_field(*onsets, "answer", 0, kMaxPageMs, true);
+    return out;
+}
+
 SessionFlow replayed(const SessionFlow& flow, double onset_ms,
+                     const std::optional<SequenceOnsets>& sequence,
                      const std::vector<AnswerEvent>& replay, int inter_trial_ms) {
     SessionFlow next = flow;
     const int64_t onset_ns = ms_to_ns(onset_ms);
@@ -112,6 +209,37 @@ SessionFlow replayed(const SessionFlow& flow, double onset_ms,
         throw RequestError(400, "the picture was shown before the " +
                                     std::to_string(inter_trial_ms) + " ms blank ended");
     next.presented(next.serial(), onset_ns);
+    if (sequence) {
+        // Each part as the page showed it; the flow moves on only once the part before
+        // has been on the display for its duration (the lab's rule, from its frames).
+        const std::pair<ChoicePhase, double> parts[] = {
+            {ChoicePhase::Gap, sequence->gap_ms},
+            {ChoicePhase::Second, sequence->second_ms},
+            {ChoicePhase::Answer, sequence->answer_ms}};
+        const Block* block = next.block();
+        double before_ms = onset_ms;
+        for (const auto& [phase, at_ms] : parts) {
+            const ChoicePhase previous = *next.choice_phase();
+            const int64_t at_ns = ms_to_ns(at_ms);
+            next.tick(at_ns);
+            if (next.choice_phase() != phase) {
+                const int needed =
+                    previous == ChoicePhase::Gap ? block->blank_ms : block->duration_ms;
+                throw RequestError(
+                    400, "field 'phase_onsets_ms." +
+                             std::string(phase == ChoicePhase::Gap      ? "gap"
+                                         : phase == ChoicePhase::Second ? "second"
+                                                                        : "answer") +
+                             "': the " + phase_name(phase) + " came " +
+                             milliseconds(at_ms - before_ms) + " ms after the " +
+                             phase_name(previous) + ", which is shown for " +
+                             std::to_string(needed) + " ms");
+            }
+            next.presented(next.serial(), at_ns);
+            before_ms = at_ms;
+        }
+    }
+    const bool choice = next.choice_phase().has_value();
     const size_t answered_before = next.answered_trials();
     for (const AnswerEvent& ev : replay) {
         if (next.answered_trials() != answered_before)
@@ -126,12 +254,17 @@ SessionFlow replayed(const SessionFlow& flow, double onset_ms,
             case AnswerEvent::Kind::Next:
                 next.click_next(ev.t_ns);
                 break;
+            case AnswerEvent::Kind::Choice:
+                next.click_choice(ev.alternative, ev.t_ns);
+                break;
         }
     }
     if (next.answered_trials() == answered_before)
-        throw RequestError(400,
-                           "the events do not rate every question and confirm it "
-                           "(Enter or Next) after the picture's onset");
+        throw RequestError(
+            400, choice ? "the events do not choose an alternative and confirm "
+                          "it (Enter or a click) after the answer screen's onset"
+                        : "the events do not rate every question and confirm it "
+                          "(Enter or Next) after the picture's onset");
     return next;
 }
 

@@ -199,6 +199,10 @@ WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions 
             throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id +
                                         "'");
     if (!options_.clock) options_.clock = [] { return std::chrono::system_clock::now(); };
+    // The main trials a session plans (the same for every seed and cell): choice
+    // blocks' designs and catch trials are not one per stimulus.
+    for (const PlannedTrial& t : plan_trials(protocol_, 0, 0).trials)
+        main_trials_ += t.practice ? 0 : 1;
     study_id_ = store_.ensure_study(protocol_);
     store_.check_stimulus_values(options_.environment.stimuli);
 }
@@ -590,10 +594,7 @@ json WebStudy::pending_state(const Live& live) const {
     out["view"] = kConsentView;
     out["title"] = protocol_.title;
     out["background"] = css_colour(protocol_.background);
-    int main = static_cast<int>(protocol_.catch_trials.size());
-    for (const Block& b : protocol_.blocks)
-        main += static_cast<int>(b.stimuli.size()) * b.repeats;
-    out["progress"] = {{"done", 0}, {"total", main}};
+    out["progress"] = {{"done", 0}, {"total", main_trials_}};
     json questions = json::array();
     for (const Question& q : protocol_.questions)
         questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
@@ -730,9 +731,16 @@ WebReply WebStudy::answer(Live& live, const json& body) {
                                     " is no longer shown (now view " +
                                     std::to_string(flow.serial()) + ")");
     const double onset_ms = *number_field(body, "onset_ms", 0, kMaxPageMs, true);
-    const std::vector<AnswerEvent> replay = events_of(body, protocol_.questions);
+    const TrialRow& trial = *flow.trial();
+    const Block* block = protocol_.find_block(trial.block);
+    const bool sequential = trial.task != Task::rating && block &&
+                            block->presentation == Presentation::sequential;
+    const std::optional<SequenceOnsets> sequence = sequence_onsets_of(body, sequential);
+    const std::vector<AnswerEvent> replay =
+        events_of(body, protocol_.questions, trial.task);
 
-    SessionFlow next = replayed(flow, onset_ms, replay, protocol_.inter_trial_ms);
+    SessionFlow next =
+        replayed(flow, onset_ms, sequence, replay, protocol_.inter_trial_ms);
     for (TrialRow& t : live.trials)
         if (t.uuid == trial_uuid) t.answered = true;
     live.flow.emplace(next);
@@ -740,6 +748,47 @@ WebReply WebStudy::answer(Live& live, const json& body) {
 }
 
 // ---- [SECTION] the state a page shows -------------------------------------------------
+json WebStudy::rating_trial(const TrialRow& t) const {
+    const WebImage& image = options_.images.at(t.stimulus);
+    return {{"id", t.uuid},
+            {"task", task_name(t.task)},
+            {"image", "/images/" + t.stimulus + ".png"},
+            {"width", image.width},
+            {"height", image.height},
+            {"practice", t.practice},
+            {"prompt", t.is_catch ? t.prompt : std::string()},
+            {"blank_ms", protocol_.inter_trial_ms}};
+}
+
+// A forced choice: its pictures in screen order, the block's question and answers, and
+// how they are shown. Never which answer is right, nor whether it is a catch trial (an
+// attention check the page could tell would be one a script could pass).
+json WebStudy::choice_trial(const TrialRow& t) const {
+    const Block& block = *protocol_.find_block(t.block);
+    json shown = json::array();
+    for (const std::string& id : t.shown) {
+        const WebImage& image = options_.images.at(id);
+        shown.push_back({{"image", "/images/" + id + ".png"},
+                         {"width", image.width},
+                         {"height", image.height}});
+    }
+    json out = {
+        {"id", t.uuid},
+        {"task", task_name(t.task)},
+        {"shown", shown},
+        {"question", block.question},
+        {"labels", block.labels},
+        {"presentation",
+         block.presentation == Presentation::sequential ? "sequential" : "side_by_side"},
+        {"practice", t.practice},
+        {"prompt", ""},
+        {"blank_ms", protocol_.inter_trial_ms}};
+    if (block.presentation == Presentation::sequential)
+        out["sequence"] = {{"duration_ms", block.duration_ms},
+                           {"blank_ms", block.blank_ms}};
+    return out;
+}
+
 json WebStudy::done_state() const {
     json out{{"screen", "done"},
              {"text", "Thank you: the study is complete and your answers are saved."}};
@@ -766,14 +815,7 @@ json WebStudy::state(const Live& live) const {
         questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
     out["questions"] = questions;
     if (const TrialRow* t = flow.trial()) {
-        const WebImage& image = options_.images.at(t->stimulus);
-        out["trial"] = {{"id", t->uuid},
-                        {"image", "/images/" + t->stimulus + ".png"},
-                        {"width", image.width},
-                        {"height", image.height},
-                        {"practice", t->practice},
-                        {"prompt", t->is_catch ? t->prompt : std::string()},
-                        {"blank_ms", protocol_.inter_trial_ms}};
+        out["trial"] = t->task == Task::rating ? rating_trial(*t) : choice_trial(*t);
     } else {
         const std::string& text = flow.text();
         out["text"] = text.empty() ? std::string("Press Enter.") : text;

@@ -120,6 +120,8 @@ private:
                                  const std::string& code, const nlohmann::json& body);
     WebReply answer(Live& live, const nlohmann::json& body);
     nlohmann::json state(const Live& live) const;
+    nlohmann::json rating_trial(const TrialRow& trial) const;
+    nlohmann::json choice_trial(const TrialRow& trial) const;
     nlohmann::json done_state() const;
     SessionEnvironment environment_for(const Live& live) const;
     Live& load(const std::string& code, const SessionRow& session,
@@ -136,6 +138,7 @@ private:
     StudyStore& store_;
     WebStudyOptions options_;
     int64_t study_id_ = 0;
+    int main_trials_ = 0;       // a session's main (not practice) trials
     mutable std::mutex mutex_;  // one store connection: requests in turn
     std::map<std::string, std::unique_ptr<Live>> live_;  // by participant code
 };

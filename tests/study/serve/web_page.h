@@ -36,6 +36,10 @@ struct Page {
     std::string token;
     json state;
     std::vector<std::string> shown;  // trial ids in the order the page was given them
+    // Forced choices: the alternative (1 or 2) the participant picks on a trial (by
+    // default the first), and what each trial shown was answered (0: a rating).
+    std::function<int(const json& trial)> choose;
+    std::vector<int> chosen;
 
     study::WebReply raw(const std::string& endpoint, const json& body) {
         return send(endpoint, body.dump());
@@ -85,7 +89,62 @@ struct Page {
                 {"onset_ms", onset},
                 {"events", events}};
     }
+    // The page's answer to the forced choice on screen, 1 or 2 chosen 100 ms after the
+    // answer screen's onset, the k-th trial shown by arrow + Enter, digit + Enter or a
+    // click in turn. A sequence's parts each come 3 ms (a frame's lateness) after the
+    // part before has been shown for its duration.
+    json choice_body(int k, int alternative) {
+        const json& trial = state["trial"];
+        const double onset = now + trial["blank_ms"].get<double>() + 20;
+        json body = {
+            {"trial", trial["id"]}, {"view", state["view"]}, {"onset_ms", onset}};
+        double answer_at = onset;
+        if (trial["presentation"] == "sequential") {
+            const double duration = trial["sequence"]["duration_ms"].get<double>();
+            const double gap = onset + duration + 3;
+            const double second = gap + trial["sequence"]["blank_ms"].get<double>() + 3;
+            answer_at = second + duration + 3;
+            body["phase_onsets_ms"] = {
+                {"gap", gap}, {"second", second}, {"answer", answer_at}};
+        }
+        const double t = answer_at + 100;
+        json events = json::array();
+        switch (k % 3) {
+            case 0:
+                events.push_back(
+                    {{"t_ms", t},
+                     {"type", "key"},
+                     {"key", alternative == 1 ? "ArrowLeft" : "ArrowRight"}});
+                events.push_back({{"t_ms", t + 100}, {"type", "key"}, {"key", "Enter"}});
+                break;
+            case 1:
+                events.push_back(
+                    {{"t_ms", t}, {"type", "key"}, {"key", std::to_string(alternative)}});
+                events.push_back({{"t_ms", t + 100}, {"type", "key"}, {"key", "Enter"}});
+                break;
+            default:
+                events.push_back(
+                    {{"t_ms", t}, {"type", "choice"}, {"alternative", alternative}});
+                break;
+        }
+        body["events"] = events;
+        return body;
+    }
+    bool on_choice() const {
+        return state.contains("trial") &&
+               state["trial"].value("task", "rating") != "rating";
+    }
     void answer(int k) {
+        if (on_choice()) {
+            const int alternative = choose ? choose(state["trial"]) : 1;
+            json body = choice_body(k, alternative);
+            shown.push_back(state["trial"]["id"]);
+            chosen.push_back(alternative);
+            now = body["events"].back()["t_ms"].get<double>() + 500;
+            state = call("answer", body);
+            return;
+        }
+        chosen.push_back(0);
         json body = answer_body(k);
         shown.push_back(state["trial"]["id"]);
         now = body["onset_ms"].get<double>() + 1000;

@@ -10,10 +10,13 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <set>
 #include <thread>
 
+#include "study/simulated_observer.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/study_store.h"
 #include "tests/study/postgres/server_environment.h"
@@ -815,6 +818,342 @@ TEST_P(Serve, ANumberBeyondADoubleIsA400NamingTheField) {
     EXPECT_EQ(a.status, 400) << a.body;
     EXPECT_NE(a.body.find("'onset_ms'"), std::string::npos) << a.body;
     EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
+}
+
+// ---- forced choices (issue 30)
+// --------------------------------------------------------- A study of every trial kind:
+// a rating block, pairs and triads side by side, quadruples in sequence (short
+// durations), in the protocol's order (no counterbalancing).
+std::string choice_web_protocol_text() {
+    std::string text = R"toml(
+[study]
+name = "web_choices"
+break_every = 8
+inter_trial_ms = 100
+
+[screens]
+consent = "Do you agree?"
+instructions = "Choose."
+debrief = "Thank you."
+
+[online]
+completion_code = "CH0ICE"
+
+[randomisation]
+counterbalance_blocks = false
+
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+)toml";
+    for (int i = 1; i <= 5; ++i)
+        text += "\n[[stimuli]]\nid = \"s" + std::to_string(i) +
+                "\"\ntechnique = \"empirical\"\nmesh = \"sphere\"\nparams = { "
+                "thickness_exponent = " +
+                std::to_string(5 + 5 * i) + " }\n";
+    return text + R"toml(
+[[blocks]]
+id = "ratings"
+stimuli = ["s1", "s5"]
+
+[[blocks]]
+id = "pairs"
+task = "pair"
+stimuli = ["s1", "s2", "s3", "s4"]
+question = "Which looks more translucent?"
+question_id = "more_translucent"
+series = "thickness_exponent"
+identical_catch = 1
+obvious_catch = ["s1", "s4"]
+practice = 1
+
+[[blocks]]
+id = "triads"
+task = "triad"
+stimuli = ["s1", "s2", "s3", "s4", "s5"]
+question = "Which pair differs more?"
+question_id = "triad_differs"
+series = "thickness_exponent"
+obvious_catch = ["s1", "s5"]
+
+[[blocks]]
+id = "quads"
+task = "quadruple"
+stimuli = ["s1", "s2", "s3", "s4", "s5"]
+question = "Which pair differs more?"
+question_id = "quad_differs"
+labels = ["the first", "the second"]
+series = "thickness_exponent"
+presentation = "sequential"
+duration_ms = 60
+blank_ms = 30
+)toml";
+}
+// practice 1 + ratings 2 + pairs C(4,2) = 6 + 2 catch + triads C(5,3) = 10 + 1 catch +
+// quadruples C(5,4) = 5.
+constexpr size_t kChoiceStudyTrials = 1 + 2 + 6 + 2 + 10 + 1 + 5;
+
+// The stimulus id of a picture URL ("/images/ID.png").
+std::string stimulus_of_url(const std::string& url) {
+    const std::string prefix = "/images/", suffix = ".png";
+    EXPECT_EQ(url.rfind(prefix, 0), 0u) << url;
+    return url.substr(prefix.size(), url.size() - prefix.size() - suffix.size());
+}
+
+// The block of each task in the protocol above.
+std::string block_of_task(const std::string& task) {
+    return task == "pair" ? "pairs" : task == "triad" ? "triads" : "quads";
+}
+
+// A page answering as the simulated observer (psi = x^0.5, sigma 0.1) from what the
+// page was shown: the pictures' names in screen order.
+Page observer_page(const Protocol& protocol, WebStudy& web, std::mt19937_64& rng) {
+    Page page{direct(web)};
+    page.choose = [&protocol, &rng](const json& trial) {
+        std::vector<std::string> shown;
+        for (const json& picture : trial["shown"])
+            shown.push_back(stimulus_of_url(picture["image"]));
+        const ObserverModel observer{0.5, 0.1, 0.0};
+        return simulated_choice(
+            observer, choice_stimuli(protocol, block_of_task(trial["task"]), shown), rng);
+    };
+    return page;
+}
+
+TEST_P(Serve, PairsTriadsAndQuadruplesAreAnsweredOnlineAsInTheLabEachChoiceStoredOnce) {
+    use_protocol(choice_web_protocol_text(), "choices");
+    std::mt19937_64 rng(30);
+    Page page = observer_page(protocol_, *web_, rng);
+    page.open({{"participant", "W1"}});
+    ASSERT_EQ(page.state["screen"], "consent");
+    EXPECT_EQ(page.state["progress"]["total"], kChoiceStudyTrials - 1);
+    std::map<std::string, json> trial_shown;  // the trial JSON the page was given, by id
+    std::map<std::string, int> chosen;        // the alternative it chose, by id
+    auto run = [&](Page& p, size_t until) {
+        for (int guard = 0; guard < 200 && p.state["screen"] != "done"; ++guard) {
+            if (p.state["screen"] != "trial") {
+                p.enter();
+                continue;
+            }
+            if (p.shown.size() >= until) return;
+            const json trial = p.state["trial"];
+            trial_shown[trial["id"]] = trial;
+            // Nothing tells the page which answer is right, or that a trial is a check.
+            const std::string text = trial.dump();
+            for (const char* secret : {"expected", "catch", "Attention"})
+                EXPECT_EQ(text.find(secret), std::string::npos) << text;
+            p.answer(static_cast<int>(p.shown.size()));
+            chosen[p.shown.back()] = p.chosen.back();
+        }
+    };
+    run(page, 14);  // into the triads
+    ASSERT_EQ(page.state["screen"], "trial");
+
+    // A reload: a fresh page with the token continues at the first open trial.
+    const int64_t session = count("SELECT id FROM sessions");
+    std::vector<TrialRow> trials = store_->trials(session);
+    ASSERT_EQ(trials.size(), kChoiceStudyTrials);
+    Page reloaded = observer_page(protocol_, *web_, rng);
+    reloaded.token = page.token;
+    reloaded.open({{"participant", "W1"}, {"token", page.token}});
+    ASSERT_EQ(reloaded.state["screen"], "trial");
+    EXPECT_EQ(reloaded.state["trial"]["id"], trials[14].uuid);
+    EXPECT_EQ(reloaded.state["trial"], page.state["trial"]);
+    reloaded.shown = page.shown;
+    reloaded.chosen = page.chosen;
+    run(reloaded, 1000);
+    ASSERT_EQ(reloaded.state["screen"], "done");
+    EXPECT_EQ(reloaded.state["completion"]["code"], "CH0ICE");
+    ASSERT_EQ(reloaded.shown.size(), kChoiceStudyTrials);
+
+    // Every trial shown once in the stored order; each choice stored once, as chosen,
+    // to its block's question, 100 ms after the answer screen's onset.
+    trials = store_->trials(session);
+    std::map<std::string, int> per_task;
+    for (size_t k = 0; k < trials.size(); ++k) {
+        const TrialRow& t = trials[k];
+        EXPECT_EQ(t.uuid, reloaded.shown[k]) << k;
+        const json& shown = trial_shown.at(t.uuid);
+        const std::string where = "trial " + std::to_string(k);
+        ++per_task[task_name(t.task)];
+        if (t.task == Task::rating) {
+            EXPECT_EQ(shown["task"], "rating");
+            EXPECT_EQ(shown["image"], "/images/" + t.stimulus + ".png");
+            continue;
+        }
+        const Block& block = *protocol_.find_block(t.block);
+        EXPECT_EQ(shown["task"], task_name(t.task)) << where;
+        ASSERT_EQ(shown["shown"].size(), t.shown.size()) << where;
+        for (size_t i = 0; i < t.shown.size(); ++i) {
+            EXPECT_EQ(shown["shown"][i]["image"], "/images/" + t.shown[i] + ".png");
+            EXPECT_EQ(shown["shown"][i]["width"], 64);
+            EXPECT_EQ(shown["shown"][i]["height"], 48);
+        }
+        EXPECT_EQ(shown["question"], block.question) << where;
+        EXPECT_EQ(shown["labels"], json(block.labels)) << where;
+        EXPECT_EQ(shown["prompt"], "") << where;
+        if (t.task == Task::quadruple) {
+            EXPECT_EQ(shown["presentation"], "sequential");
+            EXPECT_EQ(shown["sequence"], json({{"duration_ms", 60}, {"blank_ms", 30}}));
+        } else {
+            EXPECT_EQ(shown["presentation"], "side_by_side");
+            EXPECT_FALSE(shown.contains("sequence"));
+        }
+        EXPECT_EQ(count("SELECT count(*) FROM responses r JOIN trials t ON t.id = "
+                        "r.trial_id WHERE t.uuid = '" +
+                        t.uuid + "'"),
+                  1)
+            << where;
+        EXPECT_EQ(count("SELECT count(*) FROM responses r JOIN trials t ON t.id = "
+                        "r.trial_id WHERE t.uuid = '" +
+                        t.uuid + "' AND r.question = '" + block.question_id +
+                        "' AND r.rating = " + std::to_string(chosen.at(t.uuid)) +
+                        " AND abs(r.rt_ms - 100) < 0.001"),
+                  1)
+            << where << " (" << t.block << ")";
+    }
+    EXPECT_EQ(per_task,
+              (std::map<std::string, int>{
+                  {"rating", 2}, {"pair", 9}, {"triad", 11}, {"quadruple", 5}}));
+    EXPECT_EQ(responses(), static_cast<int64_t>(kChoiceStudyTrials));
+    EXPECT_EQ(
+        count("SELECT count(*) FROM responses WHERE rating NOT IN (1, 2) AND question <> "
+              "'translucent'"),
+        0);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    // Both answers occur (an observer, not a constant key).
+    EXPECT_EQ(count("SELECT count(DISTINCT rating) FROM responses WHERE question <> "
+                    "'translucent'"),
+              2);
+}
+
+// Hostile answers to forced choices: each a 4xx with one line naming what is wrong, and
+// nothing stored.
+TEST_P(Serve, HostileChoiceAnswersAreRefusedWithOneLineAndStoreNothing) {
+    use_protocol(choice_web_protocol_text(), "choices");
+    Page page{direct(*web_)};
+    page.open({{"participant", "H1"}});
+    page.run(0);  // the practice pair on screen
+    ASSERT_EQ(page.state["trial"]["task"], "pair");
+    Page other{direct(*web_)};
+    other.open({{"participant", "H2"}});
+    other.run(1);
+    auto refused = [&](const json& body, int status, const std::string& reason) {
+        const int64_t stored = responses();
+        const WebReply r = web_->handle("answer", body.dump());
+        EXPECT_EQ(r.status, status) << body.dump() << " -> " << r.body;
+        const json reply = json::parse(r.body, nullptr, false);
+        ASSERT_TRUE(reply.is_object() && reply.contains("error")) << r.body;
+        const std::string line = reply["error"];
+        EXPECT_EQ(line.find('\n'), std::string::npos);
+        EXPECT_NE(line.find(reason), std::string::npos) << line;
+        EXPECT_EQ(responses(), stored) << body.dump();
+    };
+    auto with = [&](int k, const std::function<void(json&)>& edit) {
+        json body = page.choice_body(k, 2);
+        body["token"] = page.token;
+        edit(body);
+        return body;
+    };
+    const int64_t session = count(
+        "SELECT id FROM sessions WHERE participant_id = (SELECT "
+        "id FROM participants WHERE code = 'H1')");
+    const std::vector<TrialRow> trials = store_->trials(session);
+
+    // The pair side by side.
+    refused(with(2, [](json& b) { b["events"][0]["alternative"] = 3; }), 400,
+            "'alternative' must be 1 or 2");
+    refused(with(2, [](json& b) { b["events"][0]["alternative"] = 0; }), 400,
+            "'alternative' must be 1 or 2");
+    refused(with(2, [](json& b) { b["events"][0]["alternative"] = 1.5; }), 400,
+            "'alternative' must be 1 or 2");
+    refused(with(2, [](json& b) { b["events"][0].erase("alternative"); }), 400,
+            "'alternative' must be 1 or 2");
+    refused(with(1, [](json& b) { b["events"][0]["key"] = "3"; }), 400,
+            "field 'key': '3' does not answer a forced choice");
+    refused(with(0, [](json& b) { b["events"][0]["key"] = "ArrowUp"; }), 400,
+            "field 'key': 'ArrowUp'");
+    refused(
+        with(2,
+             [](json& b) {
+                 b["events"] = {
+                     {{"t_ms", 1e4}, {"type", "point"}, {"question", 0}, {"value", 2}},
+                     {{"t_ms", 1e4 + 1}, {"type", "next"}}};
+             }),
+        400,
+        "field 'type': a 'point' event rates a question; this trial is a forced "
+        "choice (pair)");
+    refused(with(0, [](json& b) { b["events"].erase(1); }), 400,
+            "do not choose an alternative and confirm it");
+    refused(with(2,
+                 [](json& b) {
+                     b["phase_onsets_ms"] = {{"gap", 1}, {"second", 2}, {"answer", 3}};
+                 }),
+            400, "'phase_onsets_ms' is only for a trial shown in sequence");
+    refused(with(2, [&](json& b) { b["trial"] = trials[5].uuid; }), 409,
+            "trial 6 is not the one on screen");
+    refused(with(2, [&](json& b) { b["trial"] = other.shown[0]; }), 404,
+            "not one of this session's trials");
+    refused(with(2, [&](json& b) { b["token"] = other.token; }), 404,
+            "not one of this session's trials");
+    page.answer(2);
+    EXPECT_EQ(responses(), 2);  // the other page's practice pair, this one's
+
+    // A rating trial: no choice events.
+    page.run(1);
+    ASSERT_EQ(page.state["trial"]["task"], "rating");
+    json rating = page.answer_body(1);
+    rating["token"] = page.token;
+    json as_choice = rating;
+    as_choice["events"] = {{{"t_ms", rating["onset_ms"].get<double>() + 100},
+                            {"type", "choice"},
+                            {"alternative", 1}}};
+    refused(as_choice, 400,
+            "field 'type': a 'choice' event answers a forced choice; this trial is a "
+            "rating");
+
+    // A quadruple in sequence: each part's onset no earlier than the part before's
+    // onset plus its duration.
+    for (int guard = 0; guard < 100 && !(page.state["screen"] == "trial" &&
+                                         page.state["trial"]["task"] == "quadruple");
+         ++guard) {
+        if (page.state["screen"] == "trial")
+            page.answer(static_cast<int>(page.shown.size()));
+        else
+            page.enter();
+    }
+    const json ok = with(0, [](json&) {});
+    const double onset = ok["onset_ms"];
+    refused(with(0,
+                 [&](json& b) {
+                     b["phase_onsets_ms"]["answer"] =
+                         b["phase_onsets_ms"]["second"].get<double>() + 59;
+                 }),
+            400,
+            "field 'phase_onsets_ms.answer': the answer screen came 59.0 ms after the "
+            "second part, which is shown for 60 ms");
+    refused(with(0, [&](json& b) { b["phase_onsets_ms"]["gap"] = onset + 59.5; }), 400,
+            "field 'phase_onsets_ms.gap': the blank came 59.5 ms after the first part");
+    refused(
+        with(0, [&](json& b) { b["phase_onsets_ms"]["second"] = onset + 60 + 3 + 29; }),
+        400, "'phase_onsets_ms.second'");
+    refused(with(0, [](json& b) { b.erase("phase_onsets_ms"); }), 400,
+            "'phase_onsets_ms' ({\"gap\", \"second\", \"answer\"}) is required");
+    refused(with(0, [](json& b) { b["phase_onsets_ms"].erase("answer"); }), 400,
+            "'answer' is required");
+    // Keys before the answer screen are stale: they answer nothing.
+    refused(with(0,
+                 [&](json& b) {
+                     for (json& e : b["events"]) e["t_ms"] = onset + 50;
+                 }),
+            400, "do not choose an alternative");
+    const int64_t stored = responses();
+    page.answer(0);
+    EXPECT_EQ(responses(), stored + 1);
+    EXPECT_EQ(count("SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id "
+                    "WHERE t.task = 'quadruple' AND r.question = 'quad_differs' AND "
+                    "r.rating = 1 AND abs(r.rt_ms - 100) < 0.001"),
+              1);
 }
 
 INSTANTIATE_TEST_SUITE_P(Stores, Serve, ::testing::Values("sqlite", "postgresql"),
