@@ -146,5 +146,93 @@ TEST(AnalysisReportInBrowser, PlotsAndLevelThumbnailsAreDrawn) {
             << colour[0] << "," << colour[1] << "," << colour[2];
 }
 
+// The scales of forced choices (issue 30) in the same report: a choices CSV of a 9-level
+// series (MLDS triads and paired comparisons of 6 observers with a square-root scale and
+// noise from a fixed linear congruential sequence), each level's picture its own hue.
+TEST(AnalysisReportInBrowser, ScalingPlotsAndTheSeriesPicturesAreDrawn) {
+    const fs::path dir =
+        fs::path(LUCENT_BINARY_DIR) / "test-scratch" / "scaling_report_browser";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "stimuli");
+    const double values[9] = {1, 4, 7, 10, 14, 19, 25, 36, 64};
+    for (int l = 0; l < 9; ++l) {
+        Image image(128, 128);
+        for (int i = 0; i < 128 * 128; ++i) {
+            image.rgba[i * 4 + 0] = l / 8.0f;
+            image.rgba[i * 4 + 1] = 0.2f;
+            image.rgba[i * 4 + 2] = 1.0f - l / 8.0f;
+            image.rgba[i * 4 + 3] = 1.0f;
+        }
+        write_image(dir / "stimuli" / ("r_" + std::to_string(int(values[l])) + ".png"),
+                    image);
+    }
+    uint64_t state = 12345;
+    auto noise = [&] {  // roughly N(0, 0.15^2): a sum of 4 uniforms
+        double sum = 0;
+        for (int k = 0; k < 4; ++k) {
+            state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+            sum += static_cast<double>(state >> 11) * 0x1p-53 - 0.5;
+        }
+        return sum * 0.15 * std::sqrt(3.0);
+    };
+    auto psi = [&](int l) { return std::sqrt((values[l] - 1) / 63); };
+    auto id = [&](int l) { return "r_" + std::to_string(int(values[l])); };
+    auto value = [&](int l) { return std::to_string(int(values[l])); };
+    {
+        std::ofstream csv(dir / "choices.csv");
+        csv << "participant,session,trial,block,task,question,practice,catch,expected,"
+               "shown_1,shown_2,shown_3,shown_4,value_1,value_2,value_3,value_4,choice,"
+               "rt_ms\n";
+        for (int p = 1; p <= 6; ++p) {
+            int trial = 0;
+            for (int a = 0; a < 9; ++a)
+                for (int b = a + 1; b < 9; ++b)
+                    for (int c = b + 1; c < 9; ++c) {
+                        const double d = psi(b) - psi(a) - (psi(c) - psi(b)) + noise();
+                        csv << 'P' << p << ",s" << p << ',' << trial++
+                            << ",mlds,triad,differs_more,0,0,," << id(a) << ',' << id(b)
+                            << ',' << id(c) << ",," << value(a) << ',' << value(b) << ','
+                            << value(c) << ",," << (d > 0 ? 1 : 2) << ",900\n";
+                    }
+            for (int a = 0; a < 9; ++a)
+                for (int b = 0; b < 9; ++b) {
+                    if (a == b) continue;
+                    const double d = psi(a) - psi(b) + noise();
+                    csv << 'P' << p << ",s" << p << ',' << trial++
+                        << ",pairs,pair,more_translucent,0,0,," << id(a) << ',' << id(b)
+                        << ",,," << value(a) << ',' << value(b) << ",,,"
+                        << (d > 0 ? 1 : 2) << ",700\n";
+                }
+        }
+    }
+    const std::string command = std::string("'") + LUCENT_EXECUTABLE + "' analyze '" +
+                                (dir / "choices.csv").string() + "' --out '" +
+                                (dir / "report").string() + "' --images '" +
+                                (dir / "stimuli").string() +
+                                "' --bootstrap 100 --six-point 50 > '" +
+                                (dir / "analyze.log").string() + "' 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << read_file(dir / "analyze.log");
+    const std::string html = read_file(dir / "report" / "report.html");
+    for (const char* words : {"Perceptual scales", "MLDS", "Bradley-Terry", "Thurstone"})
+        EXPECT_NE(html.find(words), std::string::npos) << words;
+    EXPECT_TRUE(fs::exists(dir / "report" / "scaling.csv"));
+
+    const test::BrowserPage page = test::open_in_browser(
+        dir / "report" / "report.html", dir / "screenshot.png", 1280, 4000);
+    ASSERT_TRUE(page.ok) << page.error;
+    // Both blocks' series pictures, 9 each, decoded.
+    EXPECT_EQ(page.images_drawn, "18/18");
+    std::size_t svgs = 0;
+    for (std::size_t at = page.dom.find("<svg"); at != std::string::npos;
+         at = page.dom.find("<svg", at + 1))
+        ++svgs;
+    EXPECT_GE(svgs, 2u);  // one scale per block
+    const auto near = [](float a, float b) { return std::abs(a - b) < 0.08f; };
+    EXPECT_GT(page.count_pixels([&](float r, float g, float b) {
+        return near(r, 0x1f / 255.0f) && near(g, 0x77 / 255.0f) && near(b, 0xb4 / 255.0f);
+    }),
+              50u);  // the pooled scale's line and intervals
+}
+
 }  // namespace
 }  // namespace lucent

@@ -56,8 +56,8 @@ TEST(ScalingRecovery, MldsAndThurstoneRecoverTheObserversScale) {
 
     std::stringstream csv;
     const ChoiceExport exported = export_choices(db, csv, {.analysis = true});
-    // 10 sessions x (84 triads + 1 catch + 72 pairs + 2 identical + 1 obvious).
-    ASSERT_EQ(exported.rows, 10 * 160);
+    // 10 sessions x (126 quadruples + 1 catch + 36 pairs + 2 identical + 1 obvious).
+    ASSERT_EQ(exported.rows, 10 * 166);
     EXPECT_TRUE(exported.excluded_participants.empty());  // obvious catches are obvious
     const analysis::ChoiceTable table = analysis::read_choice_csv(csv, db);
     const std::map<std::string, std::vector<std::string>> orders =
@@ -66,12 +66,16 @@ TEST(ScalingRecovery, MldsAndThurstoneRecoverTheObserversScale) {
     const std::vector<double> r = {1, 4, 7, 10, 14, 19, 25, 36, 64};
     auto psi = [&](double v) { return observer.scale(v, 1, 64); };
 
+    // The six-point test on data that obey the model: no evidence against it.
+    analysis::MldsOptions six_point;
+    six_point.six_point_simulations = 100;
+    six_point.seed = 9;
     const std::vector<analysis::MldsBlockFits> mlds =
-        analysis::fit_mlds_blocks(table, {}, orders);
+        analysis::fit_mlds_blocks(table, six_point, orders);
     ASSERT_EQ(mlds.size(), 1u);
     const analysis::MldsFit& fit = mlds[0].pooled;
     ASSERT_EQ(fit.scale.size(), r.size());
-    // 840 triads: each scale value within 4 standard errors and 0.08 of the truth.
+    // 1260 quadruples: each scale value within 4 standard errors and 0.08 of the truth.
     for (size_t i = 0; i < r.size(); ++i) {
         ASSERT_TRUE(fit.scale[i].has_value()) << "r = " << r[i];
         EXPECT_NEAR(*fit.scale[i], psi(r[i]), 0.08) << "r = " << r[i];
@@ -81,6 +85,9 @@ TEST(ScalingRecovery, MldsAndThurstoneRecoverTheObserversScale) {
                 << "r = " << r[i];
         }
     }
+    EXPECT_GT(fit.six_point.sets, 0);
+    ASSERT_TRUE(fit.six_point.p.has_value());
+    EXPECT_GT(*fit.six_point.p, 0.01);
     ASSERT_TRUE(fit.sigma.has_value());
     EXPECT_NEAR(*fit.sigma, observer.sigma, 0.04);
 
