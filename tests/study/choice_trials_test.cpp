@@ -386,7 +386,8 @@ TEST(ChoiceStore, KeepsTheChoicesInScreenOrderAndExportsOneRowEach) {
     const ChoiceExport view = export_choices(path, analysis, {.analysis = true});
     EXPECT_EQ(view.rows, 34);
     // The same through export_file, as `lucent export --format ...` writes them.
-    EXPECT_EQ(export_file(path, "choices", (dir / "choices.csv").string(), false).rows, 35);
+    EXPECT_EQ(export_file(path, "choices", (dir / "choices.csv").string(), false).rows,
+              35);
     EXPECT_EQ(
         export_file(path, "choice-analysis", (dir / "analysis.csv").string(), false).rows,
         34);
