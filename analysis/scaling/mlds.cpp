@@ -385,47 +385,19 @@ MldsData mlds_data(const std::vector<const ChoiceRow*>& rows,
 std::vector<MldsBlockFits> fit_mlds_blocks(
     const ChoiceTable& table, const MldsOptions& options,
     const std::map<std::string, std::vector<std::string>>& orders) {
-    std::vector<std::pair<std::string, std::string>> keys;
-    std::map<std::pair<std::string, std::string>, std::vector<const ChoiceRow*>> by_key;
-    for (const ChoiceRow& row : table.rows) {
-        if (row.task == ChoiceTask::pair) continue;
-        const auto key = std::pair(row.block, row.question);
-        auto& list = by_key[key];
-        if (list.empty()) keys.push_back(key);
-        list.push_back(&row);
-    }
     std::vector<MldsBlockFits> result;
-    for (const auto& key : keys) {
-        const auto& rows = by_key[key];
+    for (const ChoiceBlock& b : choice_blocks(table, false, orders)) {
         MldsBlockFits block;
-        block.block = key.first;
-        block.question = key.second;
-        const auto order = orders.find(key.first);
-        block.stimuli = series_order(
-            rows, order == orders.end() ? std::vector<std::string>{} : order->second);
-        for (const std::string& s : block.stimuli) {
-            std::optional<double> v;
-            for (const ChoiceRow* row : rows)
-                for (int j = 0; j < shown_count(row->task) && !v; ++j)
-                    if (row->shown[j] == s) v = row->value[j];
-            block.values.push_back(v);
-        }
-        std::vector<std::string> participants;
-        std::map<std::string, std::vector<const ChoiceRow*>> of;
-        for (const ChoiceRow* row : rows) {
-            if (row->is_catch) {
-                ++block.catch_trials;
-                if (row->expected && *row->expected != row->choice) ++block.catch_failed;
-                continue;
-            }
-            auto& list = of[row->participant];
-            if (list.empty()) participants.push_back(row->participant);
-            list.push_back(row);
-        }
-        block.pooled = fit_mlds(mlds_data(rows, block.stimuli), options);
-        for (const std::string& p : participants)
+        block.block = b.block;
+        block.question = b.question;
+        block.stimuli = b.stimuli;
+        block.values = b.values;
+        block.catch_trials = b.catch_trials;
+        block.catch_failed = b.catch_failed;
+        block.pooled = fit_mlds(mlds_data(b.rows, b.stimuli), options);
+        for (const auto& [who, rows] : b.participants)
             block.participants.emplace_back(
-                p, fit_mlds(mlds_data(of[p], block.stimuli), options));
+                who, fit_mlds(mlds_data(rows, b.stimuli), options));
         result.push_back(std::move(block));
     }
     return result;

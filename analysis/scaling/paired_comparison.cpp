@@ -386,55 +386,69 @@ PairedData paired_data(const std::vector<const ChoiceRow*>& rows,
     return data;
 }
 
-std::vector<PairedBlockFits> fit_paired_blocks(
-    const ChoiceTable& table, const PairedOptions& options,
+std::vector<ChoiceBlock> choice_blocks(
+    const ChoiceTable& table, bool pairs,
     const std::map<std::string, std::vector<std::string>>& orders) {
-    std::vector<std::pair<std::string, std::string>> keys;
-    std::map<std::pair<std::string, std::string>, std::vector<const ChoiceRow*>> by_key;
+    std::vector<ChoiceBlock> blocks;
+    std::map<std::pair<std::string, std::string>, std::size_t> index;
     for (const ChoiceRow& row : table.rows) {
-        if (row.task != ChoiceTask::pair) continue;
-        const auto key = std::pair(row.block, row.question);
-        auto& list = by_key[key];
-        if (list.empty()) keys.push_back(key);
-        list.push_back(&row);
+        if ((row.task == ChoiceTask::pair) != pairs) continue;
+        const auto [it, added] =
+            index.emplace(std::pair(row.block, row.question), blocks.size());
+        if (added) blocks.push_back({row.block, row.question, {}, {}, {}, {}, 0, 0});
+        blocks[it->second].rows.push_back(&row);
     }
-    std::vector<PairedBlockFits> result;
-    for (const auto& key : keys) {
-        const auto& rows = by_key[key];
-        PairedBlockFits block;
-        block.block = key.first;
-        block.question = key.second;
-        const auto order = orders.find(key.first);
-        block.stimuli = series_order(
-            rows, order == orders.end() ? std::vector<std::string>{} : order->second);
+    for (ChoiceBlock& block : blocks) {
+        const auto order = orders.find(block.block);
+        block.stimuli =
+            series_order(block.rows, order == orders.end() ? std::vector<std::string>{}
+                                                           : order->second);
         for (const std::string& s : block.stimuli) {
             std::optional<double> v;
-            for (const ChoiceRow* row : rows)
-                for (int k = 0; k < 2 && !v; ++k)
+            for (const ChoiceRow* row : block.rows)
+                for (int k = 0; k < shown_count(row->task) && !v; ++k)
                     if (row->shown[k] == s) v = row->value[k];
             block.values.push_back(v);
         }
-        std::vector<std::string> participants;
-        std::map<std::string, std::vector<const ChoiceRow*>> of;
-        for (const ChoiceRow* row : rows) {
+        std::map<std::string, std::size_t> of;
+        for (const ChoiceRow* row : block.rows) {
             if (row->is_catch) {
                 ++block.catch_trials;
                 if (row->expected && *row->expected != row->choice) ++block.catch_failed;
                 continue;
             }
-            auto& list = of[row->participant];
-            if (list.empty()) participants.push_back(row->participant);
-            list.push_back(row);
+            const auto [it, added] =
+                of.emplace(row->participant, block.participants.size());
+            if (added)
+                block.participants.emplace_back(row->participant,
+                                                std::vector<const ChoiceRow*>{});
+            block.participants[it->second].second.push_back(row);
         }
-        block.pooled = fit_paired_comparison(paired_data(rows, block.stimuli), options);
-        PairedOptions other = options;
-        other.link = options.link == BinomialLink::logit ? BinomialLink::probit
-                                                         : BinomialLink::logit;
-        block.pooled_other_link =
-            fit_paired_comparison(paired_data(rows, block.stimuli), other);
-        for (const std::string& p : participants)
+    }
+    return blocks;
+}
+
+std::vector<PairedBlockFits> fit_paired_blocks(
+    const ChoiceTable& table, const PairedOptions& options,
+    const std::map<std::string, std::vector<std::string>>& orders) {
+    PairedOptions other = options;
+    other.link =
+        options.link == BinomialLink::logit ? BinomialLink::probit : BinomialLink::logit;
+    std::vector<PairedBlockFits> result;
+    for (const ChoiceBlock& b : choice_blocks(table, true, orders)) {
+        PairedBlockFits block;
+        block.block = b.block;
+        block.question = b.question;
+        block.stimuli = b.stimuli;
+        block.values = b.values;
+        block.catch_trials = b.catch_trials;
+        block.catch_failed = b.catch_failed;
+        const PairedData pooled = paired_data(b.rows, b.stimuli);
+        block.pooled = fit_paired_comparison(pooled, options);
+        block.pooled_other_link = fit_paired_comparison(pooled, other);
+        for (const auto& [who, rows] : b.participants)
             block.participants.emplace_back(
-                p, fit_paired_comparison(paired_data(of[p], block.stimuli), options));
+                who, fit_paired_comparison(paired_data(rows, b.stimuli), options));
         result.push_back(std::move(block));
     }
     return result;

@@ -89,6 +89,24 @@ PairedFit fit_paired_comparison(const PairedData& data,
 std::vector<std::string> series_order(const std::vector<const ChoiceRow*>& rows,
                                       const std::vector<std::string>& order = {});
 
+// The rows of one (block, question) of a choices table, as a scaling takes them: every
+// row (catch trials included), the block's series in order with each stimulus's value,
+// the judged rows (catch trials left out) of each participant in order of first
+// appearance, and the catch trials counted with their wrong answers.
+struct ChoiceBlock {
+    std::string block, question;
+    std::vector<const ChoiceRow*> rows;
+    std::vector<std::string> stimuli;
+    std::vector<std::optional<double>> values;
+    std::vector<std::pair<std::string, std::vector<const ChoiceRow*>>> participants;
+    std::size_t catch_trials = 0, catch_failed = 0;
+};
+// The pair blocks (`pairs`) or the MLDS blocks (triads, quadruples) of `table`, in order
+// of first appearance; `orders`: block -> its series (see series_order).
+std::vector<ChoiceBlock> choice_blocks(
+    const ChoiceTable& table, bool pairs,
+    const std::map<std::string, std::vector<std::string>>& orders);
+
 // Counts of one set of pair rows (catch trials left out), screen order kept.
 PairedData paired_data(const std::vector<const ChoiceRow*>& rows,
                        const std::vector<std::string>& stimuli);
