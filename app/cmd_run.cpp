@@ -1,5 +1,6 @@
 // lucent run: a participant session from a protocol file or the built-in preset.
 #include <iostream>
+#include <sstream>
 
 #include "app/commands.h"
 #include "study/protocol.h"
@@ -12,12 +13,21 @@
 namespace lucent::app {
 namespace {
 
+// The autopilot's observer unless --autopilot-observer says otherwise: the model's own
+// default (simulated_observer.h), so the two never differ.
+std::string default_observer() {
+    const study::ObserverModel m;
+    std::ostringstream text;
+    text << m.exponent << "," << m.sigma;
+    return text.str();
+}
+
 struct RunArgs {
     std::string protocol_file;
     std::string preset;
     std::string images_dir;
     int64_t seed = -1;
-    std::string observer = "0.5,0.1";
+    std::string observer = default_observer();
     study::RunOptions options;
 };
 
