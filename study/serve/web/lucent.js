@@ -3,7 +3,9 @@
 // Enter, and clicks follow the lab's rules (study/session/rating_input.h); each answer
 // sends its input events with performance.now() times, and the server replays them.
 // The picture is drawn pixel for pixel; its onset is the first requestAnimationFrame
-// after it decoded and entered the page.
+// after it decoded and entered the page. A forced choice (pair, triad, quadruple)
+// shows its pictures side by side, or its two parts in sequence with a blank between
+// and then the two answers; arrows or 1/2 pick, Enter confirms, a click answers.
 'use strict';
 (() => {
   const el = (id) => document.getElementById(id);
@@ -23,6 +25,7 @@
   let shownAt = null;   // performance.now() of the current screen's first frame
   let busy = false;     // a request is on its way: input waits
   let trial = null;     // the rating screen: onset, events, ratings, focus
+  let choice = null;    // a forced choice's answer screen: onsets, events, the pick
 
   function mark(screen) {
     document.body.dataset.screen = screen;
@@ -104,6 +107,7 @@
     state = s;
     shownAt = null;
     trial = null;
+    choice = null;
     document.body.style.background = s.background || '#000';
     const progress = s.progress;
     el('progress').hidden = !progress || s.screen === 'consent';
@@ -113,7 +117,8 @@
       localStorage.removeItem(tokenKey);
       return message(s.text, 'declined');
     }
-    if (s.screen === 'trial') return beginTrial(s);
+    if (s.screen === 'trial')
+      return s.trial.task && s.trial.task !== 'rating' ? beginChoice(s) : beginTrial(s);
     only('text-screen');
     el('text').textContent = s.text;
     const consent = s.screen === 'consent';
@@ -192,6 +197,9 @@
 
   async function beginTrial(s) {
     const t = s.trial;
+    el('rating-part').hidden = false;
+    el('choice-part').hidden = true;
+    el('trial-screen').classList.remove('choice');
     only('trial-screen');
     const screenBox = el('trial-screen');
     screenBox.style.visibility = 'hidden';  // the blank between trials
@@ -287,6 +295,220 @@
     api('answer', body).then(({ status, reply }) => settle(status, reply));
   }
 
+  // ---- a forced choice --------------------------------------------------------------
+  // Which pictures (indices into `shown`) each alternative is: a pair's two pictures, a
+  // triad's pairs (a, b) and (b, c), a quadruple's pairs (a, b) and (c, d).
+  function partsOf(task) {
+    if (task === 'pair') return [[0], [1]];
+    if (task === 'triad') return [[0, 1], [1, 2]];
+    return [[0, 1], [2, 3]];
+  }
+  function answerButton(label, alternative) {
+    const b = document.createElement('button');
+    b.type = 'button';
+    b.className = 'answer';
+    b.textContent = label;
+    b.dataset.alternative = String(alternative);
+    return b;
+  }
+  // Side by side: a pair or a quadruple as two groups (a wider gap between a
+  // quadruple's), each with its answer below it; a triad as one row with each pair's
+  // answer bracketing it below. `part` (0, 1) lays out one part of a sequence instead,
+  // and 'answer' its two answers alone.
+  function layoutChoice(t, imgs, part) {
+    const box = el('alternatives');
+    box.textContent = '';
+    box.className = 'task-' + t.task;
+    const parts = partsOf(t.task);
+    if (part === 'answer') {
+      box.classList.add('answers');
+      t.labels.forEach((label, i) => box.appendChild(answerButton(label, i + 1)));
+      return;
+    }
+    if (part !== undefined) {  // one part of a sequence: its pictures only
+      const group = document.createElement('div');
+      group.className = 'group';
+      for (const i of parts[part]) group.appendChild(imgs[i]);  // moved, never copied
+      box.classList.add('sequence');
+      box.appendChild(group);
+      return;
+    }
+    if (t.task === 'triad') {
+      const grid = document.createElement('div');
+      grid.className = 'triad';
+      imgs.forEach((img, i) => {
+        img.dataset.alternative = i === 0 ? '1' : i === 2 ? '2' : '';
+        grid.appendChild(img);
+      });
+      parts.forEach((pair, i) => {
+        const bracket = answerButton(t.labels[i], i + 1);
+        bracket.classList.add('bracket');
+        bracket.style.gridColumn = pair[0] + 1 + ' / ' + (pair[1] + 2);
+        bracket.style.gridRow = String(i + 2);
+        grid.appendChild(bracket);
+      });
+      box.appendChild(grid);
+      return;
+    }
+    parts.forEach((indices, i) => {
+      const group = document.createElement('div');
+      group.className = 'group';
+      group.dataset.alternative = String(i + 1);
+      const pictures = document.createElement('div');
+      pictures.className = 'pictures';
+      for (const k of indices) pictures.appendChild(imgs[k]);
+      group.appendChild(pictures);
+      group.appendChild(answerButton(t.labels[i], i + 1));
+      box.appendChild(group);
+    });
+  }
+  function sizeChoice(t) {
+    // One image pixel per device pixel, as for a rating's picture.
+    el('alternatives').querySelectorAll('img').forEach((img) => {
+      const k = Number(img.dataset.index);
+      img.style.width = t.shown[k].width / devicePixelRatio + 'px';
+      img.style.height = t.shown[k].height / devicePixelRatio + 'px';
+    });
+  }
+  // Waits (frame by frame at the end) until performance.now() reaches `t`.
+  async function until(t) {
+    const early = t - performance.now() - 20;
+    if (early > 0) await sleep(early);
+    while (performance.now() < t) await firstFrame();
+  }
+
+  async function beginChoice(s) {
+    const t = s.trial;
+    el('rating-part').hidden = true;
+    el('choice-part').hidden = false;
+    const screenBox = el('trial-screen');
+    screenBox.classList.add('choice');
+    el('alternatives').style.visibility = '';
+    only('trial-screen');
+    screenBox.style.visibility = 'hidden';  // the blank between trials
+    mark('blank');
+    const imgs = t.shown.map((picture, k) => {
+      const img = new Image();
+      img.alt = '';
+      img.draggable = false;
+      img.dataset.index = String(k);
+      img.src = picture.image;
+      return img;
+    });
+    const decoded = Promise.all(imgs.map((img) => img.decode()));
+    await sleep(t.blank_ms);
+    try { await decoded; } catch (e) { return message('The pictures of this trial cannot be shown.'); }
+    if (state !== s) return;
+    el('choice-prompt').textContent = t.practice ? 'Practice' : '';
+    el('question').textContent = t.question;
+    const sequential = t.presentation === 'sequential';
+    // Every layout the trial shows must fit at the pictures' true size.
+    const layouts = sequential ? [0, 1, 'answer'] : [undefined];
+    for (;;) {  // laid out invisibly and measured; too small: say so and wait
+      only('trial-screen');
+      let ok = true;
+      for (const part of layouts) {
+        layoutChoice(t, imgs, part);
+        sizeChoice(t);
+        ok = ok && fits();
+      }
+      if (ok) break;
+      const widths = t.shown.map((p) => p.width + ' x ' + p.height).join(', ');
+      message('Your browser window is too small to show the pictures side by side at ' +
+              'their true size (' + widths + ' pixels). Please enlarge the window or ' +
+              'zoom out; the study continues by itself.', 'too-small');
+      await new Promise((resolve) => addEventListener('resize', resolve, { once: true }));
+      if (state !== s) return;
+    }
+    only('trial-screen');
+    el('progress').hidden = !s.progress;
+    layoutChoice(t, imgs, layouts[0]);
+    sizeChoice(t);
+    screenBox.style.visibility = 'visible';
+    const onset = await firstFrame();
+    if (state !== s) return;
+    let answerOnset = onset;
+    let phases;
+    if (sequential) {
+      // Each part for its duration, counted from the frame that showed it (the server
+      // refuses a part shown before the one before had its time).
+      document.body.dataset.trial = t.id;
+      mark('sequence');
+      const seq = t.sequence;
+      await until(onset + seq.duration_ms);
+      if (state !== s) return;
+      el('alternatives').style.visibility = 'hidden';
+      const gap = await firstFrame();
+      await until(gap + seq.blank_ms);
+      if (state !== s) return;
+      layoutChoice(t, imgs, 1);
+      sizeChoice(t);
+      el('alternatives').style.visibility = 'visible';
+      const second = await firstFrame();
+      await until(second + seq.duration_ms);
+      if (state !== s) return;
+      layoutChoice(t, imgs, 'answer');
+      answerOnset = await firstFrame();
+      if (state !== s) return;
+      phases = { gap, second, answer: answerOnset };
+    }
+    choice = { onset, answerOnset, phases, events: [], pick: null };
+    el('alternatives').querySelectorAll('[data-alternative]').forEach((node) => {
+      const alternative = Number(node.dataset.alternative);
+      if (!alternative) return;
+      node.addEventListener('click', (ev) => {
+        ev.stopPropagation();  // an answer inside its group: one click, one event
+        if (ev.currentTarget.blur) ev.currentTarget.blur();  // Enter stays the study's key
+        choiceInput({ type: 'choice', alternative }, ev.timeStamp);
+      });
+    });
+    renderChoice();
+    document.body.dataset.trial = t.id;
+    mark('trial');
+  }
+
+  function renderChoice() {
+    const t = state.trial;
+    const parts = partsOf(t.task);
+    el('alternatives').querySelectorAll('[data-alternative]').forEach((node) =>
+      node.classList.toggle('chosen', Number(node.dataset.alternative) === choice.pick));
+    if (t.task === 'triad')  // the chosen pair's pictures
+      el('alternatives').querySelectorAll('img').forEach((img) =>
+        img.classList.toggle('chosen', choice.pick !== null &&
+                             parts[choice.pick - 1].includes(Number(img.dataset.index))));
+    document.body.dataset.choice = choice.pick === null ? '' : String(choice.pick);
+  }
+
+  // One input on a forced choice's answer screen, by the lab's rules: the arrows pick
+  // the alternative on their side, 1 and 2 pick, Enter confirms, a click picks and
+  // confirms. Recorded for the server's replay.
+  function choiceInput(ev, t) {
+    if (!choice || busy || t < choice.answerOnset) return;
+    let confirm = false;
+    if (ev.type === 'choice') {
+      choice.pick = ev.alternative;
+      confirm = true;
+    } else {
+      const k = ev.key;
+      if (k === 'ArrowLeft' || k === '1') choice.pick = 1;
+      else if (k === 'ArrowRight' || k === '2') choice.pick = 2;
+      else if (k === 'Enter') {
+        if (choice.pick === null) return;
+        confirm = true;
+      } else return;  // nothing else answers a choice
+    }
+    choice.events.push(Object.assign({ t_ms: t }, ev));
+    renderChoice();
+    if (!confirm) return;
+    busy = true;
+    const body = {
+      trial: state.trial.id, view: state.view, onset_ms: choice.onset, events: choice.events,
+    };
+    if (choice.phases) body.phase_onsets_ms = choice.phases;
+    choice = null;
+    api('answer', body).then(({ status, reply }) => settle(status, reply));
+  }
+
   // ---- keys and buttons -------------------------------------------------------------
   document.addEventListener('keydown', (ev) => {
     if (!state || ev.repeat) return;
@@ -294,7 +516,11 @@
     const k = ev.key;
     if (['ArrowLeft', 'ArrowRight', 'ArrowUp', 'ArrowDown', 'Enter', ' '].includes(k))
       ev.preventDefault();
-    if (state.screen === 'trial') return input({ type: 'key', key: k }, t);
+    if (state.screen === 'trial') {
+      if (state.trial && state.trial.task && state.trial.task !== 'rating')
+        return choiceInput({ type: 'key', key: k }, t);
+      return input({ type: 'key', key: k }, t);
+    }
     if (k === 'Enter') act('continue', t);
     else if ((k === 'n' || k === 'N') && state.screen === 'consent') act('decline', t);
   });

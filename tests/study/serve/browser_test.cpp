@@ -2,9 +2,12 @@
 // clicking (DevTools protocol, trusted input events), with and without a reload in the
 // middle. Expected ratings are the ones the test pressed, for the trials in the order
 // the page showed them; the pictures' sizes are the files' own.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <thread>
 
@@ -222,6 +225,165 @@ TEST_F(ServeBrowser, AWindowTooSmallForThePictureIsToldSoAndWaits) {
         "Emulation.setDeviceMetricsOverride",
         {{"width", 1280}, {"height", 900}, {"deviceScaleFactor", 1}, {"mobile", false}});
     EXPECT_TRUE(wait_screen("trial")) << screen();
+}
+
+// ---- forced choices (issue 30)
+// --------------------------------------------------------- Four pictures of 128 x 128
+// pixels; a pair and a triad side by side, a quadruple in sequence, one trial each, in
+// the protocol's order.
+std::string write_choice_study(const std::filesystem::path& dir) {
+    for (int k = 0; k < 4; ++k) {
+        std::vector<unsigned char> pixels(128 * 128 * 3);
+        for (size_t i = 0; i < pixels.size(); ++i)
+            pixels[i] = static_cast<unsigned char>(40 + 60 * k + (i % 3) * 10);
+        const std::string path = (dir / ("q" + std::to_string(k + 1) + ".png")).string();
+        auto out = OIIO::ImageOutput::create(path);
+        out->open(path, OIIO::ImageSpec(128, 128, 3, OIIO::TypeDesc::UINT8));
+        out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
+        out->close();
+    }
+    const std::string protocol = (dir / "choices.toml").string();
+    std::ofstream out(protocol);
+    out << R"toml(
+[study]
+name = "web_choices"
+inter_trial_ms = 100
+
+[screens]
+consent = "Do you agree to take part?"
+instructions = "Choose."
+debrief = "Thank you."
+
+[randomisation]
+counterbalance_blocks = false
+)toml";
+    for (int k = 1; k <= 4; ++k)
+        out << "\n[[stimuli]]\nid = \"q" << k << "\"\nimage = \"q" << k << ".png\"\n";
+    out << R"toml(
+[[blocks]]
+id = "pairs"
+task = "pair"
+stimuli = ["q1", "q2"]
+question = "Which looks more translucent?"
+question_id = "more_translucent"
+
+[[blocks]]
+id = "triads"
+task = "triad"
+stimuli = ["q1", "q2", "q3"]
+question = "Which pair differs more?"
+question_id = "triad_differs"
+
+[[blocks]]
+id = "quads"
+task = "quadruple"
+stimuli = ["q1", "q2", "q3", "q4"]
+question = "Which pair differs more?"
+question_id = "quad_differs"
+presentation = "sequential"
+duration_ms = 1000
+blank_ms = 300
+)toml";
+    return protocol;
+}
+
+TEST(ServeBrowserChoices, APairByAClickATriadByArrowsAndASequenceEachDrawnAtItsSize) {
+    const std::filesystem::path dir = lucent::test::scratch_dir("serve_browser_choices");
+    const std::string db = (dir / "study.db").string();
+    lucent::test::ServeProcess server(write_choice_study(dir), db, dir.string());
+    ASSERT_GT(server.port(), 0) << "lucent serve did not start: " << server.first_line();
+    lucent::test::DevToolsBrowser browser(1280, 900);
+    if (!browser.ok()) GTEST_SKIP() << browser.error();
+    auto screen = [&] {
+        return browser.evaluate("document.body.dataset.screen").get<std::string>();
+    };
+    auto wait_screen = [&](const std::string& name) {
+        return browser.wait_until("document.body.dataset.screen === '" + name + "'");
+    };
+    auto view = [&] {
+        return browser.evaluate("document.body.dataset.view").get<std::string>();
+    };
+    // The next trial's answer screen after `before`.
+    auto wait_answer = [&](const std::string& before) {
+        return browser.wait_until("document.body.dataset.view !== '" + before +
+                                  "' && document.body.dataset.screen === 'trial'");
+    };
+    // Every picture drawn pixel for pixel: its natural size is its size on the page.
+    auto pictures = [&] {
+        return browser.evaluate(
+            "[...document.querySelectorAll('#alternatives img')].map((i) => "
+            "[i.naturalWidth, i.clientWidth, i.naturalHeight, i.clientHeight])");
+    };
+    const json at_size = json::array({128, 128, 128, 128});
+
+    // A window too narrow for the pair side by side waits, as for a rating's picture.
+    browser.call(
+        "Emulation.setDeviceMetricsOverride",
+        {{"width", 320}, {"height", 900}, {"deviceScaleFactor", 1}, {"mobile", false}});
+    browser.navigate(server.url() + "/?participant=C1");
+    ASSERT_TRUE(wait_screen("consent")) << screen();
+    browser.press("Enter");
+    ASSERT_TRUE(wait_screen("instructions")) << screen();
+    const std::string instructions = view();
+    browser.press("Enter");
+    ASSERT_TRUE(wait_screen("too-small")) << screen();
+    EXPECT_NE(browser.evaluate("document.getElementById('message-text').textContent")
+                  .get<std::string>()
+                  .find("128 x 128"),
+              std::string::npos);
+    browser.call(
+        "Emulation.setDeviceMetricsOverride",
+        {{"width", 1280}, {"height", 900}, {"deviceScaleFactor", 1}, {"mobile", false}});
+    ASSERT_TRUE(wait_answer(instructions)) << screen();
+
+    // The pair: two pictures at their size, the question above; a click on the second.
+    EXPECT_EQ(pictures(), json::array({at_size, at_size}));
+    EXPECT_EQ(browser.evaluate("document.getElementById('question').textContent"),
+              "Which looks more translucent?");
+    const std::string pair = view();
+    ASSERT_TRUE(browser.click("#alternatives .group[data-alternative='2'] img"));
+
+    // The triad: three pictures; the arrows pick the pair on their side, Enter confirms.
+    ASSERT_TRUE(wait_answer(pair)) << screen();
+    EXPECT_EQ(pictures(), json::array({at_size, at_size, at_size}));
+    const std::string triad = view();
+    browser.press("ArrowRight");
+    EXPECT_TRUE(browser.wait_until("document.body.dataset.choice === '2'"));
+    EXPECT_EQ(
+        browser.evaluate("document.querySelectorAll('#alternatives .chosen').length"),
+        3);  // the bracket and its pair's two pictures
+    browser.press("ArrowLeft");
+    EXPECT_TRUE(browser.wait_until("document.body.dataset.choice === '1'"));
+    browser.press("Enter");
+
+    // The quadruple in sequence: keys while it is shown answer nothing; then the two
+    // answers alone, the second clicked.
+    ASSERT_TRUE(wait_screen("sequence")) << screen();
+    EXPECT_EQ(pictures(), json::array({at_size, at_size}));  // its first pair
+    browser.press("ArrowLeft");
+    browser.press("Enter");
+    ASSERT_TRUE(wait_answer(triad)) << screen();
+    EXPECT_EQ(pictures(), json::array());
+    EXPECT_EQ(browser.evaluate("document.body.dataset.choice"), "");
+    ASSERT_TRUE(browser.click("#alternatives button[data-alternative='2']"));
+    ASSERT_TRUE(wait_screen("debrief")) << screen();
+    browser.press("Enter");
+    ASSERT_TRUE(wait_screen("done")) << screen();
+
+    Store store(db);
+    auto stored = [&](const std::string& task, const std::string& question, int choice) {
+        return store.query_int(
+            "SELECT count(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE "
+            "t.task = '" +
+            task + "' AND r.question = '" + question +
+            "' AND r.rating = " + std::to_string(choice) + " AND r.rt_ms > 0");
+    };
+    EXPECT_EQ(stored("pair", "more_translucent", 2), 1);
+    EXPECT_EQ(stored("triad", "triad_differs", 1), 1);
+    EXPECT_EQ(stored("quadruple", "quad_differs", 2), 1);
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM responses"), 3);
+    EXPECT_EQ(store.query_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              1);
 }
 
 }  // namespace
