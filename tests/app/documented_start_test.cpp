@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -248,6 +249,82 @@ TEST(DocumentedStart, ThesisRunsAndServesFromTheSetItsRenderPresetWrites) {
 
 TEST(DocumentedStart, FabricsRunsAndServesFromTheSetItsRenderPresetWrites) {
     documented_start("fabrics");
+}
+
+// docs/scaling.md, command for command: each indented `lucent` line (a trailing
+// backslash continues it; `# ...` is a comment) runs as written in a scratch folder, in
+// the page's order, and each must succeed. Two lines get what a test needs: `serve` a
+// free port (it is checked and stopped), and the lab session without the autopilot is
+// left out (the autopilot line below it is that command with the simulated observer).
+TEST(DocumentedScaling, ThePagesCommandsRunAsWrittenAndTheReportScalesTheSession) {
+    LUCENT_REQUIRE_DISPLAY();
+    std::istringstream page(read_file(test::source_dir() / "docs" / "scaling.md"));
+    std::vector<std::string> commands;
+    std::string pending;
+    for (std::string line; std::getline(page, line);) {
+        if (pending.empty() && line.rfind("    lucent ", 0) != 0) continue;
+        line = line.substr(0, line.find('#'));
+        const bool continues = !line.empty() &&
+                               line.find_last_not_of(' ') != std::string::npos &&
+                               line[line.find_last_not_of(' ')] == '\\';
+        pending += continues ? line.substr(0, line.find_last_not_of(' ')) + " " : line;
+        if (!continues) {
+            commands.push_back(pending);
+            pending.clear();
+        }
+    }
+    ASSERT_GE(commands.size(), 7u);
+    const fs::path dir = test::scratch_dir("documented_scaling");
+    bool ran_session = false, analyzed = false;
+    for (const std::string& command : commands) {
+        std::vector<std::string> args = words(command);
+        args.erase(args.begin());  // "lucent"
+        const bool autopilot =
+            std::find(args.begin(), args.end(), "--autopilot") != args.end();
+        if (args[0] == "run" && !autopilot) continue;
+        if (args[0] == "serve") {
+            args.insert(args.end(), {"--listen", "127.0.0.1:0"});
+            Child s = start(args, dir, "serve", true);
+            const std::string line = first_line(s.stdout_fd);
+            const size_t at = line.find("http://127.0.0.1:");
+            ASSERT_NE(at, std::string::npos) << line << read_file(s.stderr_path);
+            httplib::Client client("127.0.0.1", std::stoi(line.substr(at + 17)));
+            const auto session =
+                client.Post("/api/session", R"({"participant": "WEB1", "t_ms": 0})",
+                            "application/json");
+            ASSERT_TRUE(session) << httplib::to_string(session.error());
+            EXPECT_EQ(session->status, 200) << session->body;
+            EXPECT_EQ(wait_exit(s, true), 0) << read_file(s.stderr_path);
+            continue;
+        }
+        Child c = start(args, dir, args[0], false);
+        ASSERT_EQ(wait_exit(c), 0) << command << "\n" << read_file(c.stderr_path);
+        ran_session = ran_session || args[0] == "run";
+        analyzed = analyzed || args[0] == "analyze";
+    }
+    ASSERT_TRUE(ran_session);
+    ASSERT_TRUE(analyzed);
+    // The autopilot's session completed, every planned trial answered once, and the
+    // report scaled both blocks.
+    const study::Protocol protocol = study::builtin_protocol("scaling");
+    study::Database d((dir / "scaling.db").string(), SQLITE_OPEN_READONLY);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              1);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM responses"),
+              static_cast<int64_t>(study::plan_trials(protocol, 1, 1).trials.size()));
+    EXPECT_EQ(
+        d.scalar_int("SELECT count(*) FROM trials t WHERE NOT EXISTS (SELECT 1 FROM "
+                     "responses r WHERE r.trial_id = t.id)"),
+        0);
+    const std::string report = read_file(dir / "report" / "report.md");
+    EXPECT_NE(report.find("mlds: differs_more (difference scaling, MLDS)"),
+              std::string::npos)
+        << report.substr(0, 2000);
+    EXPECT_NE(report.find("pairs: more_translucent (paired comparisons)"),
+              std::string::npos);
+    const std::string choices = read_file(dir / "choices.csv");
+    EXPECT_EQ(std::count(choices.begin(), choices.end(), '\n'),
+              1 + d.scalar_int("SELECT count(*) FROM responses"));
 }
 
 }  // namespace
