@@ -350,13 +350,6 @@ void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
             r.fail(
                 r.raw().get("question_id"), "question_id",
                 "'" + b.question_id + "' is already block '" + other.id + "'s question");
-    b.labels = r.strings("labels");
-    if (b.labels.empty())
-        b.labels = b.task == Task::pair
-                       ? std::vector<std::string>{"left", "right"}
-                       : std::vector<std::string>{"first pair", "second pair"};
-    if (b.labels.size() != 2)
-        r.fail(r.raw().get("labels"), "labels", "needs exactly two answers");
     b.design = r.string("design", "all");
     if (b.design != "all" && !(b.task == Task::pair && b.design == "cyclic"))
         r.fail(r.raw().get("design"), "design",
@@ -379,6 +372,16 @@ void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
     else if (presentation != "side_by_side")
         r.fail(r.raw().get("presentation"), "presentation",
                "must be \"side_by_side\" or \"sequential\", got '" + presentation + "'");
+    b.labels = r.strings("labels");
+    // A sequence's pair has no left and right: its pictures come first and second.
+    if (b.labels.empty())
+        b.labels = b.task != Task::pair
+                       ? std::vector<std::string>{"first pair", "second pair"}
+                   : b.presentation == Presentation::sequential
+                       ? std::vector<std::string>{"first", "second"}
+                       : std::vector<std::string>{"left", "right"};
+    if (b.labels.size() != 2)
+        r.fail(r.raw().get("labels"), "labels", "needs exactly two answers");
     b.duration_ms = r.integer("duration_ms", 1000, 50, 60000);
     b.blank_ms = r.integer("blank_ms", 500, 0, 60000);
     b.identical_catch = r.integer("identical_catch", 0, 0, 1000);

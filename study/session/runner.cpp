@@ -377,12 +377,9 @@ ChoiceShow choice_show(const Block& block, std::optional<ChoicePhase> phase) {
     return ChoiceShow::answers;
 }
 
-// The two answers' names on screen. A pair shown in sequence has no left and right: its
-// default names become "first" and "second".
+// The two answers' names on screen (a sequence's pair defaults to "first" and "second":
+// protocol.cpp).
 std::array<std::string, 2> answer_names(const Block& block) {
-    if (block.task == Task::pair && block.presentation == Presentation::sequential &&
-        block.labels == std::vector<std::string>{"left", "right"})
-        return {"first", "second"};
     return {block.labels.at(0), block.labels.at(1)};
 }
 

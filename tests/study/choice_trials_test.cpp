@@ -59,6 +59,13 @@ TEST(ChoiceProtocol, ReadsEachBlocksTaskAndItsKeys) {
     EXPECT_EQ(mlds.duration_ms, 800);
     EXPECT_EQ(mlds.blank_ms, 300);
     EXPECT_EQ(mlds.labels, (std::vector<std::string>{"first pair", "second pair"}));
+    // A pair in sequence has no left and right.
+    const Protocol sequential =
+        parse_protocol(edited("identical_catch = 2",
+                              "identical_catch = 2\npresentation = \"sequential\""),
+                       "sequential.toml");
+    EXPECT_EQ(block(sequential, "pairs").labels,
+              (std::vector<std::string>{"first", "second"}));
 }
 
 TEST(ChoiceProtocol, AStudyOfChoicesOnlyNeedsNoQuestions) {
