@@ -209,7 +209,6 @@ ScalingSection scaling_section(
         };
         rows_of("(pooled)", f);
         rows_of("(pooled)", g);
-        rows_of("(pooled)", g);
         for (const auto& [who, pf] : b.participants) rows_of(who, pf);
     }
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <sstream>
 
 #include "scaling_test_data.h"
@@ -62,6 +63,27 @@ TEST(ScalingReport, SectionForPairsAndMlds) {
     EXPECT_EQ(text.find("nan"), std::string::npos);
     EXPECT_EQ(text.find("inf"), std::string::npos);
     ASSERT_EQ(s.files.back().first, "scaling.csv");
+    // One row per (block, method, participant, stimulus): each scale once, both of a
+    // pair block's (Bradley-Terry and Thurstone), 3 stimuli x (2 pooled + 2
+    // participants).
+    std::istringstream rows(s.files.back().second);
+    std::map<std::string, int> seen;
+    int pair_rows = 0;
+    std::string line;
+    std::getline(rows, line);  // header
+    while (std::getline(rows, line)) {
+        std::istringstream cells(line);
+        std::string block, question, method, who, stimulus;
+        std::getline(cells, block, ',');
+        std::getline(cells, question, ',');
+        std::getline(cells, method, ',');
+        std::getline(cells, who, ',');
+        std::getline(cells, stimulus, ',');
+        EXPECT_EQ(++seen[block + "|" + method + "|" + who + "|" + stimulus], 1) << line;
+        pair_rows += block == "pc" ? 1 : 0;
+    }
+    EXPECT_EQ(pair_rows, 3 * (2 + 2));
+    EXPECT_EQ(seen.count("pc|Thurstone Case V (probit)|(pooled)|a"), 1u);
     EXPECT_NE(
         s.files.back().second.find("quadruple,differs_more,MLDS (probit GLM; psi_p = "
                                    "1),(pooled),s8,1,1,"),
