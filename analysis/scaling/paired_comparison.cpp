@@ -316,7 +316,12 @@ PairedFit fit_paired_comparison(const PairedData& data, const PairedOptions& opt
         fit.notes.push_back(text + ".");
     }
 
-    if (fit.lr_p && *fit.lr_p >= 0.05)
+    // With unbounded abilities the test covers only the stimuli left in the fit: the
+    // others already won or lost every comparison, which is no chance.
+    const bool any_unbounded =
+        std::any_of(fit.abilities.begin(), fit.abilities.end(),
+                    [](const StimulusAbility& a) { return a.unbounded != 0; });
+    if (fit.lr_p && *fit.lr_p >= 0.05 && !any_unbounded)
         fit.notes.push_back(
             "The abilities do not differ from 0 (the all-equal model): likelihood-ratio "
             "chi-square = " +

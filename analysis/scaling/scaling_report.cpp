@@ -75,9 +75,12 @@ std::string plot_svg(const std::string& title, const std::string& y_label,
     panel.y_high = pooled.high;
     panel.x_axis.scale = common::AxisScale::linear;
     panel.y_axis.scale = common::AxisScale::linear;
-    if (participants.size() > 1)
+    if (participants.size() > 1) {
         for (const auto& [name, fit] : participants)
             panel.series.push_back({name, x, curve_of(fit).y});
+        panel.series_behind = true;
+        panel.main_label = "pooled";
+    }
     return common::figure_svg("", {panel}, {560, 360, 1});
 }
 
@@ -90,6 +93,35 @@ Block paragraph(std::string text) { return {Block::kParagraph, std::move(text), 
 void add_notes(std::vector<Block>& blocks, const std::string& who,
                const std::vector<std::string>& notes) {
     for (const std::string& n : notes) blocks.push_back(paragraph(who + n));
+}
+
+// A participant's notes, with the unbounded abilities (one sentence per stimulus in the
+// fit, common with few comparisons each) said in one sentence.
+void add_participant_notes(std::vector<Block>& blocks, const std::string& who,
+                           const PairedFit& fit) {
+    std::vector<std::string> above, below, others;
+    for (const std::string& n : fit.notes) {
+        if (n.find("its ability is unbounded") == std::string::npos) {
+            others.push_back(n);
+            continue;
+        }
+        const std::string stimulus = n.substr(0, n.find(' '));
+        (n.find(" won ") < n.find(':') ? above : below).push_back(stimulus);
+    }
+    auto listed = [](const std::vector<std::string>& ids) {
+        std::string out;
+        for (const std::string& id : ids) out += (out.empty() ? "" : ", ") + id;
+        return out;
+    };
+    if (!above.empty() || !below.empty())
+        blocks.push_back(paragraph(
+            who +
+            ": unbounded abilities (each won or lost every comparison linking it to "
+            "the others): " +
+            (above.empty() ? "" : listed(above) + " above") +
+            (above.empty() || below.empty() ? "" : "; ") +
+            (below.empty() ? "" : listed(below) + " below") + "."));
+    add_notes(blocks, who + ": ", others);
 }
 
 Block pictures_block(const std::vector<std::string>& stimuli,
@@ -191,7 +223,7 @@ ScalingSection scaling_section(
                                     ? format_short(100.0 * *pf.position.share) + "%"
                                     : "undefined",
                                 format_p_short(pf.position.p)});
-            add_notes(section.blocks, who + ": ", pf.notes);
+            add_participant_notes(section.blocks, who, pf);
         }
         section.blocks.push_back({Block::kTable, "", per, {}});
         auto rows_of = [&](const std::string& who, const PairedFit& pf) {

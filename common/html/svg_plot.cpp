@@ -235,6 +235,44 @@ constexpr const char* kSeriesColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62
 
 // Each series as a line through its points with dots, then a legend (panel x0..x1, from
 // legend_top down, two columns).
+// Behind the main curve (PlotPanel::series_behind): the lines only, thin and faint, in
+// the colours after the main curve's.
+void draw_series_lines(std::ostringstream& svg, const std::vector<PlotSeries>& series,
+                       const Axis& xa, const Axis& ya, double left, double right,
+                       double top, double bottom) {
+    const double plot_w = right - left, plot_h = bottom - top;
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        const char* colour = kSeriesColours[(k + 1) % std::size(kSeriesColours)];
+        std::string points;
+        for (std::size_t i = 0; i < std::min(series[k].x.size(), series[k].y.size());
+             ++i) {
+            const double fx = xa.fraction(series[k].x[i]),
+                         fy = ya.fraction(series[k].y[i]);
+            if (!std::isfinite(fx) || !std::isfinite(fy)) continue;
+            points += svg_number(left + plot_w * fx) + "," +
+                      svg_number(bottom - plot_h * fy) + " ";
+        }
+        svg << "<polyline points=\"" << points << "\" fill=\"none\" stroke=\"" << colour
+            << "\" stroke-width=\"1\" stroke-opacity=\"0.55\"/>\n";
+    }
+}
+
+// The legend in two columns under the x axis's label: `labels` in the series' colours
+// from `first_colour` on.
+void draw_legend(std::ostringstream& svg, const std::vector<std::string>& labels,
+                 std::size_t first_colour, double x0, double x1, double legend_top) {
+    const double row = 12, column_w = (x1 - x0 - 8) / 2;
+    for (std::size_t k = 0; k < labels.size(); ++k) {
+        const double x = x0 + 4 + column_w * double(k % 2),
+                     y = legend_top + row * double(k / 2);
+        svg << "<rect x=\"" << svg_number(x) << "\" y=\"" << svg_number(y + 2)
+            << "\" width=\"10\" height=\"8\" fill=\""
+            << kSeriesColours[(k + first_colour) % std::size(kSeriesColours)] << "\"/>";
+        put_text(svg, x + 14, y + 9.5, labels[k], "start", kTickFont, column_w - 16);
+    }
+    svg << '\n';
+}
+
 void draw_series(std::ostringstream& svg, const std::vector<PlotSeries>& series,
                  const Axis& xa, const Axis& ya, double left, double right, double top,
                  double bottom, double x0, double x1, double legend_top) {
@@ -256,18 +294,10 @@ void draw_series(std::ostringstream& svg, const std::vector<PlotSeries>& series,
         svg << "<polyline points=\"" << points << "\" fill=\"none\" stroke=\"" << colour
             << "\" stroke-width=\"1.5\"/>" << dots << '\n';
     }
-    // The legend in two columns under the x axis's label, in the room draw_panel left.
-    const double row = 12, column_w = (x1 - x0 - 8) / 2;
-    for (std::size_t k = 0; k < series.size(); ++k) {
-        const double x = x0 + 4 + column_w * double(k % 2),
-                     y = legend_top + row * double(k / 2);
-        svg << "<rect x=\"" << svg_number(x) << "\" y=\"" << svg_number(y + 2)
-            << "\" width=\"10\" height=\"8\" fill=\""
-            << kSeriesColours[k % std::size(kSeriesColours)] << "\"/>";
-        put_text(svg, x + 14, y + 9.5, series[k].label, "start", kTickFont,
-                 column_w - 16);
-    }
-    svg << '\n';
+    // The legend, in the room draw_panel left.
+    std::vector<std::string> labels;
+    for (const PlotSeries& s : series) labels.push_back(s.label);
+    draw_legend(svg, labels, 0, x0, x1, legend_top);
 }
 
 void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double h,
@@ -311,7 +341,8 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
                                     : text_width(xa.labels.back(), kTickFont) / 2;
     const double right = x0 + w - std::max(14.0, last_x_label + 4);
     const double top = y0 + (p.title.empty() ? 12.0 : 30.0);
-    const double legend_h = 12.0 * double((p.series.size() + 1) / 2);
+    const std::size_t legend_rows = p.series.size() + (p.series_behind ? 1 : 0);
+    const double legend_h = 12.0 * double((legend_rows + 1) / 2);
     const double bottom = y0 + h - 18 - (p.x_label.empty() ? 0.0 : 16.0) -
                           (note.empty() ? 0.0 : 13.0) - legend_h;
     const double plot_w = right - left, plot_h = bottom - top;
@@ -361,6 +392,8 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
     put_text(svg, x0 + 4, y0 + h - 5, note, "start", kNoteFont, w - 8, " fill=\"#555\"");
     svg << '\n';
 
+    if (p.series_behind)
+        draw_series_lines(svg, p.series, xa, ya, left, right, top, bottom);
     // Intervals, clipped to the y axis with a triangle where they go on.
     const auto defined = [&](std::size_t i) {
         return std::isfinite(y_at(p.y, i)) && std::isfinite(ya.fraction(y_at(p.y, i))) &&
@@ -401,7 +434,8 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
                 points += svg_number(px(i)) + "," + svg_number(py(p.y[i])) + " ";
         if (!points.empty())  // no empty <polyline> where nothing is defined
             svg << "<polyline points=\"" << points << "\" fill=\"none\" stroke=\""
-                << kBlue << "\" stroke-width=\"1.5\"/>\n";
+                << kBlue << "\" stroke-width=\"" << (p.series_behind ? "2.5" : "1.5")
+                << "\"/>\n";
     }
     for (std::size_t i = 0; i < n; ++i) {
         if (!defined(i)) continue;
@@ -417,8 +451,16 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
         }
         svg << '\n';
     }
-    draw_series(svg, p.series, xa, ya, left, right, top, bottom, x0, x0 + w,
-                bottom + (p.x_label.empty() ? 18.0 : 34.0));
+    const double legend_top = bottom + (p.x_label.empty() ? 18.0 : 34.0);
+    if (!p.series_behind) {
+        draw_series(svg, p.series, xa, ya, left, right, top, bottom, x0, x0 + w,
+                    legend_top);
+        return;
+    }
+    // The main curve first in the legend, in its blue; then the series' colours.
+    std::vector<std::string> labels{p.main_label};
+    for (const PlotSeries& s : p.series) labels.push_back(s.label);
+    draw_legend(svg, labels, 0, x0, x0 + w, legend_top);
 }
 
 }  // namespace

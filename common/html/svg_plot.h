@@ -87,6 +87,11 @@ struct PlotPanel {
     // Further curves on the same numeric axes (the axes cover them too), each a line
     // through its points in order, with a legend.
     std::vector<PlotSeries> series;
+    // The series are details of the main curve (each participant's scale under the
+    // pooled one): drawn first, thin and faint, in the colours after the main curve's
+    // blue, and the main curve thicker over them; `main_label` names it in the legend.
+    bool series_behind = false;
+    std::string main_label;
 };
 
 struct FigureLayout {

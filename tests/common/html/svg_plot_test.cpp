@@ -239,5 +239,27 @@ TEST(Figures, SeriesShareThePanelsAxesWithALegend) {
     EXPECT_EQ(svg.find("nan"), std::string::npos);
 }
 
+TEST(Figures, SeriesBehindTheMainCurveAreFaintAndTheMainCurveLeadsTheLegend) {
+    PlotPanel panel;
+    panel.x = {1.0, 2.0, 3.0};
+    panel.y = {0.0, 0.5, 1.0};
+    panel.series = {{"P1", {1.0, 2.0, 3.0}, {0.0, 0.4, 1.0}},
+                    {"P2", {1.0, 2.0, 3.0}, {0.0, 0.7, 1.0}}};
+    panel.series_behind = true;
+    panel.main_label = "pooled";
+    const std::string svg = figure_svg("", {panel});
+    // Three lines: the two series first (faint, no dots), then the main curve over them.
+    EXPECT_EQ(count(svg, "<polyline"), 3u);
+    EXPECT_EQ(count(svg, "stroke-opacity=\"0.55\""), 2u);
+    EXPECT_LT(svg.find("stroke-opacity"), svg.find("stroke-width=\"2.5\""));
+    EXPECT_EQ(count(svg, "<circle"), 3u);  // the main curve's points only
+    // Legend: pooled in the main curve's blue, then P1 and P2 in the next colours.
+    EXPECT_LT(svg.find(">pooled<"), svg.find(">P1<"));
+    EXPECT_LT(svg.find(">P1<"), svg.find(">P2<"));
+    EXPECT_EQ(count(svg, "stroke=\"#1f77b4\" stroke-width=\"1\""),
+              0u);                                               // no series in blue
+    EXPECT_NE(svg.find("fill=\"#ff7f0e\""), std::string::npos);  // P1's legend swatch
+}
+
 }  // namespace
 }  // namespace lucent::common
