@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "common/content_hash.h"
+#include "common/csv.h"
 #include "lucent/version.h"
 #include "stimuli/manifest.h"
 #include "study/postgres/local_server.h"
@@ -879,17 +880,11 @@ duration_ms = 100
 blank_ms = 50
 )";
 
-// A CSV without quoted fields, as rows of column name -> text.
+// A CSV (RFC 4180, common/csv.h), as rows of column name -> text.
 std::vector<std::map<std::string, std::string>> read_csv_rows(const fs::path& path) {
     std::ifstream in(path);
-    auto split = [](const std::string& line) {
-        std::vector<std::string> fields;
-        size_t from = 0;
-        for (size_t comma; (comma = line.find(',', from)) != std::string::npos;
-             from = comma + 1)
-            fields.push_back(line.substr(from, comma - from));
-        fields.push_back(line.substr(from));
-        return fields;
+    const auto split = [](const std::string& line) {
+        return common::split_csv_line(line);
     };
     std::string line;
     std::getline(in, line);
