@@ -235,6 +235,11 @@ constexpr const char* kSeriesColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62
 
 // Each series as a line through its points with dots, then a legend (panel x0..x1, from
 // legend_top down, two columns).
+// A series behind the main curve: the colours after the main curve's blue, never it.
+const char* behind_colour(std::size_t k) {
+    return kSeriesColours[1 + k % (std::size(kSeriesColours) - 1)];
+}
+
 // Behind the main curve (PlotPanel::series_behind): the lines only, thin and faint, in
 // the colours after the main curve's.
 void draw_series_lines(std::ostringstream& svg, const std::vector<PlotSeries>& series,
@@ -242,7 +247,7 @@ void draw_series_lines(std::ostringstream& svg, const std::vector<PlotSeries>& s
                        double top, double bottom) {
     const double plot_w = right - left, plot_h = bottom - top;
     for (std::size_t k = 0; k < series.size(); ++k) {
-        const char* colour = kSeriesColours[(k + 1) % std::size(kSeriesColours)];
+        const char* colour = behind_colour(k);
         std::string points;
         for (std::size_t i = 0; i < std::min(series[k].x.size(), series[k].y.size());
              ++i) {
@@ -257,17 +262,16 @@ void draw_series_lines(std::ostringstream& svg, const std::vector<PlotSeries>& s
     }
 }
 
-// The legend in two columns under the x axis's label: `labels` in the series' colours
-// from `first_colour` on.
+// The legend in two columns under the x axis's label: each label in its colour.
 void draw_legend(std::ostringstream& svg, const std::vector<std::string>& labels,
-                 std::size_t first_colour, double x0, double x1, double legend_top) {
+                 const std::vector<const char*>& colours, double x0, double x1,
+                 double legend_top) {
     const double row = 12, column_w = (x1 - x0 - 8) / 2;
     for (std::size_t k = 0; k < labels.size(); ++k) {
         const double x = x0 + 4 + column_w * double(k % 2),
                      y = legend_top + row * double(k / 2);
         svg << "<rect x=\"" << svg_number(x) << "\" y=\"" << svg_number(y + 2)
-            << "\" width=\"10\" height=\"8\" fill=\""
-            << kSeriesColours[(k + first_colour) % std::size(kSeriesColours)] << "\"/>";
+            << "\" width=\"10\" height=\"8\" fill=\"" << colours[k] << "\"/>";
         put_text(svg, x + 14, y + 9.5, labels[k], "start", kTickFont, column_w - 16);
     }
     svg << '\n';
@@ -296,8 +300,12 @@ void draw_series(std::ostringstream& svg, const std::vector<PlotSeries>& series,
     }
     // The legend, in the room draw_panel left.
     std::vector<std::string> labels;
-    for (const PlotSeries& s : series) labels.push_back(s.label);
-    draw_legend(svg, labels, 0, x0, x1, legend_top);
+    std::vector<const char*> colours;
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        labels.push_back(series[k].label);
+        colours.push_back(kSeriesColours[k % std::size(kSeriesColours)]);
+    }
+    draw_legend(svg, labels, colours, x0, x1, legend_top);
 }
 
 void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double h,
@@ -459,8 +467,12 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
     }
     // The main curve first in the legend, in its blue; then the series' colours.
     std::vector<std::string> labels{p.main_label};
-    for (const PlotSeries& s : p.series) labels.push_back(s.label);
-    draw_legend(svg, labels, 0, x0, x0 + w, legend_top);
+    std::vector<const char*> colours{kBlue};
+    for (std::size_t k = 0; k < p.series.size(); ++k) {
+        labels.push_back(p.series[k].label);
+        colours.push_back(behind_colour(k));
+    }
+    draw_legend(svg, labels, colours, x0, x0 + w, legend_top);
 }
 
 }  // namespace

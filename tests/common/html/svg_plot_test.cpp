@@ -259,6 +259,12 @@ TEST(Figures, SeriesBehindTheMainCurveAreFaintAndTheMainCurveLeadsTheLegend) {
     EXPECT_EQ(count(svg, "stroke=\"#1f77b4\" stroke-width=\"1\""),
               0u);                                               // no series in blue
     EXPECT_NE(svg.find("fill=\"#ff7f0e\""), std::string::npos);  // P1's legend swatch
+    // Ten participants: the colours wrap round without the main curve's blue.
+    panel.series.clear();
+    for (int k = 0; k < 10; ++k)
+        panel.series.push_back({"P" + std::to_string(k), {1.0, 2.0}, {0.1 * k, 0.2}});
+    const std::string many = figure_svg("", {panel});
+    EXPECT_EQ(count(many, "fill=\"#1f77b4\"/>"), 1u + 3u);  // the swatch and 3 dots
 }
 
 }  // namespace

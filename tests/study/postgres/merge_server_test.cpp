@@ -3,8 +3,10 @@
 // values are the ratings and sessions each test wrote itself.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <sstream>
 
 #include "study/export.h"
 #include "study/postgres/merge_into_server.h"
@@ -219,6 +221,34 @@ TEST_F(MergeReconcile, IntoAServerADisagreeingCopyIsRefusedAndNothingChanges) {
     }
     auto s = server();
     EXPECT_EQ(s->query_int("SELECT count(*) FROM responses"), 10);
+}
+
+// Forced choices (issue 30) reach the server through a merge with their task and screen
+// order, each once; a second merge adds nothing. Expected: the file's own export.
+class MergeChoices : public OnServer {};
+
+TEST_F(MergeChoices, AStationFilesChoicesReachTheServerOnceWithTheirScreenOrder) {
+    p_ = lucent::test::choice_protocol();
+    {
+        Store station(path("station.db"));
+        session(station, "P1", 4);
+        session(station, "P2", 5);
+    }
+    EXPECT_EQ(merge_into_server({path("station.db")}, uri_).sessions_added, 2);
+    EXPECT_EQ(merge_into_server({path("station.db")}, uri_).sessions_added, 0);
+    auto rows = [](const std::string& db) {
+        std::ostringstream out;
+        export_choices(db, out);
+        std::vector<std::string> lines;
+        std::istringstream in(out.str());
+        for (std::string line; std::getline(in, line);) lines.push_back(line);
+        std::sort(lines.begin(), lines.end());
+        return lines;
+    };
+    const ReadableStudyFile snapshot(uri_);
+    const std::vector<std::string> expected = rows(path("station.db"));
+    EXPECT_EQ(expected.size(), 1u + 2u * 35u);  // the header and each session's choices
+    EXPECT_EQ(rows(snapshot.path()), expected);
 }
 
 }  // namespace
