@@ -462,5 +462,21 @@ TEST_F(Flow, ASequenceShowsEachPartForItsDurationBeforeItCanBeAnswered) {
     EXPECT_EQ(s.integer(2), first_shown);  // the onset is the first part's
 }
 
+TEST_F(Flow, AResumedSessionOfForcedChoicesShowsTheNextChoiceInItsPlannedScreenOrder) {
+    open(lucent::test::kChoiceProtocol, true);
+    const std::vector<TrialRow> trials = store_->trials(session_.id);
+    for (int i = 0; i < 5; ++i)
+        store_->record_trial(session_.id, trials[i].id,
+                             lucent::test::outcome_for(protocol_, trials[i]));
+    restart(true);
+    EXPECT_EQ(flow_->answered_trials(), 5u);
+    ASSERT_NE(flow_->trial(), nullptr);
+    EXPECT_EQ(flow_->trial()->id, trials[5].id);
+    // The stored plan, not a new draw: the same task and stimuli on the same sides.
+    const TrialPlan plan = plan_trials(protocol_, 5, 1);
+    EXPECT_EQ(flow_->trial()->task, plan.trials[5].task);
+    EXPECT_EQ(flow_->trial()->shown, plan.trials[5].shown);
+}
+
 }  // namespace
 }  // namespace lucent::study
