@@ -1,0 +1,371 @@
+// The psychometric function against an independent fit of the same likelihood in R
+// (nlminb, checked by optim; values from data/make_reference.R, see data/SOURCE.md), a
+// probit GLM in the closed-form case, the hard cases in words, and a simulated observer.
+#include "analysis/psychometric/psychometric.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "analysis/data/long_table.h"
+
+namespace lucent::analysis {
+namespace {
+
+std::vector<PsychometricBin> read_bins(const std::string& name) {
+    std::ifstream in(std::string(LUCENT_SOURCE_DIR) +
+                     "/tests/analysis/psychometric/data/" + name);
+    std::vector<PsychometricBin> bins;
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "x,n_correct,n_trials");
+    while (std::getline(in, line)) {
+        if (line.empty()) continue;
+        std::istringstream fields(line);
+        PsychometricBin b;
+        char comma = 0;
+        fields >> b.x >> comma >> b.n_correct >> comma >> b.n_trials;
+        bins.push_back(b);
+    }
+    return bins;
+}
+
+void expect_rel(double actual, double expected, double tolerance = 1e-6) {
+    EXPECT_NEAR(actual, expected, tolerance * std::max(std::abs(expected), 1e-3))
+        << "expected " << expected;
+}
+
+struct Reference {
+    double alpha, beta, lapse, log_likelihood, deviance;
+    int df;
+    double p_deviance, threshold, slope;
+    std::optional<double> threshold_p, slope_p;
+};
+
+void expect_equal_to_r(const PsychometricFit& fit, const Reference& r) {
+    ASSERT_TRUE(fit.fitted);
+    EXPECT_TRUE(fit.converged);
+    expect_rel(*fit.alpha, r.alpha);
+    expect_rel(*fit.beta, r.beta);
+    EXPECT_NEAR(*fit.lapse, r.lapse, 1e-7);
+    expect_rel(*fit.log_likelihood, r.log_likelihood, 1e-9);
+    expect_rel(*fit.deviance, r.deviance, 1e-7);
+    EXPECT_EQ(fit.deviance_df, r.df);
+    expect_rel(*fit.deviance_p, r.p_deviance);
+    ASSERT_EQ(fit.threshold.status, ThresholdStatus::estimated) << fit.threshold.text;
+    expect_rel(*fit.threshold.value, r.threshold);
+    expect_rel(*fit.threshold.slope, r.slope);
+    if (r.threshold_p) {
+        ASSERT_TRUE(fit.threshold_p);
+        ASSERT_EQ(fit.threshold_p->status, ThresholdStatus::estimated);
+        expect_rel(*fit.threshold_p->value, *r.threshold_p);
+        expect_rel(*fit.threshold_p->slope, *r.slope_p);
+    }
+}
+
+PsychometricOptions options(PsychometricFamily family, double guess,
+                            std::optional<double> fixed_lapse,
+                            std::optional<double> p_level = std::nullopt) {
+    PsychometricOptions o;
+    o.family = family;
+    o.guess = guess;
+    o.free_lapse = !fixed_lapse;
+    o.lapse = fixed_lapse.value_or(0.0);
+    o.p_correct_level = p_level;
+    return o;
+}
+
+constexpr auto kGauss = PsychometricFamily::cumulative_gaussian;
+constexpr auto kWeibull = PsychometricFamily::weibull;
+
+TEST(Psychometric, GaussianTwoAfcEqualsR) {
+    const auto bins = read_bins("gauss_2afc.csv");
+    ASSERT_EQ(bins.size(), 8u);
+    // Lapse free: its maximum is on the lower bound 0 (R's nlminb agrees).
+    const PsychometricFit free = fit_psychometric(bins, options(kGauss, 0.5, {}, 0.75));
+    expect_equal_to_r(free, {0.461035404548, 0.171250190493, 0.0, -16.3579523796,
+                             6.79047519705, 5, 0.236695096561, 0.461035404548,
+                             1.16479368359, 0.461035404548, 1.16479368359});
+    EXPECT_EQ(free.parameters, 3);
+    const PsychometricFit fixed = fit_psychometric(bins, options(kGauss, 0.5, 0.0, 0.75));
+    expect_equal_to_r(fixed, {0.461035402396, 0.171250192777, 0.0, -16.3579523796,
+                              6.79047519705, 6, 0.34065944426, 0.461035402396,
+                              1.16479366806, 0.461035402396, 1.16479366806});
+    EXPECT_EQ(fixed.parameters, 2);
+    EXPECT_TRUE(fixed.notes.empty()) << fixed.notes.front();
+}
+
+TEST(Psychometric, WeibullOnTwoAfcEqualsR) {
+    expect_equal_to_r(
+        fit_psychometric(read_bins("gauss_2afc.csv"), options(kWeibull, 0.5, {}, 0.75)),
+        {0.516813705526, 2.9896563957, 0.0, -16.2153507272, 6.50527189216, 5,
+         0.260108303009, 0.457185314916, 1.13316845156, 0.457185314916, 1.13316845156});
+}
+
+TEST(Psychometric, WeibullOddOneOutEqualsR) {
+    const auto bins = read_bins("weibull_oddity.csv");
+    // Lapse free, inside its bounds.
+    expect_equal_to_r(
+        fit_psychometric(bins, options(kWeibull, kGuessOddOneOutOfThree, {}, 2.0 / 3.0)),
+        {2.04573404856, 2.54027033469, 0.0362235585652, -14.3889484495, 3.94547348915, 5,
+         0.557292901012, 1.77087823871, 0.313424254978, 1.82891803271, 0.310460216166});
+    expect_equal_to_r(
+        fit_psychometric(bins,
+                         options(kWeibull, kGuessOddOneOutOfThree, 0.01, 2.0 / 3.0)),
+        {2.1446640907, 2.15493335079, 0.01, -15.0960953378, 5.35976726592, 6,
+         0.498565059268, 1.80923133383, 0.271069202933, 1.82770965803, 0.270092500757});
+    expect_equal_to_r(
+        fit_psychometric(bins, options(kGauss, kGuessOddOneOutOfThree, 0.01, 2.0 / 3.0)),
+        {1.86012635722, 0.955132194845, 0.01, -15.2592774046, 5.68613139946, 6,
+         0.459251573495, 1.86012635722, 0.274278365736, 1.8783571192, 0.274228407778});
+}
+
+// gamma = 0, lambda = 0, cumulative Gaussian: the probit GLM, alpha = -b0/b1,
+// beta = 1/b1, with R's glm at epsilon 1e-14.
+TEST(Psychometric, YesNoEqualsProbitGlm) {
+    const PsychometricFit fit = fit_psychometric(read_bins("probit_yesno.csv"),
+                                                 options(kGauss, kGuessYesNo, 0.0));
+    const double b0 = -0.197056271988, b1 = 1.27175019809;
+    ASSERT_TRUE(fit.fitted);
+    expect_rel(*fit.alpha, -b0 / b1);
+    expect_rel(*fit.beta, 1.0 / b1);
+    expect_rel(*fit.log_likelihood, -9.93982537758, 1e-9);
+    expect_rel(*fit.deviance, 2.95082116743, 1e-7);
+    EXPECT_EQ(fit.deviance_df, 7);
+    expect_rel(*fit.threshold.value, -b0 / b1);
+}
+
+TEST(Psychometric, TrialsAreBinnedByIntensity) {
+    std::vector<PsychometricTrial> trials{{0.3, true}, {0.1, false}, {0.3, false},
+                                          {0.2, true}, {0.1, true},  {0.3, true}};
+    const auto bins = bin_trials(trials);
+    ASSERT_EQ(bins.size(), 3u);
+    EXPECT_EQ(bins[0].x, 0.1);
+    EXPECT_EQ(bins[0].n_correct, 1);
+    EXPECT_EQ(bins[0].n_trials, 2);
+    EXPECT_EQ(bins[2].n_correct, 2);
+    EXPECT_EQ(bins[2].n_trials, 3);
+}
+
+TEST(Psychometric, BadInputIsRefusedInOneLine) {
+    PsychometricOptions weibull = options(kWeibull, 0.5, {});
+    try {
+        fit_psychometric(std::vector<PsychometricTrial>{{0.5, true}, {-0.25, false}},
+                         weibull);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("trial 2"), std::string::npos) << what;
+        EXPECT_NE(what.find("-0.25"), std::string::npos) << what;
+        EXPECT_NE(what.find("Weibull"), std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos);
+    }
+    EXPECT_THROW(fit_psychometric(std::vector<PsychometricBin>{{0.0, 1, 2}}, weibull),
+                 InputError);
+    EXPECT_THROW(fit_psychometric(std::vector<PsychometricBin>{{1.0, 3, 2}}), InputError);
+    EXPECT_THROW(fit_psychometric(std::vector<PsychometricBin>{{NAN, 1, 2}}), InputError);
+    EXPECT_THROW(
+        fit_psychometric_participants({{"p1", 1.0, true}, {"p2", 0.0, true}}, weibull),
+        InputError);
+    PsychometricOptions bad;
+    bad.guess = 1.0;
+    EXPECT_THROW(fit_psychometric(std::vector<PsychometricBin>{}, bad), InputError);
+    bad = {};
+    bad.p_correct_level = 0.4;  // below the 2AFC guess rate
+    EXPECT_THROW(fit_psychometric(std::vector<PsychometricBin>{}, bad), InputError);
+}
+
+// No value of a fit is NaN or infinite.
+void expect_finite(const PsychometricFit& fit) {
+    for (const auto& v :
+         {fit.alpha, fit.beta, fit.lapse, fit.log_likelihood, fit.deviance,
+          fit.deviance_p, fit.deviance_p_bootstrap, fit.constant_chi2, fit.constant_p}) {
+        if (v) {
+            EXPECT_TRUE(std::isfinite(*v));
+        }
+    }
+    for (const Threshold* t :
+         {&fit.threshold, fit.threshold_p ? &*fit.threshold_p : nullptr}) {
+        if (t == nullptr) continue;
+        for (const auto& v : {t->value, t->bound, t->slope, t->ci_low, t->ci_high,
+                              t->slope_ci_low, t->slope_ci_high}) {
+            if (v) {
+                EXPECT_TRUE(std::isfinite(*v));
+            }
+        }
+    }
+    EXPECT_FALSE(fit.threshold.text.empty());
+}
+
+bool has_note(const PsychometricFit& fit, const std::string& text) {
+    for (const std::string& n : fit.notes)
+        if (n.find(text) != std::string::npos) return true;
+    return false;
+}
+
+std::string all_notes(const PsychometricFit& fit) {
+    std::string s;
+    for (const std::string& n : fit.notes) s += n + " | ";
+    return s;
+}
+
+const std::vector<double> kLevels{0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+
+std::vector<PsychometricBin> bins_of(const std::vector<int>& correct, int n) {
+    std::vector<PsychometricBin> bins;
+    for (std::size_t i = 0; i < correct.size(); ++i)
+        bins.push_back({kLevels[i], correct[i], n});
+    return bins;
+}
+
+TEST(PsychometricHardCases, AtChanceHasNoThreshold) {
+    PsychometricOptions o = options(kGauss, 0.5, {}, 0.75);
+    o.bootstrap = 20;
+    const PsychometricFit fit =
+        fit_psychometric(bins_of({21, 19, 20, 22, 18, 21}, 40), o);
+    expect_finite(fit);
+    EXPECT_TRUE(fit.fitted);
+    EXPECT_EQ(fit.threshold.status, ThresholdStatus::not_identified);
+    EXPECT_FALSE(fit.threshold.value);
+    EXPECT_EQ(fit.threshold.text, "not identified");
+    EXPECT_EQ(fit.threshold_p->status, ThresholdStatus::not_identified);
+    ASSERT_TRUE(fit.constant_p);
+    EXPECT_GT(*fit.constant_p, 0.05);
+    EXPECT_EQ(fit.constant_df, 2);
+    EXPECT_TRUE(has_note(fit, "No threshold")) << all_notes(fit);
+    EXPECT_TRUE(has_note(fit, "at chance")) << all_notes(fit);
+    EXPECT_TRUE(has_note(fit, "likelihood-ratio test against a constant"))
+        << all_notes(fit);
+}
+
+TEST(PsychometricHardCases, AlwaysCorrectIsBelowTheSmallestIntensity) {
+    const PsychometricFit fit = fit_psychometric(bins_of({40, 40, 40, 40, 40, 40}, 40),
+                                                 options(kGauss, 0.5, {}, 0.75));
+    expect_finite(fit);
+    EXPECT_EQ(fit.threshold.status, ThresholdStatus::below_range);
+    EXPECT_FALSE(fit.threshold.value);
+    EXPECT_EQ(*fit.threshold.bound, 0.1);
+    EXPECT_EQ(fit.threshold.text, "< 0.1");
+    EXPECT_EQ(fit.threshold_p->text, "< 0.1");
+    EXPECT_TRUE(has_note(fit, "below the smallest intensity tested")) << all_notes(fit);
+}
+
+TEST(PsychometricHardCases, AlwaysWrongIsBelowChance) {
+    const PsychometricFit fit =
+        fit_psychometric(bins_of({0, 1, 0, 2, 0, 1}, 20), options(kGauss, 0.5, {}));
+    expect_finite(fit);
+    EXPECT_FALSE(fit.fitted);
+    EXPECT_EQ(fit.threshold.status, ThresholdStatus::not_identified);
+    EXPECT_TRUE(has_note(fit, "Below chance")) << all_notes(fit);
+    // In yes/no (no guessing) never "yes" is a threshold above the range.
+    const PsychometricFit yes_no =
+        fit_psychometric(bins_of({0, 0, 0}, 10), options(kGauss, kGuessYesNo, 0.0));
+    EXPECT_EQ(yes_no.threshold.text, "> 0.3");
+}
+
+TEST(PsychometricHardCases, SingleIntensityAndNoTrials) {
+    const PsychometricFit one = fit_psychometric(
+        std::vector<PsychometricBin>{{0.3, 14, 20}, {0.3, 15, 20}, {0.5, 0, 0}});
+    expect_finite(one);
+    EXPECT_FALSE(one.fitted);
+    EXPECT_EQ(one.trials, 40);
+    EXPECT_EQ(one.threshold.status, ThresholdStatus::not_identified);
+    EXPECT_TRUE(has_note(one, "One intensity only")) << all_notes(one);
+
+    const PsychometricFit none = fit_psychometric(std::vector<PsychometricTrial>{});
+    expect_finite(none);
+    EXPECT_EQ(none.trials, 0);
+    EXPECT_TRUE(has_note(none, "No trials")) << all_notes(none);
+    const PsychometricFit empty_bins =
+        fit_psychometric(std::vector<PsychometricBin>{{0.1, 0, 0}, {0.2, 0, 0}});
+    EXPECT_TRUE(has_note(empty_bins, "No trials"));
+}
+
+TEST(PsychometricHardCases, LapseAtItsUpperBound) {
+    // Errors at the top intensities: 80% correct where the function has long saturated.
+    PsychometricOptions o = options(kGauss, 0.5, {});
+    o.bootstrap = 20;
+    const PsychometricFit fit =
+        fit_psychometric(std::vector<PsychometricBin>{{0.1, 20, 40},
+                                                      {0.2, 22, 40},
+                                                      {0.3, 32, 40},
+                                                      {0.4, 32, 40},
+                                                      {0.6, 32, 40},
+                                                      {0.8, 32, 40}},
+                         o);
+    expect_finite(fit);
+    ASSERT_TRUE(fit.fitted);
+    EXPECT_DOUBLE_EQ(*fit.lapse, 0.06);
+    EXPECT_TRUE(has_note(fit, "lapse rate is at its upper bound 0.06")) << all_notes(fit);
+}
+
+TEST(PsychometricHardCases, ThresholdAboveTheRangeAndStepResponses) {
+    // Hardly above chance until the top level: the staircase hit the knob's range.
+    const PsychometricFit high = fit_psychometric(bins_of({20, 21, 20, 22, 21, 30}, 40),
+                                                  options(kGauss, 0.5, 0.0));
+    expect_finite(high);
+    EXPECT_EQ(high.threshold.status, ThresholdStatus::above_range) << all_notes(high);
+    EXPECT_EQ(high.threshold.text, "> 0.6");
+    // A jump from chance to perfect between two levels: the slope is not identified.
+    const PsychometricFit step =
+        fit_psychometric(bins_of({20, 20, 20, 40, 40, 40}, 40), options(kGauss, 0.5, {}));
+    expect_finite(step);
+    ASSERT_EQ(step.threshold.status, ThresholdStatus::estimated) << all_notes(step);
+    EXPECT_GT(*step.threshold.value, 0.3);
+    EXPECT_LT(*step.threshold.value, 0.4);
+    EXPECT_FALSE(step.threshold.slope);
+    EXPECT_TRUE(has_note(step, "slope is steeper")) << all_notes(step);
+}
+
+// A simulated 2AFC observer (cumulative Gaussian, mean 0.4, sd 0.1, lapse 0.02) at seven
+// levels, 60 trials each, per participant: the fits recover the threshold and slope.
+TEST(PsychometricRecovery, SimulatedObserverIsRecovered) {
+    const double mean = 0.4, sd = 0.1, lapse = 0.02;
+    const double true_slope = (1.0 - 0.5 - lapse) / (sd * std::sqrt(2.0 * M_PI));
+    std::mt19937_64 rng(31);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<ParticipantTrial> trials;
+    for (const std::string id : {"p1", "p2", "p3"})
+        for (int rep = 0; rep < 60; ++rep)
+            for (double x : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7}) {
+                const double psi = 0.5 + (1.0 - 0.5 - lapse) * 0.5 *
+                                             std::erfc(-(x - mean) / (sd * M_SQRT2));
+                trials.push_back({id, x, u(rng) < psi});
+            }
+    PsychometricOptions o = options(kGauss, 0.5, {}, 0.75);
+    o.bootstrap = 200;
+    o.seed = 7;
+    const ParticipantFits fits = fit_psychometric_participants(trials, o);
+    ASSERT_EQ(fits.participants.size(), 3u);
+    EXPECT_EQ(fits.participants[0].first, "p1");
+    EXPECT_EQ(fits.pooled.trials, 3 * 420);
+    for (const auto& [id, fit] : fits.participants) {
+        expect_finite(fit);
+        const Threshold& t = fit.threshold;
+        ASSERT_EQ(t.status, ThresholdStatus::estimated) << id << ": " << all_notes(fit);
+        ASSERT_TRUE(t.ci_low && t.ci_high && t.slope_ci_low && t.slope_ci_high);
+        EXPECT_EQ(fit.bootstrap_samples, 200);
+        EXPECT_LE(*t.ci_low, mean) << id;
+        EXPECT_GE(*t.ci_high, mean) << id;
+        EXPECT_LE(*t.slope_ci_low, true_slope) << id;
+        EXPECT_GE(*t.slope_ci_high, true_slope) << id;
+        EXPECT_LE(*t.ci_low, *t.value);
+        EXPECT_GE(*t.ci_high, *t.value);
+    }
+    // Pooled: 1260 trials, within 0.03 of the threshold and 25% of the slope.
+    const Threshold& pooled = fits.pooled.threshold;
+    ASSERT_EQ(pooled.status, ThresholdStatus::estimated);
+    EXPECT_NEAR(*pooled.value, mean, 0.03);
+    EXPECT_NEAR(*pooled.slope, true_slope, 0.25 * true_slope);
+    EXPECT_NEAR(*fits.pooled.threshold_p->value, mean, 0.03);  // 75% = F 1/2 at lapse 0
+    // Seeded: the same intervals again.
+    const ParticipantFits again = fit_psychometric_participants(trials, o);
+    EXPECT_EQ(*again.pooled.threshold.ci_low, *pooled.ci_low);
+    EXPECT_EQ(*again.pooled.threshold.slope_ci_high, *pooled.slope_ci_high);
+}
+
+}  // namespace
+}  // namespace lucent::analysis
