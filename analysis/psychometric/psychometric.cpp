@@ -251,7 +251,7 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
     PsychometricFit fit;
     fit.family = options.family;
     fit.guess = options.guess;
-    fit.lapse_free = options.free_lapse;
+    fit.lapse_free = options.free_lapse && options.max_lapse > 0.0;
     fit.threshold_level = options.threshold_level;
     fit.p_correct_level = options.p_correct_level;
     fit.threshold = not_identified();

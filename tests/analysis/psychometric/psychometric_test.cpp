@@ -320,6 +320,18 @@ TEST(PsychometricHardCases, ThresholdAboveTheRangeAndStepResponses) {
     EXPECT_TRUE(has_note(step, "slope is steeper")) << all_notes(step);
 }
 
+TEST(PsychometricHardCases, ProportionAboveTheCeilingHasNoThreshold) {
+    // With a lapse rate of 0.05 the function never reaches 97% correct.
+    const PsychometricFit fit =
+        fit_psychometric(read_bins("gauss_2afc.csv"), options(kGauss, 0.5, 0.05, 0.97));
+    expect_finite(fit);
+    ASSERT_EQ(fit.threshold.status, ThresholdStatus::estimated);
+    EXPECT_EQ(fit.threshold_p->status, ThresholdStatus::not_identified);
+    EXPECT_TRUE(has_note(fit, "never reaches 97% correct")) << all_notes(fit);
+    // psi at the threshold is halfway between the guess rate and the ceiling.
+    EXPECT_NEAR(psychometric_psi(fit, *fit.threshold.value), 0.5 + 0.45 / 2, 1e-12);
+}
+
 // A simulated 2AFC observer (cumulative Gaussian, mean 0.4, sd 0.1, lapse 0.02) at seven
 // levels, 60 trials each, per participant: the fits recover the threshold and slope.
 TEST(PsychometricRecovery, SimulatedObserverIsRecovered) {
