@@ -117,4 +117,57 @@ int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
     return 1;
 }
 
+DetectionObserver DetectionObserver::parse(const std::string& text) {
+    std::vector<double> parts;
+    std::istringstream in(text);
+    for (std::string item; std::getline(in, item, ',');) {
+        char* end = nullptr;
+        const double v = std::strtod(item.c_str(), &end);
+        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v))
+            throw std::invalid_argument("observer '" + text + "': '" + item +
+                                        "' is not a number (expected THRESHOLD,SPREAD"
+                                        "[,LAPSE])");
+        parts.push_back(v);
+    }
+    if (parts.size() < 2 || parts.size() > 3)
+        throw std::invalid_argument("observer '" + text +
+                                    "': expected THRESHOLD,SPREAD[,LAPSE]");
+    DetectionObserver o{parts[0], parts[1], parts.size() == 3 ? parts[2] : 0.0};
+    if (!(o.threshold >= 0))
+        throw std::invalid_argument("observer '" + text + "': THRESHOLD must be >= 0");
+    if (!(o.spread > 0))
+        throw std::invalid_argument("observer '" + text + "': SPREAD must be > 0");
+    if (!(o.lapse >= 0 && o.lapse <= 1))
+        throw std::invalid_argument("observer '" + text + "': LAPSE must be in [0, 1]");
+    return o;
+}
+
+double DetectionObserver::p_correct(double delta, double guess) const {
+    const double seen =
+        0.5 * std::erfc(-(std::abs(delta) - threshold) / (spread * std::sqrt(2.0)));
+    // Not lapsing: seen, or a guess; lapsing: a guess.
+    return (1.0 - lapse) * (seen + (1.0 - seen) * guess) + lapse * guess;
+}
+
+bool simulated_detection(const DetectionObserver& observer, double delta, double guess,
+                         std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    if (observer.lapse > 0 && uniform(rng) < observer.lapse) return uniform(rng) < guess;
+    const double seen = 0.5 * std::erfc(-(std::abs(delta) - observer.threshold) /
+                                        (observer.spread * std::sqrt(2.0)));
+    if (uniform(rng) < seen) return true;
+    return uniform(rng) < guess;
+}
+
+double simulated_match(const MatchObserver& observer, double target, double lo, double hi,
+                       std::mt19937_64& rng) {
+    std::normal_distribution<double> noise(0.0, observer.noise);
+    const double e = observer.noise > 0 ? noise(rng) : 0.0;
+    double match = observer.log_scale && target > 0
+                       ? std::exp(std::log(target) + observer.bias + e)
+                       : target + observer.bias + e;
+    if (!std::isfinite(match)) match = target;
+    return std::clamp(match, std::min(lo, hi), std::max(lo, hi));
+}
+
 }  // namespace lucent::study

@@ -55,4 +55,39 @@ ChoiceStimuli choice_stimuli(const Protocol& protocol, const std::string& block,
 int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
                      std::mt19937_64& rng);
 
+// ---- thresholds and matching (issue 31)
+// ------------------------------------------------
+
+// An observer of a difference from a standard (a staircase's 2AFC or odd-one-out trial)
+// with a known psychometric function: it sees the difference `delta` with probability
+// Phi((|delta| - threshold) / spread) (a cumulative Gaussian over the difference), and
+// otherwise guesses (right with the task's guess rate); on a share `lapse` of the
+// trials it answers at random whatever it saw. In the terms of the psychometric fit
+// (analysis/psychometric): cumulative Gaussian, alpha = threshold, beta = spread,
+// gamma = the guess rate, lambda = lapse * (1 - guess).
+struct DetectionObserver {
+    double threshold = 1.0;  // the difference seen half the time
+    double spread = 0.5;     // the cumulative Gaussian's sd (> 0)
+    double lapse = 0.0;      // share of trials answered at random
+    // "THRESHOLD,SPREAD[,LAPSE]"; throws std::invalid_argument naming the bad part.
+    static DetectionObserver parse(const std::string& text);
+    // The probability of a correct answer at `delta` with guess rate `guess` (0.5 for
+    // 2AFC, 1/3 for odd-one-out of three): the closed form the simulation draws from.
+    double p_correct(double delta, double guess) const;
+};
+bool simulated_detection(const DetectionObserver& observer, double delta, double guess,
+                         std::mt19937_64& rng);
+
+// An observer matching a target's knob value with a known bias (issue 31's
+// adjustment): the match it settles on is target + bias + N(0, noise^2), on the knob's
+// own scale, or on its logarithm when `log_scale` (a multiplicative bias, as for a
+// thickness exponent), clamped to [lo, hi].
+struct MatchObserver {
+    double bias = 0.0;
+    double noise = 0.0;
+    bool log_scale = false;
+};
+double simulated_match(const MatchObserver& observer, double target, double lo, double hi,
+                       std::mt19937_64& rng);
+
 }  // namespace lucent::study

@@ -78,5 +78,42 @@ TEST(SimulatedObserver, ABadModelIsOneLineNamingThePart) {
     }
 }
 
+// Issue 31's observers: the detection frequencies against their closed form (a
+// cumulative Gaussian seen-probability mixed with the guess rate), and the match bias.
+TEST(SimulatedObserver, DetectionFollowsItsPsychometricFunction) {
+    const DetectionObserver o = DetectionObserver::parse("2,0.5,0.04");
+    for (const double delta : {0.5, 2.0, 3.0, -3.0})
+        for (const double guess : {0.5, 1.0 / 3.0}) {
+            std::mt19937_64 rng(5);
+            int correct = 0;
+            for (int i = 0; i < 40000; ++i)
+                correct += simulated_detection(o, delta, guess, rng) ? 1 : 0;
+            // Closed form: (1 - lapse)(seen + (1 - seen) guess) + lapse guess.
+            const double seen = normal_cdf((std::abs(delta) - 2.0) / 0.5);
+            const double expected = 0.96 * (seen + (1 - seen) * guess) + 0.04 * guess;
+            EXPECT_NEAR(correct / 40000.0, expected, 0.008) << delta << " " << guess;
+            EXPECT_NEAR(o.p_correct(delta, guess), expected, 1e-12);
+        }
+    for (const char* bad : {"2", "2,0", "-1,0.5", "2,0.5,1.5", "x,1"})
+        EXPECT_THROW(DetectionObserver::parse(bad), std::invalid_argument) << bad;
+}
+
+TEST(SimulatedObserver, MatchesCarryTheirBiasOnTheKnobsScale) {
+    std::mt19937_64 rng(3);
+    const MatchObserver linear{1.5, 0.5, false};
+    double sum = 0;
+    for (int i = 0; i < 20000; ++i) sum += simulated_match(linear, 10, 0, 100, rng);
+    EXPECT_NEAR(sum / 20000, 11.5, 0.02);  // SE 0.5 / sqrt(20000) = 0.0035
+    // A multiplicative bias: the log of the match averages log(target) + bias.
+    const MatchObserver log_scale{std::log(1.25), 0.1, true};
+    double log_sum = 0;
+    for (int i = 0; i < 20000; ++i)
+        log_sum += std::log(simulated_match(log_scale, 16, 1, 64, rng));
+    EXPECT_NEAR(log_sum / 20000, std::log(20.0), 0.005);
+    // Clamped to the knob's range.
+    EXPECT_EQ(simulated_match({100, 0, false}, 10, 0, 64, rng), 64);
+    EXPECT_EQ(simulated_match({-100, 0, false}, 10, 0, 64, rng), 0);
+}
+
 }  // namespace
 }  // namespace lucent::study
