@@ -298,19 +298,6 @@ void check_stimulus_ref(const Protocol& p, TableReader& r, const std::string& ke
         r.fail(r.raw().get(key), key, "no stimulus with id '" + id + "'");
 }
 
-// A stimulus's value of the block's series parameter, as a number.
-std::optional<double> series_value(const Protocol& p, const std::string& stimulus,
-                                   const std::string& parameter) {
-    const StimulusSpec* s = p.find_stimulus(stimulus);
-    const auto it = s ? s->parameters.find(parameter) : decltype(s->parameters.end()){};
-    if (!s || it == s->parameters.end()) return std::nullopt;
-    char* end = nullptr;
-    const double v = std::strtod(it->second.c_str(), &end);
-    if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v))
-        return std::nullopt;
-    return v;
-}
-
 // The keys of a pair, triad or quadruple block (design notes: Block in protocol.h).
 void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
     const std::string task = r.string("task", "rating");
@@ -405,7 +392,7 @@ void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
     if (!b.series.empty()) {
         std::optional<double> previous;
         for (const std::string& id : b.stimuli) {
-            const std::optional<double> v = series_value(p, id, b.series);
+            const std::optional<double> v = p.numeric_parameter(id, b.series);
             if (!v)
                 r.fail(
                     r.raw().get("series"), "series",
@@ -579,6 +566,15 @@ int pictures_per_trial(Task task) {
             return 4;
     }
     return 1;
+}
+
+std::optional<double> Protocol::numeric_parameter(std::string_view stimulus,
+                                                  const std::string& parameter) const {
+    const StimulusSpec* s = find_stimulus(stimulus);
+    if (!s) return std::nullopt;
+    const auto it = s->parameters.find(parameter);
+    if (it == s->parameters.end()) return std::nullopt;
+    return common::parse_finite(it->second);
 }
 
 const Block* Protocol::find_block(std::string_view id) const {

@@ -161,6 +161,10 @@ struct Protocol {
 
     const StimulusSpec* find_stimulus(std::string_view id) const;
     const Block* find_block(std::string_view id) const;
+    // A stimulus's parameter as a finite number (e.g. its place on a block's series);
+    // nullopt when it has no such parameter or it is not a number.
+    std::optional<double> numeric_parameter(std::string_view stimulus,
+                                            const std::string& parameter) const;
     // True when some trial rates a picture on [[questions]] (a rating block or
     // [practice] stimuli); a study of forced choices only needs no [[questions]].
     bool has_rating_trials() const;

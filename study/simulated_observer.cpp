@@ -6,24 +6,40 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/number_text.h"
+
 namespace lucent::study {
 
-ObserverModel ObserverModel::parse(const std::string& text) {
-    ObserverModel m;
+namespace {
+
+// The comma-separated numbers of an observer's option, 2 or 3 of them as `form` says
+// ("EXPONENT,SIGMA[,LAPSE]"); std::invalid_argument naming the bad part.
+std::vector<double> observer_numbers(const std::string& text, const std::string& form) {
     std::vector<double> parts;
     std::istringstream in(text);
     for (std::string item; std::getline(in, item, ',');) {
-        char* end = nullptr;
-        const double v = std::strtod(item.c_str(), &end);
-        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v))
+        const std::optional<double> v = common::parse_finite(item);
+        if (!v)
             throw std::invalid_argument("observer '" + text + "': '" + item +
-                                        "' is not a number (expected EXPONENT,SIGMA"
-                                        "[,LAPSE])");
-        parts.push_back(v);
+                                        "' is not a number (expected " + form + ")");
+        parts.push_back(*v);
     }
     if (parts.size() < 2 || parts.size() > 3)
-        throw std::invalid_argument("observer '" + text +
-                                    "': expected EXPONENT,SIGMA[,LAPSE]");
+        throw std::invalid_argument("observer '" + text + "': expected " + form);
+    return parts;
+}
+
+// The share of trials on which a detection observer sees `delta`.
+double seen_probability(const DetectionObserver& o, double delta) {
+    return 0.5 *
+           std::erfc(-(std::abs(delta) - o.threshold) / (o.spread * std::sqrt(2.0)));
+}
+
+}  // namespace
+
+ObserverModel ObserverModel::parse(const std::string& text) {
+    ObserverModel m;
+    const std::vector<double> parts = observer_numbers(text, "EXPONENT,SIGMA[,LAPSE]");
     m.exponent = parts[0];
     m.sigma = parts[1];
     m.lapse = parts.size() == 3 ? parts[2] : 0.0;
@@ -56,15 +72,8 @@ ChoiceStimuli choice_stimuli(const Protocol& protocol, const std::string& block,
     if (!b) return out;
     out.task = b->task;
     if (b->series.empty()) return out;
-    auto value_of = [&](const std::string& id) -> std::optional<double> {
-        const StimulusSpec* s = protocol.find_stimulus(id);
-        if (!s) return std::nullopt;
-        const auto it = s->parameters.find(b->series);
-        if (it == s->parameters.end()) return std::nullopt;
-        char* end = nullptr;
-        const double v = std::strtod(it->second.c_str(), &end);
-        if (end == it->second.c_str() || !std::isfinite(v)) return std::nullopt;
-        return v;
+    auto value_of = [&](const std::string& id) {
+        return protocol.numeric_parameter(id, b->series);
     };
     std::vector<double> values;
     for (const std::string& id : shown) {
@@ -118,20 +127,7 @@ int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
 }
 
 DetectionObserver DetectionObserver::parse(const std::string& text) {
-    std::vector<double> parts;
-    std::istringstream in(text);
-    for (std::string item; std::getline(in, item, ',');) {
-        char* end = nullptr;
-        const double v = std::strtod(item.c_str(), &end);
-        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v))
-            throw std::invalid_argument("observer '" + text + "': '" + item +
-                                        "' is not a number (expected THRESHOLD,SPREAD"
-                                        "[,LAPSE])");
-        parts.push_back(v);
-    }
-    if (parts.size() < 2 || parts.size() > 3)
-        throw std::invalid_argument("observer '" + text +
-                                    "': expected THRESHOLD,SPREAD[,LAPSE]");
+    const std::vector<double> parts = observer_numbers(text, "THRESHOLD,SPREAD[,LAPSE]");
     DetectionObserver o{parts[0], parts[1], parts.size() == 3 ? parts[2] : 0.0};
     if (!(o.threshold >= 0))
         throw std::invalid_argument("observer '" + text + "': THRESHOLD must be >= 0");
@@ -143,8 +139,7 @@ DetectionObserver DetectionObserver::parse(const std::string& text) {
 }
 
 double DetectionObserver::p_correct(double delta, double guess) const {
-    const double seen =
-        0.5 * std::erfc(-(std::abs(delta) - threshold) / (spread * std::sqrt(2.0)));
+    const double seen = seen_probability(*this, delta);
     // Not lapsing: seen, or a guess; lapsing: a guess.
     return (1.0 - lapse) * (seen + (1.0 - seen) * guess) + lapse * guess;
 }
@@ -153,8 +148,7 @@ bool simulated_detection(const DetectionObserver& observer, double delta, double
                          std::mt19937_64& rng) {
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
     if (observer.lapse > 0 && uniform(rng) < observer.lapse) return uniform(rng) < guess;
-    const double seen = 0.5 * std::erfc(-(std::abs(delta) - observer.threshold) /
-                                        (observer.spread * std::sqrt(2.0)));
+    const double seen = seen_probability(observer, delta);
     if (uniform(rng) < seen) return true;
     return uniform(rng) < guess;
 }

@@ -7,25 +7,13 @@
 #include <map>
 #include <unordered_map>
 
+#include "common/portable_random.h"
+
 namespace lucent::study {
 namespace {
 
-// Uniform integer in [0, n) by rejection, identical on every standard library.
-uint64_t uniform_below(std::mt19937_64& rng, uint64_t n) {
-    const uint64_t limit = UINT64_MAX - UINT64_MAX % n;
-    uint64_t x;
-    do x = rng();
-    while (x >= limit);
-    return x % n;
-}
-
-// Fisher-Yates with uniform_below: the same order from the same seed on every standard
-// library (std::shuffle's draws are implementation-defined).
-template <class T>
-void portable_shuffle(std::vector<T>& items, std::mt19937_64& rng) {
-    for (size_t i = items.size(); i > 1; --i)
-        std::swap(items[i - 1], items[uniform_below(rng, i)]);
-}
+using common::portable_shuffle;
+using common::uniform_below;
 
 // Whether `level` may follow the placed prefix.
 bool may_place(const std::vector<const std::string*>& placed, const std::string& level,

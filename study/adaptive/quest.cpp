@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/number_text.h"
+
 namespace lucent::study::adaptive {
 namespace {
 
@@ -13,11 +15,7 @@ namespace {
     throw std::invalid_argument("quest: " + message);
 }
 
-std::string number(double v) {
-    std::ostringstream out;
-    out << v;
-    return out.str();
-}
+std::string number(double v) { return common::shortest_text(v); }
 
 // numpy's pairwise summation (its add.reduce over a contiguous float64 array), so
 // the sums round as PsychoPy's do.

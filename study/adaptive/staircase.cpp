@@ -7,6 +7,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/number_text.h"
+#include "common/portable_random.h"
+
 namespace lucent::study::adaptive {
 namespace {
 
@@ -14,22 +17,9 @@ namespace {
     throw std::invalid_argument("staircase: " + message);
 }
 
-std::string number(double v) {
-    std::ostringstream out;
-    out << v;
-    return out.str();
-}
+std::string number(double v) { return common::shortest_text(v); }
 
-// A uniform draw from [0, n) without the modulo bias, from the standard engine's
-// sequence only (std::uniform_int_distribution differs between libraries).
-std::size_t uniform_below(std::mt19937_64& rng, std::size_t n) {
-    const std::uint64_t bound = static_cast<std::uint64_t>(n);
-    const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() -
-                                std::numeric_limits<std::uint64_t>::max() % bound;
-    std::uint64_t draw = rng();
-    while (draw >= limit) draw = rng();
-    return static_cast<std::size_t>(draw % bound);
-}
+using common::uniform_below;
 
 }  // namespace
 
@@ -228,8 +218,7 @@ void Interleaved::start_round() {
     this_round_ = running_;
     const std::size_t n = this_round_.size();
     if (order_ == InterleaveOrder::random) {
-        for (std::size_t i = n; i > 1; --i)
-            std::swap(this_round_[i - 1], this_round_[uniform_below(rng_, i)]);
+        common::portable_shuffle(this_round_, rng_);
     } else if (order_ == InterleaveOrder::full_random) {
         for (std::size_t i = 0; i < n; ++i)
             this_round_[i] = running_[uniform_below(rng_, n)];
