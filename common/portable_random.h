@@ -20,6 +20,11 @@ inline std::uint64_t uniform_below(std::mt19937_64& rng, std::uint64_t n) {
     return x % n;
 }
 
+// Uniform double in [0, 1): the top 53 bits of one draw.
+inline double uniform_unit(std::mt19937_64& rng) {
+    return static_cast<double>(rng() >> 11) * 0x1.0p-53;
+}
+
 // Fisher-Yates with uniform_below.
 template <class T>
 void portable_shuffle(std::vector<T>& items, std::mt19937_64& rng) {

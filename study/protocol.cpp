@@ -7,8 +7,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
+#include <variant>
 
 #include "common/number_text.h"
 #include "renderer/core/knob_toml.h"
@@ -298,22 +300,11 @@ void check_stimulus_ref(const Protocol& p, TableReader& r, const std::string& ke
         r.fail(r.raw().get(key), key, "no stimulus with id '" + id + "'");
 }
 
-// The keys of a pair, triad or quadruple block (design notes: Block in protocol.h).
-void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
-    const std::string task = r.string("task", "rating");
-    const std::optional<Task> parsed = parse_task(task);
-    if (!parsed)
-        r.fail(r.raw().get("task"), "task",
-               "must be \"rating\", \"pair\", \"triad\" or \"quadruple\", got '" + task +
-                   "'");
-    b.task = *parsed;
-    if (!b.is_choice()) return;
+// What every block but a rating block has: its own question, answered by one
+// response; its stimuli distinct and free of whitespace (trials.shown holds them
+// space-separated).
+void read_block_question(const Protocol& p, TableReader& r, Block& b) {
     const int n = static_cast<int>(b.stimuli.size());
-    const int shown = pictures_per_trial(b.task);
-    if (n < shown)
-        r.fail(r.raw().get("stimuli"), "stimuli",
-               "a " + task + " block needs at least " + std::to_string(shown) +
-                   " stimuli, got " + std::to_string(n));
     for (const std::string& id : b.stimuli)
         if (id.find_first_of(" \t\r\n") != std::string::npos)
             r.fail(r.raw().get("stimuli"), "stimuli",
@@ -333,10 +324,273 @@ void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
             r.fail(r.raw().get("question_id"), "question_id",
                    "'" + b.question_id + "' is already a [[questions]] id");
     for (const Block& other : p.blocks)
-        if (other.is_choice() && other.question_id == b.question_id)
+        if (other.task != Task::rating && other.question_id == b.question_id)
             r.fail(
                 r.raw().get("question_id"), "question_id",
                 "'" + b.question_id + "' is already block '" + other.id + "'s question");
+}
+
+// How a pair's (or a staircase's) pictures are shown and what its answers are called.
+void read_presentation(TableReader& r, Block& b, int pictures) {
+    const std::string presentation = r.string("presentation", "side_by_side");
+    if (presentation == "sequential")
+        b.presentation = Presentation::sequential;
+    else if (presentation != "side_by_side")
+        r.fail(r.raw().get("presentation"), "presentation",
+               "must be \"side_by_side\" or \"sequential\", got '" + presentation + "'");
+    b.labels = r.strings("labels");
+    // A sequence's pictures have no left and right: they come first, second (third).
+    const bool sequence = b.presentation == Presentation::sequential;
+    if (b.labels.empty()) {
+        if (b.task == Task::triad || b.task == Task::quadruple)
+            b.labels = {"first pair", "second pair"};
+        else if (pictures == 3)
+            b.labels = sequence ? std::vector<std::string>{"first", "second", "third"}
+                                : std::vector<std::string>{"left", "middle", "right"};
+        else
+            b.labels = sequence ? std::vector<std::string>{"first", "second"}
+                                : std::vector<std::string>{"left", "right"};
+    }
+    const size_t answers = b.task == Task::staircase ? static_cast<size_t>(pictures) : 2;
+    if (b.labels.size() != answers)
+        r.fail(r.raw().get("labels"), "labels",
+               answers == 2 ? "needs exactly two answers"
+                            : "needs exactly " + std::to_string(answers) + " answers");
+    b.duration_ms = r.integer("duration_ms", 1000, 50, 60000);
+    b.blank_ms = r.integer("blank_ms", 500, 0, 60000);
+}
+
+// The scalar knob `b.knob` of a live stimulus's technique; fails at `key` otherwise.
+Knob block_knob(const Protocol& p, TableReader& r, const Block& b,
+                const std::string& stimulus, const std::string& key) {
+    const StimulusSpec* s = p.find_stimulus(stimulus);
+    if (!s || !s->live())
+        r.fail(r.raw().get(key), key,
+               "'" + stimulus + "' must be a live stimulus (a technique): its knob '" +
+                   b.knob + "' is rendered at the participant's value");
+    const std::vector<Knob> knobs = knobs_for(find_technique(s->technique));
+    const Knob* knob = find_knob(knobs, b.knob);
+    if (!knob)
+        r.fail(r.raw().get("knob"), "knob",
+               "'" + b.knob + "' is not a knob of technique '" + s->technique + "'");
+    if (knob->kind != KnobKind::scalar)
+        r.fail(r.raw().get("knob"), "knob",
+               "'" + b.knob + "' is not a number (only a scalar knob can be turned)");
+    return *knob;
+}
+
+// A live stimulus's value of a scalar knob: its parameter, else the knob's default.
+double knob_value_of(const Protocol& p, const std::string& stimulus, const Knob& knob) {
+    if (const std::optional<double> v = p.numeric_parameter(stimulus, knob.name))
+        return *v;
+    return std::get<double>(knob.default_value);
+}
+
+// The keys of an adjust block (design notes: Block in protocol.h).
+void read_adjust_block(const Protocol& p, TableReader& r, Block& b) {
+    b.match = r.string("match", "", true);
+    check_stimulus_ref(p, r, "match", b.match);
+    b.knob = r.string("knob", "", true);
+    const Knob knob = block_knob(p, r, b, b.match, "match");
+    b.range_min = knob.min;
+    b.range_max = knob.max;
+    if (const toml::node* range = r.get("range")) {
+        const toml::array* a = range->as_array();
+        const bool numbers =
+            a && a->size() == 2 && std::all_of(a->begin(), a->end(), [](auto& n) {
+                return n.is_integer() || n.is_floating_point();
+            });
+        if (!numbers) r.fail(range, "range", "must be [min, max], two numbers");
+        b.range_min = *(*a)[0].value<double>();
+        b.range_max = *(*a)[1].value<double>();
+        if (!(b.range_min < b.range_max) || b.range_min < knob.min ||
+            b.range_max > knob.max)
+            r.fail(range, "range",
+                   "must be [min, max] with min < max inside the knob's range [" +
+                       common::shortest_text(knob.min) + ", " +
+                       common::shortest_text(knob.max) + "]");
+    }
+    b.scale = r.string("scale", "linear");
+    if (b.scale != "linear" && b.scale != "log")
+        r.fail(r.raw().get("scale"), "scale",
+               "must be \"linear\" or \"log\", got '" + b.scale + "'");
+    if (b.scale == "log" && !(b.range_min > 0))
+        r.fail(r.raw().get("scale"), "scale",
+               "a log scale needs a range above 0, got min " +
+                   common::shortest_text(b.range_min));
+    // Default steps: 1/20 and 1/200 of the range on the scale (a log step is in log10
+    // units, a factor 10^step).
+    const double width = b.scale == "log" ? std::log10(b.range_max / b.range_min)
+                                          : b.range_max - b.range_min;
+    b.step = r.number("step", width / 20, 0, width);
+    if (!(b.step > 0)) r.fail(r.raw().get("step"), "step", "must be above 0");
+    b.fine_step = r.number("fine_step", b.step / 10, 0, b.step);
+    if (!(b.fine_step > 0))
+        r.fail(r.raw().get("fine_step"), "fine_step", "must be above 0");
+    b.start = "random";
+    if (const toml::node* start = r.get("start")) {
+        if (start->is_string()) {
+            b.start = *start->value<std::string>();
+            if (b.start != "random" && b.start != "min" && b.start != "max")
+                r.fail(start, "start",
+                       "must be \"random\", \"min\", \"max\" or a number, got '" +
+                           b.start + "'");
+        } else {
+            const double v = r.number("start", 0, b.range_min, b.range_max);
+            b.start = common::shortest_text(v);
+        }
+    }
+    for (const std::string& target : b.stimuli)
+        if (target == b.match)
+            r.fail(r.raw().get("match"), "match",
+                   "'" + b.match + "' is also a target of block '" + b.id + "'");
+}
+
+// The keys of one [[blocks.staircases]] entry.
+Block::Procedure read_procedure(TableReader& r, const Block& b, double max_delta) {
+    Block::Procedure s;
+    s.id = r.string("id", "", true);
+    if (s.id.find_first_of(" \t\r\n/") != std::string::npos)
+        r.fail(r.raw().get("id"), "id", "must not hold whitespace or '/'");
+    s.method = r.string("method", "updown");
+    if (s.method != "updown" && s.method != "quest")
+        r.fail(r.raw().get("method"), "method",
+               "must be \"updown\" or \"quest\", got '" + s.method + "'");
+    s.min_delta = r.number("min_delta", 0, 0, max_delta);
+    s.max_delta = r.number("max_delta", max_delta, 0, max_delta);
+    if (!(s.max_delta > s.min_delta))
+        r.fail(r.raw().get("max_delta"), "max_delta",
+               "must be above min_delta (" + common::shortest_text(s.min_delta) + ")");
+    s.start = r.number("start", 0, s.min_delta, s.max_delta);
+    if (!r.raw().get("start")) r.fail(nullptr, "start", "is required");
+    s.max_trials = r.integer("max_trials", 50, 1, 1000);
+    if (s.method == "updown") {
+        s.n_up = r.integer("n_up", 1, 1, 10);
+        s.n_down = r.integer("n_down", 3, 1, 10);
+        s.step_type = r.string("step_type", "lin");
+        if (s.step_type != "lin" && s.step_type != "log" && s.step_type != "db")
+            r.fail(r.raw().get("step_type"), "step_type",
+                   "must be \"lin\", \"log\" or \"db\", got '" + s.step_type + "'");
+        if (s.step_type != "lin" && !(s.start > 0))
+            r.fail(r.raw().get("start"), "start",
+                   "must be above 0 with " + s.step_type + " steps");
+        if (const toml::array* steps = r.array("step_sizes")) {
+            for (const toml::node& n : *steps) {
+                const std::optional<double> v = n.value<double>();
+                if (!v || !(n.is_integer() || n.is_floating_point()) ||
+                    !std::isfinite(*v) || !(*v > 0))
+                    r.fail(&n, "step_sizes", "must be numbers above 0");
+                s.step_sizes.push_back(*v);
+            }
+        }
+        if (s.step_sizes.empty())
+            r.fail(r.raw().get("step_sizes"), "step_sizes",
+                   "is required: the step after 0, 1, 2... reversals");
+        s.n_trials = r.integer("n_trials", 0, 0, 1000);
+        s.n_reversals = r.integer("n_reversals", 0, 0, 1000);
+        // PsychoPy runs to n_trials AND n_reversals (at least the step sizes' count).
+        const int reversals =
+            std::max<int>(s.n_reversals, static_cast<int>(s.step_sizes.size()));
+        if (s.max_trials < std::max(s.n_trials, reversals))
+            r.fail(r.raw().get("max_trials"), "max_trials",
+                   "must be at least n_trials and n_reversals (" +
+                       std::to_string(std::max(s.n_trials, reversals)) +
+                       "): the plan holds max_trials slots");
+    } else {
+        s.start_sd = r.number("start_sd", 0, 0, 1e300);
+        if (!(s.start_sd > 0))
+            r.fail(r.raw().get("start_sd"), "start_sd", "is required and above 0");
+        const double guess = b.staircase_trial == "oddity" ? 1.0 / 3 : 0.5;
+        s.p_threshold = r.number("p_threshold", guess == 0.5 ? 0.82 : 0.75, 0, 1);
+        if (!(s.p_threshold > guess) || !(s.p_threshold < 1))
+            r.fail(r.raw().get("p_threshold"), "p_threshold",
+                   "must lie between the guess rate (" + common::shortest_text(guess) +
+                       ") and 1");
+        s.beta = r.number("beta", 3.5, 1e-6, 1e6);
+        s.delta = r.number("delta", 0.01, 0, 0.5);
+        // Default grid: 500 grains over twice the deltas' range, so it covers every
+        // delta the block allows wherever the prior is centred.
+        s.quest_range = r.number("range", 0, 0, 1e300);
+        const double grid =
+            s.quest_range > 0 ? s.quest_range : 2 * (s.max_delta - s.min_delta);
+        s.grain = r.number("grain", grid / 500, 1e-12, grid);
+        if (!(s.grain > 0)) r.fail(r.raw().get("grain"), "grain", "must be above 0");
+        s.n_trials = r.integer("n_trials", s.max_trials, 1, 1000);
+        if (s.max_trials < s.n_trials)
+            r.fail(r.raw().get("max_trials"), "max_trials",
+                   "must be at least n_trials (" + std::to_string(s.n_trials) + ")");
+    }
+    r.reject_unknown();
+    return s;
+}
+
+// The keys of a staircase block (design notes: Block in protocol.h).
+void read_staircase_block(const Protocol& p, TableReader& r, Block& b) {
+    b.knob = r.string("knob", "", true);
+    b.direction = r.string("direction", "up");
+    if (b.direction != "up" && b.direction != "down")
+        r.fail(r.raw().get("direction"), "direction",
+               "must be \"up\" or \"down\", got '" + b.direction + "'");
+    // The room each standard leaves in the knob's range bounds the delta.
+    double room = std::numeric_limits<double>::infinity();
+    for (const std::string& standard : b.stimuli) {
+        const Knob knob = block_knob(p, r, b, standard, "stimuli");
+        const double value = knob_value_of(p, standard, knob);
+        room = std::min(room, b.direction == "up" ? knob.max - value : value - knob.min);
+    }
+    if (!(room > 0))
+        r.fail(r.raw().get("stimuli"), "stimuli",
+               "a standard's '" + b.knob + "' is at the end of the knob's range: no " +
+                   b.direction + "ward delta is possible");
+    b.staircase_trial = r.string("trial", "pair");
+    if (b.staircase_trial != "pair" && b.staircase_trial != "oddity")
+        r.fail(r.raw().get("trial"), "trial",
+               "must be \"pair\" or \"oddity\", got '" + b.staircase_trial + "'");
+    read_presentation(r, b, b.pictures());
+    const toml::array* procedures = r.array("staircases");
+    if (!procedures || procedures->empty())
+        r.fail(procedures, "staircases",
+               "at least one [[blocks.staircases]] entry is required");
+    for (const toml::node& node : *procedures) {
+        if (!node.is_table()) r.fail(&node, "staircases", "must be tables");
+        TableReader pr(*node.as_table(), r.full("staircases"), p.source);
+        Block::Procedure s = read_procedure(pr, b, room);
+        for (const Block::Procedure& other : b.procedures)
+            if (other.id == s.id)
+                pr.fail(pr.raw().get("id"), "id",
+                        "duplicate staircase id '" + s.id + "'");
+        b.procedures.push_back(std::move(s));
+    }
+}
+
+void read_choice_block(const Protocol& p, TableReader& r, Block& b);
+
+// The keys of a block by its task (design notes: Block in protocol.h).
+void read_block_task(const Protocol& p, TableReader& r, Block& b) {
+    const std::string task = r.string("task", "rating");
+    const std::optional<Task> parsed = parse_task(task);
+    if (!parsed)
+        r.fail(r.raw().get("task"), "task",
+               "must be \"rating\", \"pair\", \"triad\", \"quadruple\", \"adjust\" or "
+               "\"staircase\", got '" +
+                   task + "'");
+    b.task = *parsed;
+    if (b.task == Task::rating) return;
+    read_block_question(p, r, b);
+    if (b.task == Task::adjust) return read_adjust_block(p, r, b);
+    if (b.task == Task::staircase) return read_staircase_block(p, r, b);
+    read_choice_block(p, r, b);
+}
+
+// The keys of a pair, triad or quadruple block (design notes: Block in protocol.h).
+void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
+    const std::string task = task_name(b.task);
+    const int n = static_cast<int>(b.stimuli.size());
+    const int shown = pictures_per_trial(b.task);
+    if (n < shown)
+        r.fail(r.raw().get("stimuli"), "stimuli",
+               "a " + task + " block needs at least " + std::to_string(shown) +
+                   " stimuli, got " + std::to_string(n));
     b.design = r.string("design", "all");
     if (b.design != "all" && !(b.task == Task::pair && b.design == "cyclic"))
         r.fail(r.raw().get("design"), "design",
@@ -353,24 +607,7 @@ void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
     } else if (r.raw().get("neighbours")) {
         r.fail(r.raw().get("neighbours"), "neighbours", "only a cyclic design has them");
     }
-    const std::string presentation = r.string("presentation", "side_by_side");
-    if (presentation == "sequential")
-        b.presentation = Presentation::sequential;
-    else if (presentation != "side_by_side")
-        r.fail(r.raw().get("presentation"), "presentation",
-               "must be \"side_by_side\" or \"sequential\", got '" + presentation + "'");
-    b.labels = r.strings("labels");
-    // A sequence's pair has no left and right: its pictures come first and second.
-    if (b.labels.empty())
-        b.labels = b.task != Task::pair
-                       ? std::vector<std::string>{"first pair", "second pair"}
-                   : b.presentation == Presentation::sequential
-                       ? std::vector<std::string>{"first", "second"}
-                       : std::vector<std::string>{"left", "right"};
-    if (b.labels.size() != 2)
-        r.fail(r.raw().get("labels"), "labels", "needs exactly two answers");
-    b.duration_ms = r.integer("duration_ms", 1000, 50, 60000);
-    b.blank_ms = r.integer("blank_ms", 500, 0, 60000);
+    read_presentation(r, b, shown);
     b.identical_catch = r.integer("identical_catch", 0, 0, 1000);
     if (b.identical_catch > 0 && b.task != Task::pair)
         r.fail(r.raw().get("identical_catch"), "identical_catch",
@@ -426,7 +663,7 @@ void read_trials(Protocol& p, TableReader& root) {
             r.fail(nullptr, "stimuli", "block '" + b.id + "' has no stimuli");
         for (const std::string& id : b.stimuli) check_stimulus_ref(p, r, "stimuli", id);
         b.repeats = r.integer("repeats", 1, 1, 1000);
-        read_choice_block(p, r, b);
+        read_block_task(p, r, b);
         for (const Block& other : p.blocks)
             if (other.id == b.id)
                 r.fail(r.raw().get("id"), "id", "duplicate block id '" + b.id + "'");
@@ -445,11 +682,11 @@ void read_trials(Protocol& p, TableReader& root) {
             if (!block)
                 r.fail(r.raw().get("block"), "block",
                        "no block with id '" + c.block + "'");
-            if (block->is_choice())
+            if (block->task != Task::rating)
                 r.fail(r.raw().get("block"), "block",
-                       "block '" + c.block +
-                           "' is a forced choice: its catch trials are its own "
-                           "identical_catch and obvious_catch");
+                       "block '" + c.block + "' is a " + task_name(block->task) +
+                           " block: catch trials are for ratings (a forced choice has "
+                           "its own identical_catch and obvious_catch)");
             c.prompt = r.string("prompt", "", true);
             int max_points = 7;
             for (const Question& q : p.questions)
@@ -544,12 +781,17 @@ const char* task_name(Task task) {
             return "triad";
         case Task::quadruple:
             return "quadruple";
+        case Task::adjust:
+            return "adjust";
+        case Task::staircase:
+            return "staircase";
     }
     return "rating";
 }
 
 std::optional<Task> parse_task(std::string_view text) {
-    for (Task t : {Task::rating, Task::pair, Task::triad, Task::quadruple})
+    for (Task t : {Task::rating, Task::pair, Task::triad, Task::quadruple, Task::adjust,
+                   Task::staircase})
         if (text == task_name(t)) return t;
     return std::nullopt;
 }
@@ -564,8 +806,30 @@ int pictures_per_trial(Task task) {
             return 3;
         case Task::quadruple:
             return 4;
+        case Task::adjust:
+        case Task::staircase:
+            return 2;
     }
     return 1;
+}
+
+int Block::pictures() const {
+    return task == Task::staircase && staircase_trial == "oddity"
+               ? 3
+               : pictures_per_trial(task);
+}
+
+int Block::answers() const {
+    switch (task) {
+        case Task::rating:
+            return 0;
+        case Task::adjust:
+            return 1;
+        case Task::staircase:
+            return pictures();
+        default:
+            return 2;
+    }
 }
 
 std::optional<double> Protocol::numeric_parameter(std::string_view stimulus,
@@ -586,7 +850,7 @@ const Block* Protocol::find_block(std::string_view id) const {
 bool Protocol::has_rating_trials() const {
     return !practice.empty() ||
            std::any_of(blocks.begin(), blocks.end(),
-                       [](const Block& b) { return !b.is_choice(); });
+                       [](const Block& b) { return b.task == Task::rating; });
 }
 
 const StimulusSpec* Protocol::find_stimulus(std::string_view id) const {

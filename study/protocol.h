@@ -55,11 +55,15 @@ struct CatchTrial {
 // What a block's trials ask. `rating`: one picture rated on every [[questions]] entry.
 // The forced choices (issue 30): `pair`, which of two pictures is more X (paired
 // comparisons: Bradley-Terry, Thurstone); `triad` and `quadruple`, which of two pairs of
-// an ordered series differs more (Maximum Likelihood Difference Scaling).
-enum class Task { rating, pair, triad, quadruple };
+// an ordered series differs more (Maximum Likelihood Difference Scaling). Matching and
+// thresholds (issue 31): `adjust`, a live match object whose knob the participant turns
+// until it looks like a target picture; `staircase`, a forced choice between a standard
+// and the standard with a knob changed by a delta that an adaptive procedure chooses.
+enum class Task { rating, pair, triad, quadruple, adjust, staircase };
 const char* task_name(Task task);
 std::optional<Task> parse_task(std::string_view text);
-// The pictures one trial of the task shows: 1, 2, 3 or 4.
+// The pictures one trial of the task shows: 1, 2, 3 or 4 (adjust: the target and the
+// match; staircase: 2, see Block::pictures() for an odd-one-out staircase's 3).
 int pictures_per_trial(Task task);
 
 // How a choice block's pictures are shown: all at once, side by side (a triad in a row,
@@ -97,7 +101,55 @@ struct Block {
     // report's axis; MLDS blocks: numeric and increasing along `stimuli`); "" = none.
     std::string series;
     int practice = 0;  // practice trials of this task (from its design) before block 1
-    bool is_choice() const { return task != Task::rating; }
+
+    // Adjust and staircase blocks: the knob turned (adjust: of `match`; staircase: of
+    // each standard, i.e. each of `stimuli`), a scalar knob of the stimulus's technique.
+    std::string knob;
+    // Adjust: `stimuli` are the targets; `match` is the live stimulus drawn beside each
+    // with `knob` at the participant's value, within [range_min, range_max] (default:
+    // the knob's range). Arrows (and the wheel) move by `step`, Shift+arrows by
+    // `fine_step`, on the knob's value (`scale` "linear") or its logarithm ("log": the
+    // steps are then factors 10^step); a drag across the match moves over the range.
+    // Each trial starts at `start`: "random" (uniform over the range on the scale,
+    // drawn when the plan is made), "min", "max" or a number.
+    std::string match;
+    double range_min = 0, range_max = 0;
+    double step = 0, fine_step = 0;
+    std::string scale = "linear";
+    std::string start = "random";
+    // Staircase: each standard in `stimuli` runs every [[blocks.staircases]] entry,
+    // all interleaved (each round a random order of the procedures still running); a
+    // trial shows the standard and the comparison (the standard with `knob` moved by
+    // the delta, upwards or downwards by `direction`) as a pair ("pair": which is more
+    // X, the comparison's side is right) or three pictures ("oddity": which differs,
+    // the comparison's place is right). The procedure's intensity is the delta.
+    std::string staircase_trial = "pair";
+    std::string direction = "up";
+    struct Procedure {
+        std::string id;
+        std::string method = "updown";  // "updown" (StairHandler) or "quest"
+        double start = 0;
+        // updown
+        int n_up = 1, n_down = 3;
+        std::vector<double> step_sizes;
+        std::string step_type = "lin";
+        int n_trials = 0, n_reversals = 0;
+        // quest (Watson and Pelli 1983, as PsychoPy's QuestHandler)
+        double start_sd = 0, p_threshold = 0.82, beta = 3.5, delta = 0.01, grain = 0.01;
+        double quest_range = 0;  // 0: the whole range of the delta
+        // Both: deltas are held within [min_delta, max_delta] (max_delta 0: as far as the
+        // knob's range allows from the standard); the plan holds max_trials slots.
+        double min_delta = 0, max_delta = 0;
+        int max_trials = 50;
+    };
+    std::vector<Procedure> procedures;
+    // Picture count of one trial: pictures_per_trial, 3 for an odd-one-out staircase.
+    int pictures() const;
+    // Forced choices, answered 1..answers(): pair, triad, quadruple and staircase.
+    bool is_choice() const { return task != Task::rating && task != Task::adjust; }
+    // The number of answers of a trial: 2 (a choice), 3 (an odd-one-out staircase), 1
+    // (an adjustment's confirmation), 0 (a rating: its [[questions]]).
+    int answers() const;
 };
 
 // Randomisation within blocks, and block order across participants.

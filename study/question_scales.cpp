@@ -10,7 +10,7 @@ QuestionPoints question_points(const Protocol& protocol) {
     QuestionPoints out;
     for (const Question& q : protocol.questions) out[q.id] = q.points();
     for (const Block& b : protocol.blocks)
-        if (b.is_choice()) out[b.question_id] = 2;
+        if (b.task != Task::rating) out[b.question_id] = b.answers();
     return out;
 }
 
@@ -18,14 +18,15 @@ StudyQuestions study_questions(const Protocol& protocol) {
     StudyQuestions out;
     for (const Question& q : protocol.questions) out.rating[q.id] = q.points();
     for (const Block& b : protocol.blocks)
-        if (b.is_choice()) out.choice_question[b.id] = b.question_id;
+        if (b.task != Task::rating)
+            out.block_question[b.id] = {b.question_id, b.answers()};
     return out;
 }
 
 QuestionPoints StudyQuestions::of_block(const std::string& block) const {
-    const auto it = choice_question.find(block);
-    if (it == choice_question.end()) return rating;
-    return {{it->second, 2}};
+    const auto it = block_question.find(block);
+    if (it == block_question.end()) return rating;
+    return {{it->second.first, it->second.second}};
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 
 #include "study/protocol.h"
 #include "study/sqlite/database.h"
@@ -13,15 +14,17 @@ namespace lucent::study {
 
 using QuestionPoints = std::map<std::string, int>;  // question id -> points
 
-// Every question a study asks: its [[questions]] and each forced-choice block's
-// question (2 points: the first or the second alternative).
+// Every question a study asks: its [[questions]] and each other block's own question
+// (Block::answers() points: a forced choice's alternatives, an odd-one-out staircase's
+// three places, an adjustment's one "confirmed").
 QuestionPoints question_points(const Protocol& protocol);
 
-// Which questions one trial answers: a forced choice its block's question, a rating
-// every [[questions]] entry.
+// Which questions one trial answers: a rating every [[questions]] entry, any other
+// trial its block's own question.
 struct StudyQuestions {
     QuestionPoints rating;
-    std::map<std::string, std::string> choice_question;  // choice block id -> question
+    // Block id -> (its question id, its points), for every block but rating blocks.
+    std::map<std::string, std::pair<std::string, int>> block_question;
     QuestionPoints of_block(const std::string& block) const;
 };
 StudyQuestions study_questions(const Protocol& protocol);

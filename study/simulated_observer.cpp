@@ -121,6 +121,8 @@ int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
         case Task::quadruple:
             return std::abs(psi[1] - psi[0]) - std::abs(psi[3] - psi[2]) + e >= 0 ? 1 : 2;
         case Task::rating:
+        case Task::adjust:
+        case Task::staircase:
             break;
     }
     return 1;

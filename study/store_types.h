@@ -83,6 +83,24 @@ struct TrialRow {
     std::string uuid;  // schema 4: the trial's identity across stores (resends, merges)
     Task task = Task::rating;        // schema 6 (NULL before: rating)
     std::vector<std::string> shown;  // forced choices: stimulus ids in screen order
+    // Schema 7 (issue 31). Adjust: the planned start and, once answered, the confirmed
+    // value. Staircase: the slot's procedure (planned), the delta shown (answered), and
+    // whether the slot was skipped because its procedure had finished.
+    std::optional<double> start_value;
+    std::optional<double> final_value;
+    std::string staircase;
+    std::optional<double> intensity;
+    bool skipped = false;
+    // The answer to a forced choice or a staircase trial (its block's question); nullopt
+    // before it is answered and for ratings.
+    std::optional<int> choice;
+};
+
+// One change of an adjust trial's knob, as the participant made it.
+struct Adjustment {
+    double value = 0;   // the knob's value after the change
+    int64_t t_ns = 0;   // steady-clock timestamp of the change
+    std::string input;  // "key", "fine_key", "wheel" or "drag"
 };
 
 // One rating as the runner collected it.
@@ -100,6 +118,15 @@ struct TrialOutcome {
     int64_t confirm_ns = 0;             // when the answer was made final
     std::optional<int> dropped_frames;  // NULL when the refresh is unknown
     std::vector<Response> responses;
+    // Adjust trials: the confirmed value (the response is then the block's question
+    // with rating 1, "confirmed") and every change on the way, in order.
+    std::optional<double> final_value;
+    std::vector<Adjustment> adjustments;
+    // Staircase trials: the delta shown (the response is the place chosen), and whether
+    // this answer finished the slot's procedure: the store then marks the procedure's
+    // unanswered slots skipped in the same transaction.
+    std::optional<double> intensity;
+    bool finishes_staircase = false;
 };
 
 struct ParticipantCounts {

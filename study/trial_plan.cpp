@@ -3,8 +3,10 @@
 #include "study/trial_plan.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
+#include <string>
 #include <unordered_map>
 
 #include "common/portable_random.h"
@@ -14,6 +16,7 @@ namespace {
 
 using common::portable_shuffle;
 using common::uniform_below;
+using common::uniform_unit;
 
 // Whether `level` may follow the placed prefix.
 bool may_place(const std::vector<const std::string*>& placed, const std::string& level,
@@ -398,9 +401,82 @@ std::vector<PlannedTrial> choice_block_trials(const Block& block, std::mt19937_6
     return trials;
 }
 
+std::vector<PlannedTrial> adjust_block_trials(const Block& block, std::mt19937_64& rng) {
+    std::vector<PlannedTrial> trials;
+    for (int r = 0; r < block.repeats; ++r)
+        for (const std::string& target : block.stimuli) {
+            PlannedTrial t;
+            t.block = block.id;
+            t.task = Task::adjust;
+            t.stimulus = target;
+            t.shown = {target, block.match};
+            t.start_value = adjust_start_value(block, rng);
+            trials.push_back(std::move(t));
+        }
+    return trials;
+}
+
+double adjust_start_value(const Block& block, std::mt19937_64& rng) {
+    if (block.start == "min") return block.range_min;
+    if (block.start == "max") return block.range_max;
+    if (block.start != "random") return std::stod(block.start);
+    const double u = uniform_unit(rng);
+    if (block.scale == "log") {
+        const double lo = std::log(block.range_min), hi = std::log(block.range_max);
+        return std::clamp(std::exp(lo + u * (hi - lo)), block.range_min, block.range_max);
+    }
+    return block.range_min + u * (block.range_max - block.range_min);
+}
+
+std::vector<PlannedTrial> staircase_block_trials(const Block& block,
+                                                 std::mt19937_64& rng) {
+    struct Slots {
+        std::string standard, label;
+        std::vector<int> places;  // the comparison's place per slot, in order
+    };
+    const int k = block.pictures();
+    std::vector<Slots> procedures;
+    for (const std::string& standard : block.stimuli)
+        for (const Block::Procedure& p : block.procedures) {
+            Slots s{standard, standard + "/" + p.id, {}};
+            // Every place equally often; the remainder's places distinct, at random.
+            for (int i = 0; i < p.max_trials - p.max_trials % k; ++i)
+                s.places.push_back(1 + i % k);
+            std::vector<int> rest(k);
+            for (int i = 0; i < k; ++i) rest[i] = i + 1;
+            portable_shuffle(rest, rng);
+            for (int i = 0; i < p.max_trials % k; ++i) s.places.push_back(rest[i]);
+            portable_shuffle(s.places, rng);
+            procedures.push_back(std::move(s));
+        }
+    std::vector<PlannedTrial> trials;
+    std::vector<size_t> used(procedures.size(), 0);
+    for (;;) {
+        std::vector<size_t> round;
+        for (size_t i = 0; i < procedures.size(); ++i)
+            if (used[i] < procedures[i].places.size()) round.push_back(i);
+        if (round.empty()) break;
+        portable_shuffle(round, rng);
+        for (size_t i : round) {
+            PlannedTrial t;
+            t.block = block.id;
+            t.task = Task::staircase;
+            t.stimulus = procedures[i].standard;
+            t.shown.assign(k, procedures[i].standard);
+            t.staircase = procedures[i].label;
+            t.expected = procedures[i].places[used[i]++];
+            trials.push_back(std::move(t));
+        }
+    }
+    return trials;
+}
+
 std::string sequence_level(const PlannedTrial& trial,
                            const std::map<std::string, std::string>& level_of_stimulus) {
-    if (trial.shown.empty()) return level_of_stimulus.at(trial.stimulus);
+    if (trial.task == Task::staircase)
+        return "staircase " + trial.block + " " + std::to_string(trial.position);
+    if (trial.task == Task::adjust || trial.shown.empty())
+        return level_of_stimulus.at(trial.stimulus);
     std::vector<std::string> ids = trial.shown;
     std::sort(ids.begin(), ids.end());
     std::string level = "choice";
@@ -451,11 +527,18 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
         const Block& block = protocol.blocks[b];
         plan.block_order.push_back(block.id);
         std::vector<PlannedTrial>& trials = block_trials.emplace_back();
-        if (block.is_choice()) {
+        if (block.task != Task::rating) {
             // Its own stream per block, so the design of one block does not depend on
             // the order of the others.
             std::mt19937_64 design_rng(seed + 0x632be59bd9b4e019ULL * (b + 1));
-            trials = choice_block_trials(block, design_rng);
+            trials = block.task == Task::adjust ? adjust_block_trials(block, design_rng)
+                     : block.task == Task::staircase
+                         ? staircase_block_trials(block, design_rng)
+                         : choice_block_trials(block, design_rng);
+            // A slot's level names its place in the block: unique, so the constraints
+            // never hold a staircase's rounds back.
+            for (size_t i = 0; i < trials.size(); ++i)
+                trials[i].position = static_cast<int>(i);
             continue;
         }
         for (int r = 0; r < block.repeats; ++r)
@@ -500,6 +583,10 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
             throw PlanError(protocol.source + ": " + e.what());
         }
         for (size_t b = 0; b < block_trials.size(); ++b) {
+            // A staircase block keeps its rounds (its slots' levels are unique, so any
+            // order of them meets the constraints).
+            if (protocol.find_block(plan.block_order[b])->task == Task::staircase)
+                continue;
             std::vector<PlannedTrial> shuffled;
             for (int i : orders[b]) shuffled.push_back(block_trials[b][i]);
             block_trials[b] = std::move(shuffled);

@@ -4,6 +4,7 @@
 // session continues in the same order.
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -38,6 +39,16 @@ struct PlannedTrial {
     // quadruple: (shown[0], shown[1]) or (shown[2], shown[3]) differs more. Catch
     // trials: `expected` is the right answer, 0 when there is none (identical pairs).
     std::vector<std::string> shown;
+    // Adjust trials (`stimulus` is the target): the knob value the match starts at,
+    // drawn when the plan is made.
+    std::optional<double> start_value;
+    // Staircase slots: the procedure that runs here, "<standard>/<procedure id>"; the
+    // plan holds max_trials slots per procedure in rounds (each round a random order of
+    // all procedures). The delta is chosen when the slot comes, from its procedure's
+    // answers so far; a slot of a finished procedure is skipped. `shown` holds the
+    // standard once per picture and `expected` is the comparison's place (the right
+    // answer, 1..pictures).
+    std::string staircase;
 };
 
 struct TrialPlan {
@@ -102,8 +113,26 @@ std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,
 // often over the block, odd counts split at random), then the catch trials.
 std::vector<PlannedTrial> choice_block_trials(const Block& block, std::mt19937_64& rng);
 
-// A trial's level for the sequence constraints: a rating's level of the protocol's
-// factor; a forced choice's unordered set of stimuli (the same pair is one level).
+// An adjust block's trials in design order, before shuffling: each target `repeats`
+// times, each with its start value (adjust_start_value).
+std::vector<PlannedTrial> adjust_block_trials(const Block& block, std::mt19937_64& rng);
+// Where an adjust trial's match starts: block.start's number, range_min ("min"),
+// range_max ("max"), or ("random") uniform over the range on the block's scale (its
+// logarithm for "log").
+double adjust_start_value(const Block& block, std::mt19937_64& rng);
+
+// A staircase block's slots in their final order (not shuffled again): for each
+// standard and [[blocks.staircases]] entry a procedure "<standard>/<id>" with max_trials
+// slots, laid out in rounds, each round a random order of the procedures with slots
+// left; each procedure's comparison place balanced over its slots (every place equally
+// often, a remainder at random).
+std::vector<PlannedTrial> staircase_block_trials(const Block& block,
+                                                 std::mt19937_64& rng);
+
+// A trial's level for the sequence constraints: a rating's (and an adjustment's
+// target's) level of the protocol's factor; a forced choice's unordered set of stimuli
+// (the same pair is one level); a staircase slot's own level (its order is its
+// procedure's, constraints do not move it).
 std::string sequence_level(const PlannedTrial& trial,
                            const std::map<std::string, std::string>& level_of_stimulus);
 
