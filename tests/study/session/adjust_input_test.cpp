@@ -1,0 +1,113 @@
+// The adjust screen's input (issue 31): steps on a linear and a log scale, the range's
+// ends, wheel and drag, and the answer the store receives. Expected values are the
+// block's numbers stepped by hand.
+#include "study/session/adjust_input.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace lucent::study {
+namespace {
+
+Block adjust_block(const std::string& scale) {
+    Block b;
+    b.id = "m";
+    b.task = Task::adjust;
+    b.knob = "thickness_exponent";
+    b.range_min = 0.25;
+    b.range_max = 4.0;
+    b.scale = scale;
+    b.step = scale == "log" ? 0.1 : 0.5;
+    b.fine_step = scale == "log" ? 0.01 : 0.05;
+    return b;
+}
+
+TEST(AdjustInput, StepsCoarseAndFineOnALinearScaleAndStopsAtTheEnds) {
+    AdjustInput in(adjust_block("linear"), 1.0, 1'000);
+    in.step(true, false, 2'000);   // 1.5
+    in.step(true, true, 3'000);    // 1.55
+    in.step(false, false, 4'000);  // 1.05
+    EXPECT_NEAR(in.value(), 1.05, 1e-12);
+    for (int i = 0; i < 10; ++i) in.step(true, false, 5'000 + i);
+    EXPECT_EQ(in.value(), 4.0);
+    EXPECT_TRUE(in.at_max());
+    // 1.05 -> 4 takes 6 steps (the sixth is held at 4); the other four change nothing
+    // and are not counted.
+    EXPECT_EQ(in.adjustments().size(), 3u + 6u);
+    for (int i = 0; i < 20; ++i) in.step(false, false, 6'000 + i);
+    EXPECT_EQ(in.value(), 0.25);
+    EXPECT_TRUE(in.at_min());
+    EXPECT_EQ(in.adjustments().back().input, "key");
+    EXPECT_EQ(in.adjustments()[1].input, "fine_key");
+}
+
+TEST(AdjustInput, StepsAreFactorsOnALogScale) {
+    AdjustInput in(adjust_block("log"), 1.0, 0);
+    in.step(true, false, 1);  // 10^0.1
+    EXPECT_NEAR(in.value(), std::pow(10.0, 0.1), 1e-12);
+    in.step(false, true, 2);  // 10^0.09
+    EXPECT_NEAR(in.value(), std::pow(10.0, 0.09), 1e-12);
+    // The ends are the range's values exactly.
+    for (int i = 0; i < 30; ++i) in.step(false, false, 3 + i);
+    EXPECT_EQ(in.value(), 0.25);
+    for (int i = 0; i < 30; ++i) in.step(true, false, 40 + i);
+    EXPECT_EQ(in.value(), 4.0);
+}
+
+TEST(AdjustInput, WheelAndDragMoveOnTheScale) {
+    AdjustInput in(adjust_block("linear"), 1.0, 0);
+    in.wheel(2, 1);  // two coarse steps
+    EXPECT_NEAR(in.value(), 2.0, 1e-12);
+    in.wheel(-0.5, 2);  // half a step (a touchpad)
+    EXPECT_NEAR(in.value(), 1.75, 1e-12);
+    // A quarter of the match's width: a quarter of the range (3.75 / 4).
+    in.drag(-50, 200, 3);
+    EXPECT_NEAR(in.value(), 1.75 - 0.9375, 1e-12);
+    EXPECT_EQ(in.adjustments().back().input, "drag");
+    // Degenerate moves change nothing.
+    const size_t changes = in.adjustments().size();
+    in.drag(10, 0, 4);
+    in.drag(NAN, 100, 5);
+    in.wheel(INFINITY, 6);
+    EXPECT_EQ(in.adjustments().size(), changes);
+    EXPECT_TRUE(std::isfinite(in.value()));
+    // On a log scale the whole width spans log10(16).
+    AdjustInput log(adjust_block("log"), 1.0, 0);
+    log.drag(100, 100, 1);
+    EXPECT_EQ(log.value(), 4.0);
+}
+
+TEST(AdjustInput, TheAnswerHoldsEveryChangeAndNothingAfterTheConfirmation) {
+    AdjustInput in(adjust_block("linear"), 9.0, 1'000'000);  // clamped to 4
+    EXPECT_EQ(in.start(), 4.0);
+    in.step(false, false, 3'000'000);
+    in.step(false, true, 5'000'000);
+    in.confirm(8'000'000);
+    in.step(false, false, 9'000'000);  // after Enter: ignored
+    const TrialOutcome out = in.outcome("m");
+    ASSERT_TRUE(out.final_value);
+    EXPECT_NEAR(*out.final_value, 3.45, 1e-12);
+    ASSERT_EQ(out.adjustments.size(), 2u);
+    EXPECT_EQ(out.adjustments[0].t_ns, 3'000'000);
+    EXPECT_NEAR(out.adjustments[1].value, 3.45, 1e-12);
+    ASSERT_EQ(out.responses.size(), 1u);
+    EXPECT_EQ(out.responses[0].question, "m");
+    EXPECT_EQ(out.responses[0].rating, 1);
+    EXPECT_EQ(out.responses[0].changes, 2);
+    EXPECT_DOUBLE_EQ(out.responses[0].rt_ms, 7.0);
+    EXPECT_EQ(out.responses[0].first_choice_ns, 3'000'000);
+    EXPECT_EQ(out.responses[0].final_choice_ns, 5'000'000);
+    // Confirmed at the start: no change, the times are the confirmation's.
+    AdjustInput still(adjust_block("linear"), 2.0, 0);
+    EXPECT_THROW(still.outcome("m"), std::logic_error);
+    still.confirm(4'000'000);
+    const TrialOutcome kept = still.outcome("m");
+    EXPECT_EQ(*kept.final_value, 2.0);
+    EXPECT_TRUE(kept.adjustments.empty());
+    EXPECT_EQ(kept.responses[0].first_choice_ns, 4'000'000);
+    EXPECT_THROW(AdjustInput(Block{}, 1.0, 0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace lucent::study
