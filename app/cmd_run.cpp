@@ -6,6 +6,7 @@
 #include "study/protocol.h"
 #include "study/session/live_stimuli.h"
 #include "study/session/runner.h"
+#include "study/session/session_flow.h"
 #include "study/session/stimulus_source.h"
 #include "study/sqlite/database.h"
 #include "study/trial_plan.h"
@@ -47,6 +48,7 @@ int run_command(RunArgs& args) {
         o.protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                          : study::builtin_protocol(args.preset);
         if (args.seed >= 0) o.seed = static_cast<uint64_t>(args.seed);
+        study::check_presentable(o.protocol);
         study::plan_trials(o.protocol, 0,
                            0);  // impossible randomisation fails here, early
         study::LiveOrPrerenderedStimuli stimuli(args.images_dir);

@@ -26,6 +26,7 @@
 #include "study/postgres/trial_journal.h"
 #include "study/protocol.h"
 #include "study/serve/web_study.h"
+#include "study/session/session_flow.h"
 #include "study/session/stimulus_source.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/study_store.h"
@@ -143,6 +144,7 @@ int serve_command(const ServeArgs& args) {
     try {
         protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                        : study::builtin_protocol(args.preset);
+        study::check_presentable(protocol);
         study::plan_trials(protocol, 0, 0);  // impossible randomisation fails here, early
         const study::PrerenderedStimuli stimuli(args.images_dir);
         stimuli.check(protocol);

@@ -4,6 +4,15 @@
 
 namespace lucent::study {
 
+void check_presentable(const Protocol& protocol) {
+    for (const Block& b : protocol.blocks)
+        if (b.task == Task::adjust || b.task == Task::staircase)
+            throw ProtocolError(protocol.source + ": block '" + b.id + "': task '" +
+                                task_name(b.task) +
+                                "' cannot be run in a session by this build yet (it is "
+                                "planned, stored and exported)");
+}
+
 SessionFlow::SessionFlow(const Protocol& protocol, StudyStore& store, int64_t session_id,
                          std::vector<TrialRow> trials, bool consented, int64_t now_ns)
     : protocol_(protocol),

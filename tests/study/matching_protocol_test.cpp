@@ -10,6 +10,7 @@
 
 #include "study/adaptive/staircase_block.h"
 #include "study/protocol.h"
+#include "study/session/session_flow.h"
 #include "study/trial_plan.h"
 
 namespace lucent::study {
@@ -377,6 +378,24 @@ TEST(StaircaseBlock, AQuestFromTheProtocolIsHeldInsideTheDeltasRange) {
     }
     EXPECT_TRUE(finished);
     EXPECT_TRUE(block.procedure("target2/q").hit_range());
+}
+
+}  // namespace
+}  // namespace lucent::study
+
+namespace lucent::study {
+namespace {
+
+TEST(MatchingProtocol, ASessionRefusesWhatItCannotPresentBeforeStoringAnything) {
+    try {
+        check_presentable(matching());
+        FAIL() << "no refusal";
+    } catch (const ProtocolError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "matching.toml: block 'm': task 'adjust' cannot be run in a session by "
+                  "this build yet (it is planned, stored and exported)");
+    }
+    EXPECT_NO_THROW(check_presentable(builtin_protocol("thesis")));
 }
 
 }  // namespace
