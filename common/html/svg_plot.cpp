@@ -448,8 +448,16 @@ void draw_panel(std::ostringstream& svg, double x0, double y0, double w, double 
     for (std::size_t i = 0; i < n; ++i) {
         if (!defined(i)) continue;
         const double x = px(i), y = py(p.y[i]);
+        const bool open = i < p.open_points.size() && p.open_points[i];
         svg << "<circle cx=\"" << svg_number(x) << "\" cy=\"" << svg_number(y)
-            << "\" r=\"" << (categorical ? 4 : 3.5) << "\" fill=\"" << kBlue << "\"/>";
+            << "\" r=\"" << (categorical ? 4 : 3.5) << "\" fill=\""
+            << (open ? "white" : kBlue) << "\""
+            << (open ? std::string(" stroke=\"") + kBlue + "\" stroke-width=\"1.2\""
+                     : std::string())
+            << "/>";
+        if (i < p.ringed_points.size() && p.ringed_points[i])
+            svg << "<circle cx=\"" << svg_number(x) << "\" cy=\"" << svg_number(y)
+                << "\" r=\"6.5\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"1.2\"/>";
         if (i < p.point_labels.size()) {
             const bool to_left = x > left + 0.7 * plot_w;
             const double label_y = y - 6 < top + 2 ? y + 14 : y - 6;

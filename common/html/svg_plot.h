@@ -81,7 +81,10 @@ struct PlotPanel {
     std::vector<std::string> categories;
     std::vector<double> y_low, y_high;      // empty, or one per point
     std::vector<std::string> point_labels;  // text beside each point; empty: none
-    bool join = true;                       // a line through the points in order
+    // Per point (empty: none): drawn as an open circle (an adaptive track's wrong
+    // answers, the correct ones filled), and ringed by a larger circle (its reversals).
+    std::vector<bool> open_points, ringed_points;
+    bool join = true;  // a line through the points in order
     AxisOptions x_axis, y_axis;
     std::optional<Axis> fixed_y;  // this y axis instead of one chosen from the data
     // Further curves on the same numeric axes (the axes cover them too), each a line

@@ -54,6 +54,24 @@ TEST(SmallPlots, LevelValuesSkipUndefinedValuesAndNameTheAxis) {
     EXPECT_EQ(markup_escape("a<b & \"c\""), "a&lt;b &amp; &quot;c&quot;");
 }
 
+TEST(Figures, OpenAndRingedPointsMarkAnAdaptiveTrack) {
+    // Five trials: the 2nd and 4th wrong (open), the 3rd a reversal (ringed).
+    PlotPanel p;
+    p.x = {1, 2, 3, 4, 5};
+    p.y = {1, 0.8, 0.9, 0.7, 0.8};
+    p.open_points = {false, true, false, true, false};
+    p.ringed_points = {false, false, true, false, false};
+    const std::string svg = figure_svg("", {p});
+    EXPECT_EQ(count(svg, "fill=\"white\" stroke=\"#1f77b4\""), 2u);
+    EXPECT_EQ(count(svg, "r=\"6.5\""), 1u);
+    // Without them every point is filled and none is ringed.
+    p.open_points.clear();
+    p.ringed_points.clear();
+    const std::string plain = figure_svg("", {p});
+    EXPECT_EQ(count(plain, "fill=\"white\" stroke="), 0u);
+    EXPECT_EQ(count(plain, "r=\"6.5\""), 0u);
+}
+
 TEST(SvgPieces, NumbersHaveTwoDecimalsAndTheHeaderItsViewBox) {
     EXPECT_EQ(svg_number(12.5), "12.50");
     EXPECT_EQ(svg_number(-0.004), "-0.00");
