@@ -16,6 +16,24 @@ const std::set<std::string> kKeys = {"1",     "2",  "3",    "4",     "5",      "
 
 }  // namespace
 
+std::vector<std::string> adjust_keys(const AdjustView& view, double goal) {
+    auto on_scale = [&](double v) {
+        v = std::clamp(v, view.lo, view.hi);
+        return view.log_scale ? std::log10(v) : v;
+    };
+    std::vector<std::string> keys;
+    if (!std::isfinite(goal) || !(view.step > 0) || !(view.fine_step > 0)) return keys;
+    const double distance = on_scale(goal) - on_scale(view.value);
+    const char* up = distance >= 0 ? "Right" : "Left";
+    const double coarse = std::floor(std::abs(distance) / view.step);
+    const double fine =
+        std::round((std::abs(distance) - coarse * view.step) / view.fine_step);
+    for (int i = 0; i < coarse && keys.size() < 1000; ++i) keys.push_back(up);
+    for (int i = 0; i < fine && keys.size() < 1000; ++i)
+        keys.push_back(std::string("Shift+") + up);
+    return keys;
+}
+
 Autopilot Autopilot::from_seed(uint64_t seed, double speed,
                                const ObserverModel& observer) {
     Autopilot a;
@@ -80,6 +98,37 @@ void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
             // Look, pick a side with an arrow, confirm.
             const int choice = simulated_choice(observer_, view.choice, rng_);
             press(delay_ms(900), choice == 1 ? "Left" : "Right");
+            press(delay_ms(250), "Enter");
+            break;
+        }
+        case ScreenView::Kind::Adjust: {
+            // Look, then turn the knob to where the match looks like the target, and
+            // confirm. Without a target value (a picture) the start is kept.
+            const AdjustView& a = view.adjust;
+            const double goal =
+                a.target ? simulated_match(match_, *a.target, a.lo, a.hi, rng_) : a.value;
+            double after = 1200;
+            for (const std::string& key : adjust_keys(a, goal)) {
+                press(delay_ms(after), key);
+                after = 120;
+            }
+            press(delay_ms(600), "Enter");
+            break;
+        }
+        case ScreenView::Kind::Staircase: {
+            const StaircaseView& st = view.staircase;
+            const int n = std::max(2, st.answers);
+            const bool correct = simulated_detection(detection_, st.delta, 1.0 / n, rng_);
+            int answer = st.comparison_place;
+            if (!correct) {  // one of the other places, each equally likely
+                std::uniform_int_distribution<int> other(1, n - 1);
+                answer = other(rng_);
+                if (answer >= st.comparison_place) ++answer;
+            }
+            if (n == 2)
+                press(delay_ms(900), answer == 1 ? "Left" : "Right");
+            else
+                press(delay_ms(900), std::to_string(answer));
             press(delay_ms(250), "Enter");
             break;
         }

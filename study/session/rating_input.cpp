@@ -7,8 +7,8 @@ namespace lucent::study {
 RatingInput::RatingInput(std::vector<int> points, int64_t onset_ns)
     : state_(points.size()), points_(std::move(points)), onset_ns_(onset_ns) {}
 
-RatingInput RatingInput::forced_choice(int64_t onset_ns) {
-    RatingInput input(std::vector<int>{2}, onset_ns);
+RatingInput RatingInput::forced_choice(int64_t onset_ns, int alternatives) {
+    RatingInput input(std::vector<int>{alternatives}, onset_ns);
     input.choice_ = true;
     return input;
 }
@@ -36,19 +36,19 @@ void RatingInput::key(RatingKey key, int digit, int64_t t_ns) {
             set(focus_, digit, t_ns);
             break;
         // The first arrow press picks the middle point: nothing is chosen before a key.
-        // A forced choice's arrows point at the alternative on that side.
+        // A choice of two: the arrows point at the alternative on that side.
         case RatingKey::Left:
             set(focus_,
-                choice_    ? 1
-                : s.rating ? std::max(1, *s.rating - 1)
-                           : (points + 1) / 2,
+                choice_ && points == 2 ? 1
+                : s.rating             ? std::max(1, *s.rating - 1)
+                                       : (points + 1) / 2,
                 t_ns);
             break;
         case RatingKey::Right:
             set(focus_,
-                choice_    ? 2
-                : s.rating ? std::min(points, *s.rating + 1)
-                           : (points + 1) / 2,
+                choice_ && points == 2 ? 2
+                : s.rating             ? std::min(points, *s.rating + 1)
+                                       : (points + 1) / 2,
                 t_ns);
             break;
         case RatingKey::Up:

@@ -18,10 +18,12 @@ class RatingInput {
 public:
     // points[q]: the scale length of question q.
     RatingInput(std::vector<int> points, int64_t onset_ns);
-    // A forced choice (pair, triad, quadruple): one "question" of 2 alternatives; Left
-    // and Right (or 1 and 2) pick the first or the second, Enter confirms, a click on
-    // an alternative picks it (the flow confirms it at once).
-    static RatingInput forced_choice(int64_t onset_ns);
+    // A forced choice (pair, triad, quadruple, a staircase's pair): one "question" of 2
+    // alternatives; Left and Right (or 1 and 2) pick the first or the second, Enter
+    // confirms, a click on an alternative picks it (the flow confirms it at once). An
+    // odd one out of 3: digits pick, the arrows move the pick (the first picks the
+    // middle), as on a rating scale.
+    static RatingInput forced_choice(int64_t onset_ns, int alternatives = 2);
     bool is_choice() const { return choice_; }
     // `questions` questions on the same `points`-point scale.
     RatingInput(int questions, int points, int64_t onset_ns)

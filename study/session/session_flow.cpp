@@ -1,5 +1,8 @@
 #include "study/session/session_flow.h"
 
+#include <variant>
+
+#include "renderer/techniques/registry.h"
 #include "study/session/frame_timing.h"
 
 namespace lucent::study {
@@ -19,7 +22,7 @@ SessionFlow::SessionFlow(const Protocol& protocol, StudyStore& store, int64_t se
       store_(store),
       session_id_(session_id),
       trials_(std::move(trials)) {
-    while (current_ < trials_.size() && trials_[current_].answered) ++current_;
+    advance_to_open_trial();
     // A resumed session continues at its first open trial once consent is on record.
     if (current_ == trials_.size())
         enter(Screen::Debrief, now_ns);
@@ -61,7 +64,67 @@ const Block* SessionFlow::block() const {
 }
 
 bool SessionFlow::choice_trial() const {
-    return current_ < trials_.size() && trials_[current_].task != Task::rating;
+    return current_ < trials_.size() && trials_[current_].task != Task::rating &&
+           trials_[current_].task != Task::adjust;
+}
+
+adaptive::StaircaseBlock& SessionFlow::staircase_block(const Block& block) {
+    auto it = staircases_.blocks.find(block.id);
+    if (it == staircases_.blocks.end()) {
+        it = staircases_.blocks.emplace(block.id, adaptive::StaircaseBlock(block)).first;
+        try {
+            it->second.replay(trials_);
+        } catch (const std::exception& e) {
+            staircases_.blocks.erase(it);
+            throw StoreError(store_.name() + ": " + e.what());
+        }
+        // A slot on screen already has its delta: its procedure waits for the answer
+        // again (the same proposal: the procedures are deterministic).
+        if (delta_ && current_ < trials_.size() && trials_[current_].block == block.id &&
+            trials_[current_].task == Task::staircase)
+            it->second.propose(trials_[current_].staircase);
+    }
+    return it->second;
+}
+
+void SessionFlow::advance_to_open_trial() {
+    delta_.reset();
+    for (; current_ < trials_.size(); ++current_) {
+        TrialRow& t = trials_[current_];
+        if (t.answered || t.skipped) continue;
+        if (t.task != Task::staircase) return;
+        adaptive::StaircaseBlock& b = staircase_block(*protocol_.find_block(t.block));
+        // A procedure that finished has its open slots skipped in the store, in the
+        // transaction of its last answer; one that reached its cap has no slots left.
+        if (b.finished(t.staircase)) {
+            t.skipped = true;
+            continue;
+        }
+        delta_ = b.propose(t.staircase);
+        return;
+    }
+}
+
+std::optional<adaptive::Proposal> SessionFlow::staircase_delta() const {
+    if (!trial() || trials_[current_].task != Task::staircase) return std::nullopt;
+    return delta_;
+}
+
+double SessionFlow::knob_value(const std::string& stimulus,
+                               const std::string& knob) const {
+    if (const std::optional<double> v = protocol_.numeric_parameter(stimulus, knob))
+        return *v;
+    const StimulusSpec* s = protocol_.find_stimulus(stimulus);
+    const std::vector<Knob> knobs = knobs_for(find_technique(s->technique));
+    return std::get<double>(find_knob(knobs, knob)->default_value);
+}
+
+std::optional<double> SessionFlow::comparison_value() const {
+    const std::optional<adaptive::Proposal> d = staircase_delta();
+    if (!d) return std::nullopt;
+    const Block* b = block();
+    const double standard = knob_value(trials_[current_].stimulus, b->knob);
+    return b->direction == "down" ? standard - d->intensity : standard + d->intensity;
 }
 
 std::optional<ChoicePhase> SessionFlow::choice_phase() const {
@@ -71,6 +134,7 @@ std::optional<ChoicePhase> SessionFlow::choice_phase() const {
 
 void SessionFlow::start_trial_presentation() {
     input_.reset();
+    adjust_.reset();
     trial_frames_ns_.clear();
     trial_onset_ns_.reset();
     const Block* b = current_ < trials_.size()
@@ -104,6 +168,18 @@ ScreenView SessionFlow::view() const {
         case Screen::Trial:
             v.is_catch = trials_[current_].is_catch;
             v.expected = trials_[current_].expected;
+            if (trials_[current_].task == Task::adjust) {
+                v.kind = adjust_ ? ScreenView::Kind::Adjust : ScreenView::Kind::Blank;
+                if (adjust_) v.adjust = adjust_view();
+                break;
+            }
+            if (trials_[current_].task == Task::staircase) {
+                v.kind = input_ ? ScreenView::Kind::Staircase : ScreenView::Kind::Blank;
+                v.staircase.delta = delta_ ? delta_->intensity : 0.0;
+                v.staircase.answers = block()->answers();
+                v.staircase.comparison_place = trials_[current_].expected;
+                break;
+            }
             if (choice_trial()) {
                 v.kind = input_ ? ScreenView::Kind::Choice : ScreenView::Kind::Blank;
                 v.choice = choice_stimuli(protocol_, trials_[current_].block,
@@ -122,6 +198,22 @@ ScreenView SessionFlow::view() const {
             break;
     }
     return v;
+}
+
+AdjustView SessionFlow::adjust_view() const {
+    const Block& b = *block();
+    AdjustView a;
+    a.value = adjust_->value();
+    a.lo = b.range_min;
+    a.hi = b.range_max;
+    a.step = b.step;
+    a.fine_step = b.fine_step;
+    a.log_scale = b.scale == "log";
+    const StimulusSpec* target = protocol_.find_stimulus(trials_[current_].stimulus);
+    const StimulusSpec* match = protocol_.find_stimulus(b.match);
+    if (target && match && target->live() && target->technique == match->technique)
+        a.target = knob_value(target->id, b.knob);
+    return a;
 }
 
 void SessionFlow::changed() {
@@ -170,8 +262,11 @@ void SessionFlow::presented(int serial, int64_t t_ns) {
                 trial_frames_ns_.push_back(t_ns);
             }
             if (phase_ != ChoicePhase::Answer) return;  // a sequence: not answerable yet
-            if (choice_trial()) {
-                input_.emplace(RatingInput::forced_choice(t_ns));
+            const TrialRow& t = trials_[current_];
+            if (t.task == Task::adjust) {
+                adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns);
+            } else if (choice_trial()) {
+                input_.emplace(RatingInput::forced_choice(t_ns, block()->answers()));
             } else {
                 std::vector<int> points;
                 for (const Question& q : protocol_.questions)
@@ -242,6 +337,17 @@ void SessionFlow::key(const TimedKey& press) {
             }
             break;
         case Screen::Trial: {
+            if (adjust_) {
+                const int64_t t = press.t_ns;
+                if (press.key == Key::Right || press.key == Key::Up)
+                    adjust_->step(true, press.shift, t);
+                else if (press.key == Key::Left || press.key == Key::Down)
+                    adjust_->step(false, press.shift, t);
+                else if (press.key == Key::Enter)
+                    adjust_->confirm(t);
+                if (adjust_->confirmed()) finish_trial();
+                break;
+            }
             if (!input_) break;  // before onset: nothing to answer
             const int64_t t = press.t_ns;
             switch (press.key) {
@@ -297,6 +403,18 @@ void SessionFlow::click_choice(int alternative, int64_t t_ns) {
     if (input_->confirmed()) finish_trial();
 }
 
+void SessionFlow::wheel(double notches, int64_t t_ns) {
+    if (finished_ || paused_ || !adjust_ || !presented_ns_ || t_ns < *presented_ns_)
+        return;
+    adjust_->wheel(notches, t_ns);
+}
+
+void SessionFlow::drag(double dx_px, double width_px, int64_t t_ns) {
+    if (finished_ || paused_ || !adjust_ || !presented_ns_ || t_ns < *presented_ns_)
+        return;
+    adjust_->drag(dx_px, width_px, t_ns);
+}
+
 void SessionFlow::window_closed() {
     if (finished_) return;
     if (screen_ == Screen::Debrief || screen_ == Screen::Done) {  // already completed
@@ -313,25 +431,53 @@ void SessionFlow::quit_saving() {
 }
 
 void SessionFlow::finish_trial() {
-    const TrialRow& t = trials_[current_];
-    std::vector<std::string> ids;
-    if (choice_trial())
-        ids.push_back(protocol_.find_block(t.block)->question_id);
-    else
-        for (const Question& q : protocol_.questions) ids.push_back(q.id);
+    TrialRow& t = trials_[current_];
+    const Block* b = protocol_.find_block(t.block);
     TrialOutcome outcome;
+    if (t.task == Task::adjust) {
+        outcome = adjust_->outcome(b->question_id);
+    } else {
+        std::vector<std::string> ids;
+        if (choice_trial())
+            ids.push_back(b->question_id);
+        else
+            for (const Question& q : protocol_.questions) ids.push_back(q.id);
+        outcome.onset_ns = *trial_onset_ns_;
+        outcome.confirm_ns = input_->confirm_ns();
+        outcome.responses = input_->responses(ids);
+    }
     outcome.onset_ns = *trial_onset_ns_;
-    outcome.confirm_ns = input_->confirm_ns();
-    outcome.responses = input_->responses(ids);
+    if (t.task == Task::staircase) {
+        const int choice = outcome.responses.front().rating;
+        outcome.intensity = delta_->intensity;
+        outcome.finishes_staircase =
+            staircase_block(*b).answer(t.staircase, choice == t.expected);
+        t.choice = choice;
+        t.intensity = outcome.intensity;
+    }
     if (refresh_hz_)
         outcome.dropped_frames = dropped_frames(trial_frames_ns_, *refresh_hz_);
     // Committed before the next trial; the last one completes the session in the same
     // transaction.
-    store_.record_trial(session_id_, t.id, outcome);
+    try {
+        store_.record_trial(session_id_, t.id, outcome);
+    } catch (...) {
+        // Not stored: the block's procedures are rebuilt from what the store holds.
+        staircases_.blocks.erase(t.block);
+        t.choice.reset();
+        t.intensity.reset();
+        throw;
+    }
     const int64_t confirmed_ns = outcome.confirm_ns;
     const bool was_practice = t.practice;
-    trials_[current_].answered = true;
+    t.answered = true;
+    if (outcome.finishes_staircase)
+        for (TrialRow& other : trials_)
+            if (other.block == t.block && other.staircase == t.staircase &&
+                !other.answered)
+                other.skipped = true;
     ++current_;
+    advance_to_open_trial();
     if (current_ >= trials_.size())
         enter(Screen::Debrief, confirmed_ns);
     else if (was_practice && !trials_[current_].practice)

@@ -11,11 +11,14 @@
 // - The last trial's ratings and the status `completed` are one transaction
 //   (StudyStore::record_trial), and nothing turns a completed session back into paused.
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "study/adaptive/staircase_block.h"
 #include "study/protocol.h"
+#include "study/session/adjust_input.h"
 #include "study/session/autopilot.h"
 #include "study/session/rating_input.h"
 #include "study/sqlite/sqlite_store.h"
@@ -47,13 +50,15 @@ enum class Key { Digit, Enter, Escape, Left, Right, Up, Down, Quit, Resume, Decl
 
 struct TimedKey {
     Key key = Key::Enter;
-    int digit = 0;     // 1..9 for Key::Digit
-    int64_t t_ns = 0;  // steady clock, when the key went down
+    int digit = 0;       // 1..9 for Key::Digit
+    int64_t t_ns = 0;    // steady clock, when the key went down
+    bool shift = false;  // held with Shift (an adjustment's fine step)
 };
 
-// Adjust and staircase blocks are planned and stored (issue 31) but the session flow
-// does not present them yet: throws ProtocolError naming the first such block, so `lucent
-// run` and `lucent serve` refuse the protocol before anything is stored.
+// Adjust and staircase blocks are planned, stored and run by SessionFlow (issue 31),
+// but `lucent run` does not draw them and `lucent serve` does not show them yet: throws
+// ProtocolError naming the first such block, so both refuse the protocol before anything
+// is stored.
 void check_presentable(const Protocol& protocol);
 
 class SessionFlow {
@@ -72,6 +77,10 @@ public:
     // A click on a forced choice's alternative (1 or 2: a picture, or a pair's group):
     // picks it and confirms at once.
     void click_choice(int alternative, int64_t t_ns);
+    // An adjust trial's match: wheel notches (positive: up), a horizontal drag of dx
+    // pixels across a match `width_px` wide (AdjustInput).
+    void wheel(double notches, int64_t t_ns);
+    void drag(double dx_px, double width_px, int64_t t_ns);
     void window_closed();  // by the window manager; saves and quits unless completed
     // Time passes: the blank between trials gives way to the stimulus.
     void tick(int64_t now_ns);
@@ -93,6 +102,17 @@ public:
     // The trial on a Blank or Trial screen; the rating input once the stimulus is shown.
     const TrialRow* trial() const;
     const RatingInput* rating() const { return input_ ? &*input_ : nullptr; }
+    // An adjust trial's input once the target is shown (its value is the match's knob;
+    // the same screen goes on while it moves: its revision() says when to redraw).
+    const AdjustInput* adjustment() const { return adjust_ ? &*adjust_ : nullptr; }
+    // A staircase slot on a Blank or Trial screen: the delta its procedure chose (the
+    // comparison is the standard with the block's knob moved by it, Block::direction),
+    // and the comparison's value of the knob.
+    std::optional<adaptive::Proposal> staircase_delta() const;
+    std::optional<double> comparison_value() const;
+    // The value of a block's knob for a stimulus (its parameter, else the knob's
+    // default): an adjust target's, a staircase standard's.
+    double knob_value(const std::string& stimulus, const std::string& knob) const;
     // The block of the trial on screen (nullptr between trials).
     const Block* block() const;
     // On a forced choice's Trial screen, what it shows now; nullopt otherwise.
@@ -113,6 +133,11 @@ private:
     void quit_saving();
     bool choice_trial() const;
     void start_trial_presentation();  // phase and input back to the trial's start
+    // Past answered and skipped trials; a staircase slot gets its delta (skipped when
+    // its procedure has finished).
+    void advance_to_open_trial();
+    adaptive::StaircaseBlock& staircase_block(const Block& block);
+    AdjustView adjust_view() const;
 
     const Protocol& protocol_;
     StudyStore& store_;
@@ -127,6 +152,23 @@ private:
     int64_t entered_ns_ = 0;
     std::optional<int64_t> presented_ns_;
     std::optional<RatingInput> input_;
+    std::optional<AdjustInput> adjust_;
+    // The staircase blocks' procedures by block id, rebuilt from trials_ when first
+    // needed; a copy of the flow starts without them and rebuilds its own (a procedure
+    // is state that two flows must not share).
+    struct StaircaseCache {
+        std::map<std::string, adaptive::StaircaseBlock> blocks;
+        StaircaseCache() = default;
+        StaircaseCache(const StaircaseCache&) {}
+        StaircaseCache(StaircaseCache&&) = default;
+        StaircaseCache& operator=(const StaircaseCache&) {
+            blocks.clear();
+            return *this;
+        }
+        StaircaseCache& operator=(StaircaseCache&&) = default;
+    };
+    StaircaseCache staircases_;
+    std::optional<adaptive::Proposal> delta_;  // the current staircase slot's
     ChoicePhase phase_ = ChoicePhase::Answer;
     std::optional<int64_t> trial_onset_ns_;  // the trial's first picture on the display
     std::vector<int64_t> trial_frames_ns_;
