@@ -12,7 +12,8 @@ std::optional<std::string_view> stimuli_preset_file(std::string_view relative_pa
 namespace lucent::stimuli {
 
 std::vector<std::string> preset_names() {
-    return {"thesis", "heterogeneous", "fabrics", "physical", "scaling"};
+    return {"thesis",  "heterogeneous", "fabrics", "physical",
+            "scaling", "matching",      "jnd"};
 }
 
 std::optional<std::string_view> preset_text(std::string_view name) {

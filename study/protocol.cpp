@@ -936,7 +936,7 @@ Protocol load_protocol_file(const std::string& path) {
 }
 
 std::vector<std::string> builtin_protocol_names() {
-    return {"thesis", "fabrics", "scaling"};
+    return {"thesis", "fabrics", "scaling", "matching", "jnd"};
 }
 
 Protocol builtin_protocol(std::string_view name) {

@@ -400,3 +400,53 @@ TEST(MatchingProtocol, ASessionRefusesWhatItCannotPresentBeforeStoringAnything) 
 
 }  // namespace
 }  // namespace lucent::study
+
+namespace lucent::study {
+namespace {
+
+TEST(BuiltinMatchingStudies, MatchingAndJndPlanWhatTheirCommentsSay) {
+    // matching: three blocks of two targets, each three times, on a log scale 1..100.
+    const Protocol matching = builtin_protocol("matching");
+    const TrialPlan m = plan_trials(matching, 1, 1);
+    int adjust = 0;
+    std::set<std::string> matches;
+    for (const PlannedTrial& t : m.trials) {
+        ASSERT_EQ(t.task, Task::adjust);
+        ASSERT_TRUE(t.start_value);
+        EXPECT_GE(*t.start_value, 1.0);
+        EXPECT_LE(*t.start_value, 100.0);
+        matches.insert(t.shown[1]);
+        ++adjust;
+    }
+    EXPECT_EQ(adjust, 3 * 2 * 3);
+    EXPECT_EQ(matches, (std::set<std::string>{"match_front", "match_back"}));
+    // The cross block's target and match differ in exactly the light's direction.
+    const Block& cross = *matching.find_block("cross");
+    const StimulusSpec& match = *matching.find_stimulus(cross.match);
+    const StimulusSpec& target = *matching.find_stimulus(cross.stimuli[0]);
+    EXPECT_NE(match.parameters.at("light_direction"),
+              target.parameters.at("light_direction"));
+    EXPECT_EQ(matching.find_stimulus(matching.find_block("back")->match)
+                  ->parameters.at("light_direction"),
+              target.parameters.at("light_direction"));
+
+    // jnd: three standards (the thesis's r = 18, 25, 30), each an up/down staircase
+    // of at most 40 slots and a QUEST of 24, the comparison below the standard.
+    const Protocol jnd = builtin_protocol("jnd");
+    const Block& j = *jnd.find_block("jnd");
+    EXPECT_EQ(j.direction, "down");
+    std::map<std::string, int> slots;
+    for (const PlannedTrial& t : plan_trials(jnd, 1, 1).trials) ++slots[t.staircase];
+    EXPECT_EQ(slots, (std::map<std::string, int>{{"r_18/quest", 24},
+                                                 {"r_18/updown", 40},
+                                                 {"r_25/quest", 24},
+                                                 {"r_25/updown", 40},
+                                                 {"r_30/quest", 24},
+                                                 {"r_30/updown", 40}}));
+    for (const std::string& standard : j.stimuli)
+        EXPECT_GT(*jnd.numeric_parameter(standard, "thickness_exponent"),
+                  j.procedures[0].max_delta);  // the comparison's r stays above 0
+}
+
+}  // namespace
+}  // namespace lucent::study
