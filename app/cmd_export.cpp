@@ -1,5 +1,5 @@
-// lucent export: a study database as CSV (long, wide, the analysis long table, or the
-// forced choices).
+// lucent export: a study database as CSV (long, wide, the analysis long table, the
+// forced choices, the adjustments and matches, the staircase trials).
 #include <iostream>
 
 #include "app/commands.h"
@@ -16,8 +16,9 @@ void register_export(CLI::App& app, int& exit_code) {
     auto format = std::make_shared<std::string>("long");
     auto out = std::make_shared<std::string>();
     auto force = std::make_shared<bool>(false);
-    auto* cmd = app.add_subcommand("export",
-                                   "Write a study database's ratings or choices as CSV");
+    auto* cmd = app.add_subcommand(
+        "export",
+        "Write a study database's ratings, choices, matches or staircases as CSV");
     cmd->add_option("db", *db,
                     "Study database: FILE.db or postgresql://USER@HOST[:PORT]/DBNAME")
         ->required()
@@ -29,9 +30,12 @@ void register_export(CLI::App& app, int& exit_code) {
            "choices: one row per paired-comparison or MLDS choice (the stimuli in "
            "screen order, the choice, RT); choice-analysis: the same as lucent analyze "
            "scales them (no practice, the analysis plan's sessions, participants failing "
-           "catch trials left out)")
-        ->check(
-            CLI::IsMember({"long", "wide", "analysis", "choices", "choice-analysis"}));
+           "catch trials left out); adjustments: one row per change of an adjust "
+           "trial's knob (value, ms from onset, input); matches: one row per adjust "
+           "trial (start, final value, count of adjustments, total ms); staircase: one "
+           "row per answered staircase trial (intensity, expected, choice, correct, RT)")
+        ->check(CLI::IsMember({"long", "wide", "analysis", "choices", "choice-analysis",
+                               "adjustments", "matches", "staircase"}));
     cmd->add_option("--out", *out,
                     "CSV file to write (never a database; written to a temporary file in "
                     "its folder, then renamed)")

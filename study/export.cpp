@@ -8,8 +8,10 @@
 #include <sstream>
 
 #include "common/csv.h"
+#include "common/number_text.h"
 #include "common/output_file.h"
 #include "study/question_scales.h"
+#include "study/schema.h"
 #include "study/sqlite/database.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/store_rules.h"
@@ -68,12 +70,16 @@ int max_failed_catch(Database& db) {
     return protocol ? protocol->max_failed_catch : 0;
 }
 
-// SQL condition on trials `t` keeping ratings only: forced choices (schema 6) are their
-// own table (export_choices). Older databases hold nothing else.
+// The kind of trial `t` as SQL for this database's schema (schema.h).
+std::string trial_kind(Database& db) {
+    return trial_kind_sql(static_cast<int>(db.scalar_int("PRAGMA user_version")), "t");
+}
+
+// SQL condition on trials `t` keeping ratings only: forced choices (schema 6),
+// adjustments and staircases (schema 7) are their own tables (export_choices,
+// export_matches, export_staircase). Older databases hold nothing else.
 std::string rating_trials(Database& db) {
-    return db.scalar_int("PRAGMA user_version") >= 6
-               ? " AND (t.task IS NULL OR t.task = 'rating') "
-               : " ";
+    return " AND " + trial_kind(db) + " = 'rating' ";
 }
 
 std::string format_number(double v) {
@@ -408,11 +414,14 @@ ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
         return it->second.at(b->series);
     };
     Statement s = db.prepare(
-        "SELECT p.code, se.uuid, t.position, t.block, t.task, r.question, t.practice, "
+        "SELECT p.code, se.uuid, t.position, t.block, " + trial_kind(db) +
+        ", r.question, t.practice, "
         "t.catch, t.expected_rating, t.shown, r.rating, r.rt_ms, se.id FROM responses r "
         "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
         "JOIN participants p ON p.id = se.participant_id "
-        "WHERE t.task IN ('pair', 'triad', 'quadruple') "
+        "WHERE " +
+        trial_kind(db) +
+        " IN ('pair', 'triad', 'quadruple') "
         "ORDER BY p.code, se.id, t.position, r.id");
     while (s.step()) {
         const std::string participant = s.text(0);
@@ -438,6 +447,118 @@ ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
         ++result.rows;
     }
     return result;
+}
+
+namespace {
+
+// Milliseconds from `from_ns` to `to_ns`, as the shortest exact text.
+std::string ms_between(int64_t from_ns, int64_t to_ns) {
+    return common::shortest_text(static_cast<double>(to_ns - from_ns) / 1e6);
+}
+
+std::string optional_number(Statement& s, int col) {
+    return s.is_null(col) ? std::string() : common::shortest_text(s.real(col));
+}
+
+// The sessions an export of adjustments or staircases reads: every one not withdrawn.
+std::map<std::int64_t, std::string> readable_sessions(Database& db,
+                                                      const std::string& db_path) {
+    return select_sessions(db, db_path, "all", false).taken;
+}
+
+}  // namespace
+
+int export_adjustments(const std::string& db_path, std::ostream& out) {
+    Database db = open_read_only(db_path);
+    out << "participant,session,trial,block,target,start_value,step,value,t_ms,input\n";
+    if (db.scalar_int("PRAGMA user_version") < 7) return 0;  // none recorded before
+    const auto taken = readable_sessions(db, db_path);
+    Statement s = db.prepare(
+        "SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, t.start_value, "
+        "a.step, a.value, a.t_ns, t.onset_ns, a.input, se.id FROM adjustments a "
+        "JOIN trials t ON t.id = a.trial_id JOIN sessions se ON se.id = t.session_id "
+        "JOIN participants p ON p.id = se.participant_id "
+        "JOIN stimuli st ON st.id = t.stimulus_id "
+        "ORDER BY p.code, se.id, t.position, a.step");
+    int rows = 0;
+    while (s.step()) {
+        if (!taken.count(s.integer(11))) continue;  // withdrawn
+        out << common::csv_field(s.text(0)) << "," << common::csv_field(s.text(1)) << ","
+            << s.integer(2) << "," << common::csv_field(s.text(3)) << ","
+            << common::csv_field(s.text(4)) << "," << optional_number(s, 5) << ","
+            << s.integer(6) << "," << common::shortest_text(s.real(7)) << ","
+            << (s.is_null(9) ? std::string() : ms_between(s.integer(9), s.integer(8)))
+            << "," << common::csv_field(s.text(10)) << "\n";
+        ++rows;
+    }
+    return rows;
+}
+
+int export_matches(const std::string& db_path, std::ostream& out) {
+    Database db = open_read_only(db_path);
+    out << "participant,session,trial,block,practice,target,match_knob,start_value,"
+           "final_value,adjustments,total_ms\n";
+    if (db.scalar_int("PRAGMA user_version") < 7) return 0;
+    const auto taken = readable_sessions(db, db_path);
+    const std::optional<Protocol> protocol = stored_protocol(db);
+    auto knob_of = [&](const std::string& block) {
+        const Block* b = protocol ? protocol->find_block(block) : nullptr;
+        return b ? b->knob : std::string();
+    };
+    Statement s = db.prepare(
+        "SELECT p.code, se.uuid, t.position, t.block, t.practice, st.stimulus_key, "
+        "t.start_value, t.final_value, (SELECT count(*) FROM adjustments a WHERE "
+        "a.trial_id = t.id), r.rt_ms, se.id FROM responses r "
+        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
+        "JOIN participants p ON p.id = se.participant_id "
+        "JOIN stimuli st ON st.id = t.stimulus_id "
+        "WHERE " +
+        trial_kind(db) + " = 'adjust' ORDER BY p.code, se.id, t.position, r.id");
+    int rows = 0;
+    while (s.step()) {
+        if (!taken.count(s.integer(10))) continue;  // withdrawn
+        const std::string block = s.text(3);
+        out << common::csv_field(s.text(0)) << "," << common::csv_field(s.text(1)) << ","
+            << s.integer(2) << "," << common::csv_field(block) << ","
+            << (s.integer(4) != 0 ? 1 : 0) << "," << common::csv_field(s.text(5)) << ","
+            << common::csv_field(knob_of(block)) << "," << optional_number(s, 6) << ","
+            << optional_number(s, 7) << "," << s.integer(8) << ","
+            << common::shortest_text(s.real(9)) << "\n";
+        ++rows;
+    }
+    return rows;
+}
+
+int export_staircase(const std::string& db_path, std::ostream& out) {
+    Database db = open_read_only(db_path);
+    out << "participant,session,trial,block,standard,staircase,intensity,expected,"
+           "choice,correct,rt_ms\n";
+    if (db.scalar_int("PRAGMA user_version") < 7) return 0;
+    const auto taken = readable_sessions(db, db_path);
+    Statement s = db.prepare(
+        "SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, "
+        "coalesce(t.staircase, ''), t.intensity, t.expected_rating, r.rating, r.rt_ms, "
+        "se.id FROM responses r "
+        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
+        "JOIN participants p ON p.id = se.participant_id "
+        "JOIN stimuli st ON st.id = t.stimulus_id "
+        "WHERE " +
+        trial_kind(db) + " = 'staircase' ORDER BY p.code, se.id, t.position, r.id");
+    int rows = 0;
+    while (s.step()) {
+        if (!taken.count(s.integer(10))) continue;  // withdrawn
+        const bool has_expected = !s.is_null(7);
+        out << common::csv_field(s.text(0)) << "," << common::csv_field(s.text(1)) << ","
+            << s.integer(2) << "," << common::csv_field(s.text(3)) << ","
+            << common::csv_field(s.text(4)) << "," << common::csv_field(s.text(5)) << ","
+            << optional_number(s, 6) << ","
+            << (has_expected ? std::to_string(s.integer(7)) : std::string()) << ","
+            << s.integer(8) << ","
+            << (has_expected ? (s.integer(8) == s.integer(7) ? "1" : "0") : "") << ","
+            << common::shortest_text(s.real(9)) << "\n";
+        ++rows;
+    }
+    return rows;
 }
 
 std::map<std::string, std::vector<std::string>> choice_block_orders(
@@ -470,6 +591,12 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                 result.rows = choices.rows;
                 result.excluded_participants = choices.excluded_participants;
                 result.notes = choices.notes;
+            } else if (format == "adjustments") {
+                result.rows = export_adjustments(db_path, out);
+            } else if (format == "matches") {
+                result.rows = export_matches(db_path, out);
+            } else if (format == "staircase") {
+                result.rows = export_staircase(db_path, out);
             } else if (format == "long" || format == "wide") {
                 result.rows = export_csv(
                     db_path, format == "long" ? ExportFormat::Long : ExportFormat::Wide,
@@ -477,7 +604,8 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
             } else {
                 throw StoreError(
                     "export: unknown format '" + format +
-                    "' (valid: long, wide, analysis, choices, choice-analysis)");
+                    "' (valid: long, wide, analysis, choices, choice-analysis, "
+                    "adjustments, matches, staircase)");
             }
         });
     } catch (const common::OutputError& e) {

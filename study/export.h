@@ -27,8 +27,9 @@ struct ExportFileResult {
     std::vector<std::string> notes;
 };
 
-// Writes format "long", "wide", "analysis", "choices" or "choice-analysis" (the choices
-// as the scaling reads them: ChoiceExportOptions::analysis) of `db_path` to the CSV file
+// Writes format "long", "wide", "analysis", "choices", "choice-analysis" (the choices
+// as the scaling reads them: ChoiceExportOptions::analysis), "adjustments", "matches" or
+// "staircase" (export_adjustments, ...) of `db_path` to the CSV file
 // `out_path`: never the database itself (by inode: symlinks, hard links and relative
 // paths included) nor any other database; an existing file only with `force`. Written to
 // a temporary file in the same folder and renamed into place. Throws StoreError (one
@@ -111,6 +112,25 @@ struct ChoiceExport {
 };
 ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
                             const ChoiceExportOptions& options = {});
+
+// Adjustment and staircase trials (issue 31), every session not withdrawn, practice
+// included; numbers as their shortest exact text. Each returns its data rows (none from
+// a database before schema 7).
+//
+// `lucent export --format adjustments`: one row per change of an adjust trial's knob,
+// participant,session,trial,block,target,start_value,step,value,t_ms,input (t_ms from
+// the trial's onset; step 1, 2, ... in the order made).
+int export_adjustments(const std::string& db_path, std::ostream& out);
+// `--format matches`: one row per answered adjust trial, participant,session,trial,
+// block,practice,target,match_knob (the block's knob in the stored protocol; empty when
+// it no longer parses),start_value,final_value,adjustments (their count),total_ms (the
+// confirmation's RT).
+int export_matches(const std::string& db_path, std::ostream& out);
+// `--format staircase`: one row per answered staircase trial in position order,
+// participant,session,trial,block,standard,staircase (its procedure),intensity (the
+// delta shown),expected (the comparison's place),choice,correct (1 when choice is
+// expected),rt_ms; skipped slots are not rows.
+int export_staircase(const std::string& db_path, std::ostream& out);
 
 // Each forced-choice block's stimuli in the stored protocol's order (its series); empty
 // when the protocol cannot be read.

@@ -310,11 +310,13 @@ const char* const kCopySteps[] = {
     "catch_id, "
     "prompt, expected_rating, tolerance, break_before, onset_ns, confirm_ns, "
     "answered_utc, "
-    "dropped_frames, uuid, task, shown) "
+    "dropped_frames, uuid, task, shown, kind, start_value, final_value, staircase, "
+    "intensity, skipped) "
     "SELECT msn.id, t.position, t.block, mst.id, t.practice, t.catch, t.catch_id, "
     "t.prompt, "
     "t.expected_rating, t.tolerance, t.break_before, t.onset_ns, t.confirm_ns, "
-    "t.answered_utc, t.dropped_frames, t.uuid, t.task, t.shown FROM src.trials t "
+    "t.answered_utc, t.dropped_frames, t.uuid, t.task, t.shown, t.kind, t.start_value, "
+    "t.final_value, t.staircase, t.intensity, t.skipped FROM src.trials t "
     "JOIN src.sessions s ON s.id = t.session_id JOIN temp.new_sessions n ON n.uuid = "
     "s.uuid "
     "JOIN main.sessions msn ON msn.uuid = s.uuid "
@@ -332,6 +334,14 @@ const char* const kCopySteps[] = {
     "JOIN main.sessions msn ON msn.uuid = s.uuid "
     "JOIN main.trials mt ON mt.session_id = msn.id AND mt.position = t.position ORDER BY "
     "r.id",
+
+    "INSERT INTO adjustments (trial_id, step, value, t_ns, input) "
+    "SELECT mt.id, a.step, a.value, a.t_ns, a.input FROM src.adjustments a "
+    "JOIN src.trials t ON t.id = a.trial_id JOIN src.sessions s ON s.id = t.session_id "
+    "JOIN temp.new_sessions n ON n.uuid = s.uuid "
+    "JOIN main.sessions msn ON msn.uuid = s.uuid "
+    "JOIN main.trials mt ON mt.session_id = msn.id AND mt.position = t.position ORDER BY "
+    "a.trial_id, a.step",
 };
 
 }  // namespace

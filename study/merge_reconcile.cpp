@@ -1,8 +1,10 @@
 // Reconciling copies of one session in a merge (merge_reconcile.h).
 #include "study/merge_reconcile.h"
 
+#include <algorithm>
 #include <tuple>
 
+#include "common/number_text.h"
 #include "study/sqlite/sqlite_store.h"
 
 namespace lucent::study {
@@ -19,6 +21,60 @@ std::string rating_text(const std::map<std::string, int64_t>& answers,
                         const std::string& q) {
     const auto it = answers.find(q);
     return it == answers.end() ? "(none)" : std::to_string(it->second);
+}
+
+std::string number_text(const std::optional<double>& v) {
+    return v ? common::shortest_text(*v) : std::string("(none)");
+}
+
+std::string adjustment_text(const std::vector<SessionCopy::Adjusted>& adjustments,
+                            size_t k) {
+    if (k >= adjustments.size()) return "(none)";
+    const SessionCopy::Adjusted& a = adjustments[k];
+    return common::shortest_text(a.value) + " (" + a.input + " at " +
+           std::to_string(a.t_ns) + " ns)";
+}
+
+// The first difference between what two copies hold of one trial besides its ratings
+// ("final_value 1.5 in A but 1.25 in B"), or "".
+std::string outcome_difference(const SessionCopy::Outcome& x, const std::string& an,
+                               const SessionCopy::Outcome& y, const std::string& bn) {
+    auto differs = [&](const std::string& what, const std::string& a,
+                       const std::string& b) {
+        return what + " " + a + " in " + an + " but " + b + " in " + bn;
+    };
+    if (x.skipped != y.skipped)
+        return x.skipped ? "skipped in " + an + " but answered in " + bn
+                         : "answered in " + an + " but skipped in " + bn;
+    if (x.final_value != y.final_value)
+        return differs("final_value", number_text(x.final_value),
+                       number_text(y.final_value));
+    if (x.intensity != y.intensity)
+        return differs("intensity", number_text(x.intensity), number_text(y.intensity));
+    const size_t n = std::max(x.adjustments.size(), y.adjustments.size());
+    for (size_t k = 0; k < n; ++k)
+        if (k >= x.adjustments.size() || k >= y.adjustments.size() ||
+            !(x.adjustments[k] == y.adjustments[k]))
+            return differs("adjustment " + std::to_string(k + 1),
+                           adjustment_text(x.adjustments, k),
+                           adjustment_text(y.adjustments, k));
+    return "";
+}
+
+// Whether `c` holds the trial at `position`: answered, or skipped.
+bool holds(const SessionCopy& c, int64_t position) {
+    if (c.answers.count(position)) return true;
+    const auto it = c.outcomes.find(position);
+    return it != c.outcomes.end() && it->second.skipped;
+}
+
+// The positions `c` holds, in order.
+std::set<int64_t> held_positions(const SessionCopy& c) {
+    std::set<int64_t> out;
+    for (const auto& [position, ratings] : c.answers) out.insert(position);
+    for (const auto& [position, outcome] : c.outcomes)
+        if (outcome.skipped) out.insert(position);
+    return out;
 }
 
 // > 0 when `a` extends `b`, < 0 when `b` extends `a`, 0 when they are equal; throws
@@ -52,24 +108,34 @@ int compare(const std::string& uuid, const SessionCopy& a, const SessionCopy& b,
                 "')");
     }
     int64_t only_a = -1, only_b = -1;
-    for (const auto& [position, ratings] : a.answers) {
-        const auto other = b.answers.find(position);
-        if (other == b.answers.end()) {
+    static const std::map<std::string, int64_t> kNone;
+    static const SessionCopy::Outcome kNothing;
+    for (const int64_t position : held_positions(a)) {
+        if (!holds(b, position)) {
             if (only_a < 0) only_a = position;
             continue;
         }
+        const auto ra = a.answers.find(position), rb = b.answers.find(position);
+        const auto& ratings = ra == a.answers.end() ? kNone : ra->second;
+        const auto& other = rb == b.answers.end() ? kNone : rb->second;
         std::set<std::string> questions;
         for (const auto& [q, r] : ratings) questions.insert(q);
-        for (const auto& [q, r] : other->second) questions.insert(q);
+        for (const auto& [q, r] : other) questions.insert(q);
+        const auto oa = a.outcomes.find(position), ob = b.outcomes.find(position);
+        const std::string outcome =
+            outcome_difference(oa == a.outcomes.end() ? kNothing : oa->second, an,
+                               ob == b.outcomes.end() ? kNothing : ob->second, bn);
+        if (!outcome.empty())
+            throw StoreError(who + " trial " + std::to_string(position) + ": " + outcome);
         for (const std::string& q : questions)
-            if (rating_text(ratings, q) != rating_text(other->second, q))
+            if (rating_text(ratings, q) != rating_text(other, q))
                 throw StoreError(who + " trial " + std::to_string(position) +
                                  ": rating '" + q + "'=" + rating_text(ratings, q) +
-                                 " in " + an + " but " + rating_text(other->second, q) +
-                                 " in " + bn);
+                                 " in " + an + " but " + rating_text(other, q) + " in " +
+                                 bn);
     }
-    for (const auto& [position, ratings] : b.answers)
-        if (!a.answers.count(position)) {
+    for (const int64_t position : held_positions(b))
+        if (!holds(a, position)) {
             only_b = position;
             break;
         }
@@ -129,6 +195,30 @@ void read_session_details(Database& db, std::map<std::string, SessionCopy*>& wan
         const auto it = wanted.find(r.text(0));
         if (it == wanted.end()) continue;
         it->second->answers[r.integer(1)][r.text(2)] = r.integer(3);
+    }
+    // Schema 7 (inputs are read at the current schema): final values, intensities,
+    // skipped slots and adjustments.
+    Statement o = db.prepare(
+        "SELECT se.uuid, t.position, t.final_value, t.intensity, t.skipped FROM trials t "
+        "JOIN sessions se ON se.id = t.session_id WHERE t.final_value IS NOT NULL OR "
+        "t.intensity IS NOT NULL OR t.skipped <> 0");
+    while (o.step()) {
+        const auto it = wanted.find(o.text(0));
+        if (it == wanted.end()) continue;
+        SessionCopy::Outcome& outcome = it->second->outcomes[o.integer(1)];
+        outcome.final_value = o.optional_real(2);
+        outcome.intensity = o.optional_real(3);
+        outcome.skipped = o.integer(4) != 0;
+    }
+    Statement a = db.prepare(
+        "SELECT se.uuid, t.position, a.value, a.t_ns, a.input FROM adjustments a "
+        "JOIN trials t ON t.id = a.trial_id JOIN sessions se ON se.id = t.session_id "
+        "ORDER BY a.trial_id, a.step");
+    while (a.step()) {
+        const auto it = wanted.find(a.text(0));
+        if (it == wanted.end()) continue;
+        it->second->outcomes[a.integer(1)].adjustments.push_back(
+            {a.real(2), a.integer(3), a.text(4)});
     }
 }
 

@@ -5,6 +5,7 @@
 // other lacks, are refused in one line naming the session and the trial.
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -27,6 +28,20 @@ struct SessionCopy {
     std::map<int64_t, Planned> plan;  // by position
     std::map<int64_t, std::map<std::string, int64_t>>
         answers;  // position -> question -> rating
+    // Schema 7: what an answered adjust or staircase trial holds besides its rating, and
+    // the staircase slots skipped; by position, for those trials only.
+    struct Adjusted {
+        double value = 0;
+        int64_t t_ns = 0;
+        std::string input;
+        bool operator==(const Adjusted&) const = default;
+    };
+    struct Outcome {
+        std::optional<double> final_value, intensity;
+        std::vector<Adjusted> adjustments;
+        bool skipped = false;
+    };
+    std::map<int64_t, Outcome> outcomes;
 };
 
 // Every session of `db` (uuid -> copy, without plan and answers), read-only.
@@ -42,8 +57,11 @@ struct Reconciled {
 };
 
 // Chooses the copy that extends every other (`names[input]` names inputs in messages).
-// Throws StoreError, one line, when copies hold another participant or plan, disagree on
-// a rating, or no copy extends every other. The same copies in any order give the same
+// A trial is held by a copy that answered it or skipped it (a staircase slot). Throws
+// StoreError, one line, when copies hold another participant or plan, disagree on a
+// trial both hold (a rating, an adjust trial's final value or adjustments, a staircase
+// trial's intensity, one answered where the other skipped), or no copy extends every
+// other. The same copies in any order give the same
 // copy (or the same refusal).
 Reconciled reconcile_copies(const std::string& uuid,
                             const std::vector<SessionCopy>& copies,

@@ -176,6 +176,33 @@ CREATE TABLE consent_declines (
 ALTER TABLE trials ADD COLUMN task TEXT CHECK (task IN ('rating', 'pair', 'triad', 'quadruple'));
 ALTER TABLE trials ADD COLUMN shown TEXT;
 )sql",
+    // 7: adjustment and staircase trials (issue 31). trials.kind is the trial's kind,
+    // authoritative from schema 7 on: trials.task's CHECK knows only the first four, and
+    // SQLite cannot widen a CHECK without rebuilding the table, which under enforced
+    // foreign keys would cascade-delete every response. So writers keep writing task for
+    // rating, pair, triad and quadruple trials (older readers see them as before) and
+    // NULL for adjust and staircase trials; every reader reads kind.
+    // Adjust trials: the planned start_value and, answered, the confirmed final_value
+    // (the response is the block's question with rating 1), each change of the knob in
+    // adjustments. Staircase slots: the procedure (staircase, "<standard>/<procedure>"),
+    // the delta shown once answered (intensity; the response is the place chosen), and
+    // skipped = 1 for a slot left unanswered because its procedure had finished.
+    R"sql(
+ALTER TABLE trials ADD COLUMN kind TEXT CHECK (kind IN ('rating', 'pair', 'triad', 'quadruple', 'adjust', 'staircase'));
+UPDATE trials SET kind = coalesce(task, 'rating');
+ALTER TABLE trials ADD COLUMN start_value REAL;
+ALTER TABLE trials ADD COLUMN final_value REAL;
+ALTER TABLE trials ADD COLUMN staircase TEXT;
+ALTER TABLE trials ADD COLUMN intensity REAL;
+ALTER TABLE trials ADD COLUMN skipped INTEGER NOT NULL DEFAULT 0 CHECK (skipped IN (0, 1));
+CREATE TABLE adjustments (
+    trial_id INTEGER NOT NULL REFERENCES trials(id) ON DELETE CASCADE,
+    step INTEGER NOT NULL CHECK (step >= 1),
+    value REAL NOT NULL,
+    t_ns INTEGER NOT NULL,
+    input TEXT NOT NULL CHECK (input IN ('key', 'fine_key', 'wheel', 'drag')),
+    PRIMARY KEY (trial_id, step));
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 
@@ -185,6 +212,18 @@ const std::vector<std::string>& schema_migrations() {
     static const std::vector<std::string> steps(std::begin(kMigrations),
                                                 std::end(kMigrations));
     return steps;
+}
+
+std::string trial_kind_sql(int version, const std::string& alias) {
+    if (version >= 7) return "coalesce(" + alias + ".kind, " + alias + ".task, 'rating')";
+    if (version >= 6) return "coalesce(" + alias + ".task, 'rating')";
+    return "'rating'";
+}
+
+std::string open_trial_sql(const std::string& alias) {
+    return alias +
+           ".skipped = 0 AND NOT EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = " +
+           alias + ".id)";
 }
 
 std::string online_cell_counts_sql(bool postgres) {

@@ -10,10 +10,18 @@
 namespace lucent::study {
 
 inline constexpr int32_t kApplicationId = 0x4C55434E;  // "LUCN"
-inline constexpr int kSchemaVersion = 6;
+inline constexpr int kSchemaVersion = 7;
 
 // Migration steps 1..kSchemaVersion; step i brings a store from version i-1 to i.
 const std::vector<std::string>& schema_migrations();
+
+// The kind of trial `alias` (rating, pair, triad, quadruple, adjust or staircase) as SQL
+// for a database of schema `version`: trials.kind from schema 7 on (trials.task when it
+// is NULL), trials.task from 6, 'rating' before. Every reader of a trial's kind uses it.
+std::string trial_kind_sql(int version, const std::string& alias = "t");
+// The schema-7 condition on trials `alias` of a trial still open: not answered, not
+// skipped. A session is complete when none of its trials is open.
+std::string open_trial_sql(const std::string& alias = "t");
 
 // Online allocation (enrol_online): the SQL giving (cell, completed + active sessions) of
 // study ?1/$1 with activity since ?2/$2, in SQLite's or PostgreSQL's dialect.

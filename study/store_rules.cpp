@@ -1,6 +1,7 @@
 #include "study/store_rules.h"
 
 #include <cctype>
+#include <cmath>
 #include <set>
 
 #include "study/trial_plan.h"
@@ -12,6 +13,62 @@ void refuse_second_answer(const std::string& store, int64_t trial_id) {
                      " already has ratings; refusing to record it twice");
 }
 
+void refuse_skipped_trial(const std::string& store, int64_t trial_id) {
+    throw StoreError(store + ": trial " + std::to_string(trial_id) +
+                     " was skipped (its staircase had finished); refusing to record it");
+}
+
+namespace {
+
+// What an outcome carries beside its responses, by the trial's kind (schema 7).
+void check_kind_outcome(const std::string& where, const TrialAnswerFacts& facts,
+                        const TrialOutcome& outcome) {
+    const std::string kind = task_name(facts.kind);
+    const std::string a_kind =
+        std::string(facts.kind == Task::adjust ? "an " : "a ") + kind + " trial";
+    if (facts.kind == Task::adjust) {
+        if (!outcome.final_value)
+            throw StoreError(where + " is an adjust trial without a final value");
+        if (!std::isfinite(*outcome.final_value))
+            throw StoreError(where + " has a final value that is not finite");
+        for (size_t k = 0; k < outcome.adjustments.size(); ++k) {
+            const Adjustment& a = outcome.adjustments[k];
+            const std::string step = where + ": adjustment " + std::to_string(k + 1);
+            if (!std::isfinite(a.value))
+                throw StoreError(step + " has a value that is not finite");
+            if (a.input != "key" && a.input != "fine_key" && a.input != "wheel" &&
+                a.input != "drag")
+                throw StoreError(step + " has input '" + a.input +
+                                 "' (expected key, fine_key, wheel or drag)");
+            if (k > 0 && a.t_ns < outcome.adjustments[k - 1].t_ns)
+                throw StoreError(step + " is earlier than adjustment " +
+                                 std::to_string(k) + " (t_ns " + std::to_string(a.t_ns) +
+                                 " < " + std::to_string(outcome.adjustments[k - 1].t_ns) +
+                                 ")");
+        }
+    } else {
+        if (outcome.final_value)
+            throw StoreError(where + " is " + a_kind + " but carries a final value");
+        if (!outcome.adjustments.empty())
+            throw StoreError(where + " is " + a_kind + " but carries adjustments");
+    }
+    if (facts.kind == Task::staircase) {
+        if (!outcome.intensity)
+            throw StoreError(where + " is a staircase trial without an intensity");
+        if (!std::isfinite(*outcome.intensity))
+            throw StoreError(where + " has an intensity that is not finite");
+        if (outcome.finishes_staircase && facts.staircase.empty())
+            throw StoreError(where + " finishes a staircase but was planned without one");
+    } else {
+        if (outcome.intensity)
+            throw StoreError(where + " is " + a_kind + " but carries an intensity");
+        if (outcome.finishes_staircase)
+            throw StoreError(where + " is " + a_kind + " but finishes a staircase");
+    }
+}
+
+}  // namespace
+
 void check_trial_answer(const std::string& store, int64_t session_id, int64_t trial_id,
                         const TrialAnswerFacts& facts, const QuestionPoints& points,
                         const TrialOutcome& outcome) {
@@ -19,6 +76,7 @@ void check_trial_answer(const std::string& store, int64_t session_id, int64_t tr
     if (!facts.part_of_session)
         throw StoreError(where + " is not part of session " + std::to_string(session_id));
     if (facts.answered) refuse_second_answer(store, trial_id);
+    if (facts.skipped) refuse_skipped_trial(store, trial_id);
     std::set<std::string> questions;
     for (const Response& r : outcome.responses) {
         check_rating_on_scale(points, r.question, r.rating, where);
@@ -28,6 +86,7 @@ void check_trial_answer(const std::string& store, int64_t session_id, int64_t tr
     if (outcome.responses.size() != points.size())
         throw StoreError(where + " has " + std::to_string(outcome.responses.size()) +
                          " ratings for " + std::to_string(points.size()) + " questions");
+    check_kind_outcome(where, facts, outcome);
 }
 
 void check_status_change(const std::string& store, const std::string& session_uuid,
@@ -147,6 +206,7 @@ std::optional<std::string> shown_column(const PlannedTrial& trial) {
 }
 
 std::optional<int> expected_rating_column(const PlannedTrial& trial) {
+    if (!trial.is_catch && trial.task != Task::staircase) return std::nullopt;
     if (trial.task != Task::rating && trial.expected == 0) return std::nullopt;
     return trial.expected;
 }
@@ -154,6 +214,18 @@ std::optional<int> expected_rating_column(const PlannedTrial& trial) {
 Task task_column(const std::optional<std::string>& text) {
     if (!text) return Task::rating;
     return parse_task(*text).value_or(Task::rating);
+}
+
+std::string kind_column(const PlannedTrial& trial) { return task_name(trial.task); }
+
+std::optional<std::string> legacy_task_column(const PlannedTrial& trial) {
+    if (trial.task == Task::adjust || trial.task == Task::staircase) return std::nullopt;
+    return std::string(task_name(trial.task));
+}
+
+std::optional<std::string> staircase_column(const PlannedTrial& trial) {
+    if (trial.staircase.empty()) return std::nullopt;
+    return trial.staircase;
 }
 
 }  // namespace lucent::study

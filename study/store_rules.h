@@ -28,17 +28,28 @@ std::string block_order_text(const TrialPlan& plan);
 struct TrialAnswerFacts {
     bool part_of_session = false;  // a planned trial of the session named
     bool answered = false;         // ratings are held for it already (or journaled)
+    Task kind = Task::rating;      // trials.kind (schema 7; before: task, or rating)
+    bool skipped = false;          // a staircase slot skipped: its procedure finished
+    std::string staircase;         // a staircase slot's procedure (trials.staircase)
 };
 
-// A trial's answer is recorded once, for a planned trial of its session, with exactly
-// one rating for each question the study asks, each within its question's scale
-// (`points`). `store` names the store in messages. Throws StoreError.
+// A trial's answer is recorded once, for a planned trial of its session that was not
+// skipped, with exactly one rating for each question the study asks, each within its
+// question's scale (`points`). What the outcome carries besides follows the trial's
+// kind (schema 7): an adjust trial a finite final_value and its adjustments (finite
+// values, times in order, inputs key, fine_key, wheel or drag; none when the start was
+// confirmed as it was); a staircase trial a finite intensity, and finishes_staircase
+// only when it has a procedure; every other trial none of these. `store` names the
+// store in messages. Throws StoreError (one line naming the store and the trial).
 void check_trial_answer(const std::string& store, int64_t session_id, int64_t trial_id,
                         const TrialAnswerFacts& facts, const QuestionPoints& points,
                         const TrialOutcome& outcome);
 // The refusal of a second answer to `trial_id`, for a store that finds the first one
 // only later (a server holding ratings for a journaled trial).
 [[noreturn]] void refuse_second_answer(const std::string& store, int64_t trial_id);
+// The refusal of an answer to a skipped staircase slot, for a store that finds the skip
+// only later (a server where another answer finished the procedure).
+[[noreturn]] void refuse_skipped_trial(const std::string& store, int64_t trial_id);
 
 // A completed session is final: setting any other status on it throws StoreError.
 void check_status_change(const std::string& store, const std::string& session_uuid,
@@ -63,11 +74,22 @@ std::string shown_text(const std::vector<std::string>& shown);
 std::vector<std::string> shown_from_text(const std::string& text);
 // The columns of a planned trial as both backends write them: trials.shown (NULL for a
 // rating) and trials.expected_rating of a catch trial (NULL for an identical pair,
-// which has no right answer).
+// which has no right answer) or of a staircase slot (the comparison's place, schema 7);
+// NULL for every other trial.
 std::optional<std::string> shown_column(const PlannedTrial& trial);
 std::optional<int> expected_rating_column(const PlannedTrial& trial);
-// trials.task as read back (NULL: a rating, planned before schema 6).
+// trials.task as read back (NULL: a rating, planned before schema 6). From schema 7
+// on readers read trials.kind, which the migration fills: read
+// coalesce(t.kind, t.task) and give it here.
 Task task_column(const std::optional<std::string>& text);
+// The kind columns of a planned trial as both backends write them (schema 7):
+// trials.kind, its task's name; trials.task the same for the tasks its CHECK knows
+// (rating, pair, triad, quadruple; older readers see those as before), NULL for adjust
+// and staircase trials.
+std::string kind_column(const PlannedTrial& trial);
+std::optional<std::string> legacy_task_column(const PlannedTrial& trial);
+// trials.staircase: a staircase slot's procedure; NULL for every other trial.
+std::optional<std::string> staircase_column(const PlannedTrial& trial);
 
 // A participant's number: a lab code's trailing digits (-1 when none or over 9 digits).
 int participant_number_from_code(const std::string& code);

@@ -107,13 +107,18 @@ public:
     virtual bool forget_declined_session(int64_t session_id) = 0;
     virtual bool has_consent(int64_t session_id) = 0;
     // Commits one trial's ratings atomically; refuses a trial that already has ratings,
-    // lacks a question, names one the study does not ask, or has a rating outside
-    // 1..points of its question. The trial that answers the session's last open trial
-    // also sets it `completed` in the same transaction. Returns true when the session is
-    // now completed.
+    // was skipped, lacks a question, names one the study does not ask, has a rating
+    // outside 1..points of its question, or carries what its kind does not (schema 7:
+    // an adjust trial its final value and adjustments, a staircase trial its intensity;
+    // store_rules.h: check_trial_answer). In the same transaction: an adjust trial's
+    // final value and adjustments, a staircase trial's intensity and, when the answer
+    // finishes its staircase, the session's open slots of that block and procedure
+    // marked skipped; and the session set `completed` when no trial is left open
+    // (answered or skipped). Returns true when the session is now completed.
     virtual bool record_trial(int64_t session_id, int64_t trial_id,
                               const TrialOutcome& outcome) = 0;
-    // Sets `completed` when every planned trial has its ratings; true when completed.
+    // Sets `completed` when every planned trial has its ratings or was skipped; true
+    // when completed.
     virtual bool complete_session_if_answered(int64_t session_id) = 0;
     // A completed session is final: any other status for it throws StoreError.
     virtual void set_status(int64_t session_id, const std::string& status,

@@ -8,6 +8,7 @@
 #include <pqxx/pqxx>
 #include <set>
 
+#include "common/number_text.h"
 #include "study/postgres/postgres_store.h"
 #include "study/sqlite/database.h"
 #include "study/sqlite/sqlite_store.h"
@@ -18,11 +19,17 @@ namespace {
 
 using IdMap = std::map<int64_t, int64_t>;  // row id in the merged file -> on the server
 
-std::vector<std::string> columns_of(Database& m, const std::string& table) {
-    std::vector<std::string> out;
-    Statement s = m.prepare("SELECT name FROM pragma_table_info(?) WHERE name <> 'id'");
+struct Column {
+    std::string name;
+    bool real = false;  // declared REAL
+};
+
+std::vector<Column> columns_of(Database& m, const std::string& table) {
+    std::vector<Column> out;
+    Statement s =
+        m.prepare("SELECT name, type FROM pragma_table_info(?) WHERE name <> 'id'");
     s.bind(1, table);
-    while (s.step()) out.push_back(s.text(0));
+    while (s.step()) out.push_back({s.text(0), s.text(1) == "REAL"});
     return out;
 }
 
@@ -34,10 +41,10 @@ IdMap copy_rows(pqxx::work& tx, Database& m, const std::string& table,
                 const std::string& where,
                 const std::map<std::string, const IdMap*>& remap, bool has_id,
                 const std::string& conflict = "") {
-    const std::vector<std::string> columns = columns_of(m, table);
+    const std::vector<Column> columns = columns_of(m, table);
     std::string names, marks;
     for (size_t c = 0; c < columns.size(); ++c) {
-        names += (c ? ", " : "") + columns[c];
+        names += (c ? ", " : "") + columns[c].name;
         marks += (c ? ", $" : "$") + std::to_string(c + 1);
     }
     const std::string insert = "INSERT INTO " + table + " (" + names + ") VALUES (" +
@@ -53,14 +60,17 @@ IdMap copy_rows(pqxx::work& tx, Database& m, const std::string& table,
                 values.emplace_back();
                 continue;
             }
-            const auto mapped = remap.find(columns[c]);
+            const auto mapped = remap.find(columns[c].name);
             if (mapped == remap.end()) {
-                values.emplace_back(rows.text(col));
+                // A REAL as its shortest exact text: SQLite's own text keeps 15 digits.
+                values.emplace_back(columns[c].real
+                                        ? common::shortest_text(rows.real(col))
+                                        : rows.text(col));
                 continue;
             }
             const auto id = mapped->second->find(rows.integer(col));
             if (id == mapped->second->end())
-                throw StoreError("merge: " + table + "." + columns[c] + " " +
+                throw StoreError("merge: " + table + "." + columns[c].name + " " +
                                  std::to_string(rows.integer(col)) +
                                  " has no row on the server");
             values.emplace_back(std::to_string(id->second));
@@ -117,8 +127,8 @@ void extend_server_sessions(pqxx::work& tx, Database& m, const IdMap& stimuli) {
                                      .as<int64_t>();
     Statement t = m.prepare(
         "SELECT t.id, t.session_id, t.position, t.onset_ns, t.confirm_ns, "
-        "t.dropped_frames, t.answered_utc, t.segment_id FROM main.trials t "
-        "WHERE t.id IN (SELECT id FROM temp.ext_trials)");
+        "t.dropped_frames, t.answered_utc, t.segment_id, t.final_value, t.intensity "
+        "FROM main.trials t WHERE t.id IN (SELECT id FROM temp.ext_trials)");
     auto optional_int = [&t](int col) {
         return t.is_null(col) ? std::optional<int64_t>()
                               : std::optional<int64_t>(t.integer(col));
@@ -135,14 +145,27 @@ void extend_server_sessions(pqxx::work& tx, Database& m, const IdMap& stimuli) {
         if (!t.is_null(7)) segment = segments.at(t.integer(7));
         tx.exec_params(
             "UPDATE trials SET onset_ns = $1, confirm_ns = $2, dropped_frames = $3, "
-            "answered_utc = $4, segment_id = $5 WHERE id = $6",
+            "answered_utc = $4, segment_id = $5, final_value = $6, intensity = $7 "
+            "WHERE id = $8",
             optional_int(3), optional_int(4), optional_int(5),
-            t.is_null(6) ? std::optional<std::string>() : t.text(6), segment, id);
+            t.is_null(6) ? std::optional<std::string>() : t.text(6), segment,
+            t.optional_real(8), t.optional_real(9), id);
     }
     // A station answering the same trial meanwhile makes the insert fail (one rating per
     // trial and question): the whole merge is then not stored.
     copy_rows(tx, m, "responses", "trial_id IN (SELECT id FROM temp.ext_trials)",
               {{"session_id", &sessions}, {"trial_id", &trials}}, false);
+    copy_rows(tx, m, "adjustments", "trial_id IN (SELECT id FROM temp.ext_trials)",
+              {{"trial_id", &trials}}, false);
+    // Staircase slots the file's copy skipped (the reconciling kept a copy extending
+    // the server's: a slot is never answered there and skipped here).
+    Statement skipped = m.prepare(
+        "SELECT t.session_id, t.position FROM main.trials t JOIN temp.extended e ON "
+        "e.id = t.session_id WHERE t.skipped = 1");
+    while (skipped.step())
+        tx.exec_params(
+            "UPDATE trials SET skipped = 1 WHERE session_id = $1 AND position = $2",
+            sessions.at(skipped.integer(0)), skipped.integer(1));
 }
 
 // The tombstones the inputs hold, onto the server; then the server's sessions they
@@ -213,7 +236,10 @@ void classify_sessions(Database& m) {
         "OR (SELECT count(*) FROM main.responses WHERE session_id = m.id) <> "
         "(SELECT count(*) FROM srv.responses WHERE session_id = s.id) "
         "OR (SELECT count(*) FROM main.session_segments WHERE session_id = m.id) <> "
-        "(SELECT count(*) FROM srv.session_segments WHERE session_id = s.id)");
+        "(SELECT count(*) FROM srv.session_segments WHERE session_id = s.id) "
+        "OR (SELECT count(*) FROM main.trials WHERE session_id = m.id AND skipped = 1) "
+        "<> "
+        "(SELECT count(*) FROM srv.trials WHERE session_id = s.id AND skipped = 1)");
     m.exec(
         "CREATE TEMP TABLE ext_segments AS SELECT g.id FROM main.session_segments g "
         "JOIN temp.extended e ON e.id = g.session_id WHERE NOT EXISTS (SELECT 1 FROM "
@@ -370,6 +396,10 @@ void copy_new_sessions(pqxx::work& tx, Database& m, const StudyIds& study,
         true);
     copy_rows(tx, m, "responses", "session_id IN (SELECT id FROM temp.new_sessions)",
               {{"session_id", &sessions}, {"trial_id", &trials}}, false);
+    copy_rows(tx, m, "adjustments",
+              "trial_id IN (SELECT t.id FROM trials t JOIN temp.new_sessions n ON n.id = "
+              "t.session_id)",
+              {{"trial_id", &trials}}, false);
 }
 
 // Everything the merged file adds, onto the server in one transaction: stored whole or

@@ -11,12 +11,21 @@ namespace lucent::study {
 
 void PostgresStore::snapshot_to_sqlite(const std::string& sqlite_path) {
     // Parents before children, so every foreign key finds its row.
-    static const char* const kTables[] = {
-        "studies",         "stimuli",          "stimulus_parameters",
-        "stimulus_values", "participants",     "retired_participant_numbers",
-        "sessions",        "session_segments", "segment_stimuli",
-        "trials",          "responses",        "withdrawn_sessions",
-        "withdrawn_codes", "consent_declines"};
+    static const char* const kTables[] = {"studies",
+                                          "stimuli",
+                                          "stimulus_parameters",
+                                          "stimulus_values",
+                                          "participants",
+                                          "retired_participant_numbers",
+                                          "sessions",
+                                          "session_segments",
+                                          "segment_stimuli",
+                                          "trials",
+                                          "responses",
+                                          "adjustments",
+                                          "withdrawn_sessions",
+                                          "withdrawn_codes",
+                                          "consent_declines"};
     Store out(sqlite_path);
     Database& db = out.db();
     guarded("taking a snapshot", [&] {

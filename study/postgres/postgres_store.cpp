@@ -19,6 +19,14 @@
 namespace lucent::study {
 using namespace postgres_internal;
 
+namespace {
+// A nullable DOUBLE PRECISION (libpqxx 6 reads no std::optional<double>).
+std::optional<double> optional_double(const pqxx::field& f) {
+    if (f.is_null()) return std::nullopt;
+    return f.as<double>();
+}
+}  // namespace
+
 // ---- [1] connection -------------------------------------------------------------------
 
 std::string checked_server_uri(const std::string& uri) {
@@ -372,23 +380,24 @@ SessionRow insert_session(pqxx::work& tx, int64_t study_id, int64_t participant_
         insert_segment(tx, row.id, 1, env);
         for (const PlannedTrial& t : plan.trials) {
             std::optional<std::string> catch_id, prompt;
-            std::optional<int> expected, tolerance;
+            std::optional<int> tolerance;
+            const std::optional<int> expected = expected_rating_column(t);
             if (t.is_catch) {
                 catch_id = t.catch_id;
                 prompt = t.prompt;
-                expected = expected_rating_column(t);
                 tolerance = t.tolerance;
             }
             tx.exec_params(
                 "INSERT INTO trials (session_id, position, block, stimulus_id, "
                 "practice, catch, catch_id, prompt, expected_rating, tolerance, "
-                "break_before, uuid, task, shown) VALUES ($1, $2, $3, (SELECT id FROM "
-                "stimuli WHERE study_id = $4 AND stimulus_key = $5), $6, $7, $8, $9, "
-                "$10, $11, $12, $13, $14, $15)",
+                "break_before, uuid, task, shown, kind, start_value, staircase) VALUES "
+                "($1, $2, $3, (SELECT id FROM stimuli WHERE study_id = $4 AND "
+                "stimulus_key = $5), $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, "
+                "$17, $18)",
                 row.id, t.position, t.block, study_id, t.stimulus, t.practice ? 1 : 0,
                 t.is_catch ? 1 : 0, catch_id, prompt, expected, tolerance,
-                t.break_before ? 1 : 0, new_uuid_v4(), std::string(task_name(t.task)),
-                shown_column(t));
+                t.break_before ? 1 : 0, new_uuid_v4(), legacy_task_column(t),
+                shown_column(t), kind_column(t), t.start_value, staircase_column(t));
         }
     }
     return row;
@@ -491,8 +500,10 @@ std::vector<TrialRow> PostgresStore::trials(int64_t session_id) {
                 "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
                 "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
                 "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), "
-                "coalesce(t.uuid, ''), t.task, coalesce(t.shown, '') FROM trials t "
-                "JOIN stimuli st ON st.id = t.stimulus_id "
+                "coalesce(t.uuid, ''), coalesce(t.kind, t.task), coalesce(t.shown, ''), "
+                "t.start_value, t.final_value, coalesce(t.staircase, ''), t.intensity, "
+                "t.skipped, (SELECT min(r.rating) FROM responses r WHERE r.trial_id = "
+                "t.id) FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
                 "WHERE t.session_id = $1 ORDER BY t.position",
                 session_id)) {
             TrialRow t;
@@ -509,19 +520,47 @@ std::vector<TrialRow> PostgresStore::trials(int64_t session_id) {
             t.uuid = r[10].as<std::string>();
             t.task = task_column(r[11].as<std::optional<std::string>>());
             t.shown = shown_from_text(r[12].as<std::string>());
+            t.start_value = optional_double(r[13]);
+            t.final_value = optional_double(r[14]);
+            t.staircase = r[15].as<std::string>();
+            t.intensity = optional_double(r[16]);
+            t.skipped = r[17].as<int>() != 0;
+            if (t.task != Task::rating && !r[18].is_null()) t.choice = r[18].as<int>();
             rows.push_back(std::move(t));
         }
         return rows;
     });
-    // What this station journaled but the server has not confirmed counts as answered.
+    // What this station journaled but the server has not confirmed counts as answered,
+    // as it was journaled, and the slots its finishing answers skipped as skipped.
     SessionCache& cache = session_cache(session_id);
+    std::vector<std::pair<std::string, std::string>> finished;  // block, staircase
     for (TrialRow& t : out) {
         cache.trial_uuid[t.id] = t.uuid;
-        if (t.answered || journal_.contains(t.uuid)) {
-            t.answered = true;
+        cache.trial_block[t.id] = t.block;
+        cache.trial_kind[t.id] = t.task;
+        cache.trial_staircase[t.id] = t.staircase;
+        if (t.skipped) cache.skipped.insert(t.id);
+        if (t.answered) {
             cache.answered.insert(t.id);
+            continue;
         }
+        const std::optional<JournaledTrial> journaled = journal_.find(t.uuid);
+        if (!journaled) continue;
+        t.answered = true;
+        cache.answered.insert(t.id);
+        t.final_value = journaled->outcome.final_value;
+        t.intensity = journaled->outcome.intensity;
+        if (t.task != Task::rating && journaled->outcome.responses.size() == 1)
+            t.choice = journaled->outcome.responses[0].rating;
+        if (journaled->outcome.finishes_staircase)
+            finished.emplace_back(t.block, t.staircase);
     }
+    for (TrialRow& t : out)
+        for (const auto& [block, staircase] : finished)
+            if (!t.answered && t.block == block && t.staircase == staircase) {
+                t.skipped = true;
+                cache.skipped.insert(t.id);
+            }
     return out;
 }
 
@@ -547,19 +586,44 @@ PostgresStore::SessionCache& PostgresStore::session_cache(int64_t session_id) {
             throw StoreError(name_ +
                              ": the stored protocol no longer parses: " + e.what());
         }
-        for (const pqxx::row& t :
-             tx.exec_params("SELECT t.id, coalesce(t.uuid, ''), EXISTS (SELECT 1 FROM "
-                            "responses x WHERE "
-                            "x.trial_id = t.id), t.block FROM trials t WHERE "
-                            "t.session_id = $1",
-                            session_id)) {
-            c.trial_uuid[t[0].as<int64_t>()] = t[1].as<std::string>();
-            c.trial_block[t[0].as<int64_t>()] = t[3].as<std::string>();
-            if (t[2].as<bool>()) c.answered.insert(t[0].as<int64_t>());
+        for (const pqxx::row& t : tx.exec_params(
+                 "SELECT t.id, coalesce(t.uuid, ''), EXISTS (SELECT 1 FROM responses x "
+                 "WHERE x.trial_id = t.id), t.block, coalesce(t.kind, t.task), "
+                 "coalesce(t.staircase, ''), t.skipped FROM trials t WHERE "
+                 "t.session_id = $1",
+                 session_id)) {
+            const int64_t id = t[0].as<int64_t>();
+            c.trial_uuid[id] = t[1].as<std::string>();
+            c.trial_block[id] = t[3].as<std::string>();
+            c.trial_kind[id] = task_column(t[4].as<std::optional<std::string>>());
+            c.trial_staircase[id] = t[5].as<std::string>();
+            if (t[2].as<bool>()) c.answered.insert(id);
+            if (t[6].as<int>() != 0) c.skipped.insert(id);
         }
         return c;
     });
+    // Answers journaled here and not yet on the server: answered, and the slots a
+    // finishing one skipped, skipped.
+    for (const auto& [id, uuid] : cache.trial_uuid) {
+        if (cache.answered.count(id)) continue;
+        const std::optional<JournaledTrial> journaled = journal_.find(uuid);
+        if (!journaled) continue;
+        cache.answered.insert(id);
+        if (journaled->outcome.finishes_staircase) skip_finished(cache, id);
+    }
     return sessions_.emplace(session_id, std::move(cache)).first->second;
+}
+
+std::vector<int64_t> PostgresStore::skip_finished(SessionCache& cache, int64_t trial_id) {
+    std::vector<int64_t> skipped;
+    const std::string& block = cache.trial_block[trial_id];
+    const std::string& staircase = cache.trial_staircase[trial_id];
+    for (const auto& [id, uuid] : cache.trial_uuid)
+        if (id != trial_id && cache.trial_block[id] == block &&
+            cache.trial_staircase[id] == staircase && !cache.answered.count(id) &&
+            cache.skipped.insert(id).second)
+            skipped.push_back(id);
+    return skipped;
 }
 
 int PostgresStore::begin_segment(int64_t session_id, const SessionEnvironment& env) {

@@ -83,9 +83,14 @@ private:
     struct SessionCache {
         std::string uuid;
         StudyQuestions questions;
-        std::map<int64_t, std::string> trial_uuid;   // trial id -> uuid
-        std::map<int64_t, std::string> trial_block;  // trial id -> block
-        std::set<int64_t> answered;
+        std::map<int64_t, std::string> trial_uuid;       // trial id -> uuid
+        std::map<int64_t, std::string> trial_block;      // trial id -> block
+        std::map<int64_t, Task> trial_kind;              // trial id -> trials.kind
+        std::map<int64_t, std::string> trial_staircase;  // trial id -> its procedure
+        std::set<int64_t> answered;  // on the server or journaled here
+        std::set<int64_t> skipped;   // on the server, or by an answer journaled here
+        // Every planned trial answered or skipped.
+        bool complete() const;
     };
     enum class Sent { Stored, AlreadyThere, Withdrawn };
 
@@ -95,6 +100,9 @@ private:
     template <class F>
     auto guarded(const char* what, F&& body);
     SessionCache& session_cache(int64_t session_id);
+    // The open slots of the procedure `trial_id` finished (same block and staircase),
+    // marked skipped in `cache`; returns those newly marked.
+    static std::vector<int64_t> skip_finished(SessionCache& cache, int64_t trial_id);
     // One journaled trial to the server, in one transaction. `strict`: a trial already
     // holding ratings is refused (a fresh record); otherwise identical ratings confirm.
     // A trial of a session the server holds as withdrawn (withdrawn_sessions) is not

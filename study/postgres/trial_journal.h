@@ -5,7 +5,12 @@
 // it leaves the journal only once the server's transaction holding it has committed.
 // Resends are matched on the trial's UUID, so a trial whose commit reply was lost is
 // recognised, never stored twice.
+// A trial carries its whole outcome: responses, and an adjust or staircase trial's final
+// value, adjustments, intensity and whether it finished its staircase (journal version
+// 1; an older journal file gains these columns when opened), so a resend stores exactly
+// what a direct send would have.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,10 +56,16 @@ public:
     void remove(const std::string& trial_uuid);
     // This server's pending trials, oldest first.
     std::vector<JournaledTrial> pending();
+    // The pending trial `trial_uuid` (whatever its server), or nullopt.
+    std::optional<JournaledTrial> find(const std::string& trial_uuid);
     int count();
     const std::string& path() const { return db_.path(); }
 
 private:
+    // The pending trials `where` (one "?" bound to `key`) selects, oldest first, with
+    // their responses and adjustments.
+    std::vector<JournaledTrial> read(const std::string& where, const std::string& key);
+
     Database db_;
     std::string server_;
 };

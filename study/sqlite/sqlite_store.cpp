@@ -192,9 +192,10 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
     insert_segment(row.id, 1, env);
     Statement insert = db_.prepare(
         "INSERT INTO trials (session_id, position, block, stimulus_id, practice, catch, "
-        "catch_id, prompt, expected_rating, tolerance, break_before, uuid, task, shown) "
+        "catch_id, prompt, expected_rating, tolerance, break_before, uuid, task, shown, "
+        "kind, start_value, staircase) "
         "VALUES (?, ?, ?, (SELECT id FROM stimuli WHERE study_id = ? AND stimulus_key = "
-        "?), ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "?), ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     for (const PlannedTrial& t : plan.trials) {
         insert.reset();
         insert.bind(1, row.id)
@@ -204,16 +205,16 @@ SessionRow Store::insert_session(int64_t study_id, int64_t participant_id,
             .bind(5, t.stimulus)
             .bind(6, t.practice ? 1 : 0)
             .bind(7, t.is_catch ? 1 : 0);
-        if (t.is_catch) {
-            insert.bind(8, t.catch_id)
-                .bind(9, t.prompt)
-                .bind(10, expected_rating_column(t))
-                .bind(11, t.tolerance);
-        }
-        insert.bind(12, t.break_before ? 1 : 0)
+        if (t.is_catch)
+            insert.bind(8, t.catch_id).bind(9, t.prompt).bind(11, t.tolerance);
+        insert.bind(10, expected_rating_column(t))
+            .bind(12, t.break_before ? 1 : 0)
             .bind(13, new_uuid_v4())
-            .bind(14, std::string(task_name(t.task)))
+            .bind(14, legacy_task_column(t))
             .bind(15, shown_column(t))
+            .bind(16, kind_column(t))
+            .bind(17, t.start_value)
+            .bind(18, staircase_column(t))
             .run();
     }
     return row;
@@ -292,7 +293,9 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
         "SELECT t.id, t.position, t.block, st.stimulus_key, t.practice, t.catch, "
         "coalesce(t.prompt, ''), coalesce(t.expected_rating, 0), t.break_before, "
         "EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id), coalesce(t.uuid, "
-        "''), t.task, coalesce(t.shown, '') "
+        "''), coalesce(t.kind, t.task), coalesce(t.shown, ''), t.start_value, "
+        "t.final_value, coalesce(t.staircase, ''), t.intensity, t.skipped, "
+        "(SELECT min(r.rating) FROM responses r WHERE r.trial_id = t.id) "
         "FROM trials t JOIN stimuli st ON st.id = t.stimulus_id "
         "WHERE t.session_id = ? ORDER BY t.position");
     s.bind(1, session_id);
@@ -313,6 +316,13 @@ std::vector<TrialRow> Store::trials(int64_t session_id) {
         t.task = task_column(s.is_null(11) ? std::nullopt
                                            : std::optional<std::string>(s.text(11)));
         t.shown = shown_from_text(s.text(12));
+        t.start_value = s.optional_real(13);
+        t.final_value = s.optional_real(14);
+        t.staircase = s.text(15);
+        t.intensity = s.optional_real(16);
+        t.skipped = s.integer(17) != 0;
+        if (t.task != Task::rating && !s.is_null(18))
+            t.choice = static_cast<int>(s.integer(18));
         out.push_back(std::move(t));
     }
     return out;
@@ -495,21 +505,27 @@ bool Store::has_consent(int64_t session_id) {
 bool Store::record_trial(int64_t session_id, int64_t trial_id,
                          const TrialOutcome& outcome) {
     Transaction tx(db_);
-    Statement facts = db_.prepare(
-        "SELECT (SELECT count(*) FROM trials WHERE id = ? AND session_id = ?), "
-        "(SELECT count(*) FROM responses WHERE trial_id = ?), "
-        "(SELECT block FROM trials WHERE id = ? AND session_id = ?)");
-    facts.bind(1, trial_id)
-        .bind(2, session_id)
-        .bind(3, trial_id)
-        .bind(4, trial_id)
-        .bind(5, session_id);
-    facts.step();
-    const std::string block = facts.is_null(2) ? std::string() : facts.text(2);
-    check_trial_answer(
-        db_.path(), session_id, trial_id,
-        {.part_of_session = facts.integer(0) == 1, .answered = facts.integer(1) != 0},
-        questions_of_session(session_id).of_block(block), outcome);
+    TrialAnswerFacts known;
+    std::string block;
+    {
+        Statement facts = db_.prepare(
+            "SELECT t.block, coalesce(t.kind, t.task), t.skipped, coalesce(t.staircase, "
+            "''), EXISTS (SELECT 1 FROM responses r WHERE r.trial_id = t.id) "
+            "FROM trials t WHERE t.id = ? AND t.session_id = ?");
+        facts.bind(1, trial_id).bind(2, session_id);
+        if (facts.step()) {
+            known.part_of_session = true;
+            block = facts.text(0);
+            known.kind =
+                task_column(facts.is_null(1) ? std::nullopt
+                                             : std::optional<std::string>(facts.text(1)));
+            known.skipped = facts.integer(2) != 0;
+            known.staircase = facts.text(3);
+            known.answered = facts.integer(4) != 0;
+        }
+    }
+    check_trial_answer(db_.path(), session_id, trial_id, known,
+                       questions_of_session(session_id).of_block(block), outcome);
     Statement insert = db_.prepare(
         "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
         "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
@@ -529,14 +545,41 @@ bool Store::record_trial(int64_t session_id, int64_t trial_id,
     db_.prepare(
            "UPDATE trials SET onset_ns = ?, confirm_ns = ?, dropped_frames = ?, "
            "answered_utc = ?, segment_id = (SELECT max(id) FROM session_segments "
-           "WHERE session_id = ?) WHERE id = ?")
+           "WHERE session_id = ?), final_value = ?, intensity = ? WHERE id = ?")
         .bind(1, outcome.onset_ns)
         .bind(2, outcome.confirm_ns)
         .bind(3, outcome.dropped_frames)
         .bind(4, utc_now_iso8601())
         .bind(5, session_id)
-        .bind(6, trial_id)
+        .bind(6, outcome.final_value)
+        .bind(7, outcome.intensity)
+        .bind(8, trial_id)
         .run();
+    Statement adjustment = db_.prepare(
+        "INSERT INTO adjustments (trial_id, step, value, t_ns, input) VALUES (?, ?, ?, "
+        "?, "
+        "?)");
+    for (size_t k = 0; k < outcome.adjustments.size(); ++k) {
+        const Adjustment& a = outcome.adjustments[k];
+        adjustment.reset();
+        adjustment.bind(1, trial_id)
+            .bind(2, static_cast<int64_t>(k + 1))
+            .bind(3, a.value)
+            .bind(4, a.t_ns)
+            .bind(5, a.input)
+            .run();
+    }
+    // The procedure has finished: its slots still open in this block are skipped.
+    if (outcome.finishes_staircase)
+        db_.prepare(
+               "UPDATE trials SET skipped = 1 WHERE session_id = ? AND block = ? AND "
+               "staircase = ? AND id <> ? AND " +
+               open_trial_sql("trials"))
+            .bind(1, session_id)
+            .bind(2, block)
+            .bind(3, known.staircase)
+            .bind(4, trial_id)
+            .run();
     const bool completed = complete_session_if_answered(session_id);  // same transaction
     tx.commit();
     return completed;
@@ -546,9 +589,8 @@ bool Store::complete_session_if_answered(int64_t session_id) {
     db_.prepare(
            "UPDATE sessions SET status = 'completed', ended_utc = coalesce(ended_utc, ?) "
            "WHERE id = ? AND status != 'completed' AND NOT EXISTS (SELECT 1 FROM trials "
-           "t "
-           "WHERE t.session_id = sessions.id AND NOT EXISTS "
-           "(SELECT 1 FROM responses r WHERE r.trial_id = t.id))")
+           "t WHERE t.session_id = sessions.id AND " +
+           open_trial_sql() + ")")
         .bind(1, utc_now_iso8601())
         .bind(2, session_id)
         .run();

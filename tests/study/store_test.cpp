@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <map>
 #include <memory>
 #include <thread>
 
@@ -184,6 +185,67 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRows) {
     EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM pragma_table_info('sessions') "
                                     "WHERE name = 'refresh_note'"),
               1);
+}
+
+// Schema 7 (issue 31) on a file an older build left at schema 6: trials.kind filled from
+// trials.task (NULL, a trial planned before schema 6: a rating), the new columns empty,
+// every answer kept; the readers then read kind.
+TEST(Store, MigratesASchema6DatabaseFillingEachTrialsKindFromItsTask) {
+    const auto dir = lucent::test::scratch_dir("store_migrate_6");
+    const std::string path = (dir / "old.db").string();
+    const Protocol p = lucent::test::choice_protocol();
+    std::map<std::string, int64_t> by_task;  // as written, before the downgrade
+    int64_t trials = 0, responses = 0, session = 0;
+    std::vector<TrialRow> before;
+    {
+        Store store(path);
+        session = lucent::test::run_full_session(store, p, "P1", 3);
+        before = store.trials(session);
+        Database& db = store.db();
+        trials = db.scalar_int("SELECT count(*) FROM trials");
+        responses = db.scalar_int("SELECT count(*) FROM responses");
+        Statement s = db.prepare("SELECT task, count(*) FROM trials GROUP BY task");
+        while (s.step()) by_task[s.text(0)] = s.integer(1);
+        lucent::test::downgrade_schema(db, 6);
+        // One rating planned before schema 6: no task.
+        db.exec(
+            "UPDATE trials SET task = NULL WHERE id = (SELECT min(id) FROM trials WHERE "
+            "task = 'rating')");
+        ASSERT_EQ(db.scalar_int("SELECT count(*) FROM pragma_table_info('trials') WHERE "
+                                "name = 'kind'"),
+                  0);
+    }
+    ASSERT_GT(by_task["pair"], 0);
+    ASSERT_GT(by_task["triad"], 0);
+    ASSERT_GT(by_task["rating"], 1);
+    Store store(path);
+    Database& db = store.db();
+    EXPECT_EQ(db.scalar_int("PRAGMA user_version"), kSchemaVersion);
+    {
+        // kind = coalesce(task, 'rating'): the counts per task as written.
+        Statement s = db.prepare("SELECT kind, count(*) FROM trials GROUP BY kind");
+        std::map<std::string, int64_t> by_kind;
+        while (s.step()) by_kind[s.is_null(0) ? "(null)" : s.text(0)] = s.integer(1);
+        EXPECT_EQ(by_kind, by_task);
+    }
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM trials WHERE task IS NULL AND kind = "
+                            "'rating'"),
+              1);
+    EXPECT_EQ(
+        db.scalar_int("SELECT count(*) FROM trials WHERE start_value IS NOT NULL OR "
+                      "final_value IS NOT NULL OR staircase IS NOT NULL OR "
+                      "intensity IS NOT NULL OR skipped <> 0"),
+        0);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM trials"), trials);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM responses"), responses);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM adjustments"), 0);
+    const std::vector<TrialRow> after = store.trials(session);
+    ASSERT_EQ(after.size(), before.size());
+    for (size_t i = 0; i < after.size(); ++i) {
+        EXPECT_EQ(after[i].task, before[i].task) << i;
+        EXPECT_EQ(after[i].answered, before[i].answered) << i;
+        EXPECT_EQ(after[i].choice, before[i].choice) << i;
+    }
 }
 
 }  // namespace

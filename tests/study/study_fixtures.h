@@ -181,6 +181,84 @@ blank_ms = 300
 obvious_catch = ["s1", "s5"]
 )toml";
 
+// Matching and thresholds (issue 31) beside ratings: a rating block, an adjust block
+// (two targets, one live match object) and a pair staircase block over one standard
+// with two interleaved up/down procedures, "target/a" and "target/b", 4 slots each.
+inline const char* kMatchingProtocol = R"toml(
+[study]
+name = "matching"
+
+[[questions]]
+id = "translucent"
+text = "The object looks translucent."
+
+[[stimuli]]
+id = "rated"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 2.0 }
+
+[[stimuli]]
+id = "target"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 1.5 }
+
+[[stimuli]]
+id = "target2"
+technique = "empirical"
+mesh = "sphere"
+params = { thickness_exponent = 3.0 }
+
+[[stimuli]]
+id = "match"
+technique = "empirical"
+mesh = "sphere"
+
+[[blocks]]
+id = "ratings"
+stimuli = ["rated"]
+
+[[blocks]]
+id = "m"
+task = "adjust"
+stimuli = ["target", "target2"]
+match = "match"
+knob = "thickness_exponent"
+range = [0.25, 4.0]
+step = 0.1
+fine_step = 0.01
+question = "Turn the right object until it looks like the left one."
+
+[[blocks]]
+id = "j"
+task = "staircase"
+stimuli = ["target"]
+knob = "thickness_exponent"
+question = "Which looks more translucent?"
+trial = "pair"
+
+[[blocks.staircases]]
+id = "a"
+method = "updown"
+start = 0.5
+step_sizes = [0.1, 0.05]
+n_trials = 3
+max_trials = 4
+
+[[blocks.staircases]]
+id = "b"
+method = "updown"
+start = 0.8
+step_sizes = [0.2, 0.1]
+n_trials = 3
+max_trials = 4
+)toml";
+
+inline study::Protocol matching_protocol() {
+    return study::parse_protocol(kMatchingProtocol, "matching.toml");
+}
+
 inline study::Protocol choice_protocol() {
     return study::parse_protocol(kChoiceProtocol, "choices.toml");
 }
@@ -214,6 +292,18 @@ inline int rating_for(int position, int question) {
 // Deterministic choice (1 or 2) of a forced-choice trial at `position`.
 inline int choice_for(int position) { return 1 + (position * 5 + 1) % 3 % 2; }
 
+// Deterministic answers of adjust and staircase trials (issue 31): an adjust trial's
+// confirmed value and its three changes on the way (the last reaches it), a staircase
+// trial's delta.
+inline double final_value_for(int position) { return 0.25 + 0.125 * (position % 20); }
+inline std::vector<study::Adjustment> adjustments_for(int position, int64_t onset_ns) {
+    const double final_value = final_value_for(position);
+    return {{final_value + 0.5, onset_ns + 250'000'000LL + position, "key"},
+            {final_value + 0.03125, onset_ns + 600'000'123LL, "fine_key"},
+            {final_value, onset_ns + 1'000'000'000LL, "drag"}};
+}
+inline double intensity_for(int position) { return 0.0625 * (1 + position % 7); }
+
 inline study::TrialOutcome outcome_for(const study::Protocol& p, const study::TrialRow& t,
                                        int catch_rating = 7) {
     study::TrialOutcome o;
@@ -226,6 +316,14 @@ inline study::TrialOutcome outcome_for(const study::Protocol& p, const study::Tr
         r.rt_ms = 700.0 + t.position;
         r.first_choice_ns = o.onset_ns + 100;
         r.final_choice_ns = o.onset_ns + 200;
+        if (t.task == study::Task::adjust) {
+            r.rating = 1;  // confirmed
+            r.changes = 3;
+            o.final_value = final_value_for(t.position);
+            o.adjustments = adjustments_for(t.position, o.onset_ns);
+        } else if (t.task == study::Task::staircase) {
+            o.intensity = intensity_for(t.position);
+        }
         o.responses.push_back(r);
         return o;
     }

@@ -764,8 +764,9 @@ TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
                 << t.text(0) << "." << c.text(0);
         }
     }
-    // Schema 5 added withdrawn_sessions, withdrawn_codes and consent_declines to the 11.
-    EXPECT_EQ(tables, 14);
+    // Schema 5 added withdrawn_sessions, withdrawn_codes and consent_declines to the 11,
+    // schema 7 adjustments.
+    EXPECT_EQ(tables, 15);
     // The server has the same tables plus lucent_schema, nothing else.
     EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.tables WHERE "
                                 "table_schema = 'public'"),
