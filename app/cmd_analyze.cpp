@@ -1,12 +1,15 @@
 // lucent analyze: one-way ANOVA, Tukey HSD, Kruskal-Wallis and Welch reports with plots
 // from a study database or a long CSV of ratings
 // (participant,stimulus,factor,level,question,rating); and the perceptual scales of
-// forced choices (Bradley-Terry, Thurstone, MLDS) from a study database or a choices CSV.
+// forced choices (Bradley-Terry, Thurstone, MLDS) from a study database or a choices CSV;
+// and matches and thresholds of adjust and staircase blocks from a study database.
 #include <filesystem>
 #include <iostream>
 
 #include "analysis/analyze.h"
 #include "analysis/data/long_table.h"
+#include "analysis/data/matching_table.h"
+#include "analysis/matching/matching_report.h"
 #include "analysis/report/report.h"
 #include "analysis/scaling/mlds.h"
 #include "analysis/scaling/paired_comparison.h"
@@ -14,6 +17,7 @@
 #include "analysis/stats/one_way_analysis.h"
 #include "app/commands.h"
 #include "app/study_input.h"
+#include "study/study_store.h"
 
 namespace lucent::app {
 namespace {
@@ -29,6 +33,7 @@ struct AnalyzeArgs {
     double alpha = 0.10;
     double within_share = 1.0;
     int bootstrap = 200, six_point = 200;  // MLDS: bootstrap samples, six-point data sets
+    std::string psychometric = "gaussian";  // thresholds: "gaussian" or "weibull"
     uint64_t seed = 1;
 };
 
@@ -64,6 +69,44 @@ void add_scaling_section(const AnalyzeArgs& args, analysis::ReportOptions& optio
     for (const std::string& note : choices.notes) options.input_notes.push_back(note);
 }
 
+// Matching and thresholds (adjust and staircase blocks), when a study database has any;
+// appended after the scales.
+void add_matching_section(const AnalyzeArgs& args, analysis::ReportOptions& options) {
+    using namespace lucent::analysis;
+    if (!study::is_server_uri(args.input) && !is_sqlite_file(args.input)) return;
+    MatchingTable table;
+    try {
+        const study::ReadableStudyFile source(args.input);
+        table = read_matching_table(source.path());
+    } catch (const study::StoreError& e) {
+        throw InputError(e.what());
+    }
+    if (table.matches.empty() && table.staircases.empty()) return;
+    std::cerr << "lucent analyze: " << table.matches.size() << " matches, "
+              << table.staircases.size() << " staircase trials\n";
+    for (const std::string& p : table.excluded_participants)
+        std::cerr << "lucent analyze: excluded participant " << p
+                  << " from the matches and thresholds\n";
+    const study::Protocol* protocol = table.protocol ? &*table.protocol : nullptr;
+    if (!protocol)
+        options.input_notes.push_back(
+            "The stored protocol could not be read: the matches have no target values "
+            "and the staircases are taken as pairs (guess rate 1/2), not replayed.");
+    ThresholdOptions threshold_options;
+    threshold_options.family = args.psychometric == "weibull"
+                                   ? PsychometricFamily::weibull
+                                   : PsychometricFamily::cumulative_gaussian;
+    threshold_options.bootstrap = args.bootstrap;
+    threshold_options.seed = args.seed;
+    MatchingSection section = matching_section(
+        analyse_matches(table.matches, protocol),
+        analyse_thresholds(table.staircases, protocol, threshold_options));
+    options.extra_blocks.insert(options.extra_blocks.end(), section.blocks.begin(),
+                                section.blocks.end());
+    options.extra_files.insert(options.extra_files.end(), section.files.begin(),
+                               section.files.end());
+}
+
 int run_analyze(const AnalyzeArgs& args) {
     using namespace lucent::analysis;
     try {
@@ -86,8 +129,11 @@ int run_analyze(const AnalyzeArgs& args) {
                                                    &plan_design, &options.input_notes,
                                                    &options.question_scales, &plan_model);
         add_scaling_section(args, options);
+        add_matching_section(args, options);
         if (table.rows.empty() && options.extra_blocks.empty())
-            throw InputError(args.input + ": holds no ratings and no forced choices");
+            throw InputError(args.input +
+                             ": holds no ratings, no forced choices, no matches and no "
+                             "staircase trials");
         RatingModel primary_model = RatingModel::anova;
         std::string primary_model_source;
         if (!args.primary_model.empty()) {
@@ -123,7 +169,7 @@ int run_analyze(const AnalyzeArgs& args) {
             request.primary = plan_design;
             request.primary_source = "the protocol's [analysis] primary_design";
         }
-        if (table.rows.empty()) {  // forced choices only: the scales are the report
+        if (table.rows.empty()) {  // no ratings: the scales, matches, thresholds are it
             for (const auto& path : write_report({}, args.out_dir, options))
                 std::cout << path.string() << "\n";
             return kExitOk;
@@ -191,15 +237,21 @@ void register_analyze(CLI::App& app, int& exit_code) {
                     "Accepted ratings: MIN..MAX, or 'any' for any finite number")
         ->capture_default_str();
     cmd->add_option("--bootstrap", args->bootstrap,
-                    "MLDS: parametric bootstrap samples for the scale's intervals "
-                    "(0: none)")
+                    "MLDS and thresholds: parametric bootstrap samples for the scale's "
+                    "and the JNDs' intervals (0: none)")
         ->check(CLI::Range(0, 100000))
         ->capture_default_str();
     cmd->add_option("--six-point", args->six_point,
                     "MLDS: simulated data sets of the six-point test (0: no test)")
         ->check(CLI::Range(0, 100000))
         ->capture_default_str();
-    cmd->add_option("--seed", args->seed, "MLDS: the bootstrap's and the test's seed")
+    cmd->add_option("--seed", args->seed,
+                    "MLDS and thresholds: the bootstrap's and the test's seed")
+        ->capture_default_str();
+    cmd->add_option("--psychometric", args->psychometric,
+                    "Thresholds: the psychometric function fitted to staircase trials, "
+                    "gaussian (cumulative Gaussian) or weibull")
+        ->check(CLI::IsMember({"gaussian", "weibull"}))
         ->capture_default_str();
     cmd->callback([args, &exit_code] { exit_code = run_analyze(*args); });
 }

@@ -1,0 +1,251 @@
+#include "analysis/matching/matching.h"
+
+#include <algorithm>
+#include <boost/math/distributions/students_t.hpp>
+#include <cmath>
+#include <map>
+#include <variant>
+
+#include "analysis/report/format.h"
+#include "renderer/techniques/registry.h"
+
+namespace lucent::analysis {
+namespace {
+
+std::string text(double v) { return format_short(v); }
+
+// The target's value of the knob, or why it has none.
+std::optional<double> target_value(const study::Protocol& protocol,
+                                   const study::StimulusSpec& target,
+                                   const study::StimulusSpec* match,
+                                   const std::string& knob, std::string& why) {
+    if (!target.live()) {
+        why = "no physical value: the target is a picture";
+        return std::nullopt;
+    }
+    if (!match || match->technique != target.technique) {
+        why = "no physical value: the target is rendered by " + target.technique +
+              (match ? ", the match by " + match->technique : std::string()) +
+              ", whose knob '" + knob + "' is not the target's";
+        return std::nullopt;
+    }
+    if (const auto v = knob_value(protocol, target.id, knob)) return v;
+    why = "no physical value: the target states no number for '" + knob + "'";
+    return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<double> knob_value(const study::Protocol& protocol,
+                                 const std::string& stimulus, const std::string& knob) {
+    const study::StimulusSpec* s = protocol.find_stimulus(stimulus);
+    if (!s || !s->live()) return std::nullopt;
+    if (const auto v = protocol.numeric_parameter(stimulus, knob)) return v;
+    // Not stated: the technique's default, which the renderer used.
+    try {
+        for (const Knob& k : knobs_for(find_technique(s->technique)))
+            if (k.name == knob)
+                if (const double* d = std::get_if<double>(&k.default_value)) return *d;
+    } catch (const std::exception&) {
+    }
+    return std::nullopt;
+}
+
+MeanInterval mean_interval(const std::vector<double>& values, double level) {
+    MeanInterval out;
+    if (values.empty()) return out;
+    const double shift = values.front();
+    double sum = 0;
+    for (double v : values) sum += v - shift;
+    const double n = static_cast<double>(values.size());
+    const double mean = shift + sum / n;
+    out.mean = mean;
+    if (values.size() < 2) return out;
+    double squares = 0;
+    for (double v : values) squares += (v - mean) * (v - mean);
+    const double sd = std::sqrt(squares / (n - 1));
+    out.sd = sd;
+    const boost::math::students_t t(n - 1);
+    const double half = boost::math::quantile(t, 0.5 + 0.5 * level) * sd / std::sqrt(n);
+    out.low = mean - half;
+    out.high = mean + half;
+    return out;
+}
+
+std::optional<double> constancy_index(double mean_match, double target, double lo,
+                                      double hi, bool log_scale) {
+    if (log_scale) {
+        if (!(mean_match > 0 && target > 0 && lo > 0 && hi > 0)) return std::nullopt;
+        mean_match = std::log10(mean_match);
+        target = std::log10(target);
+        lo = std::log10(lo);
+        hi = std::log10(hi);
+    }
+    const double room = std::max(target - lo, hi - target);
+    if (!(room > 0) || !std::isfinite(room)) return std::nullopt;
+    const double index = 1.0 - std::abs(mean_match - target) / room;
+    if (!std::isfinite(index)) return std::nullopt;
+    return index;
+}
+
+std::vector<std::string> differing_factors(const study::StimulusSpec& a,
+                                           const study::StimulusSpec& b,
+                                           const std::string& knob) {
+    std::vector<std::string> out;
+    if (a.technique != b.technique) out.push_back("technique");
+    if (a.mesh != b.mesh) out.push_back("mesh");
+    std::map<std::string, std::pair<std::string, std::string>> all;
+    for (const auto& [k, v] : a.parameters) all[k].first = v;
+    for (const auto& [k, v] : b.parameters) all[k].second = v;
+    for (const auto& [k, v] : all)
+        if (k != knob && v.first != v.second) out.push_back(k);
+    return out;
+}
+
+std::vector<ConditionMatch> analyse_matches(const std::vector<MatchRow>& rows,
+                                            const study::Protocol* protocol,
+                                            const MatchingOptions& options) {
+    std::vector<ConditionMatch> out;
+    std::map<std::pair<std::string, std::string>, std::vector<const MatchRow*>> by;
+    for (const MatchRow& r : rows) {
+        auto& list = by[{r.block, r.target}];
+        if (list.empty()) {
+            ConditionMatch c;
+            c.block = r.block;
+            c.target = r.target;
+            c.match = r.match;
+            c.knob = r.knob;
+            out.push_back(c);
+        }
+        list.push_back(&r);
+    }
+    for (ConditionMatch& c : out) {
+        const auto& list = by[{c.block, c.target}];
+        const study::Block* block = protocol ? protocol->find_block(c.block) : nullptr;
+        if (block) {
+            c.range_min = block->range_min;
+            c.range_max = block->range_max;
+            c.log_scale = block->scale == "log";
+            if (c.match.empty()) c.match = block->match;
+            if (c.knob.empty()) c.knob = block->knob;
+        }
+        std::vector<double> values;
+        std::map<std::string, std::vector<double>> per;
+        for (const MatchRow* r : list) {
+            values.push_back(r->final_value);
+            auto [it, added] = per.try_emplace(r->participant);
+            if (added) c.participants.push_back({r->participant, 0, 0});
+            it->second.push_back(r->final_value);
+        }
+        c.n = static_cast<int>(values.size());
+        const MeanInterval m = mean_interval(values, options.level);
+        c.mean = m.mean;
+        c.sd = m.sd;
+        c.ci_low = m.low;
+        c.ci_high = m.high;
+        std::vector<double> means;
+        for (ParticipantMatch& p : c.participants) {
+            const auto& v = per[p.participant];
+            p.n = static_cast<int>(v.size());
+            p.mean = *mean_interval(v).mean;
+            means.push_back(p.mean);
+        }
+        if (means.size() >= 2) {
+            const MeanInterval pm = mean_interval(means, options.level);
+            c.participant_mean = pm.mean;
+            c.participant_sd = pm.sd;
+            c.participant_ci_low = pm.low;
+            c.participant_ci_high = pm.high;
+        }
+        if (c.n == 1)
+            c.notes.push_back("One match only: no SD and no interval.");
+        else if (c.sd && *c.sd == 0.0)
+            c.notes.push_back("Every match was the same value, " + text(*c.mean) +
+                              ": the SD is 0 and the interval a single point.");
+        if (block && c.n > 0) {
+            const double span = c.range_max - c.range_min;
+            const double tol = 1e-9 * std::max(1.0, std::abs(span));
+            const bool all_min = std::all_of(values.begin(), values.end(), [&](double v) {
+                return std::abs(v - c.range_min) <= tol;
+            });
+            const bool all_max = std::all_of(values.begin(), values.end(), [&](double v) {
+                return std::abs(v - c.range_max) <= tol;
+            });
+            if (all_min || all_max) {
+                c.all_at_range_end = true;
+                c.notes.push_back(
+                    std::string("Every match is at the range's ") +
+                    (all_min ? "lower end, " + text(c.range_min)
+                             : "upper end, " + text(c.range_max)) +
+                    ": the range did not reach the value that matches (the mean and the "
+                    "bias are bounds, not estimates).");
+            } else {
+                int at_end = 0;
+                for (double v : values)
+                    if (std::abs(v - c.range_min) <= tol ||
+                        std::abs(v - c.range_max) <= tol)
+                        ++at_end;
+                if (at_end > 0)
+                    c.notes.push_back(std::to_string(at_end) + " of " +
+                                      std::to_string(c.n) +
+                                      " matches at an end of the range " +
+                                      text(c.range_min) + ".." + text(c.range_max) + ".");
+            }
+        }
+        // The target's value and the constancy index.
+        const study::StimulusSpec* target =
+            protocol ? protocol->find_stimulus(c.target) : nullptr;
+        const study::StimulusSpec* match =
+            protocol ? protocol->find_stimulus(c.match) : nullptr;
+        std::string why = "no physical value: the stored protocol is not readable";
+        if (target && protocol)
+            c.target_value = target_value(*protocol, *target, match, c.knob, why);
+        if (c.target_value && c.mean) {
+            c.bias = *c.mean - *c.target_value;
+            if (c.ci_low && c.ci_high) {
+                c.bias_ci_low = *c.ci_low - *c.target_value;
+                c.bias_ci_high = *c.ci_high - *c.target_value;
+            }
+        }
+        if (target && !target->live()) {
+            c.constancy_text = "no constancy index: the target is a picture";
+        } else if (!c.target_value) {
+            c.constancy_text = "no constancy index: " + why;
+        } else if (!match) {
+            c.constancy_text =
+                "no constancy index: the match stimulus is not in the protocol";
+        } else {
+            const auto factors = differing_factors(*target, *match, c.knob);
+            if (factors.empty()) {
+                c.constancy_text =
+                    "no constancy index: the target and the match differ only in '" +
+                    c.knob + "' (a same-scene match measures accuracy; see the bias)";
+            } else if (factors.size() > 1) {
+                std::string list;
+                for (const auto& f : factors) list += (list.empty() ? "" : ", ") + f;
+                c.constancy_text =
+                    "no constancy index: the target and the match differ in " +
+                    std::to_string(factors.size()) + " scene factors (" + list +
+                    "), not one";
+            } else if (!c.mean) {
+                c.constancy_text = "no constancy index: no matches";
+            } else {
+                c.constancy_factor = factors.front();
+                c.constancy = constancy_index(*c.mean, *c.target_value, c.range_min,
+                                              c.range_max, c.log_scale);
+                if (c.constancy)
+                    c.constancy_text =
+                        text(*c.constancy) + " across " + c.constancy_factor;
+                else
+                    c.constancy_text =
+                        "no constancy index: the range leaves no room around the target" +
+                        std::string(c.log_scale ? " (or a value is not positive on the "
+                                                  "log scale)"
+                                                : "");
+            }
+        }
+    }
+    return out;
+}
+
+}  // namespace lucent::analysis

@@ -1,0 +1,394 @@
+#include "analysis/matching/matching_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "analysis/report/format.h"
+#include "analysis/report/report.h"
+#include "common/csv.h"
+#include "common/html/svg_plot.h"
+
+namespace lucent::analysis {
+namespace {
+
+Block paragraph(std::string text) { return {Block::kParagraph, std::move(text), {}, {}}; }
+Block heading(std::string text, int level) {
+    return {Block::kHeading, std::move(text), {}, {}, level};
+}
+
+std::string cell(const std::optional<double>& v) {
+    return v ? format_short(v) : std::string("-");
+}
+
+std::string interval(const std::optional<double>& low,
+                     const std::optional<double>& high) {
+    return low && high ? format_short(low) + " .. " + format_short(high)
+                       : std::string("-");
+}
+
+std::string full(const std::optional<double>& v) { return v ? format_full(v) : ""; }
+
+void csv_row(std::ostringstream& csv, const std::vector<std::string>& fields) {
+    for (std::size_t i = 0; i < fields.size(); ++i)
+        csv << (i ? "," : "") << common::csv_field(fields[i]);
+    csv << '\n';
+}
+
+double or_nan(const std::optional<double>& v) { return v ? *v : NAN; }
+
+// Match against target per block: the conditions with a target value on a numeric x
+// axis with the identity line; without any, one point per target by name.
+std::string match_plot(const std::string& block,
+                       const std::vector<const ConditionMatch*>& cs) {
+    common::PlotPanel panel;
+    panel.title = block;
+    const std::string knob = cs.front()->knob.empty() ? "knob" : cs.front()->knob;
+    panel.y_label = "match " + knob + " (mean, 95% CI)";
+    panel.join = false;
+    bool any_value = false;
+    for (const ConditionMatch* c : cs) any_value = any_value || c->target_value;
+    if (any_value) {
+        panel.x_label = "target's " + knob + " (line: match = target)";
+        double lo = INFINITY, hi = -INFINITY;
+        for (const ConditionMatch* c : cs) {
+            if (!c->target_value || !c->mean) continue;
+            panel.x.push_back(*c->target_value);
+            panel.y.push_back(*c->mean);
+            panel.y_low.push_back(or_nan(c->ci_low));
+            panel.y_high.push_back(or_nan(c->ci_high));
+            panel.point_labels.push_back(c->target);
+            for (double v :
+                 {*c->target_value, *c->mean, or_nan(c->ci_low), or_nan(c->ci_high)})
+                if (std::isfinite(v)) {
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
+        }
+        if (std::isfinite(lo) && std::isfinite(hi)) {
+            if (hi == lo) {
+                lo -= 0.5;
+                hi += 0.5;
+            }
+            panel.series.push_back({"match = target", {lo, hi}, {lo, hi}});
+            panel.series_behind = true;
+            panel.main_label = "mean match";
+        }
+    } else {
+        panel.x_label = "target (a picture: no value of the knob)";
+        for (const ConditionMatch* c : cs) {
+            panel.categories.push_back(c->target);
+            panel.y.push_back(or_nan(c->mean));
+            panel.y_low.push_back(or_nan(c->ci_low));
+            panel.y_high.push_back(or_nan(c->ci_high));
+        }
+    }
+    return common::figure_svg("", {panel}, {520, 360, 1});
+}
+
+void add_matching(MatchingSection& section, const std::vector<ConditionMatch>& matches) {
+    if (matches.empty()) return;
+    std::ostringstream csv;
+    csv_row(csv, {"block", "target", "match", "knob", "participant", "n", "mean", "sd",
+                  "ci_low", "ci_high", "target_value", "bias", "bias_ci_low",
+                  "bias_ci_high", "constancy_index", "constancy_factor"});
+    section.blocks.push_back(heading("Matching", 2));
+    section.blocks.push_back(paragraph(
+        "Each condition is an adjust block's target: the values of the match's knob the "
+        "participants confirmed, their mean, SD and 95% t interval over the trials (and, "
+        "with two or more participants, over the participant means). The bias is the "
+        "mean match minus the target's own value of the knob, where the target is a "
+        "live stimulus of the match's technique. The constancy index, where the target "
+        "and the match differ in exactly one scene factor, is 1 - |mean match - target| "
+        "/ max(target - low end, high end - target) on the knob's scale (its logarithm "
+        "for a log block): 1 is a perfect match across the factor, 0 a match as far "
+        "from the target as the range allows."));
+    Table t{{"block", "target", "knob", "n", "mean", "SD", "95% CI", "participants",
+             "participant means 95% CI", "target value", "bias", "bias 95% CI",
+             "constancy index"},
+            {}};
+    std::map<std::string, std::vector<const ConditionMatch*>> by_block;
+    std::vector<std::string> block_order;
+    for (const ConditionMatch& c : matches) {
+        if (by_block[c.block].empty()) block_order.push_back(c.block);
+        by_block[c.block].push_back(&c);
+        t.rows.push_back(
+            {c.block, c.target, c.knob, std::to_string(c.n), cell(c.mean),
+             c.n < 2 ? std::string("- (one match)") : cell(c.sd),
+             interval(c.ci_low, c.ci_high), std::to_string(c.participants.size()),
+             interval(c.participant_ci_low, c.participant_ci_high),
+             c.target_value ? format_short(c.target_value)
+                            : std::string("no physical value"),
+             cell(c.bias), interval(c.bias_ci_low, c.bias_ci_high), c.constancy_text});
+        csv_row(csv, {c.block, c.target, c.match, c.knob, "(all)", std::to_string(c.n),
+                      full(c.mean), full(c.sd), full(c.ci_low), full(c.ci_high),
+                      full(c.target_value), full(c.bias), full(c.bias_ci_low),
+                      full(c.bias_ci_high), full(c.constancy), c.constancy_factor});
+        for (const ParticipantMatch& p : c.participants)
+            csv_row(csv, {c.block, c.target, c.match, c.knob, p.participant,
+                          std::to_string(p.n), format_full(p.mean), "", "", "",
+                          full(c.target_value),
+                          c.target_value ? format_full(p.mean - *c.target_value) : "", "",
+                          "", "", ""});
+    }
+    section.blocks.push_back({Block::kTable, "", t, {}});
+    for (const ConditionMatch& c : matches)
+        for (const std::string& n : c.notes)
+            section.blocks.push_back(paragraph(c.block + ", " + c.target + ": " + n));
+    for (const std::string& block : block_order) {
+        const std::string file = plot_file_name("matching", block);
+        Block plot{Block::kPlot, file, {}, {}};
+        plot.svg = match_plot(block, by_block[block]);
+        section.files.emplace_back(file, plot.svg);
+        section.blocks.push_back(plot);
+    }
+    Table per{{"block", "target", "participant", "trials", "mean match", "bias"}, {}};
+    for (const ConditionMatch& c : matches)
+        for (const ParticipantMatch& p : c.participants)
+            per.rows.push_back({c.block, c.target, p.participant, std::to_string(p.n),
+                                format_short(p.mean),
+                                c.target_value ? format_short(p.mean - *c.target_value)
+                                               : std::string("-")});
+    section.blocks.push_back(paragraph("Each participant's mean match:"));
+    section.blocks.push_back({Block::kTable, "", per, {}});
+    section.files.emplace_back("matching.csv", csv.str());
+}
+
+// A participant's tracks in one block: a panel per procedure, delta against trial.
+std::string track_plot(
+    const ThresholdAnalysis& a, const std::vector<std::size_t>& tracks,
+    const std::map<std::string, const StandardThreshold*>& by_standard) {
+    std::vector<common::PlotPanel> panels;
+    for (std::size_t k : tracks) {
+        const StaircaseTrack& t = a.tracks[k];
+        common::PlotPanel p;
+        p.title = t.label;
+        p.x_label = "trial (filled: correct; ringed: reversal)";
+        p.y_label = "delta";
+        for (std::size_t i = 0; i < t.intensity.size(); ++i) {
+            p.x.push_back(static_cast<double>(i + 1));
+            p.y.push_back(t.intensity[i]);
+            p.open_points.push_back(!t.correct[i]);
+            p.ringed_points.push_back(t.reversal[i]);
+        }
+        p.x_axis.scale = common::AxisScale::linear;
+        p.y_axis.scale = common::AxisScale::linear;
+        const auto it = by_standard.find(t.standard);
+        if (it != by_standard.end() && it->second->jnd && !t.intensity.empty()) {
+            const double j = *it->second->jnd;
+            p.series.push_back({"JND (fit)", {1.0, double(t.intensity.size())}, {j, j}});
+            p.series_behind = true;
+            p.main_label = "delta shown";
+        }
+        panels.push_back(std::move(p));
+    }
+    return common::figure_svg("", panels, {320, 260, 3});
+}
+
+// The proportions correct to draw: each delta's own when there are few, else the
+// trials in kDisplayBins equal stretches of lo..hi, each at its trials' mean delta.
+constexpr int kDisplayBins = 8;
+std::vector<PsychometricBin> display_bins(const std::vector<PsychometricBin>& bins,
+                                          double lo, double hi) {
+    std::vector<PsychometricBin> out;
+    if (static_cast<int>(bins.size()) <= kDisplayBins || !(hi > lo)) {
+        for (const PsychometricBin& b : bins)
+            if (b.n_trials > 0) out.push_back(b);
+        return out;
+    }
+    std::vector<double> sum_x(kDisplayBins, 0.0);
+    out.assign(kDisplayBins, {});
+    for (const PsychometricBin& b : bins) {
+        const int k = std::clamp(static_cast<int>((b.x - lo) / (hi - lo) * kDisplayBins),
+                                 0, kDisplayBins - 1);
+        sum_x[k] += b.x * b.n_trials;
+        out[k].n_trials += b.n_trials;
+        out[k].n_correct += b.n_correct;
+    }
+    std::vector<PsychometricBin> kept;
+    for (int k = 0; k < kDisplayBins; ++k)
+        if (out[k].n_trials > 0) {
+            out[k].x = sum_x[k] / out[k].n_trials;
+            kept.push_back(out[k]);
+        }
+    return kept;
+}
+
+// The fitted functions of a participant's standards in one block, over the proportions
+// correct at each delta.
+std::string fit_plot(const std::vector<const StandardThreshold*>& standards) {
+    std::vector<common::PlotPanel> panels;
+    for (const StandardThreshold* s : standards) {
+        common::PlotPanel p;
+        p.title = s->standard;
+        p.x_label = "delta (n trials beside each dot; line: fit)";
+        p.y_label = "proportion correct";
+        p.join = false;
+        p.fixed_y = common::fixed_axis(0.0, 1.0);
+        p.x_axis.scale = common::AxisScale::linear;
+        double lo = INFINITY, hi = -INFINITY;
+        for (const PsychometricBin& b : s->fit.bins) {
+            lo = std::min(lo, b.x);
+            hi = std::max(hi, b.x);
+        }
+        for (const PsychometricBin& b : display_bins(s->fit.bins, lo, hi)) {
+            p.x.push_back(b.x);
+            p.y.push_back(static_cast<double>(b.n_correct) / b.n_trials);
+            p.point_labels.push_back(std::to_string(b.n_trials));
+        }
+        if (s->fit.fitted && std::isfinite(lo) && hi > lo) {
+            common::PlotSeries curve{"fitted psi", {}, {}};
+            for (int i = 0; i <= 60; ++i) {
+                const double x = lo + (hi - lo) * i / 60.0;
+                const double y = psychometric_psi(s->fit, x);
+                if (!std::isfinite(y)) continue;
+                curve.x.push_back(x);
+                curve.y.push_back(y);
+            }
+            p.series.push_back(std::move(curve));
+            p.series_behind = true;
+            p.main_label = "proportion correct";
+        }
+        panels.push_back(std::move(p));
+    }
+    return common::figure_svg("", panels, {320, 260, 3});
+}
+
+void add_thresholds(MatchingSection& section, const ThresholdAnalysis& a) {
+    if (a.thresholds.empty()) return;
+    std::ostringstream csv;
+    csv_row(csv,
+            {"participant",   "block",      "standard",    "knob",    "standard_value",
+             "guess",         "p_correct",  "trials",      "correct", "jnd",
+             "jnd_text",      "jnd_ci_low", "jnd_ci_high", "weber",   "weber_ci_low",
+             "weber_ci_high", "alpha",      "beta",        "lapse",   "slope"});
+    section.blocks.push_back(heading("Thresholds", 2));
+    section.blocks.push_back(paragraph(
+        "Per participant, block and standard, every trial of the standard's interleaved "
+        "procedures is fitted by maximum likelihood with a psychometric function (guess "
+        "rate 1/2 for a pair, 1/3 for an odd one out; the lapse rate free in [0, 0.06]). "
+        "The just-noticeable difference (JND) is the delta where the fitted function is "
+        "halfway between chance and perfect (75% correct for a pair, 66.7% for an odd "
+        "one "
+        "out), with a parametric-bootstrap 95% interval; the Weber fraction is the JND "
+        "over the standard's value of the knob. Each procedure's own estimate (up/down: "
+        "the mean of its last reversals; QUEST: its posterior quantile, at its own "
+        "target performance) is the cross-check."));
+    Table t{{"participant", "block", "standard", "standard value", "trials",
+             "proportion correct", "JND", "JND 95% interval", "Weber fraction",
+             "procedures' own estimates"},
+            {}};
+    for (const StandardThreshold& s : a.thresholds) {
+        std::string estimates;
+        for (std::size_t k : s.tracks)
+            estimates += (estimates.empty() ? "" : "; ") + a.tracks[k].procedure + ": " +
+                         a.tracks[k].estimate_text;
+        const Threshold& th = s.fit.threshold_p ? *s.fit.threshold_p : s.fit.threshold;
+        t.rows.push_back(
+            {s.participant, s.block, s.standard, cell(s.standard_value),
+             std::to_string(s.fit.trials),
+             s.fit.trials > 0
+                 ? format_short(static_cast<double>(s.fit.correct) / s.fit.trials)
+                 : std::string("-"),
+             s.jnd_text, interval(s.jnd_low, s.jnd_high),
+             s.weber ? format_short(s.weber) +
+                           (s.weber_low && s.weber_high
+                                ? " (" + interval(s.weber_low, s.weber_high) + ")"
+                                : std::string())
+                     : std::string("-"),
+             estimates.empty() ? std::string("-") : estimates});
+        csv_row(csv, {s.participant,
+                      s.block,
+                      s.standard,
+                      s.knob,
+                      full(s.standard_value),
+                      format_full(s.guess),
+                      format_full(s.p_correct),
+                      std::to_string(s.fit.trials),
+                      std::to_string(s.fit.correct),
+                      full(s.jnd),
+                      s.jnd_text,
+                      full(s.jnd_low),
+                      full(s.jnd_high),
+                      full(s.weber),
+                      full(s.weber_low),
+                      full(s.weber_high),
+                      full(s.fit.alpha),
+                      full(s.fit.beta),
+                      full(s.fit.lapse),
+                      full(th.slope)});
+    }
+    section.blocks.push_back({Block::kTable, "", t, {}});
+    for (const StandardThreshold& s : a.thresholds) {
+        const std::string who = s.participant + ", " + s.block + ", " + s.standard + ": ";
+        for (const std::string& n : s.notes) section.blocks.push_back(paragraph(who + n));
+        for (const std::string& n : s.fit.notes)
+            section.blocks.push_back(paragraph(who + n));
+    }
+    Table fits{{"participant", "block", "standard", "alpha", "beta", "lapse",
+                "slope at the JND", "deviance p", "bootstrap samples"},
+               {}};
+    for (const StandardThreshold& s : a.thresholds) {
+        const Threshold& th = s.fit.threshold_p ? *s.fit.threshold_p : s.fit.threshold;
+        fits.rows.push_back(
+            {s.participant, s.block, s.standard, cell(s.fit.alpha), cell(s.fit.beta),
+             cell(s.fit.lapse), cell(th.slope),
+             s.fit.deviance_p ? format_p_short(s.fit.deviance_p) : std::string("-"),
+             std::to_string(s.fit.bootstrap_samples)});
+    }
+    section.blocks.push_back(
+        paragraph(std::string("The fits (") +
+                  (a.thresholds.front().fit.family == PsychometricFamily::weibull
+                       ? "Weibull: alpha its scale, beta its shape"
+                       : "cumulative Gaussian: alpha its mean, beta its SD") +
+                  "):"));
+    section.blocks.push_back({Block::kTable, "", fits, {}});
+
+    // The figures: per participant and block, the tracks and the fits.
+    std::vector<std::pair<std::string, std::string>> groups;
+    std::map<std::pair<std::string, std::string>, std::vector<const StandardThreshold*>>
+        standards;
+    for (const StandardThreshold& s : a.thresholds) {
+        auto& list = standards[{s.participant, s.block}];
+        if (list.empty()) groups.emplace_back(s.participant, s.block);
+        list.push_back(&s);
+    }
+    for (const auto& g : groups) {
+        const auto& list = standards[g];
+        std::vector<std::size_t> tracks;
+        std::map<std::string, const StandardThreshold*> by_standard;
+        for (const StandardThreshold* s : list) {
+            tracks.insert(tracks.end(), s->tracks.begin(), s->tracks.end());
+            by_standard[s->standard] = s;
+        }
+        section.blocks.push_back(heading(g.first + ", " + g.second, 3));
+        const std::string track_file = plot_file_name("staircase_" + g.first, g.second);
+        Block plot{Block::kPlot, track_file, {}, {}};
+        plot.svg = track_plot(a, tracks, by_standard);
+        section.files.emplace_back(track_file, plot.svg);
+        section.blocks.push_back(plot);
+        const std::string fit_file = plot_file_name("psychometric_" + g.first, g.second);
+        Block fit{Block::kPlot, fit_file, {}, {}};
+        fit.svg = fit_plot(list);
+        section.files.emplace_back(fit_file, fit.svg);
+        section.blocks.push_back(fit);
+        for (std::size_t k : tracks)
+            for (const std::string& n : a.tracks[k].notes)
+                if (n.rfind("Held", 0) != 0)  // said with the threshold already
+                    section.blocks.push_back(paragraph(a.tracks[k].label + ": " + n));
+    }
+    section.files.emplace_back("thresholds.csv", csv.str());
+}
+
+}  // namespace
+
+MatchingSection matching_section(const std::vector<ConditionMatch>& matches,
+                                 const ThresholdAnalysis& thresholds) {
+    MatchingSection section;
+    add_matching(section, matches);
+    add_thresholds(section, thresholds);
+    return section;
+}
+
+}  // namespace lucent::analysis
