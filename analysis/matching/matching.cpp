@@ -7,6 +7,7 @@
 #include <variant>
 
 #include "analysis/report/format.h"
+#include "renderer/core/common_knobs.h"
 #include "renderer/techniques/registry.h"
 
 namespace lucent::analysis {
@@ -92,13 +93,22 @@ std::vector<std::string> differing_factors(const study::StimulusSpec& a,
                                            const study::StimulusSpec& b,
                                            const std::string& knob) {
     std::vector<std::string> out;
-    if (a.technique != b.technique) out.push_back("technique");
     if (a.mesh != b.mesh) out.push_back("mesh");
+    // Across techniques only the scene's knobs (light, camera, background) are factors:
+    // each technique's own knobs describe the material being matched.
+    const bool same_technique = a.technique == b.technique;
+    auto is_factor = [&](const std::string& name) {
+        if (name == knob) return false;
+        if (same_technique) return true;
+        for (const Knob& k : scene_knobs())
+            if (k.name == name) return true;
+        return false;
+    };
     std::map<std::string, std::pair<std::string, std::string>> all;
     for (const auto& [k, v] : a.parameters) all[k].first = v;
     for (const auto& [k, v] : b.parameters) all[k].second = v;
     for (const auto& [k, v] : all)
-        if (k != knob && v.first != v.second) out.push_back(k);
+        if (is_factor(k) && v.first != v.second) out.push_back(k);
     return out;
 }
 
@@ -207,43 +217,75 @@ std::vector<ConditionMatch> analyse_matches(const std::vector<MatchRow>& rows,
                 c.bias_ci_high = *c.ci_high - *c.target_value;
             }
         }
-        if (target && !target->live()) {
-            c.constancy_text = "no constancy index: the target is a picture";
-        } else if (!c.target_value) {
-            c.constancy_text = "no constancy index: " + why;
-        } else if (!match) {
-            c.constancy_text =
-                "no constancy index: the match stimulus is not in the protocol";
-        } else {
-            const auto factors = differing_factors(*target, *match, c.knob);
-            if (factors.empty()) {
-                c.constancy_text =
-                    "no constancy index: the target and the match differ only in '" +
-                    c.knob + "' (a same-scene match measures accuracy; see the bias)";
-            } else if (factors.size() > 1) {
-                std::string list;
-                for (const auto& f : factors) list += (list.empty() ? "" : ", ") + f;
-                c.constancy_text =
-                    "no constancy index: the target and the match differ in " +
-                    std::to_string(factors.size()) + " scene factors (" + list +
-                    "), not one";
-            } else if (!c.mean) {
-                c.constancy_text = "no constancy index: no matches";
-            } else {
-                c.constancy_factor = factors.front();
-                c.constancy = constancy_index(*c.mean, *c.target_value, c.range_min,
-                                              c.range_max, c.log_scale);
-                if (c.constancy)
-                    c.constancy_text =
-                        text(*c.constancy) + " across " + c.constancy_factor;
-                else
-                    c.constancy_text =
-                        "no constancy index: the range leaves no room around the target" +
-                        std::string(c.log_scale ? " (or a value is not positive on the "
-                                                  "log scale)"
-                                                : "");
-            }
+        c.picture_target = target && !target->live();
+        if (target && match && !c.picture_target) {
+            c.factors = differing_factors(*target, *match, c.knob);
+            c.factors_known = true;
         }
+        c.no_value_reason = why;
+    }
+    // The constancy index: against the target's own value, else against its match in a
+    // block where the target and the match share every scene factor.
+    for (ConditionMatch& c : out) {
+        if (c.picture_target) {
+            c.constancy_text = "no constancy index: the target is a picture";
+            continue;
+        }
+        if (!c.factors_known) {
+            c.constancy_text =
+                "no constancy index: the target or the match is not a live "
+                "stimulus of the stored protocol";
+            continue;
+        }
+        if (c.factors.empty()) {
+            c.constancy_text =
+                "no constancy index: the target and the match share every scene factor " +
+                std::string(c.target_value
+                                ? "(a same-scene match measures accuracy: see the bias)"
+                                : "(the same-scene match other conditions are compared "
+                                  "with)");
+            continue;
+        }
+        if (c.factors.size() > 1) {
+            std::string list;
+            for (const auto& f : c.factors) list += (list.empty() ? "" : ", ") + f;
+            c.constancy_text = "no constancy index: the target and the match differ in " +
+                               std::to_string(c.factors.size()) + " scene factors (" +
+                               list + "), not one";
+            continue;
+        }
+        if (!c.mean) {
+            c.constancy_text = "no constancy index: no matches";
+            continue;
+        }
+        std::optional<double> reference = c.target_value;
+        std::string against = "the target's own value";
+        if (!reference)
+            for (const ConditionMatch& o : out)
+                if (&o != &c && o.target == c.target && o.knob == c.knob &&
+                    o.factors_known && o.factors.empty() && o.mean) {
+                    reference = o.mean;
+                    against =
+                        "the same-scene match in block " + o.block + ", " + text(*o.mean);
+                    break;
+                }
+        if (!reference) {
+            c.constancy_text = "no constancy index: " + c.no_value_reason +
+                               ", and no block matches this target in the same scene";
+            continue;
+        }
+        c.constancy_factor = c.factors.front();
+        c.constancy_reference = reference;
+        c.constancy =
+            constancy_index(*c.mean, *reference, c.range_min, c.range_max, c.log_scale);
+        if (c.constancy)
+            c.constancy_text = text(*c.constancy) + " across " + c.constancy_factor +
+                               " (against " + against + ")";
+        else
+            c.constancy_text =
+                "no constancy index: the range leaves no room around the reference" +
+                std::string(c.log_scale ? " (or a value is not positive on the log scale)"
+                                        : "");
     }
     return out;
 }

@@ -12,13 +12,16 @@
 //   another technique whose knob is not the match's).
 // - Bias = mean match - target value, its interval the mean's shifted by the target.
 // - Constancy index, where the target and the match differ in exactly one scene factor
-//   (a parameter other than the knob, the technique or the mesh):
-//       CI = 1 - |mean match - target| / max(target - lo, hi - target)
-//   on the knob's scale (its logarithm for a "log" block), lo..hi the block's range: 1 a
-//   perfect match across the factor (full constancy), 0 a match as far from the target
-//   as the range allows. A simple, bounded form of the Brunswik/Thouless ratio that
-//   needs no model of the "no constancy" match, which a picture-matching observer would
-//   make and the study does not measure.
+//   (differing_factors):
+//       CI = 1 - |mean match - reference| / max(reference - lo, hi - reference)
+//   on the knob's scale (its logarithm for a "log" block), lo..hi the block's range. The
+//   reference is the target's own value, or, when it has none (another technique), the
+//   mean match of the same target in a block whose match shares every scene factor with
+//   it (the same-scene match: what the target's material is on the knob). 1: the match
+//   across the factor equals the reference (full constancy); 0: it is as far from it as
+//   the range allows. A simple, bounded form of the Brunswik/Thouless ratio that needs
+//   no model of the "no constancy" match (a picture-matching observer's setting, which
+//   the study does not measure).
 // Never NaN or Inf: what is undefined is empty, and `notes` say why in words.
 #include <optional>
 #include <string>
@@ -49,7 +52,13 @@ struct ConditionMatch {
     std::optional<double> bias, bias_ci_low, bias_ci_high;
     std::optional<double> constancy;
     std::string constancy_factor;  // the scene factor the target and match differ in
-    std::string constancy_text;    // the index, or why there is none, in words
+    std::optional<double> constancy_reference;  // what the mean match is compared with
+    // The scene factors in which the target and the match differ (differing_factors),
+    // when both are live stimuli of the protocol.
+    std::vector<std::string> factors;
+    bool factors_known = false, picture_target = false;
+    std::string no_value_reason;  // why there is no target value
+    std::string constancy_text;   // the index, or why there is none, in words
     bool all_at_range_end = false;
     std::vector<std::string> notes;
 };
@@ -81,8 +90,10 @@ std::optional<double> constancy_index(double mean_match, double target, double l
 std::optional<double> knob_value(const study::Protocol& protocol,
                                  const std::string& stimulus, const std::string& knob);
 
-// The scene factors in which two live stimuli differ, the knob aside: "technique",
-// "mesh" and each parameter whose text differs (or that one of them lacks).
+// The scene factors in which two live stimuli differ, the knob aside: "mesh", and each
+// parameter whose text differs (or that one of them lacks); across techniques only the
+// scene's knobs (light, camera, background: renderer/core/common_knobs.h), since each
+// technique's own knobs describe the material being matched.
 std::vector<std::string> differing_factors(const study::StimulusSpec& a,
                                            const study::StimulusSpec& b,
                                            const std::string& knob);

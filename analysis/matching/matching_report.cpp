@@ -100,10 +100,12 @@ void add_matching(MatchingSection& section, const std::vector<ConditionMatch>& m
         "with two or more participants, over the participant means). The bias is the "
         "mean match minus the target's own value of the knob, where the target is a "
         "live stimulus of the match's technique. The constancy index, where the target "
-        "and the match differ in exactly one scene factor, is 1 - |mean match - target| "
-        "/ max(target - low end, high end - target) on the knob's scale (its logarithm "
-        "for a log block): 1 is a perfect match across the factor, 0 a match as far "
-        "from the target as the range allows."));
+        "and the match differ in exactly one scene factor, is 1 - |mean match - "
+        "reference| / max(reference - low end, high end - reference) on the knob's "
+        "scale (its logarithm for a log block); the reference is the target's own value, "
+        "or else its match in a block where target and match share every scene factor: "
+        "1 is a match across the factor equal to the reference, 0 a match as far "
+        "from it as the range allows."));
     Table t{{"block", "target", "knob", "n", "mean", "SD", "95% CI", "participants",
              "participant means 95% CI", "target value", "bias", "bias 95% CI",
              "constancy index"},

@@ -90,13 +90,14 @@ inline study::Protocol protocol() {
     return study::parse_protocol(kProtocol, "matching.toml");
 }
 
-// A participant's staircase trials in block "j": the block's procedures interleaved in
+// A participant's staircase trials in `block_id`: the block's procedures interleaved in
 // rounds (a random order each round), each answered by `observer`, the comparison's
 // place drawn at random.
 inline std::vector<StaircaseRow> simulate_staircases(
     const study::Protocol& p, const std::string& participant,
-    const study::DetectionObserver& observer, std::mt19937_64& rng) {
-    const study::Block& block = *p.find_block("j");
+    const study::DetectionObserver& observer, std::mt19937_64& rng,
+    const std::string& block_id = "j") {
+    const study::Block& block = *p.find_block(block_id);
     study::adaptive::StaircaseBlock procedures(block);
     const double guess = study::adaptive::guess_rate(block);
     std::vector<StaircaseRow> rows;
@@ -115,12 +116,13 @@ inline std::vector<StaircaseRow> simulate_staircases(
             r.participant = participant;
             r.session = participant + "-s";
             r.trial = position++;
-            r.block = std::string("j");
+            r.block = block_id;
             r.standard = label.substr(0, label.find('/'));
             r.staircase = label;
             r.intensity = delta;
-            r.expected = 1 + static_cast<int>(rng() % 2);
-            r.choice = correct ? r.expected : 3 - r.expected;
+            const int places = block.answers();
+            r.expected = 1 + static_cast<int>(rng() % places);
+            r.choice = correct ? r.expected : 1 + r.expected % places;
             r.correct = correct;
             rows.push_back(r);
         }
