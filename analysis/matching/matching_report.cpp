@@ -47,14 +47,26 @@ std::string match_plot(const std::string& block,
     const std::string knob = cs.front()->knob.empty() ? "knob" : cs.front()->knob;
     panel.y_label = "match " + knob + " (mean, 95% CI)";
     panel.join = false;
-    bool any_value = false;
-    for (const ConditionMatch* c : cs) any_value = any_value || c->target_value;
-    if (any_value) {
-        panel.x_label = "target's " + knob + " (line: match = target)";
+    // Each condition's x: the target's value, else the same-scene match its constancy
+    // index compares it with.
+    auto x_of = [](const ConditionMatch* c) {
+        return c->target_value ? c->target_value : c->constancy_reference;
+    };
+    bool any_value = false, any_reference = false;
+    for (const ConditionMatch* c : cs) {
+        any_value = any_value || c->target_value;
+        any_reference = any_reference || (!c->target_value && c->constancy_reference);
+    }
+    if (any_value || any_reference) {
+        panel.x_label =
+            (any_reference ? (any_value ? "target's " + knob + " or its same-scene match"
+                                        : "the target's same-scene match")
+                           : "target's " + knob) +
+            " (line: equal)";
         double lo = INFINITY, hi = -INFINITY;
         for (const ConditionMatch* c : cs) {
-            if (!c->target_value || !c->mean) continue;
-            panel.x.push_back(*c->target_value);
+            if (!x_of(c) || !c->mean) continue;
+            panel.x.push_back(*x_of(c));
             panel.y.push_back(*c->mean);
             panel.y_low.push_back(or_nan(c->ci_low));
             panel.y_high.push_back(or_nan(c->ci_high));
@@ -72,6 +84,10 @@ std::string match_plot(const std::string& block,
                 hi += 0.5;
             }
             panel.series.push_back({"match = target", {lo, hi}, {lo, hi}});
+            if (cs.front()->log_scale && lo > 0) {
+                panel.x_axis.scale = common::AxisScale::log;
+                panel.y_axis.scale = common::AxisScale::log;
+            }
             panel.series_behind = true;
             panel.main_label = "mean match";
         }

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "analysis/matching/matching.h"
+#include "analysis/matching/matching_report.h"
 #include "analysis/matching/thresholds.h"
 #include "tests/analysis/matching/matching_fixtures.h"
 
@@ -50,6 +51,14 @@ TEST(BuiltinStudies, MatchingCrossedLightIsComparedWithTheSameLightMatch) {
     EXPECT_NE(cross.constancy_text.find("against the same-scene match in block back"),
               std::string::npos)
         << cross.constancy_text;
+    // The crossed-light block is plotted against the same-light match, the same-light
+    // block by target name.
+    const MatchingSection section = matching_section(cs, {});
+    std::string plots;
+    for (const Block& b : section.blocks)
+        if (b.kind == Block::kPlot) plots += b.svg;
+    EXPECT_NE(plots.find("same-scene match (line: equal)"), std::string::npos)
+        << plots.substr(0, 4000);
     // Without the same-light block there is no reference: said in words.
     const auto alone =
         analyse_matches({row("A", "cross", "dipole_marble_back", "match_front", 20)}, &p);
