@@ -148,24 +148,45 @@ std::vector<ConditionMatch> analyse_matches(const std::vector<MatchRow>& rows,
             it->second.push_back(r->final_value);
         }
         c.n = static_cast<int>(values.size());
-        const MeanInterval m = mean_interval(values, options.level);
-        c.mean = m.mean;
+        // A log block's matches are averaged on log10 (a geometric mean; its interval
+        // back-transformed, its SD in log10 units), as the participant turned the knob.
+        const bool all_positive =
+            std::all_of(values.begin(), values.end(), [](double v) { return v > 0; });
+        c.on_log10 = c.log_scale && all_positive;
+        if (c.log_scale && !all_positive)
+            c.notes.push_back(
+                "A match of 0 or less on a log block: the statistics are on the knob's "
+                "own "
+                "scale.");
+        auto scaled = [&](std::vector<double> v) {
+            if (c.on_log10)
+                for (double& x : v) x = std::log10(x);
+            return v;
+        };
+        auto back = [&](const std::optional<double>& v) -> std::optional<double> {
+            if (!v || !c.on_log10) return v;
+            const double x = std::pow(10.0, *v);
+            if (!std::isfinite(x)) return std::nullopt;
+            return x;
+        };
+        const MeanInterval m = mean_interval(scaled(values), options.level);
+        c.mean = back(m.mean);
         c.sd = m.sd;
-        c.ci_low = m.low;
-        c.ci_high = m.high;
+        c.ci_low = back(m.low);
+        c.ci_high = back(m.high);
         std::vector<double> means;
         for (ParticipantMatch& p : c.participants) {
             const auto& v = per[p.participant];
             p.n = static_cast<int>(v.size());
-            p.mean = *mean_interval(v).mean;
+            p.mean = back(mean_interval(scaled(v)).mean).value_or(0.0);
             means.push_back(p.mean);
         }
         if (means.size() >= 2) {
-            const MeanInterval pm = mean_interval(means, options.level);
-            c.participant_mean = pm.mean;
+            const MeanInterval pm = mean_interval(scaled(means), options.level);
+            c.participant_mean = back(pm.mean);
             c.participant_sd = pm.sd;
-            c.participant_ci_low = pm.low;
-            c.participant_ci_high = pm.high;
+            c.participant_ci_low = back(pm.low);
+            c.participant_ci_high = back(pm.high);
         }
         if (c.n == 1)
             c.notes.push_back("One match only: no SD and no interval.");

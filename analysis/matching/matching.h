@@ -6,7 +6,8 @@
 // - Mean, SD, n and the t interval of the mean over the condition's trials (every trial
 //   an observation); each participant's mean, and, with two or more participants, the
 //   t interval over the participant means (the interval to quote when trials of one
-//   person are not independent).
+//   person are not independent). A "log" block's on log10: geometric means, intervals
+//   back-transformed, SDs in log10 units.
 // - The target's value: its `knob` parameter when the target is a live stimulus of the
 //   match's technique that states it; else none ("no physical value": a picture, or
 //   another technique whose knob is not the match's).
@@ -42,9 +43,12 @@ struct ConditionMatch {
     std::string block, target, match, knob;
     bool log_scale = false;  // the block's scale is "log"
     double range_min = 0, range_max = 0;
-    int n = 0;                                        // trials
-    std::optional<double> mean, sd, ci_low, ci_high;  // of the final values (trials)
-    std::vector<ParticipantMatch> participants;       // first seen first
+    int n = 0;  // trials
+    // Of the final values over the trials. A log block's (on_log10): the geometric mean,
+    // its interval from log10's t interval back-transformed, the SD in log10 units.
+    std::optional<double> mean, sd, ci_low, ci_high;
+    bool on_log10 = false;
+    std::vector<ParticipantMatch> participants;  // first seen first
     // Over the participant means (two or more participants).
     std::optional<double> participant_mean, participant_sd, participant_ci_low,
         participant_ci_high;

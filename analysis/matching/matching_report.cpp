@@ -107,13 +107,15 @@ void add_matching(MatchingSection& section, const std::vector<ConditionMatch>& m
     if (matches.empty()) return;
     std::ostringstream csv;
     csv_row(csv, {"block", "target", "match", "knob", "participant", "n", "mean", "sd",
-                  "ci_low", "ci_high", "target_value", "bias", "bias_ci_low",
+                  "sd_scale", "ci_low", "ci_high", "target_value", "bias", "bias_ci_low",
                   "bias_ci_high", "constancy_index", "constancy_factor"});
     section.blocks.push_back(heading("Matching", 2));
     section.blocks.push_back(paragraph(
         "Each condition is an adjust block's target: the values of the match's knob the "
         "participants confirmed, their mean, SD and 95% t interval over the trials (and, "
-        "with two or more participants, over the participant means). The bias is the "
+        "with two or more participants, over the participant means); a log block's on "
+        "log10 (geometric means, intervals back-transformed, SDs in log10 units). The "
+        "bias is the "
         "mean match minus the target's own value of the knob, where the target is a "
         "live stimulus of the match's technique. The constancy index, where the target "
         "and the match differ in exactly one scene factor, is 1 - |mean match - "
@@ -133,19 +135,22 @@ void add_matching(MatchingSection& section, const std::vector<ConditionMatch>& m
         by_block[c.block].push_back(&c);
         t.rows.push_back(
             {c.block, c.target, c.knob, std::to_string(c.n), cell(c.mean),
-             c.n < 2 ? std::string("- (one match)") : cell(c.sd),
+             c.n < 2      ? std::string("- (one match)")
+             : c.on_log10 ? cell(c.sd) + " (log10)"
+                          : cell(c.sd),
              interval(c.ci_low, c.ci_high), std::to_string(c.participants.size()),
              interval(c.participant_ci_low, c.participant_ci_high),
              c.target_value ? format_short(c.target_value)
                             : std::string("no physical value"),
              cell(c.bias), interval(c.bias_ci_low, c.bias_ci_high), c.constancy_text});
         csv_row(csv, {c.block, c.target, c.match, c.knob, "(all)", std::to_string(c.n),
-                      full(c.mean), full(c.sd), full(c.ci_low), full(c.ci_high),
-                      full(c.target_value), full(c.bias), full(c.bias_ci_low),
-                      full(c.bias_ci_high), full(c.constancy), c.constancy_factor});
+                      full(c.mean), full(c.sd), c.on_log10 ? "log10" : "linear",
+                      full(c.ci_low), full(c.ci_high), full(c.target_value), full(c.bias),
+                      full(c.bias_ci_low), full(c.bias_ci_high), full(c.constancy),
+                      c.constancy_factor});
         for (const ParticipantMatch& p : c.participants)
             csv_row(csv, {c.block, c.target, c.match, c.knob, p.participant,
-                          std::to_string(p.n), format_full(p.mean), "", "", "",
+                          std::to_string(p.n), format_full(p.mean), "", "", "", "",
                           full(c.target_value),
                           c.target_value ? format_full(p.mean - *c.target_value) : "", "",
                           "", "", ""});

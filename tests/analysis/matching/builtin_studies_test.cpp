@@ -5,6 +5,7 @@
 // threshold).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "analysis/matching/matching.h"
@@ -40,13 +41,24 @@ TEST(BuiltinStudies, MatchingCrossedLightIsComparedWithTheSameLightMatch) {
     EXPECT_FALSE(back.constancy);
     EXPECT_NE(back.constancy_text.find("share every scene factor"), std::string::npos)
         << back.constancy_text;
+    // A log block's statistics are on log10: the geometric mean sqrt(10 * 12), the SD
+    // of log10 10 and log10 12, |log10 12 - log10 10| / sqrt(2).
+    EXPECT_TRUE(back.on_log10);
+    EXPECT_NEAR(*back.mean, std::sqrt(120.0), 1e-12);
+    EXPECT_NEAR(*back.sd, std::log10(1.2) / std::sqrt(2.0), 1e-14);
+    // t(0.975, 1) = 12.7062047361747: the interval 10^(log10 mean -+ t SD / sqrt 2).
+    const double half = 12.7062047361747 * std::log10(1.2) / 2.0;
+    EXPECT_NEAR(std::log10(*back.ci_low), std::log10(std::sqrt(120.0)) - half, 1e-9);
+    EXPECT_NEAR(std::log10(*back.ci_high), std::log10(std::sqrt(120.0)) + half, 1e-9);
     // Crossed light: one scene factor, light_direction; the reference is the same-light
-    // match 11, on log10 over the range 1..100.
+    // match sqrt(120), the cross match sqrt(440), on log10 over the range 1..100.
     EXPECT_EQ(cross.factors, std::vector<std::string>{"light_direction"});
     EXPECT_EQ(cross.constancy_factor, "light_direction");
     ASSERT_TRUE(cross.constancy_reference && cross.constancy) << cross.constancy_text;
-    EXPECT_DOUBLE_EQ(*cross.constancy_reference, 11.0);
-    const double expected = 1.0 - std::log10(21.0 / 11.0) / std::log10(11.0);
+    EXPECT_NEAR(*cross.constancy_reference, std::sqrt(120.0), 1e-12);
+    const double reference = std::log10(std::sqrt(120.0));
+    const double expected = 1.0 - (std::log10(std::sqrt(440.0)) - reference) /
+                                      std::max(reference - 0.0, 2.0 - reference);
     EXPECT_NEAR(*cross.constancy, expected, 1e-12);
     EXPECT_NE(cross.constancy_text.find("against the same-scene match in block back"),
               std::string::npos)
