@@ -15,6 +15,8 @@
 #include "analysis/data/matching_table.h"
 #include "analysis/matching/matching_report.h"
 #include "analysis/report/report.h"
+#include "app/cli_main.h"
+#include "app/commands.h"
 #include "study/adaptive/staircase_block.h"
 #include "study/study_store.h"
 #include "study/trial_plan.h"
@@ -190,6 +192,28 @@ TEST(MatchingStore, ReadsBackWhatTheStoreRecordedAndReportsIt) {
     static const std::regex bad(
         R"((^|[^A-Za-z])-?(nan|NaN|NAN|inf|Inf|INF)([^A-Za-z]|$))");
     for (const fs::path& f : written) EXPECT_FALSE(std::regex_search(read(f), bad)) << f;
+
+    // The same through `lucent analyze` (in process), with the Weibull too.
+    for (const std::string family : {"gaussian", "weibull"}) {
+        const std::string out = (dir / ("cli_" + family)).string();
+        std::vector<std::string> args = {"lucent", "analyze",     db,   "--out",
+                                         out,      "--bootstrap", "50", "--psychometric",
+                                         family};
+        std::vector<char*> argv;
+        for (std::string& a : args) argv.push_back(a.data());
+        ASSERT_EQ(app::run_cli(static_cast<int>(argv.size()), argv.data(),
+                               {app::register_analyze}),
+                  app::kExitOk)
+            << family;
+        const std::string cli_html = read(fs::path(out) / "report.html");
+        EXPECT_NE(cli_html.find(">Matching<"), std::string::npos);
+        EXPECT_NE(cli_html.find(">Thresholds<"), std::string::npos);
+        EXPECT_NE(cli_html.find(family == "weibull" ? "Weibull" : "cumulative Gaussian"),
+                  std::string::npos);
+        EXPECT_NE(cli_html.find("2 of 3 sessions analysed"), std::string::npos);
+        for (const auto& f : fs::directory_iterator(out))
+            EXPECT_FALSE(std::regex_search(read(f.path()), bad)) << f.path();
+    }
 }
 
 TEST(MatchingStore, ADatabaseWithoutSuchTrialsGivesNoRows) {
