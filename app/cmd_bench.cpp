@@ -4,6 +4,8 @@
 
 namespace lucent::app {
 
+void register_bench_adjust(CLI::App& bench, int& exit_code);  // bench_adjust.cpp
+
 void register_bench(CLI::App& app, int& exit_code) {
     auto* bench = app.add_subcommand(
         "bench",
@@ -11,6 +13,7 @@ void register_bench(CLI::App& app, int& exit_code) {
         "with ratios");
     bench->require_subcommand(1);
     register_bench_families(*bench, exit_code);
+    register_bench_adjust(*bench, exit_code);
 }
 
 }  // namespace lucent::app

@@ -29,6 +29,8 @@ struct RunArgs {
     std::string images_dir;
     int64_t seed = -1;
     std::string observer = default_observer();
+    std::string detection;  // "" = DetectionObserver{}
+    std::string match;      // "" = MatchObserver{}
     study::RunOptions options;
 };
 
@@ -45,10 +47,23 @@ int run_command(RunArgs& args) {
         return kExitUsage;
     }
     try {
+        if (!args.detection.empty())
+            o.autopilot_detection = study::DetectionObserver::parse(args.detection);
+    } catch (const std::invalid_argument& e) {
+        std::cerr << "lucent run: --autopilot-detection: " << e.what() << "\n";
+        return kExitUsage;
+    }
+    try {
+        if (!args.match.empty())
+            o.autopilot_match = study::MatchObserver::parse(args.match);
+    } catch (const std::invalid_argument& e) {
+        std::cerr << "lucent run: --autopilot-match: " << e.what() << "\n";
+        return kExitUsage;
+    }
+    try {
         o.protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                          : study::builtin_protocol(args.preset);
         if (args.seed >= 0) o.seed = static_cast<uint64_t>(args.seed);
-        study::check_presentable(o.protocol);
         study::plan_trials(o.protocol, 0,
                            0);  // impossible randomisation fails here, early
         study::LiveOrPrerenderedStimuli stimuli(args.images_dir);
@@ -120,6 +135,14 @@ void register_run(CLI::App& app, int& exit_code) {
            "(scale psi = x^EXPONENT over the block's series, decision noise SIGMA "
            "in units of its range, a share LAPSE of random choices)")
         ->capture_default_str();
+    cmd->add_option("--autopilot-detection", args->detection,
+                    "How a seeded autopilot answers staircase trials: "
+                    "THRESHOLD,SPREAD[,LAPSE] (a cumulative Gaussian in the delta, "
+                    "guessing when it does not see it)");
+    cmd->add_option(
+        "--autopilot-match", args->match,
+        "How a seeded autopilot settles an adjustment: BIAS,NOISE[,log] "
+        "(target + BIAS + N(0, NOISE^2), on the knob's logarithm with 'log')");
     cmd->add_option(
         "--screenshot", args->options.screenshot_path,
         "Save the first trial screen (rating or choice) as a PNG (for tests)");

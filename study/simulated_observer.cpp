@@ -155,6 +155,24 @@ bool simulated_detection(const DetectionObserver& observer, double delta, double
     return uniform(rng) < guess;
 }
 
+MatchObserver MatchObserver::parse(const std::string& text) {
+    std::string numbers = text;
+    MatchObserver o;
+    if (const size_t comma = numbers.rfind(',');
+        comma != std::string::npos && numbers.substr(comma + 1) == "log") {
+        o.log_scale = true;
+        numbers.resize(comma);
+    }
+    const std::vector<double> parts = observer_numbers(numbers, "BIAS,NOISE[,log]");
+    if (parts.size() != 2)
+        throw std::invalid_argument("observer '" + text + "': expected BIAS,NOISE[,log]");
+    o.bias = parts[0];
+    o.noise = parts[1];
+    if (!(o.noise >= 0))
+        throw std::invalid_argument("observer '" + text + "': NOISE must be >= 0");
+    return o;
+}
+
 double simulated_match(const MatchObserver& observer, double target, double lo, double hi,
                        std::mt19937_64& rng) {
     std::normal_distribution<double> noise(0.0, observer.noise);

@@ -86,6 +86,9 @@ struct MatchObserver {
     double bias = 0.0;
     double noise = 0.0;
     bool log_scale = false;
+    // "BIAS,NOISE[,log]" (log: on the knob's logarithm); throws std::invalid_argument
+    // naming the bad part.
+    static MatchObserver parse(const std::string& text);
 };
 double simulated_match(const MatchObserver& observer, double target, double lo, double hi,
                        std::mt19937_64& rng);

@@ -169,4 +169,50 @@ ChoiceLayout compute_choice_layout(const ChoiceLayoutInput& in) {
     return l;
 }
 
+AdjustLayout compute_adjust_layout(int screen_width, int screen_height,
+                                   PictureSize target, PictureSize match, int row_height,
+                                   int gap) {
+    ChoiceLayoutInput in;
+    in.screen_width = screen_width;
+    in.screen_height = screen_height;
+    in.task = Task::pair;
+    in.show = ChoiceShow::all;
+    in.pictures = {target, match};
+    in.row_height = row_height;
+    in.gap = gap;
+    const ChoiceLayout pair = compute_choice_layout(in);
+    if (!pair.fits) return AdjustLayout{.fits = false};
+    AdjustLayout l;
+    l.target = pair.picture[0];
+    l.match = pair.picture[1];
+    l.question = pair.question;
+    l.hint = {0, pair.label[0].y, screen_width, row_height};
+    return l;
+}
+
+OddityLayout compute_oddity_layout(int screen_width, int screen_height,
+                                   const std::vector<PictureSize>& pictures,
+                                   int row_height, int gap) {
+    ChoiceLayoutInput in;
+    in.screen_width = screen_width;
+    in.screen_height = screen_height;
+    in.task = Task::triad;
+    in.show = ChoiceShow::all;
+    in.pictures = pictures;
+    in.row_height = row_height;
+    in.gap = gap;
+    const ChoiceLayout triad = compute_choice_layout(in);
+    if (!triad.fits || pictures.size() != 3) return OddityLayout{.fits = false};
+    OddityLayout l;
+    l.picture = triad.picture;
+    l.question = triad.question;
+    // The names one row under the pictures, where a triad's brackets start.
+    const int below = triad.bracket[0].y;
+    for (const Rect& p : l.picture) {
+        l.label.push_back({p.x, below, p.width, row_height});
+        l.alternative.push_back(bounding(p, l.label.back()));
+    }
+    return l;
+}
+
 }  // namespace lucent::study

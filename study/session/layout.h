@@ -76,6 +76,30 @@ struct ChoiceLayout {
 // stay on screen. Too wide or too tall for the screen: fits = false.
 ChoiceLayout compute_choice_layout(const ChoiceLayoutInput& in);
 
+// ---- matching and thresholds (issue 31) ---------------------------------------------
+// An adjust trial: the target (left) and the live match (right) side by side, each pixel
+// for pixel, laid out as a side-by-side pair; the question one row above them, the hint
+// line (the keys) one row below. Too large for the screen: fits = false.
+struct AdjustLayout {
+    bool fits = true;
+    Rect target, match, question, hint;
+};
+AdjustLayout compute_adjust_layout(int screen_width, int screen_height,
+                                   PictureSize target, PictureSize match, int row_height,
+                                   int gap = 24);
+
+// An odd-one-out staircase trial side by side: three pictures in a row as a triad's
+// (no brackets), each picture's answer name under it, a click on a picture or its name
+// picks it (answers 1..3 left to right). Too large for the screen: fits = false.
+struct OddityLayout {
+    bool fits = true;
+    std::vector<Rect> picture, label, alternative;
+    Rect question;
+};
+OddityLayout compute_oddity_layout(int screen_width, int screen_height,
+                                   const std::vector<PictureSize>& pictures,
+                                   int row_height, int gap = 24);
+
 // Which picture indices a sequence's part shows: a pair's {0} or {1}; a triad's {0, 1}
 // or {1, 2}; a quadruple's {0, 1} or {2, 3}. `all`: every one; otherwise none.
 std::vector<int> choice_part(Task task, ChoiceShow show);

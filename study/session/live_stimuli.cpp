@@ -5,6 +5,7 @@
 #include "renderer/core/image.h"
 #include "renderer/gl/frame_executor.h"
 #include "renderer/render.h"
+#include "study/session/live_knob.h"
 
 namespace lucent::study {
 
@@ -31,6 +32,14 @@ std::vector<StimulusProvenance> LiveOrPrerenderedStimuli::provenance(
     for (const ResolvedProtocolStimulus& r : resolved(protocol))
         rows.push_back(r.provenance);
     return rows;
+}
+
+std::shared_ptr<const Scene> LiveOrPrerenderedStimuli::live_scene(
+    const StimulusSpec& spec) const {
+    if (!images_.path_for(spec).empty()) return nullptr;
+    for (const ResolvedProtocolStimulus& r : resolved_)
+        if (r.provenance.stimulus == spec.id) return r.scene;
+    return nullptr;
 }
 
 StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int width,
@@ -62,15 +71,7 @@ StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int w
                             "': " + std::to_string(rendered.non_finite_pixels) +
                             " pixels had NaN or Inf values (a renderer or driver bug); "
                             "refusing to show a repaired picture");
-    const Image& image = rendered.image;
-    CpuImage out{image.width, image.height,
-                 std::vector<uint8_t>(size_t(image.width) * image.height * 4)};
-    for (size_t i = 0; i < size_t(image.width) * image.height; ++i) {
-        for (int c = 0; c < 3; ++c)  // as write_image encodes PNG stimuli
-            out.rgba[i * 4 + c] = srgb_encode_8bit(image.rgba[i * 4 + c]);
-        out.rgba[i * 4 + 3] = 255;  // opaque, like the RGB PNG of the same stimulus
-    }
-    return upload_texture(out, "stimulus '" + spec.id + "'");
+    return upload_texture(encode_stimulus(rendered.image), "stimulus '" + spec.id + "'");
 }
 
 }  // namespace lucent::study

@@ -27,6 +27,11 @@ public:
     // The rows of the resolution check() made (made now if check() was not called).
     std::vector<StimulusProvenance> provenance(const Protocol& protocol) const override;
 
+    // The resolved scene of a live stimulus rendered live (null for an image stimulus
+    // and one shown from an --images file): what a LiveKnobRenderer (live_knob.h) turns
+    // a knob of. check() the protocol first.
+    std::shared_ptr<const Scene> live_scene(const StimulusSpec& spec) const;
+
     // Called with each scene just before it is rendered (tests: the scene the renderer
     // received).
     std::function<void(const Scene&)> on_render;

@@ -23,6 +23,8 @@
 #include "study/session/autopilot.h"
 #include "study/session/frame_timing.h"
 #include "study/session/layout.h"
+#include "study/session/live_knob.h"
+#include "study/session/live_stimuli.h"
 #include "study/session/session_flow.h"
 #include "study/session/x_key_events.h"
 #include "study/session/x_keyboard.h"
@@ -76,7 +78,8 @@ void on_glfw_key(GLFWwindow* window, int key, int scancode, int action, int mods
     int digit = 0;
     if (action == GLFW_PRESS)
         if (const auto k = key_for_glfw(key, &digit))
-            log->presses.push_back({*k, digit, steady_now_ns()});
+            log->presses.push_back(
+                {*k, digit, steady_now_ns(), (mods & GLFW_MOD_SHIFT) != 0});
     if (log->chained) log->chained(window, key, scancode, action, mods);
 }
 
@@ -112,6 +115,14 @@ private:
     void draw(int w, int h);
     void draw_rating_panel(const ScreenLayout& layout);
     void draw_choice(int w, int h);
+    // ---- adjust and staircase trials (issue 31)
+    std::string check_live_blocks() const;
+    LiveKnobRenderer& knob_renderer(const std::string& stimulus, const std::string& knob);
+    void prepare_live();  // the match (or the comparison) for what is on screen next
+    const StimulusTexture& shown_texture(size_t place) const;
+    std::optional<AdjustLayout> adjust_layout(int w, int h) const;
+    void draw_adjust(int w, int h);
+    void draw_oddity(int w, int h);
     std::optional<ChoiceLayout> choice_layout(ChoiceShow show, int w, int h) const;
     bool waits_for_a_larger_window(int w, int h);
     void present(int w, int h);
@@ -144,6 +155,13 @@ private:
     // Clicks and buttons seen while drawing, applied once the frame is drawn, so the
     // screen never changes half way through drawing it.
     std::vector<std::function<void()>> ui_actions_;
+    // Live renderers of a stimulus with one knob turned (an adjust trial's match, a
+    // staircase's comparison), by "stimulus/knob"; before window_ dies.
+    std::map<std::string, std::unique_ptr<LiveKnobRenderer>> knob_renderers_;
+    // What the match's (the comparison's) texture shows now: the trial and the value.
+    std::optional<std::pair<int64_t, double>> live_shown_;
+    const StimulusTexture* live_texture_ = nullptr;
+    bool dragging_ = false;  // a drag that started on the match
     bool screenshot_done_ = false;
     bool too_small_logged_ = false;
 };
@@ -223,6 +241,8 @@ void Session::open_window() {
     if (!opt_.autopilot.empty()) {
         autopilot_ = Autopilot::from_argument(opt_.autopilot, opt_.autopilot_speed,
                                               opt_.autopilot_observer);
+        autopilot_->set_threshold_observers(opt_.autopilot_detection,
+                                            opt_.autopilot_match);
         x_keyboard_.emplace(window_->glfw());
         x_keyboard_->focus_window();
     }
@@ -404,7 +424,10 @@ std::optional<ChoiceLayout> Session::choice_layout(ChoiceShow show, int w, int h
     ChoiceLayoutInput in;
     in.screen_width = w;
     in.screen_height = h;
-    in.task = b->task;
+    // A staircase pair is laid out as a pair, an odd one out as a triad.
+    in.task = b->task != Task::staircase ? b->task
+              : b->pictures() == 3       ? Task::triad
+                                         : Task::pair;
     in.show = show;
     for (const std::string& id : t->shown) {
         const StimulusTexture& texture = textures_.at(id);
@@ -419,15 +442,18 @@ std::optional<ChoiceLayout> Session::choice_layout(ChoiceShow show, int w, int h
 bool Session::waits_for_a_larger_window(int w, int h) {
     if (flow_->screen() != Screen::Blank || flow_->paused()) return false;
     const Block* b = flow_->block();
-    if (!b || !b->is_choice()) return false;
-    const std::optional<ChoiceLayout> l =
-        choice_layout(choice_show(*b, std::nullopt), w, h);
-    if (!l || l->fits) {
+    if (!b || (!b->is_choice() && b->task != Task::adjust)) return false;
+    const bool fits = b->task == Task::adjust
+                          ? adjust_layout(w, h).value_or(AdjustLayout{}).fits
+                          : choice_layout(choice_show(*b, std::nullopt), w, h)
+                                .value_or(ChoiceLayout{})
+                                .fits;
+    if (fits) {
         too_small_logged_ = false;
         return false;
     }
     if (!too_small_logged_) {
-        const StimulusTexture& t = textures_.at(flow_->trial()->shown.front());
+        const StimulusTexture& t = textures_.at(flow_->trial()->stimulus);
         log_ << "lucent run: the window (" << w << " x " << h
              << ") is too small to show a " << task_name(b->task) << " of " << t.width
              << " x " << t.height
@@ -446,7 +472,7 @@ void Session::draw_choice(int w, int h) {
     ImDrawList* list = ImGui::GetBackgroundDrawList();
     for (size_t k = 0; k < l->picture.size(); ++k) {
         const Rect& r = l->picture[k];
-        list->AddImage(ui::imgui_texture(textures_.at(t.shown[l->index[k]]).texture),
+        list->AddImage(ui::imgui_texture(shown_texture(l->index[k]).texture),
                        ImVec2(float(r.x), float(r.y)),
                        ImVec2(float(r.x + r.width), float(r.y + r.height)));
     }
@@ -493,6 +519,179 @@ void Session::draw_choice(int w, int h) {
                 const int64_t t_ns = steady_now_ns();
                 ui_actions_.push_back(
                     [this, k, t_ns] { flow_->click_choice(k + 1, t_ns); });
+            }
+    }
+}
+
+// ---- adjust and staircase trials (issue 31) -------------------------------------------
+// Why the protocol's adjust and staircase blocks cannot be presented live ("" when they
+// can): their match and standards must be rendered here, not loaded from files.
+std::string Session::check_live_blocks() const {
+    const auto* live = dynamic_cast<const LiveOrPrerenderedStimuli*>(&stimuli_);
+    auto not_live = [&](const Block& b, const std::string& id) -> std::string {
+        const StimulusSpec* spec = p_.find_stimulus(id);
+        if (live && spec && live->live_scene(*spec)) return "";
+        return "block '" + b.id + "': stimulus '" + id +
+               "' must be rendered live (its knob '" + b.knob +
+               "' is turned during the session), not taken from a picture file";
+    };
+    for (const Block& b : p_.blocks) {
+        if (b.task == Task::adjust) {
+            if (std::string why = not_live(b, b.match); !why.empty()) return why;
+        } else if (b.task == Task::staircase) {
+            if (b.pictures() == 3 && b.presentation == Presentation::sequential)
+                return "block '" + b.id +
+                       "': an odd-one-out staircase in sequence is not presented by "
+                       "this build (use presentation = \"side_by_side\")";
+            for (const std::string& id : b.stimuli)
+                if (std::string why = not_live(b, id); !why.empty()) return why;
+        }
+    }
+    return "";
+}
+
+LiveKnobRenderer& Session::knob_renderer(const std::string& stimulus,
+                                         const std::string& knob) {
+    std::unique_ptr<LiveKnobRenderer>& slot = knob_renderers_[stimulus + "/" + knob];
+    if (!slot) {
+        const auto& live = dynamic_cast<const LiveOrPrerenderedStimuli&>(stimuli_);
+        slot = std::make_unique<LiveKnobRenderer>(
+            "stimulus '" + stimulus + "'", *live.live_scene(*p_.find_stimulus(stimulus)),
+            knob, p_.stimulus_width, p_.stimulus_height);
+    }
+    return *slot;
+}
+
+// On the blank before an adjust trial and while it runs: the match at the participant's
+// value (the planned start until the input exists), re-rendered only when the value
+// moved. On the blank before a staircase slot: the comparison, once.
+void Session::prepare_live() {
+    const TrialRow* t = flow_->trial();
+    const Block* b = flow_->block();
+    if (!t || !b || (b->task != Task::adjust && b->task != Task::staircase)) {
+        live_shown_.reset();
+        live_texture_ = nullptr;
+        return;
+    }
+    double value = 0;
+    std::string stimulus;
+    if (b->task == Task::adjust) {
+        const AdjustInput* input = flow_->adjustment();
+        value = input ? input->value()
+                      : std::clamp(t->start_value.value_or(b->range_min), b->range_min,
+                                   b->range_max);
+        stimulus = b->match;
+    } else {
+        const std::optional<double> v = flow_->comparison_value();
+        if (!v) return;
+        value = *v;
+        stimulus = t->stimulus;
+    }
+    if (live_shown_ && live_shown_->first == t->id && live_shown_->second == value)
+        return;
+    live_texture_ = &knob_renderer(stimulus, b->knob).render(value);
+    live_shown_ = std::make_pair(t->id, value);
+}
+
+// The picture at `place` (0-based) of a choice trial: a staircase's comparison at its
+// place, else the stimulus shown there.
+const StimulusTexture& Session::shown_texture(size_t place) const {
+    const TrialRow& t = *flow_->trial();
+    if (t.task == Task::staircase && static_cast<int>(place) + 1 == t.expected &&
+        live_texture_)
+        return *live_texture_;
+    return textures_.at(t.shown[place]);
+}
+
+std::optional<AdjustLayout> Session::adjust_layout(int w, int h) const {
+    const TrialRow* t = flow_->trial();
+    if (!t) return std::nullopt;
+    const StimulusTexture& target = textures_.at(t->stimulus);
+    return compute_adjust_layout(
+        w, h, {target.width, target.height}, {p_.stimulus_width, p_.stimulus_height},
+        static_cast<int>(ImGui::GetFrameHeightWithSpacing() * 1.25f));
+}
+
+void Session::draw_adjust(int w, int h) {
+    const TrialRow& t = *flow_->trial();
+    const Block& b = *flow_->block();
+    const std::optional<AdjustLayout> l = adjust_layout(w, h);
+    if (!l || !l->fits || !live_texture_) return;
+    ImDrawList* list = ImGui::GetBackgroundDrawList();
+    auto image = [list](const StimulusTexture& texture, const Rect& r) {
+        list->AddImage(ui::imgui_texture(texture.texture), ImVec2(float(r.x), float(r.y)),
+                       ImVec2(float(r.x + r.width), float(r.y + r.height)));
+    };
+    image(textures_.at(t.stimulus), l->target);
+    image(*live_texture_, l->match);
+    // The question and the keys; never the knob's value (the match is made by eye).
+    centred_text(list, l->question, colour(1, 1, 1), b.question);
+    if (t.practice) {
+        Rect above = l->question;
+        above.y -= above.height;
+        centred_text(list, above, colour(0.75f, 0.75f, 0.75f), "Practice");
+    }
+    centred_text(list, l->hint, colour(0.75f, 0.75f, 0.75f),
+                 "Left/Right: adjust (Shift: fine), wheel or drag, Enter: confirm");
+    if (!flow_->adjustment()) return;
+    // The wheel anywhere, a horizontal drag that starts on the match.
+    const ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureMouse) return;
+    const int64_t t_ns = steady_now_ns();
+    if (io.MouseWheel != 0.f) {
+        const double notches = io.MouseWheel;
+        ui_actions_.push_back([this, notches, t_ns] { flow_->wheel(notches, t_ns); });
+    }
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left))
+        dragging_ = l->match.contains(int(io.MousePos.x), int(io.MousePos.y));
+    if (!ImGui::IsMouseDown(ImGuiMouseButton_Left)) dragging_ = false;
+    if (dragging_ && io.MouseDelta.x != 0.f) {
+        const double dx = io.MouseDelta.x, width = l->match.width;
+        ui_actions_.push_back([this, dx, width, t_ns] { flow_->drag(dx, width, t_ns); });
+    }
+}
+
+// An odd one out side by side: three pictures, the comparison at its place, each
+// picture's name under it; 1..3 (or the arrows) and Enter, or a click, answer.
+void Session::draw_oddity(int w, int h) {
+    const TrialRow& t = *flow_->trial();
+    const Block& b = *flow_->block();
+    std::vector<PictureSize> sizes;
+    for (size_t k = 0; k < t.shown.size(); ++k) {
+        const StimulusTexture& texture = shown_texture(k);
+        sizes.push_back({texture.width, texture.height});
+    }
+    const OddityLayout l = compute_oddity_layout(
+        w, h, sizes, static_cast<int>(ImGui::GetFrameHeightWithSpacing() * 1.25f));
+    if (!l.fits) return;
+    ImDrawList* list = ImGui::GetBackgroundDrawList();
+    for (size_t k = 0; k < l.picture.size(); ++k) {
+        const Rect& r = l.picture[k];
+        list->AddImage(ui::imgui_texture(shown_texture(k).texture),
+                       ImVec2(float(r.x), float(r.y)),
+                       ImVec2(float(r.x + r.width), float(r.y + r.height)));
+    }
+    const ImU32 text = colour(1, 1, 1), chosen_colour = colour(0.9f, 0.6f, 0.1f);
+    centred_text(list, l.question, text, b.question);
+    if (t.practice) {
+        Rect above = l.question;
+        above.y -= above.height;
+        centred_text(list, above, colour(0.75f, 0.75f, 0.75f), "Practice");
+    }
+    const RatingInput* input = flow_->rating();
+    const std::optional<int> chosen = input ? input->rating(0) : std::nullopt;
+    for (size_t k = 0; k < l.label.size() && k < b.labels.size(); ++k)
+        centred_text(list, l.label[k], chosen == int(k) + 1 ? chosen_colour : text,
+                     b.labels[k]);
+    if (input && ImGui::IsMouseClicked(ImGuiMouseButton_Left) &&
+        !ImGui::GetIO().WantCaptureMouse) {
+        const ImVec2 m = ImGui::GetIO().MousePos;
+        for (size_t k = 0; k < l.alternative.size(); ++k)
+            if (l.alternative[k].contains(int(m.x), int(m.y))) {
+                const int64_t t_ns = steady_now_ns();
+                const int answer = static_cast<int>(k) + 1;
+                ui_actions_.push_back(
+                    [this, answer, t_ns] { flow_->click_choice(answer, t_ns); });
             }
     }
 }
@@ -549,6 +748,15 @@ void Session::draw(int w, int h) {
             ImGui::End();
             break;
         case Screen::Trial: {
+            if (flow_->block() && flow_->block()->task == Task::adjust) {
+                draw_adjust(w, h);
+                break;
+            }
+            if (flow_->block() && flow_->block()->task == Task::staircase &&
+                flow_->block()->pictures() == 3) {
+                draw_oddity(w, h);
+                break;
+            }
             if (flow_->block() && flow_->block()->is_choice()) {
                 draw_choice(w, h);
                 break;
@@ -644,6 +852,10 @@ RunResult Session::run() {
         log_ << "lucent run: " << e.what() << "\n";
         return RunResult::UsageError;
     }
+    if (const std::string why = check_live_blocks(); !why.empty()) {
+        log_ << "lucent run: " << p_.source << ": " << why << "\n";
+        return RunResult::UsageError;
+    }
     if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY")) {
         log_ << "lucent run: no display (DISPLAY is not set): run under 'xvfb-run -a "
                 "lucent run "
@@ -695,6 +907,14 @@ RunResult Session::run() {
         window_->framebuffer_size(w, h);
         // A choice trial too large for the window does not start (see draw()).
         if (!waits_for_a_larger_window(w, h)) flow_->tick(steady_now_ns());
+        // The live match or comparison, before the frame that shows it.
+        try {
+            prepare_live();
+        } catch (const std::exception& e) {
+            log_ << "lucent run: " << e.what() << "\n";
+            store_->set_status(session_.id, "paused", false);
+            return RunResult::Failure;
+        }
         present(w, h);
         // Without a paced display (Xvfb), cap the loop near 60 Hz instead of spinning.
         const int64_t swapped = steady_now_ns();

@@ -25,7 +25,11 @@ struct RunOptions {
     double autopilot_speed = 1.0;
     // How a seeded autopilot answers forced choices (simulated_observer.h).
     ObserverModel autopilot_observer;
-    std::string screenshot_path;  // save the first rating screen as PNG (tests)
+    // How it answers staircases (a known psychometric function) and adjustments (a known
+    // match bias).
+    DetectionObserver autopilot_detection;
+    MatchObserver autopilot_match;
+    std::string screenshot_path;  // save the first trial screen as PNG (tests)
     std::string key_trace_path;   // each key press's X event time and stamp (tests)
 };
 

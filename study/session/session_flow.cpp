@@ -12,8 +12,8 @@ void check_presentable(const Protocol& protocol) {
         if (b.task == Task::adjust || b.task == Task::staircase)
             throw ProtocolError(protocol.source + ": block '" + b.id + "': task '" +
                                 task_name(b.task) +
-                                "' cannot be run in a session by this build yet (it is "
-                                "planned, stored and exported)");
+                                "' is not shown in the browser yet (it is planned, "
+                                "stored and exported; 'lucent run' presents it)");
 }
 
 SessionFlow::SessionFlow(const Protocol& protocol, StudyStore& store, int64_t session_id,

@@ -55,10 +55,10 @@ struct TimedKey {
     bool shift = false;  // held with Shift (an adjustment's fine step)
 };
 
-// Adjust and staircase blocks are planned, stored and run by SessionFlow (issue 31),
-// but `lucent run` does not draw them and `lucent serve` does not show them yet: throws
-// ProtocolError naming the first such block, so both refuse the protocol before anything
-// is stored.
+// Adjust and staircase blocks are planned, stored and run by SessionFlow (issue 31), and
+// `lucent run` presents them (live), but `lucent serve` does not show them in the
+// browser yet: throws ProtocolError naming the first such block, so `lucent serve`
+// refuses the protocol before anything is stored.
 void check_presentable(const Protocol& protocol);
 
 class SessionFlow {

@@ -123,7 +123,10 @@ void XKeyEvents::loop() {
             down.set(code);
             const int64_t stamped =
                 key_press_time(t, static_cast<uint32_t>(event.xkey.time));
-            if (const auto press = press_for(event.xkey, stamped)) {
+            if (auto press = press_for(event.xkey, stamped)) {
+                // Shift held with it (the state before the event): an adjustment's
+                // fine step.
+                press->shift = (event.xkey.state & ShiftMask) != 0;
                 std::lock_guard<std::mutex> lock(mutex_);
                 pending_.push_back(*press);
                 if (trace_.is_open())

@@ -20,6 +20,13 @@ namespace lucent::study {
 
 namespace {
 
+// "Shift+KEY": KEY held with Shift (an adjustment's fine step).
+bool shifted(std::string& key) {
+    if (key.rfind("Shift+", 0) != 0) return false;
+    key = key.substr(6);
+    return true;
+}
+
 KeyCode keycode(Display* dpy, const std::string& key) {
     static const std::map<std::string, KeySym> kSyms = {{"1", XK_1},
                                                         {"2", XK_2},
@@ -74,11 +81,16 @@ void XKeyboard::focus_window() {
     XFlush(dpy);
 }
 
-void XKeyboard::tap(const std::string& key, int hold_ms) {
+void XKeyboard::tap(const std::string& name, int hold_ms) {
     Display* dpy = static_cast<Display*>(display_);
+    std::string key = name;
+    const bool shift = shifted(key);
     const KeyCode code = keycode(dpy, key);
+    const KeyCode shift_code = XKeysymToKeycode(dpy, XK_Shift_L);
+    if (shift) XTestFakeKeyEvent(dpy, shift_code, True, CurrentTime);
     XTestFakeKeyEvent(dpy, code, True, CurrentTime);
     XTestFakeKeyEvent(dpy, code, False, static_cast<unsigned long>(hold_ms));
+    if (shift) XTestFakeKeyEvent(dpy, shift_code, False, CurrentTime);
     XFlush(dpy);
 }
 
@@ -90,11 +102,20 @@ void XKeyboard::play(const std::vector<std::pair<double, std::string>>& script) 
     // Delays are rounded from the running total, so they never drift.
     double t = 0;
     long sent = 0;  // ms from the start of the last press sent
-    for (const auto& [delay, key] : script) {
+    const KeyCode shift_code = XKeysymToKeycode(dpy, XK_Shift_L);
+    for (const auto& [delay, name] : script) {
         const long at = std::lround(t += delay);
+        std::string key = name;
+        const bool shift = shifted(key);
         const KeyCode code = keycode(dpy, key);
-        XTestFakeKeyEvent(dpy, code, True, static_cast<unsigned long>(at - sent));
+        // Shift goes down with the key's delay, the key right after it.
+        if (shift)
+            XTestFakeKeyEvent(dpy, shift_code, True,
+                              static_cast<unsigned long>(at - sent));
+        XTestFakeKeyEvent(dpy, code, True,
+                          shift ? CurrentTime : static_cast<unsigned long>(at - sent));
         XTestFakeKeyEvent(dpy, code, False, CurrentTime);
+        if (shift) XTestFakeKeyEvent(dpy, shift_code, False, CurrentTime);
         sent = at;
     }
     XFlush(dpy);

@@ -22,8 +22,9 @@ public:
     // Moves the pointer into the window and gives it the input focus (no window
     // manager runs under Xvfb to do so).
     void focus_window();
-    // Press and release `key` (names as in autopilot.h); the release follows after
-    // `hold_ms`, as the X server schedules it.
+    // Press and release `key` (names as in autopilot.h; "Shift+Left" holds Shift
+    // around the arrow); the release follows after `hold_ms`, as the X server schedules
+    // it.
     void tap(const std::string& key, int hold_ms = 40);
     // Hands a whole script of (delay ms after the previous key, key) to the X server at
     // once, each press scheduled by the server's XTest delay: the key times are then

@@ -386,14 +386,14 @@ TEST(StaircaseBlock, AQuestFromTheProtocolIsHeldInsideTheDeltasRange) {
 namespace lucent::study {
 namespace {
 
-TEST(MatchingProtocol, ASessionRefusesWhatItCannotPresentBeforeStoringAnything) {
+TEST(MatchingProtocol, TheBrowserRefusesWhatItCannotPresentBeforeStoringAnything) {
     try {
         check_presentable(matching());
         FAIL() << "no refusal";
     } catch (const ProtocolError& e) {
         EXPECT_EQ(std::string(e.what()),
-                  "matching.toml: block 'm': task 'adjust' cannot be run in a session by "
-                  "this build yet (it is planned, stored and exported)");
+                  "matching.toml: block 'm': task 'adjust' is not shown in the browser "
+                  "yet (it is planned, stored and exported; 'lucent run' presents it)");
     }
     EXPECT_NO_THROW(check_presentable(builtin_protocol("thesis")));
 }

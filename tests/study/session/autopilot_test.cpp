@@ -103,5 +103,23 @@ TEST(Autopilot, ScriptsPlayInOrderAndBadLinesNameTheLine) {
     EXPECT_FALSE(Autopilot::from_argument("42", 1.0).scripted());
 }
 
+// `lucent run --autopilot-match BIAS,NOISE[,log]` and `--autopilot-detection T,S[,L]`.
+TEST(Autopilot, TheThresholdObserversParseFromTheCommandLine) {
+    const MatchObserver m = MatchObserver::parse("0.2,0.05,log");
+    EXPECT_DOUBLE_EQ(m.bias, 0.2);
+    EXPECT_DOUBLE_EQ(m.noise, 0.05);
+    EXPECT_TRUE(m.log_scale);
+    const MatchObserver linear = MatchObserver::parse("-0.5,0");
+    EXPECT_DOUBLE_EQ(linear.bias, -0.5);
+    EXPECT_FALSE(linear.log_scale);
+    EXPECT_THROW(MatchObserver::parse("0.2"), std::invalid_argument);
+    EXPECT_THROW(MatchObserver::parse("0.2,0.1,0.3"), std::invalid_argument);
+    EXPECT_THROW(MatchObserver::parse("0.2,-1"), std::invalid_argument);
+    EXPECT_THROW(MatchObserver::parse("a,1,log"), std::invalid_argument);
+    const DetectionObserver d = DetectionObserver::parse("0.3,0.1,0.02");
+    EXPECT_DOUBLE_EQ(d.threshold, 0.3);
+    EXPECT_DOUBLE_EQ(d.lapse, 0.02);
+}
+
 }  // namespace
 }  // namespace lucent::study

@@ -1136,5 +1136,142 @@ TEST_F(DataCommands, AnalysisRefusesARatingOutsideItsQuestionsScale) {
     EXPECT_FALSE(fs::exists(csv));
 }
 
+// Issue 31: adjust and staircase trials drawn live in `lucent run` (64 x 64 empirical
+// renders), answered by the seeded autopilot as a simulated observer: its arrows with
+// Shift reach the flow as fine steps through the X server, every staircase answer is
+// stored with its delta, and the session completes.
+TEST_F(SessionE2E, AdjustAndStaircaseTrialsAreDrawnLiveAndStoredToCompletion) {
+    LUCENT_REQUIRE_DISPLAY();
+    const fs::path protocol = dir_ / "matching.toml";
+    std::ofstream(protocol) << R"toml([study]
+name = "matching_e2e"
+inter_trial_ms = 100
+stimulus_size = [64, 64]
+
+[[stimuli]]
+id = "thin"
+technique = "empirical"
+mesh = "sphere:500"
+params = { thickness_exponent = 0.8 }
+
+[[stimuli]]
+id = "match"
+technique = "empirical"
+mesh = "sphere:500"
+params = { backlight = 0.6 }
+
+[[blocks]]
+id = "m"
+task = "adjust"
+stimuli = ["thin"]
+match = "match"
+knob = "thickness_exponent"
+range = [0.2, 5.0]
+scale = "log"
+step = 0.05
+fine_step = 0.01
+repeats = 2
+question = "Turn the right object until it looks like the left one."
+
+[[blocks]]
+id = "j"
+task = "staircase"
+stimuli = ["thin"]
+knob = "thickness_exponent"
+question = "Which looks more translucent?"
+
+[[blocks.staircases]]
+id = "a"
+start = 0.6
+n_up = 1
+n_down = 3
+step_sizes = [0.2, 0.1]
+n_trials = 4
+max_trials = 6
+
+[randomisation]
+counterbalance_blocks = false
+
+[[blocks]]
+id = "k"
+task = "staircase"
+stimuli = ["thin"]
+knob = "thickness_exponent"
+trial = "oddity"
+question = "Which one differs?"
+
+[[blocks.staircases]]
+id = "b"
+start = 0.6
+n_up = 1
+n_down = 2
+step_sizes = [0.2, 0.1]
+n_trials = 4
+max_trials = 6
+)toml";
+    const std::string db = (dir_ / "study.db").string();
+    const fs::path shot = dir_ / "adjust.png";
+    const Process p = start_lucent(
+        {"run", protocol.string(), "--db", db, "--participant", "P1", "--autopilot", "5",
+         "--autopilot-speed", "12", "--seed", "3", "--autopilot-match", "0.2,0.05,log",
+         "--autopilot-detection", "0.3,0.1", "--screenshot", shot.string()},
+        dir_);
+    ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
+    Database d(db, SQLITE_OPEN_READONLY);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"),
+              1);
+    // Two adjustments: a final value in the range, every change stored, fine steps
+    // among them (the autopilot's last keys are Shift + arrows unless it landed on a
+    // coarse step).
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE kind = 'adjust' AND "
+                           "final_value BETWEEN 0.2 AND 5.0"),
+              2);
+    EXPECT_GT(d.scalar_int("SELECT count(*) FROM adjustments WHERE input = 'key'"), 0);
+    EXPECT_GT(d.scalar_int("SELECT count(*) FROM adjustments WHERE input = 'fine_key'"),
+              0);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM adjustments a JOIN trials t ON t.id = "
+                           "a.trial_id WHERE t.kind <> 'adjust'"),
+              0);
+    // The staircases: each answered slot with the delta it showed, the first the
+    // procedure's start; a pair answered 1..2, an odd one out 1..3.
+    for (const std::string block : {"j", "k"}) {
+        SCOPED_TRACE(block);
+        const std::string answered =
+            "FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.kind = "
+            "'staircase' AND t.block = '" +
+            block + "'";
+        const int64_t n = d.scalar_int("SELECT count(*) " + answered);
+        EXPECT_GE(n, 4);
+        EXPECT_LE(n, 6);
+        EXPECT_EQ(d.scalar_int("SELECT count(*) " + answered + " AND t.intensity > 0"),
+                  n);
+        EXPECT_EQ(d.scalar_int("SELECT count(*) " + answered +
+                               " AND r.rating BETWEEN 1 "
+                               "AND " +
+                               (block == "j" ? "2" : "3")),
+                  n);
+        Statement first =
+            d.prepare("SELECT t.intensity " + answered + " ORDER BY t.position LIMIT 1");
+        ASSERT_TRUE(first.step());
+        EXPECT_DOUBLE_EQ(first.real(0), 0.6);
+    }
+    // The first adjust screen (1280 x 1024): the target and the match side by side at
+    // their true size, a row of 64 + 24 + 64 pixels centred (x 564 and 652, y 480), each
+    // a lit sphere on the black background.
+    const CpuImage screen = load_image_rgba8(shot.string());
+    ASSERT_EQ(screen.width, 1280);
+    for (const int x0 : {564, 652}) {
+        int lit = 0;
+        for (int y = 480; y < 544; ++y)
+            for (int x = x0; x < x0 + 64; ++x)
+                lit += screen.rgba[(size_t(y) * screen.width + x) * 4] > 60;
+        EXPECT_GT(lit, 1500) << x0;  // a sphere fills ~2,800 of the 4,096 pixels
+        int outside = 0;             // the gap between them: background
+        for (int y = 480; y < 544; ++y)
+            outside += screen.rgba[(size_t(y) * screen.width + 640) * 4] > 60;
+        EXPECT_EQ(outside, 0);
+    }
+}
+
 }  // namespace
 }  // namespace lucent::study

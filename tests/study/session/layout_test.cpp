@@ -195,3 +195,49 @@ TEST(ChoiceLayout, PicturesOfDifferentSizesShareTheRowsCentreLine) {
 
 }  // namespace
 }  // namespace lucent::study
+
+namespace lucent::study {
+namespace {
+
+TEST(AdjustLayout, TargetLeftMatchRightAtTrueSizeQuestionAboveHintBelow) {
+    const AdjustLayout l = compute_adjust_layout(1280, 1024, {256, 256}, {256, 256}, 32);
+    ASSERT_TRUE(l.fits);
+    // 256 + 24 + 256 = 536 wide, centred: x = (1280 - 536) / 2 = 372.
+    EXPECT_EQ(l.target, (Rect{372, 384, 256, 256}));
+    EXPECT_EQ(l.match, (Rect{372 + 256 + 24, 384, 256, 256}));
+    EXPECT_EQ(l.question, (Rect{0, 384 - 16 - 32, 1280, 32}));
+    EXPECT_EQ(l.hint, (Rect{0, 384 + 256 + 16, 1280, 32}));
+    // Pictures of two sizes keep theirs, centred on one line.
+    const AdjustLayout m = compute_adjust_layout(1280, 1024, {200, 100}, {64, 64}, 32);
+    ASSERT_TRUE(m.fits);
+    EXPECT_EQ(m.target.width, 200);
+    EXPECT_EQ(m.match.height, 64);
+    EXPECT_EQ(m.target.y + 50, m.match.y + 32);
+    EXPECT_FALSE(compute_adjust_layout(500, 1024, {256, 256}, {256, 256}, 32).fits);
+    EXPECT_FALSE(compute_adjust_layout(1280, 300, {256, 256}, {256, 256}, 32).fits);
+}
+
+TEST(OddityLayout, ThreePicturesEachWithItsNameUnderItAndItsOwnClickTarget) {
+    const OddityLayout l =
+        compute_oddity_layout(1280, 1024, {{256, 256}, {256, 256}, {256, 256}}, 32);
+    ASSERT_TRUE(l.fits);
+    ASSERT_EQ(l.picture.size(), 3u);
+    ASSERT_EQ(l.label.size(), 3u);
+    EXPECT_EQ(l.picture[0].x, (1280 - (3 * 256 + 2 * 24)) / 2);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(l.label[k].x, l.picture[k].x);
+        EXPECT_EQ(l.label[k].y, l.picture[k].y + 256 + 16);
+        EXPECT_TRUE(l.alternative[k].contains(l.picture[k].x + 1, l.picture[k].y + 1));
+        EXPECT_TRUE(l.alternative[k].contains(l.label[k].x + 1, l.label[k].y + 1));
+        for (int j = 0; j < 3; ++j)
+            if (j != k)
+                EXPECT_FALSE(l.alternative[j].contains(l.picture[k].x + 128,
+                                                       l.picture[k].y + 128));
+    }
+    EXPECT_EQ(l.question.y, l.picture[0].y - 16 - 32);
+    EXPECT_FALSE(
+        compute_oddity_layout(700, 1024, {{256, 256}, {256, 256}, {256, 256}}, 32).fits);
+}
+
+}  // namespace
+}  // namespace lucent::study
