@@ -62,6 +62,28 @@ TEST(Thresholds, RecoversASimulatedObserversJnd) {
     }
 }
 
+TEST(Thresholds, AnOddOneOutIsFittedWithAGuessRateOfAThird) {
+    std::string text = testing::kProtocol;
+    const std::string knob = "knob = \"thickness_exponent\"\nquestion = \"Which looks";
+    text.replace(
+        text.find(knob), knob.size(),
+        "knob = \"thickness_exponent\"\ntrial = \"oddity\"\nquestion = \"Which looks");
+    const study::Protocol p = study::parse_protocol(text, "odd.toml");
+    ASSERT_EQ(p.find_block("j")->answers(), 3);
+    // Seen half the time at delta 1: two thirds correct there, the odd one out's JND.
+    const study::DetectionObserver observer{1.0, 0.4, 0.0};
+    std::mt19937_64 rng(9);
+    const auto rows = testing::simulate_staircases(p, "P1", observer, rng);
+    for (const StaircaseRow& r : rows) ASSERT_TRUE(r.expected >= 1 && r.expected <= 3);
+    ThresholdOptions options;
+    options.bootstrap = 100;
+    const StandardThreshold s = analyse_thresholds(rows, &p, options).thresholds[0];
+    EXPECT_DOUBLE_EQ(s.guess, 1.0 / 3.0);
+    EXPECT_DOUBLE_EQ(s.p_correct, 2.0 / 3.0);
+    ASSERT_TRUE(s.jnd) << s.jnd_text;
+    EXPECT_NEAR(*s.jnd, observer.threshold, 0.3);
+}
+
 TEST(Thresholds, TheWeibullFitRecoversItToo) {
     const study::Protocol p = testing::protocol();
     const study::DetectionObserver observer{1.0, 0.4, 0.0};
