@@ -124,8 +124,8 @@ void add_matching(MatchingSection& section, const std::vector<ConditionMatch>& m
         "or else its match in a block where target and match share every scene factor: "
         "1 is a match across the factor equal to the reference, 0 a match as far "
         "from it as the range allows."));
-    Table t{{"block", "target", "knob", "n", "mean", "SD", "95% CI", "participants",
-             "participant means 95% CI", "target value", "bias", "bias 95% CI",
+    Table t{{"block (knob)", "target", "n", "mean", "SD", "95% CI",
+             "participant means: 95% CI", "target value", "bias", "bias 95% CI",
              "constancy index"},
             {}};
     std::map<std::string, std::vector<const ConditionMatch*>> by_block;
@@ -134,12 +134,14 @@ void add_matching(MatchingSection& section, const std::vector<ConditionMatch>& m
         if (by_block[c.block].empty()) block_order.push_back(c.block);
         by_block[c.block].push_back(&c);
         t.rows.push_back(
-            {c.block, c.target, c.knob, std::to_string(c.n), cell(c.mean),
+            {c.block + (c.knob.empty() ? std::string() : " (" + c.knob + ")"), c.target,
+             std::to_string(c.n), cell(c.mean),
              c.n < 2      ? std::string("- (one match)")
              : c.on_log10 ? cell(c.sd) + " (log10)"
                           : cell(c.sd),
-             interval(c.ci_low, c.ci_high), std::to_string(c.participants.size()),
-             interval(c.participant_ci_low, c.participant_ci_high),
+             interval(c.ci_low, c.ci_high),
+             std::to_string(c.participants.size()) + ": " +
+                 interval(c.participant_ci_low, c.participant_ci_high),
              c.target_value ? format_short(c.target_value)
                             : std::string("no physical value"),
              cell(c.bias), interval(c.bias_ci_low, c.bias_ci_high), c.constancy_text});
