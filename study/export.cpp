@@ -52,19 +52,6 @@ std::map<std::string, int> catch_failures(Database& db) {
     return failed;
 }
 
-// The protocol the database was made with; empty when absent or no longer parseable
-// (a database from an older build whose keys this one does not know).
-std::optional<Protocol> stored_protocol(Database& db) {
-    Statement s = db.prepare("SELECT protocol_text, name FROM studies LIMIT 1");
-    if (!s.step()) return std::nullopt;
-    try {
-        return parse_protocol(s.text(0), db.path() + " (stored protocol)", "",
-                              KnobCheck::lenient);
-    } catch (const ProtocolError&) {
-        return std::nullopt;
-    }
-}
-
 int max_failed_catch(Database& db) {
     const std::optional<Protocol> protocol = stored_protocol(db);
     return protocol ? protocol->max_failed_catch : 0;
@@ -89,16 +76,20 @@ std::string format_number(double v) {
     return out.str();
 }
 
-// The sessions an analysis reads (withdrawn never; "completed" or "all" by status),
-// the participants excluded for failed catch trials, and the note saying so.
-struct SessionSelection {
-    std::map<std::int64_t, std::string> taken;  // session id -> participant code
-    std::set<std::string> excluded;             // participant codes
-    std::vector<std::string> excluded_participants;
-    SessionsLeftOut left_out;
-    int total = 0, analysed = 0;
-    std::string note;
-};
+}  // namespace
+
+// The protocol the database was made with; empty when absent or no longer parseable
+// (a database from an older build whose keys this one does not know).
+std::optional<Protocol> stored_protocol(Database& db) {
+    Statement s = db.prepare("SELECT protocol_text, name FROM studies LIMIT 1");
+    if (!s.step()) return std::nullopt;
+    try {
+        return parse_protocol(s.text(0), db.path() + " (stored protocol)", "",
+                              KnobCheck::lenient);
+    } catch (const ProtocolError&) {
+        return std::nullopt;
+    }
+}
 
 SessionSelection select_sessions(Database& db, const std::string& db_path,
                                  const std::string& sessions, bool exclude_failed_catch) {
@@ -179,8 +170,6 @@ SessionSelection select_sessions(Database& db, const std::string& db_path,
 
     return out;
 }
-
-}  // namespace
 
 int export_csv(const std::string& db_path, ExportFormat format, std::ostream& out,
                std::vector<std::string>* notes) {

@@ -1,10 +1,15 @@
 #pragma once
 // Data out of a study database: CSV exports (long: one row per rating; wide: one row per
 // participant), the analysis long table, and merging databases from several machines.
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
+
+#include "study/protocol.h"
 
 namespace lucent::study {
 
@@ -65,6 +70,30 @@ struct SessionsLeftOut {
     int failed_catch = 0;  // sessions of participants excluded for failed catch trials
     int total() const { return withdrawn + incomplete + failed_catch; }
 };
+
+// The sessions an analysis reads (withdrawn never; "completed" or "all" by status),
+// the participants excluded for failed catch trials (when `exclude_failed_catch`, over
+// the stored protocol's max_failed_catch), and the note saying so (LongTable's
+// sessions_note). Every reader of a study database for the analysis takes these.
+struct SessionSelection {
+    std::map<std::int64_t, std::string> taken;  // session id -> participant code
+    std::set<std::string> excluded;             // participant codes
+    std::vector<std::string> excluded_participants;
+    SessionsLeftOut left_out;
+    int total = 0, analysed = 0;
+    std::string note;
+    // A session read and not excluded.
+    bool keeps(std::int64_t session) const {
+        const auto it = taken.find(session);
+        return it != taken.end() && !excluded.count(it->second);
+    }
+};
+class Database;
+// The protocol the database was made with; empty when absent or no longer parseable
+// (a database from an older build whose keys this one does not know).
+std::optional<Protocol> stored_protocol(Database& db);
+SessionSelection select_sessions(Database& db, const std::string& db_path,
+                                 const std::string& sessions, bool exclude_failed_catch);
 
 struct LongTable {
     std::vector<LongRow> rows;
