@@ -145,7 +145,8 @@ void register_run(CLI::App& app, int& exit_code) {
         "(target + BIAS + N(0, NOISE^2), on the knob's logarithm with 'log')");
     cmd->add_option(
         "--screenshot", args->options.screenshot_path,
-        "Save the first trial screen (rating or choice) as a PNG (for tests)");
+        "Save the first trial screen (rating, choice, adjust or staircase) as a PNG "
+        "(for tests)");
     cmd->add_option(
         "--key-trace", args->options.key_trace_path,
         "Write each key press as 'X_EVENT_MS RECEIPT_NS STAMP_NS' (for tests)");

@@ -589,6 +589,7 @@ void Session::prepare_live() {
     }
     if (live_shown_ && live_shown_->first == t->id && live_shown_->second == value)
         return;
+    if (!live_shown_ || live_shown_->first != t->id) dragging_ = false;  // a new trial
     live_texture_ = &knob_renderer(stimulus, b->knob).render(value);
     live_shown_ = std::make_pair(t->id, value);
 }
