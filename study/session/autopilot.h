@@ -15,8 +15,9 @@
 namespace lucent::study {
 
 // An adjust trial as the simulated participant sees it: the match's value now, what
-// the keys do, and the target's value of the knob (when the target is a live stimulus
-// of the match's technique; the observer's match is centred on it).
+// the keys do, and the value its match centres on: the target's value of the knob when
+// the target is drawn by the match's technique, else the match stimulus's own value
+// (SessionFlow::adjust_view).
 struct AdjustView {
     double value = 0;
     double lo = 0, hi = 1;

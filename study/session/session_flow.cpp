@@ -1,5 +1,6 @@
 #include "study/session/session_flow.h"
 
+#include <algorithm>
 #include <variant>
 
 #include "renderer/techniques/registry.h"
@@ -209,10 +210,17 @@ AdjustView SessionFlow::adjust_view() const {
     a.step = b.step;
     a.fine_step = b.fine_step;
     a.log_scale = b.scale == "log";
+    // The value the simulated observer's match centres on: the target's own value of
+    // the knob when it is drawn by the match's technique; otherwise (a picture, another
+    // technique: the built-in matching study's dipole targets) the simulation takes the
+    // match stimulus's protocol value as what the target looks like, a known reference
+    // the analysis's bias is checked against.
     const StimulusSpec* target = protocol_.find_stimulus(trials_[current_].stimulus);
     const StimulusSpec* match = protocol_.find_stimulus(b.match);
     if (target && match && target->live() && target->technique == match->technique)
         a.target = knob_value(target->id, b.knob);
+    else if (match)
+        a.target = std::clamp(knob_value(match->id, b.knob), b.range_min, b.range_max);
     return a;
 }
 

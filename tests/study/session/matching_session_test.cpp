@@ -91,8 +91,9 @@ Key key_named(const std::string& name, int* digit, bool* shift) {
 
 class MatchingSession : public ::testing::Test {
 protected:
-    void SetUp() override {
-        protocol_ = parse_protocol(kProtocol, "matching_session.toml");
+    void SetUp() override { open(parse_protocol(kProtocol, "matching_session.toml")); }
+    void open(Protocol protocol) {
+        protocol_ = std::move(protocol);
         dir_ = lucent::test::scratch_dir(
             std::string("matching_session_") +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -253,6 +254,31 @@ TEST_F(MatchingSession,
     // reversals' mean is within a few steps of it.
     EXPECT_GT(delta.back(), 0.354 - 3 * 0.08);
     EXPECT_LT(delta.back(), 0.354 + 3 * 0.08);
+}
+
+TEST_F(MatchingSession, TheBuiltInMatchingStudysObserverCarriesItsBiasInEveryBlock) {
+    // Its targets are dipole renders, which have no thickness exponent: the simulated
+    // observer takes the match stimulus's own r = 10 as what a target looks like, so
+    // every block's matches centre on 10 x 1.25.
+    open(builtin_protocol("matching"));
+    run_until(1000);
+    ASSERT_EQ(flow_->result(), RunResult::Completed);
+    Database d = read();
+    std::map<std::string, std::pair<double, int>> by_block;  // sum of ln(match / 10), n
+    Statement s =
+        d.prepare("SELECT block, final_value FROM trials WHERE kind = 'adjust'");
+    while (s.step()) {
+        auto& [sum, n] = by_block[s.text(0)];
+        sum += std::log(s.real(1) / 10.0);
+        ++n;
+    }
+    ASSERT_EQ(by_block.size(), 3u);
+    for (const auto& [block, sum_n] : by_block) {
+        const auto& [sum, n] = sum_n;
+        EXPECT_EQ(n, 6) << block;
+        // 6 matches: SE 0.1 / sqrt(6) = 0.041, the fine step's rounding 0.01 ln 10 / 2.
+        EXPECT_NEAR(sum / n, std::log(1.25), 4 * 0.1 / std::sqrt(6.0) + 0.012) << block;
+    }
 }
 
 }  // namespace
