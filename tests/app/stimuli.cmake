@@ -40,7 +40,7 @@ endforeach()
 add_test(NAME app.render_unknown_preset_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=render;--preset;nope;--out;${LUCENT_STIMULI_CLI_DIR}/nope"
-                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=unknown preset 'nope' \\(valid: thesis, heterogeneous, fabrics, physical, scaling\\)"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=unknown preset 'nope' \\(valid: thesis, heterogeneous, fabrics, physical, scaling, matching, jnd\\)"
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
 add_test(NAME app.render_mesh_and_config_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
