@@ -8,6 +8,35 @@
 
 namespace lucent::study {
 
+TimedKey autopilot_key(const std::string& name, int64_t t_ns) {
+    TimedKey press;
+    press.t_ns = t_ns;
+    std::string key = name;
+    press.shift = key.rfind("Shift+", 0) == 0;
+    if (press.shift) key = key.substr(6);
+    if (key.size() == 1 && key[0] >= '1' && key[0] <= '9') {
+        press.key = Key::Digit;
+        press.digit = key[0] - '0';
+    } else if (key == "Escape") {
+        press.key = Key::Escape;
+    } else if (key == "Left") {
+        press.key = Key::Left;
+    } else if (key == "Right") {
+        press.key = Key::Right;
+    } else if (key == "Up") {
+        press.key = Key::Up;
+    } else if (key == "Down") {
+        press.key = Key::Down;
+    } else if (key == "Q") {
+        press.key = Key::Quit;
+    } else if (key == "R") {
+        press.key = Key::Resume;
+    } else {
+        press.key = Key::Enter;
+    }
+    return press;
+}
+
 void check_presentable(const Protocol& protocol) {
     for (const Block& b : protocol.blocks)
         if (b.task == Task::adjust || b.task == Task::staircase)

@@ -55,6 +55,12 @@ struct TimedKey {
     bool shift = false;  // held with Shift (an adjustment's fine step)
 };
 
+// The flow's key for one of the autopilot's key names (ScheduledKey::key: "1".."9",
+// "Enter", "Escape", "Left", "Right", "Up", "Down", "Q", "R", "Shift+ARROW"), pressed at
+// `t_ns`: what a GL-free driver of a simulated participant feeds SessionFlow::key (the
+// runner sends the names as X key events instead). Unknown names give Enter.
+TimedKey autopilot_key(const std::string& name, int64_t t_ns);
+
 // Adjust and staircase blocks are planned, stored and run by SessionFlow (issue 31), and
 // `lucent run` presents them (live), but `lucent serve` does not show them in the
 // browser yet: throws ProtocolError naming the first such block, so `lucent serve`

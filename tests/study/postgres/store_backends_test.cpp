@@ -469,22 +469,6 @@ TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
 
 // ---- stations driven by the simulated participant -------------------------------------
 
-Key key_of(const std::string& name, int* digit) {
-    *digit = 0;
-    if (name.size() == 1 && name[0] >= '1' && name[0] <= '9') {
-        *digit = name[0] - '0';
-        return Key::Digit;
-    }
-    if (name == "Escape") return Key::Escape;
-    if (name == "Left") return Key::Left;
-    if (name == "Right") return Key::Right;
-    if (name == "Up") return Key::Up;
-    if (name == "Down") return Key::Down;
-    if (name == "Q") return Key::Quit;
-    if (name == "R") return Key::Resume;
-    return Key::Enter;
-}
-
 struct StationResult {
     std::string error;
     int cell = -1;
@@ -517,11 +501,8 @@ StationResult run_station(const std::function<std::unique_ptr<StudyStore>()>& op
             now += 16'000'000;
             flow.tick(now);
             flow.presented(flow.serial(), now);
-            for (const std::string& name : pilot.due(now, flow.view())) {
-                int digit = 0;
-                const Key k = key_of(name, &digit);
-                flow.key({k, digit, now});
-            }
+            for (const std::string& name : pilot.due(now, flow.view()))
+                flow.key(autopilot_key(name, now));
             if (flow.answered_trials() != answered) {
                 answered = flow.answered_trials();
                 if (after_trial) after_trial(static_cast<int>(answered));

@@ -73,22 +73,6 @@ max_trials = 80
 counterbalance_blocks = false
 )toml";
 
-Key key_named(const std::string& name, int* digit, bool* shift) {
-    std::string k = name;
-    *shift = k.rfind("Shift+", 0) == 0;
-    if (*shift) k = k.substr(6);
-    if (k == "Left") return Key::Left;
-    if (k == "Right") return Key::Right;
-    if (k == "Up") return Key::Up;
-    if (k == "Down") return Key::Down;
-    if (k == "Escape") return Key::Escape;
-    if (k.size() == 1 && k[0] >= '1' && k[0] <= '9') {
-        *digit = k[0] - '0';
-        return Key::Digit;
-    }
-    return Key::Enter;
-}
-
 class MatchingSession : public ::testing::Test {
 protected:
     void SetUp() override { open(parse_protocol(kProtocol, "matching_session.toml")); }
@@ -122,12 +106,8 @@ protected:
             now_ += 16 * kMs;
             flow_->tick(now_);
             flow_->presented(flow_->serial(), now_);
-            for (const std::string& name : pilot_->due(now_, flow_->view())) {
-                int digit = 0;
-                bool shift = false;
-                const Key k = key_named(name, &digit, &shift);
-                flow_->key({k, digit, now_, shift});
-            }
+            for (const std::string& name : pilot_->due(now_, flow_->view()))
+                flow_->key(autopilot_key(name, now_));
         }
     }
     Database read() { return Database(db_, SQLITE_OPEN_READONLY); }
@@ -279,6 +259,31 @@ TEST_F(MatchingSession, TheBuiltInMatchingStudysObserverCarriesItsBiasInEveryBlo
         // 6 matches: SE 0.1 / sqrt(6) = 0.041, the fine step's rounding 0.01 ln 10 / 2.
         EXPECT_NEAR(sum / n, std::log(1.25), 4 * 0.1 / std::sqrt(6.0) + 0.012) << block;
     }
+}
+
+}  // namespace
+}  // namespace lucent::study
+
+namespace lucent::study {
+namespace {
+
+TEST(AutopilotKey, EveryNameTheAutopilotUsesIsTheFlowsKey) {
+    const TimedKey fine = autopilot_key("Shift+Left", 7);
+    EXPECT_EQ(fine.key, Key::Left);
+    EXPECT_TRUE(fine.shift);
+    EXPECT_EQ(fine.t_ns, 7);
+    const TimedKey three = autopilot_key("3", 0);
+    EXPECT_EQ(three.key, Key::Digit);
+    EXPECT_EQ(three.digit, 3);
+    EXPECT_FALSE(three.shift);
+    EXPECT_EQ(autopilot_key("Right", 0).key, Key::Right);
+    EXPECT_EQ(autopilot_key("Up", 0).key, Key::Up);
+    EXPECT_EQ(autopilot_key("Down", 0).key, Key::Down);
+    EXPECT_EQ(autopilot_key("Escape", 0).key, Key::Escape);
+    EXPECT_EQ(autopilot_key("Q", 0).key, Key::Quit);
+    EXPECT_EQ(autopilot_key("R", 0).key, Key::Resume);
+    EXPECT_EQ(autopilot_key("Enter", 0).key, Key::Enter);
+    EXPECT_EQ(autopilot_key("0", 0).key, Key::Enter);  // not a key the flow knows
 }
 
 }  // namespace
