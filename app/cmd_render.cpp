@@ -11,6 +11,9 @@
 #include "renderer/render.h"
 #include "renderer/techniques/registry.h"
 #include "stimuli/batch_render.h"
+#include "study/protocol.h"
+#include "study/session/browser_pictures.h"
+#include "study/session/stimulus_source.h"
 
 namespace lucent::app {
 namespace {
@@ -34,6 +37,9 @@ struct RenderOptions {
     // Batch mode (stimuli/batch_render.h): a stimulus-set config or a built-in preset.
     std::string config;
     std::string preset;
+    // A study's pictures for `lucent serve` (study/session/browser_pictures.h).
+    std::string study;
+    std::string study_preset;
     int jobs = 1;
     bool force = false;
 };
@@ -164,6 +170,28 @@ int run_render(const RenderOptions& options) {
     return kExitOk;
 }
 
+std::string study_preset_list() {
+    std::string names;
+    for (const std::string& name : study::builtin_protocol_names())
+        names += (names.empty() ? "" : ", ") + name;
+    return names;
+}
+
+// The pictures of a study for the browser; a protocol or series problem is one line
+// (exit 2, nothing written).
+stimuli::StimulusSet study_picture_set(const std::string& file,
+                                       const std::string& preset) {
+    try {
+        return study::browser_picture_set(preset.empty()
+                                              ? study::load_protocol_file(file)
+                                              : study::builtin_protocol(preset));
+    } catch (const study::ProtocolError& e) {
+        throw stimuli::StimulusSetError(e.what());
+    } catch (const study::StimulusError& e) {
+        throw stimuli::StimulusSetError(e.what());
+    }
+}
+
 }  // namespace
 
 void register_render(CLI::App& app, int& exit_code) {
@@ -186,6 +214,11 @@ void register_render(CLI::App& app, int& exit_code) {
                     "stimulus-set config (TOML): render every stimulus into --out DIR");
     cmd->add_option("--preset", options->preset,
                     "built-in stimulus set (thesis) into --out DIR");
+    cmd->add_option("--study", options->study,
+                    "study protocol (TOML): every picture 'lucent serve' shows, the "
+                    "adjust series and staircase ladders included, into --out DIR");
+    cmd->add_option("--study-preset", options->study_preset,
+                    "built-in study (" + study_preset_list() + "), as --study");
     cmd->add_option("--jobs", options->jobs,
                     "stimulus sets: parallel workers (default 1)");
     cmd->add_flag("--force", options->force,
@@ -222,16 +255,28 @@ void register_render(CLI::App& app, int& exit_code) {
         "render the technique's CPU reference (Embree) instead of the GL image: "
         "same scene, parameters and outputs");
     cmd->callback([options, &exit_code] {
-        // One image (--mesh) or a stimulus set (CONFIG or --preset), never both.
-        const bool batch = !options->config.empty() || !options->preset.empty();
-        const bool both = !options->config.empty() && !options->preset.empty();
+        // One image (--mesh), a stimulus set (CONFIG or --preset) or a study's pictures
+        // (--study or --study-preset), one of them.
+        const int sources = !options->config.empty() + !options->preset.empty() +
+                            !options->study.empty() + !options->study_preset.empty();
+        const bool batch = sources > 0;
+        const bool both = sources > 1;
+        const bool study = !options->study.empty() || !options->study_preset.empty();
         if (batch && options->reference) {
             std::cerr << "lucent render: --reference renders one image (--mesh), not a "
                          "stimulus set\n";
             exit_code = kExitUsage;
         } else if (batch && (!options->mesh.empty() || both)) {
-            std::cerr << "lucent render: give one of --mesh, CONFIG or --preset\n";
+            std::cerr
+                << "lucent render: give one of --mesh, CONFIG, --preset, --study or "
+                   "--study-preset\n";
             exit_code = kExitUsage;
+        } else if (study) {
+            exit_code = stimuli::run_render_set_command(
+                [options] {
+                    return study_picture_set(options->study, options->study_preset);
+                },
+                options->out, options->jobs, options->force);
         } else if (batch) {
             exit_code = stimuli::run_render_set_command(options->config, options->preset,
                                                         options->out, options->jobs,

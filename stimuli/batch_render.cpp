@@ -602,15 +602,24 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
 
 int run_render_set_command(const std::string& config_path, const std::string& preset,
                            const std::string& out_dir, int jobs, bool force) {
+    return run_render_set_command(
+        [&] {
+            const auto catalog = default_catalog();
+            return preset.empty() ? load_stimulus_set(config_path, catalog)
+                                  : load_preset(preset, catalog);
+        },
+        out_dir, jobs, force);
+}
+
+int run_render_set_command(const std::function<StimulusSet()>& load_set,
+                           const std::string& out_dir, int jobs, bool force) {
     StimulusSet set;
     try {
         if (out_dir.empty()) throw StimulusSetError("--out: missing (give --out DIR)");
         if (jobs < 1 || jobs > 64)
             throw StimulusSetError("--jobs: " + std::to_string(jobs) +
                                    " is out of range (accepted: 1..64)");
-        const auto catalog = default_catalog();
-        set = preset.empty() ? load_stimulus_set(config_path, catalog)
-                             : load_preset(preset, catalog);
+        set = load_set();
         std::error_code error;
         if (std::filesystem::exists(out_dir, error) &&
             !std::filesystem::is_directory(out_dir, error))

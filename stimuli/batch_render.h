@@ -74,5 +74,9 @@ BatchResult render_stimulus_set(const StimulusSet& set, const BatchOptions& opti
 // non-empty.
 int run_render_set_command(const std::string& config_path, const std::string& preset,
                            const std::string& out_dir, int jobs, bool force);
+// The same for the set `load_set` makes (throwing StimulusSetError, one line, for a set
+// that cannot be made: exit code 2, nothing written).
+int run_render_set_command(const std::function<StimulusSet()>& load_set,
+                           const std::string& out_dir, int jobs, bool force);
 
 }  // namespace lucent::stimuli

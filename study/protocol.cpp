@@ -427,6 +427,10 @@ void read_adjust_block(const Protocol& p, TableReader& r, Block& b) {
     b.fine_step = r.number("fine_step", b.step / 10, 0, b.step);
     if (!(b.fine_step > 0))
         r.fail(r.raw().get("fine_step"), "fine_step", "must be above 0");
+    b.series_steps = r.integer(
+        "series_steps",
+        static_cast<int>(std::min(10000.0, std::round(width / b.fine_step))) + 1, 2,
+        10001);
     b.start = "random";
     if (const toml::node* start = r.get("start")) {
         if (start->is_string()) {
@@ -547,6 +551,11 @@ void read_staircase_block(const Protocol& p, TableReader& r, Block& b) {
         r.fail(r.raw().get("trial"), "trial",
                "must be \"pair\" or \"oddity\", got '" + b.staircase_trial + "'");
     read_presentation(r, b, b.pictures());
+    // The flow's sequence has two parts (a pair's pictures), not three.
+    if (b.staircase_trial == "oddity" && b.presentation == Presentation::sequential)
+        r.fail(r.raw().get("presentation"), "presentation",
+               "an odd-one-out staircase is shown side by side (\"sequential\" shows two "
+               "pictures, not three)");
     const toml::array* procedures = r.array("staircases");
     if (!procedures || procedures->empty())
         r.fail(procedures, "staircases",
@@ -561,6 +570,21 @@ void read_staircase_block(const Protocol& p, TableReader& r, Block& b) {
                         "duplicate staircase id '" + s.id + "'");
         b.procedures.push_back(std::move(s));
     }
+    double low = b.procedures.front().min_delta, high = b.procedures.front().max_delta;
+    double smallest_linear_step = std::numeric_limits<double>::infinity();
+    for (const Block::Procedure& s : b.procedures) {
+        low = std::min(low, s.min_delta);
+        high = std::max(high, s.max_delta);
+        if (s.method == "updown" && s.step_type == "lin")
+            for (double step : s.step_sizes)
+                smallest_linear_step = std::min(smallest_linear_step, step);
+    }
+    const double span = high - low;
+    b.ladder_step = r.number(
+        "ladder_step",
+        std::isfinite(smallest_linear_step) ? smallest_linear_step : span / 32, 0, span);
+    if (!(b.ladder_step > 0))
+        r.fail(r.raw().get("ladder_step"), "ladder_step", "must be above 0");
 }
 
 void read_choice_block(const Protocol& p, TableReader& r, Block& b);

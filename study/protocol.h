@@ -117,6 +117,11 @@ struct Block {
     double step = 0, fine_step = 0;
     std::string scale = "linear";
     std::string start = "random";
+    // Adjust, in the browser (`lucent serve`): the match is a pre-rendered series of
+    // this many pictures, evenly spaced on the scale from range_min to range_max (both
+    // included); the keys, wheel and drag move as in the lab and show the nearest one.
+    // Default: the range in fine steps, plus one.
+    int series_steps = 0;
     // Staircase: each standard in `stimuli` runs every [[blocks.staircases]] entry,
     // all interleaved (each round a random order of the procedures still running); a
     // trial shows the standard and the comparison (the standard with `knob` moved by
@@ -143,6 +148,11 @@ struct Block {
         int max_trials = 50;
     };
     std::vector<Procedure> procedures;
+    // Staircase, in the browser: each standard's comparisons are a pre-rendered ladder
+    // of deltas k * ladder_step within the procedures' [min_delta, max_delta]; a
+    // proposed delta is shown as the nearest rung and the procedure told the delta shown.
+    // Default: the smallest step of a linear up/down procedure, else 1/32 of the span.
+    double ladder_step = 0;
     // Picture count of one trial: pictures_per_trial, 3 for an odd-one-out staircase.
     int pictures() const;
     // Forced choices, answered 1..answers(): pair, triad, quadruple and staircase.

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "common/portable_random.h"
+#include "study/web_series.h"
 
 namespace lucent::study {
 namespace {
@@ -420,12 +421,12 @@ double adjust_start_value(const Block& block, std::mt19937_64& rng) {
     if (block.start == "min") return block.range_min;
     if (block.start == "max") return block.range_max;
     if (block.start != "random") return std::stod(block.start);
+    // Uniform over the range on the scale, at one of the points of the browser's series
+    // (web_series.h), so the lab and the browser start from the same value.
+    const std::vector<double> points = adjust_series_values(block);
     const double u = uniform_unit(rng);
-    if (block.scale == "log") {
-        const double lo = std::log(block.range_min), hi = std::log(block.range_max);
-        return std::clamp(std::exp(lo + u * (hi - lo)), block.range_min, block.range_max);
-    }
-    return block.range_min + u * (block.range_max - block.range_min);
+    return points[std::min(points.size() - 1,
+                           static_cast<size_t>(u * static_cast<double>(points.size())))];
 }
 
 std::vector<PlannedTrial> staircase_block_trials(const Block& block,

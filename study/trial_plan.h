@@ -118,7 +118,8 @@ std::vector<PlannedTrial> choice_block_trials(const Block& block, std::mt19937_6
 std::vector<PlannedTrial> adjust_block_trials(const Block& block, std::mt19937_64& rng);
 // Where an adjust trial's match starts: block.start's number, range_min ("min"),
 // range_max ("max"), or ("random") uniform over the range on the block's scale (its
-// logarithm for "log").
+// logarithm for "log"), at a point of the browser's series (adjust_series_values: one of
+// Block::series_steps evenly spaced points), so both start from the same values.
 double adjust_start_value(const Block& block, std::mt19937_64& rng);
 
 // A staircase block's slots in their final order (not shuffled again): for each

@@ -21,6 +21,26 @@ AdjustInput::AdjustInput(const Block& block, double start, int64_t onset_ns)
     position_ = std::clamp(log_ ? std::log10(start_) : start_, low_, high_);
 }
 
+AdjustInput::AdjustInput(const Block& block, double start, int64_t onset_ns,
+                         std::vector<double> series)
+    : AdjustInput(block, start, onset_ns) {
+    if (series.size() < 2)
+        throw std::invalid_argument("block '" + block.id +
+                                    "': a series needs at least two values");
+    series_ = std::move(series);
+    index_ = series_index_at(position_);
+    // The page computes the same position from the index (web_series.h).
+    position_ = low_ + (high_ - low_) * static_cast<double>(index_) /
+                           static_cast<double>(series_.size() - 1);
+    start_ = value_ = series_[index_];
+}
+
+size_t AdjustInput::series_index_at(double position) const {
+    const double last = static_cast<double>(series_.size() - 1);
+    const double at = std::round((position - low_) / (high_ - low_) * last);
+    return static_cast<size_t>(std::clamp(at, 0.0, last));
+}
+
 void AdjustInput::step(bool up, bool fine, int64_t t_ns) {
     const double by = fine ? fine_ : coarse_;
     move_to(position_ + (up ? by : -by), t_ns, fine ? "fine_key" : "key");
@@ -48,6 +68,14 @@ void AdjustInput::move_to(double position, int64_t t_ns, const char* input) {
     // At an end of the range a further step changes nothing and is not a change.
     if (position == position_) return;
     position_ = position;
+    if (!series_.empty()) {
+        const size_t index = series_index_at(position);
+        if (index == index_) return;
+        index_ = index;
+        value_ = series_[index];
+        adjustments_.push_back({value_, t_ns, input});
+        return;
+    }
     // The ends exactly, whatever log10 and pow round to.
     value_ = position == low_    ? min_value_
              : position == high_ ? max_value_

@@ -5,6 +5,7 @@
 // match (its width spans the whole range), and confirms with Enter. Steps are taken on
 // the block's scale, the knob's value or its log10, and held inside the block's range.
 // Every change is kept with its time and input, as the store records it.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -20,6 +21,11 @@ public:
     // planned start value (clamped into the range). Throws std::invalid_argument when the
     // block is not an adjust block.
     AdjustInput(const Block& block, double start, int64_t onset_ns);
+    // In the browser: the knob moves as above, and its value is the nearest of the
+    // `series` values (adjust_series_values(block): the pre-rendered pictures); the start
+    // is the series value nearest `start`, and only a move to another value is a change.
+    AdjustInput(const Block& block, double start, int64_t onset_ns,
+                std::vector<double> series);
 
     // One step up (Right/Up) or down (Left/Down); `fine` with Shift.
     void step(bool up, bool fine, int64_t t_ns);
@@ -35,6 +41,8 @@ public:
     bool confirmed() const { return confirmed_; }
     bool at_min() const { return position_ <= low_; }
     bool at_max() const { return position_ >= high_; }
+    // The index of the value in the series (0 without one).
+    size_t series_index() const { return index_; }
     // Increases with every change of the value: the renderer redraws the match only
     // when it moved.
     int revision() const { return static_cast<int>(adjustments_.size()); }
@@ -47,6 +55,7 @@ public:
 
 private:
     void move_to(double position, int64_t t_ns, const char* input);
+    size_t series_index_at(double position) const;  // nearest series value's index
 
     bool log_ = false;
     double low_ = 0, high_ = 0;             // the range on the scale
@@ -58,6 +67,8 @@ private:
     bool confirmed_ = false;
     int64_t confirm_ns_ = 0;
     std::vector<Adjustment> adjustments_;
+    std::vector<double> series_;  // empty in the lab
+    size_t index_ = 0;
 };
 
 }  // namespace lucent::study

@@ -37,15 +37,6 @@ TimedKey autopilot_key(const std::string& name, int64_t t_ns) {
     return press;
 }
 
-void check_presentable(const Protocol& protocol) {
-    for (const Block& b : protocol.blocks)
-        if (b.task == Task::adjust || b.task == Task::staircase)
-            throw ProtocolError(protocol.source + ": block '" + b.id + "': task '" +
-                                task_name(b.task) +
-                                "' is not shown in the browser yet (it is planned, "
-                                "stored and exported; 'lucent run' presents it)");
-}
-
 SessionFlow::SessionFlow(const Protocol& protocol, StudyStore& store, int64_t session_id,
                          std::vector<TrialRow> trials, bool consented, int64_t now_ns)
     : protocol_(protocol),
@@ -136,17 +127,21 @@ void SessionFlow::advance_to_open_trial() {
 }
 
 std::optional<adaptive::Proposal> SessionFlow::staircase_delta() const {
-    if (!trial() || trials_[current_].task != Task::staircase) return std::nullopt;
-    return delta_;
+    if (!trial() || trials_[current_].task != Task::staircase || !delta_)
+        return std::nullopt;
+    const KnobSeries* ladder =
+        series_ ? series_->find(trials_[current_].block, trials_[current_].stimulus)
+                : nullptr;
+    if (!ladder) return delta_;
+    // The browser shows the ladder's nearest rung, and that is the delta answered.
+    adaptive::Proposal shown = *delta_;
+    shown.intensity = ladder->steps[nearest_step(ladder->steps, delta_->intensity)];
+    return shown;
 }
 
 double SessionFlow::knob_value(const std::string& stimulus,
                                const std::string& knob) const {
-    if (const std::optional<double> v = protocol_.numeric_parameter(stimulus, knob))
-        return *v;
-    const StimulusSpec* s = protocol_.find_stimulus(stimulus);
-    const std::vector<Knob> knobs = knobs_for(find_technique(s->technique));
-    return std::get<double>(find_knob(knobs, knob)->default_value);
+    return stimulus_knob_value(protocol_, stimulus, knob);
 }
 
 std::optional<double> SessionFlow::comparison_value() const {
@@ -205,7 +200,7 @@ ScreenView SessionFlow::view() const {
             }
             if (trials_[current_].task == Task::staircase) {
                 v.kind = input_ ? ScreenView::Kind::Staircase : ScreenView::Kind::Blank;
-                v.staircase.delta = delta_ ? delta_->intensity : 0.0;
+                v.staircase.delta = delta_ ? staircase_delta()->intensity : 0.0;
                 v.staircase.answers = block()->answers();
                 v.staircase.comparison_place = trials_[current_].expected;
                 break;
@@ -301,7 +296,13 @@ void SessionFlow::presented(int serial, int64_t t_ns) {
             if (phase_ != ChoicePhase::Answer) return;  // a sequence: not answerable yet
             const TrialRow& t = trials_[current_];
             if (t.task == Task::adjust) {
-                adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns);
+                const KnobSeries* series =
+                    series_ ? series_->find(t.block, block()->match) : nullptr;
+                if (series)
+                    adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns,
+                                    series->steps);
+                else
+                    adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns);
             } else if (choice_trial()) {
                 input_.emplace(RatingInput::forced_choice(t_ns, block()->answers()));
             } else {
@@ -486,9 +487,10 @@ void SessionFlow::finish_trial() {
     outcome.onset_ns = *trial_onset_ns_;
     if (t.task == Task::staircase) {
         const int choice = outcome.responses.front().rating;
-        outcome.intensity = delta_->intensity;
-        outcome.finishes_staircase =
-            staircase_block(*b).answer(t.staircase, choice == t.expected);
+        outcome.intensity = staircase_delta()->intensity;
+        outcome.finishes_staircase = staircase_block(*b).answer(
+            t.staircase, choice == t.expected,
+            outcome.intensity != delta_->intensity ? outcome.intensity : std::nullopt);
         t.choice = choice;
         t.intensity = outcome.intensity;
     }

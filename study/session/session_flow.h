@@ -22,6 +22,7 @@
 #include "study/session/autopilot.h"
 #include "study/session/rating_input.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/web_series.h"
 
 namespace lucent::study {
 
@@ -61,12 +62,6 @@ struct TimedKey {
 // runner sends the names as X key events instead). Unknown names give Enter.
 TimedKey autopilot_key(const std::string& name, int64_t t_ns);
 
-// Adjust and staircase blocks are planned, stored and run by SessionFlow (issue 31), and
-// `lucent run` presents them (live), but `lucent serve` does not show them in the
-// browser yet: throws ProtocolError naming the first such block, so `lucent serve`
-// refuses the protocol before anything is stored.
-void check_presentable(const Protocol& protocol);
-
 class SessionFlow {
 public:
     // `trials`: the session's planned trials as stored; `consented`: consent already
@@ -96,6 +91,11 @@ public:
     void presented(int serial, int64_t t_ns);
     // The display's refresh rate, once measured: trials then record dropped frames.
     void set_refresh_hz(std::optional<double> hz) { refresh_hz_ = hz; }
+    // `lucent serve`: an adjust block's match moves over its pre-rendered series (the
+    // value is the nearest picture's) and a staircase delta is shown, answered and
+    // stored as its ladder's nearest rung (web_series.h). Null (the default): the lab's
+    // continuous values. `series` must outlive the flow and its copies.
+    void show_series(const WebSeries* series) { series_ = series; }
 
     // ---- state -----------------------------------------------------------------------
     Screen screen() const { return screen_; }
@@ -179,6 +179,7 @@ private:
     std::optional<int64_t> trial_onset_ns_;  // the trial's first picture on the display
     std::vector<int64_t> trial_frames_ns_;
     std::optional<double> refresh_hz_;
+    const WebSeries* series_ = nullptr;
 };
 
 }  // namespace lucent::study

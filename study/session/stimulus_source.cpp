@@ -2,6 +2,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -121,6 +122,17 @@ namespace {
 std::string how_to_render(const Protocol& protocol, const std::string& dir) {
     const std::string out = dir.empty() ? "DIR" : dir;
     const std::string preset = "preset:";
+    const bool series =
+        std::any_of(protocol.blocks.begin(), protocol.blocks.end(), [](const Block& b) {
+            return b.task == Task::adjust || b.task == Task::staircase;
+        });
+    // A study with adjust or staircase blocks also needs their series and ladders.
+    if (series)
+        return "'lucent render " +
+               (protocol.source.rfind(preset, 0) == 0
+                    ? "--study-preset " + protocol.source.substr(preset.size())
+                    : "--study " + protocol.source) +
+               " --out " + out + "' writes every picture the study shows in the browser";
     if (protocol.source.rfind(preset, 0) == 0)
         return "'lucent render --preset " + protocol.source.substr(preset.size()) +
                " --out " + out +

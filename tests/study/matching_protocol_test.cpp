@@ -8,10 +8,12 @@
 #include <map>
 #include <set>
 
+#include "common/number_text.h"
 #include "study/adaptive/staircase_block.h"
 #include "study/protocol.h"
 #include "study/session/session_flow.h"
 #include "study/trial_plan.h"
+#include "study/web_series.h"
 
 namespace lucent::study {
 namespace {
@@ -206,6 +208,14 @@ TEST(MatchingProtocol, RefusesEachBadKeyInOneLineNamingIt) {
          "between the guess rate (0.5) and 1"},
         {down_from_zero, "at the end of the knob's range: no downward delta"},
         {no_procedures, "at least one [[blocks.staircases]] entry is required"},
+        {edited("question = \"Which looks more translucent?\"",
+                "question = \"Which differs?\"\ntrial = \"oddity\"\npresentation = "
+                "\"sequential\""),
+         "key 'blocks.presentation': an odd-one-out staircase is shown side by side"},
+        {edited("max_delta = 1", "max_delta = 1\nladder_step = 0"),
+         "key 'blocks.staircases.ladder_step': unknown key"},
+        {edited("range = [0.25, 4.0]", "range = [0.25, 4.0]\nseries_steps = 1"),
+         "key 'blocks.series_steps': must lie in [2, 10001]"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string error = error_of(text);
@@ -241,10 +251,14 @@ TEST(MatchingPlan, EachTargetRepeatsWithAStartDrawnOnTheBlocksScale) {
         const double hi = scale == "log" ? std::log(4.0) : 4.0;
         double sum = 0, sum2 = 0;
         const int n = 6000;
+        // Each start is a point of the browser's series (201 here), the lab's too.
+        const std::vector<double> points = adjust_series_values(b);
+        ASSERT_EQ(points.size(), 201u);
         for (int i = 0; i < n; ++i) {
             const double v = adjust_start_value(b, rng);
             ASSERT_GE(v, 0.25);
             ASSERT_LE(v, 4.0);
+            ASSERT_EQ(v, points[nearest_step(points, v)]);
             const double x = scale == "log" ? std::log(v) : v;
             sum += x;
             sum2 += x * x;
@@ -252,8 +266,9 @@ TEST(MatchingPlan, EachTargetRepeatsWithAStartDrawnOnTheBlocksScale) {
         const double mean = sum / n, var = sum2 / n - mean * mean;
         const double w = hi - lo;
         EXPECT_NEAR(mean, (lo + hi) / 2, 4 * w / std::sqrt(12.0 * n)) << scale;
-        // The variance of a uniform's squared deviation is w^4/80 - w^4/144.
-        EXPECT_NEAR(var, w * w / 12,
+        // The variance of a uniform's squared deviation is w^4/80 - w^4/144; the 201
+        // evenly spaced points' variance is w^2/12 * 202/200.
+        EXPECT_NEAR(var, w * w / 12 * 202 / 200,
                     4 * w * w * std::sqrt(1.0 / 80 - 1.0 / 144) / std::sqrt(n))
             << scale;
     }
@@ -386,16 +401,57 @@ TEST(StaircaseBlock, AQuestFromTheProtocolIsHeldInsideTheDeltasRange) {
 namespace lucent::study {
 namespace {
 
-TEST(MatchingProtocol, TheBrowserRefusesWhatItCannotPresentBeforeStoringAnything) {
+TEST(MatchingProtocol, TheBrowserShowsEachSeriesFromItsPicturesAndRefusesAStartOffThem) {
+    // matching(): range [0.25, 4], linear, fine steps of 3.75 / 200: 201 pictures.
+    const Protocol p =
+        parse_protocol(std::string(kMatching) + "max_delta = 0.5\n", "m.toml");
+    const WebSeries series = web_series(p);
+    const KnobSeries* s = series.find("m", p.find_block("m")->match);
+    ASSERT_NE(s, nullptr);
+    ASSERT_EQ(s->steps.size(), 201u);
+    EXPECT_EQ(s->steps.front(), 0.25);
+    EXPECT_EQ(s->steps.back(), 4.0);
+    EXPECT_NEAR(s->steps[60], 0.25 + 60 * 3.75 / 200, 1e-12);
+    EXPECT_EQ(s->pictures[60],
+              "match@thickness_exponent=" + common::shortest_text(s->steps[60]));
+    // The ladder: the smallest linear step (0.001) from 0 to the largest max_delta (1).
+    const KnobSeries* ladder = series.find("j", "target2");
+    ASSERT_NE(ladder, nullptr);
+    ASSERT_EQ(ladder->steps.size(), 1001u);
+    EXPECT_EQ(ladder->pictures.front(), "target2");  // delta 0: the standard itself
+    EXPECT_NEAR(ladder->steps[250], 0.25, 1e-12);
+    EXPECT_EQ(ladder->pictures[250], "target2@thickness_exponent=3.25");
+    EXPECT_EQ(nearest_step(ladder->steps, 0.2504), 250u);
+    EXPECT_EQ(nearest_step(ladder->steps, 7.0), 1000u);
+    // Each picture is a live stimulus of its own: the base with the knob set.
+    const Protocol shown = with_series_pictures(p, series);
+    const StimulusSpec* picture = shown.find_stimulus("target2@thickness_exponent=3.25");
+    ASSERT_NE(picture, nullptr);
+    EXPECT_EQ(picture->technique, "empirical");
+    EXPECT_EQ(shown.numeric_parameter(picture->id, "thickness_exponent"), 3.25);
+    EXPECT_EQ(shown.stimuli.size(), p.stimuli.size() + 201 + 2 * 1000);
+    // QUEST's delta as far as the knob's range goes: a million rungs, refused.
     try {
-        check_presentable(matching());
+        web_series(matching());
         FAIL() << "no refusal";
     } catch (const ProtocolError& e) {
         EXPECT_EQ(std::string(e.what()),
-                  "matching.toml: block 'm': task 'adjust' is not shown in the browser "
-                  "yet (it is planned, stored and exported; 'lucent run' presents it)");
+                  std::string("matching.toml: block 'j': the browser's ladder of deltas "
+                              "[0, 9997] in steps of 0.001 would be 9997001 pictures per "
+                              "standard (at most 2000): set ladder_step or max_delta"));
     }
-    EXPECT_NO_THROW(check_presentable(builtin_protocol("thesis")));
+    // A numeric start off the series.
+    try {
+        web_series(parse_protocol(
+            edited("range = [0.25, 4.0]\n", "range = [0.25, 4.0]\nstart = 0.26\n") +
+                "max_delta = 0.5\n",
+            "s.toml"));
+        FAIL() << "no refusal";
+    } catch (const ProtocolError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "s.toml: block 'm': start 0.26 is not one of the browser's 201 series "
+                  "values (nearest: 0.26875); change series_steps or the start");
+    }
 }
 
 }  // namespace

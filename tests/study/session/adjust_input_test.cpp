@@ -42,6 +42,41 @@ TEST(AdjustInput, StepsCoarseAndFineOnALinearScaleAndStopsAtTheEnds) {
     EXPECT_EQ(in.adjustments()[1].input, "fine_key");
 }
 
+TEST(AdjustInput, InTheBrowserTheValueIsAlwaysAPictureOfTheSeries) {
+    // Linear [0.25, 4] in 16 pictures: 0.25 apart. Coarse 0.5 = two pictures, fine
+    // 0.05 = a fifth of one.
+    Block b = adjust_block("linear");
+    std::vector<double> series;
+    for (int i = 0; i < 16; ++i) series.push_back(0.25 + 0.25 * i);
+    AdjustInput in(b, 1.1, 0, series);
+    // The start is the nearest picture: 1.0 (index 3).
+    EXPECT_EQ(in.start(), 1.0);
+    EXPECT_EQ(in.series_index(), 3u);
+    in.step(true, false, 1);  // 1.5, index 5
+    EXPECT_EQ(in.value(), 1.5);
+    EXPECT_EQ(in.series_index(), 5u);
+    // Two fine steps (0.1) stay nearest 1.5: no change is recorded; the third (0.15)
+    // is nearer 1.75.
+    in.step(true, true, 2);
+    in.step(true, true, 3);
+    EXPECT_EQ(in.value(), 1.5);
+    EXPECT_EQ(in.adjustments().size(), 1u);
+    in.step(true, true, 4);
+    EXPECT_EQ(in.value(), 1.75);
+    EXPECT_EQ(in.adjustments().size(), 2u);
+    // A drag of half the width: half the range (1.875) from 1.65 -> 3.525, nearest 3.5.
+    in.drag(50, 100, 5);
+    EXPECT_EQ(in.value(), 3.5);
+    // Held at the end, which is the last picture exactly.
+    in.wheel(10, 6);
+    EXPECT_EQ(in.value(), 4.0);
+    EXPECT_EQ(in.series_index(), 15u);
+    EXPECT_EQ(in.adjustments().size(), 4u);
+    in.confirm(7);
+    EXPECT_EQ(*in.outcome("m").final_value, 4.0);
+    EXPECT_THROW(AdjustInput(b, 1.0, 0, {1.0}), std::invalid_argument);
+}
+
 TEST(AdjustInput, StepsAreFactorsOnALogScale) {
     AdjustInput in(adjust_block("log"), 1.0, 0);
     in.step(true, false, 1);  // 10^0.1

@@ -8,8 +8,10 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "study/session/session_flow.h"
+#include "study/web_series.h"
 #include "tests/study/study_fixtures.h"
 #include "tests/support/test_paths.h"
 
@@ -98,6 +100,7 @@ protected:
     void restart() {
         flow_ = std::make_unique<SessionFlow>(protocol_, *store_, session_.id,
                                               store_->trials(session_.id), true, now_);
+        if (series_) flow_->show_series(&*series_);
     }
     // Frames until `answered` trials are answered (or the flow ends).
     void run_until(size_t answered) {
@@ -119,6 +122,7 @@ protected:
     SessionRow session_;
     std::unique_ptr<Autopilot> pilot_;
     std::unique_ptr<SessionFlow> flow_;
+    std::optional<WebSeries> series_;  // set: the browser's pre-rendered pictures
     int64_t now_ = 1'000'000'000;
 };
 
@@ -222,7 +226,12 @@ TEST_F(MatchingSession,
     if ((!last_correct && last_direction < 0) ||
         (last_correct && last_run >= 3 && last_direction > 0))
         ++reversals;
-    EXPECT_EQ(reversals, 6);
+    // Finished at the first answer with both n_trials (20) and n_reversals (6) met.
+    EXPECT_GE(reversals, 6);
+    if (delta.size() > 20)
+        EXPECT_EQ(reversals, 6);  // it went on past 20 trials only for the sixth
+    else
+        EXPECT_EQ(delta.size(), 20u);
     // Finished before its 80 slots: the rest were skipped, none answered twice.
     const int64_t answered = static_cast<int64_t>(delta.size());
     EXPECT_LT(answered, 80);
@@ -234,6 +243,66 @@ TEST_F(MatchingSession,
     // reversals' mean is within a few steps of it.
     EXPECT_GT(delta.back(), 0.354 - 3 * 0.08);
     EXPECT_LT(delta.back(), 0.354 + 3 * 0.08);
+}
+
+TEST_F(MatchingSession, InTheBrowserEveryValueShownAndStoredIsAPrerenderedPicture) {
+    // A QUEST as well, whose proposals fall between the rungs of a 0.05 ladder.
+    std::string text = kProtocol;
+    text.insert(text.find("[randomisation]"), R"toml(
+[[blocks.staircases]]
+id = "q"
+method = "quest"
+start = 0.6
+start_sd = 0.4
+n_trials = 25
+max_delta = 2
+max_trials = 25
+)toml");
+    text.insert(text.find("[[blocks.staircases]]"), "ladder_step = 0.05\n");
+    open(parse_protocol(text, "browser.toml"));
+    series_ = web_series(protocol_);
+    restart();
+    run_until(30);
+    restart();
+    run_until(1000);
+    ASSERT_EQ(flow_->result(), RunResult::Completed);
+    Database d = read();
+    // The adjust block's values: its series, 0.2 to 5 in 0.002 log10 steps: 700.
+    const std::vector<double>& values = series_->find("m", "match")->steps;
+    ASSERT_EQ(values.size(), 700u);
+    Statement a = d.prepare(
+        "SELECT t.start_value, t.final_value FROM trials t WHERE t.kind = 'adjust' UNION "
+        "ALL SELECT a.value, a.value FROM adjustments a");
+    int n = 0;
+    while (a.step())
+        for (const double v : {a.real(0), a.real(1)}) {
+            EXPECT_EQ(v, values[nearest_step(values, v)]) << v;
+            ++n;
+        }
+    EXPECT_GT(n, 48);
+    // Every delta shown is a rung k * 0.05, and the QUEST's track is its own proposals
+    // from the rungs it was told, each shown as the nearest rung: replayed here on a
+    // fresh QUEST built from the protocol.
+    const Block& j = *protocol_.find_block("j");
+    const std::unique_ptr<adaptive::AdaptiveProcedure> quest =
+        adaptive::make_procedure(j, j.procedures[1]);
+    Statement s = d.prepare(
+        "SELECT t.staircase, t.intensity, r.rating = t.expected_rating FROM trials t "
+        "JOIN "
+        "responses r ON r.trial_id = t.id WHERE t.kind = 'staircase' ORDER BY "
+        "t.position");
+    int quest_trials = 0;
+    while (s.step()) {
+        const double delta = s.real(1);
+        EXPECT_NEAR(delta / 0.05, std::round(delta / 0.05), 1e-9) << delta;
+        if (s.text(0) != "thin/q") continue;
+        const double proposed = quest->next().intensity;
+        EXPECT_NEAR(delta, 0.05 * std::round(proposed / 0.05), 1e-12)
+            << "QUEST trial " << quest_trials + 1 << " proposed " << proposed;
+        quest->add_response(s.integer(2) == 1, delta);
+        ++quest_trials;
+    }
+    EXPECT_EQ(quest_trials, 25);
 }
 
 TEST_F(MatchingSession, TheBuiltInMatchingStudysObserverCarriesItsBiasInEveryBlock) {
