@@ -31,6 +31,7 @@
 #include "study/sqlite/sqlite_store.h"
 #include "study/study_store.h"
 #include "study/trial_plan.h"
+#include "study/web_series.h"
 
 namespace lucent::app {
 namespace {
@@ -144,16 +145,23 @@ int serve_command(const ServeArgs& args) {
     try {
         protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                        : study::builtin_protocol(args.preset);
-        study::check_presentable(protocol);
         study::plan_trials(protocol, 0, 0);  // impossible randomisation fails here, early
+        // The adjust series and staircase ladders are pictures of their own, each
+        // checked against the manifest like the protocol's stimuli.
+        study::WebSeries series = study::web_series(protocol);
+        const study::Protocol shown = study::with_series_pictures(protocol, series);
         const study::PrerenderedStimuli stimuli(args.images_dir);
-        stimuli.check(protocol);
+        stimuli.check(shown);
         study::WebStudyOptions options;
         options.environment.machine_id = study::machine_id();
         options.environment.software_version = version_string();
         options.environment.build_hash = build_hash();
-        options.environment.stimuli = stimuli.provenance(protocol);
-        pictures = load_pictures(protocol, stimuli);
+        // Each segment records the protocol's stimuli; a series picture is its base
+        // stimulus with the knob at the value stored with the trial.
+        options.environment.stimuli = stimuli.provenance(shown);
+        options.environment.stimuli.resize(protocol.stimuli.size());
+        options.series = std::move(series);
+        pictures = load_pictures(shown, stimuli);
         for (const auto& [id, picture] : pictures) options.images[id] = picture.size;
         const std::string secret_file =
             !args.secret_file.empty() ? args.secret_file

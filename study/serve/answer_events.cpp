@@ -69,13 +69,15 @@ AnswerEvent rating_event_of(const json& e, const std::string& type,
     return ev;
 }
 
-// One of a forced choice's events, checked: ArrowLeft, ArrowRight, 1, 2 (pick), Enter
-// (confirm), or a click on alternative 1 or 2 (pick and confirm).
-AnswerEvent choice_event_of(const json& e, const std::string& type, Task task) {
+// One of a forced choice's events, checked: ArrowLeft, ArrowRight, 1..alternatives
+// (pick), Enter (confirm), or a click on an alternative (pick and confirm).
+AnswerEvent choice_event_of(const json& e, const std::string& type, Task task,
+                            int alternatives) {
     AnswerEvent ev{AnswerEvent::Kind::Key};
+    const std::string digits = alternatives == 3 ? "1, 2, 3" : "1, 2";
     if (type == "key") {
         const std::string key = text_field(e, "key", 16, true);
-        if (key == "1" || key == "2") {
+        if (key.size() == 1 && key[0] >= '1' && key[0] < '1' + alternatives) {
             ev.key = Key::Digit;
             ev.digit = key[0] - '0';
         } else if (key == "Enter") {
@@ -87,16 +89,18 @@ AnswerEvent choice_event_of(const json& e, const std::string& type, Task task) {
         } else {
             throw RequestError(400, "field 'key': '" + one_line(key) +
                                         "' does not answer a forced choice (ArrowLeft, "
-                                        "ArrowRight, 1, 2, Enter)");
+                                        "ArrowRight, " +
+                                        digits + ", Enter)");
         }
     } else if (type == "choice") {
         ev.kind = AnswerEvent::Kind::Choice;
         const json* a = field(e, "alternative");
         if (!a || !a->is_number_integer() || a->get<int64_t>() < 1 ||
-            a->get<int64_t>() > 2)
-            throw RequestError(400,
-                               "field 'alternative' must be 1 or 2, not " +
-                                   (a ? one_line(to_text(*a)) : std::string("none")));
+            a->get<int64_t>() > alternatives)
+            throw RequestError(
+                400, "field 'alternative' must be " +
+                         std::string(alternatives == 3 ? "1, 2 or 3" : "1 or 2") +
+                         ", not " + (a ? one_line(to_text(*a)) : std::string("none")));
         ev.alternative = static_cast<int>(a->get<int64_t>());
     } else if (type == "point" || type == "next") {
         throw RequestError(400, "field 'type': a '" + type +
@@ -109,14 +113,77 @@ AnswerEvent choice_event_of(const json& e, const std::string& type, Task task) {
     return ev;
 }
 
+// One of an adjustment's events, checked: an arrow (Shift: the fine step) or Enter, the
+// wheel's notches, a drag across the match. Bounded so that no NaN, infinity or absurd
+// move reaches AdjustInput (which would ignore or clamp them silently).
+AnswerEvent adjust_event_of(const json& e, const std::string& type) {
+    AnswerEvent ev{AnswerEvent::Kind::Key};
+    if (type == "key") {
+        const std::string key = text_field(e, "key", 16, true);
+        if (key == "ArrowLeft") {
+            ev.key = Key::Left;
+        } else if (key == "ArrowRight") {
+            ev.key = Key::Right;
+        } else if (key == "ArrowUp") {
+            ev.key = Key::Up;
+        } else if (key == "ArrowDown") {
+            ev.key = Key::Down;
+        } else if (key == "Enter") {
+            ev.key = Key::Enter;
+        } else {
+            throw RequestError(400, "field 'key': '" + one_line(key) +
+                                        "' does not adjust the match (ArrowLeft, "
+                                        "ArrowRight, ArrowUp, ArrowDown, Enter)");
+        }
+        if (const json* shift = field(e, "shift")) {
+            if (!shift->is_boolean())
+                throw RequestError(400, "field 'shift' must be true or false");
+            ev.shift = shift->get<bool>();
+        }
+    } else if (type == "wheel") {
+        ev.kind = AnswerEvent::Kind::Wheel;
+        ev.notches = *number_field(e, "notches", -100, 100, true);
+    } else if (type == "drag") {
+        ev.kind = AnswerEvent::Kind::Drag;
+        ev.dx = *number_field(e, "dx", -1e5, 1e5, true);
+        // At least a pixel: a match narrower is no match shown (and dx / width stays
+        // finite).
+        ev.width = *number_field(e, "width", 1, 1e5, true);
+    } else if (type == "choice" || type == "point" || type == "next") {
+        throw RequestError(400, "field 'type': a '" + type + "' event answers a " +
+                                    (type == "choice" ? "forced choice" : "rating") +
+                                    "; this trial is an adjustment");
+    } else {
+        throw RequestError(400, "unknown event type '" + one_line(type) + "'");
+    }
+    return ev;
+}
+
 AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
-                     int max_points, Task task) {
+                     int max_points, Task task, int alternatives) {
     if (!e.is_object()) throw RequestError(400, "each event must be an object");
     const int64_t t_ns = ms_to_ns(*number_field(e, "t_ms", 0, kMaxPageMs, true));
     const std::string type = text_field(e, "type", 16, true);
-    AnswerEvent ev = task == Task::rating
-                         ? rating_event_of(e, type, questions, max_points)
-                         : choice_event_of(e, type, task);
+    if (task != Task::adjust) {
+        // An adjustment's input on any other trial: refused, never ignored.
+        if (type == "wheel" || type == "drag")
+            throw RequestError(
+                400,
+                "field 'type': a '" + type + "' event adjusts a match; this trial is " +
+                    (task == Task::rating
+                         ? std::string("a rating")
+                         : std::string("a forced choice (") + task_name(task) + ")"));
+        if (const json* shift = field(e, "shift"); shift && *shift != json(false))
+            throw RequestError(
+                400,
+                "field 'shift' is only for an adjustment's arrows; this "
+                "trial is " +
+                    std::string(task == Task::rating ? "a rating" : "a forced choice"));
+    }
+    AnswerEvent ev =
+        task == Task::rating   ? rating_event_of(e, type, questions, max_points)
+        : task == Task::adjust ? adjust_event_of(e, type)
+                               : choice_event_of(e, type, task, alternatives);
     ev.t_ns = t_ns;
     return ev;
 }
@@ -162,7 +229,8 @@ void check_trial_on_screen(const SessionFlow& flow, const std::vector<TrialRow>&
 }
 
 std::vector<AnswerEvent> events_of(const json& body,
-                                   const std::vector<Question>& questions, Task task) {
+                                   const std::vector<Question>& questions, Task task,
+                                   int alternatives) {
     const json* events = field(body, "events");
     if (!events || !events->is_array())
         throw RequestError(400, "field 'events' must be an array");
@@ -175,7 +243,7 @@ std::vector<AnswerEvent> events_of(const json& body,
     for (const Question& q : questions) max_points = std::max(max_points, q.points());
     std::vector<AnswerEvent> replay;
     for (const json& e : *events)
-        replay.push_back(event_of(e, questions, max_points, task));
+        replay.push_back(event_of(e, questions, max_points, task, alternatives));
     return replay;
 }
 
@@ -240,13 +308,14 @@ SessionFlow replayed(const SessionFlow& flow, double onset_ms,
         }
     }
     const bool choice = next.choice_phase().has_value();
+    const bool adjust = next.adjustment() != nullptr;
     const size_t answered_before = next.answered_trials();
     for (const AnswerEvent& ev : replay) {
         if (next.answered_trials() != answered_before)
             break;  // confirmed: the rest is late
         switch (ev.kind) {
             case AnswerEvent::Kind::Key:
-                next.key({ev.key, ev.digit, ev.t_ns});
+                next.key({ev.key, ev.digit, ev.t_ns, ev.shift});
                 break;
             case AnswerEvent::Kind::Point:
                 next.click_point(ev.question, ev.value, ev.t_ns);
@@ -257,14 +326,22 @@ SessionFlow replayed(const SessionFlow& flow, double onset_ms,
             case AnswerEvent::Kind::Choice:
                 next.click_choice(ev.alternative, ev.t_ns);
                 break;
+            case AnswerEvent::Kind::Wheel:
+                next.wheel(ev.notches, ev.t_ns);
+                break;
+            case AnswerEvent::Kind::Drag:
+                next.drag(ev.dx, ev.width, ev.t_ns);
+                break;
         }
     }
     if (next.answered_trials() == answered_before)
         throw RequestError(
-            400, choice ? "the events do not choose an alternative and confirm "
-                          "it (Enter or a click) after the answer screen's onset"
-                        : "the events do not rate every question and confirm it "
-                          "(Enter or Next) after the picture's onset");
+            400, adjust   ? "the events do not confirm the match (Enter) after the "
+                            "pictures' onset"
+                 : choice ? "the events do not choose an alternative and confirm "
+                            "it (Enter or a click) after the answer screen's onset"
+                          : "the events do not rate every question and confirm it "
+                            "(Enter or Next) after the picture's onset");
     return next;
 }
 

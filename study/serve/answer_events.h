@@ -16,12 +16,16 @@
 
 namespace lucent::study {
 
-// One input event of an answer, checked, as the lab's RatingInput takes it.
+// One input event of an answer, checked, as the lab's RatingInput (an adjustment: its
+// AdjustInput) takes it.
 struct AnswerEvent {
-    enum class Kind { Key, Point, Next, Choice } kind;
+    enum class Kind { Key, Point, Next, Choice, Wheel, Drag } kind;
     Key key = Key::Enter;
+    bool shift = false;  // Key on an adjustment: the fine step
     int digit = 0, question = 0, value = 0;
-    int alternative = 0;  // Choice: 1 or 2
+    int alternative = 0;       // Choice: 1..the block's answers
+    double notches = 0;        // Wheel: positive up
+    double dx = 0, width = 0;  // Drag: pixels across a match `width` wide
     int64_t t_ns = 0;
 };
 
@@ -31,10 +35,14 @@ void check_trial_on_screen(const SessionFlow& flow, const std::vector<TrialRow>&
                            const std::string& trial_uuid);
 // The answer's `events`, at most kMaxEventsPerAnswer, each checked against the trial's
 // task. A rating: a key the scales or the lab know, a rating inside its question's
-// scale, or Next. A forced choice: ArrowLeft, ArrowRight, 1, 2, Enter, or a click on
-// alternative 1 or 2. An event of the other kind of trial is a 400 naming the field.
+// scale, or Next. A forced choice (`alternatives`: 2, 3 for an odd-one-out staircase):
+// ArrowLeft, ArrowRight, 1..alternatives, Enter, or a click on an alternative. An
+// adjustment: an arrow (with `shift`: the fine step) or Enter, wheel notches
+// (|notches| <= 100), a drag (|dx| <= 100000 px across a match 1 <= width <= 100000 px
+// wide). An event of another kind of trial is a 400 naming the field.
 std::vector<AnswerEvent> events_of(const nlohmann::json& body,
-                                   const std::vector<Question>& questions, Task task);
+                                   const std::vector<Question>& questions, Task task,
+                                   int alternatives);
 
 // When each part of a forced choice shown in sequence reached the display (the page's
 // performance.now(), ms): the blank after the first part, the second part, and the
@@ -50,8 +58,8 @@ std::optional<SequenceOnsets> sequence_onsets_of(const nlohmann::json& body,
 // Replayed on a copy: the blank gives way to the picture at its onset (a sequence's
 // parts at their onsets, each refused (400) when it came before the part before had
 // been on the display for its duration), then the keys and clicks as the lab's
-// RatingInput takes them; the copy commits the trial. 400 when the events do not rate
-// every question (choose an alternative) and confirm it.
+// RatingInput (an adjustment: AdjustInput) takes them; the copy commits the trial. 400
+// when the events do not rate every question (choose an alternative) and confirm it.
 SessionFlow replayed(const SessionFlow& flow, double onset_ms,
                      const std::optional<SequenceOnsets>& sequence,
                      const std::vector<AnswerEvent>& replay, int inter_trial_ms);

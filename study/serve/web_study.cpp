@@ -15,6 +15,7 @@
 #include "common/srgb.h"
 #include "study/serve/answer_events.h"
 #include "study/serve/request_fields.h"
+#include "study/session/adjust_input.h"
 #include "study/session/session_flow.h"
 #include "study/sha256.h"
 #include "study/sqlite/sqlite_store.h"
@@ -198,6 +199,35 @@ WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions 
         if (!options_.images.count(s.id))
             throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id +
                                         "'");
+    // What the lab renders live is shown from pictures: each adjust block's match series
+    // and each staircase standard's ladder, every picture of them served.
+    auto series_of = [&](const Block& b, const std::string& stimulus) {
+        const KnobSeries* series = options_.series.find(b.id, stimulus);
+        if (!series || series->steps.size() < 2 ||
+            series->pictures.size() != series->steps.size())
+            throw std::invalid_argument("lucent serve: block '" + b.id +
+                                        "' has no picture series for '" + stimulus + "'");
+        for (const std::string& id : series->pictures)
+            if (!options_.images.count(id))
+                throw std::invalid_argument("lucent serve: no picture for '" + id + "'");
+        return series;
+    };
+    for (const Block& b : protocol_.blocks) {
+        if (b.task == Task::adjust) {
+            // One size for the whole series: the match never jumps as it moves.
+            const KnobSeries* series = series_of(b, b.match);
+            const WebImage& first = options_.images.at(series->pictures.front());
+            for (const std::string& id : series->pictures) {
+                const WebImage& image = options_.images.at(id);
+                if (image.width != first.width || image.height != first.height)
+                    throw std::invalid_argument(
+                        "lucent serve: block '" + b.id + "': the series picture '" + id +
+                        "' differs in size from '" + series->pictures.front() + "'");
+            }
+        }
+        if (b.task == Task::staircase)
+            for (const std::string& standard : b.stimuli) series_of(b, standard);
+    }
     if (!options_.clock) options_.clock = [] { return std::chrono::system_clock::now(); };
     // The main trials a session plans (the same for every seed and cell): choice
     // blocks' designs and catch trials are not one per stimulus.
@@ -475,6 +505,7 @@ WebReply WebStudy::resume(const std::string& code, const std::string& token,
     live.trials = store_.trials(unfinished.id);
     live.flow.emplace(protocol_, store_, unfinished.id, live.trials,
                       store_.has_consent(unfinished.id), ms_to_ns(t_ms));
+    live.flow->show_series(&options_.series);
     json reply = state(live);
     reply["token"] = live.token;
     return {200, to_text(reply)};
@@ -579,6 +610,7 @@ WebReply WebStudy::consent(Live& live, bool decline, double shown_ms, double t_m
     live.trials = store_.trials(enrolled.session.id);
     SessionFlow flow(protocol_, store_, enrolled.session.id, live.trials, false,
                      ms_to_ns(shown_ms));
+    flow.show_series(&options_.series);  // copies keep it; options_ outlives them
     if (flow.screen() == Screen::Consent) {
         flow.presented(flow.serial(), ms_to_ns(shown_ms));
         flow.key({Key::Enter, 0, ms_to_ns(t_ms)});  // records consent
@@ -733,11 +765,11 @@ WebReply WebStudy::answer(Live& live, const json& body) {
     const double onset_ms = *number_field(body, "onset_ms", 0, kMaxPageMs, true);
     const TrialRow& trial = *flow.trial();
     const Block* block = protocol_.find_block(trial.block);
-    const bool sequential = trial.task != Task::rating && block &&
-                            block->presentation == Presentation::sequential;
+    const bool sequential = trial.task != Task::rating && trial.task != Task::adjust &&
+                            block && block->presentation == Presentation::sequential;
     const std::optional<SequenceOnsets> sequence = sequence_onsets_of(body, sequential);
     const std::vector<AnswerEvent> replay =
-        events_of(body, protocol_.questions, trial.task);
+        events_of(body, protocol_.questions, trial.task, block ? block->answers() : 2);
 
     SessionFlow next =
         replayed(flow, onset_ms, sequence, replay, protocol_.inter_trial_ms);
@@ -763,10 +795,11 @@ json WebStudy::rating_trial(const TrialRow& t) const {
 // A forced choice: its pictures in screen order, the block's question and answers, and
 // how they are shown. Never which answer is right, nor whether it is a catch trial (an
 // attention check the page could tell would be one a script could pass).
-json WebStudy::choice_trial(const TrialRow& t) const {
+json WebStudy::choice_trial(const TrialRow& t,
+                            const std::vector<std::string>& pictures) const {
     const Block& block = *protocol_.find_block(t.block);
     json shown = json::array();
-    for (const std::string& id : t.shown) {
+    for (const std::string& id : pictures) {
         const WebImage& image = options_.images.at(id);
         shown.push_back({{"image", "/images/" + id + ".png"},
                          {"width", image.width},
@@ -787,6 +820,55 @@ json WebStudy::choice_trial(const TrialRow& t) const {
         out["sequence"] = {{"duration_ms", block.duration_ms},
                            {"blank_ms", block.blank_ms}};
     return out;
+}
+
+// An adjustment: the target and the match's series of pictures, and what the page needs
+// to move over the series exactly as the flow's AdjustInput does (the range on the
+// block's scale, its steps, the start). Never the target's value.
+json WebStudy::adjust_trial(const TrialRow& t) const {
+    const Block& block = *protocol_.find_block(t.block);
+    const KnobSeries& series = *options_.series.find(t.block, block.match);
+    // The start as the flow takes it: the series value nearest the planned start.
+    const AdjustInput start(block, t.start_value.value_or(0.0), 0, series.steps);
+    // The range on the scale, as AdjustInput computes it (the page cannot: its log10
+    // may differ in the last bit).
+    const bool log = block.scale == "log";
+    json urls = json::array();
+    for (const std::string& id : series.pictures)
+        urls.push_back("/images/" + id + ".png");
+    const WebImage& target = options_.images.at(t.stimulus);
+    const WebImage& match = options_.images.at(series.pictures.front());
+    return {{"id", t.uuid},
+            {"task", "adjust"},
+            {"target",
+             {{"image", "/images/" + t.stimulus + ".png"},
+              {"width", target.width},
+              {"height", target.height}}},
+            {"match", {{"width", match.width}, {"height", match.height}}},
+            {"series", urls},
+            {"low", log ? std::log10(block.range_min) : block.range_min},
+            {"high", log ? std::log10(block.range_max) : block.range_max},
+            {"coarse", block.step},
+            {"fine", block.fine_step},
+            {"start_index", start.series_index()},
+            {"question", block.question},
+            {"practice", t.practice},
+            {"prompt", ""},
+            {"blank_ms", protocol_.inter_trial_ms},
+            {"max_events", kMaxEventsPerAnswer}};
+}
+
+// A staircase trial: a forced choice between the standard and the comparison, the
+// ladder's picture of the delta the flow shows (its rung), at the comparison's place;
+// an odd one out shows the standard twice. Which one is the comparison is not said.
+json WebStudy::staircase_trial(const TrialRow& t, const SessionFlow& flow) const {
+    const KnobSeries& ladder = *options_.series.find(t.block, t.stimulus);
+    const std::optional<adaptive::Proposal> delta = flow.staircase_delta();
+    if (!delta) throw std::logic_error("a staircase trial on screen without a delta");
+    std::vector<std::string> shown = t.shown;
+    shown.at(static_cast<size_t>(t.expected - 1)) =
+        ladder.pictures[nearest_step(ladder.steps, delta->intensity)];
+    return choice_trial(t, shown);
 }
 
 json WebStudy::done_state() const {
@@ -815,7 +897,10 @@ json WebStudy::state(const Live& live) const {
         questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
     out["questions"] = questions;
     if (const TrialRow* t = flow.trial()) {
-        out["trial"] = t->task == Task::rating ? rating_trial(*t) : choice_trial(*t);
+        out["trial"] = t->task == Task::rating      ? rating_trial(*t)
+                       : t->task == Task::adjust    ? adjust_trial(*t)
+                       : t->task == Task::staircase ? staircase_trial(*t, flow)
+                                                    : choice_trial(*t, t->shown);
     } else {
         const std::string& text = flow.text();
         out["text"] = text.empty() ? std::string("Press Enter.") : text;

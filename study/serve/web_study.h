@@ -9,7 +9,8 @@
 // Every action names the view it answers (the flow's serial), so an action meant for a
 // screen already left (a double Enter, a second tab) is refused, never applied twice.
 // An answer carries the participant's input events (keys, clicks, performance.now()
-// times), which the server replays through the session's RatingInput: the same rules as
+// times), which the server replays through the session's RatingInput (an adjustment's
+// through its AdjustInput, over pre-rendered pictures: web_series.h): the same rules as
 // in the lab, and the trial is committed to the store before the reply names the next
 // screen. A refused request (4xx, one-line reason) changes nothing: each action runs on
 // a copy of the participant's flow, kept only when it succeeded.
@@ -24,9 +25,11 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "study/protocol.h"
 #include "study/study_store.h"
+#include "study/web_series.h"
 
 namespace lucent::study {
 
@@ -45,8 +48,13 @@ struct WebStudyOptions {
     std::string secret;  // HMAC key of the session tokens (kept: tokens outlive restarts)
     // What every segment records besides the browser: machine, software, stimuli.
     SessionEnvironment environment;
-    std::map<std::string, WebImage> images;  // by stimulus id, every protocol stimulus
-    size_t max_body_bytes = 64 * 1024;       // larger API bodies: 413
+    // By stimulus id: every protocol stimulus and every picture of `series`.
+    std::map<std::string, WebImage> images;
+    // The pictures the lab renders live (issue 31): each adjust block's match series and
+    // each staircase standard's ladder (web_series(protocol)); required for a protocol
+    // with such blocks. Every session's flow shows them (SessionFlow::show_series).
+    WebSeries series;
+    size_t max_body_bytes = 64 * 1024;  // larger API bodies: 413
     // A page that sent nothing for this long is put aside (release_idle): its claim on
     // the participant ends, and its session no longer holds a cell (abandoned) once the
     // store has seen no activity of it for as long. A later request re-loads it.
@@ -76,6 +84,8 @@ std::string hmac_sha256_hex(std::string_view key, std::string_view message);
 // (traversal, other folders, encoded separators, unknown names).
 std::optional<std::string> image_of_target(std::string_view target,
                                            const std::map<std::string, WebImage>& images);
+
+class SessionFlow;
 
 class WebStudy {
 public:
@@ -121,7 +131,11 @@ private:
     WebReply answer(Live& live, const nlohmann::json& body);
     nlohmann::json state(const Live& live) const;
     nlohmann::json rating_trial(const TrialRow& trial) const;
-    nlohmann::json choice_trial(const TrialRow& trial) const;
+    // A forced choice showing `shown` (stimulus ids in screen order).
+    nlohmann::json choice_trial(const TrialRow& trial,
+                                const std::vector<std::string>& shown) const;
+    nlohmann::json adjust_trial(const TrialRow& trial) const;
+    nlohmann::json staircase_trial(const TrialRow& trial, const SessionFlow& flow) const;
     nlohmann::json done_state() const;
     SessionEnvironment environment_for(const Live& live) const;
     Live& load(const std::string& code, const SessionRow& session,

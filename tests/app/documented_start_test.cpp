@@ -16,6 +16,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -23,6 +25,7 @@
 #include "study/protocol.h"
 #include "study/sqlite/database.h"
 #include "study/trial_plan.h"
+#include "study/web_series.h"
 #include "tests/support/display.h"
 #include "tests/support/test_paths.h"
 
@@ -251,14 +254,10 @@ TEST(DocumentedStart, FabricsRunsAndServesFromTheSetItsRenderPresetWrites) {
     documented_start("fabrics");
 }
 
-// docs/scaling.md, command for command: each indented `lucent` line (a trailing
-// backslash continues it; `# ...` is a comment) runs as written in a scratch folder, in
-// the page's order, and each must succeed. Two lines get what a test needs: `serve` a
-// free port (it is checked and stopped), and the lab session without the autopilot is
-// left out (the autopilot line below it is that command with the simulated observer).
-TEST(DocumentedScaling, ThePagesCommandsRunAsWrittenAndTheReportScalesTheSession) {
-    LUCENT_REQUIRE_DISPLAY();
-    std::istringstream page(read_file(test::source_dir() / "docs" / "scaling.md"));
+// A page of docs/'s `lucent` command lines, in order: each indented line starting
+// `lucent ` (a trailing backslash continues it; `# ...` is a comment).
+std::vector<std::string> page_commands(const std::string& name) {
+    std::istringstream page(read_file(test::source_dir() / "docs" / name));
     std::vector<std::string> commands;
     std::string pending;
     for (std::string line; std::getline(page, line);) {
@@ -273,9 +272,28 @@ TEST(DocumentedScaling, ThePagesCommandsRunAsWrittenAndTheReportScalesTheSession
             pending.clear();
         }
     }
-    ASSERT_GE(commands.size(), 7u);
-    const fs::path dir = test::scratch_dir("documented_scaling");
-    bool ran_session = false, analyzed = false;
+    return commands;
+}
+
+// Starts `lucent serve ARGS` on a free port in `dir`; the port it listens on, or 0 when
+// it did not start (its stderr says why).
+int start_serve(std::vector<std::string> args, const fs::path& dir, Child& serve) {
+    args.insert(args.end(), {"--listen", "127.0.0.1:0"});
+    serve = start(args, dir, "serve", true);
+    const std::string line = first_line(serve.stdout_fd);
+    const size_t at = line.find("http://127.0.0.1:");
+    return at == std::string::npos ? 0 : std::stoi(line.substr(at + 17));
+}
+
+// Runs a page's commands in `dir`, in order, each as written and each to succeed, but
+// for what a test needs: the lab session without the autopilot is left out (the line
+// with the autopilot is that command with a simulated participant), and `serve` gets a
+// free port, a participant's first request (the consent screen), `check` with its
+// arguments and a client, and is stopped. Returns how many of each subcommand ran.
+std::map<std::string, int> run_page(
+    const std::vector<std::string>& commands, const fs::path& dir,
+    const std::function<void(const std::vector<std::string>&, httplib::Client&)>& check) {
+    std::map<std::string, int> ran;
     for (const std::string& command : commands) {
         std::vector<std::string> args = words(command);
         args.erase(args.begin());  // "lucent"
@@ -283,25 +301,42 @@ TEST(DocumentedScaling, ThePagesCommandsRunAsWrittenAndTheReportScalesTheSession
             std::find(args.begin(), args.end(), "--autopilot") != args.end();
         if (args[0] == "run" && !autopilot) continue;
         if (args[0] == "serve") {
-            args.insert(args.end(), {"--listen", "127.0.0.1:0"});
-            Child s = start(args, dir, "serve", true);
-            const std::string line = first_line(s.stdout_fd);
-            const size_t at = line.find("http://127.0.0.1:");
-            ASSERT_NE(at, std::string::npos) << line << read_file(s.stderr_path);
-            httplib::Client client("127.0.0.1", std::stoi(line.substr(at + 17)));
-            const auto session =
-                client.Post("/api/session", R"({"participant": "WEB1", "t_ms": 0})",
-                            "application/json");
-            ASSERT_TRUE(session) << httplib::to_string(session.error());
-            EXPECT_EQ(session->status, 200) << session->body;
+            Child s;
+            const int port = start_serve(args, dir, s);
+            EXPECT_GT(port, 0) << read_file(s.stderr_path);
+            if (port > 0) {
+                httplib::Client client("127.0.0.1", port);
+                const auto session =
+                    client.Post("/api/session", R"({"participant": "WEB1", "t_ms": 0})",
+                                "application/json");
+                EXPECT_TRUE(session) << httplib::to_string(session.error());
+                if (session) EXPECT_EQ(session->status, 200) << session->body;
+                check(args, client);
+            }
             EXPECT_EQ(wait_exit(s, true), 0) << read_file(s.stderr_path);
+            ++ran["serve"];
             continue;
         }
         Child c = start(args, dir, args[0], false);
-        ASSERT_EQ(wait_exit(c), 0) << command << "\n" << read_file(c.stderr_path);
-        ran_session = ran_session || args[0] == "run";
-        analyzed = analyzed || args[0] == "analyze";
+        EXPECT_EQ(wait_exit(c), 0) << command << "\n" << read_file(c.stderr_path);
+        ++ran[args[0]];
     }
+    return ran;
+}
+
+// docs/scaling.md, command for command: each indented `lucent` line (a trailing
+// backslash continues it; `# ...` is a comment) runs as written in a scratch folder, in
+// the page's order, and each must succeed. Two lines get what a test needs: `serve` a
+// free port (it is checked and stopped), and the lab session without the autopilot is
+// left out (the autopilot line below it is that command with the simulated observer).
+TEST(DocumentedScaling, ThePagesCommandsRunAsWrittenAndTheReportScalesTheSession) {
+    LUCENT_REQUIRE_DISPLAY();
+    const std::vector<std::string> commands = page_commands("scaling.md");
+    ASSERT_GE(commands.size(), 7u);
+    const fs::path dir = test::scratch_dir("documented_scaling");
+    const std::map<std::string, int> ran =
+        run_page(commands, dir, [](const std::vector<std::string>&, httplib::Client&) {});
+    const bool ran_session = ran.count("run") > 0, analyzed = ran.count("analyze") > 0;
     ASSERT_TRUE(ran_session);
     ASSERT_TRUE(analyzed);
     // The autopilot's session completed, every planned trial answered once, and the
@@ -325,6 +360,76 @@ TEST(DocumentedScaling, ThePagesCommandsRunAsWrittenAndTheReportScalesTheSession
     const std::string choices = read_file(dir / "choices.csv");
     EXPECT_EQ(std::count(choices.begin(), choices.end(), '\n'),
               1 + d.scalar_int("SELECT count(*) FROM responses"));
+}
+
+// docs/matching.md, command for command, as docs/scaling.md's: the lab session without
+// the autopilot is left out, `serve` gets a free port, starts only after checking every
+// picture of the series and ladders against the manifest, and serves one of each.
+TEST(DocumentedMatching, ThePagesCommandsRunAsWrittenAndServeShowsEverySeries) {
+    LUCENT_REQUIRE_DISPLAY();
+    const std::vector<std::string> commands = page_commands("matching.md");
+    ASSERT_GE(commands.size(), 8u);
+    const fs::path dir = test::scratch_dir("documented_matching");
+    // Each served study: the first and last picture of every series and ladder.
+    const auto check_series = [](const std::vector<std::string>& args,
+                                 httplib::Client& client) {
+        const std::string preset = *(std::find(args.begin(), args.end(), "--preset") + 1);
+        const study::WebSeries series =
+            study::web_series(study::builtin_protocol(preset));
+        for (const study::KnobSeries& k : series.series)
+            for (const std::string& id : {k.pictures.front(), k.pictures.back()}) {
+                const auto png = client.Get(("/images/" + id + ".png").c_str());
+                ASSERT_TRUE(png) << id;
+                EXPECT_EQ(png->status, 200) << id;
+                EXPECT_EQ(png->body.substr(1, 3), "PNG") << id;
+            }
+    };
+    std::map<std::string, int> ran = run_page(commands, dir, check_series);
+    const int served = ran["serve"];
+    const bool analyzed = ran.count("analyze") > 0;
+    EXPECT_EQ(served, 2);
+    ASSERT_TRUE(analyzed);
+    // The autopilot's 18 adjustments, each a change list ending at its final value, and
+    // the report's matching section.
+    study::Database d((dir / "matching.db").string(), SQLITE_OPEN_READONLY);
+    EXPECT_EQ(d.scalar_int("SELECT count(*) FROM trials WHERE kind = 'adjust' AND "
+                           "final_value IS NOT NULL"),
+              18);
+    const std::string adjustments = read_file(dir / "adjustments.csv");
+    EXPECT_EQ(std::count(adjustments.begin(), adjustments.end(), '\n'),
+              1 + d.scalar_int("SELECT count(*) FROM adjustments"));
+    const std::string report = read_file(dir / "matching-report" / "report.md");
+    EXPECT_NE(report.find("Matching"), std::string::npos) << report.substr(0, 2000);
+
+    // A ladder picture missing, then one changed after it was rendered: serve refuses to
+    // start, in one line naming it (and what writes it).
+    const study::WebSeries jnd = study::web_series(study::builtin_protocol("jnd"));
+    const study::KnobSeries& ladder = jnd.series.front();
+    const fs::path pictures = dir / "jnd-pictures";
+    const std::string missing = ladder.pictures[3], changed = ladder.pictures[4];
+    fs::rename(pictures / (missing + ".png"), dir / "aside.png");
+    const std::vector<std::string> serve{"serve",      "--preset", "jnd",          "--db",
+                                         "refused.db", "--images", "jnd-pictures/"};
+    Child refused;
+    EXPECT_EQ(start_serve(serve, dir, refused), 0);
+    EXPECT_EQ(wait_exit(refused), 2);
+    EXPECT_EQ(
+        read_file(refused.stderr_path),
+        "lucent serve: preset:jnd: stimulus '" + missing +
+            "' (technique empirical): no " + missing +
+            ".png, .tif or .exr in jnd-pictures/; 'lucent render --study-preset jnd "
+            "--out jnd-pictures/' writes every picture the study shows in the "
+            "browser\n");
+    fs::rename(dir / "aside.png", pictures / (missing + ".png"));
+    fs::copy_file(pictures / (missing + ".png"), pictures / (changed + ".png"),
+                  fs::copy_options::overwrite_existing);
+    EXPECT_EQ(start_serve(serve, dir, refused), 0);
+    EXPECT_EQ(wait_exit(refused), 2);
+    const std::string why = read_file(refused.stderr_path);
+    EXPECT_NE(why.find(changed + ".png: content hash "), std::string::npos) << why;
+    EXPECT_NE(why.find("the image changed after it was rendered"), std::string::npos)
+        << why;
+    EXPECT_EQ(std::count(why.begin(), why.end(), '\n'), 1) << why;
 }
 
 }  // namespace

@@ -3,9 +3,12 @@
 // Enter, and clicks follow the lab's rules (study/session/rating_input.h); each answer
 // sends its input events with performance.now() times, and the server replays them.
 // The picture is drawn pixel for pixel; its onset is the first requestAnimationFrame
-// after it decoded and entered the page. A forced choice (pair, triad, quadruple)
-// shows its pictures side by side, or its two parts in sequence with a blank between
-// and then the two answers; arrows or 1/2 pick, Enter confirms, a click answers.
+// after it decoded and entered the page. A forced choice (pair, triad, quadruple, a
+// staircase's pair or odd one out) shows its pictures side by side, or its two parts in
+// sequence with a blank between and then the two answers; arrows or digits pick, Enter
+// confirms, a click answers. An adjustment shows the target and the match, which the
+// arrows (Shift: fine), the wheel and a drag move over its pre-rendered series exactly
+// as the lab's AdjustInput moves the knob (study/session/adjust_input.cpp); Enter sends.
 'use strict';
 (() => {
   const el = (id) => document.getElementById(id);
@@ -26,6 +29,7 @@
   let busy = false;     // a request is on its way: input waits
   let trial = null;     // the rating screen: onset, events, ratings, focus
   let choice = null;    // a forced choice's answer screen: onsets, events, the pick
+  let adjust = null;    // an adjustment: onset, events, position on the scale, index
 
   function mark(screen) {
     document.body.dataset.screen = screen;
@@ -108,6 +112,7 @@
     shownAt = null;
     trial = null;
     choice = null;
+    adjust = null;
     document.body.style.background = s.background || '#000';
     const progress = s.progress;
     el('progress').hidden = !progress || s.screen === 'consent';
@@ -117,8 +122,10 @@
       localStorage.removeItem(tokenKey);
       return message(s.text, 'declined');
     }
-    if (s.screen === 'trial')
+    if (s.screen === 'trial') {
+      if (s.trial.task === 'adjust') return beginAdjust(s);
       return s.trial.task && s.trial.task !== 'rating' ? beginChoice(s) : beginTrial(s);
+    }
     only('text-screen');
     el('text').textContent = s.text;
     const consent = s.screen === 'consent';
@@ -199,6 +206,7 @@
     const t = s.trial;
     el('rating-part').hidden = false;
     el('choice-part').hidden = true;
+    el('adjust-part').hidden = true;
     el('trial-screen').classList.remove('choice');
     only('trial-screen');
     const screenBox = el('trial-screen');
@@ -297,10 +305,11 @@
 
   // ---- a forced choice --------------------------------------------------------------
   // Which pictures (indices into `shown`) each alternative is: a pair's two pictures, a
-  // triad's pairs (a, b) and (b, c), a quadruple's pairs (a, b) and (c, d).
-  function partsOf(task) {
-    if (task === 'pair') return [[0], [1]];
-    if (task === 'triad') return [[0, 1], [1, 2]];
+  // staircase's two or three, a triad's pairs (a, b) and (b, c), a quadruple's pairs
+  // (a, b) and (c, d).
+  function partsOf(t) {
+    if (t.task === 'pair' || t.task === 'staircase') return t.shown.map((p, i) => [i]);
+    if (t.task === 'triad') return [[0, 1], [1, 2]];
     return [[0, 1], [2, 3]];
   }
   function answerButton(label, alternative) {
@@ -319,7 +328,7 @@
     const box = el('alternatives');
     box.textContent = '';
     box.className = 'task-' + t.task;
-    const parts = partsOf(t.task);
+    const parts = partsOf(t);
     if (part === 'answer') {
       box.classList.add('answers');
       t.labels.forEach((label, i) => box.appendChild(answerButton(label, i + 1)));
@@ -381,6 +390,7 @@
     const t = s.trial;
     el('rating-part').hidden = true;
     el('choice-part').hidden = false;
+    el('adjust-part').hidden = true;
     const screenBox = el('trial-screen');
     screenBox.classList.add('choice');
     el('alternatives').style.visibility = '';
@@ -469,7 +479,7 @@
 
   function renderChoice() {
     const t = state.trial;
-    const parts = partsOf(t.task);
+    const parts = partsOf(t);
     el('alternatives').querySelectorAll('[data-alternative]').forEach((node) =>
       node.classList.toggle('chosen', Number(node.dataset.alternative) === choice.pick));
     if (t.task === 'triad')  // the chosen pair's pictures
@@ -479,19 +489,22 @@
     document.body.dataset.choice = choice.pick === null ? '' : String(choice.pick);
   }
 
-  // One input on a forced choice's answer screen, by the lab's rules: the arrows pick
-  // the alternative on their side, 1 and 2 pick, Enter confirms, a click picks and
-  // confirms. Recorded for the server's replay.
+  // One input on a forced choice's answer screen, by the lab's rules: of two, the
+  // arrows pick the alternative on their side; of three (an odd one out), the first
+  // arrow picks the middle one and the next move by one; a digit picks, Enter confirms,
+  // a click picks and confirms. Recorded for the server's replay.
   function choiceInput(ev, t) {
     if (!choice || busy || t < choice.answerOnset) return;
+    const n = state.trial.labels.length;  // the answers
     let confirm = false;
     if (ev.type === 'choice') {
       choice.pick = ev.alternative;
       confirm = true;
     } else {
-      const k = ev.key;
-      if (k === 'ArrowLeft' || k === '1') choice.pick = 1;
-      else if (k === 'ArrowRight' || k === '2') choice.pick = 2;
+      const k = ev.key, p = choice.pick, middle = Math.floor((n + 1) / 2);
+      if (k.length === 1 && k >= '1' && k <= String(n)) choice.pick = Number(k);
+      else if (k === 'ArrowLeft') choice.pick = n === 2 ? 1 : p ? Math.max(1, p - 1) : middle;
+      else if (k === 'ArrowRight') choice.pick = n === 2 ? 2 : p ? Math.min(n, p + 1) : middle;
       else if (k === 'Enter') {
         if (choice.pick === null) return;
         confirm = true;
@@ -509,6 +522,164 @@
     api('answer', body).then(({ status, reply }) => settle(status, reply));
   }
 
+  // ---- an adjustment ----------------------------------------------------------------
+  async function beginAdjust(s) {
+    const t = s.trial;
+    el('rating-part').hidden = true;
+    el('choice-part').hidden = true;
+    el('adjust-part').hidden = false;
+    const screenBox = el('trial-screen');
+    screenBox.classList.add('choice');  // the whole width, as a forced choice's row
+    only('trial-screen');
+    screenBox.style.visibility = 'hidden';  // the blank between trials
+    mark('blank');
+    const picture = (url) => {
+      const img = new Image();
+      img.alt = '';
+      img.draggable = false;
+      img.src = url;
+      return img;
+    };
+    // Every picture of the series loaded and decoded before the onset: a move never
+    // waits for one (the browser caches them for the block's next trials).
+    const target = picture(t.target.image);
+    const series = t.series.map(picture);
+    const decoded = Promise.all([target, ...series].map((img) => img.decode()));
+    await sleep(t.blank_ms);
+    try { await decoded; } catch (e) { return message('The pictures of this trial cannot be shown.'); }
+    if (state !== s) return;
+    el('adjust-prompt').textContent = t.practice ? 'Practice' : '';
+    el('adjust-question').textContent = t.question;
+    el('target').textContent = '';
+    el('target').appendChild(target);
+    const size = () => {  // one image pixel per device pixel, as everywhere
+      target.style.width = t.target.width / devicePixelRatio + 'px';
+      target.style.height = t.target.height / devicePixelRatio + 'px';
+      for (const img of series) {
+        img.style.width = t.match.width / devicePixelRatio + 'px';
+        img.style.height = t.match.height / devicePixelRatio + 'px';
+      }
+    };
+    const showMatch = (i) => {
+      el('match').textContent = '';
+      el('match').appendChild(series[i]);
+      document.body.dataset.matchIndex = String(i);
+    };
+    showMatch(t.start_index);
+    for (;;) {  // laid out invisibly and measured; too small: say so and wait
+      only('trial-screen');
+      size();
+      if (fits()) break;
+      message('Your browser window is too small to show the two pictures side by side at ' +
+              'their true size (' + t.target.width + ' x ' + t.target.height + ' and ' +
+              t.match.width + ' x ' + t.match.height + ' pixels). Please enlarge the ' +
+              'window or zoom out; the study continues by itself.', 'too-small');
+      await new Promise((resolve) => addEventListener('resize', resolve, { once: true }));
+      if (state !== s) return;
+    }
+    only('trial-screen');
+    el('progress').hidden = !s.progress;
+    screenBox.style.visibility = 'visible';
+    const onset = await firstFrame();
+    if (state !== s) return;
+    // The position on the scale of the start's picture, as AdjustInput computes it.
+    const last = t.series.length - 1;
+    adjust = {
+      t, onset, events: [], index: t.start_index, showMatch,
+      position: t.low + (t.high - t.low) * t.start_index / last,
+      dragging: false, lastX: 0, pendingDx: 0,
+    };
+    document.body.dataset.trial = t.id;
+    mark('trial');
+  }
+
+  // The series index nearest `position` (AdjustInput::series_index_at; Math.round and
+  // std::round agree on the non-negative values it rounds).
+  function indexAt(a, position) {
+    const last = a.t.series.length - 1;
+    const at = Math.round((position - a.t.low) / (a.t.high - a.t.low) * last);
+    return Math.min(Math.max(at, 0), last);
+  }
+  // AdjustInput::move_to: the position held inside the range; false when it did not
+  // move (a step past an end), which the page neither shows nor sends.
+  function moveTo(a, position) {
+    position = Math.min(Math.max(position, a.t.low), a.t.high);
+    if (position === a.position) return false;
+    a.position = position;
+    const index = indexAt(a, position);
+    if (index !== a.index) {
+      a.index = index;
+      a.showMatch(index);
+    }
+    return true;
+  }
+
+  // One input on the adjust screen, applied as the server will replay it, and recorded.
+  function adjustInput(ev, t) {
+    const a = adjust;
+    if (!a || busy || t < a.onset) return;
+    if (ev.type === 'key' && ev.key === 'Enter') {
+      a.events.push({ t_ms: t, type: 'key', key: 'Enter' });
+      busy = true;
+      const body = { trial: state.trial.id, view: state.view, onset_ms: a.onset, events: a.events };
+      adjust = null;
+      api('answer', body).then(({ status, reply }) => settle(status, reply));
+      return;
+    }
+    if (a.events.length >= a.t.max_events - 1) return;  // the answer's bound: room for Enter
+    const range = a.t.high - a.t.low;
+    let moved = false;
+    if (ev.type === 'key') {
+      const up = ev.key === 'ArrowRight' || ev.key === 'ArrowUp';
+      if (!up && ev.key !== 'ArrowLeft' && ev.key !== 'ArrowDown') return;
+      const by = ev.shift ? a.t.fine : a.t.coarse;
+      moved = moveTo(a, a.position + (up ? by : -by));
+    } else if (ev.type === 'wheel') {
+      moved = moveTo(a, a.position + ev.notches * a.t.coarse);
+    } else if (ev.type === 'drag') {
+      moved = moveTo(a, a.position + ev.dx / ev.width * range);
+    }
+    if (moved) a.events.push(Object.assign({ t_ms: t }, ev));
+  }
+
+  // The wheel anywhere: one coarse step per event, up (away from the participant) up.
+  document.addEventListener('wheel', (ev) => {
+    if (!adjust) return;
+    ev.preventDefault();
+    if (ev.deltaY === 0) return;
+    adjustInput({ type: 'wheel', notches: -Math.sign(ev.deltaY) }, ev.timeStamp);
+  }, { passive: false });
+  // A drag that starts on the match: its width spans the range. Mouse moves add up until
+  // they would show another picture, and go as one event (an answer holds at most
+  // max_events); the page applies exactly what it sends, so it shows what the server
+  // will store.
+  el('match').addEventListener('mousedown', (ev) => {
+    if (!adjust || ev.button !== 0) return;
+    ev.preventDefault();
+    adjust.dragging = true;
+    adjust.lastX = ev.clientX;
+    adjust.pendingDx = 0;
+  });
+  document.addEventListener('mousemove', (ev) => {
+    const a = adjust;
+    if (!a || !a.dragging) return;
+    a.pendingDx += ev.clientX - a.lastX;
+    a.lastX = ev.clientX;
+    const width = el('match').getBoundingClientRect().width;
+    if (!(width >= 1) || a.pendingDx === 0) return;  // the server takes 1..100000 px
+    const range = a.t.high - a.t.low;
+    const position = Math.min(Math.max(a.position + a.pendingDx / width * range, a.t.low), a.t.high);
+    // Held at an end: the moves beyond it are lost, as each of them would be in the lab.
+    if (position === a.position) a.pendingDx = 0;
+    if (indexAt(a, position) === a.index) return;
+    const dx = a.pendingDx;
+    a.pendingDx = 0;
+    adjustInput({ type: 'drag', dx, width }, ev.timeStamp);
+  });
+  document.addEventListener('mouseup', () => {
+    if (adjust) adjust.dragging = false;
+  });
+
   // ---- keys and buttons -------------------------------------------------------------
   document.addEventListener('keydown', (ev) => {
     if (!state || ev.repeat) return;
@@ -517,6 +688,8 @@
     if (['ArrowLeft', 'ArrowRight', 'ArrowUp', 'ArrowDown', 'Enter', ' '].includes(k))
       ev.preventDefault();
     if (state.screen === 'trial') {
+      if (state.trial && state.trial.task === 'adjust')
+        return adjustInput({ type: 'key', key: k, shift: ev.shiftKey }, t);
       if (state.trial && state.trial.task && state.trial.task !== 'rating')
         return choiceInput({ type: 'key', key: k }, t);
       return input({ type: 'key', key: k }, t);
