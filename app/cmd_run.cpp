@@ -31,6 +31,7 @@ struct RunArgs {
     std::string observer = default_observer();
     std::string detection;  // "" = DetectionObserver{}
     std::string match;      // "" = MatchObserver{}
+    std::string adjust = "keys";
     study::RunOptions options;
 };
 
@@ -60,6 +61,9 @@ int run_command(RunArgs& args) {
         std::cerr << "lucent run: --autopilot-match: " << e.what() << "\n";
         return kExitUsage;
     }
+    // CLI::IsMember has checked the name.
+    o.autopilot_adjust =
+        study::parse_adjust_by(args.adjust).value_or(study::AdjustBy::keys);
     try {
         o.protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                          : study::builtin_protocol(args.preset);
@@ -143,6 +147,13 @@ void register_run(CLI::App& app, int& exit_code) {
         "--autopilot-match", args->match,
         "How a seeded autopilot settles an adjustment: BIAS,NOISE[,log] "
         "(target + BIAS + N(0, NOISE^2), on the knob's logarithm with 'log')");
+    cmd->add_option("--autopilot-adjust", args->adjust,
+                    "How a seeded autopilot turns an adjust trial's match: keys (arrows, "
+                    "Shift for fine steps), wheel (one notch a coarse step) or drag "
+                    "(across the match, whose width spans the range), the last two "
+                    "finished with Shift + arrows")
+        ->check(CLI::IsMember({"keys", "wheel", "drag"}))
+        ->capture_default_str();
     cmd->add_option(
         "--screenshot", args->options.screenshot_path,
         "Save the first trial screen (rating, choice, adjust or staircase) as a PNG "

@@ -64,6 +64,9 @@ void AdjustInput::confirm(int64_t t_ns) {
 
 void AdjustInput::move_to(double position, int64_t t_ns, const char* input) {
     if (confirmed_) return;
+    // Changes are kept in order: keys carry their X event times, the wheel and a drag
+    // the frame's, so a key read late may be stamped before the change drawn before it.
+    t_ns = std::max(t_ns, adjustments_.empty() ? onset_ns_ : adjustments_.back().t_ns);
     position = std::clamp(position, low_, high_);
     // At an end of the range a further step changes nothing and is not a change.
     if (position == position_) return;

@@ -14,24 +14,90 @@ const std::set<std::string> kKeys = {"1",     "2",  "3",    "4",     "5",      "
                                      "7",     "8",  "9",    "Enter", "Escape", "Left",
                                      "Right", "Up", "Down", "Q",     "R"};
 
-}  // namespace
+// A value's place on the view's scale (clamped into the range first).
+double on_scale(const AdjustView& view, double v) {
+    v = std::clamp(v, view.lo, view.hi);
+    return view.log_scale ? std::log10(v) : v;
+}
 
-std::vector<std::string> adjust_keys(const AdjustView& view, double goal) {
-    auto on_scale = [&](double v) {
-        v = std::clamp(v, view.lo, view.hi);
-        return view.log_scale ? std::log10(v) : v;
-    };
-    std::vector<std::string> keys;
-    if (!std::isfinite(goal) || !(view.step > 0) || !(view.fine_step > 0)) return keys;
-    const double distance = on_scale(goal) - on_scale(view.value);
-    const char* up = distance >= 0 ? "Right" : "Left";
+bool plannable(const AdjustView& view, double goal) {
+    return std::isfinite(goal) && view.step > 0 && view.fine_step > 0;
+}
+
+// Coarse steps (`up` / `down`, one each) then fine ones (Shift + arrows) over
+// `distance` on the scale; at most 1000 in all.
+void append_steps(std::vector<std::string>& out, const AdjustView& view, double distance,
+                  const char* up, const char* down) {
+    const bool rising = distance >= 0;
     const double coarse = std::floor(std::abs(distance) / view.step);
     const double fine =
         std::round((std::abs(distance) - coarse * view.step) / view.fine_step);
-    for (int i = 0; i < coarse && keys.size() < 1000; ++i) keys.push_back(up);
-    for (int i = 0; i < fine && keys.size() < 1000; ++i)
-        keys.push_back(std::string("Shift+") + up);
+    for (int i = 0; i < coarse && out.size() < 1000; ++i)
+        out.push_back(rising ? up : down);
+    for (int i = 0; i < fine && out.size() < 1000; ++i)
+        out.push_back(rising ? "Shift+Right" : "Shift+Left");
+}
+
+std::string pixel_event(const char* name, int x, int y) {
+    return std::string(name) + ":" + std::to_string(x) + "," + std::to_string(y);
+}
+
+}  // namespace
+
+std::optional<AdjustBy> parse_adjust_by(const std::string& name) {
+    if (name == "keys") return AdjustBy::keys;
+    if (name == "wheel") return AdjustBy::wheel;
+    if (name == "drag") return AdjustBy::drag;
+    return std::nullopt;
+}
+
+bool is_pointer_event(const std::string& name) {
+    return name == "WheelUp" || name == "WheelDown" || name == "Release" ||
+           name.rfind("Press:", 0) == 0 || name.rfind("Move:", 0) == 0;
+}
+
+std::vector<std::string> adjust_keys(const AdjustView& view, double goal) {
+    std::vector<std::string> keys;
+    if (!plannable(view, goal)) return keys;
+    append_steps(keys, view, on_scale(view, goal) - on_scale(view, view.value), "Right",
+                 "Left");
     return keys;
+}
+
+std::vector<std::string> adjust_wheel(const AdjustView& view, double goal) {
+    std::vector<std::string> events;
+    if (!plannable(view, goal)) return events;
+    append_steps(events, view, on_scale(view, goal) - on_scale(view, view.value),
+                 "WheelUp", "WheelDown");
+    return events;
+}
+
+std::vector<std::string> adjust_drag(const AdjustView& view, double goal) {
+    const double low = on_scale(view, view.lo), high = on_scale(view, view.hi);
+    if (!view.match || view.match->width <= 0 || !(high > low))
+        return adjust_keys(view, goal);
+    std::vector<std::string> events;
+    if (!plannable(view, goal)) return events;
+    const Rect& m = *view.match;
+    const double from = on_scale(view, view.value), to = on_scale(view, goal);
+    const long dx = std::lround((to - from) / (high - low) * m.width);
+    if (dx != 0) {
+        // Centred on the match so both ends stay on it; the press must be on it. The
+        // pointer gets there a frame before the press: the runner drags by the
+        // pointer's moves since the last frame, the press's frame included.
+        const int x0 = std::clamp(m.x + static_cast<int>((m.width - dx) / 2), m.x,
+                                  m.x + m.width - 1);
+        const int y = m.y + m.height / 2;
+        events.push_back(pixel_event("Move", x0, y));
+        events.push_back(pixel_event("Press", x0, y));
+        events.push_back(pixel_event("Move", x0 + static_cast<int>(dx), y));
+        events.push_back("Release");
+    }
+    // Where the drag leaves the value (AdjustInput::drag), to fine-tune from there.
+    const double after =
+        std::clamp(from + static_cast<double>(dx) / m.width * (high - low), low, high);
+    append_steps(events, view, to - after, "Right", "Left");
+    return events;
 }
 
 Autopilot Autopilot::from_seed(uint64_t seed, double speed,
@@ -107,9 +173,16 @@ void Autopilot::plan_screen(int64_t now_ns, const ScreenView& view) {
             const AdjustView& a = view.adjust;
             const double goal =
                 a.target ? simulated_match(match_, *a.target, a.lo, a.hi, rng_) : a.value;
+            const std::vector<std::string> events =
+                adjust_by_ == AdjustBy::wheel  ? adjust_wheel(a, goal)
+                : adjust_by_ == AdjustBy::drag ? adjust_drag(a, goal)
+                                               : adjust_keys(a, goal);
             double after = 1200;
-            for (const std::string& key : adjust_keys(a, goal)) {
-                press(delay_ms(after), key);
+            for (const std::string& event : events) {
+                // Pointer events at least two 60 Hz frames apart, as a hand's are.
+                press(is_pointer_event(event) ? std::max(delay_ms(after), 35.0)
+                                              : delay_ms(after),
+                      event);
                 after = 120;
             }
             press(delay_ms(600), "Enter");
@@ -161,7 +234,14 @@ std::vector<std::string> Autopilot::due(int64_t now_ns, const ScreenView& view) 
         planned_serial_ = view.serial;
         plan_screen(now_ns, view);
     }
+    ++frames_since_pointer_;
     while (!queue_.empty() && queue_.front().at_ns <= now_ns) {
+        // The runner gets a pointer event from ImGui while drawing the next frame,
+        // after that frame's keys: a pointer event waits one frame after the last, a
+        // key two, so they reach the flow in the order sent.
+        const bool pointer = is_pointer_event(queue_.front().key);
+        if (frames_since_pointer_ < (pointer ? 1 : 2)) break;
+        if (pointer) frames_since_pointer_ = 0;
         keys.push_back(queue_.front().key);
         queue_.erase(queue_.begin());
     }

@@ -162,6 +162,7 @@ private:
     std::optional<std::pair<int64_t, double>> live_shown_;
     const StimulusTexture* live_texture_ = nullptr;
     bool dragging_ = false;  // a drag that started on the match
+    int64_t frame_ns_ = 0;   // when this frame's events were polled
     bool screenshot_done_ = false;
     bool too_small_logged_ = false;
 };
@@ -243,6 +244,7 @@ void Session::open_window() {
                                               opt_.autopilot_observer);
         autopilot_->set_threshold_observers(opt_.autopilot_detection,
                                             opt_.autopilot_match);
+        autopilot_->set_adjust_by(opt_.autopilot_adjust);
         x_keyboard_.emplace(window_->glfw());
         x_keyboard_->focus_window();
     }
@@ -638,7 +640,9 @@ void Session::draw_adjust(int w, int h) {
     // The wheel anywhere, a horizontal drag that starts on the match.
     const ImGuiIO& io = ImGui::GetIO();
     if (io.WantCaptureMouse) return;
-    const int64_t t_ns = steady_now_ns();
+    // The wheel and the drag happened before this frame's poll (AdjustInput keeps the
+    // changes in time order against keys stamped with their own X event times).
+    const int64_t t_ns = frame_ns_;
     if (io.MouseWheel != 0.f) {
         const double notches = io.MouseWheel;
         ui_actions_.push_back([this, notches, t_ns] { flow_->wheel(notches, t_ns); });
@@ -646,7 +650,9 @@ void Session::draw_adjust(int w, int h) {
     if (ImGui::IsMouseClicked(ImGuiMouseButton_Left))
         dragging_ = l->match.contains(int(io.MousePos.x), int(io.MousePos.y));
     if (!ImGui::IsMouseDown(ImGuiMouseButton_Left)) dragging_ = false;
-    if (dragging_ && io.MouseDelta.x != 0.f) {
+    // The press frame's motion came before the button went down: not part of the drag.
+    if (dragging_ && !ImGui::IsMouseClicked(ImGuiMouseButton_Left) &&
+        io.MouseDelta.x != 0.f) {
         const double dx = io.MouseDelta.x, width = l->match.width;
         ui_actions_.push_back([this, dx, width, t_ns] { flow_->drag(dx, width, t_ns); });
     }
@@ -892,12 +898,20 @@ RunResult Session::run() {
             break;
         }
         const int64_t now = steady_now_ns();
+        frame_ns_ = now;
         if (autopilot_ && autopilot_->scripted() && !script_sent_) {
             x_keyboard_->play(
                 autopilot_->script());  // the whole script, timed by the server
             script_sent_ = true;
         } else if (autopilot_ && !autopilot_->scripted()) {
-            const std::vector<std::string> keys = autopilot_->due(now, flow_->view());
+            ScreenView view = flow_->view();
+            if (view.kind == ScreenView::Kind::Adjust) {  // where a drag must start
+                int w = 0, h = 0;
+                window_->framebuffer_size(w, h);
+                const std::optional<AdjustLayout> l = adjust_layout(w, h);
+                if (l && l->fits) view.adjust.match = l->match;
+            }
+            const std::vector<std::string> keys = autopilot_->due(now, view);
             // Take the focus back first: another window on the same X server may hold it.
             if (!keys.empty()) x_keyboard_->focus_window();
             for (const std::string& key : keys) x_keyboard_->tap(key);

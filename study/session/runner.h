@@ -7,6 +7,7 @@
 #include <string>
 
 #include "study/protocol.h"
+#include "study/session/autopilot.h"
 #include "study/session/session_flow.h"
 #include "study/session/stimulus_source.h"
 #include "study/simulated_observer.h"
@@ -29,6 +30,9 @@ struct RunOptions {
     // match bias).
     DetectionObserver autopilot_detection;
     MatchObserver autopilot_match;
+    // How it turns an adjust trial's match: arrows, the wheel or a drag (then fine
+    // arrows).
+    AdjustBy autopilot_adjust = AdjustBy::keys;
     std::string screenshot_path;  // save the first trial screen as PNG (tests)
     std::string key_trace_path;   // each key press's X event time and stamp (tests)
 };

@@ -10,6 +10,9 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <string>
+
+#include "study/session/autopilot.h"
 
 // GLFW's X11 native access, declared here because glfw3native.h also pulls in Xrandr
 // headers (libxrandr-dev) that nothing else needs.
@@ -76,13 +79,40 @@ void XKeyboard::focus_window() {
     int x = 0, y = 0, w = 0, h = 0;
     glfwGetWindowPos(window_, &x, &y);
     glfwGetWindowSize(window_, &w, &h);
-    XTestFakeMotionEvent(dpy, -1, x + w / 2, y + h / 2, CurrentTime);
+    if (!button_down_) XTestFakeMotionEvent(dpy, -1, x + w / 2, y + h / 2, CurrentTime);
     XSetInputFocus(dpy, glfwGetX11Window(window_), RevertToParent, CurrentTime);
+    XFlush(dpy);
+}
+
+void XKeyboard::pointer(const std::string& event) {
+    Display* dpy = static_cast<Display*>(display_);
+    if (event == "WheelUp" || event == "WheelDown") {
+        const unsigned button = event == "WheelUp" ? 4 : 5;
+        XTestFakeButtonEvent(dpy, button, True, CurrentTime);
+        XTestFakeButtonEvent(dpy, button, False, CurrentTime);
+    } else if (event == "Release") {
+        XTestFakeButtonEvent(dpy, 1, False, CurrentTime);
+        button_down_ = false;
+    } else {  // "Press:X,Y" or "Move:X,Y", in window pixels
+        const size_t colon = event.find(':'), comma = event.find(',', colon);
+        if (colon == std::string::npos || comma == std::string::npos)
+            throw std::runtime_error("autopilot: bad pointer event '" + event + "'");
+        const int px = std::stoi(event.substr(colon + 1, comma - colon - 1));
+        const int py = std::stoi(event.substr(comma + 1));
+        int wx = 0, wy = 0;
+        glfwGetWindowPos(window_, &wx, &wy);
+        XTestFakeMotionEvent(dpy, -1, wx + px, wy + py, CurrentTime);
+        if (event.rfind("Press:", 0) == 0) {
+            XTestFakeButtonEvent(dpy, 1, True, CurrentTime);
+            button_down_ = true;
+        }
+    }
     XFlush(dpy);
 }
 
 void XKeyboard::tap(const std::string& name, int hold_ms) {
     Display* dpy = static_cast<Display*>(display_);
+    if (is_pointer_event(name)) return pointer(name);
     std::string key = name;
     const bool shift = shifted(key);
     const KeyCode code = keycode(dpy, key);

@@ -77,6 +77,22 @@ TEST(AdjustInput, InTheBrowserTheValueIsAlwaysAPictureOfTheSeries) {
     EXPECT_THROW(AdjustInput(b, 1.0, 0, {1.0}), std::invalid_argument);
 }
 
+TEST(AdjustInput, AChangeStampedBeforeThePreviousOneIsKeptInOrder) {
+    // A key whose X event time is earlier than the wheel notch the frame drew before it
+    // (and one before the onset): stored at the previous change's time, never earlier.
+    AdjustInput in(adjust_block("linear"), 1.0, 1'000);
+    in.step(true, false, 500);  // before the onset: 1'000
+    in.wheel(1, 5'000);
+    in.step(true, true, 4'000);  // read late: 5'000
+    in.step(true, true, 6'000);
+    ASSERT_EQ(in.adjustments().size(), 4u);
+    EXPECT_EQ(in.adjustments()[0].t_ns, 1'000);
+    EXPECT_EQ(in.adjustments()[1].t_ns, 5'000);
+    EXPECT_EQ(in.adjustments()[2].t_ns, 5'000);
+    EXPECT_EQ(in.adjustments()[3].t_ns, 6'000);
+    EXPECT_NEAR(in.value(), 1.0 + 0.5 + 0.5 + 0.05 + 0.05, 1e-12);
+}
+
 TEST(AdjustInput, StepsAreFactorsOnALogScale) {
     AdjustInput in(adjust_block("log"), 1.0, 0);
     in.step(true, false, 1);  // 10^0.1

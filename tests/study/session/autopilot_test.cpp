@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <set>
 
@@ -121,5 +122,117 @@ TEST(Autopilot, TheThresholdObserversParseFromTheCommandLine) {
     EXPECT_DOUBLE_EQ(d.lapse, 0.02);
 }
 
+// --autopilot-adjust wheel|drag: the pointer events that take the match to its goal.
+// A log knob over [0.2, 5] (log10 range 1.39794), steps 0.05 / 0.01 on log10, from 0.5
+// to 1.1: log10(2.2) = 0.34242 is 6 coarse steps (0.30) and 4 fine ones (0.04242).
+AdjustView log_view() {
+    AdjustView v;
+    v.value = 0.5;
+    v.lo = 0.2;
+    v.hi = 5.0;
+    v.step = 0.05;
+    v.fine_step = 0.01;
+    v.log_scale = true;
+    return v;
+}
+
+std::vector<std::string> repeated(const std::string& name, int n,
+                                  std::vector<std::string> then = {}) {
+    std::vector<std::string> out(n, name);
+    out.insert(out.end(), then.begin(), then.end());
+    return out;
+}
+
+TEST(Autopilot, WheelNotchesAreWholeCoarseStepsThenFineKeys) {
+    EXPECT_EQ(adjust_wheel(log_view(), 1.1),
+              repeated("WheelUp", 6, repeated("Shift+Right", 4)));
+    // Linear [0, 1], steps 0.1 / 0.01, from 0.9 down to 0.23: 0.67 is 6 notches
+    // and 7 fine steps.
+    AdjustView v;
+    v.value = 0.9;
+    v.step = 0.1;
+    v.fine_step = 0.01;
+    EXPECT_EQ(adjust_wheel(v, 0.23), repeated("WheelDown", 6, repeated("Shift+Left", 7)));
+    EXPECT_TRUE(adjust_wheel(v, std::nan("")).empty());
+}
+
+TEST(Autopilot, ADragCrossesTheMatchByTheGoalsShareOfItsWidth) {
+    // The 64-pixel match at (652, 480): 0.34242 / 1.39794 of 64 px is 15.68, so 16 px,
+    // centred on the match (676 -> 692) along its middle row (480 + 32), the pointer
+    // on the match before the press. 16 px move log10 by 0.349485, from -0.30103 to
+    // 0.048455: 0.00706 past log10(1.1) = 0.041393, one fine step back.
+    AdjustView v = log_view();
+    v.match = Rect{652, 480, 64, 64};
+    EXPECT_EQ(adjust_drag(v, 1.1),
+              (std::vector<std::string>{"Move:676,512", "Press:676,512", "Move:692,512",
+                                        "Release", "Shift+Left"}));
+    // Linear [0, 1] on a 200-pixel match at (100, 50): 0.9 to 0.2 is -140 px, centred
+    // (270 -> 130) at row 100, landing on the goal: no keys after it.
+    AdjustView lin;
+    lin.value = 0.9;
+    lin.match = Rect{100, 50, 200, 100};
+    EXPECT_EQ(adjust_drag(lin, 0.2),
+              (std::vector<std::string>{"Move:270,100", "Press:270,100", "Move:130,100",
+                                        "Release"}));
+    // Less than half a pixel away: no drag, only the fine steps (0.002 of 0.01: none).
+    EXPECT_TRUE(adjust_drag(lin, 0.902).empty());
+    // Without the match's place, the keys.
+    lin.match.reset();
+    EXPECT_EQ(adjust_drag(lin, 0.2), adjust_keys(lin, 0.2));
+}
+
+TEST(Autopilot, PointerEventsComeOnePerFrameAtLeastTwoFramesApart) {
+    EXPECT_EQ(parse_adjust_by("wheel"), AdjustBy::wheel);
+    EXPECT_EQ(parse_adjust_by("drag"), AdjustBy::drag);
+    EXPECT_EQ(parse_adjust_by("keys"), AdjustBy::keys);
+    EXPECT_FALSE(parse_adjust_by("mouse"));
+    ScreenView v;
+    v.kind = ScreenView::Kind::Adjust;
+    v.serial = 1;
+    v.adjust = log_view();
+    v.adjust.target = 1.1;  // the default match observer: no bias, no noise
+    v.adjust.match = Rect{652, 480, 64, 64};
+    for (const AdjustBy by : {AdjustBy::wheel, AdjustBy::drag}) {
+        SCOPED_TRACE(by == AdjustBy::wheel ? "wheel" : "drag");
+        std::vector<std::string> expected = by == AdjustBy::wheel
+                                                ? adjust_wheel(v.adjust, 1.1)
+                                                : adjust_drag(v.adjust, 1.1);
+        expected.push_back("Enter");
+        // Fast (speed 100: 1.2 ms between moves), in 16 ms frames: each pointer event
+        // still two frames or more after the one before.
+        Autopilot a = Autopilot::from_seed(3, 100.0);
+        a.set_adjust_by(by);
+        std::vector<std::string> events;
+        int64_t last_pointer = -1'000'000'000;
+        for (int64_t t = 0; t < 10'000'000'000LL; t += 16'000'000) {
+            for (const std::string& e : a.due(t, v)) {
+                events.push_back(e);
+                if (!is_pointer_event(e)) continue;
+                EXPECT_GE(t - last_pointer, 32'000'000) << e;
+                last_pointer = t;
+            }
+            if (!events.empty() && events.back() == "Enter") break;
+        }
+        EXPECT_EQ(events, expected);
+        // A frame late enough for all of them (a slow render): one pointer event per
+        // frame, the keys after the last one two frames after it (the runner applies
+        // pointer events while drawing the next frame, keys before drawing).
+        Autopilot late = Autopilot::from_seed(3, 100.0);
+        late.set_adjust_by(by);
+        late.due(0, v);  // the screen appears
+        std::vector<size_t> per_frame;
+        events.clear();
+        for (int frame = 0; frame < 20 && (events.empty() || events.back() != "Enter");
+             ++frame) {
+            const std::vector<std::string> due = late.due(10'000'000'000LL, v);
+            per_frame.push_back(due.size());
+            events.insert(events.end(), due.begin(), due.end());
+        }
+        EXPECT_EQ(events, expected);
+        const std::vector<size_t> wheel_frames = {1, 1, 1, 1, 1, 1, 0, 5},
+                                  drag_frames = {1, 1, 1, 1, 0, 2};
+        EXPECT_EQ(per_frame, by == AdjustBy::wheel ? wheel_frames : drag_frames);
+    }
+}
 }  // namespace
 }  // namespace lucent::study

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -1136,18 +1137,13 @@ TEST_F(DataCommands, AnalysisRefusesARatingOutsideItsQuestionsScale) {
     EXPECT_FALSE(fs::exists(csv));
 }
 
-// Issue 31: adjust and staircase trials drawn live in `lucent run` (64 x 64 empirical
-// renders), answered by the seeded autopilot as a simulated observer: its arrows with
-// Shift reach the flow as fine steps through the X server, every staircase answer is
-// stored with its delta, and the session completes.
-TEST_F(SessionE2E, AdjustAndStaircaseTrialsAreDrawnLiveAndStoredToCompletion) {
-    LUCENT_REQUIRE_DISPLAY();
-    const fs::path protocol = dir_ / "matching.toml";
-    std::ofstream(protocol) << R"toml([study]
-name = "matching_e2e"
-inter_trial_ms = 100
-stimulus_size = [64, 64]
-
+// The adjust e2e tests' study: two live 64 x 64 spheres, a target (r = 0.8) and the
+// match, and the start of an adjust block "m" on r over [0.2, 5] (log10 steps 0.05 and
+// 0.01); each test adds the block's start and repeats, and any other block.
+std::string adjust_study(const std::string& name) {
+    return "[study]\nname = \"" + name +
+           "\"\ninter_trial_ms = 100\nstimulus_size = [64, 64]\n" +
+           R"toml(
 [[stimuli]]
 id = "thin"
 technique = "empirical"
@@ -1170,7 +1166,17 @@ range = [0.2, 5.0]
 scale = "log"
 step = 0.05
 fine_step = 0.01
-repeats = 2
+)toml";
+}
+
+// Issue 31: adjust and staircase trials drawn live in `lucent run` (64 x 64 empirical
+// renders), answered by the seeded autopilot as a simulated observer: its arrows with
+// Shift reach the flow as fine steps through the X server, every staircase answer is
+// stored with its delta, and the session completes.
+TEST_F(SessionE2E, AdjustAndStaircaseTrialsAreDrawnLiveAndStoredToCompletion) {
+    LUCENT_REQUIRE_DISPLAY();
+    const fs::path protocol = dir_ / "matching.toml";
+    std::ofstream(protocol) << adjust_study("matching_e2e") << R"toml(repeats = 2
 question = "Turn the right object until it looks like the left one."
 
 [[blocks]]
@@ -1270,6 +1276,80 @@ max_trials = 6
         for (int y = 480; y < 544; ++y)
             outside += screen.rgba[(size_t(y) * screen.width + 640) * 4] > 60;
         EXPECT_EQ(outside, 0);
+    }
+}
+
+// The wheel and the drag of an adjust trial, end to end: `lucent run --autopilot-adjust
+// wheel|drag` sends them as X pointer events (XTest), GLFW and ImGui hand them to the
+// runner, and every move is stored with its input. Two trials from the range's minimum
+// 0.2 to the autopilot's goal 0.8 + 0.4 = 1.2 (no noise), on log10: from -0.69897 to
+// 0.079181, a distance of 0.778151 in a range of log10(25) = 1.39794.
+TEST_F(SessionE2E, AdjustTrialsAreTurnedByTheWheelAndByADrag) {
+    LUCENT_REQUIRE_DISPLAY();
+    const fs::path protocol = dir_ / "adjust.toml";
+    std::ofstream(protocol) << adjust_study("adjust_pointer_e2e") << R"toml(start = "min"
+repeats = 2
+question = "Turn the right object until it looks like the left one."
+)toml";
+    const double start = std::log10(0.2), goal = std::log10(1.2);
+    const double range = std::log10(25.0), pixel = range / 64;  // the match: 64 px wide
+    for (const std::string input : {"wheel", "drag"}) {
+        SCOPED_TRACE(input);
+        const std::string db = (dir_ / (input + ".db")).string();
+        const Process p =
+            start_lucent({"run", protocol.string(), "--db", db, "--participant", "P1",
+                          "--autopilot", "5", "--autopilot-speed", "12", "--seed", "3",
+                          "--autopilot-match", "0.4,0", "--autopilot-adjust", input},
+                         dir_);
+        ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
+        Database d(db, SQLITE_OPEN_READONLY);
+        EXPECT_EQ(
+            d.scalar_int("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+        // Both confirmed: the block's question answered with rating 1.
+        EXPECT_EQ(
+            d.scalar_int("SELECT count(*) FROM trials t JOIN responses r ON "
+                         "r.trial_id = t.id WHERE t.kind = 'adjust' AND r.rating = 1 "
+                         "AND t.final_value IS NOT NULL"),
+            2);
+        Statement trials = d.prepare(
+            "SELECT id, start_value, final_value FROM trials WHERE kind = 'adjust' ORDER "
+            "BY position");
+        int n = 0;
+        while (trials.step()) {
+            ++n;
+            EXPECT_DOUBLE_EQ(trials.real(1), 0.2);
+            Statement moves =
+                d.prepare("SELECT value, input FROM adjustments WHERE trial_id = " +
+                          std::to_string(trials.integer(0)) + " ORDER BY step");
+            std::vector<std::string> inputs;
+            double last = start;
+            while (moves.step()) {
+                const double v = std::log10(moves.real(0));
+                inputs.push_back(moves.text(1));
+                if (inputs.back() == "wheel") {  // one notch: one coarse step
+                    EXPECT_NEAR(v - last, 0.05, 1e-9);
+                } else if (inputs.back() == "drag") {  // the goal's share of 64 px
+                    EXPECT_NEAR(v - last, goal - start, pixel);
+                } else if (inputs.back() == "fine_key") {
+                    EXPECT_NEAR(std::abs(v - last), 0.01, 1e-9);
+                }
+                last = v;
+            }
+            // 0.778151 is 15 notches (0.75) and 3 fine steps (0.028151). A drag of
+            // round(0.778151 / 1.39794 * 64) = 36 px (0.786341) overshoots by 0.00819:
+            // one fine step back.
+            const std::vector<std::string> wheel = {"wheel",    "wheel",    "wheel",
+                                                    "wheel",    "wheel",    "wheel",
+                                                    "wheel",    "wheel",    "wheel",
+                                                    "wheel",    "wheel",    "wheel",
+                                                    "wheel",    "wheel",    "wheel",
+                                                    "fine_key", "fine_key", "fine_key"},
+                                           drag = {"drag", "fine_key"};
+            EXPECT_EQ(inputs, input == "wheel" ? wheel : drag);
+            EXPECT_NEAR(std::log10(trials.real(2)), last, 1e-12);  // the last move's
+            EXPECT_NEAR(std::log10(trials.real(2)), goal, 0.01);
+        }
+        EXPECT_EQ(n, 2);
     }
 }
 
