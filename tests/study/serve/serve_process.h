@@ -95,7 +95,8 @@ inline constexpr int kServeStudyTrials = 5;  // 1 practice + 3 rated + 1 catch
 
 class ServeProcess {
 public:
-    // `state_dir`: the server's journal and key folder (LUCENT_JOURNAL_DIR).
+    // `state_dir`: the server's journal and key folder (LUCENT_JOURNAL_DIR). An empty
+    // `protocol` is left out (a built-in one named by --preset in `extra_args`).
     ServeProcess(const std::string& protocol, const std::string& db,
                  const std::string& state_dir,
                  const std::vector<std::string>& extra_args = {}) {
@@ -107,9 +108,10 @@ public:
             close(out[0]);
             close(out[1]);
             setenv("LUCENT_JOURNAL_DIR", state_dir.c_str(), 1);
-            std::vector<std::string> args = {
-                LUCENT_EXECUTABLE, "serve",      protocol, "--db", db,
-                "--listen",        "127.0.0.1:0"};
+            std::vector<std::string> args = {LUCENT_EXECUTABLE, "serve"};
+            if (!protocol.empty())
+                args.push_back(protocol);  // else --preset in extra_args
+            args.insert(args.end(), {"--db", db, "--listen", "127.0.0.1:0"});
             args.insert(args.end(), extra_args.begin(), extra_args.end());
             std::vector<char*> argv;
             for (std::string& a : args) argv.push_back(a.data());
