@@ -415,28 +415,43 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
                             ": errors at the highest intensities pull it there; the "
                             "threshold and slope may be biased (fix the lapse rate or "
                             "test higher intensities).");
-    // No threshold when psi does not change with intensity.
-    if (fit.constant_p.value_or(1.0) >= options.test_level || flattest) {
-        std::string what =
-            "No threshold: the proportion correct does not change with intensity "
-            "(likelihood-ratio test against a constant " +
-            short_text(proportion) + ": chi2(" + std::to_string(fit.constant_df) +
-            ") = " + short_text(lr) + ", p = " + format_p_short(fit.constant_p) + "); " +
-            tally;
-        if (options.guess > 0.0) {
-            const boost::math::binomial_distribution<> chance(fit.trials, options.guess);
-            const double p_above =
-                fit.correct == 0 ? 1.0
-                                 : boost::math::cdf(boost::math::complement(
-                                       chance, static_cast<double>(fit.correct - 1)));
-            what += (p_above >= options.test_level ? ", at chance (guess rate "
-                                                   : ", above chance (guess rate ") +
-                    short_text(options.guess) +
-                    ", binomial test p = " + format_p_short(p_above) + ")";
-        }
-        fit.notes.push_back(what + ".");
+    // No threshold when psi does not change with intensity: the fit is as flat as its
+    // bounds allow, or the rise is not significant and the answers are at chance. An
+    // adaptive track keeps its trials near the threshold, where psi changes least over
+    // the deltas it tries, so a participant above chance whose rise is not significant
+    // still has the fitted threshold, with a note and its bootstrap interval.
+    double p_above = 1.0;
+    if (options.guess > 0.0 && fit.correct > 0) {
+        const boost::math::binomial_distribution<> chance(fit.trials, options.guess);
+        p_above = boost::math::cdf(
+            boost::math::complement(chance, static_cast<double>(fit.correct - 1)));
+    }
+    const bool above_chance = options.guess > 0.0 && p_above < options.test_level;
+    const bool rise_significant = fit.constant_p.value_or(1.0) < options.test_level;
+    const std::string constant_test =
+        "likelihood-ratio test against a constant " + short_text(proportion) + ": chi2(" +
+        std::to_string(fit.constant_df) + ") = " + short_text(lr) +
+        ", p = " + format_p_short(fit.constant_p);
+    const std::string chance_test =
+        options.guess > 0.0 ? (above_chance ? ", above chance (guess rate "
+                                            : ", at chance (guess rate ") +
+                                  short_text(options.guess) +
+                                  ", binomial test p = " + format_p_short(p_above) + ")"
+                            : std::string();
+    if (flattest || (!rise_significant && !above_chance)) {
+        fit.notes.push_back(
+            "No threshold: the proportion correct does not change with intensity (" +
+            constant_test + "); " + tally + chance_test + ".");
         return fit;
     }
+    if (!rise_significant)
+        fit.notes.push_back(
+            "The rise with intensity is not significant (" + constant_test +
+            "), as on "
+            "an adaptive track that keeps its trials near the threshold; " +
+            tally + chance_test +
+            ", so the threshold is the fit's, its uncertainty the "
+            "bootstrap interval.");
 
     if (steepest)
         fit.notes.push_back(

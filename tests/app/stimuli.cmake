@@ -45,7 +45,19 @@ add_test(NAME app.render_unknown_preset_exits_2
 add_test(NAME app.render_mesh_and_config_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=render;x.toml;--mesh;sphere;--out;${LUCENT_STIMULI_CLI_DIR}/both"
-                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=one of --mesh, CONFIG or --preset"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=one of --mesh, CONFIG, --preset, --study or --study-preset"
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+# lucent render --study: an unknown built-in study, and a ladder too long to pre-render,
+# are refused in one line (exit 2).
+add_test(NAME app.render_study_unknown_preset_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=render;--study-preset;nope;--out;${LUCENT_STIMULI_CLI_DIR}/nope_study"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=unknown preset 'nope' \\(valid: thesis, fabrics, scaling, matching, jnd\\)"
+                 -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
+add_test(NAME app.render_study_ladder_too_long_exits_2
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 "-DARGS=render;--study;${CMAKE_CURRENT_SOURCE_DIR}/data/long_ladder.toml;--out;${LUCENT_STIMULI_CLI_DIR}/long_ladder"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=long_ladder.toml: block 'j': the browser's ladder of deltas \\[0, 9997\\] in steps of 0.001 would be 9997001 pictures per standard \\(at most 2000\\): set ladder_step or max_delta"
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
 
 # lucent stimuli report: a folder that is not a rendered set is refused in one line

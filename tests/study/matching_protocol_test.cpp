@@ -469,7 +469,7 @@ TEST(BuiltinMatchingStudies, MatchingAndJndPlanWhatTheirCommentsSay) {
     for (const PlannedTrial& t : m.trials) {
         ASSERT_EQ(t.task, Task::adjust);
         ASSERT_TRUE(t.start_value);
-        EXPECT_GE(*t.start_value, 1.0);
+        EXPECT_GE(*t.start_value, 2.5);
         EXPECT_LE(*t.start_value, 100.0);
         matches.insert(t.shown[1]);
         ++adjust;
@@ -487,18 +487,18 @@ TEST(BuiltinMatchingStudies, MatchingAndJndPlanWhatTheirCommentsSay) {
               target.parameters.at("light_direction"));
 
     // jnd: three standards (the thesis's r = 18, 25, 30), each an up/down staircase
-    // of at most 40 slots and a QUEST of 24, the comparison below the standard.
+    // of at most 60 slots and a QUEST of 40, the comparison below the standard.
     const Protocol jnd = builtin_protocol("jnd");
     const Block& j = *jnd.find_block("jnd");
     EXPECT_EQ(j.direction, "down");
     std::map<std::string, int> slots;
     for (const PlannedTrial& t : plan_trials(jnd, 1, 1).trials) ++slots[t.staircase];
-    EXPECT_EQ(slots, (std::map<std::string, int>{{"r_18/quest", 24},
-                                                 {"r_18/updown", 40},
-                                                 {"r_25/quest", 24},
-                                                 {"r_25/updown", 40},
-                                                 {"r_30/quest", 24},
-                                                 {"r_30/updown", 40}}));
+    EXPECT_EQ(slots, (std::map<std::string, int>{{"r_18/quest", 40},
+                                                 {"r_18/updown", 60},
+                                                 {"r_25/quest", 40},
+                                                 {"r_25/updown", 60},
+                                                 {"r_30/quest", 40},
+                                                 {"r_30/updown", 60}}));
     for (const std::string& standard : j.stimuli)
         EXPECT_GT(*jnd.numeric_parameter(standard, "thickness_exponent"),
                   j.procedures[0].max_delta);  // the comparison's r stays above 0

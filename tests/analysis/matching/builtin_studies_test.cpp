@@ -51,14 +51,15 @@ TEST(BuiltinStudies, MatchingCrossedLightIsComparedWithTheSameLightMatch) {
     EXPECT_NEAR(std::log10(*back.ci_low), std::log10(std::sqrt(120.0)) - half, 1e-9);
     EXPECT_NEAR(std::log10(*back.ci_high), std::log10(std::sqrt(120.0)) + half, 1e-9);
     // Crossed light: one scene factor, light_direction; the reference is the same-light
-    // match sqrt(120), the cross match sqrt(440), on log10 over the range 1..100.
+    // match sqrt(120), the cross match sqrt(440), on log10 over the range 2.5..100.
     EXPECT_EQ(cross.factors, std::vector<std::string>{"light_direction"});
     EXPECT_EQ(cross.constancy_factor, "light_direction");
     ASSERT_TRUE(cross.constancy_reference && cross.constancy) << cross.constancy_text;
     EXPECT_NEAR(*cross.constancy_reference, std::sqrt(120.0), 1e-12);
     const double reference = std::log10(std::sqrt(120.0));
-    const double expected = 1.0 - (std::log10(std::sqrt(440.0)) - reference) /
-                                      std::max(reference - 0.0, 2.0 - reference);
+    const double expected =
+        1.0 - (std::log10(std::sqrt(440.0)) - reference) /
+                  std::max(reference - std::log10(2.5), 2.0 - reference);
     EXPECT_NEAR(*cross.constancy, expected, 1e-12);
     EXPECT_NE(cross.constancy_text.find("against the same-scene match in block back"),
               std::string::npos)
@@ -107,7 +108,9 @@ TEST(BuiltinStudies, JndRecoversEachStandardsThresholdOfASimulatedObserver) {
             << s.participant << " " << s.standard;
         EXPECT_DOUBLE_EQ(*s.weber, *s.jnd / *s.standard_value);
     }
-    EXPECT_GE(estimated, 7);
+    // Every standard: a participant above chance has a threshold even where the rise
+    // over the track's deltas is not significant (checked over seeds 1..12 as well).
+    EXPECT_EQ(estimated, 9);
     EXPECT_NEAR(sum / estimated, observer.threshold, 1.0);
 }
 

@@ -241,6 +241,26 @@ TEST(PsychometricHardCases, AtChanceHasNoThreshold) {
         << all_notes(fit);
 }
 
+TEST(PsychometricHardCases, AboveChanceWithoutASignificantRiseKeepsTheFitsThreshold) {
+    // An adaptive track's trials: most near the threshold, 80% correct, a weak rise.
+    PsychometricOptions o = options(kGauss, 0.5, {}, 0.75);
+    o.bootstrap = 20;
+    const PsychometricFit fit = fit_psychometric(
+        std::vector<PsychometricBin>{
+            {1.0, 3, 5}, {2.0, 11, 15}, {3.0, 17, 20}, {4.0, 9, 10}, {5.0, 4, 5}},
+        o);
+    expect_finite(fit);
+    ASSERT_TRUE(fit.constant_p);
+    EXPECT_GT(*fit.constant_p, 0.05);  // the rise alone would not be significant
+    ASSERT_EQ(fit.threshold.status, ThresholdStatus::estimated) << all_notes(fit);
+    // psi at the threshold is halfway between the guess rate and the ceiling 1 - lapse.
+    EXPECT_NEAR(psychometric_psi(fit, *fit.threshold.value),
+                0.5 + (0.5 - fit.lapse.value_or(0.0)) / 2, 1e-9);
+    EXPECT_TRUE(has_note(fit, "The rise with intensity is not significant"))
+        << all_notes(fit);
+    EXPECT_TRUE(has_note(fit, "above chance")) << all_notes(fit);
+}
+
 TEST(PsychometricHardCases, AlwaysCorrectIsBelowTheSmallestIntensity) {
     const PsychometricFit fit = fit_psychometric(bins_of({40, 40, 40, 40, 40, 40}, 40),
                                                  options(kGauss, 0.5, {}, 0.75));
