@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <utility>
 
 #include "study/serve/request_fields.h"
@@ -13,6 +14,16 @@ namespace lucent::study {
 using nlohmann::json;
 
 namespace {
+
+// The browser's name of an arrow key or Enter, as the flow's key; nullopt for any other.
+std::optional<Key> arrow_or_enter(const std::string& key) {
+    if (key == "ArrowLeft") return Key::Left;
+    if (key == "ArrowRight") return Key::Right;
+    if (key == "ArrowUp") return Key::Up;
+    if (key == "ArrowDown") return Key::Down;
+    if (key == "Enter") return Key::Enter;
+    return std::nullopt;
+}
 
 // One of a rating's events, checked: a key the scales (at most `max_points`) or the
 // lab know, a rating inside its question's scale, or Next.
@@ -27,16 +38,8 @@ AnswerEvent rating_event_of(const json& e, const std::string& type,
             if (ev.digit > max_points)
                 throw RequestError(400, "key '" + key + "' is outside every scale (1.." +
                                             std::to_string(max_points) + ")");
-        } else if (key == "Enter") {
-            ev.key = Key::Enter;
-        } else if (key == "ArrowLeft") {
-            ev.key = Key::Left;
-        } else if (key == "ArrowRight") {
-            ev.key = Key::Right;
-        } else if (key == "ArrowUp") {
-            ev.key = Key::Up;
-        } else if (key == "ArrowDown") {
-            ev.key = Key::Down;
+        } else if (const std::optional<Key> k = arrow_or_enter(key)) {
+            ev.key = *k;
         } else {
             throw RequestError(400, "unknown key '" + one_line(key) + "'");
         }
@@ -120,16 +123,8 @@ AnswerEvent adjust_event_of(const json& e, const std::string& type) {
     AnswerEvent ev{AnswerEvent::Kind::Key};
     if (type == "key") {
         const std::string key = text_field(e, "key", 16, true);
-        if (key == "ArrowLeft") {
-            ev.key = Key::Left;
-        } else if (key == "ArrowRight") {
-            ev.key = Key::Right;
-        } else if (key == "ArrowUp") {
-            ev.key = Key::Up;
-        } else if (key == "ArrowDown") {
-            ev.key = Key::Down;
-        } else if (key == "Enter") {
-            ev.key = Key::Enter;
+        if (const std::optional<Key> k = arrow_or_enter(key)) {
+            ev.key = *k;
         } else {
             throw RequestError(400, "field 'key': '" + one_line(key) +
                                         "' does not adjust the match (ArrowLeft, "
