@@ -29,6 +29,7 @@
 #include "study/session/session_flow.h"
 #include "study/session/stimulus_source.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/store_pool.h"
 #include "study/study_store.h"
 #include "study/trial_plan.h"
 #include "study/web_series.h"
@@ -44,6 +45,8 @@ struct ServeArgs {
     std::string listen = "127.0.0.1:8080";
     std::string secret_file;
     int threads = 64;
+    int store_connections = 4;
+    int store_wait_ms = 2000;
     double idle_minutes = 30;
     double request_timeout_s = 5;
 };
@@ -139,7 +142,7 @@ int serve_command(const ServeArgs& args) {
         return kExitUsage;
     }
     study::Protocol protocol;
-    std::unique_ptr<study::StudyStore> store;
+    std::unique_ptr<study::StorePool> stores;
     std::unique_ptr<study::WebStudy> web;
     std::map<std::string, ServedPicture> pictures;
     try {
@@ -171,8 +174,19 @@ int serve_command(const ServeArgs& args) {
         options.secret = load_or_create_secret(secret_file);
         options.idle_timeout = std::chrono::milliseconds(
             static_cast<int64_t>(std::llround(args.idle_minutes * 60'000)));
-        store = study::open_study_store(args.db);
-        web = std::make_unique<study::WebStudy>(protocol, *store, options);
+        // No local journal: an answer is acknowledged only once the study's database
+        // committed it (study/serve/README.md).
+        study::StoreOptions store_options;
+        store_options.journal = false;
+        // An SQLite file takes one writer at a time anyway: one connection (several
+        // gain nothing there, and are not yet tested to see each other's commits).
+        const size_t connections = study::is_server_uri(args.db)
+                                       ? static_cast<size_t>(args.store_connections)
+                                       : 1;
+        stores = std::make_unique<study::StorePool>(
+            args.db, connections, store_options,
+            std::chrono::milliseconds(args.store_wait_ms));
+        web = std::make_unique<study::WebStudy>(protocol, *stores, options);
     } catch (const study::ProtocolError& e) {
         std::cerr << "lucent serve: " << e.what() << "\n";
         return kExitUsage;
@@ -220,7 +234,8 @@ int serve_command(const ServeArgs& args) {
         http.stop();
     });
     std::cout << "lucent serve: study '" << protocol.name << "' (" << pictures.size()
-              << " pictures) from " << store->name() << " on http://"
+              << " pictures) from " << stores->name() << " (" << stores->size()
+              << " connections) on http://"
               << (host.find(':') != std::string::npos ? "[" + host + "]" : host) << ":"
               << port << "/?participant=ID" << std::endl;
     if (!is_loopback(host))
@@ -228,47 +243,16 @@ int serve_command(const ServeArgs& args) {
                   << "); serve participants through an HTTPS reverse proxy "
                      "(docs/run-and-serve.md)"
                   << std::endl;
-    // Pages idle past --idle-minutes are put aside (their claims end) even when no
-    // request comes to do it.
-    std::mutex sweep_mutex;
-    std::condition_variable sweep_wake;
-    bool sweep_stop = false;
-    std::thread sweeper([&] {
-        const auto every =
-            std::clamp(std::chrono::duration_cast<std::chrono::milliseconds>(
-                           std::chrono::duration<double>(args.idle_minutes * 15)),
-                       std::chrono::milliseconds(50), std::chrono::milliseconds(30'000));
-        std::unique_lock lock(sweep_mutex);
-        while (!sweep_wake.wait_for(lock, every, [&] { return sweep_stop; }))
-            web->release_idle();
-    });
     http.listen_after_bind();
     listen_over = true;
-    {
-        std::lock_guard lock(sweep_mutex);
-        sweep_stop = true;
-    }
-    sweep_wake.notify_all();
-    sweeper.join();
     if (stopper.joinable()) {
         pthread_kill(stopper.native_handle(),
                      SIGTERM);  // wakes sigwait when stopped otherwise
         stopper.join();
     }
-    std::cout << "lucent serve: stopped; " << web->live_sessions()
-              << " sessions were open (they resume from their links)" << std::endl;
-    if (store->pending_trials() > 0) {
-        try {
-            store->sync();
-        } catch (const study::StoreError& e) {
-            std::cerr << "lucent serve: " << e.what() << "\n";
-        }
-        if (const int left = store->pending_trials(); left > 0)
-            std::cerr << "lucent serve: " << left
-                      << " trials are kept in the local journal until " << store->name()
-                      << " confirms them; send them with 'lucent store sync --db "
-                      << store->name() << "'\n";
-    }
+    std::cout << "lucent serve: stopped (every answer acknowledged is in "
+              << stores->name() << "; open pages go on with another instance or after "
+              << "a restart)" << std::endl;
     return kExitOk;
 }
 
@@ -299,11 +283,18 @@ void register_serve(CLI::App& app, int& exit_code) {
     cmd->add_option("--threads", args->threads,
                     "HTTP worker threads (connections served at once)")
         ->check(CLI::Range(2, 1024));
+    cmd->add_option("--store-connections", args->store_connections,
+                    "Store connections this process keeps (default 4); requests beyond "
+                    "them wait --store-wait-ms")
+        ->check(CLI::Range(1, 256));
+    cmd->add_option("--store-wait-ms", args->store_wait_ms,
+                    "How long a request waits for a free store connection before it "
+                    "is answered 503 with Retry-After (default 2000)")
+        ->check(CLI::Range(1, 600'000));
     cmd->add_option(
            "--idle-minutes", args->idle_minutes,
-           "A page silent this long is put aside: its claim on the participant ends "
-           "(a lab station may run them) and its cell is free for the next arrival "
-           "(default 30)")
+           "A session with no activity this long no longer holds its counterbalancing "
+           "cell: the next arrival may take it (it still resumes; default 30)")
         ->check(CLI::Range(0.001, 1e6));
     cmd->add_option("--request-timeout", args->request_timeout_s,
                     "Seconds a request may take to arrive; slower connections are cut "

@@ -247,8 +247,18 @@ void configure_serve_http(httplib::Server& http, study::WebStudy& web,
         R"(/api/([a-z_]+))", [&web](const httplib::Request& req, httplib::Response& res) {
             const study::WebReply reply = web.handle(req.matches[1].str(), req.body);
             res.status = reply.status;
+            if (reply.retry_after_s > 0)
+                res.set_header("Retry-After", std::to_string(reply.retry_after_s));
             res.set_content(reply.body, "application/json");
         });
+    // For the proxy's and the operator's health checks: 200 only when the store answers.
+    http.Get("/healthz", [&web](const httplib::Request&, httplib::Response& res) {
+        const study::WebReply reply = web.health();
+        res.status = reply.status;
+        if (reply.retry_after_s > 0)
+            res.set_header("Retry-After", std::to_string(reply.retry_after_s));
+        res.set_content(reply.body, "application/json");
+    });
     http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
         if (!res.body.empty()) return;
         const std::string why = res.status == 413 ? "request body over 65536 bytes"

@@ -203,6 +203,17 @@ CREATE TABLE adjustments (
     input TEXT NOT NULL CHECK (input IN ('key', 'fine_key', 'wheel', 'drag')),
     PRIMARY KEY (trial_id, step));
 )sql",
+    // 8: several serve processes on one database (issue 32). sessions.web_position:
+    // where a browser's page stands (the screen it shows, that screen's view number, the
+    // page-clock time it began), one line the server writes after each action, so any
+    // process continues the page where another left it; NULL for lab sessions.
+    // declined_pages: the UUIDs a serve process drew for pages whose person declined
+    // consent (random, linked to nothing of them: the code is never stored), so a
+    // decline sent twice counts once and its page stays declined.
+    R"sql(
+ALTER TABLE sessions ADD COLUMN web_position TEXT;
+CREATE TABLE declined_pages (uuid TEXT PRIMARY KEY);
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 

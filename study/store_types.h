@@ -19,6 +19,14 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// The store cannot be reached now (a server away, every pooled connection busy past the
+// wait): nothing was written, and the same call may succeed later. `lucent serve` answers
+// it with 503 and Retry-After.
+class StoreUnavailable : public StoreError {
+public:
+    using StoreError::StoreError;
+};
+
 // The resolved description of a stimulus as stored (technique, mesh, mesh hash, every
 // knob value); compared between sessions and between databases being merged.
 struct ResolvedStimulus {

@@ -86,6 +86,11 @@ public:
     // The participant's newest running or paused session (not completed, not declined).
     virtual std::optional<SessionRow> unfinished_session(const std::string& code) = 0;
     virtual bool has_completed_session(const std::string& code) = 0;
+    // The session with this UUID, whatever its status (`lucent serve`: the session a
+    // page's token names); nullopt when none.
+    virtual std::optional<SessionRow> session_by_uuid(const std::string& uuid) = 0;
+    // True when a session of this UUID was withdrawn (its tombstone, withdrawal.h).
+    virtual bool session_withdrawn(const std::string& uuid) = 0;
     virtual std::vector<TrialRow> trials(int64_t session_id) = 0;
     // A resume: adds segment n+1 with `env` and what it shows. Returns its number.
     virtual int begin_segment(int64_t session_id, const SessionEnvironment& env) = 0;
@@ -100,12 +105,24 @@ public:
     virtual void set_consent(int64_t session_id) = 0;
     // One more declined consent of the study (consent_declines: a count, nothing else).
     virtual void count_declined_consent(int64_t study_id) = 0;
+    // `lucent serve`: a page (`page_uuid`, the session UUID it would have had) declined:
+    // counted once, with its UUID kept in declined_pages, in one transaction; false
+    // (nothing changed) when that page had declined already.
+    virtual bool decline_online_consent(int64_t study_id,
+                                        const std::string& page_uuid) = 0;
+    // True when the page of this UUID declined (decline_online_consent).
+    virtual bool consent_declined(const std::string& page_uuid) = 0;
     // A lab station's declined consent: when the session has no consent and no answered
     // trial, deletes it (segments, planned trials), and its participant when they have no
     // other session, and counts the decline, in one transaction; true then. Otherwise
     // (a resumed session that had consent or answers) changes nothing and returns false.
     virtual bool forget_declined_session(int64_t session_id) = 0;
     virtual bool has_consent(int64_t session_id) = 0;
+    // `lucent serve` (schema 8): where the session's page stands, as the server wrote it
+    // (web_study.cpp's text), so that any serve process continues it; nullopt when never
+    // written (a lab session, or an older serve's).
+    virtual std::optional<std::string> web_position(int64_t session_id) = 0;
+    virtual void set_web_position(int64_t session_id, const std::string& position) = 0;
     // Commits one trial's ratings atomically; refuses a trial that already has ratings,
     // was skipped, lacks a question, names one the study does not ask, has a rating
     // outside 1..points of its question, or carries what its kind does not (schema 7:
@@ -151,6 +168,11 @@ struct StoreOptions {
     // PostgreSQL: after a failed send, the next attempt waits at least this long (a
     // trial is journaled meanwhile, so the session runs on).
     int retry_interval_ms = 1000;
+    // PostgreSQL: false sends each trial straight to the server (no local journal):
+    // record_trial returns only once the server's transaction committed, and throws
+    // StoreUnavailable when it cannot be reached. `lucent serve` opens it so: a server
+    // process acknowledges to a browser only what the study's database holds.
+    bool journal = true;
     // SQLite: the VFS (fault tests).
     std::string vfs;
 };

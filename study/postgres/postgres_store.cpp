@@ -55,9 +55,12 @@ PostgresStore::PostgresStore(const std::string& uri, const StoreOptions& options
     : uri_(checked_server_uri(uri)),
       name_(uri),
       options_(options),
-      journal_(
-          options.journal_path.empty() ? default_journal_path(uri) : options.journal_path,
-          uri) {
+      journal_(options.journal
+                   ? std::make_unique<TrialJournal>(options.journal_path.empty()
+                                                        ? default_journal_path(uri)
+                                                        : options.journal_path,
+                                                    uri)
+                   : nullptr) {
     // Refuse an uninitialised or newer schema now, with one line, before any session.
     guarded("opening", [&] {
         pqxx::work tx(connection());
@@ -121,6 +124,11 @@ PostgresStore::Connection& PostgresStore::connection() {
 }
 
 void PostgresStore::drop_connection() { conn_.reset(); }
+
+const std::string& PostgresStore::journal_path() const {
+    static const std::string none;
+    return journal_ ? journal_->path() : none;
+}
 
 // ---- [2] studies, participants, claims -----------------------------------------------
 
@@ -479,6 +487,27 @@ std::optional<SessionRow> PostgresStore::unfinished_session(const std::string& c
     });
 }
 
+std::optional<SessionRow> PostgresStore::session_by_uuid(const std::string& uuid) {
+    return guarded("finding the session", [&]() -> std::optional<SessionRow> {
+        pqxx::work tx(connection());
+        const pqxx::result r = tx.exec_params(
+            "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
+            "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+            "WHERE s.uuid = $1",
+            uuid);
+        if (r.empty()) return std::nullopt;
+        return session_row(r[0]);
+    });
+}
+
+bool PostgresStore::session_withdrawn(const std::string& uuid) {
+    return guarded("finding the session", [&] {
+        pqxx::work tx(connection());
+        return !tx.exec_params("SELECT 1 FROM withdrawn_sessions WHERE uuid = $1", uuid)
+                    .empty();
+    });
+}
+
 bool PostgresStore::has_completed_session(const std::string& code) {
     return guarded("finding the session", [&] {
         pqxx::work tx(connection());
@@ -544,7 +573,8 @@ std::vector<TrialRow> PostgresStore::trials(int64_t session_id) {
             cache.answered.insert(t.id);
             continue;
         }
-        const std::optional<JournaledTrial> journaled = journal_.find(t.uuid);
+        const std::optional<JournaledTrial> journaled =
+            journal_ ? journal_->find(t.uuid) : std::nullopt;
         if (!journaled) continue;
         t.answered = true;
         cache.answered.insert(t.id);
@@ -606,7 +636,8 @@ PostgresStore::SessionCache& PostgresStore::session_cache(int64_t session_id) {
     // finishing one skipped, skipped.
     for (const auto& [id, uuid] : cache.trial_uuid) {
         if (cache.answered.count(id)) continue;
-        const std::optional<JournaledTrial> journaled = journal_.find(uuid);
+        const std::optional<JournaledTrial> journaled =
+            journal_ ? journal_->find(uuid) : std::nullopt;
         if (!journaled) continue;
         cache.answered.insert(id);
         if (journaled->outcome.finishes_staircase) skip_finished(cache, id);
@@ -707,6 +738,29 @@ void PostgresStore::count_declined_consent(int64_t study_id) {
     });
 }
 
+bool PostgresStore::decline_online_consent(int64_t study_id,
+                                           const std::string& page_uuid) {
+    return guarded("counting a declined consent", [&] {
+        pqxx::work tx(connection());
+        if (tx.exec_params("INSERT INTO declined_pages (uuid) VALUES ($1) ON CONFLICT "
+                           "DO NOTHING",
+                           page_uuid)
+                .affected_rows() == 0)
+            return false;
+        add_declined_consent(tx, study_id);
+        tx.commit();
+        return true;
+    });
+}
+
+bool PostgresStore::consent_declined(const std::string& page_uuid) {
+    return guarded("finding a declined page", [&] {
+        pqxx::work tx(connection());
+        return !tx.exec_params("SELECT 1 FROM declined_pages WHERE uuid = $1", page_uuid)
+                    .empty();
+    });
+}
+
 bool PostgresStore::forget_declined_session(int64_t session_id) {
     return guarded("forgetting a declined session", [&] {
         pqxx::work tx(connection());
@@ -746,6 +800,26 @@ bool PostgresStore::has_consent(int64_t session_id) {
         const pqxx::result r = tx.exec_params(
             "SELECT consent_utc IS NOT NULL FROM sessions WHERE id = $1", session_id);
         return !r.empty() && r[0][0].as<bool>();
+    });
+}
+
+std::optional<std::string> PostgresStore::web_position(int64_t session_id) {
+    return guarded("reading the page's position", [&]() -> std::optional<std::string> {
+        pqxx::work tx(connection());
+        const pqxx::result r =
+            tx.exec_params("SELECT web_position FROM sessions WHERE id = $1", session_id);
+        if (r.empty() || r[0][0].is_null()) return std::nullopt;
+        return r[0][0].as<std::string>();
+    });
+}
+
+void PostgresStore::set_web_position(int64_t session_id, const std::string& position) {
+    guarded("storing the page's position", [&] {
+        pqxx::work tx(connection());
+        tx.exec_params("UPDATE sessions SET web_position = $1 WHERE id = $2", position,
+                       session_id);
+        tx.commit();
+        return 0;
     });
 }
 

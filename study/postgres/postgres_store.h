@@ -10,7 +10,9 @@
 //   advisory lock, so a second station starting it is refused.
 // - Failures: each trial goes to the local journal first (trial_journal.h), then to the
 //   server; when the server cannot be reached the session runs on and later trials
-//   resend the journal (idempotent by trial UUID), as does `lucent store sync`.
+//   resend the journal (idempotent by trial UUID), as does `lucent store sync`. A store
+//   opened without a journal (`lucent serve`) sends each trial straight to the server
+//   and throws StoreUnavailable when it cannot.
 // - Every statement is parameterised (exec_params); the URI may not hold a password
 //   (libpq reads PGPASSWORD or ~/.pgpass).
 #include <map>
@@ -52,16 +54,24 @@ public:
                               const SessionEnvironment& env) override;
     std::optional<SessionRow> unfinished_session(const std::string& code) override;
     bool has_completed_session(const std::string& code) override;
+    std::optional<SessionRow> session_by_uuid(const std::string& uuid) override;
+    bool session_withdrawn(const std::string& uuid) override;
     std::vector<TrialRow> trials(int64_t session_id) override;
     int begin_segment(int64_t session_id, const SessionEnvironment& env) override;
     int resume_segment(int64_t session_id, const SessionEnvironment& env) override;
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
     void count_declined_consent(int64_t study_id) override;
+    bool decline_online_consent(int64_t study_id, const std::string& page_uuid) override;
+    bool consent_declined(const std::string& page_uuid) override;
     bool forget_declined_session(int64_t session_id) override;
     bool has_consent(int64_t session_id) override;
+    std::optional<std::string> web_position(int64_t session_id) override;
+    void set_web_position(int64_t session_id, const std::string& position) override;
     // Journal first, then the server (see the file comment); the return value is the
-    // server's when it answered, else whether every trial is now recorded here.
+    // server's when it answered, else whether every trial is now recorded here. Without
+    // a journal: the server's transaction only, StoreUnavailable when it cannot be
+    // reached (nothing is kept here, so nothing is acknowledged that it does not hold).
     bool record_trial(int64_t session_id, int64_t trial_id,
                       const TrialOutcome& outcome) override;
     bool complete_session_if_answered(int64_t session_id) override;
@@ -71,11 +81,12 @@ public:
     std::optional<ParticipantCounts> participant_counts(const std::string& code) override;
     int64_t query_int(const std::string& sql) override;
     void snapshot_to_sqlite(const std::string& sqlite_path) override;
-    int pending_trials() override { return journal_.count(); }
+    int pending_trials() override { return journal_ ? journal_->count() : 0; }
     int sync() override;
     int withdrawn_trials_dropped() const override { return withdrawn_dropped_; }
 
-    const std::string& journal_path() const { return journal_.path(); }
+    // "" without a journal (StoreOptions::journal false).
+    const std::string& journal_path() const;
 
 private:
     // What the station knows of a session it runs, so trials are checked and journaled
@@ -115,7 +126,8 @@ private:
     std::string name_;
     StoreOptions options_;
     std::unique_ptr<Connection> conn_;
-    TrialJournal journal_;
+    // Null when StoreOptions::journal is false: trials go straight to the server.
+    std::unique_ptr<TrialJournal> journal_;
     std::set<std::string> claimed_;
     std::map<int64_t, SessionCache> sessions_;
     int withdrawn_dropped_ = 0;  // journaled trials dropped: their session was withdrawn

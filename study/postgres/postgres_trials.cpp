@@ -59,8 +59,8 @@ PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict,
         if (t.empty())
             throw StoreError(name_ + ": trial " + j.trial_uuid + " (session " +
                              j.session_uuid +
-                             ") is not on the server (participant withdrawn?); kept in " +
-                             journal_.path());
+                             ") is not on the server (participant withdrawn?)" +
+                             (journal_ ? "; kept in " + journal_->path() : ""));
         const int64_t trial_id = t[0][0].as<int64_t>(),
                       session_id = t[0][1].as<int64_t>();
         const pqxx::result held = tx.exec_params(
@@ -80,7 +80,7 @@ PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict,
                     static_cast<int64_t>(j.outcome.adjustments.size()))
                 throw StoreError(name_ + ": trial " + j.trial_uuid +
                                  " holds another answer on the server than in " +
-                                 journal_.path() + "; kept in the journal");
+                                 journal_path() + "; kept in the journal");
             if (completed) *completed = complete_if_answered(tx, session_id);
             tx.commit();
             return Sent::AlreadyThere;
@@ -131,8 +131,8 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
     check_trial_answer(
         name_, session_id, trial_id,
         {.part_of_session = part_of_session,
-         .answered = part_of_session &&
-                     (cache.answered.count(trial_id) || journal_.contains(uuid->second)),
+         .answered = part_of_session && (cache.answered.count(trial_id) ||
+                                         (journal_ && journal_->contains(uuid->second))),
          .kind = part_of_session ? cache.trial_kind[trial_id] : Task::rating,
          .skipped = part_of_session && cache.skipped.count(trial_id) > 0,
          .staircase = part_of_session ? cache.trial_staircase[trial_id] : std::string()},
@@ -144,16 +144,29 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
         throw StoreError(where +
                          " has no UUID (planned before schema 4); cannot journal it");
 
-    // Durable on this machine first; only then the network.
     const JournaledTrial journaled{uuid->second, cache.uuid, utc_now_iso8601(), outcome};
-    journal_.add(journaled);
+    if (!journal_) {
+        // `lucent serve`: acknowledged only once the server's transaction committed; an
+        // unreachable server throws (Unreachable is a StoreUnavailable) and nothing is
+        // kept here. A commit whose reply was lost is on the server: the page's retry
+        // finds the trial answered there.
+        bool completed = false;
+        if (send(journaled, true, &completed) == Sent::Withdrawn)
+            throw StoreError(where + ": session " + cache.uuid +
+                             " was withdrawn on the server; the trial is not kept");
+        cache.answered.insert(trial_id);
+        if (outcome.finishes_staircase) skip_finished(cache, trial_id);
+        return completed;
+    }
+    // Durable on this machine first; only then the network.
+    journal_->add(journaled);
     cache.answered.insert(trial_id);
     const std::vector<int64_t> skipped_now = outcome.finishes_staircase
                                                  ? skip_finished(cache, trial_id)
                                                  : std::vector<int64_t>();
     // Undoes what this trial marked here, when the server refuses it.
     auto forget = [&] {
-        journal_.remove(journaled.trial_uuid);
+        journal_->remove(journaled.trial_uuid);
         cache.answered.erase(trial_id);
         for (int64_t id : skipped_now) cache.skipped.erase(id);
     };
@@ -162,13 +175,13 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
     // One sender at a time per journal (every station of this server on this machine
     // shares it), older trials first: each session's trials reach the server in the order
     // they were recorded, and no two stations send one trial at once.
-    const TrialJournal::SendLock sending(journal_);
+    const TrialJournal::SendLock sending(*journal_);
     const int64_t attempt = next_attempt_ns_;
     flush(journaled.trial_uuid);
     if (next_attempt_ns_ != attempt)
         return local_completed;  // unreachable: all stay journaled
     // Another station sent it from the shared journal while this one waited: confirmed.
-    if (!journal_.contains(journaled.trial_uuid)) return local_completed;
+    if (!journal_->contains(journaled.trial_uuid)) return local_completed;
     bool completed = local_completed;
     try {
         if (send(journaled, true, &completed) == Sent::Withdrawn) {
@@ -176,7 +189,7 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
             throw StoreError(where + ": session " + cache.uuid +
                              " was withdrawn on the server; the trial is not kept");
         }
-        journal_.remove(journaled.trial_uuid);
+        journal_->remove(journaled.trial_uuid);
     } catch (const Unreachable&) {
         next_attempt_ns_ = steady_ns() + int64_t(options_.retry_interval_ms) * 1'000'000;
         return local_completed;
@@ -190,11 +203,11 @@ bool PostgresStore::record_trial(int64_t session_id, int64_t trial_id,
 
 int PostgresStore::flush(const std::string& skip_uuid) {
     int confirmed = 0;
-    for (const JournaledTrial& j : journal_.pending()) {
+    for (const JournaledTrial& j : journal_->pending()) {
         if (j.trial_uuid == skip_uuid) continue;
         try {
             const Sent sent = send(j, false, nullptr);
-            journal_.remove(j.trial_uuid);
+            journal_->remove(j.trial_uuid);
             if (sent == Sent::Withdrawn) {
                 ++withdrawn_dropped_;
                 continue;
@@ -212,13 +225,14 @@ int PostgresStore::flush(const std::string& skip_uuid) {
 }
 
 int PostgresStore::sync() {
-    const TrialJournal::SendLock sending(journal_);
+    if (!journal_) return 0;
+    const TrialJournal::SendLock sending(*journal_);
     int confirmed = 0;
-    for (const JournaledTrial& j : journal_.pending()) {
+    for (const JournaledTrial& j : journal_->pending()) {
         // Unreachable or refused: one line, the rest stays. A withdrawn session's trial
         // leaves the journal unsent.
         const Sent sent = send(j, false, nullptr);
-        journal_.remove(j.trial_uuid);
+        journal_->remove(j.trial_uuid);
         if (sent == Sent::Withdrawn)
             ++withdrawn_dropped_;
         else

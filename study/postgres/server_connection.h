@@ -21,9 +21,9 @@ constexpr int kNumberLock = 2;
 
 // The server could not be reached, or went away mid-transaction: the caller may journal
 // and retry. Anything else is a real refusal.
-class Unreachable : public StoreError {
+class Unreachable : public StoreUnavailable {
 public:
-    using StoreError::StoreError;
+    using StoreUnavailable::StoreUnavailable;
 };
 
 inline std::string first_line(const std::string& s) {

@@ -9,8 +9,8 @@
 #include <cstdio>
 #include <ctime>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <stdexcept>
+#include <thread>
 
 #include "common/srgb.h"
 #include "study/serve/answer_events.h"
@@ -19,6 +19,7 @@
 #include "study/session/session_flow.h"
 #include "study/sha256.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/store_pool.h"
 
 namespace lucent::study {
 
@@ -58,12 +59,6 @@ WebReply error_reply(int status, const std::string& why) {
 void check_code(const std::string& code, const char* what) {
     if (const std::string why = participant_code_problem(code); !why.empty())
         throw RequestError(400, std::string(what) + " " + why);
-}
-
-int64_t random_seed() {
-    std::random_device device;
-    return static_cast<int64_t>((uint64_t(device()) << 32 | device()) &
-                                0x7FFFFFFFFFFFFFFFull);
 }
 
 std::string css_colour(const float rgb[3]) {
@@ -126,6 +121,12 @@ std::string participant_code_problem(std::string_view code) {
 
 std::string session_token(std::string_view secret, std::string_view code,
                           std::string_view session_uuid) {
+    return std::string(code) + "." + std::string(session_uuid) + "." +
+           hmac_sha256_hex(secret, std::string(code) + " " + std::string(session_uuid));
+}
+
+std::string legacy_session_token(std::string_view secret, std::string_view code,
+                                 std::string_view session_uuid) {
     return std::string(code) + "." + hmac_sha256_hex(secret, session_uuid);
 }
 
@@ -162,24 +163,29 @@ std::optional<std::string> image_of_target(
 
 // ---- [SECTION] sessions ---------------------------------------------------------------
 // A page is `pending` from its first request until the participant agrees on the consent
-// screen: held in memory only (the session UUID and so its token, the seed, what the
-// browser said), nothing stored. Agreeing enrols it (StudyStore::enrol_online), and from
-// then on it is a session like a lab station's.
-struct WebStudy::Live {
-    std::string code;
-    bool pending = false;
-    uint64_t seed = 0;   // pending: the seed its plan will have
-    SessionRow session;  // pending: only the UUID
-    std::string token;
-    std::vector<TrialRow> trials;  // as stored when loaded; `answered` kept up to date
-    std::optional<SessionFlow> flow;
-    std::chrono::system_clock::time_point seen;  // the page's last request
-    // What the browser said about itself (the segment's environment).
+// screen: nothing of it is stored and nothing kept in memory. Its token names the session
+// UUID it will have (and with it the seed of its plan), and the page sends what the
+// browser says about itself with its answer. Agreeing enrols it
+// (StudyStore::enrol_online), and from then on it is a session like a lab station's, its
+// flow rebuilt from the store for every request at the position the last one stored
+// (schema 8: web_position).
+
+// What the browser says about itself (the segment's environment).
+struct WebStudy::Browser {
     std::string user_agent;
     int window_width = 0, window_height = 0, screen_width = 0, screen_height = 0;
     double device_pixel_ratio = 0;
     std::optional<double> refresh_hz;
     std::string prolific_study, prolific_session;
+};
+
+// One request's view of a participant's session: as stored, and its flow.
+struct WebStudy::Page {
+    std::string code;
+    SessionRow session;
+    std::vector<TrialRow> trials;
+    std::optional<SessionFlow> flow;
+    bool done = false;  // the debrief was continued: only the completion screen is left
 };
 
 namespace {
@@ -191,10 +197,134 @@ const char* const kWithdrawn =
     "this session was withdrawn: nothing more of it is recorded. You may close this "
     "window.";
 
+// A token's parts: "<code>.<uuid>.<mac>" (or an earlier serve's "<code>.<mac>").
+struct TokenParts {
+    std::string code, uuid;
+    bool legacy = false;
+};
+
+std::optional<TokenParts> token_parts(const std::string& token) {
+    const size_t first = token.find('.');
+    if (first == std::string::npos) return std::nullopt;
+    TokenParts parts;
+    parts.code = token.substr(0, first);
+    const size_t second = token.find('.', first + 1);
+    parts.legacy = second == std::string::npos;
+    if (!parts.legacy) parts.uuid = token.substr(first + 1, second - first - 1);
+    if (!participant_code_problem(parts.code).empty() ||
+        (!parts.legacy && (parts.uuid.empty() || parts.uuid.size() > 64)))
+        return std::nullopt;
+    return parts;
+}
+
+// The page's position as stored (sessions.web_position): "<screen> <view> <entered_ns>
+// <first open trial id>", or "done <view>" once the debrief was continued.
+std::string position_text(const FlowPosition& p) {
+    return std::string(screen_name(p.screen)) + " " + std::to_string(p.serial) + " " +
+           std::to_string(p.entered_ns) + " " + std::to_string(p.trial_id);
+}
+
+std::optional<FlowPosition> position_of_text(const std::string& text) {
+    char name[32] = {};
+    FlowPosition p;
+    long long entered = 0, trial = 0;
+    if (std::sscanf(text.c_str(), "%31s %d %lld %lld", name, &p.serial, &entered,
+                    &trial) != 4)
+        return std::nullopt;
+    p.entered_ns = entered;
+    p.trial_id = trial;
+    const std::string n = name;
+    if (n == "instructions")
+        p.screen = Screen::Instructions;
+    else if (n == "practice_done")
+        p.screen = Screen::PracticeDone;
+    else if (n == "trial")
+        p.screen = Screen::Blank;
+    else if (n == "break")
+        p.screen = Screen::Break;
+    else if (n == "debrief")
+        p.screen = Screen::Debrief;
+    else if (n == "consent")
+        p.screen = Screen::Consent;
+    else
+        return std::nullopt;
+    return p;
+}
+
+// The view number stored with a position (also "done N"); 0 when none.
+int stored_view(const std::optional<std::string>& text) {
+    int view = 0;
+    char name[32] = {};
+    if (text && std::sscanf(text->c_str(), "%31s %d", name, &view) == 2) return view;
+    return 0;
+}
+
+bool stored_done(const std::optional<std::string>& text) {
+    return text && text->rfind("done ", 0) == 0;
+}
+
+WebReply declined_reply() {
+    return {200,
+            to_text(json{{"screen", "declined"},
+                         {"text",
+                          "You did not agree to take part. Nothing of yours was stored; "
+                          "the study counts only that one person declined. You may "
+                          "close this window."}})};
+}
+
+// Holds the participant for one request: requests of one participant (on any serve
+// process, through any store of a pool) take turns, as lab stations do for a whole
+// session. Waits up to `wait` for another request to end; a lab station that runs the
+// participant keeps it past that (409).
+class ParticipantTurn {
+public:
+    ParticipantTurn(StudyStore& store, const std::string& code,
+                    std::chrono::milliseconds wait)
+        : store_(store), code_(code) {
+        const auto deadline = std::chrono::steady_clock::now() + wait;
+        for (;;) {
+            try {
+                store_.claim_participant(code_);
+                return;
+            } catch (const StoreUnavailable&) {
+                throw;
+            } catch (const StoreError&) {
+                if (std::chrono::steady_clock::now() >= deadline) throw;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+    }
+    ~ParticipantTurn() {
+        try {
+            store_.release_participant(code_);
+        } catch (const std::exception&) {
+            // A connection in doubt releases its locks as it closes.
+        }
+    }
+    ParticipantTurn(const ParticipantTurn&) = delete;
+    ParticipantTurn& operator=(const ParticipantTurn&) = delete;
+
+private:
+    StudyStore& store_;
+    std::string code_;
+};
+
 }  // namespace
 
 WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions options)
-    : protocol_(protocol), store_(store), options_(std::move(options)) {
+    : protocol_(protocol),
+      own_pool_(std::make_unique<StorePool>(store)),
+      pool_(*own_pool_),
+      options_(std::move(options)) {
+    init();
+}
+
+WebStudy::WebStudy(const Protocol& protocol, StorePool& pool, WebStudyOptions options)
+    : protocol_(protocol), pool_(pool), options_(std::move(options)) {
+    init();
+}
+
+void WebStudy::init() {
     for (const StimulusSpec& s : protocol_.stimuli)
         if (!options_.images.count(s.id))
             throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id +
@@ -233,8 +363,9 @@ WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions 
     // blocks' designs and catch trials are not one per stimulus.
     for (const PlannedTrial& t : plan_trials(protocol_, 0, 0).trials)
         main_trials_ += t.practice ? 0 : 1;
-    study_id_ = store_.ensure_study(protocol_);
-    store_.check_stimulus_values(options_.environment.stimuli);
+    StorePool::Lease store = pool_.lease();
+    study_id_ = store->ensure_study(protocol_);
+    store->check_stimulus_values(options_.environment.stimuli);
 }
 
 WebStudy::~WebStudy() = default;
@@ -247,60 +378,9 @@ std::string WebStudy::active_since_utc() const {
                            options_.idle_timeout));
 }
 
-size_t WebStudy::live_sessions() const {
-    std::lock_guard lock(mutex_);
-    size_t n = 0;
-    for (const auto& [code, live] : live_) n += live->pending ? 0 : 1;
-    return n;
-}
-
-size_t WebStudy::pending_sessions() const {
-    std::lock_guard lock(mutex_);
-    size_t n = 0;
-    for (const auto& [code, live] : live_) n += live->pending ? 1 : 0;
-    return n;
-}
-
-size_t WebStudy::release_idle() {
-    std::lock_guard lock(mutex_);
-    return release_idle_locked();
-}
-
-size_t WebStudy::release_idle_locked() {
-    const auto cutoff =
-        now() - std::chrono::duration_cast<std::chrono::system_clock::duration>(
-                    options_.idle_timeout);
-    std::vector<std::string> idle;
-    for (const auto& [code, live] : live_)
-        if (live->seen < cutoff) idle.push_back(code);
-    for (const std::string& code : idle) {
-        Live& live = *live_.at(code);
-        if (!live.pending && live.flow &&
-            live.flow->answered_trials() < live.flow->total_trials()) {
-            try {
-                store_.set_status(live.session.id, "paused",
-                                  false);  // as a lab quit leaves it
-            } catch (const std::exception&) {
-                // Withdrawn, completed meanwhile, or the server away: the claim ends
-                // anyway.
-            }
-        }
-        drop(code);
-    }
-    return idle.size();
-}
-
-void WebStudy::drop(const std::string& code) {
-    const auto it = live_.find(code);
-    if (it == live_.end()) return;
-    const bool loaded = !it->second->pending;
-    live_.erase(it);
-    if (!loaded) return;
-    try {
-        store_.release_participant(code);
-    } catch (const std::exception&) {
-        // A release that fails leaves the lock to the connection's end (its next loss).
-    }
+uint64_t WebStudy::seed_of(const std::string& uuid) const {
+    const std::string mac = hmac_sha256_hex(options_.secret, "seed " + uuid);
+    return std::stoull(mac.substr(0, 16), nullptr, 16) & 0x7FFFFFFFFFFFFFFFull;
 }
 
 WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
@@ -327,18 +407,25 @@ WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
     }
     if (!request.is_object())
         return error_reply(400, "the request body must be a JSON object");
-    std::lock_guard lock(mutex_);
-    try {
-        release_idle_locked();
-        if (endpoint == "session") return start(request);
-        if (endpoint == "state" || endpoint == "continue" || endpoint == "decline" ||
-            endpoint == "answer" || endpoint == "environment")
-            return act(endpoint, request);
+    const bool action = endpoint == "state" || endpoint == "continue" ||
+                        endpoint == "decline" || endpoint == "answer" ||
+                        endpoint == "environment";
+    if (endpoint != "session" && !action)
         return error_reply(404, "no API endpoint '" + std::string(endpoint) + "'");
+    try {
+        StorePool::Lease store = pool_.lease();
+        return endpoint == "session" ? start(*store, request)
+                                     : act(*store, endpoint, request);
     } catch (const RequestError& e) {
         return error_reply(e.status, e.what());
     } catch (const json::exception& e) {
         return error_reply(400, std::string("bad request: ") + e.what());
+    } catch (const StoreUnavailable& e) {
+        // The store cannot be reached, or every connection stayed busy: nothing was
+        // written or acknowledged; the page tries again.
+        WebReply reply = error_reply(503, e.what());
+        reply.retry_after_s = 1;
+        return reply;
     } catch (const StoreError& e) {
         // Refused by the store (a participant run on a lab station now, a rating it
         // does not accept): nothing was written.
@@ -348,40 +435,41 @@ WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
     }
 }
 
-SessionEnvironment WebStudy::environment_for(const Live& live) const {
+WebReply WebStudy::health() {
+    try {
+        StorePool::Lease store = pool_.lease();
+        store->query_int("SELECT 1");
+        return {200, to_text(json{{"store", "ok"}, {"connections", pool_.size()}})};
+    } catch (const std::exception& e) {
+        WebReply reply = error_reply(503, std::string("store: ") + e.what());
+        reply.retry_after_s = 1;
+        return reply;
+    }
+}
+
+SessionEnvironment WebStudy::environment_for(const Browser& browser) const {
     SessionEnvironment env = options_.environment;
     env.gl_vendor = "web browser";
-    env.gl_renderer = live.user_agent;  // the browser draws: its user agent
-    std::string mode = "browser window " + std::to_string(live.window_width) + "x" +
-                       std::to_string(live.window_height) + " CSS px, devicePixelRatio ";
+    env.gl_renderer = browser.user_agent;  // the browser draws: its user agent
+    std::string mode = "browser window " + std::to_string(browser.window_width) + "x" +
+                       std::to_string(browser.window_height) +
+                       " CSS px, devicePixelRatio ";
     char dpr[32];
-    std::snprintf(dpr, sizeof dpr, "%g", live.device_pixel_ratio);
+    std::snprintf(dpr, sizeof dpr, "%g", browser.device_pixel_ratio);
     mode += dpr;
-    if (live.screen_width > 0)
-        mode += ", screen " + std::to_string(live.screen_width) + "x" +
-                std::to_string(live.screen_height);
-    if (!live.prolific_study.empty() || !live.prolific_session.empty())
-        mode += "; Prolific STUDY_ID=" + live.prolific_study +
-                " SESSION_ID=" + live.prolific_session;
+    if (browser.screen_width > 0)
+        mode += ", screen " + std::to_string(browser.screen_width) + "x" +
+                std::to_string(browser.screen_height);
+    if (!browser.prolific_study.empty() || !browser.prolific_session.empty())
+        mode += "; Prolific STUDY_ID=" + browser.prolific_study +
+                " SESSION_ID=" + browser.prolific_session;
     env.display_mode = mode;
     env.display_refresh_hz.reset();
-    env.measured_refresh_hz = live.refresh_hz;
-    env.refresh_note = live.refresh_hz
+    env.measured_refresh_hz = browser.refresh_hz;
+    env.refresh_note = browser.refresh_hz
                            ? "browser estimate: median requestAnimationFrame interval"
                            : "refresh not measured by the browser (yet)";
     return env;
-}
-
-WebStudy::Live& WebStudy::load(const std::string& code, const SessionRow& session,
-                               const std::string& token) {
-    auto live = std::make_unique<Live>();
-    live->code = code;
-    live->session = session;
-    live->token = token;
-    live->seen = now();
-    Live& out = *live;
-    live_[code] = std::move(live);
-    return out;
 }
 
 namespace {
@@ -423,10 +511,10 @@ Participant participant_of(const json& body) {
 
 }  // namespace
 
-// What this page says about itself: the request's `client` fields (Prolific's ids are
-// the caller's to add).
-WebStudy::Live WebStudy::browser_of(const json& body) {
-    Live browser;
+// What this page says about itself: the request's `client` fields, with Prolific's ids
+// when it names them (`prolific`, as on the start request).
+WebStudy::Browser WebStudy::browser_of(const json& body) {
+    Browser browser;
     if (const json* client = field(body, "client")) {
         if (!client->is_object())
             throw RequestError(400, "field 'client' must be an object");
@@ -444,183 +532,168 @@ WebStudy::Live WebStudy::browser_of(const json& body) {
             number_field(*client, "device_pixel_ratio", 0.05, 16, false).value_or(0);
         browser.refresh_hz = number_field(*client, "refresh_hz", 1, 1000, false);
     }
+    if (field(body, "prolific")) {
+        const Participant who = participant_of(body);
+        browser.prolific_study = who.prolific_study;
+        browser.prolific_session = who.prolific_session;
+    }
     return browser;
 }
 
-void WebStudy::take_browser(Live& live, const Live& browser) {
-    live.user_agent = browser.user_agent;
-    live.window_width = browser.window_width;
-    live.window_height = browser.window_height;
-    live.screen_width = browser.screen_width;
-    live.screen_height = browser.screen_height;
-    live.device_pixel_ratio = browser.device_pixel_ratio;
-    live.refresh_hz = browser.refresh_hz;
-    live.prolific_study = browser.prolific_study;
-    live.prolific_session = browser.prolific_session;
+void WebStudy::load_flow(StudyStore& store, Page& page, double now_ms,
+                         bool reload) const {
+    const int64_t id = page.session.id;
+    page.trials = store.trials(id);
+    page.flow.emplace(protocol_, store, id, page.trials, store.has_consent(id),
+                      ms_to_ns(now_ms));
+    page.flow->show_series(&options_.series);
+    const std::optional<std::string> text = store.web_position(id);
+    const int view = stored_view(text);
+    page.done = stored_done(text);
+    std::optional<FlowPosition> at = text ? position_of_text(*text) : std::nullopt;
+    if (at && reload) {
+        // A new page: its clock starts anew, and views of the page before are stale.
+        at->serial = view + 1;
+        at->entered_ns = ms_to_ns(now_ms);
+    }
+    if (at && page.flow->restore(*at)) return;
+    // The position no longer fits (an answer committed whose position was not stored,
+    // a lab station ran the participant meanwhile) or was never stored: from the first
+    // open trial, as a resume, with a view past any the page may still show.
+    FlowPosition fresh = page.flow->position();
+    fresh.serial = std::max(fresh.serial, view + 1);
+    page.flow->restore(fresh);
 }
 
-// The participant's session in progress in the store, if any; a loaded page whose
-// session ended is forgotten first, and a session whose every trial is answered is
-// completed instead.
-std::optional<SessionRow> WebStudy::unfinished_session_of(const std::string& code,
-                                                          const std::string& token) {
-    std::optional<SessionRow> unfinished = store_.unfinished_session(code);
-    if (const auto it = live_.find(code);
-        it != live_.end() && !it->second->pending &&
-        (!unfinished || unfinished->id != it->second->session.id)) {
-        // The loaded session is no longer an unfinished one of the store: completed, or
-        // withdrawn (`participants withdraw`) while its page was open.
-        const bool same_page = same_secret_text(token, it->second->token);
-        drop(code);
-        if (same_page && !store_.has_completed_session(code) &&
-            !store_.participant_counts(code))
-            throw RequestError(410, kWithdrawn);
-    }
-    if (unfinished && store_.complete_session_if_answered(unfinished->id)) {
-        drop(code);
-        unfinished.reset();
-    }
-    return unfinished;
+void WebStudy::save_position(StudyStore& store, const Page& page) const {
+    const SessionFlow& flow = *page.flow;
+    store.set_web_position(page.session.id, flow.finished()
+                                                ? "done " + std::to_string(flow.serial())
+                                                : position_text(flow.position()));
 }
 
-// A page (re)loaded for a session in progress: from the first unanswered trial, as
-// `lucent run --resume` does; a new segment only once the last one has an answer.
-WebReply WebStudy::resume(const std::string& code, const std::string& token,
-                          const SessionRow& unfinished, const Live& browser,
+// A page (re)loaded for a session in progress: where its page stood (a reload renumbers
+// the views), or from the first unanswered trial; a new segment only once the last one
+// has an answer.
+WebReply WebStudy::resume(StudyStore& store, const std::string& code,
+                          const SessionRow& unfinished, const Browser& browser,
                           double t_ms) {
-    const std::string in_progress =
-        "participant '" + code +
-        "' has a session in progress in another browser; continue "
-        "it there (the study link in that browser holds its key)";
-    const std::string expected = session_token(options_.secret, code, unfinished.uuid);
-    if (!same_secret_text(token, expected)) throw RequestError(403, in_progress);
-    store_.claim_participant(code);
-    Live probe;
-    take_browser(probe, browser);
-    const SessionEnvironment env = environment_for(probe);
-    store_.set_status(unfinished.id, "running", false);
-    store_.resume_segment(unfinished.id, env);
-    Live& live = load(code, unfinished, expected);
-    take_browser(live, browser);
-    live.trials = store_.trials(unfinished.id);
-    live.flow.emplace(protocol_, store_, unfinished.id, live.trials,
-                      store_.has_consent(unfinished.id), ms_to_ns(t_ms));
-    live.flow->show_series(&options_.series);
-    json reply = state(live);
-    reply["token"] = live.token;
+    store.set_status(unfinished.id, "running", false);
+    store.resume_segment(unfinished.id, environment_for(browser));
+    Page page{code, unfinished, {}, std::nullopt, false};
+    load_flow(store, page, t_ms, true);
+    save_position(store, page);
+    json reply = state(page);
+    reply["token"] = session_token(options_.secret, code, unfinished.uuid);
     return {200, to_text(reply)};
 }
 
-// A new participant: the consent screen, nothing stored (the same page reloaded
-// keeps its pending session; another page without its token starts a new one).
-WebReply WebStudy::show_consent(const std::string& code, const std::string& token,
-                                const Live& browser, double t_ms) {
-    const auto it = live_.find(code);
-    if (it == live_.end() || !it->second->pending ||
-        !same_secret_text(token, it->second->token)) {
-        drop(code);
-        if (live_.size() >= options_.max_pending) {
-            // Forget the pending page idle longest (it holds nothing but memory).
-            auto oldest = live_.end();
-            for (auto i = live_.begin(); i != live_.end(); ++i)
-                if (i->second->pending &&
-                    (oldest == live_.end() || i->second->seen < oldest->second->seen))
-                    oldest = i;
-            if (oldest != live_.end()) live_.erase(oldest);
-        }
-        SessionRow planned;
-        planned.uuid = new_uuid_v4();
-        Live& live =
-            load(code, planned, session_token(options_.secret, code, planned.uuid));
-        live.pending = true;
-        live.seed = static_cast<uint64_t>(random_seed());
-    }
-    Live& live = *live_.at(code);
-    take_browser(live, browser);
-    live.seen = now();
+// A new participant: the consent screen, nothing stored (the same page reloaded keeps
+// its pending session's UUID; another page without its token starts a new one).
+WebReply WebStudy::show_consent(StudyStore& store, const std::string& code,
+                                const std::string& uuid, const Browser& browser,
+                                double t_ms) {
+    const std::string token = session_token(options_.secret, code, uuid);
     if (protocol_.screens.consent.empty()) {
         // No consent screen in the protocol: the session starts at once.
-        WebReply reply = consent(live, false, t_ms, t_ms);
+        WebReply reply = consent(store, code, uuid, browser, false, t_ms, t_ms);
         if (reply.status == 200) {
             json out = json::parse(reply.body);
-            out["token"] = live_.at(code)->token;
+            out["token"] = token;
             reply.body = to_text(out);
         }
         return reply;
     }
-    json reply = pending_state(live);
-    reply["token"] = live.token;
+    json reply = pending_state();
+    reply["token"] = token;
     return {200, to_text(reply)};
 }
 
-WebReply WebStudy::start(const json& body) {
+WebReply WebStudy::start(StudyStore& store, const json& body) {
     const Participant who = participant_of(body);
     const std::string& code = who.code;
     const std::string token = text_field(body, "token", kMaxTokenLength, false);
     const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
+    Browser browser = browser_of(body);  // what this page says about itself
 
-    Live browser = browser_of(body);  // what this page says about itself
-    browser.prolific_study = who.prolific_study;
-    browser.prolific_session = who.prolific_session;
-
-    if (const std::optional<SessionRow> unfinished = unfinished_session_of(code, token))
-        return resume(code, token, *unfinished, browser, t_ms);
-    if (store_.has_completed_session(code)) {
-        drop(code);
+    const ParticipantTurn turn(store, code, options_.participant_wait);
+    std::optional<SessionRow> unfinished = store.unfinished_session(code);
+    if (unfinished && store.complete_session_if_answered(unfinished->id))
+        unfinished.reset();  // every trial answered: completed now
+    const std::optional<TokenParts> parts = token_parts(token);
+    const bool ours = parts && parts->code == code;
+    if (unfinished) {
+        const bool names_it =
+            ours && (same_secret_text(
+                         token, session_token(options_.secret, code, unfinished->uuid)) ||
+                     same_secret_text(token, legacy_session_token(options_.secret, code,
+                                                                  unfinished->uuid)));
+        if (!names_it)
+            throw RequestError(403, "participant '" + code +
+                                        "' has a session in progress in another browser; "
+                                        "continue it there (the study link in that "
+                                        "browser holds its key)");
+        return resume(store, code, *unfinished, browser, t_ms);
+    }
+    if (store.has_completed_session(code)) {
         json reply = done_state();
         reply["already_completed"] = true;
         return {200, to_text(reply)};
     }
-    return show_consent(code, token, browser, t_ms);
+    const bool valid =
+        ours && !parts->legacy &&
+        same_secret_text(token, session_token(options_.secret, code, parts->uuid));
+    // A page whose session was withdrawn is told so once (it then forgets its token).
+    if (valid && store.session_withdrawn(parts->uuid))
+        throw RequestError(410, kWithdrawn);
+    const bool keeps_uuid = valid && !store.session_by_uuid(parts->uuid) &&
+                            !store.consent_declined(parts->uuid);
+    return show_consent(store, code, keeps_uuid ? parts->uuid : new_uuid_v4(), browser,
+                        t_ms);
 }
 
-// The answer on a pending page's consent screen. Declined: one more in the study's count,
-// the page forgotten. Agreed: enrolled (number, cell, session, plan) and consent recorded
-// through the same SessionFlow as in the lab.
-WebReply WebStudy::consent(Live& live, bool decline, double shown_ms, double t_ms) {
-    const std::string code = live.code;
+// The answer on a pending page's consent screen. Declined: one more in the study's count.
+// Agreed: enrolled (number, cell, session, plan) and consent recorded through the same
+// SessionFlow as in the lab.
+WebReply WebStudy::consent(StudyStore& store, const std::string& code,
+                           const std::string& uuid, const Browser& browser, bool decline,
+                           double shown_ms, double t_ms) {
     if (decline) {
-        store_.count_declined_consent(study_id_);
-        drop(code);
-        return {200,
-                to_text(json{{"screen", "declined"},
-                             {"text",
-                              "You did not agree to take part. Nothing of yours was "
-                              "stored; the study counts only that one person declined. "
-                              "You may close this window."}})};
+        // Counted once per page (a decline sent again is not a second person).
+        store.decline_online_consent(study_id_, uuid);
+        return declined_reply();
     }
-    store_.claim_participant(code);
-    OnlineSession enrolled;
-    try {
-        OnlineEnrolment how;
-        how.session_uuid = live.session.uuid;
-        how.seed = live.seed;
-        how.cells = protocol_.randomisation.counterbalance_blocks
-                        ? latin_square_rows(static_cast<int>(protocol_.blocks.size()))
-                        : 1;
-        how.active_since_utc = active_since_utc();
-        how.plan = [&](int cell) { return plan_trials(protocol_, live.seed, cell); };
-        enrolled = store_.enrol_online(study_id_, code, how, environment_for(live));
-    } catch (...) {
-        store_.release_participant(code);
-        throw;
-    }
-    live.pending = false;
-    live.session = enrolled.session;
-    live.trials = store_.trials(enrolled.session.id);
-    SessionFlow flow(protocol_, store_, enrolled.session.id, live.trials, false,
+    // One session in progress per participant: another browser's is theirs to go on.
+    if (store.unfinished_session(code))
+        throw RequestError(403, "participant '" + code +
+                                    "' has a session in progress in another browser; "
+                                    "continue it there");
+    if (store.has_completed_session(code)) return {200, to_text(done_state())};
+    OnlineEnrolment how;
+    how.session_uuid = uuid;
+    how.seed = seed_of(uuid);
+    how.cells = protocol_.randomisation.counterbalance_blocks
+                    ? latin_square_rows(static_cast<int>(protocol_.blocks.size()))
+                    : 1;
+    how.active_since_utc = active_since_utc();
+    how.plan = [&](int cell) { return plan_trials(protocol_, how.seed, cell); };
+    const OnlineSession enrolled =
+        store.enrol_online(study_id_, code, how, environment_for(browser));
+    Page page{code, enrolled.session, store.trials(enrolled.session.id), std::nullopt,
+              false};
+    SessionFlow flow(protocol_, store, enrolled.session.id, page.trials, false,
                      ms_to_ns(shown_ms));
     flow.show_series(&options_.series);  // copies keep it; options_ outlives them
     if (flow.screen() == Screen::Consent) {
         flow.presented(flow.serial(), ms_to_ns(shown_ms));
         flow.key({Key::Enter, 0, ms_to_ns(t_ms)});  // records consent
     }
-    live.flow.emplace(flow);
-    return {200, to_text(state(live))};
+    page.flow.emplace(flow);
+    save_position(store, page);
+    return {200, to_text(state(page))};
 }
 
-json WebStudy::pending_state(const Live& live) const {
-    (void)live;
+json WebStudy::pending_state() const {
     json out;
     out["screen"] = "consent";
     out["view"] = kConsentView;
@@ -636,31 +709,66 @@ json WebStudy::pending_state(const Live& live) const {
 }
 
 // ---- [SECTION] actions ----------------------------------------------------------------
-// The page a token names: loaded here, and the token its own.
-WebStudy::Live& WebStudy::page_of_token(const std::string& code,
-                                        const std::string& token) {
-    const auto it = live_.find(code);
-    if (participant_code_problem(code).empty() && it == live_.end()) {
-        // Not loaded here (the server restarted, the page was idle, or the session
-        // ended): the page starts again through /api/session, which checks the token
-        // against the store.
+// The session a token names, checked against the secret: pending (no session of its UUID
+// yet), withdrawn (410), or the participant's session in the store.
+WebReply WebStudy::act(StudyStore& store, std::string_view endpoint, const json& body) {
+    const std::string token = text_field(body, "token", kMaxTokenLength, true);
+    const std::optional<TokenParts> parts = token_parts(token);
+    if (!parts) throw RequestError(403, "unknown session token");
+    const std::string& code = parts->code;
+    if (parts->legacy) {
+        // An earlier serve's token: /api/session takes it (for the session in progress)
+        // and gives the page a new one.
+        const std::optional<SessionRow> unfinished = store.unfinished_session(code);
+        if (!unfinished ||
+            !same_secret_text(
+                token, legacy_session_token(options_.secret, code, unfinished->uuid)))
+            throw RequestError(403, "unknown session token");
         throw RequestError(409, "session of '" + code +
-                                    "' is not loaded; start it again "
-                                    "(POST /api/session with its token)");
+                                    "' is not loaded; start it again (POST /api/session "
+                                    "with its token)");
     }
-    if (it == live_.end() || !same_secret_text(token, it->second->token))
+    if (!same_secret_text(token, session_token(options_.secret, code, parts->uuid)))
         throw RequestError(403, "unknown session token");
-    return *it->second;
+
+    const ParticipantTurn turn(store, code, options_.participant_wait);
+    const std::optional<SessionRow> session = store.session_by_uuid(parts->uuid);
+    if (!session) {
+        if (store.session_withdrawn(parts->uuid)) throw RequestError(410, kWithdrawn);
+        if (store.consent_declined(parts->uuid)) {
+            if (endpoint == "decline") return declined_reply();  // sent again
+            throw RequestError(409,
+                               "this page declined; start again to see the consent "
+                               "screen anew");
+        }
+        return act_pending(store, endpoint, code, parts->uuid, body);
+    }
+    if (session->participant != code) throw RequestError(403, "unknown session token");
+    if (session->status == "aborted")
+        throw RequestError(410, "this session has ended; you may close this window");
+    Page page{code, *session, {}, std::nullopt, false};
+    try {
+        return act_enrolled(store, endpoint, page, body);
+    } catch (const StoreUnavailable&) {
+        throw;
+    } catch (const StoreError&) {
+        // Refused by the store: when because the participant was withdrawn while the page
+        // was open, the page is told so instead of the store's words.
+        if (!store.participant_counts(code)) throw RequestError(410, kWithdrawn);
+        throw;
+    }
 }
 
 // An action of a pending page: only its consent screen is shown (the answer agrees or
-// declines).
-WebReply WebStudy::act_pending(std::string_view endpoint, Live& live, const json& body) {
-    if (endpoint == "state") return {200, to_text(pending_state(live))};
+// declines, with what the browser says about itself).
+WebReply WebStudy::act_pending(StudyStore& store, std::string_view endpoint,
+                               const std::string& code, const std::string& uuid,
+                               const json& body) {
+    if (endpoint == "state") return {200, to_text(pending_state())};
     if (endpoint == "environment") {
-        live.refresh_hz =
-            number_field(body, "refresh_hz", 1, 1000, true);  // kept in memory
-        return {200, to_text(pending_state(live))};
+        // Nothing is kept before consent: the page sends its estimate with its answer.
+        number_field(body, "refresh_hz", 1, 1000, true);
+        return {200, to_text(pending_state())};
     }
     if (endpoint == "answer")
         throw RequestError(409, "the consent screen is shown; no trial yet");
@@ -674,13 +782,36 @@ WebReply WebStudy::act_pending(std::string_view endpoint, Live& live, const json
     if (t_ms < shown_ms)
         throw RequestError(400,
                            "the key came before the screen was shown (t_ms < shown_ms)");
-    return consent(live, endpoint == "decline", shown_ms, t_ms);
+    if (field(body, "prolific") && participant_of(body).code != code)
+        throw RequestError(400, "PROLIFIC_PID differs from the token's participant");
+    return consent(store, code, uuid, browser_of(body), endpoint == "decline", shown_ms,
+                   t_ms);
+}
+
+WebReply WebStudy::act_enrolled(StudyStore& store, std::string_view endpoint, Page& page,
+                                const json& body) {
+    // The page's clock: the request's t_ms when it has one (a new screen's blank begins
+    // then), else the stored position's.
+    const double t_ms = number_field(body, "t_ms", 0, kMaxPageMs, false).value_or(0.0);
+    load_flow(store, page, t_ms, false);
+    if (page.done) return {200, to_text(done_state())};
+    if (endpoint == "state") return {200, to_text(state(page))};
+    if (endpoint == "environment") {
+        Browser browser = browser_of(body);
+        browser.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);
+        store.update_environment(page.session.id, environment_for(browser));
+        return {200, to_text(state(page))};
+    }
+    WebReply reply = endpoint == "answer" ? answer(page, body)
+                                          : continue_or_decline(endpoint, page, body);
+    if (reply.status == 200 && page.flow) save_position(store, page);
+    return reply;
 }
 
 // continue / decline: Enter (or N on the consent screen) on the view shown.
-WebReply WebStudy::continue_or_decline(std::string_view endpoint, Live& live,
-                                       const std::string& code, const json& body) {
-    SessionFlow& flow = *live.flow;
+WebReply WebStudy::continue_or_decline(std::string_view endpoint, Page& page,
+                                       const json& body) {
+    SessionFlow& flow = *page.flow;
     const double view = *number_field(body, "view", 0, 1e9, true);
     const double shown_ms = *number_field(body, "shown_ms", 0, kMaxPageMs, true);
     const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
@@ -704,59 +835,29 @@ WebReply WebStudy::continue_or_decline(std::string_view endpoint, Live& live,
     if (decline) {
         // A session stored before consent (by a lab station, or an older lucent
         // serve) is left 'aborted', as a lab decline leaves it.
-        drop(code);
+        page.flow.reset();
         return {200, to_text(json{{"screen", "declined"},
                                   {"text",
                                    "You did not agree to take part. You may close this "
                                    "window."}})};
     }
-    live.flow.emplace(next);
-    if (next.screen() == Screen::Done) {
-        drop(code);
-        return {200, to_text(done_state())};
-    }
-    return {200, to_text(state(live))};
+    page.flow.emplace(next);
+    if (next.screen() == Screen::Done) return {200, to_text(done_state())};
+    return {200, to_text(state(page))};
 }
 
-WebReply WebStudy::act(std::string_view endpoint, const json& body) {
-    const std::string token = text_field(body, "token", kMaxTokenLength, true);
-    const size_t dot = token.rfind('.');
-    const std::string code = token.substr(0, dot == std::string::npos ? 0 : dot);
-    Live& live = page_of_token(code, token);
-    live.seen = now();
-
-    if (live.pending) return act_pending(endpoint, live, body);
-
-    try {
-        if (endpoint == "state") return {200, to_text(state(live))};
-        if (endpoint == "environment") {
-            live.refresh_hz = number_field(body, "refresh_hz", 1, 1000, true);
-            store_.update_environment(live.session.id, environment_for(live));
-            return {200, to_text(state(live))};
-        }
-        if (endpoint == "answer") {
-            WebReply reply = answer(live, body);
-            if (live.flow->answered_trials() == live.flow->total_trials())
-                store_.release_participant(
-                    code);  // completed: the debrief writes nothing
-            return reply;
-        }
-        return continue_or_decline(endpoint, live, code, body);
-    } catch (const StoreError&) {
-        // Refused by the store: when because the participant was withdrawn while the page
-        // was open, the page is told so (and forgotten) instead of the store's words.
-        if (!store_.participant_counts(code)) {
-            drop(code);
-            throw RequestError(410, kWithdrawn);
-        }
-        throw;
-    }
-}
-
-WebReply WebStudy::answer(Live& live, const json& body) {
-    SessionFlow& flow = *live.flow;
+WebReply WebStudy::answer(Page& page, const json& body) {
+    SessionFlow& flow = *page.flow;
     const std::string trial_uuid = text_field(body, "trial", 64, true);
-    check_trial_on_screen(flow, live.trials, trial_uuid);
+    // The same answer sent again (its reply was lost; the proxy or the page retried it,
+    // perhaps to another serve process): stored once, and the page shown where it is.
+    for (const TrialRow& t : page.trials)
+        if (t.uuid == trial_uuid && t.answered) {
+            json reply = state(page);
+            reply["already_answered"] = true;
+            return {200, to_text(reply)};
+        }
+    check_trial_on_screen(flow, page.trials, trial_uuid);
     const double view = *number_field(body, "view", 0, 1e9, true);
     if (static_cast<int>(view) != flow.serial())
         throw RequestError(409, "view " + std::to_string(static_cast<int>(view)) +
@@ -773,10 +874,10 @@ WebReply WebStudy::answer(Live& live, const json& body) {
 
     SessionFlow next =
         replayed(flow, onset_ms, sequence, replay, protocol_.inter_trial_ms);
-    for (TrialRow& t : live.trials)
+    for (TrialRow& t : page.trials)
         if (t.uuid == trial_uuid) t.answered = true;
-    live.flow.emplace(next);
-    return {200, to_text(state(live))};
+    page.flow.emplace(next);
+    return {200, to_text(state(page))};
 }
 
 // ---- [SECTION] the state a page shows -------------------------------------------------
@@ -883,8 +984,8 @@ json WebStudy::done_state() const {
     return out;
 }
 
-json WebStudy::state(const Live& live) const {
-    const SessionFlow& flow = *live.flow;
+json WebStudy::state(const Page& page) const {
+    const SessionFlow& flow = *page.flow;
     json out;
     out["screen"] = screen_name(flow.screen());
     out["view"] = flow.serial();

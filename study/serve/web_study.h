@@ -14,6 +14,11 @@
 // in the lab, and the trial is committed to the store before the reply names the next
 // screen. A refused request (4xx, one-line reason) changes nothing: each action runs on
 // a copy of the participant's flow, kept only when it succeeded.
+//
+// Nothing of a participant is held in memory between requests (issue 32): the flow is
+// rebuilt from the store for each request, at the position the last request stored, and
+// a page before consent is carried by its token. So several serve processes on one
+// database answer any participant's request, and one dying loses nothing.
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -35,7 +40,8 @@ namespace lucent::study {
 
 struct WebReply {
     int status = 200;
-    std::string body;  // JSON: the state, or {"error": "one line"} for a 4xx/5xx
+    std::string body;       // JSON: the state, or {"error": "one line"} for a 4xx/5xx
+    int retry_after_s = 0;  // 503: when to try again (the Retry-After header)
 };
 
 // A picture the page shows, served at /images/<stimulus id>.png.
@@ -55,28 +61,33 @@ struct WebStudyOptions {
     // with such blocks. Every session's flow shows them (SessionFlow::show_series).
     WebSeries series;
     size_t max_body_bytes = 64 * 1024;  // larger API bodies: 413
-    // A page that sent nothing for this long is put aside (release_idle): its claim on
-    // the participant ends, and its session no longer holds a cell (abandoned) once the
-    // store has seen no activity of it for as long. A later request re-loads it.
+    // A session the store has seen no activity of (start, segment, answer) for this
+    // long no longer holds its counterbalancing cell (abandoned); it still resumes.
     std::chrono::milliseconds idle_timeout = std::chrono::minutes(30);
+    // A request waits this long for another request of the same participant (on this
+    // process or another) to end, then is refused (409: a lab station runs them now).
+    std::chrono::milliseconds participant_wait = std::chrono::seconds(3);
     // Wall time (tests pass a fake one).
     std::function<std::chrono::system_clock::time_point()> clock;
-    // Pages shown the consent screen and not yet answered (held in memory only); beyond
-    // this many, the one idle longest is forgotten.
-    size_t max_pending = 10000;
 };
 
 // Field limits of API requests (beyond them: 400).
 inline constexpr size_t kMaxCodeLength = 64;  // participant code, Prolific ids
 inline constexpr size_t kMaxUserAgentLength = 512;
-inline constexpr size_t kMaxTokenLength = 160;
+inline constexpr size_t kMaxTokenLength = 200;
 inline constexpr size_t kMaxEventsPerAnswer = 500;
 
 // A participant code or Prolific id: 1..64 of [A-Za-z0-9_-]. "" when valid, else why.
 std::string participant_code_problem(std::string_view code);
-// The token of a session: "<code>.<hex HMAC-SHA256(secret, session uuid)>".
+// The token of a session (or of a page before consent, whose session it names):
+// "<code>.<session uuid>.<hex HMAC-SHA256(secret, code + ' ' + uuid)>". Any serve
+// process holding the secret checks it without keeping anything.
 std::string session_token(std::string_view secret, std::string_view code,
                           std::string_view session_uuid);
+// The token an earlier lucent serve gave (before issue 32): "<code>.<hex
+// HMAC-SHA256(secret, uuid)>"; still taken by /api/session for a session in progress.
+std::string legacy_session_token(std::string_view secret, std::string_view code,
+                                 std::string_view session_uuid);
 // HMAC-SHA256 (RFC 2104) in lower-case hex.
 std::string hmac_sha256_hex(std::string_view key, std::string_view message);
 // The stimulus id an /images/ request names, from the raw request target (percent-
@@ -86,50 +97,54 @@ std::optional<std::string> image_of_target(std::string_view target,
                                            const std::map<std::string, WebImage>& images);
 
 class SessionFlow;
+class StorePool;
 
 class WebStudy {
 public:
-    // `protocol` and `store` must outlive this; ensure_study runs here (StoreError when
-    // the store holds another protocol).
+    // `protocol` and the store (or pool of stores) must outlive this; ensure_study runs
+    // here (StoreError when the store holds another protocol).
+    WebStudy(const Protocol& protocol, StorePool& pool, WebStudyOptions options);
+    // One store, one request at a time (tests; a single connection).
     WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions options);
     ~WebStudy();
 
     // One API request: `endpoint` is the name after /api/ (session, state, continue,
-    // decline, answer, environment), `body` its JSON. Thread-safe (one at a time).
+    // decline, answer, environment), `body` its JSON. Thread-safe: requests run at once,
+    // each on a store of the pool (503 with retry_after_s when none came free, or the
+    // store cannot be reached); two of one participant take turns.
     WebReply handle(std::string_view endpoint, std::string_view body);
-
-    // Participants whose session is loaded now (consented, a page open and not yet done).
-    size_t live_sessions() const;
-    // Pages on the consent screen (nothing of them stored).
-    size_t pending_sessions() const;
-    // Puts aside every page idle for longer than idle_timeout: a loaded session's claim
-    // ends (its status becomes paused), a pending one is forgotten. Also runs at the
-    // start of every request. Returns how many were put aside.
-    size_t release_idle();
+    // GET /healthz: 200 when a store of the pool answers a query now, else 503.
+    WebReply health();
 
 private:
-    struct Live;
-    WebReply start(const nlohmann::json& body);
-    // start()'s stages: what the browser says, the participant's session in progress,
-    // resuming it, or a new participant's consent screen.
-    static Live browser_of(const nlohmann::json& body);
-    static void take_browser(Live& live, const Live& browser);
-    std::optional<SessionRow> unfinished_session_of(const std::string& code,
-                                                    const std::string& token);
-    WebReply resume(const std::string& code, const std::string& token,
-                    const SessionRow& unfinished, const Live& browser, double t_ms);
-    WebReply show_consent(const std::string& code, const std::string& token,
-                          const Live& browser, double t_ms);
-    WebReply act(std::string_view endpoint, const nlohmann::json& body);
-    // act()'s stages: the page a token names, a pending page's actions, Enter or N on a
-    // loaded session's screen.
-    Live& page_of_token(const std::string& code, const std::string& token);
-    WebReply act_pending(std::string_view endpoint, Live& live,
+    struct Browser;
+    struct Page;
+    void init();  // both constructors: checks the pictures, ensures the study
+    WebReply start(StudyStore& store, const nlohmann::json& body);
+    static Browser browser_of(const nlohmann::json& body);
+    WebReply resume(StudyStore& store, const std::string& code,
+                    const SessionRow& unfinished, const Browser& browser, double t_ms);
+    WebReply show_consent(StudyStore& store, const std::string& code,
+                          const std::string& uuid, const Browser& browser, double t_ms);
+    WebReply act(StudyStore& store, std::string_view endpoint,
+                 const nlohmann::json& body);
+    WebReply act_pending(StudyStore& store, std::string_view endpoint,
+                         const std::string& code, const std::string& uuid,
                          const nlohmann::json& body);
-    WebReply continue_or_decline(std::string_view endpoint, Live& live,
-                                 const std::string& code, const nlohmann::json& body);
-    WebReply answer(Live& live, const nlohmann::json& body);
-    nlohmann::json state(const Live& live) const;
+    WebReply act_enrolled(StudyStore& store, std::string_view endpoint, Page& page,
+                          const nlohmann::json& body);
+    WebReply continue_or_decline(std::string_view endpoint, Page& page,
+                                 const nlohmann::json& body);
+    WebReply answer(Page& page, const nlohmann::json& body);
+    // The session's flow as its page left it (the stored position), or, when that no
+    // longer fits the stored trials, from its first open trial as a resume does, with a
+    // view past the stored one. `reload`: a new page (its clock starts anew at `now_ms`).
+    void load_flow(StudyStore& store, Page& page, double now_ms, bool reload) const;
+    // Stores where the page stands now (after each action that changed it).
+    void save_position(StudyStore& store, const Page& page) const;
+    WebReply consent(StudyStore& store, const std::string& code, const std::string& uuid,
+                     const Browser& browser, bool decline, double shown_ms, double t_ms);
+    nlohmann::json state(const Page& page) const;
     nlohmann::json rating_trial(const TrialRow& trial) const;
     // A forced choice showing `shown` (stimulus ids in screen order).
     nlohmann::json choice_trial(const TrialRow& trial,
@@ -137,24 +152,20 @@ private:
     nlohmann::json adjust_trial(const TrialRow& trial) const;
     nlohmann::json staircase_trial(const TrialRow& trial, const SessionFlow& flow) const;
     nlohmann::json done_state() const;
-    SessionEnvironment environment_for(const Live& live) const;
-    Live& load(const std::string& code, const SessionRow& session,
-               const std::string& token);
-    // Forgets a page; ends the claim when its session was loaded.
-    void drop(const std::string& code);
-    size_t release_idle_locked();
-    WebReply consent(Live& live, bool decline, double shown_ms, double t_ms);
-    nlohmann::json pending_state(const Live& live) const;
+    SessionEnvironment environment_for(const Browser& browser) const;
+    nlohmann::json pending_state() const;
     std::chrono::system_clock::time_point now() const;
     std::string active_since_utc() const;
+    // The seed of a pending session's plan, from its UUID (kept nowhere, unpredictable
+    // without the secret).
+    uint64_t seed_of(const std::string& uuid) const;
 
     const Protocol& protocol_;
-    StudyStore& store_;
+    std::unique_ptr<StorePool> own_pool_;  // the one-store constructor's
+    StorePool& pool_;
     WebStudyOptions options_;
     int64_t study_id_ = 0;
-    int main_trials_ = 0;       // a session's main (not practice) trials
-    mutable std::mutex mutex_;  // one store connection: requests in turn
-    std::map<std::string, std::unique_ptr<Live>> live_;  // by participant code
+    int main_trials_ = 0;  // a session's main (not practice) trials
 };
 
 }  // namespace lucent::study

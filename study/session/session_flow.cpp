@@ -42,6 +42,7 @@ SessionFlow::SessionFlow(const Protocol& protocol, StudyStore& store, int64_t se
     : protocol_(protocol),
       store_(store),
       session_id_(session_id),
+      consented_(consented),
       trials_(std::move(trials)) {
     advance_to_open_trial();
     // A resumed session continues at its first open trial once consent is on record.
@@ -52,6 +53,47 @@ SessionFlow::SessionFlow(const Protocol& protocol, StudyStore& store, int64_t se
     else
         enter(protocol_.screens.consent.empty() ? Screen::Instructions : Screen::Consent,
               now_ns);
+}
+
+bool SessionFlow::restore(const FlowPosition& p) {
+    const int64_t open = current_ < trials_.size() ? trials_[current_].id : 0;
+    if (p.trial_id != open || finished_ || paused_) return false;
+    bool answered_any = false;
+    for (const TrialRow& t : trials_) answered_any = answered_any || t.answered;
+    const bool before_trial = consented_ && current_ < trials_.size();
+    bool fits = false;
+    switch (p.screen) {
+        case Screen::Consent:
+            fits = !consented_;
+            break;
+        case Screen::Instructions:
+            fits = before_trial && !answered_any;
+            break;
+        case Screen::PracticeDone:
+        case Screen::Break:
+        case Screen::Blank:
+            fits = before_trial;
+            break;
+        case Screen::Debrief:
+            fits = current_ == trials_.size();
+            break;
+        case Screen::Trial:
+        case Screen::Done:
+            fits = false;
+            break;
+    }
+    if (!fits) return false;
+    screen_ = p.screen;
+    serial_ = p.serial;
+    entered_ns_ = p.entered_ns;
+    start_trial_presentation();
+    presented_ns_.reset();
+    return true;
+}
+
+FlowPosition SessionFlow::position() const {
+    return {screen_, serial_, entered_ns_,
+            current_ < trials_.size() ? trials_[current_].id : 0};
 }
 
 const TrialRow* SessionFlow::trial() const {
@@ -349,6 +391,7 @@ void SessionFlow::key(const TimedKey& press) {
         case Screen::Consent:
             if (press.key == Key::Enter) {
                 store_.set_consent(session_id_);
+                consented_ = true;
                 if (protocol_.screens.instructions.empty())
                     begin_trial_or_debrief(press.t_ns);
                 else

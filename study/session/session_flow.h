@@ -43,6 +43,16 @@ enum class Screen {
 // blank_ms, the second for duration_ms, then Answer (the two answers only).
 enum class ChoicePhase { First, Gap, Second, Answer };
 
+// Where a flow stands between two actions of a browser's page (`lucent serve`): the
+// screen (never Trial: a trial's screen lasts only within the request answering it),
+// its view number, when it began on the page's clock, and the first open trial (0: none).
+struct FlowPosition {
+    Screen screen = Screen::Blank;
+    int serial = 0;
+    int64_t entered_ns = 0;
+    int64_t trial_id = 0;
+};
+
 // How a session ended, mapped to exit codes by the caller.
 enum class RunResult { Completed, SavedAndQuit, Declined, UsageError, Failure };
 
@@ -96,6 +106,14 @@ public:
     // stored as its ladder's nearest rung (web_series.h). Null (the default): the lab's
     // continuous values. `series` must outlive the flow and its copies.
     void show_series(const WebSeries* series) { series_ = series; }
+    // `lucent serve`: continues a page where a request (perhaps of another serve process)
+    // left it. Applied only when it fits the trials as stored: the same first open trial,
+    // and a screen that can stand before it (instructions before any answer, a break or
+    // practice-done before an open trial, the debrief after the last, consent only
+    // before consent was recorded); false, and nothing changed, otherwise.
+    bool restore(const FlowPosition& position);
+    // Where the flow stands now (at a request's end: nothing presented yet).
+    FlowPosition position() const;
 
     // ---- state -----------------------------------------------------------------------
     Screen screen() const { return screen_; }
@@ -148,6 +166,7 @@ private:
     const Protocol& protocol_;
     StudyStore& store_;
     int64_t session_id_;
+    bool consented_ = false;  // on record when the flow was made, or recorded by it
     std::vector<TrialRow> trials_;
     size_t current_ = 0;  // the first unanswered trial
     Screen screen_ = Screen::Consent;

@@ -261,14 +261,10 @@ OnlineSession Store::enrol_online(int64_t study_id, const std::string& code,
     return out;
 }
 
-std::optional<SessionRow> Store::unfinished_session(const std::string& participant_code) {
-    Statement s = db_.prepare(
-        "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
-        "FROM sessions s JOIN participants p ON p.id = s.participant_id "
-        "WHERE p.code = ? AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT "
-        "1");
-    s.bind(1, participant_code);
-    if (!s.step()) return std::nullopt;
+namespace {
+// A session row from "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell,
+// s.status ..." stepped onto a row.
+SessionRow session_row(const Statement& s) {
     SessionRow row;
     row.id = s.integer(0);
     row.uuid = s.text(1);
@@ -278,6 +274,34 @@ std::optional<SessionRow> Store::unfinished_session(const std::string& participa
     row.cell = static_cast<int>(s.integer(5));
     row.status = s.text(6);
     return row;
+}
+}  // namespace
+
+std::optional<SessionRow> Store::unfinished_session(const std::string& participant_code) {
+    Statement s = db_.prepare(
+        "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
+        "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+        "WHERE p.code = ? AND s.status IN ('running', 'paused') ORDER BY s.id DESC LIMIT "
+        "1");
+    s.bind(1, participant_code);
+    if (!s.step()) return std::nullopt;
+    return session_row(s);
+}
+
+std::optional<SessionRow> Store::session_by_uuid(const std::string& uuid) {
+    Statement s = db_.prepare(
+        "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
+        "FROM sessions s JOIN participants p ON p.id = s.participant_id WHERE s.uuid = "
+        "?");
+    s.bind(1, uuid);
+    if (!s.step()) return std::nullopt;
+    return session_row(s);
+}
+
+bool Store::session_withdrawn(const std::string& uuid) {
+    Statement s = db_.prepare("SELECT count(*) FROM withdrawn_sessions WHERE uuid = ?");
+    s.bind(1, uuid);
+    return s.step() && s.integer(0) > 0;
 }
 
 bool Store::has_completed_session(const std::string& participant_code) {
@@ -466,6 +490,23 @@ void Store::count_declined_consent(int64_t study_id) {
         .run();
 }
 
+bool Store::decline_online_consent(int64_t study_id, const std::string& page_uuid) {
+    Transaction tx(db_);
+    db_.prepare("INSERT OR IGNORE INTO declined_pages (uuid) VALUES (?)")
+        .bind(1, page_uuid)
+        .run();
+    if (sqlite3_changes(db_.handle()) == 0) return false;
+    count_declined_consent(study_id);
+    tx.commit();
+    return true;
+}
+
+bool Store::consent_declined(const std::string& page_uuid) {
+    Statement s = db_.prepare("SELECT count(*) FROM declined_pages WHERE uuid = ?");
+    s.bind(1, page_uuid);
+    return s.step() && s.integer(0) > 0;
+}
+
 bool Store::forget_declined_session(int64_t session_id) {
     Transaction tx(db_);
     Statement s = db_.prepare(
@@ -500,6 +541,20 @@ bool Store::has_consent(int64_t session_id) {
         db_.prepare("SELECT consent_utc IS NOT NULL FROM sessions WHERE id = ?");
     s.bind(1, session_id);
     return s.step() && s.integer(0) != 0;
+}
+
+std::optional<std::string> Store::web_position(int64_t session_id) {
+    Statement s = db_.prepare("SELECT web_position FROM sessions WHERE id = ?");
+    s.bind(1, session_id);
+    if (!s.step() || s.is_null(0)) return std::nullopt;
+    return s.text(0);
+}
+
+void Store::set_web_position(int64_t session_id, const std::string& position) {
+    db_.prepare("UPDATE sessions SET web_position = ? WHERE id = ?")
+        .bind(1, position)
+        .bind(2, session_id)
+        .run();
 }
 
 bool Store::record_trial(int64_t session_id, int64_t trial_id,

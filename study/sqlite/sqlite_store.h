@@ -61,14 +61,20 @@ public:
     std::optional<SessionRow> unfinished_session(
         const std::string& participant_code) override;
     bool has_completed_session(const std::string& participant_code) override;
+    std::optional<SessionRow> session_by_uuid(const std::string& uuid) override;
+    bool session_withdrawn(const std::string& uuid) override;
     std::vector<TrialRow> trials(int64_t session_id) override;
     int begin_segment(int64_t session_id, const SessionEnvironment& env) override;
     int resume_segment(int64_t session_id, const SessionEnvironment& env) override;
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
     void count_declined_consent(int64_t study_id) override;
+    bool decline_online_consent(int64_t study_id, const std::string& page_uuid) override;
+    bool consent_declined(const std::string& page_uuid) override;
     bool forget_declined_session(int64_t session_id) override;
     bool has_consent(int64_t session_id) override;
+    std::optional<std::string> web_position(int64_t session_id) override;
+    void set_web_position(int64_t session_id, const std::string& position) override;
     bool record_trial(int64_t session_id, int64_t trial_id,
                       const TrialOutcome& outcome) override;
     // Also repairs sessions written before completion was atomic.

@@ -48,32 +48,57 @@
   function firstFrame() {
     return new Promise((resolve) => requestAnimationFrame(() => resolve(performance.now())));
   }
+  let refreshHz = null;  // the display's refresh, once measured
   function client() {
-    return {
+    const c = {
       user_agent: navigator.userAgent, window_width: innerWidth, window_height: innerHeight,
       device_pixel_ratio: devicePixelRatio, screen_width: screen.width,
       screen_height: screen.height,
     };
+    if (refreshHz) c.refresh_hz = refreshHz;
+    return c;
   }
 
+  // Every call is safe to send again (an answer names its trial and view; the server
+  // stores the same answer once), so a lost reply, a proxy's 502/504 or a busy or
+  // restarting server (503) is retried with backoff (Retry-After when given) for about
+  // a minute before the page says the server cannot be reached.
+  const kRetryDelaysMs = [250, 500, 1000, 2000, 4000, 8000, 8000, 8000, 8000, 8000];
   async function api(endpoint, body) {
     if (token && !body.token) body.token = token;
-    try {
-      const r = await fetch('/api/' + endpoint, {
-        method: 'POST', headers: { 'Content-Type': 'application/json' },
-        body: JSON.stringify(body), cache: 'no-store',
-      });
-      let reply;
-      try { reply = await r.json(); } catch (e) { reply = { error: 'no reply (' + r.status + ')' }; }
-      return { status: r.status, reply };
-    } catch (e) {
-      return { status: 0, reply: { error: 'the study server cannot be reached: ' + e.message } };
+    // The server keeps nothing of a page before consent: it says who and what it is
+    // with every call.
+    if (!body.client) body.client = client();
+    for (const key in who) if (!(key in body)) body[key] = who[key];
+    const text = JSON.stringify(body);
+    for (let attempt = 0; ; ++attempt) {
+      let status = 0, reply, retryAfterMs = 0;
+      try {
+        const r = await fetch('/api/' + endpoint, {
+          method: 'POST', headers: { 'Content-Type': 'application/json' },
+          body: text, cache: 'no-store',
+        });
+        status = r.status;
+        retryAfterMs = 1000 * (Number(r.headers.get('Retry-After')) || 0);
+        try { reply = await r.json(); } catch (e) { reply = { error: 'no reply (' + r.status + ')' }; }
+      } catch (e) {
+        reply = { error: 'the study server cannot be reached: ' + e.message };
+      }
+      const transient = status === 0 || status === 502 || status === 503 || status === 504;
+      if (!transient || attempt >= kRetryDelaysMs.length) return { status, reply };
+      document.body.dataset.retries = String(Number(document.body.dataset.retries || 0) + 1);
+      await new Promise((resolve) =>
+        setTimeout(resolve, Math.max(kRetryDelaysMs[attempt], retryAfterMs)));
     }
   }
   // 200: the next screen; 409: the page is behind the server (another tab, a restart),
   // so it asks again; anything else is shown.
   function settle(status, reply) {
     busy = false;
+    if (status === 200 && reply.token) {
+      token = reply.token;
+      localStorage.setItem(tokenKey, token);
+    }
     if (status === 200) return show(reply);
     if (status === 409 || status === 0) return setTimeout(start, status ? 0 : 2000);
     if (status === 410) localStorage.removeItem(tokenKey);  // withdrawn: the key is spent
@@ -103,7 +128,10 @@
     for (let i = 0; i < 61; ++i) times.push(await firstFrame());
     const gaps = times.slice(1).map((t, i) => t - times[i]).sort((a, b) => a - b);
     const median = gaps[Math.floor(gaps.length / 2)];
-    if (median > 0) await api('environment', { refresh_hz: 1000 / median });
+    if (median > 0) {
+      refreshHz = 1000 / median;
+      await api('environment', { refresh_hz: refreshHz });
+    }
     document.body.dataset.refreshSent = '1';  // (tests wait for it)
   }
 

@@ -746,8 +746,8 @@ TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
         }
     }
     // Schema 5 added withdrawn_sessions, withdrawn_codes and consent_declines to the 11,
-    // schema 7 adjustments.
-    EXPECT_EQ(tables, 15);
+    // schema 7 adjustments, schema 8 declined_pages.
+    EXPECT_EQ(tables, 16);
     // The server has the same tables plus lucent_schema, nothing else.
     EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.tables WHERE "
                                 "table_schema = 'public'"),

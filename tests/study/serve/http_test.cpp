@@ -150,7 +150,13 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     post("answer", bad.dump(), 403);
     bad["token"] = p1.token;
     bad["trial"] = p1.shown[0];
-    post("answer", bad.dump(), 409);
+    {
+        // The answered practice trial again (a retried request): stored once, 200.
+        auto r = http.Post("/api/answer", bad.dump(), "application/json");
+        ASSERT_TRUE(r);
+        EXPECT_EQ(r->status, 200) << r->body;
+        EXPECT_EQ(json::parse(r->body)["already_answered"], true) << r->body;
+    }
     post("session", json{{"participant", "P1"}, {"t_ms", 1}}.dump(), 403);  // no key
     // A URI too long for the server: refused before routing.
     auto long_uri = http.Get(("/images/" + std::string(20000, 'a') + ".png").c_str());

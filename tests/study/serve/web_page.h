@@ -44,21 +44,34 @@ struct Page {
     study::WebReply raw(const std::string& endpoint, const json& body) {
         return send(endpoint, body.dump());
     }
+    // What the page says about itself with every request, as lucent.js does (the server
+    // keeps nothing of a page before consent): the browser, its refresh once measured.
+    json client = {{"user_agent", "TestBrowser/1.0"},
+                   {"window_width", 1280},
+                   {"window_height", 900},
+                   {"device_pixel_ratio", 2},
+                   {"screen_width", 2560},
+                   {"screen_height", 1440}};
+    json who = json::object();  // the link's participant code or Prolific ids
+
     json call(const std::string& endpoint, json body, int expected = 200) {
         if (!token.empty() && !body.contains("token")) body["token"] = token;
+        if (endpoint == "environment" && body.contains("refresh_hz") &&
+            body["refresh_hz"].is_number() && body["refresh_hz"].get<double>() > 0)
+            client["refresh_hz"] = body["refresh_hz"];
+        if (!body.contains("client")) body["client"] = client;
+        for (const auto& [key, value] : who.items())
+            if (!body.contains(key)) body[key] = value;
         const study::WebReply r = send(endpoint, body.dump());
         EXPECT_EQ(r.status, expected) << endpoint << ": " << r.body;
         return json::parse(r.body);
     }
-    void open(const json& who, int expected = 200) {
-        json body = who;
+    void open(const json& link, int expected = 200) {
+        json body = link;
         body["t_ms"] = now;
-        body["client"] = {{"user_agent", "TestBrowser/1.0"},
-                          {"window_width", 1280},
-                          {"window_height", 900},
-                          {"device_pixel_ratio", 2},
-                          {"screen_width", 2560},
-                          {"screen_height", 1440}};
+        who = json::object();
+        for (const char* key : {"participant", "prolific"})
+            if (link.contains(key)) who[key] = link[key];
         const json reply = call("session", body, expected);
         if (expected != 200 || !reply.is_object()) return;
         if (reply.contains("token")) token = reply["token"];

@@ -18,6 +18,7 @@
 
 #include "study/simulated_observer.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/store_pool.h"
 #include "study/study_store.h"
 #include "tests/study/postgres/server_environment.h"
 #include "tests/study/serve/web_page.h"
@@ -109,6 +110,8 @@ protected:
         for (const StimulusSpec& s : protocol_.stimuli) o.images[s.id] = {64, 48};
         o.idle_timeout = std::chrono::minutes(30);
         o.clock = [this] { return now_; };
+        o.participant_wait = std::chrono::milliseconds(300);
+        options_ = o;
         web_ = std::make_unique<WebStudy>(protocol_, *store_, o);
     }
     // Another connection to the same store (a lab station, a second serve process).
@@ -125,6 +128,7 @@ protected:
     std::string db_;
     Protocol protocol_;
     std::unique_ptr<StudyStore> store_;
+    WebStudyOptions options_;
     std::unique_ptr<WebStudy> web_;
     // The server's wall clock: the real time until a test moves it on.
     std::chrono::system_clock::time_point now_ = std::chrono::system_clock::now();
@@ -204,7 +208,11 @@ TEST_P(Serve, APageCompletesTheWholeProtocolAndEveryAnswerIsStoredAsSent) {
               "1280x900 CSS px, devicePixelRatio 2, screen 2560x1440' AND "
               "machine_id = 'server-machine'"),
         1);
-    EXPECT_EQ(web_->live_sessions(), 0u);
+    {
+        // Nothing holds the participant between requests: a lab station may claim them.
+        auto station = open_store("station");
+        EXPECT_NO_THROW(station->claim_participant("P1"));
+    }
     // A return after completion shows the completion page and starts nothing.
     Page again{direct(*web_)};
     again.open({{"participant", "P1"}});
@@ -365,8 +373,17 @@ TEST_P(Serve, HostileRequestsAreRefusedWithOneLineAndStoreNothing) {
                     b["events"].push_back({{"t_ms", 1}, {"type", "next"}});
             }),
             400, "more than 500 events");
-    refused("answer", with([&](json& b) { b["trial"] = page.shown[0]; }), 409,
-            "trial 1 is already answered");
+    {
+        // An answer to a trial already answered (a retry after a lost reply, perhaps
+        // through another serve process) is stored once: 200, the page where it stands.
+        const WebReply again =
+            web_->handle("answer", with([&](json& b) { b["trial"] = page.shown[0]; }));
+        EXPECT_EQ(again.status, 200) << again.body;
+        const json reply = json::parse(again.body);
+        EXPECT_EQ(reply["already_answered"], true);
+        EXPECT_EQ(reply["view"], page.state["view"]);
+        EXPECT_EQ(responses(), stored);
+    }
     refused("answer", with([&](json& b) { b["trial"] = other.shown[0]; }), 404,
             "not one of this session's trials");
     refused("answer", with([&](json& b) { b["token"] = other.token; }), 404,
@@ -441,8 +458,11 @@ TEST_P(Serve, TheConsentScreenCanBeDeclinedAndADoubleEnterActsOnce) {
     // Declined: no participant, no session; only the count (issue 26 item 5).
     EXPECT_EQ(count("SELECT count(*) FROM participants WHERE code = 'P7'"), 0);
     EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
-    EXPECT_EQ(web_->live_sessions(), 1u);
-    EXPECT_EQ(web_->pending_sessions(), 0u);
+    // The same decline sent again (a lost reply) counts once.
+    const json again_declined =
+        no.call("decline", {{"view", 1}, {"shown_ms", 60}, {"t_ms", 900}});
+    EXPECT_EQ(again_declined["screen"], "declined");
+    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
 }
 
 // Fifty pages at once through one server (threads calling handle as the HTTP server's
@@ -505,7 +525,6 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
     page.open(prolific);                             // and is reloaded
     ASSERT_EQ(page.state["screen"], "consent");
     nothing_of_them("after a reload and the refresh estimate");
-    EXPECT_EQ(web_->pending_sessions(), 1u);
 
     const json declined = page.call(
         "decline", {{"view", page.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
@@ -514,7 +533,6 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
               std::string::npos);
     nothing_of_them("after the decline");
     EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
-    EXPECT_EQ(web_->pending_sessions(), 0u);
     // The declined page's token is spent: it acts on nothing.
     page.call("continue", {{"view", 1}, {"shown_ms", 60}, {"t_ms", 900}}, 409);
     nothing_of_them("after the spent token was used");
@@ -576,23 +594,15 @@ TEST_P(Serve, CompletedSessionsLeaveNoClaimBehind) {
     EXPECT_NO_THROW(station->claim_participant("D1"));
 }
 
-// Item 7: a participant who gave up online is released after the idle timeout (a lab
-// station can run them); the page coming back later re-loads and re-claims.
-TEST_P(Serve, AParticipantWhoGaveUpOnlineCanBeRunOnALabStationAfterTheIdleTimeout) {
+// Item 7, issue 32: nothing holds an online participant between requests (a claim
+// lasts one request), so a lab station can take over at once, a request while it runs
+// them is refused and changes nothing, and the page goes on where it stood afterwards.
+TEST_P(Serve, AnOnlineParticipantIsHeldOnlyWhileARequestRuns) {
     Page page{direct(*web_)};
     page.open({{"participant", "G1"}});
     page.run(2);
     ASSERT_EQ(page.state["screen"], "trial");
-    {
-        auto station = open_store("station");
-        EXPECT_THROW(station->claim_participant("G1"), StoreError);  // the page is open
-    }
-    now_ += std::chrono::minutes(29);
-    EXPECT_EQ(web_->release_idle(), 0u);
-    now_ += std::chrono::minutes(2);  // 31 minutes without a request
-    EXPECT_EQ(web_->release_idle(), 1u);
-    EXPECT_EQ(web_->live_sessions(), 0u);
-    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'paused'"), 1);
+    const json before = page.state;
     if (GetParam() == "postgresql")
         EXPECT_EQ(count("SELECT count(*) FROM pg_locks WHERE locktype = 'advisory' AND "
                         "pid = pg_backend_pid()"),
@@ -600,18 +610,18 @@ TEST_P(Serve, AParticipantWhoGaveUpOnlineCanBeRunOnALabStationAfterTheIdleTimeou
     {
         auto station = open_store("station");
         EXPECT_NO_THROW(station->claim_participant("G1"));
-        // While the station runs them, the page's return is refused and changes nothing.
+        // While the station runs them, the page's requests are refused (after waiting
+        // WebStudyOptions::participant_wait) and change nothing.
         const WebReply busy = web_->handle(
             "session",
             json{{"participant", "G1"}, {"token", page.token}, {"t_ms", 5}}.dump());
         EXPECT_EQ(busy.status, 409) << busy.body;
+        page.call("state", json::object(), 409);
     }
-    // The station is done with them: the page re-loads at its first unanswered trial.
-    const json back = page.call("state", json::object(), 409);  // not loaded any more
-    EXPECT_NE(back["error"].get<std::string>().find("not loaded"), std::string::npos);
-    page.now = 40;
-    page.open({{"participant", "G1"}, {"token", page.token}});
-    EXPECT_EQ(page.state["screen"], "trial");
+    // The station is done with them: the page goes on at the screen it showed.
+    const json after = page.call("state", json::object());
+    EXPECT_EQ(after["view"], before["view"]);
+    EXPECT_EQ(after["trial"]["id"], before["trial"]["id"]);
     page.run();
     EXPECT_EQ(page.state["screen"], "done");
     auto station = open_store("station");
@@ -770,7 +780,6 @@ TEST_P(Serve, AWithdrawnParticipantsOpenPageIsToldTheSessionWasWithdrawn) {
     EXPECT_NE(answered.body.find("withdrawn"), std::string::npos) << answered.body;
     EXPECT_EQ(answered.body.find("FOREIGN KEY"), std::string::npos) << answered.body;
     EXPECT_EQ(count("SELECT count(*) FROM responses"), 0);
-    EXPECT_EQ(web_->live_sessions(), 0u);
 
     // The same on a reload of a page whose participant was withdrawn.
     Page other{direct(*web_)};
@@ -1154,6 +1163,70 @@ TEST_P(Serve, HostileChoiceAnswersAreRefusedWithOneLineAndStoreNothing) {
                     "WHERE t.task = 'quadruple' AND r.question = 'quad_differs' AND "
                     "r.rating = 1 AND abs(r.rt_ms - 100) < 0.001"),
               1);
+}
+
+// ---- issue 32: several serve processes on one database
+// ---------------------------------
+
+// Two serve processes (each its own WebStudy and store connections, no journal) on one
+// database, a proxy sending each request of a page to the other one in turn: the page
+// goes from consent to completion, every answer stored once, the views one sequence.
+TEST_P(Serve, AnyServeProcessAnswersAnyRequestOfAPage) {
+    StoreOptions no_journal;
+    no_journal.journal = false;
+    StorePool pool_a(db_, 2, no_journal, std::chrono::seconds(2));
+    StorePool pool_b(db_, 2, no_journal, std::chrono::seconds(2));
+    WebStudy a(protocol_, pool_a, options_), b(protocol_, pool_b, options_);
+    int turn = 0;
+    std::map<char, int> served;
+    Page page{[&](const std::string& endpoint, const std::string& body) {
+        const char which = turn++ % 2 == 0 ? 'a' : 'b';
+        ++served[which];
+        return (which == 'a' ? a : b).handle(endpoint, body);
+    }};
+    page.open({{"participant", "M1"}});
+    ASSERT_EQ(page.state["screen"], "consent");
+    page.run();
+    EXPECT_EQ(page.state["screen"], "done");
+    EXPECT_GT(served['a'], 3);
+    EXPECT_GT(served['b'], 3);
+    const int64_t n = static_cast<int64_t>(planned_trials(protocol_));
+    EXPECT_EQ(static_cast<int64_t>(page.shown.size()), n);
+    EXPECT_EQ(responses(), n * static_cast<int64_t>(protocol_.questions.size()));
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE status = 'completed'"), 1);
+    // One segment: no request was taken for a reload.
+    EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 1);
+}
+
+// A request that finds every store connection busy past the wait is told to come back
+// (503, Retry-After), changes nothing, and the health check says the same; the next
+// request, once a connection is free, goes on.
+TEST_P(Serve, ABusyStoreIsA503WithRetryAfterAndNothingChanges) {
+    StoreOptions no_journal;
+    no_journal.journal = false;
+    StorePool pool(db_, 1, no_journal, std::chrono::milliseconds(50));
+    WebStudy web(protocol_, pool, options_);
+    Page page{direct(web)};
+    page.open({{"participant", "B1"}});
+    page.run(1);
+    ASSERT_EQ(page.state["screen"], "trial");
+    EXPECT_EQ(web.health().status, 200);
+    const int64_t stored = responses();
+    {
+        StorePool::Lease held = pool.lease();  // every connection busy
+        json body = page.answer_body(1);
+        body["token"] = page.token;
+        const WebReply busy = web.handle("answer", body.dump());
+        EXPECT_EQ(busy.status, 503) << busy.body;
+        EXPECT_EQ(busy.retry_after_s, 1);
+        EXPECT_NE(busy.body.find("busy"), std::string::npos) << busy.body;
+        const WebReply health = web.health();
+        EXPECT_EQ(health.status, 503) << health.body;
+        EXPECT_EQ(responses(), stored);
+    }
+    EXPECT_EQ(web.health().status, 200);
+    page.answer(1);
+    EXPECT_EQ(responses(), stored + static_cast<int64_t>(protocol_.questions.size()));
 }
 
 INSTANTIATE_TEST_SUITE_P(Stores, Serve, ::testing::Values("sqlite", "postgresql"),
