@@ -1,6 +1,9 @@
 // lucent bench store: trial commits per second and commit latency (p50, p99) of each
 // study store backend with 1, 8 and 50 concurrent writers (stations), each its own
 // connection, participant and session, measured in one run on this machine.
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,12 +19,14 @@
 #include <vector>
 
 #include "app/commands.h"
+#include "app/nginx_proxy.h"
 #include "app/serve_http.h"
 #include "study/postgres/local_server.h"
 #include "study/protocol.h"
 #include "study/serve/web_study.h"
 #include "study/sqlite/database.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/store_pool.h"
 #include "study/study_store.h"
 #include "study/trial_plan.h"
 
@@ -37,7 +42,44 @@ struct BenchRow {
     int failed_writers =
         0;  // writers that stopped on an error (e.g. SQLite's busy timeout)
     std::string first_error;
+    int instances = 0;  // serve instances behind the proxy (0: not such a row)
+    // The machine's CPUs busy over the row (0..1), and of that this process's share (the
+    // serve instances and the simulated browsers); -1: not measured.
+    double cpu_busy = -1;
+    double cpu_self = -1;
 };
+
+// The machine's CPU time so far (/proc/stat's first line, in clock ticks): busy and all.
+struct CpuTimes {
+    double busy = 0, total = 0;
+    double self = 0;  // this process's (the instances and the browsers), in ticks
+};
+CpuTimes cpu_times() {
+    std::ifstream stat("/proc/stat");
+    std::string cpu;
+    double user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0, softirq = 0,
+           steal = 0;
+    stat >> cpu >> user >> nice >> system >> idle >> iowait >> irq >> softirq >> steal;
+    CpuTimes t;
+    t.busy = user + nice + system + irq + softirq + steal;
+    t.total = t.busy + idle + iowait;
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double seconds = usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
+                           1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+    t.self = seconds * static_cast<double>(sysconf(_SC_CLK_TCK));
+    return t;
+}
+// Of the busy time between two readings, the share of this process (the rest: the
+// PostgreSQL server, nginx, anything else running).
+double self_share(const CpuTimes& before, const CpuTimes& after) {
+    const double busy = after.busy - before.busy;
+    return busy > 0 ? std::clamp((after.self - before.self) / busy, 0.0, 1.0) : -1;
+}
+double busy_fraction(const CpuTimes& before, const CpuTimes& after) {
+    const double total = after.total - before.total;
+    return total > 0 ? (after.busy - before.busy) / total : -1;
+}
 
 // Commits per second; 0 for a row without commits (never Inf or NaN in the table).
 double rate(const BenchRow& r) { return r.seconds > 0 ? r.commits / r.seconds : 0.0; }
@@ -154,50 +196,72 @@ BenchRow run_writers(const std::string& backend, const std::string& db, int writ
     return summarise(backend, times);
 }
 
-// `writers` browsers at once through `lucent serve`'s HTTP server on loopback (the same
-// routes), each a participant answering `trials` trials; a commit's latency is the whole
-// /api/answer round trip (request, checks, replay, the store's commit, the reply).
-BenchRow run_serve_writers(const std::string& backend, const std::string& db, int writers,
-                           int trials, const std::string& journal_dir) {
-    using nlohmann::json;
-    const study::Protocol protocol = study::builtin_protocol("thesis");
-    study::StoreOptions store_options;
-    store_options.journal_path =
-        journal_dir + "/serve-journal-" + std::to_string(writers) + ".db";
-    auto store = study::open_study_store(db, store_options);
-    study::WebStudyOptions options;
-    options.secret = "bench";
-    std::map<std::string, ServedPicture> pictures;
-    for (const study::StimulusSpec& s : protocol.stimuli) {
-        options.images[s.id] = {protocol.stimulus_width, protocol.stimulus_height};
-        pictures[s.id] = {"", options.images[s.id]};
+// An in-process `lucent serve` instance: a pool of store connections without the
+// journal, the core and the HTTP server on a loopback port, as a `lucent serve` process
+// runs them (without pictures to serve).
+class BenchInstance {
+public:
+    BenchInstance(const study::Protocol& protocol, const std::string& db,
+                  size_t connections, const study::WebStudyOptions& options,
+                  const std::map<std::string, ServedPicture>& pictures, int threads) {
+        study::StoreOptions store_options;
+        store_options.journal = false;
+        pool_ = std::make_unique<study::StorePool>(db, connections, store_options,
+                                                   std::chrono::seconds(2));
+        web_ = std::make_unique<study::WebStudy>(protocol, *pool_, options);
+        configure_serve_http(http_, *web_, pictures, threads);
+        port_ = bind_serve_port(http_, "127.0.0.1", 0);
+        if (port_ < 0)
+            throw study::StoreError("cannot listen on 127.0.0.1 for the serve rows");
+        thread_ = std::thread([this] { http_.listen_after_bind(); });
+        while (!http_.is_running())
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    study::WebStudy web(protocol, *store, options);
-    httplib::Server http;
-    configure_serve_http(http, web, pictures, std::max(8, writers + 4));
-    const int port = bind_serve_port(http, "127.0.0.1", 0);
-    if (port < 0)
-        throw study::StoreError("cannot listen on 127.0.0.1 for the serve rows");
-    std::thread server([&] { http.listen_after_bind(); });
+    ~BenchInstance() {
+        http_.stop();
+        thread_.join();
+    }
+    int port() const { return port_; }
 
+private:
+    std::unique_ptr<study::StorePool> pool_;
+    std::unique_ptr<study::WebStudy> web_;
+    httplib::Server http_;
+    std::thread thread_;
+    int port_ = 0;
+};
+
+// `writers` browsers at once against `port` on loopback (an instance, or the proxy in
+// front of several), each a participant answering `trials` trials; a commit's latency is
+// the whole /api/answer round trip (request, checks, replay, the store's commit, the
+// reply).
+WriterTimes drive_pages(const study::Protocol& protocol, int port, int writers,
+                        int trials, const std::string& code_prefix, int think_ms = 0) {
+    using nlohmann::json;
     using Clock = WriterTimes::Clock;
-    const WriterTimes times = time_writers(writers, [&](int w, WriterTimes& measured) {
+    return time_writers(writers, [&](int w, WriterTimes& measured) {
         httplib::Client client("127.0.0.1", port);
         client.set_keep_alive(true);
         client.set_tcp_nodelay(true);  // as browsers do
         client.set_read_timeout(60);
         double now = 10;  // the simulated page's performance.now()
-        auto post = [&](const std::string& endpoint, const json& body) {
-            const auto r = client.Post(("/api/" + endpoint).c_str(), body.dump(),
-                                       "application/json");
-            if (!r)
-                throw std::runtime_error(endpoint + ": " + httplib::to_string(r.error()));
-            if (r->status != 200) throw std::runtime_error(endpoint + ": " + r->body);
-            return json::parse(r->body);
+        auto post = [&](const std::string& endpoint, json body) {
+            // A busy or restarting server is asked again, as the page does.
+            for (int attempt = 0;; ++attempt) {
+                const auto r = client.Post(("/api/" + endpoint).c_str(), body.dump(),
+                                           "application/json");
+                if (r && r->status == 200) return json::parse(r->body);
+                const bool transient =
+                    !r || r->status == 502 || r->status == 503 || r->status == 504;
+                if (!transient || attempt == 20)
+                    throw std::runtime_error(
+                        endpoint + ": " + (r ? r->body : httplib::to_string(r.error())));
+                std::this_thread::sleep_for(
+                    std::chrono::milliseconds(50 << std::min(attempt, 4)));
+            }
         };
-        json state = post("session", {{"participant", "web" + std::to_string(writers) +
-                                                          "w" + std::to_string(w)},
-                                      {"t_ms", now}});
+        json state = post(
+            "session", {{"participant", code_prefix + std::to_string(w)}, {"t_ms", now}});
         const std::string token = state["token"];
         int answered = 0;
         while (state["screen"] != "done" && answered < trials) {
@@ -220,6 +284,10 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
                                                      : 1 + (answered + int(q)) % 7}});
             events.push_back({{"t_ms", onset + 400}, {"type", "next"}});
             now = onset + 1000;
+            // The participant looks and decides (not timed); pages start out of step.
+            if (think_ms > 0)
+                std::this_thread::sleep_for(std::chrono::milliseconds(
+                    answered == 0 ? (w * 7919) % think_ms : think_ms));
             const auto t0 = Clock::now();
             state = post("answer", {{"token", token},
                                     {"trial", state["trial"]["id"]},
@@ -230,14 +298,62 @@ BenchRow run_serve_writers(const std::string& backend, const std::string& db, in
             ++answered;
         }
     });
-    http.stop();
-    server.join();
-    if (store->pending_trials() > 0) store->sync();
+}
 
-    return summarise(backend, times);
+// What every serve row's instances share: the thesis protocol, its pictures' sizes.
+struct ServeSetup {
+    study::Protocol protocol = study::builtin_protocol("thesis");
+    study::WebStudyOptions options;
+    std::map<std::string, ServedPicture> pictures;
+    ServeSetup() {
+        options.secret = "bench";
+        for (const study::StimulusSpec& s : protocol.stimuli) {
+            options.images[s.id] = {protocol.stimulus_width, protocol.stimulus_height};
+            pictures[s.id] = {"", options.images[s.id]};
+        }
+    }
+};
+
+// One `lucent serve` (its own pool: 4 connections to a server, 1 to a file) answering
+// `writers` browsers directly.
+BenchRow run_serve_writers(const std::string& backend, const std::string& db, int writers,
+                           int trials) {
+    const ServeSetup setup;
+    const BenchInstance instance(setup.protocol, db, study::is_server_uri(db) ? 4 : 1,
+                                 setup.options, setup.pictures, std::max(8, writers + 4));
+    return summarise(backend, drive_pages(setup.protocol, instance.port(), writers,
+                                          trials, "web" + std::to_string(writers) + "w"));
+}
+
+// `instances` serve instances (each as `lucent serve` runs: 4 store connections, 64 HTTP
+// workers) on one PostgreSQL database behind Debian's nginx (round robin), `writers`
+// browsers through the proxy.
+BenchRow run_instance_writers(const std::string& db, int instances, int writers,
+                              int trials, int think_ms) {
+    const ServeSetup setup;
+    std::vector<std::unique_ptr<BenchInstance>> running;
+    std::vector<int> ports;
+    for (int i = 0; i < instances; ++i) {
+        running.push_back(std::make_unique<BenchInstance>(
+            setup.protocol, db, 4, setup.options, setup.pictures, 64));
+        ports.push_back(running.back()->port());
+    }
+    NginxProxy proxy(ports);
+    const CpuTimes before = cpu_times();
+    BenchRow row = summarise(
+        "serve x" + std::to_string(instances) + " behind nginx + postgresql",
+        drive_pages(setup.protocol, proxy.port(), writers, trials,
+                    "i" + std::to_string(instances) + "p" + std::to_string(writers) + "w",
+                    think_ms));
+    const CpuTimes after = cpu_times();
+    row.cpu_busy = busy_fraction(before, after);
+    row.cpu_self = self_share(before, after);
+    return row;
 }
 
 int run_bench_store(const std::vector<int>& writer_counts, int trials,
+                    const std::vector<int>& instance_counts,
+                    const std::vector<int>& participant_counts, int think_ms,
                     const std::string& server, const std::string& csv) {
     namespace fs = std::filesystem;
     std::string pattern =
@@ -245,7 +361,7 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials,
     if (!mkdtemp(pattern.data()))
         throw study::StoreError("cannot create a scratch folder");
     const std::string scratch = pattern;
-    std::vector<BenchRow> rows, serve_rows;
+    std::vector<BenchRow> rows, serve_rows, instance_rows;
     {
         std::unique_ptr<study::LocalPostgres> local;
         if (server.empty()) local = std::make_unique<study::LocalPostgres>();
@@ -266,14 +382,33 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials,
             const std::string file =
                 scratch + "/serve-w" + std::to_string(writers) + ".db";
             serve_rows.push_back(run_serve_writers("serve + sqlite (HTTP round trip)",
-                                                   file, writers, trials, scratch));
+                                                   file, writers, trials));
             std::string uri = server;
             if (local) uri = local->create_database("bench_serve_" + std::to_string(k++));
             study::init_study_store(uri);
             serve_rows.push_back(
                 run_serve_writers(local ? "serve + postgresql (HTTP round trip)"
                                         : "serve + postgresql " + server,
-                                  uri, writers, trials, scratch));
+                                  uri, writers, trials));
+        }
+        // Several instances on one database behind Debian's nginx (issue 32).
+        if (!NginxProxy::available()) {
+            std::printf("no rows for instances behind a proxy: %s is not installed\n",
+                        NginxProxy::kBinary);
+        } else {
+            for (int instances : instance_counts) {
+                for (int participants : participant_counts) {
+                    std::string uri = server;
+                    if (local) {
+                        uri = local->create_database("bench_instances_" +
+                                                     std::to_string(k++));
+                        study::init_study_store(uri);
+                    }
+                    instance_rows.push_back(run_instance_writers(
+                        uri, instances, participants, trials, think_ms));
+                    instance_rows.back().instances = instances;
+                }
+            }
         }
     }
     std::error_code ec;
@@ -281,12 +416,21 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials,
 
     std::vector<BenchRow> all_rows = rows;
     all_rows.insert(all_rows.end(), serve_rows.begin(), serve_rows.end());
-    std::printf("%-34s %7s %8s %9s %10s %8s %8s %7s\n", "backend", "writers", "commits",
-                "seconds", "commits/s", "p50 ms", "p99 ms", "failed");
-    for (const BenchRow& r : all_rows)
-        std::printf("%-34s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d\n", r.backend.c_str(),
-                    r.writers, r.commits, r.seconds, rate(r), r.p50_ms, r.p99_ms,
-                    r.failed_writers);
+    all_rows.insert(all_rows.end(), instance_rows.begin(), instance_rows.end());
+    // cpu: the machine's CPUs busy over the row, and of that the share of this process
+    // (the serve instances and the simulated browsers; the rest is PostgreSQL and nginx).
+    std::printf("%-42s %7s %8s %9s %10s %8s %8s %7s %12s\n", "backend", "writers",
+                "commits", "seconds", "commits/s", "p50 ms", "p99 ms", "failed",
+                "cpu (ours)");
+    for (const BenchRow& r : all_rows) {
+        char cpu[32] = "-";
+        if (r.cpu_busy >= 0)
+            std::snprintf(cpu, sizeof cpu, "%.0f%% (%.0f%%)", 100 * r.cpu_busy,
+                          100 * std::max(0.0, r.cpu_self));
+        std::printf("%-42s %7d %8d %9.3f %10.1f %8.3f %8.3f %7d %12s\n",
+                    r.backend.c_str(), r.writers, r.commits, r.seconds, rate(r), r.p50_ms,
+                    r.p99_ms, r.failed_writers, cpu);
+    }
     for (const BenchRow& r : all_rows)
         if (r.failed_writers)
             std::printf("%s, %d writers: %d stopped, first: %s\n", r.backend.c_str(),
@@ -306,14 +450,23 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials,
                     "serve/postgresql %.2f\n",
                     serve_rows[i].writers, rate(serve_rows[i]) / rate(rows[j]),
                     rate(serve_rows[i + 1]) / rate(rows[j + 1]));
+    // Instances behind the proxy: throughput against one instance, same participants.
+    for (const BenchRow& r : instance_rows)
+        for (const BenchRow& one : instance_rows)
+            if (r.instances > 1 && one.instances == 1 && one.writers == r.writers &&
+                rate(one) > 0)
+                std::printf("participants %d: %d instances / 1 throughput ratio %.2f\n",
+                            r.writers, r.instances, rate(r) / rate(one));
     if (!csv.empty()) {
         std::ofstream out(csv);
-        out << "backend,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,failed_"
-               "writers\n";
+        out << "backend,instances,writers,commits,seconds,commits_per_s,p50_ms,p99_ms,"
+               "failed_writers,cpu_busy,cpu_self_share\n";
         for (const BenchRow& r : all_rows)
-            out << '"' << r.backend << "\"," << r.writers << ',' << r.commits << ','
-                << r.seconds << ',' << rate(r) << ',' << r.p50_ms << ',' << r.p99_ms
-                << ',' << r.failed_writers << "\n";
+            out << '"' << r.backend << "\"," << r.instances << ',' << r.writers << ','
+                << r.commits << ',' << r.seconds << ',' << rate(r) << ',' << r.p50_ms
+                << ',' << r.p99_ms << ',' << r.failed_writers << ','
+                << (r.cpu_busy >= 0 ? std::to_string(r.cpu_busy) : std::string()) << ','
+                << (r.cpu_self >= 0 ? std::to_string(r.cpu_self) : std::string()) << "\n";
         if (!out) throw study::StoreError(csv + ": cannot write");
     }
     return kExitOk;
@@ -324,6 +477,9 @@ int run_bench_store(const std::vector<int>& writer_counts, int trials,
 void register_bench_store(CLI::App& bench, int& exit_code) {
     struct Args {
         std::vector<int> writers{1, 8, 50};
+        std::vector<int> instances{1, 2, 4};
+        std::vector<int> participants{1, 50, 300};
+        int think_ms = 1000;
         int trials = 40;
         std::string server;
         std::string csv;
@@ -332,10 +488,26 @@ void register_bench_store(CLI::App& bench, int& exit_code) {
     auto* cmd = bench.add_subcommand(
         "store",
         "Trial commits per second and p50/p99 commit latency: SQLite file and PostgreSQL "
-        "over "
-        "a Unix socket (a throwaway local server unless --server), 1, 8 and 50 writers");
+        "over a Unix socket (a throwaway local server unless --server), 1, 8 and 50 "
+        "writers; lucent serve into each; 1, 2 and 4 serve instances behind nginx with "
+        "1, 50 and 300 browsers");
     cmd->add_option("--writers", args->writers, "Concurrent writers per row")
         ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_option("--instances", args->instances,
+                    "Serve instances behind Debian's nginx, per group of rows")
+        ->delimiter(',')
+        ->check(CLI::Range(1, 16))
+        ->capture_default_str();
+    cmd->add_option("--participants", args->participants,
+                    "Concurrent browsers through the proxy, per row")
+        ->delimiter(',')
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
+    cmd->add_option("--think-ms", args->think_ms,
+                    "Milliseconds each browser behind the proxy waits before an answer "
+                    "(a participant looking; real ones take seconds)")
+        ->check(CLI::Range(0, 60000))
         ->capture_default_str();
     cmd->add_option("--trials", args->trials, "Trials each writer commits")
         ->check(CLI::PositiveNumber)
@@ -345,8 +517,9 @@ void register_bench_store(CLI::App& bench, int& exit_code) {
     cmd->add_option("--csv", args->csv, "Also write the table as CSV to this file");
     cmd->callback([args, &exit_code] {
         try {
-            exit_code =
-                run_bench_store(args->writers, args->trials, args->server, args->csv);
+            exit_code = run_bench_store(args->writers, args->trials, args->instances,
+                                        args->participants, args->think_ms, args->server,
+                                        args->csv);
         } catch (const study::StoreError& e) {
             std::cerr << "lucent bench store: " << e.what() << "\n";
             exit_code = kExitFailure;

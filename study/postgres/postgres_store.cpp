@@ -1,5 +1,8 @@
 // The PostgreSQL study store (postgres_store.h). Every statement goes through
 // exec_params with $n parameters; the only SQL built from strings is constant text.
+// A call of one statement runs it alone (pqxx::nontransaction: atomic by itself) rather
+// than between BEGIN and COMMIT, two round trips fewer; `lucent serve` makes several
+// such calls per request.
 //
 // [1] connection  [2] studies, participants, claims  [3] sessions, segments
 // [5] status, withdrawal, counts. The connection's error handling is
@@ -475,7 +478,7 @@ OnlineSession PostgresStore::enrol_online(int64_t study_id, const std::string& c
 
 std::optional<SessionRow> PostgresStore::unfinished_session(const std::string& code) {
     return guarded("finding the session", [&]() -> std::optional<SessionRow> {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         const pqxx::result r = tx.exec_params(
             "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
             "FROM sessions s JOIN participants p ON p.id = s.participant_id "
@@ -489,7 +492,7 @@ std::optional<SessionRow> PostgresStore::unfinished_session(const std::string& c
 
 std::optional<SessionRow> PostgresStore::session_by_uuid(const std::string& uuid) {
     return guarded("finding the session", [&]() -> std::optional<SessionRow> {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         const pqxx::result r = tx.exec_params(
             "SELECT s.id, s.uuid, s.participant_id, p.code, s.seed, s.cell, s.status "
             "FROM sessions s JOIN participants p ON p.id = s.participant_id "
@@ -502,7 +505,7 @@ std::optional<SessionRow> PostgresStore::session_by_uuid(const std::string& uuid
 
 bool PostgresStore::session_withdrawn(const std::string& uuid) {
     return guarded("finding the session", [&] {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         return !tx.exec_params("SELECT 1 FROM withdrawn_sessions WHERE uuid = $1", uuid)
                     .empty();
     });
@@ -510,7 +513,7 @@ bool PostgresStore::session_withdrawn(const std::string& uuid) {
 
 bool PostgresStore::has_completed_session(const std::string& code) {
     return guarded("finding the session", [&] {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         return tx.exec_params1(
                      "SELECT count(*) FROM sessions s JOIN participants p ON "
                      "p.id = s.participant_id WHERE p.code = $1 AND "
@@ -755,7 +758,7 @@ bool PostgresStore::decline_online_consent(int64_t study_id,
 
 bool PostgresStore::consent_declined(const std::string& page_uuid) {
     return guarded("finding a declined page", [&] {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         return !tx.exec_params("SELECT 1 FROM declined_pages WHERE uuid = $1", page_uuid)
                     .empty();
     });
@@ -786,7 +789,7 @@ bool PostgresStore::forget_declined_session(int64_t session_id) {
 
 void PostgresStore::set_consent(int64_t session_id) {
     guarded("recording consent", [&] {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         tx.exec_params("UPDATE sessions SET consent_utc = $1 WHERE id = $2",
                        utc_now_iso8601(), session_id);
         tx.commit();
@@ -796,7 +799,7 @@ void PostgresStore::set_consent(int64_t session_id) {
 
 bool PostgresStore::has_consent(int64_t session_id) {
     return guarded("reading consent", [&] {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         const pqxx::result r = tx.exec_params(
             "SELECT consent_utc IS NOT NULL FROM sessions WHERE id = $1", session_id);
         return !r.empty() && r[0][0].as<bool>();
@@ -805,7 +808,7 @@ bool PostgresStore::has_consent(int64_t session_id) {
 
 std::optional<std::string> PostgresStore::web_position(int64_t session_id) {
     return guarded("reading the page's position", [&]() -> std::optional<std::string> {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         const pqxx::result r =
             tx.exec_params("SELECT web_position FROM sessions WHERE id = $1", session_id);
         if (r.empty() || r[0][0].is_null()) return std::nullopt;
@@ -815,7 +818,7 @@ std::optional<std::string> PostgresStore::web_position(int64_t session_id) {
 
 void PostgresStore::set_web_position(int64_t session_id, const std::string& position) {
     guarded("storing the page's position", [&] {
-        pqxx::work tx(connection());
+        pqxx::nontransaction tx(connection());
         tx.exec_params("UPDATE sessions SET web_position = $1 WHERE id = $2", position,
                        session_id);
         tx.commit();

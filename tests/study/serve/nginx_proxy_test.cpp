@@ -1,7 +1,7 @@
-// The nginx harness (tests/support/nginx_proxy.h) the multi-instance serve tests stand
+// The nginx harness (app/nginx_proxy.h) the multi-instance serve tests stand
 // on: Debian's nginx round-robins over small httplib servers on loopback, routes around
 // a stopped one, passes bodies through and takes a new upstream on reload.
-#include "tests/support/nginx_proxy.h"
+#include "app/nginx_proxy.h"
 
 #include <gtest/gtest.h>
 #include <httplib.h>
@@ -16,6 +16,7 @@
 
 namespace lucent::test {
 namespace {
+using app::NginxProxy;
 
 // A tiny upstream: GET /who answers its name, POST /echo its request body.
 class Upstream {

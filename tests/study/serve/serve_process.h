@@ -3,15 +3,21 @@
 // colours), the server started on a free loopback port (--listen 127.0.0.1:0, the port
 // read from its first line) and stopped with SIGTERM.
 #include <OpenImageIO/imageio.h>
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -111,7 +117,12 @@ public:
             std::vector<std::string> args = {LUCENT_EXECUTABLE, "serve"};
             if (!protocol.empty())
                 args.push_back(protocol);  // else --preset in extra_args
-            args.insert(args.end(), {"--db", db, "--listen", "127.0.0.1:0"});
+            args.insert(args.end(), {"--db", db});
+            // A port of the caller's (--listen in extra_args: an instance restarted
+            // behind a proxy keeps its port), else a free one.
+            if (std::find(extra_args.begin(), extra_args.end(), "--listen") ==
+                extra_args.end())
+                args.insert(args.end(), {"--listen", "127.0.0.1:0"});
             args.insert(args.end(), extra_args.begin(), extra_args.end());
             std::vector<char*> argv;
             for (std::string& a : args) argv.push_back(a.data());
@@ -132,9 +143,18 @@ public:
     }
     ~ServeProcess() { stop(); }
     // SIGTERM; the exit status (0 when it stopped cleanly).
-    int stop() {
+    int stop() { return signal_and_wait(SIGTERM); }
+    // SIGKILL: the process dies at once, as on a crash or a lost machine; the exit
+    // status (128 + 9).
+    int kill_now() { return signal_and_wait(SIGKILL); }
+    int port() const { return port_; }
+    const std::string& first_line() const { return first_line_; }
+    std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
+
+private:
+    int signal_and_wait(int signal) {
         if (pid_ <= 0) return exit_status_;
-        kill(pid_, SIGTERM);
+        kill(pid_, signal);
         int status = 0;
         waitpid(pid_, &status, 0);
         pid_ = -1;
@@ -143,17 +163,55 @@ public:
         exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
         return exit_status_;
     }
-    int port() const { return port_; }
-    const std::string& first_line() const { return first_line_; }
-    std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
 
-private:
     int pid_ = -1;
     int stdout_ = -1;
     int port_ = 0;
     int exit_status_ = -1;
     std::string first_line_;
 };
+
+// A free TCP port on loopback now (bound, read back and released: a server started
+// right after takes it, barring a race with another process).
+inline int free_loopback_port() {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t size = sizeof addr;
+    int port = 0;
+    if (::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0 &&
+        ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &size) == 0)
+        port = ntohs(addr.sin_port);
+    ::close(fd);
+    return port;
+}
+
+// The token key every instance of one study shares (--secret-file): 32 random bytes in
+// DIR/serve.key, mode 0600. Returns its path.
+inline std::string write_serve_key(const std::filesystem::path& dir) {
+    const std::string key = (dir / "serve.key").string();
+    std::random_device random;
+    std::string bytes(32, '\0');
+    for (char& c : bytes) c = static_cast<char>(random());
+    std::ofstream(key, std::ios::binary) << bytes;
+    std::filesystem::permissions(
+        key, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+    return key;
+}
+
+// Instance `index` of several on one database: its own port and state folder
+// (DIR/instanceN), the shared key; started again the same way after it was killed.
+inline std::unique_ptr<ServeProcess> start_serve_instance(
+    const std::string& protocol, const std::string& db, const std::filesystem::path& dir,
+    int index, int port, const std::string& key) {
+    const std::filesystem::path state = dir / ("instance" + std::to_string(index));
+    std::filesystem::create_directories(state);
+    return std::make_unique<ServeProcess>(
+        protocol, db, state.string(),
+        std::vector<std::string>{"--listen", "127.0.0.1:" + std::to_string(port),
+                                 "--secret-file", key, "--store-connections", "4"});
+}
 
 // The API over HTTP, one keep-alive connection per page.
 inline Transport over_http(httplib::Client& client) {

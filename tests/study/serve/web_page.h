@@ -54,7 +54,8 @@ struct Page {
                    {"screen_height", 1440}};
     json who = json::object();  // the link's participant code or Prolific ids
 
-    json call(const std::string& endpoint, json body, int expected = 200) {
+    // A request as lucent.js sends it (token, browser, link ids), its reply unchecked.
+    study::WebReply request(const std::string& endpoint, json body) {
         if (!token.empty() && !body.contains("token")) body["token"] = token;
         if (endpoint == "environment" && body.contains("refresh_hz") &&
             body["refresh_hz"].is_number() && body["refresh_hz"].get<double>() > 0)
@@ -62,7 +63,10 @@ struct Page {
         if (!body.contains("client")) body["client"] = client;
         for (const auto& [key, value] : who.items())
             if (!body.contains(key)) body[key] = value;
-        const study::WebReply r = send(endpoint, body.dump());
+        return send(endpoint, body.dump());
+    }
+    json call(const std::string& endpoint, json body, int expected = 200) {
+        const study::WebReply r = request(endpoint, std::move(body));
         EXPECT_EQ(r.status, expected) << endpoint << ": " << r.body;
         return json::parse(r.body);
     }

@@ -1,4 +1,4 @@
-#include "tests/support/nginx_proxy.h"
+#include "app/nginx_proxy.h"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -19,7 +19,7 @@
 #include <system_error>
 #include <thread>
 
-namespace lucent::test {
+namespace lucent::app {
 
 namespace {
 
@@ -167,7 +167,7 @@ bool NginxProxy::running() {
 void NginxProxy::write_config() const {
     const std::string p = prefix_.string();
     std::ostringstream c;
-    c << "# Written by tests/support/nginx_proxy.cpp (generation " << generation_
+    c << "# Written by lucent (app/nginx_proxy.cpp) (generation " << generation_
       << "); every path is in this prefix.\n"
       << "daemon off;\n"
       << "master_process on;\n"
@@ -177,7 +177,7 @@ void NginxProxy::write_config() const {
       << "error_log \"" << p << "/error.log\" warn;\n";
     // As root, workers would otherwise run as nobody (Debian's build names no user).
     if (geteuid() == 0) c << "user root;\n";
-    c << "events { worker_connections 256; }\n"
+    c << "events { worker_connections 4096; }\n"
       << "http {\n"
       << "    access_log off;\n"
       << "    client_body_temp_path \"" << p << "/client_body\";\n"
@@ -362,4 +362,4 @@ std::string NginxProxy::last_log_line() const {
     return line.empty() ? "(nothing in its error log)" : line;
 }
 
-}  // namespace lucent::test
+}  // namespace lucent::app

@@ -1,6 +1,7 @@
 #pragma once
 // Debian's nginx as a round-robin reverse proxy in front of several HTTP servers on
-// loopback, for tests of `lucent serve` run as several instances: /usr/sbin/nginx
+// loopback, for `lucent bench store`'s rows of several serve instances and the tests of
+// `lucent serve` run as several instances: /usr/sbin/nginx
 // started as a child process (master and one worker, not daemonised) with a config of
 // its own in a fresh temporary prefix folder (pid file, error log, temp paths all in
 // there), listening on 127.0.0.1 on a free port. Nothing of a system nginx is used or
@@ -17,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace lucent::test {
+namespace lucent::app {
 
 struct NginxProxyOptions {
     // proxy_next_upstream with `non_idempotent`: POST requests are retried on another
@@ -77,4 +78,4 @@ private:
     int generation_ = 0;
 };
 
-}  // namespace lucent::test
+}  // namespace lucent::app
