@@ -273,6 +273,20 @@ TEST_F(ServeInstances, ParticipantsWaitOutAPostgresRestartAndLoseNothing) {
     });
 }
 
+// docs/deploy.md's change of instances while a study runs: the proxy starts over two
+// instances; a third is added (a reload), then the first two are drained (a reload
+// without them) and stopped. The rest of the study goes through the new one alone, and
+// nothing is lost or doubled.
+TEST_F(ServeInstances, AnInstanceAddedWhileAStudyRunsTakesItOverFromTheOthers) {
+    proxy_->reload({ports_[0], ports_[1]});
+    run_study([&] {
+        proxy_->reload(ports_);       // add instance 2
+        proxy_->reload({ports_[2]});  // drain 0 and 1
+        EXPECT_EQ(instances_[0]->stop(), 0);
+        EXPECT_EQ(instances_[1]->stop(), 0);
+    });
+}
+
 // Today's hostile requests across instances: a token answers only for its own
 // participant on every instance (directly and through the proxy), a refusal stores
 // nothing, and an instance that cannot reach PostgreSQL says so (503 with Retry-After,
