@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <httplib.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include <fstream>
 #include <iostream>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -83,16 +85,44 @@ std::map<std::string, ServedPicture> load_pictures(
     return out;
 }
 
-// The key of the session tokens: 32 random bytes kept in a file (mode 0600) so tokens
-// survive a restart. Default: beside an SQLite database, else in the journal folder.
-std::string load_or_create_secret(const std::string& path) {
-    if (std::filesystem::exists(path)) {
+// The key of the session tokens, kept in a file so tokens survive a restart and every
+// instance of a study checks every other's (docs/deploy.md). Refused: a file others may
+// read (anyone who reads it can sign any participant's token) and a key with too little
+// entropy (shorter than 32 bytes, or fewer than 8 distinct byte values: all one byte, a
+// short pattern repeated; a hex or base64 text of 32 random bytes passes). Created (32
+// bytes of /dev/urandom, mode 0600, said on stderr) only where that cannot split a
+// study: beside an SQLite file, which one machine serves.
+std::string load_or_create_secret(const std::string& path, bool may_create) {
+    struct stat info {};
+    if (::stat(path.c_str(), &info) == 0) {
+        if ((info.st_mode & 077) != 0) {
+            char mode[8];
+            std::snprintf(mode, sizeof mode, "%04o", unsigned(info.st_mode & 07777));
+            throw std::runtime_error(path +
+                                     ": the session key file may be read by group "
+                                     "or others (mode " +
+                                     mode + "); chmod 600 " + path);
+        }
         const std::string secret = read_file(path);
         if (secret.size() < 32)
-            throw std::runtime_error(path +
-                                     ": session key file is shorter than 32 bytes");
+            throw std::runtime_error(path + ": session key of " +
+                                     std::to_string(secret.size()) +
+                                     " bytes is shorter than 32 bytes (head -c 32 "
+                                     "/dev/urandom > KEY)");
+        const std::set<char> distinct(secret.begin(), secret.end());
+        if (distinct.size() < 8)
+            throw std::runtime_error(
+                path + ": session key has too little entropy (" +
+                std::to_string(distinct.size()) + " distinct byte values in " +
+                std::to_string(secret.size()) +
+                " bytes); make it with head -c 32 /dev/urandom > KEY");
         return secret;
     }
+    if (!may_create)
+        throw std::runtime_error(path +
+                                 ": no such session key file (make it once with "
+                                 "head -c 32 /dev/urandom, mode 0600, and give "
+                                 "every instance the same file)");
     std::filesystem::create_directories(std::filesystem::absolute(path).parent_path());
     std::string secret(32, '\0');
     std::ifstream random("/dev/urandom", std::ios::binary);
@@ -107,6 +137,8 @@ std::string load_or_create_secret(const std::string& path) {
                          ::fsync(fd) == 0;
     ::close(fd);
     if (!written) throw std::runtime_error(path + ": cannot write the session key file");
+    std::cerr << "lucent serve: created the session key " << path
+              << " (32 random bytes, mode 0600)" << std::endl;
     return secret;
 }
 
@@ -141,6 +173,16 @@ int serve_command(const ServeArgs& args) {
                   << "': expected HOST:PORT, e.g. 127.0.0.1:8080\n";
         return kExitUsage;
     }
+    // A server store is shared by instances: each must be given the study's one key, or
+    // every page another instance started would be refused by this one (403).
+    const bool server = study::is_server_uri(args.db);
+    if (server && args.secret_file.empty()) {
+        std::cerr << "lucent serve: --db " << args.db
+                  << ": a server store needs --secret-file KEY, the one key file every "
+                     "instance of the study shares (docs/deploy.md)\n";
+        return kExitUsage;
+    }
+    std::string key_line;
     study::Protocol protocol;
     std::unique_ptr<study::StorePool> stores;
     std::unique_ptr<study::WebStudy> web;
@@ -167,11 +209,11 @@ int serve_command(const ServeArgs& args) {
         pictures = load_pictures(shown, stimuli);
         for (const auto& [id, picture] : pictures) options.images[id] = picture.size;
         const std::string secret_file =
-            !args.secret_file.empty() ? args.secret_file
-            : study::is_server_uri(args.db)
-                ? study::default_journal_path(args.db) + ".serve-key"
-                : args.db + "-serve-key";
-        options.secret = load_or_create_secret(secret_file);
+            !args.secret_file.empty() ? args.secret_file : args.db + "-serve-key";
+        options.secret = load_or_create_secret(secret_file, !server);
+        key_line = "lucent serve: session key " + secret_file + ", fingerprint " +
+                   study::key_fingerprint(options.secret) +
+                   " (the same on every instance of the study: /healthz)";
         options.idle_timeout = std::chrono::milliseconds(
             static_cast<int64_t>(std::llround(args.idle_minutes * 60'000)));
         // No local journal: an answer is acknowledged only once the study's database
@@ -238,6 +280,7 @@ int serve_command(const ServeArgs& args) {
               << " connections) on http://"
               << (host.find(':') != std::string::npos ? "[" + host + "]" : host) << ":"
               << port << "/?participant=ID" << std::endl;
+    std::cout << key_line << std::endl;
     if (!is_loopback(host))
         std::cout << "lucent serve: note: listening beyond this machine (" << host
                   << "); serve participants through an HTTPS reverse proxy "
@@ -278,8 +321,9 @@ void register_serve(CLI::App& app, int& exit_code) {
                     "0 picks one)");
     cmd->add_option(
         "--secret-file", args->secret_file,
-        "Key of the participants' session tokens (created when absent; default "
-        "DB-serve-key beside an SQLite file)");
+        "Key of the participants' session tokens, at least 32 random bytes, mode "
+        "0600: required with a server store (every instance gives the same file); "
+        "default beside an SQLite file, DB-serve-key, created when absent");
     cmd->add_option("--threads", args->threads,
                     "HTTP worker threads (connections served at once)")
         ->check(CLI::Range(2, 1024));

@@ -109,6 +109,10 @@ std::string hmac_sha256_hex(std::string_view key, std::string_view message) {
     return sha256_hex(outer + bytes_of_hex(sha256_hex(inner + std::string(message))));
 }
 
+std::string key_fingerprint(std::string_view secret) {
+    return hmac_sha256_hex(secret, "lucent serve key fingerprint").substr(0, 16);
+}
+
 std::string participant_code_problem(std::string_view code) {
     if (code.empty()) return "is empty";
     if (code.size() > kMaxCodeLength)
@@ -439,9 +443,13 @@ WebReply WebStudy::health() {
     try {
         StorePool::Lease store = pool_.lease();
         store->query_int("SELECT 1");
-        return {200, to_text(json{{"store", "ok"}, {"connections", pool_.size()}})};
+        return {200, to_text(json{{"store", "ok"},
+                                  {"connections", pool_.size()},
+                                  {"key", key_fingerprint(options_.secret)}})};
     } catch (const std::exception& e) {
-        WebReply reply = error_reply(503, std::string("store: ") + e.what());
+        WebReply reply{
+            503, to_text(json{{"error", one_line(std::string("store: ") + e.what())},
+                              {"key", key_fingerprint(options_.secret)}})};
         reply.retry_after_s = 1;
         return reply;
     }

@@ -90,6 +90,9 @@ std::string legacy_session_token(std::string_view secret, std::string_view code,
                                  std::string_view session_uuid);
 // HMAC-SHA256 (RFC 2104) in lower-case hex.
 std::string hmac_sha256_hex(std::string_view key, std::string_view message);
+// A short public name of a session key (16 hex digits of an HMAC under it, telling
+// nothing of the key): /healthz shows it, so a monitor sees instances that disagree.
+std::string key_fingerprint(std::string_view secret);
 // The stimulus id an /images/ request names, from the raw request target (percent-
 // encoded or not): exactly "/images/<id>.png" for a stimulus in `images`, else nullopt
 // (traversal, other folders, encoded separators, unknown names).
@@ -113,7 +116,8 @@ public:
     // each on a store of the pool (503 with retry_after_s when none came free, or the
     // store cannot be reached); two of one participant take turns.
     WebReply handle(std::string_view endpoint, std::string_view body);
-    // GET /healthz: 200 when a store of the pool answers a query now, else 503.
+    // GET /healthz: 200 when a store of the pool answers a query now, else 503; both
+    // name the key's fingerprint.
     WebReply health();
 
 private:

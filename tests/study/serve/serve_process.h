@@ -99,6 +99,19 @@ expected = 5
 }
 inline constexpr int kServeStudyTrials = 5;  // 1 practice + 3 rated + 1 catch
 
+// The token key every instance of one study shares (--secret-file): 32 random bytes in
+// DIR/serve.key, mode 0600. Returns its path.
+inline std::string write_serve_key(const std::filesystem::path& dir) {
+    const std::string key = (dir / "serve.key").string();
+    std::random_device random;
+    std::string bytes(32, '\0');
+    for (char& c : bytes) c = static_cast<char>(random());
+    std::ofstream(key, std::ios::binary) << bytes;
+    std::filesystem::permissions(
+        key, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+    return key;
+}
+
 class ServeProcess {
 public:
     // `state_dir`: the server's journal and key folder (LUCENT_JOURNAL_DIR). An empty
@@ -124,6 +137,15 @@ public:
                 extra_args.end())
                 args.insert(args.end(), {"--listen", "127.0.0.1:0"});
             args.insert(args.end(), extra_args.begin(), extra_args.end());
+            // A server store needs the study's key file (docs/deploy.md): one written
+            // for this server unless the caller gives one.
+            if (db.rfind("postgresql://", 0) == 0 &&
+                std::find(extra_args.begin(), extra_args.end(), "--secret-file") ==
+                    extra_args.end())
+                args.insert(args.end(), {"--secret-file",
+                                         std::filesystem::exists(state_dir + "/serve.key")
+                                             ? state_dir + "/serve.key"
+                                             : write_serve_key(state_dir)});
             std::vector<char*> argv;
             for (std::string& a : args) argv.push_back(a.data());
             argv.push_back(nullptr);
@@ -185,19 +207,6 @@ inline int free_loopback_port() {
         port = ntohs(addr.sin_port);
     ::close(fd);
     return port;
-}
-
-// The token key every instance of one study shares (--secret-file): 32 random bytes in
-// DIR/serve.key, mode 0600. Returns its path.
-inline std::string write_serve_key(const std::filesystem::path& dir) {
-    const std::string key = (dir / "serve.key").string();
-    std::random_device random;
-    std::string bytes(32, '\0');
-    for (char& c : bytes) c = static_cast<char>(random());
-    std::ofstream(key, std::ios::binary) << bytes;
-    std::filesystem::permissions(
-        key, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
-    return key;
 }
 
 // Instance `index` of several on one database: its own port and state folder
