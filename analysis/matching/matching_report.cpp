@@ -283,11 +283,37 @@ std::string fit_plot(const std::vector<const StandardThreshold*>& standards) {
 void add_thresholds(MatchingSection& section, const ThresholdAnalysis& a) {
     if (a.thresholds.empty()) return;
     std::ostringstream csv;
-    csv_row(csv,
-            {"participant",   "block",      "standard",    "knob",    "standard_value",
-             "guess",         "p_correct",  "trials",      "correct", "jnd",
-             "jnd_text",      "jnd_ci_low", "jnd_ci_high", "weber",   "weber_ci_low",
-             "weber_ci_high", "alpha",      "beta",        "lapse",   "slope"});
+    csv_row(csv, {"participant",
+                  "block",
+                  "standard",
+                  "knob",
+                  "standard_value",
+                  "guess",
+                  "p_correct",
+                  "trials",
+                  "correct",
+                  "jnd",
+                  "jnd_text",
+                  "jnd_ci_low",
+                  "jnd_ci_high",
+                  "weber",
+                  "weber_ci_low",
+                  "weber_ci_high",
+                  "alpha",
+                  "beta",
+                  "lapse",
+                  "slope",
+                  "jnd_between_low",
+                  "jnd_between_high",
+                  "jnd_ci_text",
+                  "weber_text",
+                  "weber_ci_text",
+                  "bootstrap_samples",
+                  "bootstrap_below",
+                  "bootstrap_above",
+                  "nonzero_delta_trials",
+                  "nonzero_delta_correct",
+                  "all_nonzero_correct"});
     section.blocks.push_back(heading("Thresholds", 2));
     section.blocks.push_back(paragraph(
         "Per participant, block and standard, every trial of the standard's interleaved "
@@ -297,12 +323,22 @@ void add_thresholds(MatchingSection& section, const ThresholdAnalysis& a) {
         "halfway between chance and perfect (75% correct for a pair, 66.7% for an odd "
         "one "
         "out), with a parametric-bootstrap 95% interval; the Weber fraction is the JND "
-        "over the standard's value of the knob. Each procedure's own estimate (up/down: "
+        "over the standard's value of the knob. Where the answers jump from chance to "
+        "correct between two neighbouring deltas the slope is not identified: the JND is "
+        "only said to lie between them, with no interval. A bootstrap resample whose JND "
+        "falls outside the deltas shown counts only as below or above them; when more "
+        "than the 2.5% the interval leaves out on a side do, that end is only \"< the "
+        "smallest delta\" or \"> the largest\". Each procedure's own estimate (up/down: "
         "the mean of its last reversals; QUEST: its posterior quantile, at its own "
-        "target performance) is the cross-check."));
+        "target performance) is the cross-check. Flagged: a participant right on every "
+        "trial with a non-zero delta, on " +
+        std::to_string(kAllCorrectFlagTrials) +
+        " or more of them, as a script that reads the answer would be (an observer "
+        "right 80% of the time near the threshold, where a staircase keeps its trials, "
+        "does that with probability 0.8^20 = 0.012)."));
     Table t{{"participant", "block", "standard", "standard value", "trials",
              "proportion correct", "JND", "JND 95% interval", "Weber fraction",
-             "procedures' own estimates"},
+             "procedures' own estimates", "flagged"},
             {}};
     for (const StandardThreshold& s : a.thresholds) {
         std::string estimates;
@@ -316,13 +352,15 @@ void add_thresholds(MatchingSection& section, const ThresholdAnalysis& a) {
              s.fit.trials > 0
                  ? format_short(static_cast<double>(s.fit.correct) / s.fit.trials)
                  : std::string("-"),
-             s.jnd_text, interval(s.jnd_low, s.jnd_high),
-             s.weber ? format_short(s.weber) +
-                           (s.weber_low && s.weber_high
-                                ? " (" + interval(s.weber_low, s.weber_high) + ")"
-                                : std::string())
-                     : std::string("-"),
-             estimates.empty() ? std::string("-") : estimates});
+             s.jnd_text, s.jnd_ci_text.empty() ? std::string("-") : s.jnd_ci_text,
+             s.weber_text.empty()
+                 ? std::string("-")
+                 : s.weber_text +
+                       (s.weber_ci_text.empty() ? "" : " (" + s.weber_ci_text + ")"),
+             estimates.empty() ? std::string("-") : estimates,
+             s.all_nonzero_correct
+                 ? "right on all " + std::to_string(s.nonzero_trials) + " non-zero deltas"
+                 : std::string("-")});
         csv_row(csv, {s.participant,
                       s.block,
                       s.standard,
@@ -342,7 +380,18 @@ void add_thresholds(MatchingSection& section, const ThresholdAnalysis& a) {
                       full(s.fit.alpha),
                       full(s.fit.beta),
                       full(s.fit.lapse),
-                      full(th.slope)});
+                      full(th.slope),
+                      full(s.jnd_between_low),
+                      full(s.jnd_between_high),
+                      s.jnd_ci_text,
+                      s.weber_text,
+                      s.weber_ci_text,
+                      std::to_string(s.fit.bootstrap_samples),
+                      std::to_string(th.bootstrap_below),
+                      std::to_string(th.bootstrap_above),
+                      std::to_string(s.nonzero_trials),
+                      std::to_string(s.nonzero_correct),
+                      s.all_nonzero_correct ? "yes" : "no"});
     }
     section.blocks.push_back({Block::kTable, "", t, {}});
     for (const StandardThreshold& s : a.thresholds) {

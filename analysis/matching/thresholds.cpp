@@ -75,6 +75,96 @@ void replay(StaircaseTrack& track, const study::Block& block,
     }
 }
 
+// The Weber fraction, JND / the standard's value, and its interval, in numbers and words;
+// never a non-positive one.
+void weber_of(StandardThreshold& s, const Threshold& t) {
+    if (!s.standard_value) return;
+    const double sv = *s.standard_value;
+    const bool has_jnd = t.status != ThresholdStatus::not_identified;
+    if (!(sv > 0)) {
+        if (has_jnd)
+            s.notes.push_back("No Weber fraction: the standard's " + s.knob + " is " +
+                              text(sv) + ", not positive.");
+        return;
+    }
+    const auto positive = [](std::optional<double> v) { return v && *v > 0; };
+    switch (t.status) {
+        case ThresholdStatus::estimated:
+            if (!positive(s.jnd)) {
+                s.notes.push_back("No Weber fraction: the JND, " + s.jnd_text +
+                                  ", is not positive.");
+                return;
+            }
+            s.weber = *s.jnd / sv;
+            s.weber_text = text(*s.weber);
+            break;
+        case ThresholdStatus::below_range:
+            if (positive(t.bound)) s.weber_text = "< " + text(*t.bound / sv);
+            return;
+        case ThresholdStatus::above_range:
+            if (positive(t.bound)) s.weber_text = "> " + text(*t.bound / sv);
+            return;
+        case ThresholdStatus::between:
+            if (t.between_low && *t.between_low >= 0 && positive(t.between_high))
+                s.weber_text = "between " + text(*t.between_low / sv) + " and " +
+                               text(*t.between_high / sv);
+            return;
+        case ThresholdStatus::not_identified:
+            return;
+    }
+    // The interval's ends: a number, or "< smallest delta / standard" or "> largest".
+    if (t.ci_low_status == ThresholdStatus::not_identified ||
+        t.ci_high_status == ThresholdStatus::not_identified || s.fit.bins.empty())
+        return;
+    const double x_min = s.fit.bins.front().x, x_max = s.fit.bins.back().x;
+    const auto end = [&](ThresholdStatus status, std::optional<double> value,
+                         std::optional<double>& weber) -> std::optional<std::string> {
+        if (status == ThresholdStatus::estimated && positive(value)) {
+            weber = *value / sv;
+            return text(*weber);
+        }
+        if (status == ThresholdStatus::below_range && x_min > 0)
+            return "< " + text(x_min / sv);
+        if (status == ThresholdStatus::above_range && x_max > 0)
+            return "> " + text(x_max / sv);
+        return std::nullopt;
+    };
+    const auto low = end(t.ci_low_status, t.ci_low, s.weber_low);
+    const auto high = end(t.ci_high_status, t.ci_high, s.weber_high);
+    if (low && high) {
+        s.weber_ci_text = *low + " .. " + *high;
+    } else {
+        s.weber_low.reset();
+        s.weber_high.reset();
+        s.notes.push_back("No interval of the Weber fraction: the JND's interval, " +
+                          t.ci_text + ", reaches a delta that is not positive.");
+    }
+}
+
+// Right on every trial with a non-zero delta, on enough of them to be suspicious.
+void flag_all_correct(StandardThreshold& s,
+                      const std::vector<PsychometricTrial>& trials) {
+    double scale = 1.0;
+    for (const PsychometricTrial& t : trials) scale = std::max(scale, std::abs(t.x));
+    for (const PsychometricTrial& t : trials) {
+        if (!(std::abs(t.x) > 1e-9 * scale)) continue;  // a delta of 0: a guess
+        ++s.nonzero_trials;
+        if (t.correct) ++s.nonzero_correct;
+    }
+    s.all_nonzero_correct = s.nonzero_trials >= kAllCorrectFlagTrials &&
+                            s.nonzero_correct == s.nonzero_trials;
+    if (s.all_nonzero_correct)
+        s.notes.push_back(
+            "Flagged: right on every one of the " + std::to_string(s.nonzero_trials) +
+            " trials with a non-zero delta, as a script that reads the answer would be "
+            "(flagged from " +
+            std::to_string(kAllCorrectFlagTrials) +
+            " such trials: a staircase keeps its trials near the threshold, where an "
+            "observer right 80% of the time is right on 20 in a row with probability "
+            "0.8^20 = 0.012). Check the sessions before keeping them; an observer whose "
+            "JND is below the smallest delta shown would be right on them too.");
+}
+
 }  // namespace
 
 std::optional<double> reversal_estimate(const std::vector<double>& reversal_intensities,
@@ -213,6 +303,7 @@ ThresholdAnalysis analyse_thresholds(const std::vector<StaircaseRow>& rows,
                 s.jnd_low = t.ci_low;
                 s.jnd_high = t.ci_high;
                 s.jnd_text = text(*t.value);
+                s.jnd_ci_text = t.ci_text;
                 break;
             case ThresholdStatus::below_range:
                 s.jnd_text = "< " + text(t.bound.value_or(0.0));
@@ -226,6 +317,18 @@ ThresholdAnalysis analyse_thresholds(const std::vector<StaircaseRow>& rows,
                                   ") is above the largest delta shown, " +
                                   text(t.bound.value_or(0.0)) + ".");
                 break;
+            case ThresholdStatus::between:
+                s.jnd_between_low = t.between_low;
+                s.jnd_between_high = t.between_high;
+                s.jnd_text = t.text;
+                s.notes.push_back(
+                    "The JND (" + level + ") lies somewhere between the deltas " +
+                    text(t.between_low.value_or(0.0)) + " and " +
+                    text(t.between_high.value_or(0.0)) +
+                    ": the answers jump from chance to correct between "
+                    "these two deltas shown, so the slope is not identified "
+                    "and no JND value or interval is given.");
+                break;
             case ThresholdStatus::not_identified:
                 s.jnd_text = "no threshold";
                 s.notes.push_back(
@@ -237,16 +340,8 @@ ThresholdAnalysis analyse_thresholds(const std::vector<StaircaseRow>& rows,
             for (const std::string& n : out.tracks[k].notes)
                 if (out.tracks[k].held_at_max && n.rfind("Held", 0) == 0)
                     s.notes.push_back(out.tracks[k].label + ": " + n);
-        if (s.jnd && s.standard_value && !(*s.standard_value > 0))
-            s.notes.push_back("No Weber fraction: the standard's " + s.knob + " is " +
-                              text(*s.standard_value) + ", not positive.");
-        if (s.jnd && s.standard_value && *s.standard_value > 0) {
-            s.weber = *s.jnd / *s.standard_value;
-            if (s.jnd_low && s.jnd_high) {
-                s.weber_low = *s.jnd_low / *s.standard_value;
-                s.weber_high = *s.jnd_high / *s.standard_value;
-            }
-        }
+        weber_of(s, t);
+        flag_all_correct(s, trials[{s.participant, s.block, s.standard}]);
     }
     return out;
 }

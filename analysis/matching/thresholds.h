@@ -17,9 +17,23 @@
 // stored deltas and answers with study/adaptive's engines.
 //
 // Hard cases in words: at chance (no threshold), every answer correct (the JND is below
-// the smallest delta shown), a procedure held at the largest delta the block allows
-// (reached at least twice: the knob's range limits the staircase; the threshold may lie
-// beyond it).
+// the smallest delta shown), answers that jump from chance to correct between two
+// neighbouring deltas (the slope is not identified: the JND is "between a and b", with
+// no interval), bootstrap resamples beyond the deltas shown (more than the interval
+// leaves out on a side: that end is only "< smallest delta" or "> largest"), a procedure
+// held at the largest delta the block allows (reached at least twice: the knob's range
+// limits the staircase; the threshold may lie beyond it). A Weber fraction is never
+// negative: none where the JND or an end of its interval is not positive.
+//
+// Right on every trial with a non-zero delta: a participant who answers every one of at
+// least kAllCorrectFlagTrials (20) trials with a non-zero delta correctly is flagged (as
+// a script that reads the answer would be). A staircase keeps its trials near the
+// threshold, where a genuine observer is right about 80% of the time (1-up/3-down
+// converges at 79.4%, QUEST at its p_threshold): such an observer is right on 20 of them
+// in a row with probability 0.8^20 = 0.012; one who is right 90% of the time even
+// there, 0.9^20 = 0.12. The flag is a prompt to look, not a verdict: an observer whose
+// JND is below the smallest delta shown is right on them too. Trials at a delta of 0 are
+// left out of the count (there the two are the same and the answer is a guess).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -29,6 +43,8 @@
 #include "analysis/psychometric/psychometric.h"
 
 namespace lucent::analysis {
+
+inline constexpr int kAllCorrectFlagTrials = 20;
 
 struct ThresholdOptions {
     PsychometricFamily family = PsychometricFamily::cumulative_gaussian;
@@ -59,9 +75,18 @@ struct StandardThreshold {
     double guess = 0.5;
     double p_correct = 0.75;  // the JND's proportion correct, (1 + guess) / 2
     PsychometricFit fit;
+    // The JND and its interval's ends, where they are numbers within the deltas shown.
     std::optional<double> jnd, jnd_low, jnd_high;
-    std::optional<double> weber, weber_low, weber_high;
-    std::string jnd_text;  // "0.123", "< 0.05 (below the smallest delta shown)", ...
+    // The slope not identified: the two deltas the answers jump between.
+    std::optional<double> jnd_between_low, jnd_between_high;
+    std::optional<double> weber, weber_low, weber_high;  // positive only
+    std::string jnd_text;     // "0.123", "< 0.05", "> 3", "between 0.1 and 0.15", ...
+    std::string jnd_ci_text;  // "0.1 .. 0.2", "< 0.05 .. 0.25", "0.1 .. > 3", or ""
+    std::string weber_text, weber_ci_text;  // the same for the Weber fraction, or ""
+    // Trials with a non-zero delta, and how many of them were answered correctly; flagged
+    // when all of at least kAllCorrectFlagTrials were.
+    int nonzero_trials = 0, nonzero_correct = 0;
+    bool all_nonzero_correct = false;
     std::vector<std::size_t> tracks;  // indices into ThresholdAnalysis::tracks
     std::vector<std::string> notes;   // hard cases in words (the fit's notes included)
 };

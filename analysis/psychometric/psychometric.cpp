@@ -125,12 +125,32 @@ Search minimise(const Problem& p, const Bounds& b, std::vector<double> start) {
     return best;
 }
 
-// The percentile of sorted values (R's quantile type 7).
-double percentile(const std::vector<double>& sorted, double q) {
-    const double h = (static_cast<double>(sorted.size()) - 1.0) * q;
+// One end of a bootstrap interval: the percentile (R's quantile type 7) of the resamples
+// where `below` of them lie below the tested range and `above` above it, only their side
+// known, `inside` (sorted) holding the others' values. A percentile that reaches an
+// outside resample is withheld: only its side is known (below_range or above_range).
+struct End {
+    ThresholdStatus status = ThresholdStatus::not_identified;
+    std::optional<double> value;
+};
+
+End percentile_end(const std::vector<double>& inside, std::size_t below,
+                   std::size_t above, double q) {
+    const std::size_t n = inside.size() + below + above;
+    if (n == 0) return {};
+    const double h = (static_cast<double>(n) - 1.0) * q;
     const auto lo = static_cast<std::size_t>(std::floor(h));
-    const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
-    return sorted[lo] + (h - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
+    const std::size_t hi = std::min(lo + 1, n - 1);
+    const double frac = h - static_cast<double>(lo);
+    const auto side = [&](std::size_t i) {
+        return i < below ? -1 : (i >= below + inside.size() ? 1 : 0);
+    };
+    if (side(lo) < 0) return {ThresholdStatus::below_range, std::nullopt};
+    if (side(lo) > 0 || (frac > 0.0 && side(hi) > 0))
+        return {ThresholdStatus::above_range, std::nullopt};
+    const double a = inside[lo - below];
+    const double b = side(hi) == 0 ? inside[hi - below] : a;
+    return {ThresholdStatus::estimated, a + frac * (b - a)};
 }
 
 double uniform(std::mt19937_64& rng) {
@@ -334,7 +354,13 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
     }
     const double u_min = p.u.front(), u_max = p.u.back(), span = u_max - u_min;
     Bounds bounds;
-    bounds.lower = {u_min - 10.0 * span, std::log(span * 1e-4)};
+    // The steepest function allowed rises within a hundredth of the closest two
+    // intensities tested (and of 1e-4 of their range), so that a jump between two
+    // neighbours shows as one: F near 0 at one and near 1 at the other.
+    double gap = span;
+    for (std::size_t i = 1; i < p.u.size(); ++i)
+        if (p.u[i] > p.u[i - 1]) gap = std::min(gap, p.u[i] - p.u[i - 1]);
+    bounds.lower = {u_min - 10.0 * span, std::log(std::min(span * 1e-4, gap * 1e-2))};
     bounds.upper = {u_max + 10.0 * span, std::log(span * 1e2)};
     if (p.free_lapse) {
         bounds.lower.push_back(0.0);
@@ -399,14 +425,42 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
 
     // The slope is not identified when no tested intensity lies on the rising part of F
     // (every fitted F within 0.001 of 0 or 1): the responses jump between two levels and
-    // the likelihood only grows as the function steepens.
-    bool off_slope = true, low = false, high = false;
-    for (double u : p.u) {
-        const double f = g_cdf(gauss, (u - st.m) / st.s);
-        if (f > 1e-3 && f < 1.0 - 1e-3) off_slope = false;
-        (f <= 1e-3 ? low : high) = true;
-    }
-    const bool steepest = off_slope && low && high;
+    // the likelihood only grows as the function steepens. With F near 0 at some
+    // intensities and near 1 at the others, the jump is between the largest of the first
+    // and the smallest of the second, neighbours (F rises with x). A function as steep as
+    // its bound allows, its middle within the range, is such a jump too: between the
+    // intensities either side of its middle.
+    struct Rise {
+        bool off_slope = true, low = false, high = false;
+        std::size_t last_low = 0, first_high = 0;
+        bool jump() const { return off_slope && low && high; }
+    };
+    const double s_min = std::exp(bounds.lower[1]);
+    const auto rise_of = [&](const State& s) {
+        Rise r;
+        for (std::size_t i = 0; i < p.u.size(); ++i) {
+            const double f = g_cdf(gauss, (p.u[i] - s.m) / s.s);
+            if (f > 1e-3 && f < 1.0 - 1e-3) r.off_slope = false;
+            if (f <= 1e-3) {
+                r.low = true;
+                r.last_low = i;
+            } else if (!r.high) {
+                r.high = true;
+                r.first_high = i;
+            }
+        }
+        if (!r.off_slope && s.s <= s_min * (1.0 + 1e-6) && s.m >= u_min && s.m < u_max) {
+            r = Rise{};
+            r.low = r.high = true;
+            while (r.last_low + 1 < p.u.size() && p.u[r.last_low + 1] <= s.m)
+                ++r.last_low;
+            r.first_high = r.last_low + 1;
+        }
+        return r;
+    };
+    const Rise rise = rise_of(st);
+    const bool off_slope = rise.off_slope;
+    const bool steepest = rise.jump();
     // F as flat as the bounds allow: no change over the range tested.
     const bool flattest = best.theta[1] >= bounds.upper[1] - 1e-6;
     if (p.free_lapse && st.lapse >= options.max_lapse - 1e-7)
@@ -455,12 +509,24 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
 
     if (steepest)
         fit.notes.push_back(
-            "The responses jump between two neighbouring intensities: the "
-            "slope is steeper than these intensities can measure (not "
-            "identified).");
+            "The responses jump between two neighbouring intensities, " +
+            short_text(fit.bins[rise.last_low].x) + " and " +
+            short_text(fit.bins[rise.first_high].x) +
+            ": the slope is steeper than these intensities can measure (not "
+            "identified), so the threshold lies anywhere between them; no value and no "
+            "interval is given (test intensities between them to measure it).");
 
     // Thresholds and slopes.
     const auto make = [&](double f_level, const std::string& name) {
+        if (steepest) {
+            Threshold t;
+            t.status = ThresholdStatus::between;
+            t.between_low = fit.bins[rise.last_low].x;
+            t.between_high = fit.bins[rise.first_high].x;
+            t.text = "between " + short_text(*t.between_low) + " and " +
+                     short_text(*t.between_high);
+            return t;
+        }
         const auto [x, slope] = threshold_at(p, st, f_level);
         if (x < x_min) {
             fit.notes.push_back("The " + name +
@@ -499,16 +565,34 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
         }
     }
 
-    // The parametric bootstrap.
+    // The parametric bootstrap. Each resample follows the point estimate's rules: a
+    // threshold outside the tested range counts only as below or above it, and a slope
+    // that is not identified as steeper than any (a jump) or, with the threshold outside
+    // the range, as unknown.
+    enum class SlopeKind { identified, steep, unknown };
+    struct Resample {
+        double x = 0.0, slope = 0.0;
+        int side = 0;  // -1 below the tested range, +1 above, 0 within
+        SlopeKind kind = SlopeKind::identified;
+    };
     if (options.bootstrap > 0) {
         std::mt19937_64 rng(options.seed);
-        std::vector<double> th, sl, thp, slp;
+        std::vector<Resample> th, thp;
         int exceed = 0;
         std::vector<double> psi(p.u.size());
         for (std::size_t i = 0; i < p.u.size(); ++i)
             psi[i] = p.guess +
                      (1.0 - p.guess - st.lapse) * g_cdf(gauss, (p.u[i] - st.m) / st.s);
         Problem sample = p;
+        const auto resample_of = [&](double x, double slope, const Rise& r) {
+            Resample out{x, slope, x < x_min ? -1 : (x > x_max ? 1 : 0),
+                         SlopeKind::identified};
+            if (out.side != 0 || (r.off_slope && !r.jump()))
+                out.kind = SlopeKind::unknown;
+            else if (r.jump())
+                out.kind = SlopeKind::steep;
+            return out;
+        };
         for (int b = 0; b < options.bootstrap; ++b) {
             for (std::size_t i = 0; i < p.u.size(); ++i) {
                 int k = 0;
@@ -521,36 +605,111 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
             const State ss = parameters_of(s.theta);
             const auto [x, slope] = threshold_at(p, ss, options.threshold_level);
             if (!std::isfinite(x) || !std::isfinite(slope)) continue;
+            const Rise r = rise_of(ss);
             if (f_p) {
                 const double f = (*options.p_correct_level - options.guess) /
                                  (1.0 - options.guess - ss.lapse);
-                const auto [xp, slopep] = threshold_at(p, ss, std::min(f, 1.0 - 1e-12));
-                if (!std::isfinite(xp) || !std::isfinite(slopep)) continue;
-                thp.push_back(xp);
-                slp.push_back(slopep);
+                if (f >= 1.0) {  // never reaches that proportion: above the range
+                    thp.push_back({x_max, 0.0, 1, SlopeKind::unknown});
+                } else {
+                    const auto [xp, slopep] = threshold_at(p, ss, f);
+                    if (!std::isfinite(xp) || !std::isfinite(slopep)) continue;
+                    thp.push_back(resample_of(xp, slopep, r));
+                }
             }
-            th.push_back(x);
-            sl.push_back(slope);
+            th.push_back(resample_of(x, slope, r));
             if (deviance_of(ss, sample.k) >= deviance) ++exceed;
         }
         fit.bootstrap_samples = static_cast<int>(th.size());
         if (!th.empty()) {
             fit.deviance_p_bootstrap = static_cast<double>(exceed) / th.size();
             const double lo = (1.0 - options.level) / 2.0, hi = 1.0 - lo;
-            const auto interval = [&](Threshold& t, std::vector<double> v,
-                                      std::vector<double> s) {
+            const std::string level_text = short_text(100.0 * options.level) + "%";
+            const auto interval = [&](Threshold& t, const std::vector<Resample>& v,
+                                      const std::string& name) {
                 if (t.status != ThresholdStatus::estimated) return;
-                std::sort(v.begin(), v.end());
-                std::sort(s.begin(), s.end());
-                t.ci_low = percentile(v, lo);
-                t.ci_high = percentile(v, hi);
-                if (t.slope) {
-                    t.slope_ci_low = percentile(s, lo);
-                    t.slope_ci_high = percentile(s, hi);
+                std::vector<double> inside, slopes;
+                std::size_t below = 0, above = 0, steep = 0, unknown = 0;
+                for (const Resample& r : v) {
+                    if (r.side < 0) ++below;
+                    if (r.side > 0) ++above;
+                    if (r.side == 0) inside.push_back(r.x);
+                    if (r.kind == SlopeKind::steep) ++steep;
+                    if (r.kind == SlopeKind::unknown) ++unknown;
+                    if (r.kind == SlopeKind::identified) slopes.push_back(r.slope);
                 }
+                std::sort(inside.begin(), inside.end());
+                std::sort(slopes.begin(), slopes.end());
+                t.bootstrap_below = static_cast<int>(below);
+                t.bootstrap_above = static_cast<int>(above);
+                const End low_end = percentile_end(inside, below, above, lo);
+                const End high_end = percentile_end(inside, below, above, hi);
+                t.ci_low_status = low_end.status;
+                t.ci_low = low_end.value;
+                t.ci_high_status = high_end.status;
+                t.ci_high = high_end.value;
+                const auto end_text = [&](const End& e) {
+                    if (e.status == ThresholdStatus::below_range)
+                        return "< " + short_text(x_min);
+                    if (e.status == ThresholdStatus::above_range)
+                        return "> " + short_text(x_max);
+                    return short_text(*e.value);
+                };
+                t.ci_text = end_text(low_end) + " .. " + end_text(high_end);
+                const std::string of =
+                    "Of the " + std::to_string(v.size()) + " bootstrap resamples, ";
+                const auto share = [&](std::size_t k) {
+                    return std::to_string(k) + " (" +
+                           short_text(100.0 * static_cast<double>(k) / v.size()) + "%)";
+                };
+                const std::string leaves = "more than the " + short_text(100.0 * lo) +
+                                           "% that the " + level_text +
+                                           " interval leaves out on that side";
+                if (below > 0 && (low_end.status == ThresholdStatus::below_range ||
+                                  high_end.status == ThresholdStatus::below_range))
+                    fit.notes.push_back(
+                        of + share(below) + " put the " + name +
+                        " below the smallest intensity tested, " + short_text(x_min) +
+                        ": " + leaves +
+                        ", so the interval's lower end is only said to be "
+                        "below " +
+                        short_text(x_min) + " (" + t.ci_text + ").");
+                if (above > 0 && (high_end.status == ThresholdStatus::above_range ||
+                                  low_end.status == ThresholdStatus::above_range))
+                    fit.notes.push_back(
+                        of + share(above) + " put the " + name +
+                        " above the largest intensity tested, " + short_text(x_max) +
+                        ": " + leaves +
+                        ", so the interval's upper end is only said to be "
+                        "above " +
+                        short_text(x_max) + " (" + t.ci_text + ").");
+                if (!t.slope) return;
+                // Unknown slopes on the far side of each end, steep ones above.
+                const End slope_low = percentile_end(slopes, unknown, steep, lo);
+                const End slope_high = percentile_end(slopes, 0, unknown + steep, hi);
+                if (slope_low.status == ThresholdStatus::estimated)
+                    t.slope_ci_low = slope_low.value;
+                if (slope_high.status == ThresholdStatus::estimated)
+                    t.slope_ci_high = slope_high.value;
+                if (!t.slope_ci_low || !t.slope_ci_high)
+                    fit.notes.push_back(
+                        of + share(steep + unknown) +
+                        " have no identified slope at the " + name + " (" +
+                        std::to_string(steep) + " jump between two intensities, " +
+                        std::to_string(unknown) + " put the " + name +
+                        " outside the tested range or rise nowhere "
+                        "on it): " +
+                        leaves + ", so the slope's interval has no " +
+                        (!t.slope_ci_low && !t.slope_ci_high
+                             ? std::string("ends")
+                             : std::string(t.slope_ci_low ? "upper end" : "lower end")) +
+                        ".");
             };
-            interval(fit.threshold, th, sl);
-            if (fit.threshold_p && !thp.empty()) interval(*fit.threshold_p, thp, slp);
+            interval(fit.threshold, th, "threshold");
+            if (fit.threshold_p && !thp.empty())
+                interval(*fit.threshold_p, thp,
+                         "threshold at " + short_text(100.0 * *options.p_correct_level) +
+                             "% correct");
         }
     }
     return fit;

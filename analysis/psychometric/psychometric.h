@@ -23,12 +23,25 @@
 //
 // Intervals: parametric bootstrap (responses simulated from the fitted psi at the tested
 // intensities with the same numbers of trials, seeded mt19937_64, each sample refitted),
-// percentile intervals (R's quantile type 7).
+// percentile intervals (R's quantile type 7). Each resample follows the point estimate's
+// rules: a resample whose threshold lies below the smallest intensity tested counts as
+// "below", above the largest as "above", and its value is not used, only its side (the
+// fit's search stops somewhere out there, at no meaningful value). A percentile that
+// reaches such a resample is withheld and said as "< smallest" or "> largest": with n
+// resamples that happens when more than (n - 1) (1 - level) / 2 of them lie on that side
+// (more than 2.5% of a 95% interval's). Likewise a resample whose slope is not
+// identified counts as steeper than any measured (a jump between two intensities) or,
+// with its threshold outside the range, as unknown on either side.
+//
+// A slope that is not identified (no tested intensity on the rising part of F: the
+// responses jump between two neighbouring intensities and the likelihood only grows as
+// the function steepens) leaves the threshold anywhere between those two intensities:
+// it is reported as "between a and b", with no value and no interval.
 //
 // Hard cases are never a NaN or an infinity: the values are left empty and the `notes`
 // say why in words (no trials, one intensity only, every response correct, below
-// chance, no change with intensity, a threshold outside the tested range, a lapse rate or
-// slope at its bound).
+// chance, no change with intensity, a threshold outside the tested range or between two
+// intensities, a lapse rate or slope at its bound, an interval end withheld).
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -82,16 +95,31 @@ enum class ThresholdStatus {
     below_range,     // below the smallest intensity tested (`bound`): "< bound"
     above_range,     // above the largest intensity tested (`bound`): "> bound"
     not_identified,  // no threshold: chance, below chance, one intensity, no trials
+    between,  // the slope is not identified: anywhere in [between_low, between_high]
 };
 
 struct Threshold {
     ThresholdStatus status = ThresholdStatus::not_identified;
     std::optional<double> value;  // the intensity (estimated only)
     std::optional<double> bound;  // the tested range's end (below_range, above_range)
+    // The two neighbouring intensities tested that the responses jump between (between).
+    std::optional<double> between_low, between_high;
     std::optional<double> slope;  // dpsi/dx there (estimated, slope identified)
-    std::optional<double> ci_low, ci_high;              // bootstrap, of the value
-    std::optional<double> slope_ci_low, slope_ci_high;  // bootstrap, of the slope
-    std::string text;  // "0.4610", "< 0.1", "> 0.8" or "not identified"
+    // Bootstrap interval of the value (estimated only). Each end's status: estimated (the
+    // number in ci_low / ci_high), below_range or above_range (withheld: more resamples
+    // than the interval leaves out on that side put the threshold beyond the tested
+    // range; that end is only "< smallest intensity" or "> largest"), not_identified (no
+    // interval).
+    std::optional<double> ci_low, ci_high;
+    ThresholdStatus ci_low_status = ThresholdStatus::not_identified;
+    ThresholdStatus ci_high_status = ThresholdStatus::not_identified;
+    int bootstrap_below = 0, bootstrap_above = 0;  // resamples outside the tested range
+    std::string ci_text;  // "0.31 .. 0.45", "< 0.05 .. 0.25", "0.1 .. > 0.6" or ""
+    // Bootstrap interval of the slope; an end is empty (with a note) when it reaches the
+    // resamples whose slope is not identified.
+    std::optional<double> slope_ci_low, slope_ci_high;
+    std::string
+        text;  // "0.4610", "< 0.1", "> 0.8", "between 0.3 and 0.4", "not identified"
 };
 
 struct PsychometricFit {

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "analysis/data/long_table.h"
+#include "analysis/report/format.h"
 
 namespace lucent::analysis {
 namespace {
@@ -329,15 +330,149 @@ TEST(PsychometricHardCases, ThresholdAboveTheRangeAndStepResponses) {
     expect_finite(high);
     EXPECT_EQ(high.threshold.status, ThresholdStatus::above_range) << all_notes(high);
     EXPECT_EQ(high.threshold.text, "> 0.6");
-    // A jump from chance to perfect between two levels: the slope is not identified.
+    // A jump from chance to perfect between two levels: the slope is not identified, and
+    // the likelihood is as high for a step anywhere between 0.3 and 0.4, so the
+    // threshold is only "between 0.3 and 0.4".
     const PsychometricFit step =
         fit_psychometric(bins_of({20, 20, 20, 40, 40, 40}, 40), options(kGauss, 0.5, {}));
     expect_finite(step);
-    ASSERT_EQ(step.threshold.status, ThresholdStatus::estimated) << all_notes(step);
-    EXPECT_GT(*step.threshold.value, 0.3);
-    EXPECT_LT(*step.threshold.value, 0.4);
+    ASSERT_EQ(step.threshold.status, ThresholdStatus::between) << all_notes(step);
+    EXPECT_EQ(*step.threshold.between_low, 0.3);
+    EXPECT_EQ(*step.threshold.between_high, 0.4);
+    EXPECT_EQ(step.threshold.text, "between 0.3 and 0.4");
+    EXPECT_FALSE(step.threshold.value);
     EXPECT_FALSE(step.threshold.slope);
     EXPECT_TRUE(has_note(step, "slope is steeper")) << all_notes(step);
+}
+
+// Issue 44, item 3: a sharp observer on a coarse ladder got "JND 0.1475, 95% interval
+// 0.1475 .. 0.1475": the slope runs off to infinity, every resample puts the step in
+// the same gap, and the interval collapsed onto an arbitrary point of it.
+TEST(PsychometricBootstrap, ASharpObserverOnACoarseLadderIsBetweenTwoIntensities) {
+    // At chance (5 of 10) at 0.05 and 0.1, right on 27 of 28 from 0.15 up: the best
+    // function is a step between 0.1 and 0.15 with psi = 1/2 below and 1 - 1/28 above
+    // (a lapse rate of 0.036, within its bound 0.06); any step in that gap is as likely.
+    const std::vector<PsychometricBin> ladder{
+        {0.05, 3, 6}, {0.1, 2, 4}, {0.15, 10, 10}, {0.2, 11, 12}, {0.25, 6, 6}};
+    for (const PsychometricFamily family : {kGauss, kWeibull}) {
+        PsychometricOptions o = options(family, 0.5, {}, 0.75);
+        o.bootstrap = 200;
+        const PsychometricFit fit = fit_psychometric(ladder, o);
+        expect_finite(fit);
+        ASSERT_TRUE(fit.fitted);
+        EXPECT_NEAR(*fit.lapse, 1.0 / 28.0, 1e-3);
+        for (const Threshold* t : {&fit.threshold, &*fit.threshold_p}) {
+            ASSERT_EQ(t->status, ThresholdStatus::between) << all_notes(fit);
+            EXPECT_EQ(*t->between_low, 0.1);
+            EXPECT_EQ(*t->between_high, 0.15);
+            EXPECT_EQ(t->text, "between 0.1 and 0.15");
+            EXPECT_FALSE(t->value);
+            EXPECT_FALSE(t->slope);
+            // No interval at all, not a collapsed one.
+            EXPECT_FALSE(t->ci_low);
+            EXPECT_FALSE(t->ci_high);
+            EXPECT_EQ(t->ci_low_status, ThresholdStatus::not_identified);
+            EXPECT_EQ(t->ci_text, "");
+            EXPECT_FALSE(t->slope_ci_low || t->slope_ci_high);
+        }
+        EXPECT_TRUE(has_note(fit, "between two neighbouring intensities, 0.1 and 0.15"))
+            << all_notes(fit);
+        EXPECT_TRUE(has_note(fit, "no value and no interval")) << all_notes(fit);
+    }
+}
+
+// Issue 44, item 3: an interval of "-11.72 .. 0.25" on deltas from 0.05: resamples
+// where every answer is right put the threshold below every delta shown, where the
+// search stops at its bound, and the percentile took that bound as a number.
+TEST(PsychometricBootstrap, ResamplesBelowTheTestedRangeWithholdTheLowerEnd) {
+    const std::vector<PsychometricBin> bins{{0.05, 2, 3}, {0.1, 4, 5}, {0.2, 6, 6}};
+    PsychometricOptions o = options(kGauss, 0.5, {}, 0.75);
+    o.bootstrap = 1000;
+    o.seed = 3;
+    const PsychometricFit fit = fit_psychometric(bins, o);
+    expect_finite(fit);
+    const Threshold& t = fit.threshold;
+    ASSERT_EQ(t.status, ThresholdStatus::estimated) << all_notes(fit);
+    EXPECT_GE(*t.value, 0.05);
+    EXPECT_LE(*t.value, 0.2);
+    // A resample with all 14 answers right has its threshold below 0.05 (the point
+    // estimate's rule for every response correct); under the fitted psi that happens
+    // with probability prod psi(x)^n, well above the 2.5% the interval leaves out below.
+    double all_correct = 1.0;
+    for (const PsychometricBin& b : bins)
+        all_correct *= std::pow(psychometric_psi(fit, b.x), b.n_trials);
+    ASSERT_GT(all_correct, 0.06);
+    ASSERT_EQ(fit.bootstrap_samples, 1000);
+    // At least those resamples (binomial, 1000 draws: more than 4.5 SDs below its mean
+    // would be needed to fall under 0.6 of it).
+    EXPECT_GE(t.bootstrap_below, 0.6 * 1000 * all_correct);
+    EXPECT_GT(t.bootstrap_below, 0.025 * 999);
+    // So the lower end is withheld, said in words, never a number below the range.
+    EXPECT_EQ(t.ci_low_status, ThresholdStatus::below_range);
+    EXPECT_FALSE(t.ci_low);
+    ASSERT_EQ(t.ci_high_status, ThresholdStatus::estimated);
+    ASSERT_TRUE(t.ci_high);
+    EXPECT_GE(*t.ci_high, *t.value);
+    EXPECT_LE(*t.ci_high, 0.2);
+    EXPECT_EQ(t.ci_text.rfind("< 0.05 .. ", 0), 0u) << t.ci_text;
+    EXPECT_TRUE(has_note(fit,
+                         "put the threshold below the smallest intensity tested, "
+                         "0.05"))
+        << all_notes(fit);
+    EXPECT_TRUE(has_note(fit, "lower end is only said to be below 0.05"))
+        << all_notes(fit);
+    // The same at 75% correct.
+    ASSERT_EQ(fit.threshold_p->status, ThresholdStatus::estimated);
+    EXPECT_FALSE(fit.threshold_p->ci_low);
+    EXPECT_EQ(fit.threshold_p->ci_text.rfind("< 0.05 .. ", 0), 0u);
+}
+
+// The rule, on either side: an end is withheld exactly when more than (n - 1) x 2.5% of
+// the n resamples lie beyond the range on its side (R's type-7 percentile reaches them).
+TEST(PsychometricBootstrap, AnEndIsWithheldWhenMoreThanAlphaHalfOfResamplesAreBeyond) {
+    PsychometricOptions o = options(kGauss, 0.5, {}, 0.75);
+    o.bootstrap = 400;
+    // Flat until 0.3, then up at 0.4, the top delta: many resamples rise past it.
+    const PsychometricFit high = fit_psychometric(
+        std::vector<PsychometricBin>{
+            {0.1, 10, 20}, {0.2, 10, 20}, {0.3, 11, 20}, {0.4, 17, 20}},
+        o);
+    // A clean rise in the middle of the range: none beyond it.
+    const PsychometricFit clean =
+        fit_psychometric(bins_of({21, 24, 30, 36, 39, 40}, 40), o);
+    for (const PsychometricFit* fit : {&high, &clean}) {
+        expect_finite(*fit);
+        for (const Threshold* t : {&fit->threshold, &*fit->threshold_p}) {
+            ASSERT_EQ(t->status, ThresholdStatus::estimated) << all_notes(*fit);
+            const double cut = 0.025 * (fit->bootstrap_samples - 1);
+            EXPECT_EQ(t->ci_low_status == ThresholdStatus::below_range,
+                      t->bootstrap_below > cut);
+            EXPECT_EQ(t->ci_high_status == ThresholdStatus::above_range,
+                      t->bootstrap_above > cut);
+            EXPECT_EQ(t->ci_low.has_value(),
+                      t->ci_low_status == ThresholdStatus::estimated);
+            EXPECT_EQ(t->ci_high.has_value(),
+                      t->ci_high_status == ThresholdStatus::estimated);
+            const double x_min = fit->bins.front().x, x_max = fit->bins.back().x;
+            if (t->ci_low) {
+                EXPECT_GE(*t->ci_low, x_min);
+            }
+            if (t->ci_high) {
+                EXPECT_LE(*t->ci_high, x_max);
+            }
+        }
+    }
+    const Threshold& h = high.threshold;
+    EXPECT_GT(h.bootstrap_above, 0.025 * 399) << all_notes(high);
+    EXPECT_EQ(h.ci_high_status, ThresholdStatus::above_range);
+    ASSERT_TRUE(h.ci_low);
+    EXPECT_EQ(h.ci_text, format_short(*h.ci_low) + " .. > 0.4");
+    EXPECT_TRUE(has_note(high, "upper end is only said to be above 0.4"))
+        << all_notes(high);
+    const Threshold& c = clean.threshold;
+    EXPECT_EQ(c.bootstrap_below + c.bootstrap_above, 0);
+    ASSERT_TRUE(c.ci_low && c.ci_high);
+    EXPECT_EQ(c.ci_text, format_short(*c.ci_low) + " .. " + format_short(*c.ci_high));
 }
 
 TEST(PsychometricHardCases, ProportionAboveTheCeilingHasNoThreshold) {
