@@ -279,38 +279,69 @@ WebReply declined_reply() {
 // Holds the participant for one request: requests of one participant (on any serve
 // process, through any store of a pool) take turns, as lab stations do for a whole
 // session. Waits up to `wait` for another request to end; a lab station that runs the
-// participant keeps it past that (409).
+// participant keeps it past that (409). The wait holds no store connection: the claim
+// is tried on a leased store, which goes back to the pool between tries, so requests for
+// a held code never starve other participants of connections (issue 44). At most one
+// request per code waits in a process; another arriving meanwhile is told to come back
+// (503, Retry-After), holding nothing.
 class ParticipantTurn {
 public:
-    ParticipantTurn(StudyStore& store, const std::string& code,
-                    std::chrono::milliseconds wait)
-        : store_(store), code_(code) {
+    ParticipantTurn(StorePool& pool, const std::string& code,
+                    std::chrono::milliseconds wait, WaitingCodes& waiting)
+        : code_(code) {
+        if (try_claim(pool)) return;
+        {
+            std::lock_guard lock(waiting.mutex);
+            if (!waiting.codes.insert(code_).second)
+                throw StoreUnavailable("participant '" + code_ +
+                                       "' has another request waiting for its turn");
+        }
+        struct Unlist {
+            WaitingCodes& waiting;
+            const std::string& code;
+            ~Unlist() {
+                std::lock_guard lock(waiting.mutex);
+                waiting.codes.erase(code);
+            }
+        } unlist{waiting, code_};
         const auto deadline = std::chrono::steady_clock::now() + wait;
         for (;;) {
-            try {
-                store_.claim_participant(code_);
-                return;
-            } catch (const StoreUnavailable&) {
-                throw;
-            } catch (const StoreError&) {
-                if (std::chrono::steady_clock::now() >= deadline) throw;
-            }
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            const bool last = std::chrono::steady_clock::now() >= deadline;
+            if (try_claim(pool, last)) return;
         }
     }
     ~ParticipantTurn() {
         try {
-            store_.release_participant(code_);
+            (*lease_)->release_participant(code_);
         } catch (const std::exception&) {
             // A connection in doubt releases its locks as it closes.
         }
     }
     ParticipantTurn(const ParticipantTurn&) = delete;
     ParticipantTurn& operator=(const ParticipantTurn&) = delete;
+    // The store holding the claim, for the rest of the request.
+    StudyStore& store() const { return **lease_; }
 
 private:
-    StudyStore& store_;
+    // True when claimed (the lease kept); false after giving the store back; `last`:
+    // the store's refusal is thrown instead.
+    bool try_claim(StorePool& pool, bool last = false) {
+        lease_.emplace(pool.lease());
+        try {
+            (*lease_)->claim_participant(code_);
+            return true;
+        } catch (const StoreUnavailable&) {
+            throw;
+        } catch (const StoreError&) {
+            lease_.reset();
+            if (last) throw;
+        }
+        return false;
+    }
+
     std::string code_;
+    std::optional<StorePool::Lease> lease_;
 };
 
 }  // namespace
@@ -319,12 +350,16 @@ WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions 
     : protocol_(protocol),
       own_pool_(std::make_unique<StorePool>(store)),
       pool_(*own_pool_),
-      options_(std::move(options)) {
+      options_(std::move(options)),
+      waiting_(std::make_unique<WaitingCodes>()) {
     init();
 }
 
 WebStudy::WebStudy(const Protocol& protocol, StorePool& pool, WebStudyOptions options)
-    : protocol_(protocol), pool_(pool), options_(std::move(options)) {
+    : protocol_(protocol),
+      pool_(pool),
+      options_(std::move(options)),
+      waiting_(std::make_unique<WaitingCodes>()) {
     init();
 }
 
@@ -417,9 +452,7 @@ WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
     if (endpoint != "session" && !action)
         return error_reply(404, "no API endpoint '" + std::string(endpoint) + "'");
     try {
-        StorePool::Lease store = pool_.lease();
-        return endpoint == "session" ? start(*store, request)
-                                     : act(*store, endpoint, request);
+        return endpoint == "session" ? start(request) : act(endpoint, request);
     } catch (const RequestError& e) {
         return error_reply(e.status, e.what());
     } catch (const json::exception& e) {
@@ -617,14 +650,15 @@ WebReply WebStudy::show_consent(StudyStore& store, const std::string& code,
     return {200, to_text(reply)};
 }
 
-WebReply WebStudy::start(StudyStore& store, const json& body) {
+WebReply WebStudy::start(const json& body) {
     const Participant who = participant_of(body);
     const std::string& code = who.code;
     const std::string token = text_field(body, "token", kMaxTokenLength, false);
     const double t_ms = *number_field(body, "t_ms", 0, kMaxPageMs, true);
     Browser browser = browser_of(body);  // what this page says about itself
 
-    const ParticipantTurn turn(store, code, options_.participant_wait);
+    const ParticipantTurn turn(pool_, code, options_.participant_wait, *waiting_);
+    StudyStore& store = turn.store();
     std::optional<SessionRow> unfinished = store.unfinished_session(code);
     if (unfinished && store.complete_session_if_answered(unfinished->id))
         unfinished.reset();  // every trial answered: completed now
@@ -719,7 +753,7 @@ json WebStudy::pending_state() const {
 // ---- [SECTION] actions ----------------------------------------------------------------
 // The session a token names, checked against the secret: pending (no session of its UUID
 // yet), withdrawn (410), or the participant's session in the store.
-WebReply WebStudy::act(StudyStore& store, std::string_view endpoint, const json& body) {
+WebReply WebStudy::act(std::string_view endpoint, const json& body) {
     const std::string token = text_field(body, "token", kMaxTokenLength, true);
     const std::optional<TokenParts> parts = token_parts(token);
     if (!parts) throw RequestError(403, "unknown session token");
@@ -727,7 +761,8 @@ WebReply WebStudy::act(StudyStore& store, std::string_view endpoint, const json&
     if (parts->legacy) {
         // An earlier serve's token: /api/session takes it (for the session in progress)
         // and gives the page a new one.
-        const std::optional<SessionRow> unfinished = store.unfinished_session(code);
+        StorePool::Lease lease = pool_.lease();
+        const std::optional<SessionRow> unfinished = lease->unfinished_session(code);
         if (!unfinished ||
             !same_secret_text(
                 token, legacy_session_token(options_.secret, code, unfinished->uuid)))
@@ -739,7 +774,8 @@ WebReply WebStudy::act(StudyStore& store, std::string_view endpoint, const json&
     if (!same_secret_text(token, session_token(options_.secret, code, parts->uuid)))
         throw RequestError(403, "unknown session token");
 
-    const ParticipantTurn turn(store, code, options_.participant_wait);
+    const ParticipantTurn turn(pool_, code, options_.participant_wait, *waiting_);
+    StudyStore& store = turn.store();
     const std::optional<SessionRow> session = store.session_by_uuid(parts->uuid);
     if (!session) {
         if (store.session_withdrawn(parts->uuid)) throw RequestError(410, kWithdrawn);

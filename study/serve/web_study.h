@@ -28,6 +28,7 @@
 #include <mutex>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -101,6 +102,11 @@ std::optional<std::string> image_of_target(std::string_view target,
 
 class SessionFlow;
 class StorePool;
+// The codes a request of this process waits for (web_study.cpp's ParticipantTurn).
+struct WaitingCodes {
+    std::mutex mutex;
+    std::set<std::string> codes;
+};
 
 class WebStudy {
 public:
@@ -124,14 +130,13 @@ private:
     struct Browser;
     struct Page;
     void init();  // both constructors: checks the pictures, ensures the study
-    WebReply start(StudyStore& store, const nlohmann::json& body);
+    WebReply start(const nlohmann::json& body);
     static Browser browser_of(const nlohmann::json& body);
     WebReply resume(StudyStore& store, const std::string& code,
                     const SessionRow& unfinished, const Browser& browser, double t_ms);
     WebReply show_consent(StudyStore& store, const std::string& code,
                           const std::string& uuid, const Browser& browser, double t_ms);
-    WebReply act(StudyStore& store, std::string_view endpoint,
-                 const nlohmann::json& body);
+    WebReply act(std::string_view endpoint, const nlohmann::json& body);
     WebReply act_pending(StudyStore& store, std::string_view endpoint,
                          const std::string& code, const std::string& uuid,
                          const nlohmann::json& body);
@@ -170,6 +175,7 @@ private:
     WebStudyOptions options_;
     int64_t study_id_ = 0;
     int main_trials_ = 0;  // a session's main (not practice) trials
+    std::unique_ptr<WaitingCodes> waiting_;
 };
 
 }  // namespace lucent::study
