@@ -49,7 +49,7 @@ void register_export(CLI::App& app, int& exit_code) {
             for (const std::string& p : r.excluded_participants)
                 std::cerr << "lucent export: excluded " << p << "\n";
             for (const std::string& note : r.notes)  // on stderr: the CSV stays plain
-                std::cerr << "lucent export: note: " << note << "\n";
+                std::cerr << "lucent export: note: " << source.as_given(note) << "\n";
             std::cout << "wrote " << r.rows << " rows to " << *out << "\n";
             exit_code = kExitOk;
         } catch (const study::StoreError& e) {

@@ -28,15 +28,15 @@ analysis::LongTable read_ratings(
     const bool server = study::is_server_uri(path);
     if (!server && !is_sqlite_file(path)) return analysis::read_long_csv(path, scale);
     study::LongTable rows;
-    std::string read_path;
+    std::string note;
     try {
         const study::ReadableStudyFile source(path);  // a server: one snapshot of it
-        read_path = source.path();
         // Each rating on its own question's scale, which the report's plots then use.
         for (const auto& [question, points] : study::check_stored_ratings(source.path()))
             if (question_scales)
                 (*question_scales)[question] = {false, 1.0, double(points)};
         rows = study::analysis_long_table(source.path());
+        note = source.as_given(rows.sessions_note);
     } catch (const study::StoreError& e) {
         throw analysis::InputError(e.what());
     }
@@ -47,8 +47,6 @@ analysis::LongTable read_ratings(
     for (const std::string& p : rows.excluded_participants)
         std::cerr << "lucent analyze: excluded participant " << p << "\n";
     // The snapshot of a server has a temporary name: the note names what was given.
-    std::string note = rows.sessions_note;
-    if (note.rfind(read_path, 0) == 0) note = path + note.substr(read_path.size());
     std::cerr << "lucent analyze: note: " << note << "\n";
     if (notes) notes->push_back("Sessions: " + note + ".");
     analysis::LongTable table;

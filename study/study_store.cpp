@@ -48,7 +48,7 @@ std::pair<int, int> init_study_store(const std::string& db) {
     return {before, kSchemaVersion};
 }
 
-ReadableStudyFile::ReadableStudyFile(const std::string& db) {
+ReadableStudyFile::ReadableStudyFile(const std::string& db) : given_(db) {
     refuse_unknown_scheme(db);
     if (!is_server_uri(db)) {
         path_ = db;
@@ -70,6 +70,14 @@ ReadableStudyFile::ReadableStudyFile(const std::string& db) {
         std::filesystem::remove_all(temporary_dir_, ec);
         throw;
     }
+}
+
+std::string ReadableStudyFile::as_given(std::string text) const {
+    if (path_ == given_) return text;
+    for (size_t at = text.find(path_); at != std::string::npos;
+         at = text.find(path_, at + given_.size()))
+        text.replace(at, path_.size(), given_);
+    return text;
 }
 
 ReadableStudyFile::~ReadableStudyFile() {

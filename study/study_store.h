@@ -195,8 +195,12 @@ public:
     ReadableStudyFile(const ReadableStudyFile&) = delete;
     ReadableStudyFile& operator=(const ReadableStudyFile&) = delete;
     const std::string& path() const { return path_; }
+    // `text` (a note about the file read) naming the store as given, never the
+    // temporary snapshot: a reader of a report cannot open /tmp/lucent-snapshot-*.
+    std::string as_given(std::string text) const;
 
 private:
+    std::string given_;
     std::string path_;
     std::string temporary_dir_;
 };
