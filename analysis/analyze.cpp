@@ -1,9 +1,93 @@
 #include "analysis/analyze.h"
 
+#include <chrono>
+#include <map>
+
 #include "analysis/data/grouping.h"
 #include "analysis/data/subject_matrix.h"
 
 namespace lucent::analysis {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_between(Clock::time_point from, Clock::time_point to) {
+    return std::chrono::duration<double>(to - from).count();
+}
+
+// The mixed-model fits of a run, in order, timed for ModelFitProgress.
+class FitProgress {
+public:
+    FitProgress(const std::vector<FactorData>& pairs, const AnalysisRequest& request)
+        : on_fit_(request.on_fit) {
+        for (const FactorData& pair : pairs) {
+            std::size_t ratings = 0;
+            for (const Group& g : pair.data.groups) ratings += g.values.size();
+            for (const RatingModel model : {RatingModel::lmm, RatingModel::clmm})
+                if (model == RatingModel::lmm ? request.models.lmm : request.models.clmm)
+                    fits_.push_back({model, ratings});
+        }
+    }
+    // Before a pair's models: the time from here to the first one's end is its (the
+    // model frame is built for the pair's first model).
+    void pair_starts() { mark_ = Clock::now(); }
+    ModelFitHook hook(const FactorData& pair) {
+        if (!on_fit_) return {};
+        return [this, &pair](RatingModel, const RatingModelFit* fit) {
+            const Fit& f = fits_.at(next_);
+            ModelFitProgress p;
+            p.model = f.model;
+            p.index = static_cast<int>(next_) + 1;
+            p.total = static_cast<int>(fits_.size());
+            p.question = pair.question;
+            p.factor = pair.factor;
+            p.ratings = f.ratings;
+            if (!fit) {
+                if (next_ == 0) start_ = mark_;
+                on_fit_(p);
+                return;
+            }
+            const Clock::time_point now = Clock::now();
+            p.done = true;
+            p.fitted = fit->fitted;
+            p.seconds = seconds_between(mark_, now);
+            mark_ = now;
+            p.elapsed = seconds_between(start_, now);
+            Rate& rate = rates_[f.model];
+            rate.seconds += p.seconds;
+            rate.ratings += static_cast<double>(f.ratings);
+            all_.seconds += p.seconds;
+            all_.ratings += static_cast<double>(f.ratings);
+            ++next_;
+            for (std::size_t i = next_; i < fits_.size(); ++i) {
+                const auto known = rates_.find(fits_[i].model);
+                const Rate& r = known != rates_.end() ? known->second : all_;
+                if (r.ratings > 0)
+                    p.left +=
+                        r.seconds / r.ratings * static_cast<double>(fits_[i].ratings);
+            }
+            on_fit_(p);
+        };
+    }
+
+private:
+    struct Fit {
+        RatingModel model;
+        std::size_t ratings;
+    };
+    struct Rate {
+        double seconds = 0.0, ratings = 0.0;
+    };
+    std::function<void(const ModelFitProgress&)> on_fit_;
+    std::vector<Fit> fits_;
+    std::size_t next_ = 0;
+    Clock::time_point start_, mark_;
+    std::map<RatingModel, Rate> rates_;
+    Rate all_;
+};
+
+}  // namespace
 
 AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& request) {
     const auto pairs =
@@ -15,6 +99,7 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
             (request.factor.empty() ? "" : " for factor '" + request.factor + "'"));
     AnalysisResult result;
     std::vector<OneWayAnalysis>& analyses = result.pairs;
+    FitProgress progress(pairs, request);
     for (const FactorData& pair : pairs) {
         if (request.on_pair)
             request.on_pair(pair.question, pair.factor, pair.data.groups.size());
@@ -27,8 +112,10 @@ AnalysisResult analyze_table(const LongTable& table, const AnalysisRequest& requ
             subject_by_level(table, pair.question, pair.factor, levels);
         analyses.back().within = analyze_within_subject(
             matrix.complete, std::move(matrix.incomplete_participants));
+        progress.pair_starts();
         analyses.back().models =
-            fit_pair_models(table, pair.question, pair.factor, levels, request.models);
+            fit_pair_models(table, pair.question, pair.factor, levels, request.models,
+                            progress.hook(pair));
     }
     if (request.primary) {
         result.primary = *request.primary;

@@ -7,9 +7,25 @@
 #include <vector>
 
 #include "analysis/data/long_table.h"
+#include "analysis/mixed/rating_models.h"
 #include "analysis/stats/one_way_analysis.h"
 
 namespace lucent::analysis {
+
+// The progress of one mixed-model fit (lucent analyze shows it on stderr): called before
+// each fit (`done` false) and after it.
+struct ModelFitProgress {
+    RatingModel model = RatingModel::clmm;
+    int index = 0, total = 0;  // this fit (from 1) of every mixed-model fit of the run
+    std::string question, factor;
+    std::size_t ratings = 0;  // the pair's ratings, which a fit's time grows with
+    bool done = false;
+    bool fitted = false;  // done: the model was fitted (else its notes say why not)
+    // Done: this fit's seconds, the seconds since the first fit began, and the seconds
+    // the fits left should take: each one's ratings at the seconds per rating its model
+    // took so far (all the fits so far', before its model has one).
+    double seconds = 0.0, elapsed = 0.0, left = 0.0;
+};
 
 struct AnalysisRequest {
     double alpha = 0.10;   // the thesis's level; Tukey intervals at 1 - alpha
@@ -29,6 +45,8 @@ struct AnalysisRequest {
     double within_share = 1.0;
     // The analyses to run besides the one-way ones, and which leads the report.
     ModelChoice models;
+    // Called before and after each mixed-model fit (progress on long runs); may be empty.
+    std::function<void(const ModelFitProgress&)> on_fit;
 };
 
 struct AnalysisResult {

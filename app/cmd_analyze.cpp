@@ -3,6 +3,8 @@
 // (participant,stimulus,factor,level,question,rating); and the perceptual scales of
 // forced choices (Bradley-Terry, Thurstone, MLDS) from a study database or a choices CSV;
 // and matches and thresholds of adjust and staircase blocks from a study database.
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -107,6 +109,38 @@ void add_matching_section(const AnalyzeArgs& args, analysis::ReportOptions& opti
                                section.files.end());
 }
 
+// "0.4 s", "12 s", "3 min 05 s".
+std::string duration_text(double seconds) {
+    char text[32];
+    if (seconds < 10.0)
+        std::snprintf(text, sizeof text, "%.1f s", seconds);
+    else if (seconds < 120.0)
+        std::snprintf(text, sizeof text, "%.0f s", seconds);
+    else {
+        const long whole = std::lround(seconds);
+        std::snprintf(text, sizeof text, "%ld min %02ld s", whole / 60, whole % 60);
+    }
+    return text;
+}
+
+// The mixed models are the slow part of a large study (1e6 ratings: over a minute, the
+// one-way tests a second): one stderr line per fit, begun before it and ended after it
+// with its time, the time so far and an estimate of the time left. Like lucent render's
+// batch progress, on stderr only, so stdout keeps the report's file names.
+void show_fit_progress(const analysis::ModelFitProgress& p) {
+    if (!p.done) {
+        std::cerr << "lucent analyze: " << analysis::rating_model_name(p.model) << " "
+                  << p.index << "/" << p.total << ": question " << p.question
+                  << ", factor " << p.factor << " (" << p.ratings << " ratings) ..."
+                  << std::flush;
+        return;
+    }
+    std::cerr << " " << (p.fitted ? "" : "not fitted, ") << duration_text(p.seconds)
+              << "; " << duration_text(p.elapsed) << " elapsed, ~"
+              << duration_text(p.left) << " left\n"
+              << std::flush;
+}
+
 int run_analyze(const AnalyzeArgs& args) {
     using namespace lucent::analysis;
     try {
@@ -154,6 +188,7 @@ int run_analyze(const AnalyzeArgs& args) {
                                     std::cerr << "analyzing " << question << " ~ "
                                               << factor << " (" << levels << " levels)\n";
                                 }};
+        request.on_fit = show_fit_progress;
         request.within_share = args.within_share;
         request.models = parse_model_list(args.models, primary_model);
         request.models.random_slopes = args.random_slopes;

@@ -396,9 +396,16 @@ ModelChoice parse_model_list(const std::string& list, RatingModel primary) {
 PairModels fit_pair_models(const LongTable& table, const std::string& question,
                            const std::string& factor,
                            const std::vector<std::string>& levels,
-                           const ModelChoice& choice) {
+                           const ModelChoice& choice, const ModelFitHook& on_fit) {
     PairModels models;
     if (!choice.lmm && !choice.clmm) return models;
+    // Each model between the hook's two calls.
+    const auto fit = [&](RatingModel model, const auto& make) {
+        if (on_fit) on_fit(model, nullptr);
+        RatingModelFit result = make();
+        if (on_fit) on_fit(model, &result);
+        return result;
+    };
     const PairFrame pair = pair_frame(table, question, factor, levels);
     RandomStructure structure = random_structure(pair);
     std::map<std::string, int> ratings_per_level;
@@ -412,8 +419,14 @@ PairModels fit_pair_models(const LongTable& table, const std::string& question,
             "Needs at least 2 ratings in some level (each level has 1): "
             "a model with a parameter per level fits them exactly, so "
             "no model is fitted.");
-        if (choice.lmm) models.lmm = empty_fit(RatingModel::lmm, pair, structure);
-        if (choice.clmm) models.clmm = empty_fit(RatingModel::clmm, pair, structure);
+        if (choice.lmm)
+            models.lmm = fit(RatingModel::lmm, [&] {
+                return empty_fit(RatingModel::lmm, pair, structure);
+            });
+        if (choice.clmm)
+            models.clmm = fit(RatingModel::clmm, [&] {
+                return empty_fit(RatingModel::clmm, pair, structure);
+            });
         return models;
     }
     if (pair.levels.size() < 2) {
@@ -421,12 +434,23 @@ PairModels fit_pair_models(const LongTable& table, const std::string& question,
                                std::to_string(pair.levels.size()) +
                                    " level with ratings: there is nothing to compare, so "
                                    "no model is fitted.");
-        if (choice.lmm) models.lmm = empty_fit(RatingModel::lmm, pair, structure);
-        if (choice.clmm) models.clmm = empty_fit(RatingModel::clmm, pair, structure);
+        if (choice.lmm)
+            models.lmm = fit(RatingModel::lmm, [&] {
+                return empty_fit(RatingModel::lmm, pair, structure);
+            });
+        if (choice.clmm)
+            models.clmm = fit(RatingModel::clmm, [&] {
+                return empty_fit(RatingModel::clmm, pair, structure);
+            });
         return models;
     }
-    if (choice.lmm) models.lmm = fit_linear(pair, structure, choice.random_slopes);
-    if (choice.clmm) models.clmm = fit_ordinal(pair, structure);
+    if (choice.lmm)
+        models.lmm = fit(RatingModel::lmm, [&] {
+            return fit_linear(pair, structure, choice.random_slopes);
+        });
+    if (choice.clmm)
+        models.clmm =
+            fit(RatingModel::clmm, [&] { return fit_ordinal(pair, structure); });
     return models;
 }
 

@@ -11,6 +11,7 @@
 // A term the data cannot carry is left out and said so in words: one participant (no
 // participant variance), one stimulus per level (stimulus and level confounded), a
 // single stimulus. Nothing is ever NaN: what is undefined is empty with a note.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -76,11 +77,15 @@ struct PairModels {
     std::optional<RatingModelFit> lmm, clmm;
 };
 
+// Called before each model `choice` asks for (fit: nullptr) and after it (fit: the
+// result, fitted or not), lmm first: progress on long runs.
+using ModelFitHook = std::function<void(RatingModel model, const RatingModelFit* fit)>;
+
 // Fits the models `choice` asks for to the ratings of (question, factor) at `levels`
 // (in that order; levels without ratings are left out).
 PairModels fit_pair_models(const LongTable& table, const std::string& question,
                            const std::string& factor,
                            const std::vector<std::string>& levels,
-                           const ModelChoice& choice);
+                           const ModelChoice& choice, const ModelFitHook& on_fit = {});
 
 }  // namespace lucent::analysis

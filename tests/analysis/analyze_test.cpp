@@ -47,6 +47,46 @@ TEST(AnalyzeTable, OnePairPerQuestionAndFactor) {
     EXPECT_THROW(analyze_table(t, request), InputError);
 }
 
+// Each mixed-model fit is announced before and reported after, numbered over the run's
+// fits (lmm before clmm within a pair), with its pair's ratings; after the last, none is
+// left. A pair the models cannot fit (one rating per level) is reported as not fitted.
+TEST(AnalyzeTable, MixedModelProgressCountsEveryFitBeforeAndAfter) {
+    const LongTable t = table_of(
+        "participant,stimulus,factor,level,question,rating\n"
+        "p1,a,thickness,18,translucent,2\np1,b,thickness,25,translucent,5\n"
+        "p2,a,thickness,18,translucent,3\np2,b,thickness,25,translucent,6\n"
+        "p3,a,thickness,18,translucent,3\np3,b,thickness,25,translucent,4\n"
+        "p1,a,thickness,18,realistic,4\np1,b,thickness,25,realistic,5\n");
+    AnalysisRequest request;
+    request.models = parse_model_list("anova,lmm,clmm", RatingModel::anova);
+    std::vector<ModelFitProgress> seen;
+    request.on_fit = [&](const ModelFitProgress& p) { seen.push_back(p); };
+    analyze_table(t, request);
+    ASSERT_EQ(seen.size(), 8u);  // 2 pairs x 2 models, each before and after
+    for (std::size_t i = 0; i < seen.size(); ++i) {
+        const ModelFitProgress& p = seen[i];
+        EXPECT_EQ(p.index, static_cast<int>(i / 2) + 1);
+        EXPECT_EQ(p.total, 4);
+        EXPECT_EQ(p.done, i % 2 == 1);
+        EXPECT_EQ(p.model, (i / 2) % 2 == 0 ? RatingModel::lmm : RatingModel::clmm);
+        EXPECT_EQ(p.question, i < 4 ? "translucent" : "realistic");
+        EXPECT_EQ(p.factor, "thickness");
+        EXPECT_EQ(p.ratings, i < 4 ? 6u : 2u);
+        if (p.done) {
+            EXPECT_GE(p.seconds, 0.0);
+            EXPECT_GE(p.elapsed, p.seconds);
+            EXPECT_GE(p.left, 0.0);
+            EXPECT_EQ(p.fitted, i < 4) << i;
+        }
+    }
+    EXPECT_EQ(seen.back().left, 0.0);
+
+    request.models = parse_model_list("anova", RatingModel::anova);
+    seen.clear();
+    analyze_table(t, request);
+    EXPECT_TRUE(seen.empty());
+}
+
 TEST(AnalyzeTable, WithinSubjectLayoutUsesParticipantMeansAndLeavesOutIncompleteOnes) {
     // p1 and p2 rate both levels (p1 twice at level 18: mean 2.5); p3 rates only one.
     const LongTable t = table_of(

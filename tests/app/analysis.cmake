@@ -67,6 +67,10 @@ add_test(NAME app.analyze_simulated_study
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/pipeline
                  -P ${LUCENT_APP_TEST_DIR}/analyze_pipeline.cmake)
+add_test(NAME app.analyze_shows_mixed_model_progress
+         COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
+                 -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/analyze_progress
+                 -P ${LUCENT_APP_TEST_DIR}/analyze_progress.cmake)
 add_test(NAME app.analyze_mixed_models_lead_when_asked
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  -DDATA=${LUCENT_APP_TEST_DIR}/data/wine_long.csv
