@@ -1,6 +1,7 @@
 // lucent render: one image of a mesh under a technique, with parameters from --set.
 // The work itself is lucent::build_scene + render_image + write_image
 // (renderer/render.h), the same path batch rendering and the explorer use.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -192,6 +193,43 @@ stimuli::StimulusSet study_picture_set(const std::string& file,
     }
 }
 
+bool is_builtin_study(const std::string& name) {
+    const std::vector<std::string> studies = study::builtin_protocol_names();
+    return std::find(studies.begin(), studies.end(), name) != studies.end();
+}
+
+// `render --preset NAME`: one name, one folder that `lucent run|serve --preset NAME
+// --images DIR` shows. The built-in stimulus set NAME (its factor series, for the
+// report), and when NAME is also a built-in study, every other picture that study shows:
+// its adjust series and staircase ladders (study/web_series.h). A picture of both must
+// be the same render, or the study would check its folder against another picture.
+stimuli::StimulusSet preset_picture_set(const std::string& name) {
+    stimuli::StimulusSet set = stimuli::load_preset(name, stimuli::default_catalog());
+    if (!is_builtin_study(name)) return set;
+    const stimuli::StimulusSet shown = study_picture_set("", name);
+    const std::string where = "--preset " + name + ": ";
+    if (shown.width != set.width || shown.height != set.height)
+        throw stimuli::StimulusSetError(
+            where +
+            "the stimulus set's resolution differs from the study's stimulus_size");
+    std::map<std::string, const stimuli::Stimulus*> by_id;
+    for (const stimuli::Stimulus& s : set.stimuli) by_id[s.id] = &s;
+    for (const stimuli::Stimulus& picture : shown.stimuli) {
+        const auto it = by_id.find(picture.id);
+        if (it == by_id.end()) {
+            set.stimuli.push_back(picture);
+            continue;
+        }
+        const stimuli::Stimulus& own = *it->second;
+        if (own.technique != picture.technique || own.mesh_spec != picture.mesh_spec ||
+            own.parameters.all() != picture.parameters.all())
+            throw stimuli::StimulusSetError(
+                where + "stimulus '" + picture.id +
+                "' of the stimulus set differs from the built-in study's");
+    }
+    return set;
+}
+
 }  // namespace
 
 void register_render(CLI::App& app, int& exit_code) {
@@ -212,13 +250,23 @@ void register_render(CLI::App& app, int& exit_code) {
                         "; optional face budget, e.g. torus_knot:60k) or a mesh file");
     cmd->add_option("config", options->config,
                     "stimulus-set config (TOML): render every stimulus into --out DIR");
-    cmd->add_option("--preset", options->preset,
-                    "built-in stimulus set (thesis) into --out DIR");
+    std::string presets;
+    for (const std::string& name : stimuli::preset_names())
+        presets += (presets.empty() ? "" : ", ") + name;
+    cmd->add_option(
+        "--preset", options->preset,
+        "built-in set NAME (" + presets +
+            ") into --out DIR: every picture 'lucent run|serve --preset NAME' "
+            "shows; for a built-in study (" +
+            study_preset_list() + ") its adjust series and staircase ladders too");
     cmd->add_option("--study", options->study,
-                    "study protocol (TOML): every picture 'lucent serve' shows, the "
-                    "adjust series and staircase ladders included, into --out DIR");
+                    "study protocol (TOML) of your own: every picture 'lucent serve' "
+                    "shows, the adjust series and staircase ladders included, into --out "
+                    "DIR");
+    // The old name of --preset for a built-in study; hidden, it means nothing else.
     cmd->add_option("--study-preset", options->study_preset,
-                    "built-in study (" + study_preset_list() + "), as --study");
+                    "the same as --preset NAME for a built-in study")
+        ->group("");
     cmd->add_option("--jobs", options->jobs,
                     "stimulus sets: parallel workers (default 1)");
     cmd->add_flag("--force", options->force,
@@ -255,32 +303,40 @@ void register_render(CLI::App& app, int& exit_code) {
         "render the technique's CPU reference (Embree) instead of the GL image: "
         "same scene, parameters and outputs");
     cmd->callback([options, &exit_code] {
-        // One image (--mesh), a stimulus set (CONFIG or --preset) or a study's pictures
-        // (--study or --study-preset), one of them.
+        // One image (--mesh), a stimulus set (CONFIG), a built-in set (--preset, its
+        // study's series included) or a study's pictures (--study), one of them.
         const int sources = !options->config.empty() + !options->preset.empty() +
                             !options->study.empty() + !options->study_preset.empty();
         const bool batch = sources > 0;
         const bool both = sources > 1;
-        const bool study = !options->study.empty() || !options->study_preset.empty();
         if (batch && options->reference) {
             std::cerr << "lucent render: --reference renders one image (--mesh), not a "
                          "stimulus set\n";
             exit_code = kExitUsage;
         } else if (batch && (!options->mesh.empty() || both)) {
             std::cerr
-                << "lucent render: give one of --mesh, CONFIG, --preset, --study or "
-                   "--study-preset\n";
+                << "lucent render: give one of --mesh, CONFIG, --preset or --study\n";
             exit_code = kExitUsage;
-        } else if (study) {
+        } else if (!options->study.empty()) {
+            exit_code = stimuli::run_render_set_command(
+                [options] { return study_picture_set(options->study, ""); }, options->out,
+                options->jobs, options->force);
+        } else if (!options->preset.empty() || !options->study_preset.empty()) {
             exit_code = stimuli::run_render_set_command(
                 [options] {
-                    return study_picture_set(options->study, options->study_preset);
+                    const std::string& name =
+                        options->preset.empty() ? options->study_preset : options->preset;
+                    // --study-preset names a built-in study.
+                    if (options->preset.empty() && !is_builtin_study(name))
+                        throw stimuli::StimulusSetError(
+                            "unknown preset '" + name +
+                            "' (valid: " + study_preset_list() + ")");
+                    return preset_picture_set(name);
                 },
                 options->out, options->jobs, options->force);
         } else if (batch) {
-            exit_code = stimuli::run_render_set_command(options->config, options->preset,
-                                                        options->out, options->jobs,
-                                                        options->force);
+            exit_code = stimuli::run_render_set_command(options->config, "", options->out,
+                                                        options->jobs, options->force);
         } else if (options->mesh.empty()) {
             std::cerr << "lucent render: --mesh is required (or a stimulus-set CONFIG or "
                          "--preset)\n";

@@ -116,8 +116,8 @@ std::string PrerenderedStimuli::path_for(const StimulusSpec& spec) const {
 
 namespace {
 
-// What to run so that `dir` holds the picture: the protocol's own stimulus set when it is
-// a built-in study (its `render --preset` writes every picture the study shows, practice
+// What to run so that `dir` holds the picture: `render --preset` when it is a built-in
+// study (it writes every picture the study shows, practice, series and ladders
 // included), else a stimulus set that lists the stimulus.
 std::string how_to_render(const Protocol& protocol, const std::string& dir) {
     const std::string out = dir.empty() ? "DIR" : dir;
@@ -130,7 +130,7 @@ std::string how_to_render(const Protocol& protocol, const std::string& dir) {
     if (series)
         return "'lucent render " +
                (protocol.source.rfind(preset, 0) == 0
-                    ? "--study-preset " + protocol.source.substr(preset.size())
+                    ? "--preset " + protocol.source.substr(preset.size())
                     : "--study " + protocol.source) +
                " --out " + out + "' writes every picture the study shows in the browser";
     if (protocol.source.rfind(preset, 0) == 0)

@@ -413,13 +413,12 @@ TEST(DocumentedMatching, ThePagesCommandsRunAsWrittenAndServeShowsEverySeries) {
     Child refused;
     EXPECT_EQ(start_serve(serve, dir, refused), 0);
     EXPECT_EQ(wait_exit(refused), 2);
-    EXPECT_EQ(
-        read_file(refused.stderr_path),
-        "lucent serve: preset:jnd: stimulus '" + missing +
-            "' (technique empirical): no " + missing +
-            ".png, .tif or .exr in jnd-pictures/; 'lucent render --study-preset jnd "
-            "--out jnd-pictures/' writes every picture the study shows in the "
-            "browser\n");
+    EXPECT_EQ(read_file(refused.stderr_path),
+              "lucent serve: preset:jnd: stimulus '" + missing +
+                  "' (technique empirical): no " + missing +
+                  ".png, .tif or .exr in jnd-pictures/; 'lucent render --preset jnd "
+                  "--out jnd-pictures/' writes every picture the study shows in the "
+                  "browser\n");
     fs::rename(dir / "aside.png", pictures / (missing + ".png"));
     fs::copy_file(pictures / (missing + ".png"), pictures / (changed + ".png"),
                   fs::copy_options::overwrite_existing);

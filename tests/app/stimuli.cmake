@@ -45,10 +45,11 @@ add_test(NAME app.render_unknown_preset_exits_2
 add_test(NAME app.render_mesh_and_config_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=render;x.toml;--mesh;sphere;--out;${LUCENT_STIMULI_CLI_DIR}/both"
-                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=one of --mesh, CONFIG, --preset, --study or --study-preset"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=one of --mesh, CONFIG, --preset or --study$"
                  -P ${CMAKE_CURRENT_SOURCE_DIR}/expect_exit.cmake)
-# lucent render --study: an unknown built-in study, and a ladder too long to pre-render,
-# are refused in one line (exit 2).
+# lucent render --study: an unknown built-in study (--study-preset, the old name of
+# --preset for a study), and a ladder too long to pre-render, are refused in one line
+# (exit 2).
 add_test(NAME app.render_study_unknown_preset_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=render;--study-preset;nope;--out;${LUCENT_STIMULI_CLI_DIR}/nope_study"
