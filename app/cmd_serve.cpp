@@ -61,26 +61,14 @@ std::string read_file(const std::filesystem::path& path) {
 }
 
 // Every stimulus's picture as the lab shows it (load_image_rgba8: 8-bit sRGB, EXR
-// encoded on the way), written once as PNG and kept in memory: nothing else on disk is
-// ever served.
+// encoded on the way), kept in memory as PNG: nothing else on disk is ever served. Each
+// serving decodes it and adds its own noise (picture_names.h).
 std::map<std::string, ServedPicture> load_pictures(
     const study::Protocol& protocol, const study::PrerenderedStimuli& stimuli) {
     std::map<std::string, ServedPicture> out;
-    char scratch_template[] = "/tmp/lucent-serve-XXXXXX";
-    const char* scratch = mkdtemp(scratch_template);
-    if (!scratch) throw std::runtime_error("cannot create a scratch folder in /tmp");
-    struct Cleanup {
-        std::filesystem::path dir;
-        ~Cleanup() {
-            std::error_code ignored;
-            std::filesystem::remove_all(dir, ignored);
-        }
-    } cleanup{scratch};
     for (const study::StimulusSpec& s : protocol.stimuli) {
         const study::CpuImage image = study::load_image_rgba8(stimuli.path_for(s));
-        const auto png = cleanup.dir / "picture.png";
-        study::save_image_rgba8(png.string(), image);
-        out[s.id] = {read_file(png), {image.width, image.height}};
+        out[s.id] = {study::encode_png_rgba8(image), {image.width, image.height}};
     }
     return out;
 }

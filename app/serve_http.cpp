@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "study/serve/web_files.h"
+#include "study/session/stimulus_source.h"
 
 namespace lucent::app {
 namespace {
@@ -228,20 +229,23 @@ void configure_serve_http(httplib::Server& http, study::WebStudy& web,
     http.Get("/", page_file("index.html", "text/html; charset=utf-8"));
     http.Get("/lucent.js", page_file("lucent.js", "text/javascript; charset=utf-8"));
     http.Get("/lucent.css", page_file("lucent.css", "text/css; charset=utf-8"));
-    std::map<std::string, study::WebImage> sizes;
-    for (const auto& [id, picture] : pictures) sizes[id] = picture.size;
-    http.Get(R"(/images/.*)", [sizes, &pictures](const httplib::Request& req,
-                                                 httplib::Response& res) {
-        // Matched on the raw target, so no decoding here can turn a name into a path.
-        const std::optional<std::string> id = study::image_of_target(req.target, sizes);
-        if (!id) {
+    http.Get(R"(/images/.*)", [&web, &pictures](const httplib::Request& req,
+                                                httplib::Response& res) {
+        // Matched on the raw target: only a name this study gave is a picture.
+        const std::optional<study::NamedPicture> named = web.picture(req.target);
+        if (!named) {
             res.status = 404;
             res.set_content(one_line_json_error("no such picture: " + req.target),
                             "application/json");
             return;
         }
+        // This serving's bytes: the picture with its own one-step noise, so no two
+        // servings hash alike (picture_names.h).
+        study::CpuImage image =
+            study::decode_png_rgba8(pictures.at(named->id).png, named->id);
+        study::add_serving_noise(image.rgba, named->noise_seed);
         res.set_header("Cache-Control", "private, max-age=3600");
-        res.set_content(pictures.at(*id).png, "image/png");
+        res.set_content(study::encode_png_rgba8(image), "image/png");
     });
     http.Post(
         R"(/api/([a-z_]+))", [&web](const httplib::Request& req, httplib::Response& res) {

@@ -77,4 +77,25 @@ std::string sha256_hex(std::string_view data) {
     return std::string(out, 64);
 }
 
+std::string bytes_of_hex(std::string_view hex) {
+    auto digit = [](char c) { return c <= '9' ? c - '0' : (c | 0x20) - 'a' + 10; };
+    std::string out;
+    for (size_t i = 0; i + 1 < hex.size(); i += 2)
+        out += static_cast<char>(digit(hex[i]) * 16 + digit(hex[i + 1]));
+    return out;
+}
+
+std::string hmac_sha256_hex(std::string_view key, std::string_view message) {
+    constexpr size_t kBlock = 64;
+    std::string k =
+        key.size() > kBlock ? bytes_of_hex(sha256_hex(key)) : std::string(key);
+    k.resize(kBlock, '\0');
+    std::string inner(kBlock, '\0'), outer(kBlock, '\0');
+    for (size_t i = 0; i < kBlock; ++i) {
+        inner[i] = static_cast<char>(k[i] ^ 0x36);
+        outer[i] = static_cast<char>(k[i] ^ 0x5c);
+    }
+    return sha256_hex(outer + bytes_of_hex(sha256_hex(inner + std::string(message))));
+}
+
 }  // namespace lucent::study

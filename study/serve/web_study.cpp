@@ -28,26 +28,12 @@ using nlohmann::json;
 namespace {
 
 // ---- [SECTION] tokens and names -------------------------------------------------------
-std::string bytes_of_hex(const std::string& hex) {
-    std::string out;
-    for (size_t i = 0; i + 1 < hex.size(); i += 2)
-        out += static_cast<char>(std::stoi(hex.substr(i, 2), nullptr, 16));
-    return out;
-}
-
 // Compares without an early exit, so the time taken tells nothing about the token.
 bool same_secret_text(std::string_view a, std::string_view b) {
     if (a.size() != b.size()) return false;
     unsigned char diff = 0;
     for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
     return diff == 0;
-}
-
-int hex_digit(char c) {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
 }
 
 // ---- [SECTION] request fields (request_fields.h)
@@ -96,19 +82,6 @@ const char* screen_name(Screen screen) {
 
 }  // namespace
 
-std::string hmac_sha256_hex(std::string_view key, std::string_view message) {
-    constexpr size_t kBlock = 64;
-    std::string k =
-        key.size() > kBlock ? bytes_of_hex(sha256_hex(key)) : std::string(key);
-    k.resize(kBlock, '\0');
-    std::string inner(kBlock, '\0'), outer(kBlock, '\0');
-    for (size_t i = 0; i < kBlock; ++i) {
-        inner[i] = static_cast<char>(k[i] ^ 0x36);
-        outer[i] = static_cast<char>(k[i] ^ 0x5c);
-    }
-    return sha256_hex(outer + bytes_of_hex(sha256_hex(inner + std::string(message))));
-}
-
 std::string key_fingerprint(std::string_view secret) {
     return hmac_sha256_hex(secret, "lucent serve key fingerprint").substr(0, 16);
 }
@@ -132,37 +105,6 @@ std::string session_token(std::string_view secret, std::string_view code,
 std::string legacy_session_token(std::string_view secret, std::string_view code,
                                  std::string_view session_uuid) {
     return std::string(code) + "." + hmac_sha256_hex(secret, session_uuid);
-}
-
-std::optional<std::string> image_of_target(
-    std::string_view target, const std::map<std::string, WebImage>& images) {
-    target = target.substr(0, target.find('?'));
-    std::string path;
-    for (size_t i = 0; i < target.size(); ++i) {
-        if (target[i] != '%') {
-            path += target[i];
-            continue;
-        }
-        if (i + 2 >= target.size() || hex_digit(target[i + 1]) < 0 ||
-            hex_digit(target[i + 2]) < 0)
-            return std::nullopt;
-        path +=
-            static_cast<char>(hex_digit(target[i + 1]) * 16 + hex_digit(target[i + 2]));
-        i += 2;
-    }
-    const std::string_view prefix = "/images/", suffix = ".png";
-    if (path.size() <= prefix.size() + suffix.size() ||
-        path.compare(0, prefix.size(), prefix) != 0 ||
-        path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
-        return std::nullopt;
-    const std::string id =
-        path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
-    // A name, never a path: no separator, no parent, nothing a file system would resolve.
-    if (id.find_first_of("/\\%") != std::string::npos ||
-        id.find("..") != std::string::npos || id.find('\0') != std::string::npos ||
-        !images.count(id))
-        return std::nullopt;
-    return id;
 }
 
 // ---- [SECTION] sessions ---------------------------------------------------------------
@@ -346,11 +288,20 @@ private:
 
 }  // namespace
 
+namespace {
+std::vector<std::string> picture_ids(const std::map<std::string, WebImage>& images) {
+    std::vector<std::string> ids;
+    for (const auto& entry : images) ids.push_back(entry.first);
+    return ids;
+}
+}  // namespace
+
 WebStudy::WebStudy(const Protocol& protocol, StudyStore& store, WebStudyOptions options)
     : protocol_(protocol),
       own_pool_(std::make_unique<StorePool>(store)),
       pool_(*own_pool_),
       options_(std::move(options)),
+      picture_names_(options_.secret, picture_ids(options_.images)),
       waiting_(std::make_unique<WaitingCodes>()) {
     init();
 }
@@ -359,6 +310,7 @@ WebStudy::WebStudy(const Protocol& protocol, StorePool& pool, WebStudyOptions op
     : protocol_(protocol),
       pool_(pool),
       options_(std::move(options)),
+      picture_names_(options_.secret, picture_ids(options_.images)),
       waiting_(std::make_unique<WaitingCodes>()) {
     init();
 }
@@ -470,6 +422,10 @@ WebReply WebStudy::handle(std::string_view endpoint, std::string_view body) {
     } catch (const std::exception& e) {
         return error_reply(500, e.what());
     }
+}
+
+std::optional<NamedPicture> WebStudy::picture(std::string_view target) const {
+    return picture_names_.picture(target);
 }
 
 WebReply WebStudy::health() {
@@ -929,7 +885,7 @@ json WebStudy::rating_trial(const TrialRow& t) const {
     const WebImage& image = options_.images.at(t.stimulus);
     return {{"id", t.uuid},
             {"task", task_name(t.task)},
-            {"image", "/images/" + t.stimulus + ".png"},
+            {"image", picture_names_.url(t.uuid, 0, t.stimulus)},
             {"width", image.width},
             {"height", image.height},
             {"practice", t.practice},
@@ -944,9 +900,10 @@ json WebStudy::choice_trial(const TrialRow& t,
                             const std::vector<std::string>& pictures) const {
     const Block& block = *protocol_.find_block(t.block);
     json shown = json::array();
-    for (const std::string& id : pictures) {
+    for (size_t slot = 0; slot < pictures.size(); ++slot) {
+        const std::string& id = pictures[slot];
         const WebImage& image = options_.images.at(id);
-        shown.push_back({{"image", "/images/" + id + ".png"},
+        shown.push_back({{"image", picture_names_.url(t.uuid, slot, id)},
                          {"width", image.width},
                          {"height", image.height}});
     }
@@ -978,15 +935,16 @@ json WebStudy::adjust_trial(const TrialRow& t) const {
     // The range on the scale, as AdjustInput computes it (the page cannot: its log10
     // may differ in the last bit).
     const bool log = block.scale == "log";
+    // Slot 0 is the target, 1.. the series.
     json urls = json::array();
-    for (const std::string& id : series.pictures)
-        urls.push_back("/images/" + id + ".png");
+    for (size_t i = 0; i < series.pictures.size(); ++i)
+        urls.push_back(picture_names_.url(t.uuid, i + 1, series.pictures[i]));
     const WebImage& target = options_.images.at(t.stimulus);
     const WebImage& match = options_.images.at(series.pictures.front());
     return {{"id", t.uuid},
             {"task", "adjust"},
             {"target",
-             {{"image", "/images/" + t.stimulus + ".png"},
+             {{"image", picture_names_.url(t.uuid, 0, t.stimulus)},
               {"width", target.width},
               {"height", target.height}}},
             {"match", {{"width", match.width}, {"height", match.height}}},

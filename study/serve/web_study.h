@@ -34,6 +34,8 @@
 #include <vector>
 
 #include "study/protocol.h"
+#include "study/serve/picture_names.h"
+#include "study/sha256.h"
 #include "study/study_store.h"
 #include "study/web_series.h"
 
@@ -45,7 +47,7 @@ struct WebReply {
     int retry_after_s = 0;  // 503: when to try again (the Retry-After header)
 };
 
-// A picture the page shows, served at /images/<stimulus id>.png.
+// A picture the page shows, served under a name of each trial's (picture_names.h).
 struct WebImage {
     int width = 0;
     int height = 0;
@@ -89,16 +91,9 @@ std::string session_token(std::string_view secret, std::string_view code,
 // HMAC-SHA256(secret, uuid)>"; still taken by /api/session for a session in progress.
 std::string legacy_session_token(std::string_view secret, std::string_view code,
                                  std::string_view session_uuid);
-// HMAC-SHA256 (RFC 2104) in lower-case hex.
-std::string hmac_sha256_hex(std::string_view key, std::string_view message);
 // A short public name of a session key (16 hex digits of an HMAC under it, telling
 // nothing of the key): /healthz shows it, so a monitor sees instances that disagree.
 std::string key_fingerprint(std::string_view secret);
-// The stimulus id an /images/ request names, from the raw request target (percent-
-// encoded or not): exactly "/images/<id>.png" for a stimulus in `images`, else nullopt
-// (traversal, other folders, encoded separators, unknown names).
-std::optional<std::string> image_of_target(std::string_view target,
-                                           const std::map<std::string, WebImage>& images);
 
 class SessionFlow;
 class StorePool;
@@ -125,6 +120,9 @@ public:
     // GET /healthz: 200 when a store of the pool answers a query now, else 503; both
     // name the key's fingerprint.
     WebReply health();
+    // GET /images/<name>.png: the picture a name this study gave names, and the seed of
+    // that serving's noise (picture_names.h); nullopt for any other target (404).
+    std::optional<NamedPicture> picture(std::string_view target) const;
 
 private:
     struct Browser;
@@ -173,6 +171,7 @@ private:
     std::unique_ptr<StorePool> own_pool_;  // the one-store constructor's
     StorePool& pool_;
     WebStudyOptions options_;
+    PictureNames picture_names_;  // of options_.images, under options_.secret
     int64_t study_id_ = 0;
     int main_trials_ = 0;  // a session's main (not practice) trials
     std::unique_ptr<WaitingCodes> waiting_;

@@ -1,5 +1,6 @@
 #include "study/session/stimulus_source.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -58,6 +59,45 @@ void save_image_rgba8(const std::string& path, const CpuImage& image) {
     if (!out || !out->open(path, spec) ||
         !out->write_image(OIIO::TypeDesc::UINT8, image.rgba.data()) || !out->close())
         throw StimulusError(path + ": cannot write image: " + OIIO::geterror());
+}
+
+// Straight alpha both ways ("oiio:UnassociatedAlpha"): OIIO would otherwise divide the
+// colour by alpha on the way out and multiply on the way in, which does not round-trip
+// in 8 bits.
+std::string encode_png_rgba8(const CpuImage& image) {
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput memory(bytes);
+    auto out = OIIO::ImageOutput::create("served.png", &memory);
+    OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    // The fastest deflate level: each serving is encoded anew (picture_names.h).
+    spec.attribute("png:compressionLevel", 1);
+    if (!out || !out->open("served.png", spec) ||
+        !out->write_image(OIIO::TypeDesc::UINT8, image.rgba.data()) || !out->close())
+        throw StimulusError("cannot encode a PNG: " + OIIO::geterror());
+    return std::string(bytes.begin(), bytes.end());
+}
+
+CpuImage decode_png_rgba8(std::string_view png, const std::string& what) {
+    OIIO::Filesystem::IOMemReader memory(png.data(), png.size());
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    // With a config, OIIO 2.4 takes the proxy from it, not from the argument.
+    OIIO::Filesystem::IOProxy* proxy = &memory;
+    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+    auto in = OIIO::ImageInput::open("served.png", &config, &memory);
+    if (!in) throw StimulusError(what + ": cannot read the PNG: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.width > 16384 ||
+        spec.height > 16384 || spec.nchannels != 4)
+        throw StimulusError(what + ": not an RGBA PNG of a usable size");
+    CpuImage image;
+    image.width = spec.width;
+    image.height = spec.height;
+    image.rgba.resize(static_cast<size_t>(spec.width) * spec.height * 4);
+    if (!in->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, image.rgba.data()))
+        throw StimulusError(what + ": cannot read the PNG: " + in->geterror());
+    return image;
 }
 
 StimulusTexture upload_texture(const CpuImage& image, const std::string& what) {

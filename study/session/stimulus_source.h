@@ -6,6 +6,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "renderer/gl/objects.h"
@@ -30,6 +31,11 @@ struct CpuImage {
 // Loads PNG/TIFF/JPEG as 8-bit; EXR (linear float) is sRGB-encoded on the way.
 CpuImage load_image_rgba8(const std::string& path);
 void save_image_rgba8(const std::string& path, const CpuImage& image);
+// The same as PNG in memory (straight alpha: what is decoded is what was encoded), for
+// lucent serve, which re-encodes each serving; StimulusError naming `what` when the
+// bytes are not a PNG it can read.
+std::string encode_png_rgba8(const CpuImage& image);
+CpuImage decode_png_rgba8(std::string_view png, const std::string& what);
 
 struct StimulusTexture {
     gl::Texture texture;  // RGBA8, nearest filtering, row 0 = top of the picture

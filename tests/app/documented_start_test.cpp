@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "study/protocol.h"
+#include "study/serve/picture_names.h"
 #include "study/sqlite/database.h"
 #include "study/trial_plan.h"
 #include "study/web_series.h"
@@ -158,6 +159,25 @@ std::string first_line(int fd) {
     return line;
 }
 
+// The URL a serve instance holding the study's key (`key_file`) gives picture `id`
+// (study/serve/picture_names.h): the test mints it as a second instance would, since
+// no picture is served by its stimulus id.
+std::string picture_url(const fs::path& key_file, const study::Protocol& protocol,
+                        const std::string& id) {
+    const study::Protocol shown =
+        study::with_series_pictures(protocol, study::web_series(protocol));
+    std::vector<std::string> ids;
+    for (const study::StimulusSpec& s : shown.stimuli) ids.push_back(s.id);
+    return study::PictureNames(read_file(key_file), ids).url("documented start", 0, id);
+}
+
+// The key file a `serve` command line uses: --secret-file, else beside its --db.
+fs::path key_file_of(const std::vector<std::string>& args, const fs::path& dir) {
+    const auto secret = std::find(args.begin(), args.end(), "--secret-file");
+    if (secret != args.end()) return dir / *(secret + 1);
+    return dir / (*(std::find(args.begin(), args.end(), "--db") + 1) + "-serve-key");
+}
+
 void documented_start(const std::string& name) {
     LUCENT_REQUIRE_DISPLAY();
     const std::vector<std::string> documented = documented_start_commands();
@@ -202,7 +222,8 @@ void documented_start(const std::string& name) {
         EXPECT_NE(session->body.find("\"screen\":\"consent\""), std::string::npos)
             << session->body;
         for (const std::string& id : protocol.practice) {
-            const auto png = client.Get(("/images/" + id + ".png").c_str());
+            const auto png =
+                client.Get(picture_url(key_file_of(serve, dir), protocol, id).c_str());
             ASSERT_TRUE(png) << id;
             EXPECT_EQ(png->status, 200) << id;
             EXPECT_EQ(png->body.substr(1, 3), "PNG") << id;
@@ -371,14 +392,15 @@ TEST(DocumentedMatching, ThePagesCommandsRunAsWrittenAndServeShowsEverySeries) {
     ASSERT_GE(commands.size(), 8u);
     const fs::path dir = test::scratch_dir("documented_matching");
     // Each served study: the first and last picture of every series and ladder.
-    const auto check_series = [](const std::vector<std::string>& args,
-                                 httplib::Client& client) {
+    const auto check_series = [&dir](const std::vector<std::string>& args,
+                                     httplib::Client& client) {
         const std::string preset = *(std::find(args.begin(), args.end(), "--preset") + 1);
-        const study::WebSeries series =
-            study::web_series(study::builtin_protocol(preset));
+        const study::Protocol protocol = study::builtin_protocol(preset);
+        const study::WebSeries series = study::web_series(protocol);
         for (const study::KnobSeries& k : series.series)
             for (const std::string& id : {k.pictures.front(), k.pictures.back()}) {
-                const auto png = client.Get(("/images/" + id + ".png").c_str());
+                const auto png =
+                    client.Get(picture_url(key_file_of(args, dir), protocol, id).c_str());
                 ASSERT_TRUE(png) << id;
                 EXPECT_EQ(png->status, 200) << id;
                 EXPECT_EQ(png->body.substr(1, 3), "PNG") << id;

@@ -15,7 +15,9 @@
 #include <map>
 #include <thread>
 
+#include "study/serve/picture_names.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/web_series.h"
 #include "tests/study/serve/serve_process.h"
 #include "tests/support/devtools.h"
 #include "tests/support/test_paths.h"
@@ -499,13 +501,18 @@ std::pair<double, double> centre(lucent::test::DevToolsBrowser& browser,
     return {box[0].get<double>(), box[1].get<double>()};
 }
 
-// The path of the picture an <img> shows ("/images/<id>.png").
+// The picture an <img> shows, as "/images/<stimulus id>.png": its src is a name of the
+// trial's (study/serve/picture_names.h), which `names` (the server's key and pictures)
+// decodes.
 std::string shown_picture(lucent::test::DevToolsBrowser& browser,
+                          const lucent::study::PictureNames& names,
                           const std::string& selector) {
-    return browser
-        .evaluate("decodeURIComponent(new URL(document.querySelector(" +
-                  json(selector).dump() + ").src).pathname)")
-        .get<std::string>();
+    const std::string path = browser
+                                 .evaluate("new URL(document.querySelector(" +
+                                           json(selector).dump() + ").src).pathname")
+                                 .get<std::string>();
+    const std::optional<lucent::study::NamedPicture> named = names.picture(path);
+    return named ? "/images/" + named->id + ".png" : "(no picture name: " + path + ")";
 }
 
 TEST(ServeBrowserMatching,
@@ -522,6 +529,12 @@ TEST(ServeBrowserMatching,
     lucent::test::ServeProcess server(protocol.string(), db, dir.string(),
                                       {"--images", images.string()});
     ASSERT_GT(server.port(), 0) << "lucent serve did not start: " << server.first_line();
+    // The names the server gives its pictures, decoded with its key (beside the db).
+    const Protocol parsed = parse_protocol(kMatchingProtocol, protocol.string());
+    std::vector<std::string> ids;
+    for (const StimulusSpec& s : with_series_pictures(parsed, web_series(parsed)).stimuli)
+        ids.push_back(s.id);
+    const lucent::study::PictureNames names(file_text(db + "-serve-key"), ids);
     lucent::test::DevToolsBrowser browser(1280, 900);
     if (!browser.ok()) GTEST_SKIP() << browser.error();
     auto screen = [&] {
@@ -558,9 +571,9 @@ TEST(ServeBrowserMatching,
     // Shift+ArrowLeft (one picture).
     ASSERT_TRUE(wait_trial(before)) << screen();
     const std::string adjust1 = browser.evaluate("document.body.dataset.trial");
-    EXPECT_EQ(shown_picture(browser, "#target img"), "/images/target.png");
+    EXPECT_EQ(shown_picture(browser, names, "#target img"), "/images/target.png");
     EXPECT_EQ(browser.evaluate("document.body.dataset.matchIndex"), "10");
-    EXPECT_EQ(shown_picture(browser, match_img), series_picture(15));
+    EXPECT_EQ(shown_picture(browser, names, match_img), series_picture(15));
     // Both pictures pixel for pixel, side by side, the question above.
     EXPECT_EQ(
         browser.evaluate("[...document.querySelectorAll('#adjust-row img')].map("
@@ -574,7 +587,7 @@ TEST(ServeBrowserMatching,
     ASSERT_TRUE(wait_index(14));
     press_key(browser, "ArrowLeft", true);
     ASSERT_TRUE(wait_index(13));
-    const std::string confirmed1 = shown_picture(browser, match_img);
+    const std::string confirmed1 = shown_picture(browser, names, match_img);
     EXPECT_EQ(confirmed1, series_picture(18));
     before = view();
     press_key(browser, "Enter", false);
@@ -616,7 +629,7 @@ TEST(ServeBrowserMatching,
     ASSERT_TRUE(wait_index(7));
     press_key(browser, "ArrowRight", true);
     ASSERT_TRUE(wait_index(8));
-    const std::string confirmed2 = shown_picture(browser, match_img);
+    const std::string confirmed2 = shown_picture(browser, names, match_img);
     EXPECT_EQ(confirmed2, series_picture(13));
     before = view();
     press_key(browser, "Enter", false);
@@ -643,10 +656,11 @@ TEST(ServeBrowserMatching,
         const std::string group = "#alternatives .group[data-alternative='";
         char comparison[64];
         std::snprintf(comparison, sizeof comparison, "%g", 10 + rungs[k]);
-        EXPECT_EQ(shown_picture(browser, group + std::to_string(expected) + "'] img"),
-                  std::string("/images/std@thickness_exponent=") + comparison + ".png")
+        EXPECT_EQ(
+            shown_picture(browser, names, group + std::to_string(expected) + "'] img"),
+            std::string("/images/std@thickness_exponent=") + comparison + ".png")
             << k;
-        EXPECT_EQ(shown_picture(browser, group + std::to_string(other) + "'] img"),
+        EXPECT_EQ(shown_picture(browser, names, group + std::to_string(other) + "'] img"),
                   "/images/std.png")
             << k;
         const int pick = right[k] ? expected : other;

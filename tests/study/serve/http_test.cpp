@@ -1,17 +1,21 @@
 // The real `lucent serve` over loopback, on every store backend: hostile HTTP requests,
 // and 50 simulated participants at once. Expected values come from the study folder the
 // test wrote (pictures of known bytes, the protocol's trial count and scales).
+#include <OpenImageIO/imageio.h>
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
 #include <thread>
 
+#include "study/protocol.h"
+#include "study/serve/picture_names.h"
 #include "study/study_store.h"
 #include "tests/study/postgres/server_environment.h"
 #include "tests/study/serve/serve_process.h"
@@ -57,6 +61,16 @@ protected:
     std::unique_ptr<lucent::test::ServeProcess> server_;
 };
 
+// A picture file's RGB values (OIIO, independent of the server's own decoding).
+std::vector<uint8_t> rgb_pixels(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) return {};
+    const OIIO::ImageSpec spec = in->spec();
+    std::vector<uint8_t> rgb(static_cast<size_t>(spec.width) * spec.height * 3);
+    in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data());
+    return rgb;
+}
+
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
     return info.param;
 }
@@ -69,11 +83,6 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     EXPECT_EQ(page->status, 200);
     EXPECT_NE(page->body.find("<script src=\"/lucent.js\">"), std::string::npos);
     EXPECT_EQ(page->get_header_value("X-Content-Type-Options"), "nosniff");
-    auto picture = http.Get("/images/a.png");
-    ASSERT_TRUE(picture);
-    EXPECT_EQ(picture->status, 200);
-    EXPECT_EQ(picture->get_header_value("Content-Type"), "image/png");
-    EXPECT_EQ(picture->body.substr(1, 3), "PNG");
 
     // Paths out of the pictures, plain and encoded: never a file, always a 404.
     std::ofstream(dir_ / "secret.txt") << "not for participants";
@@ -85,7 +94,7 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
              "/../secret.txt", "/%2e%2e/secret.txt", "/images/..%5csecret.txt",
              "/images/" + db_name, "/images/../" + db_name, "/etc/passwd",
              "/../../../../etc/passwd", "/images/a.png/../../secret.txt", "/secret.txt",
-             "/study.toml", "/a.png"}) {
+             "/study.toml", "/a.png", "/images/a.png"}) {
         auto r = http.Get(target.c_str());
         ASSERT_TRUE(r) << target;
         EXPECT_EQ(r->status, 404) << target;
@@ -139,6 +148,48 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
     ASSERT_EQ(p1.state["screen"], "consent");
     p1.run(1);  // consent, instructions, the practice trial, the practice-done screen
     ASSERT_EQ(p1.state["screen"], "trial");
+    // The trial's picture, by the name the page was given (never by its stimulus id:
+    // "/images/a.png" is a 404 above); asked again, the same bytes.
+    const std::string picture_url = p1.state["trial"]["image"];
+    auto picture = http.Get(picture_url.c_str());
+    ASSERT_TRUE(picture);
+    EXPECT_EQ(picture->status, 200);
+    EXPECT_EQ(picture->get_header_value("Content-Type"), "image/png");
+    EXPECT_EQ(picture->body.substr(1, 3), "PNG");
+    auto again = http.Get(picture_url.c_str());
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->body, picture->body);
+    // Another serving of the picture (the name another trial gets, minted with the
+    // server's key): other bytes, and both the file's picture within one step per
+    // channel (issue 44, item 4).
+    {
+        const std::string key =
+            GetParam() == "sqlite" ? db_ + "-serve-key" : (dir_ / "serve.key").string();
+        std::ifstream key_in(key, std::ios::binary);
+        const std::string secret(std::istreambuf_iterator<char>(key_in), {});
+        std::vector<std::string> ids;
+        for (const StimulusSpec& s : load_protocol_file(protocol_).stimuli)
+            ids.push_back(s.id);
+        const PictureNames names(secret, ids);
+        const std::optional<NamedPicture> named = names.picture(picture_url);
+        ASSERT_TRUE(named) << picture_url;
+        auto other = http.Get(names.url("another trial", 0, named->id).c_str());
+        ASSERT_TRUE(other);
+        ASSERT_EQ(other->status, 200);
+        EXPECT_NE(other->body, picture->body);
+        const std::vector<uint8_t> file =
+            rgb_pixels((dir_ / (named->id + ".png")).string());
+        for (const std::string& png : {picture->body, other->body}) {
+            const std::string path = (dir_ / "served.png").string();
+            std::ofstream(path, std::ios::binary) << png;
+            const std::vector<uint8_t> served = rgb_pixels(path);
+            ASSERT_EQ(served.size(), file.size());
+            int largest = 0;
+            for (size_t i = 0; i < file.size(); ++i)
+                largest = std::max(largest, std::abs(int(served[i]) - int(file[i])));
+            EXPECT_EQ(largest, 1);
+        }
+    }
     json bad = p1.answer_body(1);
     bad["token"] = p1.token;
     bad["events"][0]["value"] = 8;

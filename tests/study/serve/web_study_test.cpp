@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -902,11 +903,11 @@ blank_ms = 30
 // quadruples C(5,4) = 5.
 constexpr size_t kChoiceStudyTrials = 1 + 2 + 6 + 2 + 10 + 1 + 5;
 
-// The stimulus id of a picture URL ("/images/ID.png").
-std::string stimulus_of_url(const std::string& url) {
-    const std::string prefix = "/images/", suffix = ".png";
-    EXPECT_EQ(url.rfind(prefix, 0), 0u) << url;
-    return url.substr(prefix.size(), url.size() - prefix.size() - suffix.size());
+// The stimulus id of a picture URL the page was given (the server decodes it).
+std::string stimulus_of_url(const WebStudy& web, const std::string& url) {
+    const std::optional<NamedPicture> named = web.picture(url);
+    EXPECT_TRUE(named) << url;
+    return named ? named->id : std::string();
 }
 
 // The block of each task in the protocol above.
@@ -918,10 +919,10 @@ std::string block_of_task(const std::string& task) {
 // page was shown: the pictures' names in screen order.
 Page observer_page(const Protocol& protocol, WebStudy& web, std::mt19937_64& rng) {
     Page page{direct(web)};
-    page.choose = [&protocol, &rng](const json& trial) {
+    page.choose = [&protocol, &web, &rng](const json& trial) {
         std::vector<std::string> shown;
         for (const json& picture : trial["shown"])
-            shown.push_back(stimulus_of_url(picture["image"]));
+            shown.push_back(stimulus_of_url(web, picture["image"]));
         const ObserverModel observer{0.5, 0.1, 0.0};
         return simulated_choice(
             observer, choice_stimuli(protocol, block_of_task(trial["task"]), shown), rng);
@@ -987,14 +988,14 @@ TEST_P(Serve, PairsTriadsAndQuadruplesAreAnsweredOnlineAsInTheLabEachChoiceStore
         ++per_task[task_name(t.task)];
         if (t.task == Task::rating) {
             EXPECT_EQ(shown["task"], "rating");
-            EXPECT_EQ(shown["image"], "/images/" + t.stimulus + ".png");
+            EXPECT_EQ(stimulus_of_url(*web_, shown["image"]), t.stimulus);
             continue;
         }
         const Block& block = *protocol_.find_block(t.block);
         EXPECT_EQ(shown["task"], task_name(t.task)) << where;
         ASSERT_EQ(shown["shown"].size(), t.shown.size()) << where;
         for (size_t i = 0; i < t.shown.size(); ++i) {
-            EXPECT_EQ(shown["shown"][i]["image"], "/images/" + t.shown[i] + ".png");
+            EXPECT_EQ(stimulus_of_url(*web_, shown["shown"][i]["image"]), t.shown[i]);
             EXPECT_EQ(shown["shown"][i]["width"], 64);
             EXPECT_EQ(shown["shown"][i]["height"], 48);
         }
@@ -1245,19 +1246,92 @@ TEST(ServeNames, HmacMatchesRfc4231) {
               "60e431591ee0b67f0d8a26aacbf5b77f8e0bc6213728c5140546040f0ee37f54");
 }
 
-TEST(ServeNames, OnlyProtocolPicturesByNameAreImages) {
-    const std::map<std::string, WebImage> images = {{"emp1", {1, 1}}, {"b", {1, 1}}};
-    EXPECT_EQ(image_of_target("/images/emp1.png", images), "emp1");
-    EXPECT_EQ(image_of_target("/images/emp1.png?v=2", images), "emp1");
-    EXPECT_EQ(image_of_target("/images/%65mp1.png", images),
-              "emp1");  // an encoded letter
+// A picture's name says nothing of the picture, differs per trial and slot, and only
+// the key and the list that made it decode it (issue 44, item 4).
+TEST(ServeNames, PictureNamesAreOpaquePerTrialAndSlotAndDecodeOnlyUnderTheirKey) {
+    const std::vector<std::string> ids = {"std", "std@r=10.5", "std@r=11", "emp1"};
+    const PictureNames names("test secret", ids);
+    std::set<std::string> given;
+    for (const char* trial : {"trial-a", "trial-b"})
+        for (size_t slot = 0; slot < 3; ++slot)
+            for (const std::string& id : ids) {
+                const std::string url = names.url(trial, slot, id);
+                ASSERT_EQ(url.size(), 52u) << url;  // "/images/" + 40 hex digits + ".png"
+                EXPECT_EQ(url.rfind("/images/", 0), 0u);
+                EXPECT_EQ(url.find_first_not_of("0123456789abcdef", 8), url.size() - 4)
+                    << url;
+                EXPECT_TRUE(given.insert(url).second) << url << " given twice";
+                const std::optional<NamedPicture> named = names.picture(url);
+                ASSERT_TRUE(named) << url;
+                EXPECT_EQ(named->id, id);
+                EXPECT_EQ(names.picture(url + "?v=2")->id, id);
+            }
+    // The same trial, slot and picture: the same name (a page asking again).
+    EXPECT_EQ(names.url("trial-a", 1, "std"), names.url("trial-a", 1, "std"));
+    // Any instance with the key and the same pictures, in any order, reads it.
+    const std::string url = names.url("trial-a", 0, "std@r=11");
+    EXPECT_EQ(PictureNames("test secret", {"emp1", "std@r=11", "std", "std@r=10.5"})
+                  .picture(url)
+                  ->id,
+              "std@r=11");
+    // Another key, another list, an altered digit, another spelling: no picture.
+    EXPECT_FALSE(PictureNames("other secret", ids).picture(url));
+    EXPECT_FALSE(PictureNames("test secret", {"std", "std@r=10.5"}).picture(url));
+    for (size_t at = 8; at < 48; ++at) {
+        std::string altered = url;
+        altered[at] = altered[at] == '0' ? '1' : '0';
+        EXPECT_FALSE(names.picture(altered)) << altered;
+    }
+    std::string upper = url;
+    for (char& c : upper)
+        if (c >= 'a' && c <= 'f') c = static_cast<char>(c - 'a' + 'A');
+    if (upper != url) {
+        EXPECT_FALSE(names.picture(upper)) << upper;
+    }
+    EXPECT_THROW(names.url("trial-a", 0, "not a picture"), std::out_of_range);
+    // A stimulus by its id, and every path trick, is no picture.
     for (const char* bad :
-         {"/images/../study.db", "/images/..%2f..%2fetc%2fpasswd", "/images/%2e%2e/b.png",
-          "/images/%2E%2E%2Fb.png", "/images/%252e%252e%252fb.png",
-          "/images/b.png%00.txt", "/images//b.png", "/images/sub/b.png", "/images/b.PNG",
-          "/images/c.png", "/b.png", "/images/.png", "/images/b.png/", "/images/%zz.png",
-          "/images/b.png%", "/IMAGES/b.png", "/images/..\\b.png"})
-        EXPECT_FALSE(image_of_target(bad, images)) << bad;
+         {"/images/emp1.png", "/images/std.png", "/images/../study.db",
+          "/images/..%2f..%2fetc%2fpasswd", "/images/%2e%2e/b.png",
+          "/images/b.png%00.txt", "/images//b.png", "/images/sub/b.png", "/images/.png",
+          "/b.png", "/IMAGES/b.png", "/images/..\\b.png"})
+        EXPECT_FALSE(names.picture(bad)) << bad;
+    EXPECT_FALSE(names.picture(url.substr(0, 20)));
+    EXPECT_FALSE(names.picture(url + "/"));
+    EXPECT_FALSE(names.picture("/images/" + std::string(40, 'z') + ".png"));
+}
+
+// One serving's noise: at most one step, zero on average, black, white and alpha kept,
+// and another serving's noise is another pattern.
+TEST(ServeNames, ServingNoiseMovesEachMidtoneByAtMostOneStepAndKeepsTheMean) {
+    std::vector<uint8_t> picture(256 * 256 * 4);
+    for (size_t i = 0; i < picture.size(); ++i)
+        picture[i] = i % 4 == 3 ? static_cast<uint8_t>(i / 4 % 256)
+                                : static_cast<uint8_t>(i * 7 % 256);
+    std::vector<uint8_t> first = picture, second = picture;
+    const size_t changed = add_serving_noise(first, 1);
+    add_serving_noise(second, 2);
+    EXPECT_NE(first, second);
+    size_t midtones = 0;
+    double sum_of_changes = 0;
+    for (size_t i = 0; i < picture.size(); ++i) {
+        const int change = int(first[i]) - int(picture[i]);
+        EXPECT_LE(std::abs(change), 1) << i;
+        if (i % 4 == 3 || picture[i] == 0 || picture[i] == 255) {
+            EXPECT_EQ(change, 0) << i;
+            continue;
+        }
+        ++midtones;
+        sum_of_changes += change;
+    }
+    // Two in three midtones move; the mean change is zero within 4 standard errors
+    // (each change has variance 2/3).
+    EXPECT_NEAR(double(changed) / double(midtones), 2.0 / 3.0, 0.01);
+    EXPECT_NEAR(sum_of_changes / double(midtones), 0.0,
+                4 * std::sqrt(2.0 / 3.0 / double(midtones)));
+    std::vector<uint8_t> again = picture;
+    add_serving_noise(again, 1);
+    EXPECT_EQ(again, first);  // the same serving, the same bytes
 }
 
 TEST(ServeNames, ParticipantCodes) {

@@ -4,12 +4,14 @@
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "renderer/gl/errors.h"
 #include "study/session/stimulus_source.h"
 #include "tests/support/gl_test_fixture.h"
+#include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {
@@ -86,6 +88,42 @@ TEST_F(StimulusUpload, PixelStoreStateLeftByOtherCodeDoesNotChangeThePicture) {
     glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
     glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
     EXPECT_NO_THROW(gl::check_errors("after the upload"));
+}
+
+}  // namespace
+}  // namespace lucent::study
+
+namespace lucent::study {
+namespace {
+
+// lucent serve's in-memory PNG (issue 44, item 4): what is decoded is what was encoded,
+// translucent pixels included (straight alpha), and another reader sees the same.
+TEST(ServedPng, EncodesAndDecodesEveryPixelExactlyAndRefusesOtherBytesInOneLine) {
+    CpuImage image;
+    image.width = 37;
+    image.height = 11;
+    image.rgba.resize(size_t(image.width) * image.height * 4);
+    for (size_t i = 0; i < image.rgba.size(); ++i)
+        image.rgba[i] = static_cast<uint8_t>((i * 37 + i / 4) % 256);
+    const std::string png = encode_png_rgba8(image);
+    ASSERT_EQ(png.substr(1, 3), "PNG");
+    const CpuImage back = decode_png_rgba8(png, "picture");
+    EXPECT_EQ(back.width, image.width);
+    EXPECT_EQ(back.height, image.height);
+    EXPECT_EQ(back.rgba, image.rgba);
+    // Opaque, through the file reader the lab uses.
+    for (size_t i = 3; i < image.rgba.size(); i += 4) image.rgba[i] = 255;
+    const std::string path = (test::scratch_dir("served_png") / "opaque.png").string();
+    std::ofstream(path, std::ios::binary) << encode_png_rgba8(image);
+    EXPECT_EQ(load_image_rgba8(path).rgba, image.rgba);
+    try {
+        decode_png_rgba8("not a png", "stimulus 'a'");
+        ADD_FAILURE() << "not refused";
+    } catch (const StimulusError& e) {
+        const std::string why = e.what();
+        EXPECT_EQ(why.rfind("stimulus 'a': ", 0), 0u) << why;
+        EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+    }
 }
 
 }  // namespace
