@@ -15,6 +15,7 @@
 #include "study/sqlite/database.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/store_rules.h"
+#include "study/withdrawal.h"
 
 namespace lucent::study {
 namespace {
@@ -91,6 +92,30 @@ std::optional<Protocol> stored_protocol(Database& db) {
     }
 }
 
+std::string declined_consent_figure(Database& db) {
+    auto has_table = [&](const char* name) {
+        Statement s = db.prepare("SELECT count(*) FROM sqlite_schema WHERE name = ?");
+        s.bind(1, name);
+        return s.step() && s.integer(0) > 0;
+    };
+    std::string out;
+    if (has_table("declined_codes")) {
+        const int64_t codes = db.scalar_int("SELECT count(*) FROM declined_codes");
+        out = (codes >= kMaxDeclinedCodes ? "at least " : "") + std::to_string(codes) +
+              (codes == 1 ? " participant code" : " participant codes") +
+              " declined consent";
+    }
+    if (has_table("consent_declines")) {
+        const int64_t pages =
+            db.scalar_int("SELECT coalesce(sum(declined), 0) FROM consent_declines");
+        if (pages > 0 || out.empty())
+            out += (out.empty() ? "" : ", and ") + std::to_string(pages) +
+                   (pages == 1 ? " consent decline" : " consent declines") +
+                   " counted per page before schema 9 (page loads, not people)";
+    }
+    return out;
+}
+
 SessionSelection select_sessions(Database& db, const std::string& db_path,
                                  const std::string& sessions, bool exclude_failed_catch) {
     SessionSelection out;
@@ -165,6 +190,8 @@ SessionSelection select_sessions(Database& db, const std::string& db_path,
         }
         note += ", " + std::to_string(l.failed_catch) + " failed catch trials, " +
                 std::to_string(l.withdrawn) + " withdrawn";
+        if (const std::string declined = declined_consent_figure(db); !declined.empty())
+            note += "; " + declined;
         out.note = note;
     }
 

@@ -94,6 +94,13 @@ class Database;
 std::optional<Protocol> stored_protocol(Database& db);
 SessionSelection select_sessions(Database& db, const std::string& db_path,
                                  const std::string& sessions, bool exclude_failed_catch);
+// Who declined consent, named for what was counted; the sessions note ends with it.
+// Schema 9: "2 participant codes declined consent" (each code once however often it
+// declined; "at least 1000 ..." once kMaxDeclinedCodes are kept, past which a decline
+// adds nothing). A database counting before schema 9 counted pages: "3 consent declines
+// counted per page before schema 9 (page loads, not people)". "" when neither was kept
+// (before schema 5).
+std::string declined_consent_figure(Database& db);
 
 struct LongTable {
     std::vector<LongRow> rows;

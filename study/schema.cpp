@@ -214,6 +214,24 @@ CREATE TABLE adjustments (
 ALTER TABLE sessions ADD COLUMN web_position TEXT;
 CREATE TABLE declined_pages (uuid TEXT PRIMARY KEY);
 )sql",
+    // 9: declined consents per participant code (issue 44). consent_declines and
+    // declined_pages counted a page that declined, so a script reloading and declining
+    // counted each time, and one person declining twice counted twice. declined_codes:
+    // one row per code that declined, the code kept as withdrawn_codes keep one (a
+    // random salt per row and SHA-256, withdrawal.h), page_uuid the newest page of that
+    // code that declined (NULL for a lab station), so that page stays declined. At most
+    // kMaxDeclinedCodes rows per study (withdrawal.h). The older tables are kept as they
+    // were, no longer written: their count is reported beside, as page declines before
+    // schema 9, and pages they hold stay declined.
+    R"sql(
+CREATE TABLE declined_codes (
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    salt TEXT NOT NULL,
+    code_hash TEXT NOT NULL,
+    page_uuid TEXT UNIQUE,
+    PRIMARY KEY (salt, code_hash));
+CREATE INDEX declined_codes_by_study ON declined_codes(study_id);
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 

@@ -10,7 +10,7 @@
 namespace lucent::study {
 
 inline constexpr int32_t kApplicationId = 0x4C55434E;  // "LUCN"
-inline constexpr int kSchemaVersion = 8;
+inline constexpr int kSchemaVersion = 9;
 
 // Migration steps 1..kSchemaVersion; step i brings a store from version i-1 to i.
 const std::vector<std::string>& schema_migrations();

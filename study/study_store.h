@@ -33,6 +33,10 @@ struct OnlineEnrolment {
     std::string active_since_utc;
     std::function<TrialPlan(int cell)>
         plan;  // the plan of the cell chosen (plan.cell == cell)
+    // The participant agreed on the consent screen: sessions.consent_utc is written in
+    // the enrolment's own transaction, so no session is ever stored without the consent
+    // it was enrolled on (false: a protocol without a consent screen).
+    bool consented = false;
 };
 
 struct OnlineSession {
@@ -69,7 +73,8 @@ public:
     // study (active: not completed, not aborted, activity since how.active_since_utc;
     // ties go to the first such cell from number mod cells), the session with how.plan
     // of that cell, its first segment and its trials, and sessions.allocation saying
-    // how the cell was chosen. Writes nothing when it throws.
+    // how the cell was chosen, and its consent when how.consented. Writes nothing when it
+    // throws.
     virtual OnlineSession enrol_online(int64_t study_id, const std::string& code,
                                        const OnlineEnrolment& how,
                                        const SessionEnvironment& env) = 0;
@@ -103,19 +108,24 @@ public:
     virtual void update_environment(int64_t session_id,
                                     const SessionEnvironment& env) = 0;
     virtual void set_consent(int64_t session_id) = 0;
-    // One more declined consent of the study (consent_declines: a count, nothing else).
-    virtual void count_declined_consent(int64_t study_id) = 0;
-    // `lucent serve`: a page (`page_uuid`, the session UUID it would have had) declined:
-    // counted once, with its UUID kept in declined_pages, in one transaction; false
-    // (nothing changed) when that page had declined already.
-    virtual bool decline_online_consent(int64_t study_id,
-                                        const std::string& page_uuid) = 0;
-    // True when the page of this UUID declined (decline_online_consent).
+    // Participant `code` declined consent (schema 9: declined_codes). Counted once per
+    // code however often it declines (a reload, a second page, a script reusing it), the
+    // code kept only as a salted SHA-256 (withdrawal.h: salted_code); `page_uuid`
+    // (`lucent serve`: the session UUID the declining page would have had; "" for a lab
+    // station) becomes that code's declined page, so the page stays declined. One
+    // transaction, the codes compared under a lock, so two processes never count one code
+    // twice. A study keeps at most kMaxDeclinedCodes codes: past them a new code adds
+    // nothing. True when `code` is counted now for the first time.
+    virtual bool decline_consent(int64_t study_id, const std::string& code,
+                                 const std::string& page_uuid) = 0;
+    // True when the page of this UUID declined: its code's newest declined page
+    // (decline_consent), or a page a serve before schema 9 kept in declined_pages.
     virtual bool consent_declined(const std::string& page_uuid) = 0;
     // A lab station's declined consent: when the session has no consent and no answered
     // trial, deletes it (segments, planned trials), and its participant when they have no
-    // other session, and counts the decline, in one transaction; true then. Otherwise
-    // (a resumed session that had consent or answers) changes nothing and returns false.
+    // other session, and counts the participant's code as decline_consent does, in one
+    // transaction; true then. Otherwise (a resumed session that had consent or answers)
+    // changes nothing and returns false.
     virtual bool forget_declined_session(int64_t session_id) = 0;
     virtual bool has_consent(int64_t session_id) = 0;
     // `lucent serve` (schema 8): where the session's page stands, as the server wrote it

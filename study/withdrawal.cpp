@@ -31,6 +31,8 @@ std::pair<std::string, bool> split_suffix(const std::string& code,
     return {code.substr(0, at), numbered};
 }
 
+}  // namespace
+
 std::string random_salt() {
     std::random_device device;
     char out[40];
@@ -38,8 +40,6 @@ std::string random_salt() {
                   device());
     return out;
 }
-
-}  // namespace
 
 std::string enrolled_code(const std::string& code, const std::string& machine_id) {
     const auto [base, numbered] = split_suffix(code, machine_id);
@@ -52,9 +52,21 @@ bool is_split_on_one_machine(const std::string& code, const std::string& machine
     return !base.empty() && numbered;
 }
 
-std::string withdrawn_code_hash(const std::string& salt, const std::string& code,
-                                const std::string& machine_id) {
+std::string salted_code_hash(const std::string& salt, const std::string& code,
+                             const std::string& machine_id) {
     return sha256_hex(salt + code + "\n" + machine_id);
+}
+
+SaltedCode salted_code(const std::string& code) {
+    const std::string salt = random_salt();
+    return {salt, salted_code_hash(salt, code, "")};
+}
+
+std::optional<SaltedCode> find_salted_code(const std::vector<SaltedCode>& held,
+                                           const std::string& code) {
+    for (const SaltedCode& row : held)
+        if (salted_code_hash(row.salt, code, "") == row.code_hash) return row;
+    return std::nullopt;
 }
 
 std::vector<WithdrawnCode> code_tombstones(
@@ -71,7 +83,7 @@ std::vector<WithdrawnCode> code_tombstones(
     for (const std::string& machine : machines) {
         const std::string salt = random_salt();
         out.push_back({salt,
-                       withdrawn_code_hash(salt, enrolled_code(code, machine), machine),
+                       salted_code_hash(salt, enrolled_code(code, machine), machine),
                        withdrawn_utc});
     }
     return out;
@@ -111,7 +123,7 @@ bool Tombstones::covers(const std::string& uuid, const std::string& code,
     const std::string enrolled = enrolled_code(code, machine_id);
     for (const WithdrawnCode& c : codes_)
         if (started_utc < c.withdrawn_utc &&
-            withdrawn_code_hash(c.salt, enrolled, machine_id) == c.code_hash)
+            salted_code_hash(c.salt, enrolled, machine_id) == c.code_hash)
             return true;
     return false;
 }

@@ -3,8 +3,10 @@
 // rows and leaves tombstones in the same transaction: each withdrawn session's UUID, and
 // each (code, machine) the person was enrolled under as a salted SHA-256 (the code itself
 // is not kept). Merge, merge into a server and `store sync` read the tombstones of every
-// database they see and never add a session they cover.
+// database they see and never add a session they cover. Declined consents (schema 9)
+// keep the participant code the same way (salted_code below).
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,8 +25,28 @@ std::string enrolled_code(const std::string& code, const std::string& machine_id
 bool is_split_on_one_machine(const std::string& code, const std::string& machine_id);
 
 // Lower-case hex SHA-256 of salt + code + "\n" + machine_id.
-std::string withdrawn_code_hash(const std::string& salt, const std::string& code,
-                                const std::string& machine_id);
+std::string salted_code_hash(const std::string& salt, const std::string& code,
+                             const std::string& machine_id);
+// 32 hex digits from the system's random device: a fresh salt for each kept code.
+std::string random_salt();
+
+// A participant code kept without the code: a fresh random salt and
+// salted_code_hash(salt, code, "") (declined_codes, schema 9).
+struct SaltedCode {
+    std::string salt, code_hash;
+};
+SaltedCode salted_code(const std::string& code);
+// The row of `held` that is `code`'s (each row's hash taken again under its own salt);
+// nullopt when none is.
+std::optional<SaltedCode> find_salted_code(const std::vector<SaltedCode>& held,
+                                           const std::string& code);
+
+// The most participant codes of one study kept as having declined consent. One row per
+// code bounds what one person (or one script reusing a code) adds; this bounds a script
+// posting fresh codes: past it a decline adds nothing, and the figure reads "at least
+// kMaxDeclinedCodes" (declined_consent_figure, export.h). Finding a code hashes each
+// row again under its own salt, so the cap also bounds a decline's cost.
+inline constexpr int kMaxDeclinedCodes = 1000;
 
 struct WithdrawnCode {
     std::string salt, code_hash, withdrawn_utc;

@@ -25,7 +25,8 @@ void PostgresStore::snapshot_to_sqlite(const std::string& sqlite_path) {
                                           "adjustments",
                                           "withdrawn_sessions",
                                           "withdrawn_codes",
-                                          "consent_declines"};
+                                          "consent_declines",
+                                          "declined_codes"};
     Store out(sqlite_path);
     Database& db = out.db();
     guarded("taking a snapshot", [&] {

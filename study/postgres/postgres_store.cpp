@@ -471,6 +471,9 @@ OnlineSession PostgresStore::enrol_online(int64_t study_id, const std::string& c
         out.session = insert_session(tx, study_id, participant_id, plan, how.seed, env,
                                      uuid, allocation);
         out.allocation = allocation;
+        if (how.consented)
+            tx.exec_params("UPDATE sessions SET consent_utc = $1 WHERE id = $2",
+                           utc_now_iso8601(), out.session.id);
         tx.commit();
         return out;
     });
@@ -722,45 +725,57 @@ void PostgresStore::update_environment(int64_t session_id,
 }
 
 namespace {
-// One more declined consent of `study_id`, inside the caller's transaction.
-void add_declined_consent(pqxx::work& tx, int64_t study_id) {
+// decline_consent inside the caller's transaction, under the decline lock (one decline
+// at a time compares the codes, so two processes never count one code twice).
+bool add_declined_code(pqxx::work& tx, int64_t study_id, const std::string& code,
+                       const std::string& page_uuid) {
+    tx.exec_params("SELECT pg_advisory_xact_lock($1, $2)", kLockClass, kDeclineLock);
+    std::vector<SaltedCode> held;
+    for (const pqxx::row& r : tx.exec_params(
+             "SELECT salt, code_hash FROM declined_codes WHERE study_id = $1", study_id))
+        held.push_back({r[0].as<std::string>(), r[1].as<std::string>()});
+    const std::optional<SaltedCode> found = find_salted_code(held, code);
+    if (!found && held.size() >= static_cast<size_t>(kMaxDeclinedCodes)) return false;
+    if (!page_uuid.empty())  // the page is this code's now (a UUID is one page's)
+        tx.exec_params("UPDATE declined_codes SET page_uuid = NULL WHERE page_uuid = $1",
+                       page_uuid);
+    if (found) {
+        if (!page_uuid.empty())
+            tx.exec_params(
+                "UPDATE declined_codes SET page_uuid = $1 WHERE salt = $2 AND "
+                "code_hash = $3",
+                page_uuid, found->salt, found->code_hash);
+        return false;
+    }
+    const SaltedCode row = salted_code(code);
     tx.exec_params(
-        "INSERT INTO consent_declines (study_id, declined) VALUES ($1, 1) "
-        "ON CONFLICT (study_id) DO UPDATE SET declined = "
-        "consent_declines.declined + 1",
-        study_id);
+        "INSERT INTO declined_codes (study_id, salt, code_hash, page_uuid) "
+        "VALUES ($1, $2, $3, $4)",
+        study_id, row.salt, row.code_hash,
+        page_uuid.empty() ? std::optional<std::string>() : page_uuid);
+    return true;
 }
 }  // namespace
 
-void PostgresStore::count_declined_consent(int64_t study_id) {
-    guarded("counting a declined consent", [&] {
-        pqxx::work tx(connection());
-        add_declined_consent(tx, study_id);
-        tx.commit();
-        return 0;
-    });
-}
-
-bool PostgresStore::decline_online_consent(int64_t study_id,
-                                           const std::string& page_uuid) {
+bool PostgresStore::decline_consent(int64_t study_id, const std::string& code,
+                                    const std::string& page_uuid) {
     return guarded("counting a declined consent", [&] {
         pqxx::work tx(connection());
-        if (tx.exec_params("INSERT INTO declined_pages (uuid) VALUES ($1) ON CONFLICT "
-                           "DO NOTHING",
-                           page_uuid)
-                .affected_rows() == 0)
-            return false;
-        add_declined_consent(tx, study_id);
+        const bool counted = add_declined_code(tx, study_id, code, page_uuid);
         tx.commit();
-        return true;
+        return counted;
     });
 }
 
 bool PostgresStore::consent_declined(const std::string& page_uuid) {
     return guarded("finding a declined page", [&] {
         pqxx::nontransaction tx(connection());
-        return !tx.exec_params("SELECT 1 FROM declined_pages WHERE uuid = $1", page_uuid)
-                    .empty();
+        return tx
+            .exec_params1(
+                "SELECT EXISTS (SELECT 1 FROM declined_codes WHERE page_uuid = $1) "
+                "OR EXISTS (SELECT 1 FROM declined_pages WHERE uuid = $1)",
+                page_uuid)[0]
+            .as<bool>();
     });
 }
 
@@ -776,12 +791,16 @@ bool PostgresStore::forget_declined_session(int64_t session_id) {
         if (found.empty()) return false;
         const int64_t study_id = found[0][0].as<int64_t>();
         const int64_t participant_id = found[0][1].as<int64_t>();
+        const std::string code =
+            tx.exec_params1("SELECT code FROM participants WHERE id = $1",
+                            participant_id)[0]
+                .as<std::string>();
         tx.exec_params("DELETE FROM sessions WHERE id = $1", session_id);
         tx.exec_params(
             "DELETE FROM participants WHERE id = $1 AND NOT EXISTS "
             "(SELECT 1 FROM sessions WHERE participant_id = $1)",
             participant_id);
-        add_declined_consent(tx, study_id);
+        add_declined_code(tx, study_id, code, "");
         tx.commit();
         return true;
     });

@@ -61,8 +61,8 @@ public:
     int resume_segment(int64_t session_id, const SessionEnvironment& env) override;
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
-    void count_declined_consent(int64_t study_id) override;
-    bool decline_online_consent(int64_t study_id, const std::string& page_uuid) override;
+    bool decline_consent(int64_t study_id, const std::string& code,
+                         const std::string& page_uuid) override;
     bool consent_declined(const std::string& page_uuid) override;
     bool forget_declined_session(int64_t session_id) override;
     bool has_consent(int64_t session_id) override;

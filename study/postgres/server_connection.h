@@ -13,11 +13,13 @@
 namespace lucent::study {
 namespace postgres_internal {
 
-// Advisory lock keys (two-key form, class 0x4C55 'LU'): the study rows, and participant
-// numbers. Participant claims use the one-key form over a hash of the code.
+// Advisory lock keys (two-key form, class 0x4C55 'LU'): the study rows, participant
+// numbers, and declined codes (compared one decline at a time, so a code is counted
+// once). Participant claims use the one-key form over a hash of the code.
 constexpr int kLockClass = 0x4C55;
 constexpr int kStudyLock = 1;
 constexpr int kNumberLock = 2;
+constexpr int kDeclineLock = 3;
 
 // The server could not be reached, or went away mid-transaction: the caller may journal
 // and retry. Anything else is a real refusal.

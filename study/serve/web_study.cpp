@@ -213,9 +213,10 @@ WebReply declined_reply() {
     return {200,
             to_text(json{{"screen", "declined"},
                          {"text",
-                          "You did not agree to take part. Nothing of yours was stored; "
-                          "the study counts only that one person declined. You may "
-                          "close this window."}})};
+                          "You did not agree to take part. Nothing of yours was stored "
+                          "but a salted hash of your participant code, so that you are "
+                          "counted once among those who declined. You may close this "
+                          "window."}})};
 }
 
 // Holds the participant for one request: requests of one participant (on any serve
@@ -650,15 +651,16 @@ WebReply WebStudy::start(const json& body) {
                         t_ms);
 }
 
-// The answer on a pending page's consent screen. Declined: one more in the study's count.
-// Agreed: enrolled (number, cell, session, plan) and consent recorded through the same
-// SessionFlow as in the lab.
+// The answer on a pending page's consent screen. Declined: the code counted among those
+// that declined. Agreed: enrolled (number, cell, session, plan) with its consent in one
+// transaction, then the same SessionFlow as in the lab takes it past the consent screen.
 WebReply WebStudy::consent(StudyStore& store, const std::string& code,
                            const std::string& uuid, const Browser& browser, bool decline,
                            double shown_ms, double t_ms) {
     if (decline) {
-        // Counted once per page (a decline sent again is not a second person).
-        store.decline_online_consent(study_id_, uuid);
+        // Counted once per code (a decline sent again, a reload or a second page is not
+        // a second person); this page stays declined.
+        store.decline_consent(study_id_, code, uuid);
         return declined_reply();
     }
     // One session in progress per participant: another browser's is theirs to go on.
@@ -675,16 +677,19 @@ WebReply WebStudy::consent(StudyStore& store, const std::string& code,
                     : 1;
     how.active_since_utc = active_since_utc();
     how.plan = [&](int cell) { return plan_trials(protocol_, how.seed, cell); };
+    // Consent goes with the enrolment: a fault after it cannot leave a stored session,
+    // with its user agent and Prolific ids, that has no consent.
+    how.consented = !protocol_.screens.consent.empty();
     const OnlineSession enrolled =
         store.enrol_online(study_id_, code, how, environment_for(browser));
     Page page{code, enrolled.session, store.trials(enrolled.session.id), std::nullopt,
               false};
-    SessionFlow flow(protocol_, store, enrolled.session.id, page.trials, false,
+    SessionFlow flow(protocol_, store, enrolled.session.id, page.trials, how.consented,
                      ms_to_ns(shown_ms));
     flow.show_series(&options_.series);  // copies keep it; options_ outlives them
     if (flow.screen() == Screen::Consent) {
         flow.presented(flow.serial(), ms_to_ns(shown_ms));
-        flow.key({Key::Enter, 0, ms_to_ns(t_ms)});  // records consent
+        flow.key({Key::Enter, 0, ms_to_ns(t_ms)});  // consent is on record already
     }
     page.flow.emplace(flow);
     save_position(store, page);

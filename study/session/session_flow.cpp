@@ -390,7 +390,9 @@ void SessionFlow::key(const TimedKey& press) {
     switch (screen_) {
         case Screen::Consent:
             if (press.key == Key::Enter) {
-                store_.set_consent(session_id_);
+                // Consent already on record (an online enrolment writes it in its own
+                // transaction; a resumed session had it) keeps its time.
+                if (!consented_) store_.set_consent(session_id_);
                 consented_ = true;
                 if (protocol_.screens.instructions.empty())
                     begin_trial_or_debrief(press.t_ns);

@@ -257,6 +257,11 @@ OnlineSession Store::enrol_online(int64_t study_id, const std::string& code,
         study_id, participant_id, plan, how.seed, env,
         how.session_uuid.empty() ? new_uuid_v4() : how.session_uuid, allocation);
     out.allocation = allocation;
+    if (how.consented)
+        db_.prepare("UPDATE sessions SET consent_utc = ? WHERE id = ?")
+            .bind(1, utc_now_iso8601())
+            .bind(2, out.session.id)
+            .run();
     tx.commit();
     return out;
 }
@@ -482,40 +487,68 @@ void Store::update_environment(int64_t session_id, const SessionEnvironment& env
     tx.commit();
 }
 
-void Store::count_declined_consent(int64_t study_id) {
+bool Store::add_declined_code(int64_t study_id, const std::string& code,
+                              const std::string& page_uuid) {
+    std::vector<SaltedCode> held;
+    Statement rows =
+        db_.prepare("SELECT salt, code_hash FROM declined_codes WHERE study_id = ?");
+    rows.bind(1, study_id);
+    while (rows.step()) held.push_back({rows.text(0), rows.text(1)});
+    const std::optional<SaltedCode> found = find_salted_code(held, code);
+    if (!found && held.size() >= static_cast<size_t>(kMaxDeclinedCodes)) return false;
+    if (!page_uuid.empty())  // the page is this code's now (a UUID is one page's)
+        db_.prepare("UPDATE declined_codes SET page_uuid = NULL WHERE page_uuid = ?")
+            .bind(1, page_uuid)
+            .run();
+    if (found) {
+        if (!page_uuid.empty())
+            db_.prepare(
+                   "UPDATE declined_codes SET page_uuid = ? WHERE salt = ? AND "
+                   "code_hash = ?")
+                .bind(1, page_uuid)
+                .bind(2, found->salt)
+                .bind(3, found->code_hash)
+                .run();
+        return false;
+    }
+    const SaltedCode row = salted_code(code);
     db_.prepare(
-           "INSERT INTO consent_declines (study_id, declined) VALUES (?, 1) "
-           "ON CONFLICT (study_id) DO UPDATE SET declined = declined + 1")
+           "INSERT INTO declined_codes (study_id, salt, code_hash, page_uuid) "
+           "VALUES (?, ?, ?, ?)")
         .bind(1, study_id)
+        .bind(2, row.salt)
+        .bind(3, row.code_hash)
+        .bind(4, page_uuid.empty() ? std::nullopt : std::optional<std::string>(page_uuid))
         .run();
-}
-
-bool Store::decline_online_consent(int64_t study_id, const std::string& page_uuid) {
-    Transaction tx(db_);
-    db_.prepare("INSERT OR IGNORE INTO declined_pages (uuid) VALUES (?)")
-        .bind(1, page_uuid)
-        .run();
-    if (sqlite3_changes(db_.handle()) == 0) return false;
-    count_declined_consent(study_id);
-    tx.commit();
     return true;
 }
 
+bool Store::decline_consent(int64_t study_id, const std::string& code,
+                            const std::string& page_uuid) {
+    Transaction tx(db_);
+    const bool counted = add_declined_code(study_id, code, page_uuid);
+    tx.commit();
+    return counted;
+}
+
 bool Store::consent_declined(const std::string& page_uuid) {
-    Statement s = db_.prepare("SELECT count(*) FROM declined_pages WHERE uuid = ?");
+    Statement s = db_.prepare(
+        "SELECT EXISTS (SELECT 1 FROM declined_codes WHERE page_uuid = ?1) OR "
+        "EXISTS (SELECT 1 FROM declined_pages WHERE uuid = ?1)");
     s.bind(1, page_uuid);
-    return s.step() && s.integer(0) > 0;
+    return s.step() && s.integer(0) != 0;
 }
 
 bool Store::forget_declined_session(int64_t session_id) {
     Transaction tx(db_);
     Statement s = db_.prepare(
-        "SELECT study_id, participant_id FROM sessions WHERE id = ? AND consent_utc IS "
-        "NULL "
-        "AND NOT EXISTS (SELECT 1 FROM responses r WHERE r.session_id = sessions.id)");
+        "SELECT s.study_id, s.participant_id, p.code FROM sessions s JOIN participants p "
+        "ON p.id = s.participant_id WHERE s.id = ? AND s.consent_utc IS NULL "
+        "AND NOT EXISTS (SELECT 1 FROM responses r WHERE r.session_id = s.id)");
     s.bind(1, session_id);
     if (!s.step()) return false;
     const int64_t study_id = s.integer(0), participant_id = s.integer(1);
+    const std::string code = s.text(2);
     s.reset();
     db_.prepare("DELETE FROM sessions WHERE id = ?").bind(1, session_id).run();
     db_.prepare(
@@ -524,7 +557,7 @@ bool Store::forget_declined_session(int64_t session_id) {
         .bind(1, participant_id)
         .bind(2, participant_id)
         .run();
-    count_declined_consent(study_id);
+    add_declined_code(study_id, code, "");
     tx.commit();
     return true;
 }

@@ -68,8 +68,8 @@ public:
     int resume_segment(int64_t session_id, const SessionEnvironment& env) override;
     void update_environment(int64_t session_id, const SessionEnvironment& env) override;
     void set_consent(int64_t session_id) override;
-    void count_declined_consent(int64_t study_id) override;
-    bool decline_online_consent(int64_t study_id, const std::string& page_uuid) override;
+    bool decline_consent(int64_t study_id, const std::string& code,
+                         const std::string& page_uuid) override;
     bool consent_declined(const std::string& page_uuid) override;
     bool forget_declined_session(int64_t session_id) override;
     bool has_consent(int64_t session_id) override;
@@ -100,6 +100,10 @@ private:
                               const std::string& allocation);
 
     const StudyQuestions& questions_of_session(int64_t session_id);
+    // decline_consent inside the caller's transaction (a write lock: one decline at a
+    // time compares the codes).
+    bool add_declined_code(int64_t study_id, const std::string& code,
+                           const std::string& page_uuid);
 
     Database db_;
     std::map<int64_t, StudyQuestions> questions_by_session_;  // parsed once

@@ -51,7 +51,7 @@ std::string uuid_of(const std::string& path, int64_t session_id) {
 // The lab's database: P1 completed and attentive; P2 completed, failed the catch trial;
 // P3 quit after one rated trial (still `running`, before any catch trial); P4 paused
 // after two; P5 aborted after one; P6 completed and then withdrew, its tombstone beside
-// one of a session whose rows are already gone.
+// one of a session whose rows are already gone; D1 (twice) and D2 declined consent.
 class AnalysisSessions : public ::testing::Test {
 protected:
     void fill(const Protocol& p) {
@@ -67,6 +67,11 @@ protected:
             partial_rated_ += run_partial_session(store, p, "P4", 14, 2, "paused");
             partial_rated_ += run_partial_session(store, p, "P5", 15, 1, "aborted");
             withdrawn_id = lucent::test::run_full_session(store, p, "P6", 16);
+            // Two people declined consent, one of them on two pages: two codes.
+            const int64_t study = store.ensure_study(p);
+            store.decline_consent(study, "D1", "page-1");
+            store.decline_consent(study, "D1", "page-2");
+            store.decline_consent(study, "D2", "page-3");
         }
         const std::string withdrawn_uuid = uuid_of(path_, withdrawn_id);
         Database db(path_, SQLITE_OPEN_READWRITE);
@@ -107,7 +112,8 @@ TEST_F(AnalysisSessions, OnlyCompletedSessionsAreAnalysedAndTheRestCountedByReas
               path_ +
                   ": 1 of 7 sessions analysed (completed sessions only, the analysis "
                   "plan's default); left out: 3 incomplete (1 aborted, 1 paused, "
-                  "1 running), 1 failed catch trials, 2 withdrawn");
+                  "1 running), 1 failed catch trials, 2 withdrawn; 2 participant codes "
+                  "declined consent");
     std::ifstream in(csv);
     std::set<std::string> participants;
     std::string line;

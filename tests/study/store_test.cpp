@@ -7,6 +7,7 @@
 #include <memory>
 #include <thread>
 
+#include "study/export.h"
 #include "study/sqlite/sqlite_store.h"
 #include "tests/study/study_fixtures.h"
 #include "tests/support/test_paths.h"
@@ -185,6 +186,47 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRows) {
     EXPECT_EQ(store.db().scalar_int("SELECT count(*) FROM pragma_table_info('sessions') "
                                     "WHERE name = 'refresh_note'"),
               1);
+}
+
+// Schema 9 (issue 44) on a file an older build left at schema 8: declined_codes added,
+// the per-page count and the declined pages of schema 8 kept (and still read), every
+// answer kept; the sessions note names both counts for what they are.
+TEST(Store, MigratesASchema8DatabaseKeepingItsPageDeclinesBesideTheNewCodes) {
+    const auto dir = lucent::test::scratch_dir("store_migrate_8");
+    const std::string path = (dir / "old.db").string();
+    const Protocol p = lucent::test::small_protocol();
+    int64_t responses = 0;
+    {
+        Store store(path);
+        lucent::test::run_full_session(store, p, "P1", 3);
+        Database& db = store.db();
+        responses = db.scalar_int("SELECT count(*) FROM responses");
+        db.exec(
+            "INSERT INTO consent_declines (study_id, declined) VALUES (1, 401); "
+            "INSERT INTO declined_pages (uuid) VALUES ('old-page')");
+        lucent::test::downgrade_schema(db, 8);
+        ASSERT_EQ(db.scalar_int(
+                      "SELECT count(*) FROM sqlite_schema WHERE name = 'declined_codes'"),
+                  0);
+    }
+    {
+        Database old(path, SQLITE_OPEN_READONLY);  // read as it is: the page count alone
+        EXPECT_EQ(declined_consent_figure(old),
+                  "401 consent declines counted per page before schema 9 (page loads, "
+                  "not people)");
+    }
+    Store store(path);
+    Database& db = store.db();
+    EXPECT_EQ(db.scalar_int("PRAGMA user_version"), kSchemaVersion);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM responses"), responses);
+    EXPECT_EQ(db.scalar_int("SELECT declined FROM consent_declines"), 401);
+    EXPECT_TRUE(store.consent_declined("old-page"));
+    EXPECT_TRUE(store.decline_consent(1, "P2", "new-page"));
+    EXPECT_FALSE(store.decline_consent(1, "P2", "newer-page"));
+    EXPECT_EQ(db.scalar_int("SELECT declined FROM consent_declines"), 401);
+    EXPECT_EQ(declined_consent_figure(db),
+              "1 participant code declined consent, and 401 consent declines counted "
+              "per page before schema 9 (page loads, not people)");
 }
 
 // Schema 7 (issue 31) on a file an older build left at schema 6: trials.kind filled from

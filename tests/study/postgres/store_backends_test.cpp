@@ -15,12 +15,14 @@
 #include <set>
 #include <thread>
 
+#include "study/export.h"
 #include "study/postgres/postgres_store.h"
 #include "study/postgres/trial_journal.h"
 #include "study/session/autopilot.h"
 #include "study/session/session_flow.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/study_store.h"
+#include "study/withdrawal.h"
 #include "tests/study/postgres/server_environment.h"
 #include "tests/study/study_fixtures.h"
 #include "tests/support/test_paths.h"
@@ -250,7 +252,7 @@ TEST_P(Backend, WithdrawalDeletesEverythingAndRetiresTheNumber) {
     EXPECT_EQ(third, 3);  // 2 is retired, never handed out again
 }
 
-TEST_P(Backend, ALabDeclineBeforeConsentKeepsOnlyTheCount) {
+TEST_P(Backend, ALabDeclineBeforeConsentKeepsOnlyTheCodesSaltedHash) {
     auto store = open();
     const Protocol p = lucent::test::small_protocol();
     const int64_t study = store->ensure_study(p);
@@ -265,7 +267,16 @@ TEST_P(Backend, ALabDeclineBeforeConsentKeepsOnlyTheCount) {
     for (const char* table : {"participants", "sessions", "session_segments", "trials"})
         EXPECT_EQ(store->query_int(std::string("SELECT count(*) FROM ") + table), 0)
             << table;
-    EXPECT_EQ(store->query_int("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes"), 1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes WHERE code_hash = "
+                               "'dora' OR salt = 'dora' OR page_uuid IS NOT NULL"),
+              0);
+    // dora declines again later: the same code, still one.
+    const int64_t again = store->ensure_participant(study, "dora", &number);
+    const SessionRow s2 =
+        store->create_session(study, again, plan_trials(p, number, number), 5, env);
+    EXPECT_TRUE(store->forget_declined_session(s2.id));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes"), 1);
 
     // A session with consent and an answer is not forgotten (it is aborted instead).
     const int64_t emil = store->ensure_participant(study, "emil", &number);
@@ -277,7 +288,82 @@ TEST_P(Backend, ALabDeclineBeforeConsentKeepsOnlyTheCount) {
     EXPECT_FALSE(store->forget_declined_session(e.id));
     EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"),
               static_cast<int64_t>(p.questions.size()));
-    EXPECT_EQ(store->query_int("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes"), 1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM consent_declines"), 0);
+}
+
+// Issue 44 item 5: declines count participant codes, not pages. One code declining on
+// many pages (a script reloading, a person coming back) is one row, its newest page the
+// declined one; stations declining one code at once count it once; fresh codes stop
+// adding rows at kMaxDeclinedCodes.
+TEST_P(Backend, DeclinesCountEachCodeOnceAndStopAddingRowsAtTheCap) {
+    auto store = open();
+    const int64_t study = store->ensure_study(lucent::test::small_protocol());
+    EXPECT_TRUE(store->decline_consent(study, "P1", "page-1"));
+    for (int i = 2; i <= 40; ++i)
+        EXPECT_FALSE(store->decline_consent(study, "P1", "page-" + std::to_string(i)));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes"), 1);
+    EXPECT_TRUE(store->consent_declined("page-40"));
+    EXPECT_FALSE(store->consent_declined("page-1"));  // superseded by the code's newest
+    EXPECT_FALSE(store->consent_declined("page-never"));
+    // Nothing of the code itself is kept.
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes WHERE code_hash LIKE "
+                               "'%P1%' OR salt LIKE '%P1%'"),
+              0);
+
+    // Eight connections declining one new code at once: counted once.
+    std::vector<std::thread> threads;
+    std::atomic<int> counted{0};
+    std::vector<std::string> errors(8);
+    for (int k = 0; k < 8; ++k)
+        threads.emplace_back([&, k] {
+            try {
+                auto other = open("decline" + std::to_string(k));
+                if (other->decline_consent(study, "TWICE", "t-" + std::to_string(k)))
+                    ++counted;
+            } catch (const std::exception& e) {
+                errors[k] = e.what();
+            }
+        });
+    for (std::thread& t : threads) t.join();
+    for (const std::string& e : errors) EXPECT_EQ(e, "");
+    EXPECT_EQ(counted.load(), 1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes"), 2);
+
+    // Fresh codes (a script): the rows stop at the cap; a code already held still
+    // updates its page.
+    for (int i = 2; i < kMaxDeclinedCodes; ++i)
+        store->decline_consent(study, "F" + std::to_string(i), "");
+    ASSERT_EQ(store->query_int("SELECT count(*) FROM declined_codes"), kMaxDeclinedCodes);
+    EXPECT_FALSE(store->decline_consent(study, "ONE-TOO-MANY", "over"));
+    EXPECT_FALSE(store->consent_declined("over"));
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM declined_codes"), kMaxDeclinedCodes);
+    EXPECT_FALSE(store->decline_consent(study, "P1", "page-41"));
+    EXPECT_TRUE(store->consent_declined("page-41"));
+}
+
+// Issue 44 item 6: consent is written in the enrolment's transaction: a session enrolled
+// on consent has it without a second call, and an enrolment that fails leaves neither.
+TEST_P(Backend, AnOnlineEnrolmentOnConsentStoresTheConsentInItsOwnTransaction) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    OnlineEnrolment how;
+    how.seed = 7;
+    how.active_since_utc = "2000-01-01T00:00:00.000Z";
+    how.plan = [&](int cell) { return plan_trials(p, how.seed, cell); };
+    how.consented = true;
+    const OnlineSession yes = store->enrol_online(study, "C1", how, {});
+    EXPECT_TRUE(store->has_consent(yes.session.id));
+    how.consented = false;  // a protocol without a consent screen
+    const OnlineSession none = store->enrol_online(study, "C2", how, {});
+    EXPECT_FALSE(store->has_consent(none.session.id));
+    // A fault inside the enrolment: nothing of it, consent included.
+    how.consented = true;
+    how.plan = [&](int) -> TrialPlan { throw StoreUnavailable("fault injected"); };
+    EXPECT_THROW(store->enrol_online(study, "C3", how, {}), StoreUnavailable);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM sessions"), 2);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM participants WHERE code = 'C3'"), 0);
 }
 
 TEST_P(Backend, AParticipantRunningOnOneStationIsRefusedOnAnother) {
@@ -746,8 +832,8 @@ TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
         }
     }
     // Schema 5 added withdrawn_sessions, withdrawn_codes and consent_declines to the 11,
-    // schema 7 adjustments, schema 8 declined_pages.
-    EXPECT_EQ(tables, 16);
+    // schema 7 adjustments, schema 8 declined_pages, schema 9 declined_codes.
+    EXPECT_EQ(tables, 17);
     // The server has the same tables plus lucent_schema, nothing else.
     EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.tables WHERE "
                                 "table_schema = 'public'"),
@@ -873,25 +959,28 @@ TEST_F(Server, SnapshotHoldsEveryRowTheServerHolds) {
         for (const TrialRow& t : store->trials(s.id))
             store->record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
     }
-    // Schema 5's tables: a withdrawal's tombstones and an anonymous decline.
+    // Schema 5's tables: a withdrawal's tombstones; schema 9's: a declined code.
     {
         int number = 0;
         const int64_t pid = store->ensure_participant(study, "P3", &number);
         store->create_session(study, pid, plan_trials(p, number, number), number, {});
         ASSERT_TRUE(store->withdraw_participant("P3"));
-        store->count_declined_consent(study);
+        store->decline_consent(study, "P4", "a-page");
     }
     const ReadableStudyFile snapshot(uri_);
     Database copy(snapshot.path(), SQLITE_OPEN_READONLY);
     for (const char* table :
          {"studies", "stimuli", "stimulus_parameters", "participants", "sessions",
           "session_segments", "trials", "responses", "retired_participant_numbers",
-          "withdrawn_sessions", "withdrawn_codes", "consent_declines"})
+          "withdrawn_sessions", "withdrawn_codes", "consent_declines", "declined_codes"})
         EXPECT_EQ(copy.scalar_int(std::string("SELECT count(*) FROM ") + table),
                   store->query_int(std::string("SELECT count(*) FROM ") + table))
             << table;
     EXPECT_EQ(copy.scalar_int("SELECT count(*) FROM withdrawn_sessions"), 1);
-    EXPECT_EQ(copy.scalar_int("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(copy.scalar_int("SELECT count(*) FROM declined_codes WHERE page_uuid = "
+                              "'a-page'"),
+              1);
+    EXPECT_EQ(declined_consent_figure(copy), "1 participant code declined consent");
     // The ratings themselves, against the deterministic answers given.
     Statement s = copy.prepare(
         "SELECT t.position, r.question, r.rating, t.catch FROM responses r JOIN trials t "
@@ -907,6 +996,43 @@ TEST_F(Server, SnapshotHoldsEveryRowTheServerHolds) {
         ++checked;
     }
     EXPECT_GT(checked, 0);
+}
+
+// Schema 9 on a server an older build left at schema 8: `lucent store init` adds
+// declined_codes and keeps what schema 8 counted (per page) and the pages it kept
+// declined; the report names both for what they are.
+TEST_F(Server, ASchema8ServerMigratesKeepingItsPageDeclinesBesideTheNewCodes) {
+    {
+        pqxx::connection c(uri_);
+        pqxx::work tx(c);
+        tx.exec(
+            "CREATE TABLE lucent_schema (application_id BIGINT NOT NULL, version INTEGER "
+            "NOT NULL)");
+        const std::vector<std::string> steps = postgres_migrations();
+        for (int v = 1; v <= 8; ++v) tx.exec(steps[v - 1]);
+        tx.exec_params("INSERT INTO lucent_schema VALUES ($1, 8)",
+                       static_cast<int64_t>(kApplicationId));
+        tx.exec(R"sql(
+INSERT INTO studies (id, name, protocol_text, protocol_hash, created_utc)
+    VALUES (1, 's', 'x', 'h', 'now');
+INSERT INTO consent_declines (study_id, declined) VALUES (1, 401);
+INSERT INTO declined_pages (uuid) VALUES ('old-page');
+)sql");
+        tx.commit();
+    }
+    EXPECT_EQ(init_study_store(uri_), std::make_pair(8, kSchemaVersion));
+    auto store = open_study_store(uri_, options("a"));
+    EXPECT_EQ(store->query_int("SELECT declined FROM consent_declines"), 401);
+    EXPECT_TRUE(store->consent_declined("old-page"));
+    EXPECT_TRUE(store->decline_consent(1, "P1", "new-page"));
+    EXPECT_FALSE(store->decline_consent(1, "P1", "newer-page"));
+    EXPECT_TRUE(store->consent_declined("newer-page"));
+    EXPECT_EQ(store->query_int("SELECT declined FROM consent_declines"), 401);
+    const ReadableStudyFile snapshot(uri_);
+    Database copy(snapshot.path(), SQLITE_OPEN_READONLY);
+    EXPECT_EQ(declined_consent_figure(copy),
+              "1 participant code declined consent, and 401 consent declines counted "
+              "per page before schema 9 (page loads, not people)");
 }
 
 }  // namespace

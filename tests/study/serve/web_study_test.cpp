@@ -17,6 +17,7 @@
 #include <set>
 #include <thread>
 
+#include "study/postgres/postgres_store.h"
 #include "study/simulated_observer.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/store_pool.h"
@@ -456,14 +457,15 @@ TEST_P(Serve, TheConsentScreenCanBeDeclinedAndADoubleEnterActsOnce) {
     const json declined =
         no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
     EXPECT_EQ(declined["screen"], "declined");
-    // Declined: no participant, no session; only the count (issue 26 item 5).
+    // Declined: no participant, no session; only the code, salted and hashed, counted
+    // (issue 26 item 5, issue 44 item 5).
     EXPECT_EQ(count("SELECT count(*) FROM participants WHERE code = 'P7'"), 0);
-    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 1);
     // The same decline sent again (a lost reply) counts once.
     const json again_declined =
         no.call("decline", {{"view", 1}, {"shown_ms", 60}, {"t_ms", 900}});
     EXPECT_EQ(again_declined["screen"], "declined");
-    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 1);
 }
 
 // Fifty pages at once through one server (threads calling handle as the HTTP server's
@@ -496,7 +498,8 @@ TEST_P(Serve, FiftyParticipantsAtOnceLoseAndDuplicateNothing) {
 
 // ---- issue 26: consent first, claims that end, arrival-order cells, bounded rows ------
 
-// Item 5: before consent nothing of the person is stored; a decline leaves only a count.
+// Item 5: before consent nothing of the person is stored; a decline leaves only their
+// code counted once, as a salted hash (issue 44).
 TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
     const std::string pid = "5f3a9c1b2d4e6f708192a3b4";
     auto nothing_of_them = [&](const std::string& when) {
@@ -533,7 +536,7 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
     EXPECT_NE(declined["text"].get<std::string>().find("Nothing of yours was stored"),
               std::string::npos);
     nothing_of_them("after the decline");
-    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 1);
     // The declined page's token is spent: it acts on nothing.
     page.call("continue", {{"view", 1}, {"shown_ms", 60}, {"t_ms", 900}}, 409);
     nothing_of_them("after the spent token was used");
@@ -543,7 +546,7 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
     second.open({{"participant", "P2"}});
     second.call("decline",
                 {{"view", second.state["view"]}, {"shown_ms", 10}, {"t_ms", 20}});
-    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 2);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 2);
     nothing_of_them("after the second decline");
 
     // Agreeing stores them, with the browser's details, and the consent time.
@@ -558,7 +561,7 @@ TEST_P(Serve, DecliningConsentStoresNothingOfThePersonOnlyTheCount) {
     EXPECT_EQ(count("SELECT count(*) FROM session_segments WHERE display_mode LIKE "
                     "'%Prolific STUDY_ID=60aabbccddeeff0011223344 SESSION_ID=abc123XYZ'"),
               1);
-    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 2);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 2);
     // The token handed out before consent is the stored session's: a reload with it
     // resumes that session (403 without it).
     const std::string token = yes.token;
@@ -751,7 +754,7 @@ TEST_P(Serve, FiftyReloadsAndDeclinesAddBoundedRows) {
     EXPECT_EQ(count("SELECT count(*) FROM trials t JOIN session_segments g ON g.id = "
                     "t.segment_id"),
               answered);
-    // Fifty pages opened and declined: no rows at all, one count.
+    // Fifty codes declined: one row each (a salted hash), nothing else.
     for (int i = 0; i < 50; ++i) {
         Page no{direct(*web_)};
         no.open({{"participant", "N" + std::to_string(i)}});
@@ -759,7 +762,77 @@ TEST_P(Serve, FiftyReloadsAndDeclinesAddBoundedRows) {
     }
     EXPECT_EQ(count("SELECT count(*) FROM participants"), 1);
     EXPECT_EQ(count("SELECT count(*) FROM sessions"), 1);
-    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 50);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 50);
+}
+
+// Issue 44 item 5: a decline counts a participant code, not a page load. 400 scripted
+// declines of one code (each a fresh page, as a reload without the token gets) are one
+// code that declined consent, one row; the old count made 400.
+TEST_P(Serve, OneCodeDecliningOnFourHundredPagesCountsOnce) {
+    std::string last_token;
+    for (int i = 0; i < 400; ++i) {
+        Page no{direct(*web_)};
+        no.open({{"participant", "S1"}});
+        ASSERT_EQ(no.state["screen"], "consent") << i;
+        no.call("decline", {{"view", no.state["view"]}, {"shown_ms", 10}, {"t_ms", 20}});
+        last_token = no.token;
+    }
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM participants"), 0);
+    // The newest declined page stays declined: its token acts on nothing.
+    Page again{direct(*web_)};
+    again.token = last_token;
+    again.who = {{"participant", "S1"}};
+    again.call("continue", {{"view", 1}, {"shown_ms", 60}, {"t_ms", 900}}, 409);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions"), 0);
+    // The person may still agree later, from a new page: enrolled, still counted once.
+    Page yes{direct(*web_)};
+    yes.open({{"participant", "S1"}});
+    yes.enter();
+    EXPECT_EQ(yes.state["screen"], "instructions");
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 1);
+}
+
+// A store whose consent write fails, as a fault between two commits would: enrolment
+// commits, then the connection or the disk goes.
+template <class Base>
+class ConsentWriteFails : public Base {
+public:
+    using Base::Base;
+    void set_consent(int64_t) override {
+        throw StoreUnavailable("fault injected: the consent write after enrolment");
+    }
+};
+
+// Issue 44 item 6: consent is part of the enrolment's transaction. With a second commit
+// for it, a fault between the two left a stored session (user agent, Prolific ids)
+// without consent; now no session is ever stored without its consent.
+TEST_P(Serve, AFaultAfterEnrolmentLeavesNoSessionWithoutConsent) {
+    web_.reset();
+    store_.reset();
+    std::unique_ptr<StudyStore> faulty;
+    if (GetParam() == "sqlite") {
+        faulty = std::make_unique<ConsentWriteFails<Store>>(db_);
+    } else {
+        StoreOptions options;
+        options.journal = false;
+        faulty = std::make_unique<ConsentWriteFails<PostgresStore>>(db_, options);
+    }
+    WebStudy web(protocol_, *faulty, options_);
+    Page page{direct(web)};
+    page.open({{"prolific",
+                {{"PROLIFIC_PID", "5f3a9c1b2d4e6f708192a3b4"},
+                 {"STUDY_ID", "60aabbccddeeff0011223344"},
+                 {"SESSION_ID", "abc123XYZ"}}}});
+    ASSERT_EQ(page.state["screen"], "consent");
+    const WebReply agreed = page.request(
+        "continue", {{"view", page.state["view"]}, {"shown_ms", 60}, {"t_ms", 900}});
+    EXPECT_EQ(agreed.status, 200) << agreed.body;
+    EXPECT_EQ(
+        faulty->query_int("SELECT count(*) FROM sessions WHERE consent_utc IS NULL"), 0);
+    EXPECT_EQ(
+        faulty->query_int("SELECT count(*) FROM sessions WHERE consent_utc IS NOT NULL"),
+        1);
 }
 
 // Item 10: a participant withdrawn while their page is open: the page is told so (410),

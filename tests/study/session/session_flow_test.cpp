@@ -322,12 +322,13 @@ TEST_F(Flow, WindowCloseMidSessionSavesAndADeclineBeforeConsentKeepsOnlyTheCount
     frame();
     press(Key::Decline);
     EXPECT_EQ(flow_->result(), RunResult::Declined);
-    // Nothing of the person is kept: no session, trial, segment or participant; a count.
+    // Nothing of the person is kept: no session, trial, segment or participant; their
+    // code once among those that declined, as a salted hash.
     EXPECT_EQ(stored_status(), "");
     EXPECT_EQ(count("SELECT count(*) FROM participants"), 0);
     EXPECT_EQ(count("SELECT count(*) FROM trials"), 0);
     EXPECT_EQ(count("SELECT count(*) FROM session_segments"), 0);
-    EXPECT_EQ(count("SELECT declined FROM consent_declines"), 1);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 1);
 }
 
 TEST_F(Flow, DecliningAResumedSessionThatHadConsentAbortsItAndKeepsItsAnswers) {
@@ -342,7 +343,22 @@ TEST_F(Flow, DecliningAResumedSessionThatHadConsentAbortsItAndKeepsItsAnswers) {
     EXPECT_EQ(stored_status(), "aborted+ended");
     EXPECT_EQ(count("SELECT count(*) FROM responses"),
               static_cast<int64_t>(protocol_.questions.size()));
-    EXPECT_EQ(count("SELECT count(*) FROM consent_declines"), 0);
+    EXPECT_EQ(count("SELECT count(*) FROM declined_codes"), 0);
+}
+
+// Consent on record (an online enrolment writes it with the session) is not written
+// again when the flow passes the consent screen: one write, its time kept.
+TEST_F(Flow, ConsentAlreadyOnRecordIsNotWrittenAgain) {
+    open(small_with_screens(), true);
+    store_->db().exec("UPDATE sessions SET consent_utc = '2020-01-01T00:00:00.000Z'");
+    restart(true);
+    frame();
+    ASSERT_EQ(flow_->screen(), Screen::Consent);
+    press(Key::Enter);
+    EXPECT_EQ(flow_->screen(), Screen::Instructions);
+    EXPECT_EQ(count("SELECT count(*) FROM sessions WHERE consent_utc = "
+                    "'2020-01-01T00:00:00.000Z'"),
+              1);
 }
 
 TEST_F(Flow, AResumedSessionStartsAtItsFirstOpenTrial) {
