@@ -189,9 +189,13 @@ int serve_command(const ServeArgs& args) {
         options.environment.machine_id = study::machine_id();
         options.environment.software_version = version_string();
         options.environment.build_hash = build_hash();
-        // Each segment records the protocol's stimuli; a series picture is its base
-        // stimulus with the knob at the value stored with the trial.
+        // Each segment records the protocol's stimuli, and names the set of series
+        // pictures it serves (each picture's file and content hash, once per set).
         options.environment.stimuli = stimuli.provenance(shown);
+        options.environment.series_pictures.assign(
+            options.environment.stimuli.begin() +
+                static_cast<std::ptrdiff_t>(protocol.stimuli.size()),
+            options.environment.stimuli.end());
         options.environment.stimuli.resize(protocol.stimuli.size());
         options.series = std::move(series);
         pictures = load_pictures(shown, stimuli);

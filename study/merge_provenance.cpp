@@ -31,10 +31,11 @@ const char* const kProvenanceCopySteps[] = {
 
     "INSERT INTO session_segments (session_id, segment, started_utc, machine_id, "
     "software_version, build_hash, gl_vendor, gl_renderer, display_mode, "
-    "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source) "
+    "display_refresh_hz, measured_refresh_hz, refresh_note, stimulus_source, series_set) "
     "SELECT msn.id, g.segment, g.started_utc, g.machine_id, g.software_version, "
     "g.build_hash, g.gl_vendor, g.gl_renderer, g.display_mode, g.display_refresh_hz, "
-    "g.measured_refresh_hz, g.refresh_note, g.stimulus_source FROM src.session_segments "
+    "g.measured_refresh_hz, g.refresh_note, g.stimulus_source, g.series_set FROM "
+    "src.session_segments "
     "g "
     "JOIN src.sessions s ON s.id = g.session_id JOIN temp.new_sessions n ON n.uuid = "
     "s.uuid "
@@ -52,6 +53,16 @@ const char* const kProvenanceCopySteps[] = {
     "JOIN src.stimuli st ON st.id = x.stimulus_id "
     "JOIN main.stimuli mst ON mst.study_id = msn.study_id AND mst.stimulus_key = "
     "st.stimulus_key",
+
+    // A set is its hash: the same set from two inputs is one set of rows.
+    "INSERT OR IGNORE INTO series_pictures (study_id, set_hash, picture, file, "
+    "content_hash, software_version, build_hash) "
+    "SELECT ms.id, x.set_hash, x.picture, x.file, x.content_hash, x.software_version, "
+    "x.build_hash FROM src.series_pictures x JOIN src.studies ss ON ss.id = x.study_id "
+    "JOIN main.studies ms ON ms.protocol_hash = ss.protocol_hash "
+    "WHERE x.set_hash IN (SELECT g.series_set FROM src.session_segments g "
+    "JOIN src.sessions s ON s.id = g.session_id JOIN temp.new_sessions n ON n.uuid = "
+    "s.uuid)",
 
     "UPDATE main.trials SET segment_id = ("
     "SELECT mg.id FROM src.trials t JOIN src.sessions s ON s.id = t.session_id "

@@ -231,6 +231,23 @@ CREATE TABLE declined_codes (
     page_uuid TEXT UNIQUE,
     PRIMARY KEY (salt, code_hash));
 CREATE INDEX declined_codes_by_study ON declined_codes(study_id);
+)sql"
+    // Also in 9: provenance of the pictures a study shows beyond its stimuli (an adjust
+    // series' steps, a staircase's ladder: `lucent serve` serves each as a picture of
+    // its own). One row per picture of each distinct set of files a study was served
+    // from, keyed by the set's hash; a segment names its set (series_set, NULL when it
+    // showed none), so rows grow with the folders used, not with the sessions.
+    R"sql(
+CREATE TABLE series_pictures (
+    study_id INTEGER NOT NULL REFERENCES studies(id) ON DELETE CASCADE,
+    set_hash TEXT NOT NULL,
+    picture TEXT NOT NULL,
+    file TEXT NOT NULL,
+    content_hash TEXT NOT NULL,
+    software_version TEXT NOT NULL,
+    build_hash TEXT NOT NULL,
+    PRIMARY KEY (study_id, set_hash, picture));
+ALTER TABLE session_segments ADD COLUMN series_set TEXT;
 )sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);

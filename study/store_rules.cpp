@@ -1,9 +1,11 @@
 #include "study/store_rules.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <set>
 
+#include "study/sha256.h"
 #include "study/trial_plan.h"
 
 namespace lucent::study {
@@ -150,6 +152,19 @@ std::optional<std::string> segment_source(
     for (const StimulusProvenance& p : stimuli) sources.insert(p.source);
     if (sources.empty()) return std::nullopt;
     return sources.size() == 1 ? *sources.begin() : std::string("mixed");
+}
+
+std::optional<std::string> series_set_hash(
+    const std::vector<StimulusProvenance>& pictures) {
+    if (pictures.empty()) return std::nullopt;
+    std::vector<std::pair<std::string, std::string>> held;
+    for (const StimulusProvenance& p : pictures)
+        held.emplace_back(p.stimulus, p.content_hash + "\t" + p.file + "\t" +
+                                          p.software_version + "\t" + p.build_hash);
+    std::sort(held.begin(), held.end());
+    std::string text;
+    for (const auto& [picture, what] : held) text += picture + "\t" + what + "\n";
+    return sha256_hex(text);
 }
 
 ResolvedStimulus resolved_of(const StimulusProvenance& p) {

@@ -67,6 +67,10 @@ std::string resolved_difference(const std::string& stimulus, const ResolvedStimu
 ResolvedStimulus resolved_of(const StimulusProvenance& p);
 // One word for a segment's pictures: the common source, "mixed", or nullopt when unknown.
 std::optional<std::string> segment_source(const std::vector<StimulusProvenance>& stimuli);
+// session_segments.series_set: SHA-256 of the pictures' ids and content hashes, in id
+// order (one value per distinct set of files), or nullopt when there are none.
+std::optional<std::string> series_set_hash(
+    const std::vector<StimulusProvenance>& pictures);
 
 // trials.shown: a forced choice's stimulus keys in screen order, space-separated (keys
 // hold no whitespace: the protocol refuses them in choice blocks); "" for a rating.

@@ -65,6 +65,10 @@ struct SessionEnvironment {
     std::optional<double> measured_refresh_hz;  // from swap intervals; NULL when unknown
     std::string refresh_note;                   // why a refresh is NULL, or a warning
     std::vector<StimulusProvenance> stimuli;    // what this segment shows (may be empty)
+    // Pictures shown beyond the protocol's stimuli (`lucent serve`: an adjust series'
+    // steps, a staircase's ladder), each with `stimulus` = the picture's id (BASE@...),
+    // its file and content hash; recorded once per distinct set (series_pictures).
+    std::vector<StimulusProvenance> series_pictures;
 };
 
 struct SessionRow {

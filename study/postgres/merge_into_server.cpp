@@ -82,12 +82,28 @@ IdMap copy_rows(pqxx::work& tx, Database& m, const std::string& table,
     return ids;
 }
 
+struct StudyIds {
+    IdMap studies, stimuli;
+};
+
+// The series pictures the copied segments (`segments_where` over session_segments g)
+// name: a set is its hash, so a set the server holds already adds nothing.
+void copy_series_pictures(pqxx::work& tx, Database& m, const IdMap& studies,
+                          const std::string& segments_where) {
+    copy_rows(tx, m, "series_pictures",
+              "(study_id, set_hash) IN (SELECT se.study_id, g.series_set FROM "
+              "session_segments g JOIN sessions se ON se.id = g.session_id WHERE " +
+                  segments_where + ")",
+              {{"study_id", &studies}}, false, " ON CONFLICT DO NOTHING");
+}
+
 // The server's sessions that a file's copy extends (temp.extended): the status, end
 // and consent the kept copy holds (never undoing a completion), its segments the
 // server lacks (temp.ext_segments) with what they showed, and each trial answered there
 // but not on the server (temp.ext_trials) with its ratings. The server's session keeps
 // its id and every row it had.
-void extend_server_sessions(pqxx::work& tx, Database& m, const IdMap& stimuli) {
+void extend_server_sessions(pqxx::work& tx, Database& m, const StudyIds& study) {
+    const IdMap& stimuli = study.stimuli;
     IdMap sessions, segments, trials;
     Statement e = m.prepare(
         "SELECT e.id, e.uuid, s.status, s.ended_utc, s.consent_utc "
@@ -114,6 +130,8 @@ void extend_server_sessions(pqxx::work& tx, Database& m, const IdMap& stimuli) {
     copy_rows(tx, m, "segment_stimuli",
               "segment_id IN (SELECT id FROM temp.ext_segments)",
               {{"segment_id", &segments}, {"stimulus_id", &stimuli}}, false);
+    copy_series_pictures(tx, m, study.studies,
+                         "g.id IN (SELECT id FROM temp.ext_segments)");
     // The segments both hold, by number.
     Statement g = m.prepare(
         "SELECT g.id, g.session_id, g.segment FROM main.session_segments g "
@@ -301,9 +319,6 @@ MergeReport report_of(Database& m, const MergeReport& merged,
 }
 
 // The server's ids of the merged file's studies and stimuli.
-struct StudyIds {
-    IdMap studies, stimuli;
-};
 
 // The study and its stimuli on the server: looked up when the server holds the study
 // (with the stimulus values it has not recorded yet), copied otherwise.
@@ -390,6 +405,8 @@ void copy_new_sessions(pqxx::work& tx, Database& m, const StudyIds& study,
         "segment_id IN (SELECT g.id FROM session_segments g JOIN temp.new_sessions n "
         "ON n.id = g.session_id)",
         {{"segment_id", &segments}, {"stimulus_id", &stimuli}}, false);
+    copy_series_pictures(tx, m, studies,
+                         "g.session_id IN (SELECT id FROM temp.new_sessions)");
     const IdMap trials = copy_rows(
         tx, m, "trials", "session_id IN (SELECT id FROM temp.new_sessions)",
         {{"session_id", &sessions}, {"stimulus_id", &stimuli}, {"segment_id", &segments}},
@@ -418,7 +435,7 @@ void store_on_server(Database& m, const std::string& uri,
         copy_rows(tx, m, "retired_participant_numbers", "1", {}, false,
                   " ON CONFLICT DO NOTHING");
         copy_new_sessions(tx, m, study, participants);
-        extend_server_sessions(tx, m, study.stimuli);
+        extend_server_sessions(tx, m, study);
         withdraw_on_server(tx, m, withdrawn_on_server);
         tx.commit();
     } catch (const StoreError&) {

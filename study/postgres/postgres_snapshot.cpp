@@ -26,7 +26,8 @@ void PostgresStore::snapshot_to_sqlite(const std::string& sqlite_path) {
                                           "withdrawn_sessions",
                                           "withdrawn_codes",
                                           "consent_declines",
-                                          "declined_codes"};
+                                          "declined_codes",
+                                          "series_pictures"};
     Store out(sqlite_path);
     Database& db = out.db();
     guarded("taking a snapshot", [&] {

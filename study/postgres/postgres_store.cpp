@@ -331,16 +331,31 @@ void insert_segment(pqxx::work& tx, int64_t session_id, int segment,
                 "$3, $4)",
                 study_id, p.stimulus, name, text);
     }
+    const std::optional<std::string> series_set = series_set_hash(env.series_pictures);
     const int64_t segment_id =
         exec_with_environment(
             tx,
             "INSERT INTO session_segments (" + std::string(kEnvironmentColumns) +
-                ", session_id, segment, started_utc, stimulus_source) "
+                ", session_id, segment, started_utc, stimulus_source, series_set) "
                 "VALUES (" +
-                environment_values(true, 1) + ", $10, $11, $12, $13) RETURNING id",
-            env, session_id, segment, utc_now_iso8601(),
-            segment_source(env.stimuli))[0][0]
+                environment_values(true, 1) + ", $10, $11, $12, $13, $14) RETURNING id",
+            env, session_id, segment, utc_now_iso8601(), segment_source(env.stimuli),
+            series_set)[0][0]
             .as<int64_t>();
+    // One row per picture of each distinct set; instances racing to record one set both
+    // insert, and the primary key keeps one of each.
+    if (series_set &&
+        tx.exec_params("SELECT 1 FROM series_pictures WHERE study_id = $1 AND set_hash = "
+                       "$2 LIMIT 1",
+                       study_id, *series_set)
+            .empty())
+        for (const StimulusProvenance& p : env.series_pictures)
+            tx.exec_params(
+                "INSERT INTO series_pictures (study_id, set_hash, picture, file, "
+                "content_hash, software_version, build_hash) VALUES ($1, $2, $3, $4, $5, "
+                "$6, $7) ON CONFLICT DO NOTHING",
+                study_id, *series_set, p.stimulus, p.file, p.content_hash,
+                p.software_version, p.build_hash);
     for (const StimulusProvenance& p : env.stimuli)
         tx.exec_params(
             "INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, "

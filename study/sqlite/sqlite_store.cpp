@@ -399,15 +399,39 @@ void Store::insert_segment(int64_t session_id, int segment,
     }
     Statement segment_row = db_.prepare(
         "INSERT INTO session_segments (session_id, segment, started_utc, "
-        "stimulus_source, " +
-        std::string(kEnvironmentColumns) + ") VALUES (?, ?, ?, ?, " +
+        "stimulus_source, series_set, " +
+        std::string(kEnvironmentColumns) + ") VALUES (?, ?, ?, ?, ?, " +
         environment_values(false, 1) + ")");
+    const std::optional<std::string> series_set = series_set_hash(env.series_pictures);
     segment_row.bind(1, session_id)
         .bind(2, segment)
         .bind(3, utc_now_iso8601())
-        .bind(4, segment_source(env.stimuli));
-    bind_environment(segment_row, 5, env).run();
+        .bind(4, segment_source(env.stimuli))
+        .bind(5, series_set);
+    bind_environment(segment_row, 6, env).run();
     const int64_t segment_id = db_.last_insert_id();
+    // A set already recorded (an earlier session served from the same files) adds
+    // nothing.
+    Statement known = db_.prepare(
+        "SELECT count(*) FROM series_pictures WHERE study_id = ? AND set_hash = ?");
+    known.bind(1, study_id).bind(2, series_set.value_or(""));
+    if (series_set && known.step() && known.integer(0) == 0) {
+        Statement picture = db_.prepare(
+            "INSERT INTO series_pictures (study_id, set_hash, picture, file, "
+            "content_hash, "
+            "software_version, build_hash) VALUES (?, ?, ?, ?, ?, ?, ?)");
+        for (const StimulusProvenance& p : env.series_pictures) {
+            picture.reset();
+            picture.bind(1, study_id)
+                .bind(2, *series_set)
+                .bind(3, p.stimulus)
+                .bind(4, p.file)
+                .bind(5, p.content_hash)
+                .bind(6, p.software_version)
+                .bind(7, p.build_hash)
+                .run();
+        }
+    }
     Statement shown = db_.prepare(
         "INSERT INTO segment_stimuli (segment_id, stimulus_id, source, file, "
         "content_hash, "

@@ -18,12 +18,14 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "study/protocol.h"
 #include "study/serve/picture_names.h"
+#include "study/session/stimulus_source.h"
 #include "study/sqlite/database.h"
 #include "study/trial_plan.h"
 #include "study/web_series.h"
@@ -405,6 +407,21 @@ TEST(DocumentedMatching, ThePagesCommandsRunAsWrittenAndServeShowsEverySeries) {
                 EXPECT_EQ(png->status, 200) << id;
                 EXPECT_EQ(png->body.substr(1, 3), "PNG") << id;
             }
+        // A participant agrees: their session's segment names the set of series
+        // pictures it is served from (issue 44, item 6).
+        const auto opened = client.Post(
+            "/api/session", R"({"participant": "WEB2", "t_ms": 0})", "application/json");
+        ASSERT_TRUE(opened);
+        ASSERT_EQ(opened->status, 200) << opened->body;
+        const nlohmann::json page = nlohmann::json::parse(opened->body);
+        const nlohmann::json agree = {{"token", page["token"]},
+                                      {"view", page["view"]},
+                                      {"shown_ms", 10},
+                                      {"t_ms", 20}};
+        const auto agreed =
+            client.Post("/api/continue", agree.dump(), "application/json");
+        ASSERT_TRUE(agreed);
+        EXPECT_EQ(agreed->status, 200) << agreed->body;
     };
     std::map<std::string, int> ran = run_page(commands, dir, check_series);
     const int served = ran["serve"];
@@ -422,6 +439,36 @@ TEST(DocumentedMatching, ThePagesCommandsRunAsWrittenAndServeShowsEverySeries) {
               1 + d.scalar_int("SELECT count(*) FROM adjustments"));
     const std::string report = read_file(dir / "matching-report" / "report.md");
     EXPECT_NE(report.find("Matching"), std::string::npos) << report.substr(0, 2000);
+
+    // Each served picture beyond the study's stimuli has its provenance row: one set per
+    // folder, each picture's file and content hash as its manifest gives them.
+    for (const std::string preset : {"matching", "jnd"}) {
+        const study::Protocol protocol = study::builtin_protocol(preset);
+        const study::Protocol shown =
+            study::with_series_pictures(protocol, study::web_series(protocol));
+        const std::vector<study::StimulusProvenance> expected =
+            study::PrerenderedStimuli((dir / (preset + "-pictures")).string())
+                .provenance(shown);
+        study::Database db((dir / (preset + ".db")).string(), SQLITE_OPEN_READONLY);
+        EXPECT_EQ(
+            db.scalar_int("SELECT count(DISTINCT series_set) FROM session_segments"), 1)
+            << preset;
+        EXPECT_EQ(db.scalar_int("SELECT count(*) FROM series_pictures p JOIN "
+                                "session_segments g ON g.series_set = p.set_hash"),
+                  static_cast<int64_t>(shown.stimuli.size() - protocol.stimuli.size()))
+            << preset;
+        for (size_t i = protocol.stimuli.size(); i < expected.size(); ++i) {
+            study::Statement row = db.prepare(
+                "SELECT file, content_hash FROM series_pictures WHERE picture = ?");
+            row.bind(1, expected[i].stimulus);
+            ASSERT_TRUE(row.step()) << preset << " " << expected[i].stimulus;
+            // The file as serve's --images named it (relative), the test's absolute.
+            EXPECT_EQ(fs::path(row.text(0)).filename(),
+                      fs::path(expected[i].file).filename())
+                << expected[i].stimulus;
+            EXPECT_EQ(row.text(1), expected[i].content_hash) << expected[i].stimulus;
+        }
+    }
 
     // A ladder picture missing, then one changed after it was rendered: serve refuses to
     // start, in one line naming it (and what writes it).

@@ -185,6 +185,53 @@ TEST(Provenance, MergeCarriesSegmentsAndWhatEachShowed) {
     EXPECT_TRUE(notes.empty()) << notes.front();
 }
 
+// A served session of `code` whose segment names a set of series pictures (issue 44,
+// item 6): pictures a@k=0.1..0.3, the second with content hash `second_hash`.
+void served_session(const std::string& path, const std::string& code,
+                    const std::string& second_hash) {
+    Store store(path);
+    const Protocol p = small_protocol();
+    const int64_t study = store.ensure_study(p);
+    int number = 0;
+    const int64_t pid = store.ensure_participant(study, code, &number);
+    SessionEnvironment env = environment("web", "agent", 60);
+    env.stimuli = provenance_for(p, "0.8,0.55,0.35");
+    for (const std::string& hash : {std::string("h1"), second_hash, std::string("h3")}) {
+        StimulusProvenance picture;
+        picture.stimulus = "a@k=0." + std::to_string(env.series_pictures.size() + 1);
+        picture.source = "images";
+        picture.file = picture.stimulus + ".png";
+        picture.content_hash = hash;
+        picture.software_version = "9.9.9";
+        picture.build_hash = "test";
+        env.series_pictures.push_back(picture);
+    }
+    const SessionRow s =
+        store.create_session(study, pid, plan_trials(p, 5, number), 5, env);
+    for (const TrialRow& t : store.trials(s.id))
+        store.record_trial(s.id, t.id, lucent::test::outcome_for(p, t));
+}
+
+TEST(Provenance, MergeCarriesSeriesPicturesOncePerSet) {
+    const auto dir = lucent::test::scratch_dir("provenance_merge_series");
+    const std::string a = (dir / "a.db").string(), b = (dir / "b.db").string(),
+                      c = (dir / "c.db").string(), out = (dir / "all.db").string();
+    served_session(a, "P1", "h2");
+    served_session(b, "P2", "h2");      // the same set as a's
+    served_session(c, "P3", "h2-new");  // another
+    merge_databases({a, b, c}, out);
+    Database db(out, SQLITE_OPEN_READONLY);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM series_pictures"), 6);
+    EXPECT_EQ(db.scalar_int("SELECT count(DISTINCT series_set) FROM session_segments"),
+              2);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM session_segments g JOIN "
+                            "series_pictures x ON x.set_hash = g.series_set"),
+              9);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM series_pictures WHERE picture = "
+                            "'a@k=0.2' AND content_hash = 'h2-new'"),
+              1);
+}
+
 TEST(Provenance, AVersion2DatabaseStillExportsWithANoteAndStaysVersion2) {
     const auto dir = lucent::test::scratch_dir("provenance_v2_export");
     const std::string path = (dir / "old.db").string();

@@ -95,6 +95,42 @@ TEST_F(Withdrawal, MergingAStationFileIntoAServerDoesNotBringAWithdrawnParticipa
     EXPECT_EQ(c.text(1), sha256_hex(c.text(0) + "P01\n"));
 }
 
+// Issue 44 item 6: a station file's series pictures reach the server once per set,
+// however often the file is merged, and the merged segment names its set.
+TEST_F(Withdrawal, MergingIntoAServerCarriesSeriesPicturesOncePerSet) {
+    const std::string station = path("station.db");
+    {
+        Store store(station);
+        const int64_t study = store.ensure_study(p_);
+        SessionEnvironment env;
+        env.machine_id = "web";
+        for (int i = 1; i <= 3; ++i) {
+            StimulusProvenance picture;
+            picture.stimulus = "a@k=0." + std::to_string(i);
+            picture.source = "images";
+            picture.file = picture.stimulus + ".png";
+            picture.content_hash = "h" + std::to_string(i);
+            picture.software_version = "9.9.9";
+            picture.build_hash = "test";
+            env.series_pictures.push_back(picture);
+        }
+        for (const char* code : {"P01", "P02"}) {
+            int number = 0;
+            const int64_t pid = store.ensure_participant(study, code, &number);
+            store.create_session(study, pid, plan_trials(p_, 1, number), 1, env);
+        }
+    }
+    EXPECT_EQ(merge_into_server({station}, uri_).sessions_added, 2);
+    merge_into_server({station}, uri_);
+    auto s = server();
+    EXPECT_EQ(s->query_int("SELECT count(*) FROM series_pictures"), 3);
+    EXPECT_EQ(
+        s->query_int("SELECT count(*) FROM session_segments g JOIN series_pictures x "
+                     "ON x.set_hash = g.series_set AND x.picture = 'a@k=0.2' AND "
+                     "x.content_hash = 'h2'"),
+        2);
+}
+
 TEST_F(Withdrawal, AWithdrawalInAFileRemovesTheSessionFromTheServer) {
     const std::string station = path("station.db"), study = path("study.db");
     {

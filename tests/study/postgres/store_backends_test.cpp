@@ -495,6 +495,60 @@ SessionEnvironment environment(const std::string& machine, const std::string& gp
     return env;
 }
 
+// Issue 44 item 6: the pictures served beyond the study's stimuli (series steps,
+// staircase ladders) have provenance rows: each picture's file and content hash, once per
+// distinct set of files, and each segment names its set.
+TEST_P(Backend, SeriesPicturesAreRecordedOncePerSetAndEachSegmentNamesItsSet) {
+    auto store = open();
+    const Protocol p = lucent::test::small_protocol();
+    const int64_t study = store->ensure_study(p);
+    auto picture = [](const std::string& id, const std::string& hash) {
+        StimulusProvenance s;
+        s.stimulus = id;
+        s.source = "images";
+        s.file = id + ".png";
+        s.content_hash = hash;
+        s.software_version = "lucent test";
+        s.build_hash = "b1";
+        return s;
+    };
+    SessionEnvironment env = environment("web", "agent", 60);
+    env.series_pictures = {picture("a@k=0.1", "h1"), picture("a@k=0.2", "h2"),
+                           picture("a@k=0.3", "h3")};
+    auto enrol = [&](const std::string& code) {
+        int number = 0;
+        const int64_t pid = store->ensure_participant(study, code, &number);
+        return store->create_session(study, pid, plan_trials(p, 5, number), 5, env);
+    };
+    enrol("P1");
+    enrol("P2");
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM series_pictures"), 3);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM series_pictures WHERE picture = "
+                               "'a@k=0.2' AND file = 'a@k=0.2.png' AND content_hash = "
+                               "'h2' AND software_version = 'lucent test'"),
+              1);
+    EXPECT_EQ(store->query_int("SELECT count(DISTINCT series_set) FROM session_segments"),
+              1);
+    EXPECT_EQ(
+        store->query_int("SELECT count(*) FROM session_segments g WHERE "
+                         "(SELECT count(*) FROM series_pictures x WHERE x.set_hash = "
+                         "g.series_set) = 3"),
+        2);
+    // One picture re-rendered (another folder, another instance): a second set.
+    env.series_pictures[1].content_hash = "h2-new";
+    enrol("P3");
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM series_pictures"), 6);
+    EXPECT_EQ(store->query_int("SELECT count(DISTINCT series_set) FROM session_segments"),
+              2);
+    // A lab segment that showed no series names none.
+    env.series_pictures.clear();
+    enrol("P4");
+    EXPECT_EQ(store->query_int(
+                  "SELECT count(*) FROM session_segments WHERE series_set IS NULL"),
+              1);
+    EXPECT_EQ(store->query_int("SELECT count(*) FROM series_pictures"), 6);
+}
+
 TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
     auto store = open();
     const Protocol p = lucent::test::small_protocol();
@@ -832,8 +886,9 @@ TEST_F(Server, SchemaIsTheSqliteSchemaTableForTableAndColumnForColumn) {
         }
     }
     // Schema 5 added withdrawn_sessions, withdrawn_codes and consent_declines to the 11,
-    // schema 7 adjustments, schema 8 declined_pages, schema 9 declined_codes.
-    EXPECT_EQ(tables, 17);
+    // schema 7 adjustments, schema 8 declined_pages, schema 9 declined_codes and
+    // series_pictures.
+    EXPECT_EQ(tables, 18);
     // The server has the same tables plus lucent_schema, nothing else.
     EXPECT_EQ(server->query_int("SELECT count(*) FROM information_schema.tables WHERE "
                                 "table_schema = 'public'"),
