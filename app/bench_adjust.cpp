@@ -1,8 +1,9 @@
 // lucent bench adjust: the adjust trial's frame after one knob step (issue 31): the
 // match re-rendered with the knob moved, read back, encoded and put in its texture, as
 // `lucent run` does, with pass reuse (only the passes the knob touches re-run) against
-// a full render (every pass), on the empirical technique, per size; median and p95 and
-// their ratios, measured in one run on this machine.
+// a full render (every pass), on the registry's default technique (the empirical shader)
+// or the one named, per size; median and p95 and their ratios, measured in one run on
+// this machine.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include "app/commands.h"
 #include "renderer/gl/context.h"
 #include "renderer/render.h"
+#include "renderer/techniques/registry.h"
 #include "study/session/live_knob.h"
 
 namespace lucent::app {
@@ -24,6 +26,7 @@ namespace {
 
 struct AdjustBenchOptions {
     std::string mesh = "sphere:10k";
+    std::string technique = default_technique_name();
     std::string knob = "thickness_exponent";
     std::vector<int> sizes = {256, 512};
     int frames = 30;
@@ -80,6 +83,18 @@ int run_adjust_bench(const AdjustBenchOptions& o) {
                      "given\n";
         return kExitUsage;
     }
+    if (!is_technique_name(o.technique)) {
+        std::cerr << "lucent bench adjust: --technique: '" << o.technique
+                  << "' is unknown (valid: " << technique_names_listed() << ")\n";
+        return kExitUsage;
+    }
+    const auto knobs = knobs_for(find_technique(o.technique));
+    const Knob* knob = find_knob(knobs, o.knob);
+    if (!knob || knob->kind != KnobKind::scalar) {
+        std::cerr << "lucent bench adjust: --knob: '" << o.knob
+                  << "' is not a number knob of " << o.technique << "\n";
+        return kExitUsage;
+    }
     std::unique_ptr<gl::Context> context;
     try {
         context = gl::create_headless_context();
@@ -89,7 +104,8 @@ int run_adjust_bench(const AdjustBenchOptions& o) {
     }
     const gl::GlInfo info = context->info();
     std::cout << "lucent bench adjust: an adjust trial's match after one knob step ("
-              << o.knob << ", empirical, " << o.mesh << "), rendered, read back and "
+              << o.knob << ", " << o.technique << ", " << o.mesh
+              << "), rendered, read back and "
               << "uploaded as `lucent run` does\nGL: " << info.renderer << "\n"
               << o.frames << " frames per row after " << o.warmup << " warm-up\n\n";
     char line[256];
@@ -101,7 +117,7 @@ int run_adjust_bench(const AdjustBenchOptions& o) {
     for (const int size : o.sizes) {
         RenderRequest request;
         request.mesh = o.mesh;
-        request.technique = "empirical";
+        request.technique = o.technique;
         request.width = request.height = size;
         try {
             const Scene scene = build_scene(request);
@@ -157,7 +173,10 @@ void register_bench_adjust(CLI::App& bench, int& exit_code) {
         "An adjust trial's frame after one knob step: pass reuse vs a full render");
     cmd->add_option("--mesh", options->mesh, "mesh (built-in name[:faces] or a file)")
         ->capture_default_str();
-    cmd->add_option("--knob", options->knob, "the empirical technique's knob turned")
+    cmd->add_option("--technique", options->technique,
+                    "the technique rendered (" + technique_names_listed() + ")")
+        ->capture_default_str();
+    cmd->add_option("--knob", options->knob, "the technique's number knob turned")
         ->capture_default_str();
     cmd->add_option("--sizes", options->sizes, "square frame sizes in pixels")
         ->delimiter(',')

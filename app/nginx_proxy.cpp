@@ -188,7 +188,8 @@ void NginxProxy::write_config() const {
       << "    client_max_body_size 1m;\n"
       << "    upstream lucent_instances {\n";
     for (int upstream : upstreams_)
-        c << "        server 127.0.0.1:" << upstream << " max_fails=1 fail_timeout=2s;\n";
+        c << "        server 127.0.0.1:" << upstream
+          << " max_fails=" << options_.max_fails << " fail_timeout=2s;\n";
     c << "        keepalive 16;\n"
       << "    }\n"
       << "    server {\n"

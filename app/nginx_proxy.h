@@ -8,10 +8,10 @@
 // touched (its config, its logs, /var/lib/nginx, port 80).
 //
 // The config is the deployment's (docs/deploy.md) without TLS and with a 1m body limit
-// (not 64k): upstreams with max_fails=1 fail_timeout=2s and keepalive,
-// proxy_next_upstream on errors, timeouts, 502 and 503. One location of its own,
-// /.nginx-proxy-generation, answers which config is active; the harness polls it to know
-// that nginx is up and that a reload took.
+// (not 64k): upstreams with max_fails=1 (Options::max_fails) fail_timeout=2s and
+// keepalive, proxy_next_upstream on errors, timeouts, 502 and 503. One location of its
+// own, /.nginx-proxy-generation, answers which config is active; the harness polls it to
+// know that nginx is up and that a reload took.
 #include <sys/types.h>
 
 #include <filesystem>
@@ -25,6 +25,11 @@ struct NginxProxyOptions {
     // upstream too (lucent's API is idempotent by design: the same answer twice is
     // stored once).
     bool retry_non_idempotent = true;
+    // Each upstream's max_fails (fail_timeout 2s): 1, the deployment's, takes an upstream
+    // that failed out of the rotation for 2 s; 0 never does, so a dead upstream is
+    // met again by every other request (nginx passing each on to the next one), which a
+    // test can rely on without waiting out a timeout.
+    int max_fails = 1;
 };
 
 class NginxProxy {

@@ -9,9 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 #include "common/content_hash.h"
@@ -162,9 +162,9 @@ std::vector<float> generate(const DensitySpec& spec, int r) {
 
 // [SECTION] NRRD files (the documented subset)
 
-std::vector<float> read_nrrd(const std::string& path, glm::ivec3& size) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail(path + ": cannot open the file");
+// An NRRD file's voxels from its bytes in `in` (`path` names the file in errors).
+std::vector<float> read_nrrd(std::istream& in, const std::string& path,
+                             glm::ivec3& size) {
     const auto bad = [&](const std::string& what) { fail(path + ": " + what); };
     std::string line;
     if (!std::getline(in, line) || line.rfind("NRRD", 0) != 0)
@@ -233,6 +233,22 @@ std::vector<float> read_nrrd(const std::string& path, glm::ivec3& size) {
             }
     }
     return voxels;
+}
+
+std::vector<float> read_nrrd(const std::string& path, glm::ivec3& size) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path + ": cannot open the file");
+    return read_nrrd(in, path, size);
+}
+
+// A whole file's bytes; nullopt when it cannot be read.
+std::optional<std::string> file_bytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return std::nullopt;
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    if (in.bad()) return std::nullopt;
+    return std::move(bytes).str();
 }
 
 std::string hash_of(glm::ivec3 size, const std::vector<float>& voxels) {
@@ -342,14 +358,23 @@ DensityVolume finish_density_volume(glm::ivec3 size, std::vector<float> voxels,
     return v;
 }
 
-std::shared_ptr<const DensityVolume> make_density_volume(std::string_view text,
-                                                         int resolution,
-                                                         double contrast) {
+namespace {
+
+// make_density_volume, a file's volume from `bytes` when given (the bytes its cache key
+// was made of), else read from the file.
+std::shared_ptr<const DensityVolume> build_density_volume(std::string_view text,
+                                                          int resolution, double contrast,
+                                                          const std::string* bytes) {
     const DensitySpec spec = parse_density_spec(text);
     glm::ivec3 size(resolution);
     std::vector<float> voxels;
     if (!spec.file.empty()) {
-        voxels = read_nrrd(spec.file, size);
+        if (bytes) {
+            std::istringstream in(*bytes);
+            voxels = read_nrrd(in, spec.file, size);
+        } else {
+            voxels = read_nrrd(spec.file, size);
+        }
     } else {
         if (resolution < 1 || resolution > 512)
             fail("resolution " + std::to_string(resolution) + " is not in [1, 512]");
@@ -369,6 +394,14 @@ std::shared_ptr<const DensityVolume> make_density_volume(std::string_view text,
         finish_density_volume(size, std::move(voxels), std::string(text)));
 }
 
+}  // namespace
+
+std::shared_ptr<const DensityVolume> make_density_volume(std::string_view text,
+                                                         int resolution,
+                                                         double contrast) {
+    return build_density_volume(text, resolution, contrast, nullptr);
+}
+
 void write_density_nrrd(const DensityVolume& volume, const std::string& path) {
     std::ofstream out(path, std::ios::binary);
     out << "NRRD0004\n# written by lucent\ntype: float\ndimension: 3\nsizes: "
@@ -385,15 +418,18 @@ std::shared_ptr<const DensityVolume> density_from_knobs(const KnobValues& values
     const int resolution = std::stoi(values.choice("density_resolution"));
     const double contrast = values.scalar("density_contrast");
     // The last few volumes, so the explorer (a scene per frame) and batch rendering (a
-    // scene per stimulus) build each once. A file's key includes its size and time.
+    // scene per stimulus) build each once. A file's key is its bytes (their size and
+    // FNV-1a hash), never its size and modification time: a file rewritten within
+    // a coarse timestamp's tick, or given its old time back, is another volume.
     std::string key =
         spec + "|" + std::to_string(resolution) + "|" + std::to_string(contrast);
+    std::optional<std::string> bytes;
     if (ends_with(spec, ".nrrd")) {
-        std::error_code error;
-        key +=
-            "|" + std::to_string(std::filesystem::file_size(spec, error)) + "|" +
-            std::to_string(
-                std::filesystem::last_write_time(spec, error).time_since_epoch().count());
+        bytes = file_bytes(spec);
+        // Unreadable: make_density_volume says why, and nothing is cached.
+        if (!bytes) return make_density_volume(spec, resolution, contrast);
+        key += "|" + std::to_string(bytes->size()) + "|" +
+               common::ContentHash().bytes(*bytes).hex();
     }
     static std::mutex mutex;
     static std::vector<std::pair<std::string, std::shared_ptr<const DensityVolume>>>
@@ -403,7 +439,8 @@ std::shared_ptr<const DensityVolume> density_from_knobs(const KnobValues& values
         for (const auto& [k, volume] : cache)
             if (k == key) return volume;
     }
-    auto volume = make_density_volume(spec, resolution, contrast);
+    auto volume =
+        build_density_volume(spec, resolution, contrast, bytes ? &*bytes : nullptr);
     std::lock_guard lock(mutex);
     cache.insert(cache.begin(), {key, volume});
     if (cache.size() > 8) cache.pop_back();

@@ -1,6 +1,9 @@
 # Runs COMMAND with ARGS plus `--csv CSV` and fails unless it exits 0 and the CSV file
 # starts with the HEADER line (default: section,name,value,unit) and matches every regular
-# expression in EXPECT_CSV (a list).
+# expression in EXPECT_CSV (a list). Optional shape checks, none of them on which
+# measurement is larger (a timing is whatever the machine gave): ROWS, the number of
+# rows below the header, each with as many fields as the header; NUMBER_COLUMNS, header
+# names whose every value is a finite, non-negative number.
 if(NOT DEFINED HEADER)
   set(HEADER "section,name,value,unit")
 endif()
@@ -20,3 +23,36 @@ foreach(pattern IN LISTS EXPECT_CSV)
     message(FATAL_ERROR "${CSV} does not match '${pattern}':\n${csv}")
   endif()
 endforeach()
+if(DEFINED ROWS OR DEFINED NUMBER_COLUMNS)
+  string(REPLACE "," ";" header_fields "${HEADER}")
+  list(LENGTH header_fields field_count)
+  set(number_at "")
+  foreach(name IN LISTS NUMBER_COLUMNS)
+    list(FIND header_fields "${name}" at)
+    if(at LESS 0)
+      message(FATAL_ERROR "NUMBER_COLUMNS names '${name}', not in the header ${HEADER}")
+    endif()
+    list(APPEND number_at ${at})
+  endforeach()
+  file(STRINGS "${CSV}" lines)
+  list(POP_FRONT lines)  # the header, checked above
+  list(LENGTH lines row_count)
+  if(DEFINED ROWS AND NOT row_count EQUAL ROWS)
+    message(FATAL_ERROR "${CSV}: ${row_count} rows below the header, not ${ROWS}:\n${csv}")
+  endif()
+  foreach(line IN LISTS lines)
+    string(REPLACE "," ";" fields "${line}")
+    list(LENGTH fields count)
+    if(NOT count EQUAL field_count)
+      message(FATAL_ERROR "${CSV}: '${line}' has ${count} fields, the header ${field_count}")
+    endif()
+    foreach(at IN LISTS number_at)
+      list(GET fields ${at} value)
+      list(GET header_fields ${at} name)
+      if(NOT value MATCHES "^([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][+-]?[0-9]+)?$")
+        message(FATAL_ERROR
+                "${CSV}: ${name} '${value}' is not a finite, non-negative number in '${line}'")
+      endif()
+    endforeach()
+  endforeach()
+endif()

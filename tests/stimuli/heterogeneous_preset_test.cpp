@@ -2,11 +2,10 @@
 // transport distances, each Td one factor series.
 #include <gtest/gtest.h>
 
-#include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "renderer/core/density_volume.h"
 #include "stimuli/batch_render.h"
@@ -46,7 +45,8 @@ TEST(HeterogeneousPreset, ThreeStructuresAtTwoTransportDistances) {
 
 // The volume's content hash travels like the mesh hash: a manifest column beside the
 // spec, and part of the input hash, so a density file changed under the same path is
-// rendered again.
+// rendered again, even with its size and modification time unchanged (rewritten within
+// a coarse timestamp's tick; here the old time is put back).
 TEST(HeterogeneousPreset, ManifestCarriesTheDensityHashAndAChangedFileRerenders) {
     const auto dir = test::scratch_dir("htsm_density_manifest");
     const std::string volume_path = (dir / "volume.nrrd").string();
@@ -68,8 +68,11 @@ TEST(HeterogeneousPreset, ManifestCarriesTheDensityHashAndAChangedFileRerenders)
     EXPECT_EQ(rows.at("h").at("density"), volume_path);
     // Unchanged: reused. Changed file, same spec: rendered again with the new hash.
     EXPECT_EQ(render_stimulus_set(set, options).rendered, 0u);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const auto size = std::filesystem::file_size(volume_path);
+    const auto written = std::filesystem::last_write_time(volume_path);
     write_density_nrrd(*make_density_volume("spheres", 8, 1.0), volume_path);
+    std::filesystem::last_write_time(volume_path, written);
+    ASSERT_EQ(std::filesystem::file_size(volume_path), size);
     EXPECT_EQ(render_stimulus_set(set, options).rendered, 1u);
     rows = read_manifest_csv(out);
     EXPECT_EQ(rows.at("h").at("density_hash"),

@@ -114,6 +114,40 @@ TEST(DensityVolume, NrrdRoundTripsFloatAndReadsBytes) {
     std::filesystem::remove(bytes);
 }
 
+// The volume cache keys a file on its bytes: the file rewritten with other voxels of
+// the same size and given its old modification time back (as a coarse-timestamp file
+// system, or a copy that keeps times, leaves it) is the new volume, and the old bytes
+// again are the old volume.
+TEST(DensityVolume, TheCacheSeesAFileRewrittenWithTheSameSizeAndModificationTime) {
+    const std::string path = temp_path("rewritten.nrrd");
+    const auto cube = make_density_volume("cube", 8, 1.0);
+    const auto spheres = make_density_volume("spheres", 8, 1.0);
+    ASSERT_NE(cube->content_hash, spheres->content_hash);
+    KnobValues values;
+    values.set("density", path);
+    values.set("density_resolution", std::string("64"));
+    values.set("density_contrast", 1.0);
+
+    write_density_nrrd(*cube, path);
+    const auto size = std::filesystem::file_size(path);
+    const auto written = std::filesystem::last_write_time(path);
+    EXPECT_EQ(density_from_knobs(values)->content_hash, cube->content_hash);
+    EXPECT_EQ(density_from_knobs(values)->content_hash, cube->content_hash);  // cached
+
+    write_density_nrrd(*spheres, path);
+    std::filesystem::last_write_time(path, written);
+    ASSERT_EQ(std::filesystem::file_size(path), size);
+    ASSERT_EQ(std::filesystem::last_write_time(path), written);
+    EXPECT_EQ(density_from_knobs(values)->content_hash, spheres->content_hash);
+
+    write_density_nrrd(*cube, path);
+    std::filesystem::last_write_time(path, written);
+    EXPECT_EQ(density_from_knobs(values)->content_hash, cube->content_hash);
+    std::filesystem::remove(path);
+    EXPECT_NE(error_of([&] { density_from_knobs(values); }).find("cannot open"),
+              std::string::npos);
+}
+
 TEST(DensityVolume, BadFilesNameTheFieldOrVoxel) {
     const std::string path = temp_path("bad.nrrd");
     const auto write = [&](const std::string& header, const std::vector<float>& data) {

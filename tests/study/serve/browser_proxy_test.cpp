@@ -3,7 +3,10 @@
 // killed with SIGKILL in the middle of the session (nginx fails over to the other), then
 // the other one too while instance 0 is restarted on its port (nginx answers 502 and
 // lucent.js retries with backoff). The page, pressed on as a person would, reaches the
-// completion screen by itself; every answer is stored once, as pressed.
+// completion screen by itself; every answer is stored once, as pressed. Nothing waits a
+// fixed time: nginx keeps a dead instance in its rotation (max_fails=0), so the page's
+// next requests meet it without waiting out fail_timeout, and instance 0 comes back once
+// the page has been seen retrying; a minute is only where a wait gives up.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -15,7 +18,6 @@
 #include <map>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/nginx_proxy.h"
@@ -53,7 +55,9 @@ TEST(ServeBrowserProxy,
     for (int i = 0; i < 2; ++i)
         ASSERT_EQ(instances[i]->port(), ports[i])
             << "instance " << i << " did not start: " << instances[i]->first_line();
-    lucent::app::NginxProxy proxy({ports[0], ports[1]});
+    lucent::app::NginxProxy::Options proxy_options;
+    proxy_options.max_fails = 0;  // a dead instance stays in the rotation: met again
+    lucent::app::NginxProxy proxy({ports[0], ports[1]}, proxy_options);
     auto since = [&] {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - started)
             .count();
@@ -69,6 +73,11 @@ TEST(ServeBrowserProxy,
     auto view = [&] {
         return browser.evaluate("document.body.dataset.view").get<std::string>();
     };
+    auto page_retries = [&] {
+        return std::stoi(
+            browser.evaluate("document.body.dataset.retries || '0'").get<std::string>());
+    };
+    constexpr auto kGiveUp = std::chrono::seconds(60);  // never the assertion
     // Digits, arrows (the first press picks the middle point) or clicks in turn; the
     // catch trial by digits as its prompt asks. Returns the ratings given.
     auto rate = [&](int k) -> std::pair<int, int> {
@@ -97,13 +106,13 @@ TEST(ServeBrowserProxy,
     };
 
     browser.navigate(proxy.url() + "/?participant=BP1");
-    ASSERT_TRUE(browser.wait_until("document.body.dataset.screen === 'consent'"))
+    ASSERT_TRUE(browser.wait_until("document.body.dataset.screen === 'consent'", kGiveUp))
         << screen();
     // Ratings given by trial id, in the order shown; the instance is killed once the
     // practice trial and the first main trial are answered.
     std::map<std::string, std::pair<int, int>> given;
     bool killed = false, both_down = false, restart_after_press = false;
-    int retries_while_down = 0;
+    int retries_while_down = 0, retries_before_down = 0;
     for (int guard = 0; guard < 40 && screen() != "done"; ++guard) {
         const std::string s = screen(), v = view();
         if (s == "trial") {
@@ -114,11 +123,14 @@ TEST(ServeBrowserProxy,
         }
         if (restart_after_press) {
             // No instance answers: nginx says 502 and the page retries with backoff
-            // until instance 0 is back on its port.
-            std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-            retries_while_down =
-                std::stoi(browser.evaluate("document.body.dataset.retries || '0'")
-                              .get<std::string>());
+            // until instance 0 is back on its port; it comes back once the page has
+            // been seen retrying.
+            EXPECT_TRUE(
+                browser.wait_until("Number(document.body.dataset.retries || 0) > " +
+                                       std::to_string(retries_before_down),
+                                   kGiveUp))
+                << "the page did not retry while no instance answered";
+            retries_while_down = page_retries() - retries_before_down;
             instances[0] = start_instance(0);
             ASSERT_EQ(instances[0]->port(), ports[0]) << instances[0]->first_line();
             restart_after_press = false;
@@ -127,18 +139,16 @@ TEST(ServeBrowserProxy,
             // The answer is on its way (or back): kill instance 0 at once.
             EXPECT_EQ(instances[0]->kill_now(), 128 + SIGKILL);
             killed = true;
-            // Past nginx's fail_timeout (2 s), so that the page's next API calls meet
-            // the dead instance again rather than only the other one.
-            std::this_thread::sleep_for(std::chrono::milliseconds(2500));
         }
         // The next screen: a text screen, a trial's rating screen or the end (the page
         // may be retrying or starting again meanwhile).
         browser.wait_until("document.body.dataset.view !== '" + v +
                                "' && ['blank', 'loading'].indexOf("
                                "document.body.dataset.screen) < 0",
-                           std::chrono::seconds(20));
+                           kGiveUp);
         if (given.size() == 3 && !both_down && screen() != "done") {
             // Then instance 1 dies too: the page's next call finds no instance at all.
+            retries_before_down = page_retries();
             EXPECT_EQ(instances[1]->kill_now(), 128 + SIGKILL);
             both_down = restart_after_press = true;
         }
@@ -179,7 +189,8 @@ TEST(ServeBrowserProxy,
     ASSERT_EQ(instances[1]->port(), ports[1]) << instances[1]->first_line();
     for (int again = 0; again < 2; ++again) {
         browser.navigate(proxy.url() + "/?participant=BP1");
-        EXPECT_TRUE(browser.wait_until("document.body.dataset.screen === 'done'"))
+        EXPECT_TRUE(
+            browser.wait_until("document.body.dataset.screen === 'done'", kGiveUp))
             << screen();
         EXPECT_EQ(browser.evaluate("document.body.dataset.completionCode"), "C0DE42");
     }

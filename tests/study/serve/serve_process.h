@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -230,7 +231,10 @@ inline Transport over_http(httplib::Client& client) {
         if (!r)
             return study::WebReply{
                 0, json{{"error", "no reply: " + httplib::to_string(r.error())}}.dump()};
-        return study::WebReply{r->status, r->body};
+        study::WebReply reply{r->status, r->body};
+        if (r->has_header("Retry-After"))
+            reply.retry_after_s = std::atoi(r->get_header_value("Retry-After").c_str());
+        return reply;
     };
 }
 

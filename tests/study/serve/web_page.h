@@ -4,9 +4,14 @@
 // transport: WebStudy::handle directly, or HTTP to a running `lucent serve`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "study/serve/web_study.h"
@@ -20,6 +25,51 @@ using Transport =
 inline Transport direct(study::WebStudy& web) {
     return [&web](const std::string& endpoint, const std::string& body) {
         return web.handle(endpoint, body);
+    };
+}
+
+// lucent.js's retry (api() in study/serve/web/lucent.js): a network error (status 0),
+// 502, 503 or 504 is sent again after each of these waits in turn (Retry-After when
+// longer), about a minute in all; then the page shows the error. A test that checks
+// what a server under load loses retries as the page does: a busy server's 503 is an
+// answer the page waits out, not a lost participant.
+inline constexpr std::array<int, 10> kRetryDelaysMs = {250,  500,  1000, 2000, 4000,
+                                                       8000, 8000, 8000, 8000, 8000};
+inline bool transient_status(int status) {
+    return status == 0 || status == 502 || status == 503 || status == 504;
+}
+
+// What a retrying transport waited through: how many requests were sent again (the
+// page's data-retries) and how long it slept in all. Reported, never asserted on: how
+// often a loaded machine answers 503 is the machine's business.
+struct Retries {
+    std::atomic<int> sent_again{0};
+    std::atomic<long long> waited_ms{0};
+};
+
+using Sleep = std::function<void(std::chrono::milliseconds)>;
+
+// `send` retried as lucent.js retries: the same body again after kRetryDelaysMs[attempt]
+// (or the reply's Retry-After, when longer) while the status is transient, the last
+// reply returned once the waits are spent. `sleep` waits (a test of the policy itself
+// records the waits instead).
+inline Transport retrying(Transport send, Retries* retries = nullptr, Sleep sleep = {}) {
+    if (!sleep)
+        sleep = [](std::chrono::milliseconds ms) { std::this_thread::sleep_for(ms); };
+    return [send = std::move(send), retries, sleep = std::move(sleep)](
+               const std::string& endpoint, const std::string& body) {
+        for (std::size_t attempt = 0;; ++attempt) {
+            study::WebReply reply = send(endpoint, body);
+            if (!transient_status(reply.status) || attempt >= kRetryDelaysMs.size())
+                return reply;
+            const int wait_ms =
+                std::max(kRetryDelaysMs[attempt], 1000 * reply.retry_after_s);
+            if (retries) {
+                ++retries->sent_again;
+                retries->waited_ms += wait_ms;
+            }
+            sleep(std::chrono::milliseconds(wait_ms));
+        }
     };
 }
 

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@
 #include <thread>
 
 #include "study/postgres/postgres_store.h"
+#include "study/serve/web_files.h"
 #include "study/simulated_observer.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/store_pool.h"
@@ -469,21 +471,28 @@ TEST_P(Serve, TheConsentScreenCanBeDeclinedAndADoubleEnterActsOnce) {
 }
 
 // Fifty pages at once through one server (threads calling handle as the HTTP server's
-// workers do): every answer stored exactly once, cells from the participant numbers.
+// workers do), each retrying a busy server's 503 as lucent.js does: every answer stored
+// exactly once, cells from the participant numbers. Whether a page had to wait (every
+// pooled connection busy on a loaded machine) is not the question; that nothing is lost
+// or doubled is.
 TEST_P(Serve, FiftyParticipantsAtOnceLoseAndDuplicateNothing) {
     constexpr int kPages = 50;
     std::vector<std::thread> threads;
     std::atomic<int> finished{0};
+    lucent::test::Retries retries;
     std::vector<std::vector<std::string>> shown(kPages);
     for (int i = 0; i < kPages; ++i)
         threads.emplace_back([&, i] {
-            Page page{direct(*web_)};
+            Page page{lucent::test::retrying(direct(*web_), &retries)};
             page.open({{"participant", "W" + std::to_string(i + 1)}});
             page.run();
             if (page.state["screen"] == "done") ++finished;
             shown[i] = page.shown;
         });
     for (std::thread& t : threads) t.join();
+    RecordProperty("requests_sent_again", retries.sent_again.load());
+    std::printf("[ measured ] %d pages (%s): %d requests sent again after a 503\n",
+                kPages, GetParam().c_str(), retries.sent_again.load());
     EXPECT_EQ(finished, kPages);
     const int64_t n = static_cast<int64_t>(planned_trials(protocol_));
     EXPECT_EQ(responses(), kPages * n * static_cast<int64_t>(protocol_.questions.size()));
@@ -1420,6 +1429,69 @@ TEST(ServeNames, ParticipantCodes) {
     EXPECT_NE(session_token("s", "P1", "u1"), session_token("s", "P1", "u2"));
     EXPECT_NE(session_token("s", "P1", "u1"), session_token("t", "P1", "u1"));
     EXPECT_EQ(session_token("s", "P1", "u1").rfind("P1.", 0), 0u);
+}
+
+// ---- the test page's retry is lucent.js's
+// ---------------------------------------------- The waits and the statuses retried are
+// the page's own (read from the embedded lucent.js), so a test that retries as the page
+// does asserts what a participant sees.
+TEST(ServePageRetry, WaitsAndStatusesAreLucentJs) {
+    const auto script = lucent::embedded::serve_file("lucent.js");
+    ASSERT_TRUE(script.has_value());
+    const std::string js(*script);
+    std::string delays;
+    for (std::size_t i = 0; i < lucent::test::kRetryDelaysMs.size(); ++i)
+        delays += (i ? ", " : "") + std::to_string(lucent::test::kRetryDelaysMs[i]);
+    EXPECT_NE(js.find("const kRetryDelaysMs = [" + delays + "];"), std::string::npos)
+        << "lucent.js's retry waits changed; tests/study/serve/web_page.h mirrors them";
+    EXPECT_NE(
+        js.find("status === 0 || status === 502 || status === 503 || status === 504"),
+        std::string::npos);
+    EXPECT_NE(js.find("Math.max(kRetryDelaysMs[attempt], retryAfterMs)"),
+              std::string::npos);
+    for (int status : {0, 502, 503, 504})
+        EXPECT_TRUE(lucent::test::transient_status(status));
+    for (int status : {200, 400, 403, 404, 409, 410, 500})
+        EXPECT_FALSE(lucent::test::transient_status(status));
+}
+
+TEST(ServePageRetry, SendsTheSameBodyAgainAfterEachWaitThenGivesTheLastReply) {
+    std::vector<std::string> bodies;
+    std::vector<int> waits;
+    std::vector<WebReply> replies = {
+        {503, "{}", 3}, {502, "{}"}, {0, "{}"}, {200, "{\"ok\":1}"}};
+    lucent::test::Retries retries;
+    auto send = lucent::test::retrying(
+        [&](const std::string&, const std::string& body) {
+            bodies.push_back(body);
+            return replies[bodies.size() - 1];
+        },
+        &retries,
+        [&](std::chrono::milliseconds ms) { waits.push_back(int(ms.count())); });
+    const WebReply got = send("answer", "{\"trial\":7}");
+    EXPECT_EQ(got.status, 200);
+    EXPECT_EQ(bodies, std::vector<std::string>(4, "{\"trial\":7}"));
+    // Retry-After (3 s) is longer than the first wait; then the page's own waits.
+    EXPECT_EQ(waits, (std::vector<int>{3000, 500, 1000}));
+    EXPECT_EQ(retries.sent_again, 3);
+    EXPECT_EQ(retries.waited_ms, 4500);
+
+    // Not transient: returned at once.
+    bodies.clear();
+    waits.clear();
+    replies = {{500, "{}"}, {200, "{}"}};
+    EXPECT_EQ(send("answer", "{}").status, 500);
+    EXPECT_EQ(bodies.size(), 1u);
+    EXPECT_TRUE(waits.empty());
+
+    // Always busy: every wait of lucent.js's spent, then the last 503 returned.
+    bodies.clear();
+    waits.clear();
+    replies.assign(lucent::test::kRetryDelaysMs.size() + 1, WebReply{503, "{}"});
+    EXPECT_EQ(send("answer", "{}").status, 503);
+    EXPECT_EQ(bodies.size(), lucent::test::kRetryDelaysMs.size() + 1);
+    EXPECT_EQ(waits, std::vector<int>(lucent::test::kRetryDelaysMs.begin(),
+                                      lucent::test::kRetryDelaysMs.end()));
 }
 
 }  // namespace

@@ -65,9 +65,25 @@ Process start_lucent(const std::vector<std::string>& args, const fs::path& dir,
     return p;
 }
 
-int wait_exit(const Process& p) {
+// The process's exit code (128 + signal when killed). One that has not ended after
+// `give_up` (far past any run here, even on a loaded machine) is stopped and reported
+// as the test's failure, with its stderr, instead of holding the suite until CTest's
+// timeout says only that something hung.
+int wait_exit(const Process& p,
+              std::chrono::seconds give_up = std::chrono::seconds(300)) {
     int status = 0;
-    waitpid(p.pid, &status, 0);
+    const auto deadline = std::chrono::steady_clock::now() + give_up;
+    while (waitpid(p.pid, &status, WNOHANG) == 0) {
+        if (std::chrono::steady_clock::now() > deadline) {
+            kill(p.pid, SIGKILL);
+            waitpid(p.pid, &status, 0);
+            ADD_FAILURE() << "lucent (pid " << p.pid << ") still running after "
+                          << give_up.count() << " s; stopped. Its stderr:\n"
+                          << std::ifstream(p.stderr_path).rdbuf();
+            return -1;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
@@ -562,15 +578,27 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
     const Process p = start_lucent(args, dir_);
     ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
 
-    // Each press: its X event time (server ms) and the time the runner gave it.
-    std::map<int64_t, uint32_t> server_ms_of_stamp;
+    // Each press: its X event time (server ms), when the runner's key thread received
+    // it, and the time the runner gave it.
+    struct Press {
+        uint32_t server_ms;
+        int64_t receipt_ns;
+    };
+    std::map<int64_t, Press> press_of_stamp;
     {
         std::ifstream in(trace);
         uint32_t server_ms;
         int64_t receipt, stamp;
-        while (in >> server_ms >> receipt >> stamp) server_ms_of_stamp[stamp] = server_ms;
+        while (in >> server_ms >> receipt >> stamp)
+            press_of_stamp[stamp] = {server_ms, receipt};
     }
-    ASSERT_EQ(server_ms_of_stamp.size(), 2 + 1 + 5 * d.size() + 2) << read_file(trace);
+    ASSERT_EQ(press_of_stamp.size(), 2 + 1 + 5 * d.size() + 2) << read_file(trace);
+    // The X server counts its event times in ms of the steady clock; a receipt a second
+    // or more after its event time (a key thread not scheduled for that long) cannot be
+    // told from another clock, and the runner then keeps the receipt (x_key_events.h).
+    const auto on_event_clock = [](const Press& p) {
+        return static_cast<uint32_t>(p.receipt_ns / 1000000) - p.server_ms < 1000;
+    };
     Database data(db, SQLITE_OPEN_READONLY);
     Statement s = data.prepare(
         "SELECT q1.first_choice_ns, q1.final_choice_ns, q2.first_choice_ns, "
@@ -583,26 +611,49 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
     size_t trials = 0;
     for (; s.step(); ++trials) {
         ASSERT_LT(trials, d.size());
-        // 1. Every recorded time is a key's, within 1 ms of the X server's time for that
-        //    event: the server stamps whole ms of the same steady clock. (A key stamped
-        //    after the vsync-blocked swap is up to a frame, 16.7 ms, behind it.)
+        // 1. Every recorded time is a key's own: the time the runner gave that press,
+        //    inside the millisecond the X server stamped on the event (not the frame's
+        //    time after the vsync-blocked swap, up to 16.7 ms later), or, for a press
+        //    received a second or more late, its receipt.
+        Press press[5];
         for (int c : {0, 1, 2, 3, 4}) {
             const int64_t recorded = s.integer(c);
-            const auto it = server_ms_of_stamp.find(recorded);
-            ASSERT_NE(it, server_ms_of_stamp.end())
-                << "trial " << trials << " column " << c;
-            const double behind_ms =
-                recorded / 1e6 - static_cast<uint32_t>(recorded / 1000000);
-            EXPECT_EQ(static_cast<uint32_t>(recorded / 1000000), it->second)
-                << "trial " << trials << " column " << c << " (" << behind_ms << ")";
+            const auto it = press_of_stamp.find(recorded);
+            ASSERT_NE(it, press_of_stamp.end()) << "trial " << trials << " column " << c;
+            press[c] = it->second;
+            if (on_event_clock(press[c]))
+                EXPECT_EQ(static_cast<uint32_t>(recorded / 1000000), press[c].server_ms)
+                    << "trial " << trials << " column " << c;
+            else
+                EXPECT_EQ(recorded, press[c].receipt_ns)
+                    << "trial " << trials << " column " << c;
         }
+        // 2. In the order the keys were scripted: the stimulus, the first choice and the
+        //    change of mind, Enter, question 2's only choice, the confirmation.
         EXPECT_GT(s.integer(0), s.integer(5)) << "a choice before the stimulus onset";
-        // 2. The recorded intervals are the scripted ones, up to the X server's timer.
+        EXPECT_LT(s.integer(0), s.integer(1)) << "trial " << trials;
+        EXPECT_LT(s.integer(1), s.integer(2)) << "trial " << trials;
+        EXPECT_EQ(s.integer(2), s.integer(3)) << "trial " << trials;
+        EXPECT_LT(s.integer(3), s.integer(4)) << "trial " << trials;
+        // 3. Each recorded interval is the X server's interval between the same two
+        //    events, to the server's whole ms (both stamps lie in their event's ms). How
+        //    far that is from the script's delay is the X server's timer on this machine
+        //    (a loaded one fires late), only reported; a frame-stamped key would miss its
+        //    event's interval by up to a frame.
         const auto ms = [&](int a, int b) { return (s.integer(b) - s.integer(a)) / 1e6; };
-        const double measured[] = {ms(0, 1), ms(1, 2), ms(3, 4)};
+        const int pairs[3][2] = {{0, 1}, {1, 2}, {3, 4}};
         const double expected[] = {double(d[trials].first), 300.0,
                                    double(d[trials].second)};
-        for (int k = 0; k < 3; ++k) scripted_errors.push_back(measured[k] - expected[k]);
+        for (int k = 0; k < 3; ++k) {
+            const auto [a, b] = pairs[k];
+            const double measured = ms(a, b);
+            scripted_errors.push_back(measured - expected[k]);
+            if (!on_event_clock(press[a]) || !on_event_clock(press[b])) continue;
+            const double server_interval =
+                static_cast<double>(press[b].server_ms - press[a].server_ms);
+            EXPECT_LT(std::abs(measured - server_interval), 1.0)
+                << "trial " << trials << " interval " << k;
+        }
     }
     EXPECT_EQ(trials, d.size());
     std::string errors;
@@ -610,12 +661,7 @@ TEST_F(SessionE2E, KeyTimesAreTheEventSourcesAndScriptedIntervalsAreKept) {
     std::vector<double> magnitudes;
     for (double e : scripted_errors) magnitudes.push_back(std::abs(e));
     std::sort(magnitudes.begin(), magnitudes.end());
-    const double median = magnitudes[magnitudes.size() / 2];
-    // 2 ms: each interval is two X event times, each kept to the server timer's 1 ms
-    // steps. The median, because on a loaded test machine the X server's timer itself
-    // now and then fires a few ms late (that key then really was late); keys stamped
-    // after the swap instead miss by up to a frame, a median near 5 ms at 60 Hz.
-    EXPECT_LE(median, 2.0) << "interval errors (ms): " << errors;
+    const double median = magnitudes.empty() ? 0.0 : magnitudes[magnitudes.size() / 2];
     RecordProperty("scripted_interval_errors_ms", errors);
     std::printf("scripted key intervals: errors (ms) %s; median |error| %.3f ms\n",
                 errors.c_str(), median);
