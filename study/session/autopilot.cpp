@@ -233,6 +233,12 @@ std::vector<std::string> Autopilot::due(int64_t now_ns, const ScreenView& view) 
     if (view.serial != planned_serial_) {
         planned_serial_ = view.serial;
         plan_screen(now_ns, view);
+        last_event_ns_ = now_ns;
+    } else if (queue_.empty() && view.kind != ScreenView::Kind::Blank &&
+               now_ns - last_event_ns_ > kPatienceNs) {
+        plan_screen(now_ns, view);
+        last_event_ns_ = now_ns;
+        ++presses_again_;
     }
     ++frames_since_pointer_;
     while (!queue_.empty() && queue_.front().at_ns <= now_ns) {
@@ -243,6 +249,7 @@ std::vector<std::string> Autopilot::due(int64_t now_ns, const ScreenView& view) 
         if (frames_since_pointer_ < (pointer ? 1 : 2)) break;
         if (pointer) frames_since_pointer_ = 0;
         keys.push_back(queue_.front().key);
+        last_event_ns_ = now_ns;
         queue_.erase(queue_.begin());
     }
     return keys;

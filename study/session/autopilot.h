@@ -117,7 +117,12 @@ public:
     // move. A key after a pointer event waits two calls: the runner applies pointer
     // events while drawing the frame after, keys before drawing. (A script's keys are
     // not due here: see script().)
+    // A screen still shown kPatienceNs after its last key (a key lost on the way, as a
+    // person's sometimes is) is answered again, as a person would press again: once
+    // per kPatienceNs, counted in presses_again().
     std::vector<std::string> due(int64_t now_ns, const ScreenView& view);
+    static constexpr int64_t kPatienceNs = 5'000'000'000;
+    int presses_again() const { return presses_again_; }
     bool scripted() const { return scripted_; }
     // A script's (delay ms after the previous key, key) lines, for XKeyboard::play.
     const std::vector<std::pair<double, std::string>>& script() const { return script_; }
@@ -134,6 +139,8 @@ private:
     MatchObserver match_;
     AdjustBy adjust_by_ = AdjustBy::keys;
     int planned_serial_ = -1;
+    int64_t last_event_ns_ = 0;  // when the last key or pointer event was due
+    int presses_again_ = 0;
     int frames_since_pointer_ = 2;  // due() calls since the last pointer event
     std::vector<std::pair<double, std::string>> script_;  // (delay ms, key)
     std::vector<ScheduledKey> queue_;

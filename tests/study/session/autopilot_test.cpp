@@ -47,6 +47,35 @@ TEST(Autopilot, AnswersEveryStatementWithHumanLikeDelays) {
     }
 }
 
+// A key lost on its way to the window leaves the screen up: the participant presses
+// again once the screen has stayed kPatienceNs after its last key, not before, and a
+// blank screen (nothing to answer) is only waited on.
+TEST(Autopilot, AScreenStillShownAfterItsKeysIsAnsweredAgain) {
+    Autopilot a = Autopilot::from_seed(11, 12.0);
+    const ScreenView text{ScreenView::Kind::Text, 4, {}, false, 0};
+    std::vector<int64_t> enters;
+    const int64_t step = 1'000'000;
+    for (int64_t t = 0; t < 12'000'000'000LL; t += step)
+        for (const std::string& k : a.due(t, text))
+            if (k == "Enter") enters.push_back(t);
+    ASSERT_EQ(enters.size(), 3u);  // the first press, then once per patience
+    EXPECT_EQ(a.presses_again(), 2);
+    EXPECT_GE(enters[1] - enters[0], Autopilot::kPatienceNs);
+    EXPECT_LT(enters[1] - enters[0], Autopilot::kPatienceNs + 2'000'000'000LL);
+    // A new screen is planned afresh: no press again before its own patience.
+    const ScreenView next{ScreenView::Kind::Text, 5, {}, false, 0};
+    int next_enters = 0;
+    for (int64_t t = 12'000'000'000LL; t < 16'000'000'000LL; t += step)
+        for (const std::string& k : a.due(t, next)) next_enters += k == "Enter";
+    EXPECT_EQ(next_enters, 1);
+    EXPECT_EQ(a.presses_again(), 2);
+    Autopilot waiting = Autopilot::from_seed(11, 12.0);
+    const ScreenView blank{ScreenView::Kind::Blank, 1, {}, false, 0};
+    for (int64_t t = 0; t < 20'000'000'000LL; t += 10 * step)
+        EXPECT_TRUE(waiting.due(t, blank).empty());
+    EXPECT_EQ(waiting.presses_again(), 0);
+}
+
 TEST(Autopilot, CatchTrialsGetTheExpectedAnswerAndSpeedScalesDelays) {
     Autopilot slow = Autopilot::from_seed(9, 1.0), fast = Autopilot::from_seed(9, 10.0);
     ScreenView v{ScreenView::Kind::Rating, 1, {7, 7}, true, 7};

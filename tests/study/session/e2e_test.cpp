@@ -75,11 +75,18 @@ int wait_exit(const Process& p,
     const auto deadline = std::chrono::steady_clock::now() + give_up;
     while (waitpid(p.pid, &status, WNOHANG) == 0) {
         if (std::chrono::steady_clock::now() > deadline) {
+            // Where it is stuck, when gdb is installed (it need not be).
+            const fs::path stacks = p.stderr_path.string() + ".stacks";
+            const std::string gdb = "gdb -batch -p " + std::to_string(p.pid) +
+                                    " -ex 'thread apply all bt' -ex detach > '" +
+                                    stacks.string() + "' 2>&1";
+            if (std::system(gdb.c_str()) != 0) std::ofstream(stacks) << "(no gdb)\n";
             kill(p.pid, SIGKILL);
             waitpid(p.pid, &status, 0);
             ADD_FAILURE() << "lucent (pid " << p.pid << ") still running after "
                           << give_up.count() << " s; stopped. Its stderr:\n"
-                          << std::ifstream(p.stderr_path).rdbuf();
+                          << std::ifstream(p.stderr_path).rdbuf() << "Its threads:\n"
+                          << std::ifstream(stacks).rdbuf();
             return -1;
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
