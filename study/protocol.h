@@ -20,7 +20,8 @@ public:
 // One stimulus: either rendered live (technique + parameters) or a pre-rendered image.
 struct StimulusSpec {
     std::string id;         // unique within the protocol, e.g. "emp1"
-    std::string technique;  // "empirical", "ward", "contrast_reversed"; "" for images
+    std::string technique;  // a registered technique (renderer/techniques/registry.cpp);
+                            // "" for images
     std::string mesh;       // built-in mesh name or path (live stimuli)
     std::string image;      // image path (pre-rendered stimuli), relative to the protocol
     // Technique parameters by knob name, ordered by name; they become analysis factors.
