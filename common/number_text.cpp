@@ -14,6 +14,12 @@ std::string full_precision_text(double value) {
     return text;
 }
 
+std::string nine_digit_text(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.9g", value);
+    return text;
+}
+
 std::string shortest_text(double value) {
     char text[32];
     const auto [end, error] = std::to_chars(text, text + sizeof text, value);

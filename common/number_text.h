@@ -10,6 +10,9 @@ namespace lucent::common {
 // printf's "%.17g": 17 significant digits, which read back to the same double
 // ("0.10000000000000001"; "inf", "-inf", "nan" as printf writes them).
 std::string full_precision_text(double value);
+// printf's "%.9g": 9 significant digits (every float reads back; a double to 1 part in
+// 1e9), for plans, messages and manifests people read ("0.1", "1e+300", "inf", "nan").
+std::string nine_digit_text(double value);
 // The shortest text that reads back to the same double (std::to_chars: "0.1", "1e+300").
 std::string shortest_text(double value);
 

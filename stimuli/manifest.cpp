@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "common/csv.h"
+#include "common/number_text.h"
 #include "common/output_file.h"
 #include "lucent/version.h"
 
@@ -16,9 +17,7 @@ namespace {
 
 std::string number(double value) {
     if (!std::isfinite(value)) value = 0.0;  // never let NaN/Inf into a table
-    char text[32];
-    std::snprintf(text, sizeof text, "%.9g", value);
-    return text;
+    return common::nine_digit_text(value);
 }
 
 std::string json_escape(std::string_view text) {

@@ -10,12 +10,7 @@ namespace lucent {
 namespace {
 
 // Numbers in messages (ranges, a refused value): 9 digits read easily.
-std::string message_number(double value) {
-    std::ostringstream out;
-    out.precision(9);
-    out << value;
-    return out.str();
-}
+std::string message_number(double value) { return common::nine_digit_text(value); }
 
 std::string_view trim(std::string_view text) {
     while (!text.empty() && (text.front() == ' ' || text.front() == '\t'))

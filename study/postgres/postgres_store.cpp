@@ -22,14 +22,6 @@
 namespace lucent::study {
 using namespace postgres_internal;
 
-namespace {
-// A nullable DOUBLE PRECISION (libpqxx 6 reads no std::optional<double>).
-std::optional<double> optional_double(const pqxx::field& f) {
-    if (f.is_null()) return std::nullopt;
-    return f.as<double>();
-}
-}  // namespace
-
 // ---- [1] connection -------------------------------------------------------------------
 
 std::string checked_server_uri(const std::string& uri) {

@@ -14,14 +14,6 @@ namespace lucent::study {
 
 using namespace postgres_internal;
 
-namespace {
-// A nullable DOUBLE PRECISION (libpqxx 6 reads no std::optional<double>).
-std::optional<double> optional_double(const pqxx::field& f) {
-    if (f.is_null()) return std::nullopt;
-    return f.as<double>();
-}
-}  // namespace
-
 // ---- [4] trials: journal, send, sync -------------------------------------------------
 
 namespace {

@@ -5,6 +5,7 @@
 // server went away and the caller may journal and retry.
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <pqxx/pqxx>
 #include <string>
 
@@ -43,6 +44,12 @@ inline int64_t steady_ns() {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
                std::chrono::steady_clock::now().time_since_epoch())
         .count();
+}
+
+// A nullable DOUBLE PRECISION (libpqxx 6 reads no std::optional<double>).
+inline std::optional<double> optional_double(const pqxx::field& f) {
+    if (f.is_null()) return std::nullopt;
+    return f.as<double>();
 }
 
 }  // namespace postgres_internal

@@ -53,6 +53,19 @@ TEST(NumberText, ShortestIsTheFewestDigitsThatReadBack) {
     EXPECT_EQ(shortest_text(0.3 - 0.1), "0.19999999999999998");
 }
 
+TEST(NumberText, NineDigitsReadEveryFloatBack) {
+    EXPECT_EQ(nine_digit_text(0.1), "0.1");
+    EXPECT_EQ(nine_digit_text(1.0 / 3.0), "0.333333333");
+    EXPECT_EQ(nine_digit_text(0.3 - 0.1), "0.2");
+    EXPECT_EQ(nine_digit_text(123456789012.0), "1.23456789e+11");
+    EXPECT_EQ(nine_digit_text(-0.0), "-0");
+    EXPECT_EQ(nine_digit_text(std::numeric_limits<double>::infinity()), "inf");
+    // 9 significant digits are enough for any float (FLT_DECIMAL_DIG).
+    for (const float f :
+         {0.1f, 1.0f / 3.0f, 3.4e38f, 1.17549435e-38f, 16777217.0f, 2.5e-7f})
+        EXPECT_EQ(std::strtof(nine_digit_text(f).c_str(), nullptr), f) << f;
+}
+
 TEST(NumberText, BothFormsReadBackToTheSameDouble) {
     for (const double value : kAwkward) {
         const std::string full = full_precision_text(value);

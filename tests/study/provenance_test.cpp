@@ -14,41 +14,9 @@
 namespace lucent::study {
 namespace {
 
+using lucent::test::environment;
+using lucent::test::provenance_for;
 using lucent::test::small_protocol;
-
-// A hand-written provenance for every stimulus of the small protocol: `albedo` is the
-// one value the tests vary.
-std::vector<StimulusProvenance> provenance_for(const Protocol& p,
-                                               const std::string& albedo) {
-    std::vector<StimulusProvenance> out;
-    for (const StimulusSpec& s : p.stimuli) {
-        StimulusProvenance v;
-        v.stimulus = s.id;
-        v.source = "live";
-        v.technique = s.technique;
-        v.mesh = s.mesh;
-        v.mesh_hash = "00000000000000aa";
-        v.values = {{"albedo", albedo}, {"fov_y", "60"}};
-        for (const auto& [name, value] : s.parameters) v.values.emplace_back(name, value);
-        v.software_version = "9.9.9";
-        v.build_hash = "test";
-        out.push_back(v);
-    }
-    return out;
-}
-
-SessionEnvironment environment(const std::string& machine, const std::string& gpu,
-                               double hz) {
-    SessionEnvironment env;
-    env.machine_id = machine;
-    env.software_version = "9.9.9";
-    env.build_hash = "test";
-    env.gl_vendor = "vendor " + machine;
-    env.gl_renderer = gpu;
-    env.display_mode = "1280x1024 fullscreen";
-    env.display_refresh_hz = hz;
-    return env;
-}
 
 // A session for P1 whose every trial is answered; `albedo` goes into its provenance.
 void one_session(const std::string& path, const std::string& albedo) {

@@ -7,9 +7,45 @@
 
 #include "study/protocol.h"
 #include "study/sqlite/sqlite_store.h"
+#include "study/store_types.h"
 #include "study/trial_plan.h"
 
 namespace lucent::test {
+
+// A hand-written provenance for every stimulus of protocol `p`: `albedo` is the one
+// value the tests vary.
+inline std::vector<study::StimulusProvenance> provenance_for(const study::Protocol& p,
+                                                             const std::string& albedo) {
+    std::vector<study::StimulusProvenance> out;
+    for (const study::StimulusSpec& s : p.stimuli) {
+        study::StimulusProvenance v;
+        v.stimulus = s.id;
+        v.source = "live";
+        v.technique = s.technique;
+        v.mesh = s.mesh;
+        v.mesh_hash = "00000000000000aa";
+        v.values = {{"albedo", albedo}, {"fov_y", "60"}};
+        for (const auto& [name, value] : s.parameters) v.values.emplace_back(name, value);
+        v.software_version = "9.9.9";
+        v.build_hash = "test";
+        out.push_back(v);
+    }
+    return out;
+}
+
+// A station's environment: its machine id, GPU and display refresh rate.
+inline study::SessionEnvironment environment(const std::string& machine,
+                                             const std::string& gpu, double hz) {
+    study::SessionEnvironment env;
+    env.machine_id = machine;
+    env.software_version = "9.9.9";
+    env.build_hash = "test";
+    env.gl_vendor = "vendor " + machine;
+    env.gl_renderer = gpu;
+    env.display_mode = "1280x1024 fullscreen";
+    env.display_refresh_hz = hz;
+    return env;
+}
 
 // Turns a database written by this build into one of schema `version`, as an older build
 // left it: every table and index rebuilt from migrations 1..version with the columns

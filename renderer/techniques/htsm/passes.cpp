@@ -11,16 +11,13 @@
 // ring with a lod above 0 the mips; no diffuse or specular the shadow read.
 #include <cstdio>
 
+#include "common/number_text.h"
 #include "renderer/techniques/htsm/htsm.h"
 
 namespace lucent::htsm {
 namespace {
 
-std::string number(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.9g", value);
-    return text;
-}
+std::string number(double value) { return common::nine_digit_text(value); }
 
 bool any_coarse_lod(const std::vector<PatternSample>& samples) {
     bool coarse = false;

@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 
+#include "common/number_text.h"
 #include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
@@ -58,11 +59,7 @@ TextureData pyramid_texels(const RecordPyramid& pyramid, Texel texel) {
     return data;
 }
 
-std::string number(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.9g", value);
-    return text;
-}
+std::string number(double value) { return common::nine_digit_text(value); }
 
 // What every stage reads, derived once from the scene and the knobs.
 struct FrameInputs {

@@ -230,6 +230,20 @@
     return root.scrollWidth <= innerWidth && root.scrollHeight <= innerHeight;
   }
 
+  // Lays the trial screen out invisibly with layOut() (true when it fits) until it fits
+  // the window; while it does not, says what is too small ("the picture at its true size
+  // (...)") and waits for a resize. False when the session moved on meanwhile.
+  async function waitUntilItFits(s, layOut, what) {
+    for (;;) {
+      only('trial-screen');
+      if (layOut()) return true;
+      message('Your browser window is too small to show ' + what + '. Please enlarge ' +
+              'the window or zoom out; the study continues by itself.', 'too-small');
+      await new Promise((resolve) => addEventListener('resize', resolve, { once: true }));
+      if (state !== s) return false;
+    }
+  }
+
   async function beginTrial(s) {
     const t = s.trial;
     el('rating-part').hidden = false;
@@ -256,16 +270,9 @@
     el('picture').appendChild(img);
     el('prompt').textContent = t.prompt || (t.practice ? 'Practice' : '');
     buildQuestions(s);
-    for (;;) {  // laid out invisibly and measured; too small: say so and wait
-      only('trial-screen');
-      size();
-      if (fits()) break;
-      message('Your browser window is too small to show the picture at its true size (' +
-              t.width + ' x ' + t.height + ' pixels) with the rating scales. Please enlarge ' +
-              'the window or zoom out; the study continues by itself.', 'too-small');
-      await new Promise((resolve) => addEventListener('resize', resolve, { once: true }));
-      if (state !== s) return;
-    }
+    if (!await waitUntilItFits(s, () => { size(); return fits(); },
+                               'the picture at its true size (' + t.width + ' x ' +
+                               t.height + ' pixels) with the rating scales')) return;
     only('trial-screen');
     el('progress').hidden = !s.progress;
     screenBox.style.visibility = 'visible';
@@ -442,22 +449,18 @@
     const sequential = t.presentation === 'sequential';
     // Every layout the trial shows must fit at the pictures' true size.
     const layouts = sequential ? [0, 1, 'answer'] : [undefined];
-    for (;;) {  // laid out invisibly and measured; too small: say so and wait
-      only('trial-screen');
+    const everyLayoutFits = () => {
       let ok = true;
       for (const part of layouts) {
         layoutChoice(t, imgs, part);
         sizeChoice(t);
         ok = ok && fits();
       }
-      if (ok) break;
-      const widths = t.shown.map((p) => p.width + ' x ' + p.height).join(', ');
-      message('Your browser window is too small to show the pictures side by side at ' +
-              'their true size (' + widths + ' pixels). Please enlarge the window or ' +
-              'zoom out; the study continues by itself.', 'too-small');
-      await new Promise((resolve) => addEventListener('resize', resolve, { once: true }));
-      if (state !== s) return;
-    }
+      return ok;
+    };
+    const widths = t.shown.map((p) => p.width + ' x ' + p.height).join(', ');
+    if (!await waitUntilItFits(s, everyLayoutFits, 'the pictures side by side at their ' +
+                               'true size (' + widths + ' pixels)')) return;
     only('trial-screen');
     el('progress').hidden = !s.progress;
     layoutChoice(t, imgs, layouts[0]);
@@ -594,17 +597,10 @@
       document.body.dataset.matchIndex = String(i);
     };
     showMatch(t.start_index);
-    for (;;) {  // laid out invisibly and measured; too small: say so and wait
-      only('trial-screen');
-      size();
-      if (fits()) break;
-      message('Your browser window is too small to show the two pictures side by side at ' +
-              'their true size (' + t.target.width + ' x ' + t.target.height + ' and ' +
-              t.match.width + ' x ' + t.match.height + ' pixels). Please enlarge the ' +
-              'window or zoom out; the study continues by itself.', 'too-small');
-      await new Promise((resolve) => addEventListener('resize', resolve, { once: true }));
-      if (state !== s) return;
-    }
+    if (!await waitUntilItFits(s, () => { size(); return fits(); },
+                               'the two pictures side by side at their true size (' +
+                               t.target.width + ' x ' + t.target.height + ' and ' +
+                               t.match.width + ' x ' + t.match.height + ' pixels)')) return;
     only('trial-screen');
     el('progress').hidden = !s.progress;
     screenBox.style.visibility = 'visible';

@@ -30,6 +30,9 @@
 namespace lucent::study {
 namespace {
 
+using lucent::test::environment;
+using lucent::test::provenance_for;
+
 LocalPostgres& server() { return lucent::test::postgres_server(); }
 
 // Two blocks, counterbalanced: participants alternate between 2 Latin-square cells.
@@ -461,38 +464,6 @@ TEST_P(Backend, EachRatingIsCheckedAgainstItsOwnQuestionsScale) {
     EXPECT_EQ(store->pending_trials(), 0);  // refused trials leave no journal entry
     store->record_trial(s.id, trials[1].id, outcome(1, 1));
     EXPECT_EQ(store->query_int("SELECT count(*) FROM responses"), 4);
-}
-
-std::vector<StimulusProvenance> provenance_for(const Protocol& p,
-                                               const std::string& albedo) {
-    std::vector<StimulusProvenance> out;
-    for (const StimulusSpec& s : p.stimuli) {
-        StimulusProvenance v;
-        v.stimulus = s.id;
-        v.source = "live";
-        v.technique = s.technique;
-        v.mesh = s.mesh;
-        v.mesh_hash = "00000000000000aa";
-        v.values = {{"albedo", albedo}, {"fov_y", "60"}};
-        for (const auto& [name, value] : s.parameters) v.values.emplace_back(name, value);
-        v.software_version = "9.9.9";
-        v.build_hash = "test";
-        out.push_back(v);
-    }
-    return out;
-}
-
-SessionEnvironment environment(const std::string& machine, const std::string& gpu,
-                               double hz) {
-    SessionEnvironment env;
-    env.machine_id = machine;
-    env.software_version = "9.9.9";
-    env.build_hash = "test";
-    env.gl_vendor = "vendor " + machine;
-    env.gl_renderer = gpu;
-    env.display_mode = "1280x1024 fullscreen";
-    env.display_refresh_hz = hz;
-    return env;
 }
 
 // Issue 44 item 6: the pictures served beyond the study's stimuli (series steps,
