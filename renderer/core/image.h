@@ -74,11 +74,4 @@ Image read_image(const std::filesystem::path& path);
 // True when write_image() accepts the extension of `path`.
 bool is_supported_image_path(const std::filesystem::path& path);
 
-// sRGB transfer function (IEC 61966-2-1) of one linear value clamped to [0, 1]: the one
-// in common/srgb.h (a float in, computed in float).
-using common::srgb_encode;
-// lround(srgb_encode(v) * 255) by table (what 8-bit files store), NaN as 0: the same
-// codes, several times faster.
-std::uint8_t srgb_encode_8bit(float linear);
-
 }  // namespace lucent

@@ -659,24 +659,6 @@ TextureData FrameExecutor::read_texture(const std::string& resource, int level) 
 
 std::size_t FrameExecutor::uploads_performed() const { return impl_->uploads; }
 
-void FrameExecutor::present(const FramePlan& plan, int x, int y, int width, int height) {
-    const auto& texture = impl_->textures.at(plan.output);
-    const GLuint prog =
-        impl_->program({"gl/shaders/fullscreen.vert", "gl/shaders/present.frag", {}});
-    glViewport(x, y, width, height);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    glUseProgram(prog);
-    glBindTextureUnit(0, texture.texture.id());
-    glProgramUniform1i(prog, glGetUniformLocation(prog, "image"), 0);
-    glBindVertexArray(impl_->empty_vao.id());
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glUseProgram(0);
-    glBindVertexArray(0);
-    glBindTextureUnit(0, 0);
-    check_errors("presenting '" + plan.output + "'");
-}
-
 Image FrameExecutor::render(const Scene& scene, const FramePlan& plan) {
     execute(scene, plan);
     return read_output(plan);

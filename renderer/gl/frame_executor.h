@@ -66,9 +66,6 @@ public:
     // A frame-sized single-channel resource (a depth layer, the smoothed layer), top row
     // first: for tests and the explorer's buffer view.
     std::vector<float> read_channel(const std::string& resource) const;
-    // Draws the plan's output, clamped and sRGB-encoded, into the viewport (x, y, w, h)
-    // of the framebuffer currently bound for drawing (0: the window), for the explorer.
-    void present(const FramePlan& plan, int x, int y, int width, int height);
     // execute() then read_output().
     Image render(const Scene& scene, const FramePlan& plan);
 

@@ -5,7 +5,8 @@
 namespace lucent::gl {
 
 // Sets the viewport to width x height and clears the bound framebuffer's colour to the
-// opaque linear colour `rgb`.
+// opaque linear colour `rgb` through the final colour pass (core/display_transform.h):
+// the screen's background has the codes of the stimuli's rendered background.
 void clear_frame(int width, int height, const float rgb[3]);
 
 // Blocks until the GPU has executed every command issued so far (glFinish): before a

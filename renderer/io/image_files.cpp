@@ -11,6 +11,7 @@
 #include <limits>
 #include <system_error>
 
+#include "renderer/core/display_transform.h"
 #include "renderer/core/image.h"
 
 namespace lucent {
@@ -32,13 +33,9 @@ std::string lower_extension(const std::filesystem::path& path) {
 float clamp_unit(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
 
 std::uint16_t encode_channel(float v, bool linear, float scale) {
-    const float u = clamp_unit(v);
-    return static_cast<std::uint16_t>(std::lround((linear ? u : srgb_encode(u)) * scale));
+    return static_cast<std::uint16_t>(
+        std::lround((linear ? clamp_unit(v) : display_value(v)) * scale));
 }
-
-struct Srgb8Table;
-const Srgb8Table& srgb8_table();
-std::uint8_t encode_srgb8(const Srgb8Table& table, float v);
 
 // Rows stay top first; both OIIO and Image store them so.
 template <typename T>
@@ -46,9 +43,8 @@ std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
     std::vector<T> out(static_cast<std::size_t>(image.width) * image.height * 3);
     const std::size_t values = out.size();
     if (!linear && sizeof(T) == 1) {  // the common case: by table
-        const Srgb8Table& table = srgb8_table();
         for (std::size_t i = 0; i < values; ++i)
-            out[i] = static_cast<T>(encode_srgb8(table, image.rgba[i / 3 * 4 + i % 3]));
+            out[i] = static_cast<T>(display_code(image.rgba[i / 3 * 4 + i % 3]));
         return out;
     }
     for (std::size_t i = 0; i < values; ++i)
@@ -64,56 +60,7 @@ std::vector<T> encode_rgb(const Image& image, bool linear, float scale) {
 constexpr const char* kPngStrategy = "rle";
 constexpr int kPngFilterPaeth = 0x80;  // libpng's PNG_FILTER_PAETH
 
-// The 8-bit sRGB encoding by table: threshold[k] is the smallest float whose
-// lround(srgb_encode(v) * 255) is at least k (binary search over the float bit
-// patterns, as the encoding is monotone), and bucket[] the code at the start of each
-// run of 2^16 bit patterns, so a lookup is one index plus at most a few compares.
-struct Srgb8Table {
-    static constexpr int kShift = 16;
-    float threshold[257];
-    std::vector<std::uint8_t> bucket;
-
-    static int direct(float v) { return int(std::lround(srgb_encode(v) * 255.0f)); }
-    static std::uint32_t bits(float v) { return std::bit_cast<std::uint32_t>(v); }
-
-    Srgb8Table() {
-        threshold[0] = 0.0f;
-        for (int k = 1; k <= 255; ++k) {
-            std::uint32_t lo = 0, hi = bits(1.0f);  // direct(lo) < k <= direct(hi)
-            while (hi - lo > 1) {
-                const std::uint32_t mid = lo + (hi - lo) / 2;
-                (direct(std::bit_cast<float>(mid)) >= k ? hi : lo) = mid;
-            }
-            threshold[k] = std::bit_cast<float>(hi);
-        }
-        threshold[256] = std::numeric_limits<float>::infinity();
-        bucket.resize((bits(1.0f) >> kShift) + 1);
-        int k = 0;
-        for (std::size_t b = 0; b < bucket.size(); ++b) {
-            const float start = std::bit_cast<float>(std::uint32_t(b << kShift));
-            while (k < 255 && threshold[k + 1] <= start) ++k;
-            bucket[b] = static_cast<std::uint8_t>(k);
-        }
-    }
-};
-
-const Srgb8Table& srgb8_table() {
-    static const Srgb8Table table;
-    return table;
-}
-
-std::uint8_t encode_srgb8(const Srgb8Table& table, float v) {
-    const float u = clamp_unit(v);  // non-negative: bit patterns order as values
-    int k = table.bucket[Srgb8Table::bits(u) >> Srgb8Table::kShift];
-    while (table.threshold[k + 1] <= u) ++k;
-    return static_cast<std::uint8_t>(k);
-}
-
 }  // namespace
-
-std::uint8_t srgb_encode_8bit(float linear) {
-    return encode_srgb8(srgb8_table(), linear);
-}
 
 std::size_t replace_non_finite(Image& image) {
     std::size_t replaced = 0;

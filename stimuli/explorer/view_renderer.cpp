@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "renderer/core/display_transform.h"
 #include "renderer/core/technique.h"
 #include "renderer/gl/upload.h"
 #include "renderer/techniques/registry.h"
@@ -61,20 +62,9 @@ void upload(RenderedSide& side, const std::vector<std::uint8_t>& rgba, int width
 }  // namespace
 
 std::vector<std::uint8_t> encode_for_display(const Image& image) {
-    static const std::array<std::uint8_t, 4096> table = [] {
-        std::array<std::uint8_t, 4096> t{};
-        for (std::size_t i = 0; i < t.size(); ++i)
-            t[i] = static_cast<std::uint8_t>(
-                std::lround(srgb_encode(float(i) / 4095.f) * 255.f));
-        return t;
-    }();
     std::vector<std::uint8_t> out(image.rgba.size());
-    for (std::size_t i = 0; i < image.rgba.size(); ++i) {
-        const float v = image.rgba[i];
-        const float clamped = v > 0.f ? (v < 1.f ? v : 1.f) : 0.f;  // NaN -> 0
-        out[i] =
-            (i % 4 == 3) ? 255 : table[static_cast<std::size_t>(clamped * 4095.f + 0.5f)];
-    }
+    for (std::size_t i = 0; i < image.rgba.size(); ++i)
+        out[i] = (i % 4 == 3) ? 255 : display_code(image.rgba[i]);
     return out;
 }
 

@@ -75,7 +75,7 @@ private:
     std::string buffer_message_;
 };
 
-// Linear float RGBA -> 8-bit sRGB RGBA for display (a 4096-entry table of srgb_encode).
+// Linear float RGBA -> the 8-bit RGBA a PNG of it stores (display_code), alpha opaque.
 std::vector<std::uint8_t> encode_for_display(const Image& image);
 // A single-channel depth buffer as grey: near bright, far dark, background (1) black.
 std::vector<std::uint8_t> depth_for_display(const std::vector<float>& depth);

@@ -6,7 +6,7 @@
 #include <nlopt.hpp>
 #include <stdexcept>
 
-#include "common/srgb.h"
+#include "renderer/core/display_transform.h"
 #include "renderer/render.h"
 #include "stimuli/set_report/colour_difference.h"
 
@@ -17,8 +17,7 @@ namespace {
 std::vector<float> displayed(const Image& image) {
     std::vector<float> rgb(std::size_t(image.width) * image.height * 3);
     for (std::size_t i = 0, n = rgb.size() / 3; i < n; ++i)
-        for (int c = 0; c < 3; ++c)
-            rgb[i * 3 + c] = common::srgb_encode(image.rgba[i * 4 + c]);
+        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = display_value(image.rgba[i * 4 + c]);
     return rgb;
 }
 

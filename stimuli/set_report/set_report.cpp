@@ -25,6 +25,7 @@
 #include "common/number_text.h"
 #include "common/output_file.h"
 #include "common/srgb.h"
+#include "renderer/core/display_transform.h"
 #include "renderer/core/image.h"
 #include "renderer/core/progress.h"
 #include "stimuli/manifest.h"
@@ -190,7 +191,7 @@ Displayed decode(const fs::path& file, const std::string& background) {
     for (int c = 0; c < 3; ++c)
         if (parts.size() == 3)
             if (const auto v = common::parse_finite(parts[std::size_t(c)]))
-                encoded_background[c] = srgb_encode(float(*v));
+                encoded_background[c] = display_value(float(*v));
     Displayed out;
     out.width = image.width;
     out.height = image.height;
@@ -202,7 +203,7 @@ Displayed decode(const fs::path& file, const std::string& background) {
         for (int c = 0; c < 3; ++c) {
             float v = image.rgba[i * 4 + c];
             if (!std::isfinite(v)) v = 0.0f;
-            v = linear_with_alpha ? srgb_encode(v) : std::clamp(v, 0.0f, 1.0f);
+            v = linear_with_alpha ? display_value(v) : std::clamp(v, 0.0f, 1.0f);
             out.rgb[i * 3 + c] = v;
             object |= std::fabs(v - encoded_background[c]) > 0.5f / 255.0f;
         }

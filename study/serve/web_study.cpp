@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "common/srgb.h"
+#include "renderer/core/display_transform.h"
 #include "study/serve/answer_events.h"
 #include "study/serve/request_fields.h"
 #include "study/session/adjust_input.h"
@@ -48,11 +48,8 @@ void check_code(const std::string& code, const char* what) {
 }
 
 std::string css_colour(const float rgb[3]) {
-    // The protocol's background is linear; the page takes sRGB.
-    // In double (as the page always had it), rounded to 8 bits.
-    auto encode = [](float c) {
-        return static_cast<int>(std::lround(common::srgb_encode(double(c)) * 255));
-    };
+    // The protocol's background is linear; the page takes the codes a PNG stores.
+    auto encode = [](float c) { return int(display_code(c)); };
     char out[8];
     std::snprintf(out, sizeof out, "#%02x%02x%02x", encode(rgb[0]), encode(rgb[1]),
                   encode(rgb[2]));

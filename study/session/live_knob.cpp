@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "renderer/core/common_knobs.h"
+#include "renderer/core/display_transform.h"
 #include "renderer/core/frame_plan.h"
 #include "renderer/gl/errors.h"
 #include "renderer/gl/upload.h"
@@ -18,7 +19,7 @@ CpuImage encode_stimulus(const Image& image) {
                  std::vector<uint8_t>(size_t(image.width) * image.height * 4)};
     for (size_t i = 0; i < size_t(image.width) * image.height; ++i) {
         for (int c = 0; c < 3; ++c)  // as write_image encodes PNG stimuli
-            out.rgba[i * 4 + c] = srgb_encode_8bit(image.rgba[i * 4 + c]);
+            out.rgba[i * 4 + c] = display_code(image.rgba[i * 4 + c]);
         out.rgba[i * 4 + 3] = 255;  // opaque, like the RGB PNG of the same stimulus
     }
     return out;

@@ -7,19 +7,13 @@
 #include <cmath>
 #include <filesystem>
 
+#include "renderer/core/display_transform.h"
 #include "renderer/core/image.h"
 #include "renderer/gl/errors.h"
 #include "renderer/gl/upload.h"
 #include "study/session/stimulus_provenance.h"
 
 namespace lucent::study {
-
-namespace {
-uint8_t encode_srgb(float linear) {
-    if (!std::isfinite(linear)) return 0;  // no NaN reaches the screen
-    return static_cast<uint8_t>(std::lround(lucent::srgb_encode(linear) * 255.f));
-}
-}  // namespace
 
 CpuImage load_image_rgba8(const std::string& path) {
     auto in = OIIO::ImageInput::open(path);
@@ -44,7 +38,7 @@ CpuImage load_image_rgba8(const std::string& path) {
         const float alpha = channels == 4 ? v[3] : channels == 2 ? v[1] : 1.f;
         for (int c = 0; c < 3; ++c)
             image.rgba[i * 4 + c] =
-                linear ? encode_srgb(rgb[c])
+                linear ? display_code(rgb[c])
                        : static_cast<uint8_t>(
                              std::lround(std::fmin(std::fmax(rgb[c], 0.f), 1.f) * 255.f));
         image.rgba[i * 4 + 3] = static_cast<uint8_t>(

@@ -11,6 +11,8 @@
 #include <random>
 #include <string>
 
+#include "common/srgb.h"
+#include "renderer/core/display_transform.h"
 #include "renderer/core/image_compare.h"
 #include "tests/support/test_paths.h"
 
@@ -52,12 +54,13 @@ TEST(ImageIo, PngIsEightBitSrgbUnlessLinear) {
     EXPECT_FLOAT_EQ(linear.at(0, 0).r, 128.0f / 255.0f);
 }
 
-// The table gives exactly the codes of the formula, lround(srgb_encode(v) * 255): at
+// The final colour pass's table gives exactly the codes of the formula,
+// lround(srgb_encode(v) * 255): at
 // every code transition (found here by scanning the formula), over random values, and
 // for out-of-range and non-finite input.
 TEST(ImageIo, EightBitSrgbTableMatchesTheFormulaEverywhere) {
     const auto formula = [](float v) {
-        return int(std::lround(srgb_encode(v) * 255.0f));
+        return int(std::lround(common::srgb_encode(v) * 255.0f));
     };
     // Transitions by stepping through the codes' preimages with nextafter near each
     // analytic crossing: sRGB^-1((k - 0.5) / 255).
@@ -68,25 +71,38 @@ TEST(ImageIo, EightBitSrgbTableMatchesTheFormulaEverywhere) {
         for (int step = 0; step < 2000; ++step) v = std::nextafter(v, 0.0f);
         ASSERT_LT(formula(v), k);  // the scan below crosses the transition to k
         for (int step = 0; step < 4000; ++step, v = std::nextafter(v, 2.0f))
-            ASSERT_EQ(srgb_encode_8bit(v), formula(v)) << "v = " << v << ", code " << k;
+            ASSERT_EQ(display_code(v), formula(v)) << "v = " << v << ", code " << k;
         ASSERT_GE(formula(v), k);
     }
     std::mt19937 engine(17);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     for (int i = 0; i < 1'000'000; ++i) {
         const float v = unit(engine);
-        ASSERT_EQ(srgb_encode_8bit(v), formula(v)) << "v = " << v;
+        ASSERT_EQ(display_code(v), formula(v)) << "v = " << v;
     }
     // Denormals and exact ends.
     for (float v : {0.0f, -0.0f, std::numeric_limits<float>::denorm_min(),
                     std::numeric_limits<float>::min(), 1.0f, std::nextafter(1.0f, 0.0f)})
-        EXPECT_EQ(srgb_encode_8bit(v), formula(v)) << v;
+        EXPECT_EQ(display_code(v), formula(v)) << v;
     const float inf = std::numeric_limits<float>::infinity();
-    EXPECT_EQ(srgb_encode_8bit(-0.5f), 0);
-    EXPECT_EQ(srgb_encode_8bit(7.0f), 255);
-    EXPECT_EQ(srgb_encode_8bit(inf), 255);
-    EXPECT_EQ(srgb_encode_8bit(-inf), 0);
-    EXPECT_EQ(srgb_encode_8bit(std::nanf("")), 0);
+    EXPECT_EQ(display_code(-0.5f), 0);
+    EXPECT_EQ(display_code(7.0f), 255);
+    EXPECT_EQ(display_code(inf), 255);
+    EXPECT_EQ(display_code(-inf), 0);
+    EXPECT_EQ(display_code(std::nanf("")), 0);
+}
+
+// The final colour pass's value for 16-bit files and reports: clamped (NaN and -Inf as
+// black, +Inf as white), then the IEC 61966-2-1 curve.
+TEST(DisplayTransform, ValuesAreClampedThenEncodedAndNeverNaN) {
+    const float inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(display_value(std::nanf("")), 0.0f);
+    EXPECT_EQ(display_value(-inf), 0.0f);
+    EXPECT_FLOAT_EQ(display_value(inf), 1.0f);
+    EXPECT_FLOAT_EQ(display_value(7.0f), 1.0f);
+    EXPECT_EQ(display_value(-0.25f), 0.0f);
+    EXPECT_NEAR(display_value(0.5f), 0.735356983f, 1e-6f);
+    EXPECT_NEAR(display_value(0.001f), 0.01292f, 1e-7f);  // the linear segment
 }
 
 // PNG is lossless with either encoding: every pixel of a noisy image (no runs for the
@@ -113,7 +129,7 @@ TEST(ImageIo, PngStoresTheEightBitCodesLosslesslyAndDeterministically) {
             for (int x = 0; x < image.width; ++x)
                 for (int c = 0; c < 3; ++c) {
                     const float v = std::clamp(image.at(x, y)[c], 0.0f, 1.0f);
-                    const long code = std::lround(srgb_encode(v) * 255.0f);
+                    const long code = std::lround(common::srgb_encode(v) * 255.0f);
                     ASSERT_EQ(std::lround(back.at(x, y)[c] * 255.0f), code)
                         << x << "," << y << " channel " << c << ", encoding " << int(png);
                 }

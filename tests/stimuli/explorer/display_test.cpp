@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "common/srgb.h"
 #include "stimuli/explorer/view_renderer.h"
 
 namespace lucent::explorer {
@@ -24,9 +25,29 @@ TEST(Display, ShadedImageIsClampedSrgbWithOpaqueAlpha) {
     EXPECT_EQ(bytes[4], 0);  // NaN never reaches the screen
     EXPECT_EQ(bytes[5], 255);
     EXPECT_EQ(bytes[6], 0);
-    EXPECT_EQ(bytes[8], 10);         // 12.92 * 0.0031308 * 255 = 10.3 (linear segment)
-    EXPECT_NEAR(bytes[9], 124, 1);   // 0.2 -> 0.4845
-    EXPECT_NEAR(bytes[10], 231, 1);  // 0.8 -> 0.9063
+    EXPECT_EQ(bytes[8], 10);    // 12.92 * 0.0031308 * 255 = 10.3 (linear segment)
+    EXPECT_EQ(bytes[9], 124);   // 0.2 -> 0.4845
+    EXPECT_EQ(bytes[10], 231);  // 0.8 -> 0.9063
+}
+
+// The explorer shows what `lucent render` writes: every value of a fine ramp gets the
+// code of the formula a PNG stores, lround(srgb_encode(v) * 255) (a coarser table
+// rounded the value first and missed codes near each transition).
+TEST(Display, EveryValueGetsTheCodeAPngStores) {
+    const int n = 200'000;
+    Image ramp(n, 1);
+    for (int i = 0; i < n; ++i) {
+        const float v = float(i) / float(n - 1);
+        ramp.set(i, 0, {v, v * v, 1.0f - v, 1.f});
+    }
+    const auto bytes = encode_for_display(ramp);
+    int differ = 0;
+    for (int i = 0; i < n * 4; ++i) {
+        if (i % 4 == 3) continue;
+        const float v = ramp.rgba[std::size_t(i)];
+        differ += bytes[std::size_t(i)] != std::lround(common::srgb_encode(v) * 255.0f);
+    }
+    EXPECT_EQ(differ, 0);
 }
 
 TEST(Display, DepthIsGreyNearBrightFarDarkBackgroundBlack) {

@@ -295,6 +295,30 @@ TEST_F(SessionE2E, FullSessionStoresEveryRatingWithSensibleResponseTimes) {
     EXPECT_EQ(scale_bands(screen, y0 + 128), (std::vector<int>{7, 7}));
 }
 
+// The protocol's background is linear light, as the renderer's is: the screen around the
+// picture shows the codes a PNG of that background stores (0.5 -> 1.055 * 0.5^(1/2.4) -
+// 0.055 = 0.7354 -> 188; 0.2 -> 0.4845 -> 124), not the linear value (128, 51).
+TEST_F(SessionE2E, TheScreensBackgroundHasTheCodesOfTheStimulisBackground) {
+    LUCENT_REQUIRE_DISPLAY();
+    std::string text = lucent::test::kSmallProtocol;
+    text.replace(text.find("name = \"small\""), 14,
+                 "name = \"small\"\nbackground = [0.5, 0.5, 0.2]");
+    const std::string protocol = write_protocol(1, text);
+    const fs::path shot = dir_ / "grey_screen.png";
+    auto args = run_args(protocol, (dir_ / "grey.db").string(), "7");
+    args.insert(args.end(), {"--screenshot", shot.string()});
+    const Process p = start_lucent(args, dir_);
+    ASSERT_EQ(wait_exit(p), 0) << read_file(p.stderr_path);
+    const CpuImage screen = load_image_rgba8(shot.string());
+    const int x0 = (screen.width - 128) / 2, y0 = (screen.height - 128) / 2;
+    for (auto [x, y] : {std::pair{x0 - 1, y0 + 64}, {x0 + 128, y0 + 64}, {5, y0 + 64}}) {
+        const uint8_t* px = &screen.rgba[(size_t(y) * screen.width + x) * 4];
+        EXPECT_EQ(int(px[0]), 188) << x << "," << y;
+        EXPECT_EQ(int(px[1]), 188) << x << "," << y;
+        EXPECT_EQ(int(px[2]), 124) << x << "," << y;
+    }
+}
+
 TEST_F(SessionE2E, MixedScalesAreDrawnAndAnsweredPerQuestion) {
     LUCENT_REQUIRE_DISPLAY();
     // 'translucent' on 7 points, 'realistic' on 5: the screen shows a 7-point and a
