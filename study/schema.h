@@ -27,6 +27,11 @@ std::string open_trial_sql(const std::string& alias = "t");
 // study ?1/$1 with activity since ?2/$2, in SQLite's or PostgreSQL's dialect.
 std::string online_cell_counts_sql(bool postgres);
 
+// A response's answer columns, in Response's order: both stores and the station journal
+// write (after session_id, trial_id or trial_uuid) and read them in this order.
+inline constexpr const char* kResponseColumns =
+    "question, rating, rt_ms, changes, first_choice_ns, final_choice_ns";
+
 // A segment's environment columns (the session row repeats the first segment's), in
 // SessionEnvironment's order: each backend binds their values in this order.
 inline constexpr int kEnvironmentColumnCount = 9;

@@ -80,12 +80,11 @@ PostgresStore::Sent PostgresStore::send(const JournaledTrial& j, bool strict,
         // Another answer finished this slot's procedure on the server meanwhile.
         if (t[0][2].as<int>() != 0) refuse_skipped_trial(name_, trial_id);
         for (const Response& r : j.outcome.responses)
-            tx.exec_params(
-                "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, "
-                "changes, first_choice_ns, final_choice_ns) VALUES ($1, $2, $3, $4, $5, "
-                "$6, $7, $8)",
-                session_id, trial_id, r.question, r.rating, r.rt_ms, r.changes,
-                r.first_choice_ns, r.final_choice_ns);
+            tx.exec_params("INSERT INTO responses (session_id, trial_id, " +
+                               std::string(kResponseColumns) +
+                               ") VALUES ($1, $2, $3, $4, $5, $6, $7, $8)",
+                           session_id, trial_id, r.question, r.rating, r.rt_ms, r.changes,
+                           r.first_choice_ns, r.final_choice_ns);
         tx.exec_params(
             "UPDATE trials SET onset_ns = $1, confirm_ns = $2, dropped_frames = $3, "
             "answered_utc = $4, segment_id = (SELECT max(id) FROM session_segments "

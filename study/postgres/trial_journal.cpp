@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "study/schema.h"
 #include "study/sha256.h"
 
 namespace lucent::study {
@@ -176,9 +177,9 @@ void TrialJournal::add(const JournaledTrial& t) {
             .bind(5, x.input)
             .run();
     }
-    Statement r = db_.prepare(
-        "INSERT INTO pending_responses (trial_uuid, question, rating, rt_ms, changes, "
-        "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?)");
+    Statement r =
+        db_.prepare("INSERT INTO pending_responses (trial_uuid, " +
+                    std::string(kResponseColumns) + ") VALUES (?, ?, ?, ?, ?, ?, ?)");
     for (const Response& x : t.outcome.responses) {
         r.reset();
         r.bind(1, t.trial_uuid)
@@ -221,9 +222,9 @@ std::vector<JournaledTrial> TrialJournal::read(const std::string& where,
         t.outcome.finishes_staircase = s.integer(8) != 0;
         out.push_back(std::move(t));
     }
-    Statement r = db_.prepare(
-        "SELECT question, rating, rt_ms, changes, first_choice_ns, final_choice_ns "
-        "FROM pending_responses WHERE trial_uuid = ? ORDER BY question");
+    Statement r =
+        db_.prepare("SELECT " + std::string(kResponseColumns) +
+                    " FROM pending_responses WHERE trial_uuid = ? ORDER BY question");
     Statement a = db_.prepare(
         "SELECT value, t_ns, input FROM pending_adjustments WHERE trial_uuid = ? ORDER "
         "BY step");

@@ -638,9 +638,9 @@ bool Store::record_trial(int64_t session_id, int64_t trial_id,
     }
     check_trial_answer(db_.path(), session_id, trial_id, known,
                        questions_of_session(session_id).of_block(block), outcome);
-    Statement insert = db_.prepare(
-        "INSERT INTO responses (session_id, trial_id, question, rating, rt_ms, changes, "
-        "first_choice_ns, final_choice_ns) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
+    Statement insert =
+        db_.prepare("INSERT INTO responses (session_id, trial_id, " +
+                    std::string(kResponseColumns) + ") VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
     for (const Response& r : outcome.responses) {
         insert.reset();
         insert.bind(1, session_id)
