@@ -222,6 +222,213 @@ std::pair<double, double> threshold_at(const Problem& p, const State& st,
     return {x, slope};
 }
 
+// A bootstrap resample's threshold and slope, as the point estimate's rules classify
+// them.
+enum class SlopeKind { identified, steep, unknown };
+struct Resample {
+    double x = 0.0, slope = 0.0;
+    int side = 0;  // -1 below the tested range, +1 above, 0 within
+    SlopeKind kind = SlopeKind::identified;
+};
+
+// Stage 5: a threshold's percentile interval from its bootstrap resamples, with the
+// slope's; an end that the resamples put outside the tested range [x_min, x_max] is
+// said as "< x_min" or "> x_max" with a note, not given a number.
+void bootstrap_interval(Threshold& t, const std::vector<Resample>& v,
+                        const std::string& name, const PsychometricOptions& options,
+                        double x_min, double x_max, std::vector<std::string>& notes) {
+    const double lo = (1.0 - options.level) / 2.0, hi = 1.0 - lo;
+    const std::string level_text = short_text(100.0 * options.level) + "%";
+    if (t.status != ThresholdStatus::estimated) return;
+    std::vector<double> inside, slopes;
+    std::size_t below = 0, above = 0, steep = 0, unknown = 0;
+    for (const Resample& r : v) {
+        if (r.side < 0) ++below;
+        if (r.side > 0) ++above;
+        if (r.side == 0) inside.push_back(r.x);
+        if (r.kind == SlopeKind::steep) ++steep;
+        if (r.kind == SlopeKind::unknown) ++unknown;
+        if (r.kind == SlopeKind::identified) slopes.push_back(r.slope);
+    }
+    std::sort(inside.begin(), inside.end());
+    std::sort(slopes.begin(), slopes.end());
+    t.bootstrap_below = static_cast<int>(below);
+    t.bootstrap_above = static_cast<int>(above);
+    const End low_end = percentile_end(inside, below, above, lo);
+    const End high_end = percentile_end(inside, below, above, hi);
+    t.ci_low_status = low_end.status;
+    t.ci_low = low_end.value;
+    t.ci_high_status = high_end.status;
+    t.ci_high = high_end.value;
+    const auto end_text = [&](const End& e) {
+        if (e.status == ThresholdStatus::below_range) return "< " + short_text(x_min);
+        if (e.status == ThresholdStatus::above_range) return "> " + short_text(x_max);
+        return short_text(*e.value);
+    };
+    t.ci_text = end_text(low_end) + " .. " + end_text(high_end);
+    const std::string of =
+        "Of the " + std::to_string(v.size()) + " bootstrap resamples, ";
+    const auto share = [&](std::size_t k) {
+        return std::to_string(k) + " (" +
+               short_text(100.0 * static_cast<double>(k) / v.size()) + "%)";
+    };
+    const std::string leaves = "more than the " + short_text(100.0 * lo) + "% that the " +
+                               level_text + " interval leaves out on that side";
+    if (below > 0 && (low_end.status == ThresholdStatus::below_range ||
+                      high_end.status == ThresholdStatus::below_range))
+        notes.push_back(of + share(below) + " put the " + name +
+                        " below the smallest intensity tested, " + short_text(x_min) +
+                        ": " + leaves +
+                        ", so the interval's lower end is only said to be "
+                        "below " +
+                        short_text(x_min) + " (" + t.ci_text + ").");
+    if (above > 0 && (high_end.status == ThresholdStatus::above_range ||
+                      low_end.status == ThresholdStatus::above_range))
+        notes.push_back(of + share(above) + " put the " + name +
+                        " above the largest intensity tested, " + short_text(x_max) +
+                        ": " + leaves +
+                        ", so the interval's upper end is only said to be "
+                        "above " +
+                        short_text(x_max) + " (" + t.ci_text + ").");
+    if (!t.slope) return;
+    // Unknown slopes on the far side of each end, steep ones above.
+    const End slope_low = percentile_end(slopes, unknown, steep, lo);
+    const End slope_high = percentile_end(slopes, 0, unknown + steep, hi);
+    if (slope_low.status == ThresholdStatus::estimated) t.slope_ci_low = slope_low.value;
+    if (slope_high.status == ThresholdStatus::estimated)
+        t.slope_ci_high = slope_high.value;
+    if (!t.slope_ci_low || !t.slope_ci_high)
+        notes.push_back(of + share(steep + unknown) +
+                        " have no identified slope at the " + name + " (" +
+                        std::to_string(steep) + " jump between two intensities, " +
+                        std::to_string(unknown) + " put the " + name +
+                        " outside the tested range or rise nowhere "
+                        "on it): " +
+                        leaves + ", so the slope's interval has no " +
+                        (!t.slope_ci_low && !t.slope_ci_high
+                             ? std::string("ends")
+                             : std::string(t.slope_ci_low ? "upper end" : "lower end")) +
+                        ".");
+}
+
+// Stage 1: the bins with trials, checked (finite intensities, 0 <= correct <= trials,
+// positive intensities for the Weibull) and sorted by intensity.
+std::vector<PsychometricBin> checked_bins(const std::vector<PsychometricBin>& input,
+                                          bool gauss) {
+    std::vector<PsychometricBin> bins;
+    for (std::size_t i = 0; i < input.size(); ++i) {
+        const PsychometricBin& b = input[i];
+        const std::string where = "psychometric function: bin " + std::to_string(i + 1);
+        if (!std::isfinite(b.x)) throw InputError(where + " has no finite intensity");
+        if (b.n_trials < 0 || b.n_correct < 0 || b.n_correct > b.n_trials)
+            throw InputError(where + " has " + std::to_string(b.n_correct) +
+                             " correct of " + std::to_string(b.n_trials) + " trials");
+        if (!gauss && b.x <= 0.0)
+            throw InputError(
+                where +
+                ": the Weibull needs positive intensities, not x = " + short_text(b.x));
+        if (b.n_trials > 0) bins.push_back(b);
+    }
+    std::stable_sort(
+        bins.begin(), bins.end(),
+        [](const PsychometricBin& a, const PsychometricBin& b) { return a.x < b.x; });
+    return bins;
+}
+
+// Stage 2: the data that settle the answer without a fit (no trials, all or none
+// correct, below chance, one intensity), said in fit.notes; true when one did.
+bool settled_without_a_fit(PsychometricFit& fit, const PsychometricOptions& options) {
+    auto both = [&](const Threshold& t) {
+        fit.threshold = t;
+        if (options.p_correct_level) fit.threshold_p = t;
+    };
+    if (fit.trials == 0) {
+        fit.notes.push_back("No trials: there is no psychometric function to fit.");
+        return true;
+    }
+    const double x_min = fit.bins.front().x, x_max = fit.bins.back().x;
+    const double proportion = static_cast<double>(fit.correct) / fit.trials;
+    const std::string tally = std::to_string(fit.correct) + " of " +
+                              std::to_string(fit.trials) + " trials correct";
+    if (fit.correct == fit.trials) {
+        both(bounded(ThresholdStatus::below_range, x_min));
+        fit.notes.push_back("Every response was correct (" + tally +
+                            "): the threshold is below the smallest intensity tested, " +
+                            short_text(x_min) + "; the slope is not identified.");
+        return true;
+    }
+    if (fit.correct == 0 && options.guess == 0.0) {
+        both(bounded(ThresholdStatus::above_range, x_max));
+        fit.notes.push_back("No response was correct (" + tally +
+                            "): the threshold is above the largest intensity tested, " +
+                            short_text(x_max) + "; the slope is not identified.");
+        return true;
+    }
+    if (options.guess > 0.0) {
+        const boost::math::binomial_distribution<> chance(fit.trials, options.guess);
+        const double p_below = boost::math::cdf(chance, fit.correct);
+        if (p_below < options.test_level) {
+            fit.notes.push_back(
+                "Below chance: " + tally + " (" + short_text(100.0 * proportion) +
+                "%) against a guess rate of " + short_text(100.0 * options.guess) +
+                "% (binomial test p = " + format_p_short(p_below) +
+                "); no threshold (are the responses inverted?).");
+            return true;
+        }
+    }
+    if (x_min == x_max) {
+        fit.notes.push_back("One intensity only (x = " + short_text(x_min) + ", " +
+                            tally + "): the threshold and the slope are not identified.");
+        return true;
+    }
+    return false;
+}
+
+// Stage 3: the maximum-likelihood fit from nine starts, within bounds that let the
+// steepest function jump between the two closest intensities.
+struct LikelihoodFit {
+    Problem problem;
+    Bounds bounds;
+    Search best;
+};
+
+LikelihoodFit maximum_likelihood(const std::vector<PsychometricBin>& bins,
+                                 const PsychometricOptions& options, bool gauss) {
+    LikelihoodFit out;
+    Problem& p = out.problem;
+    p.gauss = gauss;
+    p.guess = options.guess;
+    p.free_lapse = options.free_lapse && options.max_lapse > 0.0;
+    p.lapse = options.free_lapse ? 0.0 : options.lapse;
+    for (const PsychometricBin& b : bins) {
+        p.u.push_back(to_u(gauss, b.x));
+        p.k.push_back(b.n_correct);
+        p.n.push_back(b.n_trials);
+    }
+    const double u_min = p.u.front(), u_max = p.u.back(), span = u_max - u_min;
+    Bounds& bounds = out.bounds;
+    // The steepest function allowed rises within a hundredth of the closest two
+    // intensities tested (and of 1e-4 of their range), so that a jump between two
+    // neighbours shows as one: F near 0 at one and near 1 at the other.
+    double gap = span;
+    for (std::size_t i = 1; i < p.u.size(); ++i)
+        if (p.u[i] > p.u[i - 1]) gap = std::min(gap, p.u[i] - p.u[i - 1]);
+    bounds.lower = {u_min - 10.0 * span, std::log(std::min(span * 1e-4, gap * 1e-2))};
+    bounds.upper = {u_max + 10.0 * span, std::log(span * 1e2)};
+    if (p.free_lapse) {
+        bounds.lower.push_back(0.0);
+        bounds.upper.push_back(options.max_lapse);
+    }
+    for (double fm : {0.25, 0.5, 0.75})
+        for (double fs : {0.05, 0.2, 1.0}) {
+            std::vector<double> start{u_min + fm * span, std::log(fs * span)};
+            if (p.free_lapse) start.push_back(options.max_lapse / 3.0);
+            const Search s = minimise(p, bounds, start);
+            if (s.value < out.best.value) out.best = s;
+        }
+    return out;
+}
+
 }  // namespace
 
 double psychometric_f(PsychometricFamily family, double x, double alpha, double beta) {
@@ -277,103 +484,22 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
     fit.threshold = not_identified();
     if (options.p_correct_level) fit.threshold_p = not_identified();
     const bool gauss = gaussian(options.family);
-    for (std::size_t i = 0; i < input.size(); ++i) {
-        const PsychometricBin& b = input[i];
-        const std::string where = "psychometric function: bin " + std::to_string(i + 1);
-        if (!std::isfinite(b.x)) throw InputError(where + " has no finite intensity");
-        if (b.n_trials < 0 || b.n_correct < 0 || b.n_correct > b.n_trials)
-            throw InputError(where + " has " + std::to_string(b.n_correct) +
-                             " correct of " + std::to_string(b.n_trials) + " trials");
-        if (!gauss && b.x <= 0.0)
-            throw InputError(
-                where +
-                ": the Weibull needs positive intensities, not x = " + short_text(b.x));
-        if (b.n_trials > 0) fit.bins.push_back(b);
-    }
-    std::stable_sort(
-        fit.bins.begin(), fit.bins.end(),
-        [](const PsychometricBin& a, const PsychometricBin& b) { return a.x < b.x; });
+    fit.bins = checked_bins(input, gauss);
     for (const PsychometricBin& b : fit.bins) {
         fit.trials += b.n_trials;
         fit.correct += b.n_correct;
     }
-    auto both = [&](const Threshold& t) {
-        fit.threshold = t;
-        if (options.p_correct_level) fit.threshold_p = t;
-    };
-    if (fit.trials == 0) {
-        fit.notes.push_back("No trials: there is no psychometric function to fit.");
-        return fit;
-    }
+    if (settled_without_a_fit(fit, options)) return fit;
     const double x_min = fit.bins.front().x, x_max = fit.bins.back().x;
     const double proportion = static_cast<double>(fit.correct) / fit.trials;
     const std::string tally = std::to_string(fit.correct) + " of " +
                               std::to_string(fit.trials) + " trials correct";
-    if (fit.correct == fit.trials) {
-        both(bounded(ThresholdStatus::below_range, x_min));
-        fit.notes.push_back("Every response was correct (" + tally +
-                            "): the threshold is below the smallest intensity tested, " +
-                            short_text(x_min) + "; the slope is not identified.");
-        return fit;
-    }
-    if (fit.correct == 0 && options.guess == 0.0) {
-        both(bounded(ThresholdStatus::above_range, x_max));
-        fit.notes.push_back("No response was correct (" + tally +
-                            "): the threshold is above the largest intensity tested, " +
-                            short_text(x_max) + "; the slope is not identified.");
-        return fit;
-    }
-    if (options.guess > 0.0) {
-        const boost::math::binomial_distribution<> chance(fit.trials, options.guess);
-        const double p_below = boost::math::cdf(chance, fit.correct);
-        if (p_below < options.test_level) {
-            fit.notes.push_back(
-                "Below chance: " + tally + " (" + short_text(100.0 * proportion) +
-                "%) against a guess rate of " + short_text(100.0 * options.guess) +
-                "% (binomial test p = " + format_p_short(p_below) +
-                "); no threshold (are the responses inverted?).");
-            return fit;
-        }
-    }
-    if (x_min == x_max) {
-        fit.notes.push_back("One intensity only (x = " + short_text(x_min) + ", " +
-                            tally + "): the threshold and the slope are not identified.");
-        return fit;
-    }
 
-    // The maximum-likelihood fit from several starts.
-    Problem p;
-    p.gauss = gauss;
-    p.guess = options.guess;
-    p.free_lapse = options.free_lapse && options.max_lapse > 0.0;
-    p.lapse = options.free_lapse ? 0.0 : options.lapse;
-    for (const PsychometricBin& b : fit.bins) {
-        p.u.push_back(to_u(gauss, b.x));
-        p.k.push_back(b.n_correct);
-        p.n.push_back(b.n_trials);
-    }
-    const double u_min = p.u.front(), u_max = p.u.back(), span = u_max - u_min;
-    Bounds bounds;
-    // The steepest function allowed rises within a hundredth of the closest two
-    // intensities tested (and of 1e-4 of their range), so that a jump between two
-    // neighbours shows as one: F near 0 at one and near 1 at the other.
-    double gap = span;
-    for (std::size_t i = 1; i < p.u.size(); ++i)
-        if (p.u[i] > p.u[i - 1]) gap = std::min(gap, p.u[i] - p.u[i - 1]);
-    bounds.lower = {u_min - 10.0 * span, std::log(std::min(span * 1e-4, gap * 1e-2))};
-    bounds.upper = {u_max + 10.0 * span, std::log(span * 1e2)};
-    if (p.free_lapse) {
-        bounds.lower.push_back(0.0);
-        bounds.upper.push_back(options.max_lapse);
-    }
-    Search best;
-    for (double fm : {0.25, 0.5, 0.75})
-        for (double fs : {0.05, 0.2, 1.0}) {
-            std::vector<double> start{u_min + fm * span, std::log(fs * span)};
-            if (p.free_lapse) start.push_back(options.max_lapse / 3.0);
-            const Search s = minimise(p, bounds, start);
-            if (s.value < best.value) best = s;
-        }
+    const LikelihoodFit ml = maximum_likelihood(fit.bins, options, gauss);
+    const Problem& p = ml.problem;
+    const Bounds& bounds = ml.bounds;
+    const Search& best = ml.best;
+    const double u_min = p.u.front(), u_max = p.u.back();
     if (!std::isfinite(best.value)) {
         fit.notes.push_back("The likelihood could not be maximised.");
         return fit;
@@ -565,16 +691,10 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
         }
     }
 
-    // The parametric bootstrap. Each resample follows the point estimate's rules: a
-    // threshold outside the tested range counts only as below or above it, and a slope
-    // that is not identified as steeper than any (a jump) or, with the threshold outside
-    // the range, as unknown.
-    enum class SlopeKind { identified, steep, unknown };
-    struct Resample {
-        double x = 0.0, slope = 0.0;
-        int side = 0;  // -1 below the tested range, +1 above, 0 within
-        SlopeKind kind = SlopeKind::identified;
-    };
+    // Stage 4, the parametric bootstrap. Each resample follows the point estimate's
+    // rules: a threshold outside the tested range counts only as below or above it, and
+    // a slope that is not identified as steeper than any (a jump) or, with the
+    // threshold outside the range, as unknown.
     if (options.bootstrap > 0) {
         std::mt19937_64 rng(options.seed);
         std::vector<Resample> th, thp;
@@ -623,93 +743,14 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
         fit.bootstrap_samples = static_cast<int>(th.size());
         if (!th.empty()) {
             fit.deviance_p_bootstrap = static_cast<double>(exceed) / th.size();
-            const double lo = (1.0 - options.level) / 2.0, hi = 1.0 - lo;
-            const std::string level_text = short_text(100.0 * options.level) + "%";
-            const auto interval = [&](Threshold& t, const std::vector<Resample>& v,
-                                      const std::string& name) {
-                if (t.status != ThresholdStatus::estimated) return;
-                std::vector<double> inside, slopes;
-                std::size_t below = 0, above = 0, steep = 0, unknown = 0;
-                for (const Resample& r : v) {
-                    if (r.side < 0) ++below;
-                    if (r.side > 0) ++above;
-                    if (r.side == 0) inside.push_back(r.x);
-                    if (r.kind == SlopeKind::steep) ++steep;
-                    if (r.kind == SlopeKind::unknown) ++unknown;
-                    if (r.kind == SlopeKind::identified) slopes.push_back(r.slope);
-                }
-                std::sort(inside.begin(), inside.end());
-                std::sort(slopes.begin(), slopes.end());
-                t.bootstrap_below = static_cast<int>(below);
-                t.bootstrap_above = static_cast<int>(above);
-                const End low_end = percentile_end(inside, below, above, lo);
-                const End high_end = percentile_end(inside, below, above, hi);
-                t.ci_low_status = low_end.status;
-                t.ci_low = low_end.value;
-                t.ci_high_status = high_end.status;
-                t.ci_high = high_end.value;
-                const auto end_text = [&](const End& e) {
-                    if (e.status == ThresholdStatus::below_range)
-                        return "< " + short_text(x_min);
-                    if (e.status == ThresholdStatus::above_range)
-                        return "> " + short_text(x_max);
-                    return short_text(*e.value);
-                };
-                t.ci_text = end_text(low_end) + " .. " + end_text(high_end);
-                const std::string of =
-                    "Of the " + std::to_string(v.size()) + " bootstrap resamples, ";
-                const auto share = [&](std::size_t k) {
-                    return std::to_string(k) + " (" +
-                           short_text(100.0 * static_cast<double>(k) / v.size()) + "%)";
-                };
-                const std::string leaves = "more than the " + short_text(100.0 * lo) +
-                                           "% that the " + level_text +
-                                           " interval leaves out on that side";
-                if (below > 0 && (low_end.status == ThresholdStatus::below_range ||
-                                  high_end.status == ThresholdStatus::below_range))
-                    fit.notes.push_back(
-                        of + share(below) + " put the " + name +
-                        " below the smallest intensity tested, " + short_text(x_min) +
-                        ": " + leaves +
-                        ", so the interval's lower end is only said to be "
-                        "below " +
-                        short_text(x_min) + " (" + t.ci_text + ").");
-                if (above > 0 && (high_end.status == ThresholdStatus::above_range ||
-                                  low_end.status == ThresholdStatus::above_range))
-                    fit.notes.push_back(
-                        of + share(above) + " put the " + name +
-                        " above the largest intensity tested, " + short_text(x_max) +
-                        ": " + leaves +
-                        ", so the interval's upper end is only said to be "
-                        "above " +
-                        short_text(x_max) + " (" + t.ci_text + ").");
-                if (!t.slope) return;
-                // Unknown slopes on the far side of each end, steep ones above.
-                const End slope_low = percentile_end(slopes, unknown, steep, lo);
-                const End slope_high = percentile_end(slopes, 0, unknown + steep, hi);
-                if (slope_low.status == ThresholdStatus::estimated)
-                    t.slope_ci_low = slope_low.value;
-                if (slope_high.status == ThresholdStatus::estimated)
-                    t.slope_ci_high = slope_high.value;
-                if (!t.slope_ci_low || !t.slope_ci_high)
-                    fit.notes.push_back(
-                        of + share(steep + unknown) +
-                        " have no identified slope at the " + name + " (" +
-                        std::to_string(steep) + " jump between two intensities, " +
-                        std::to_string(unknown) + " put the " + name +
-                        " outside the tested range or rise nowhere "
-                        "on it): " +
-                        leaves + ", so the slope's interval has no " +
-                        (!t.slope_ci_low && !t.slope_ci_high
-                             ? std::string("ends")
-                             : std::string(t.slope_ci_low ? "upper end" : "lower end")) +
-                        ".");
-            };
-            interval(fit.threshold, th, "threshold");
+            bootstrap_interval(fit.threshold, th, "threshold", options, x_min, x_max,
+                               fit.notes);
             if (fit.threshold_p && !thp.empty())
-                interval(*fit.threshold_p, thp,
-                         "threshold at " + short_text(100.0 * *options.p_correct_level) +
-                             "% correct");
+                bootstrap_interval(*fit.threshold_p, thp,
+                                   "threshold at " +
+                                       short_text(100.0 * *options.p_correct_level) +
+                                       "% correct",
+                                   options, x_min, x_max, fit.notes);
         }
     }
     return fit;
