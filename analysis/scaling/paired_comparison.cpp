@@ -46,21 +46,22 @@ std::vector<std::vector<char>> closure(std::vector<std::vector<char>> reach) {
     return reach;
 }
 
-}  // namespace
-
-PairedFit fit_paired_comparison(const PairedData& data, const PairedOptions& options) {
-    const std::size_t n = data.stimuli.size();
-    PairedFit fit;
-    fit.model = options.link == BinomialLink::logit ? "Bradley-Terry (logit)"
-                                                    : "Thurstone Case V (probit)";
-    fit.abilities.resize(n);
-    for (std::size_t s = 0; s < n; ++s) fit.abilities[s].stimulus = data.stimuli[s];
-
-    // Rows of the GLM: ordered pairs as given, or unordered pairs (lower index first).
-    const bool ordered = options.screen_order_rows || options.order_effect;
+// Stage 1: the rows of the GLM (ordered pairs as given, or unordered pairs with the
+// lower index first), who beat whom how often, and each stimulus's wins and comparisons
+// and the first-shown tally in `fit`; counts naming an unknown stimulus or not finite
+// and >= 0 are refused.
+struct Tally {
     std::vector<PairCount> rows;
+    std::vector<std::vector<double>> beat;  // beat[s][t]: times s was chosen over t
+};
+
+Tally tally_counts(const PairedData& data, bool ordered, PairedFit& fit) {
+    const std::size_t n = data.stimuli.size();
+    Tally out;
+    std::vector<PairCount>& rows = out.rows;
     std::map<std::pair<std::size_t, std::size_t>, std::size_t> row_of;
-    std::vector<std::vector<double>> beat(n, std::vector<double>(n, 0.0));
+    std::vector<std::vector<double>>& beat = out.beat;
+    beat.assign(n, std::vector<double>(n, 0.0));
     for (const PairCount& c : data.counts) {
         if (c.first >= n || c.second >= n)
             throw InputError("paired comparison: a pair names stimulus index " +
@@ -94,8 +95,13 @@ PairedFit fit_paired_comparison(const PairedData& data, const PairedOptions& opt
             fit.abilities[s].comparisons += beat[s][t] + beat[t][s];
         }
 
-    // Position: the share of first-shown choices and the exact binomial test (R's
-    // binom.test against 1/2: twice the smaller tail, at most 1).
+    return out;
+}
+
+// Stage 2: the share of first-shown choices and its exact binomial test, with a note
+// when it shows a position bias.
+void test_position(PairedFit& fit) {
+    // R's binom.test against 1/2: twice the smaller tail, at most 1.
     if (fit.position.trials > 0) {
         const double x = fit.position.first_chosen, t = fit.position.trials;
         fit.position.share = x / t;
@@ -109,15 +115,18 @@ PairedFit fit_paired_comparison(const PairedData& data, const PairedOptions& opt
                 "%; exact binomial test against 50%: p = " + p_text(fit.position.p) +
                 "): a position bias, e.g. always pressing the same key.");
     }
+}
 
-    // Connected parts of the comparison graph: each has a scale of its own.
-    std::vector<std::vector<char>> linked(n, std::vector<char>(n, 0)),
-        wins(n, std::vector<char>(n, 0));
+// Stage 3: the connected parts of the comparison graph, largest first (each has a
+// scale of its own), each stimulus's group in `fit`, with notes for a stimulus never
+// compared and for unconnected groups.
+std::vector<std::vector<std::size_t>> connected_groups(
+    const PairedData& data, const std::vector<std::vector<double>>& beat,
+    PairedFit& fit) {
+    const std::size_t n = data.stimuli.size();
+    std::vector<std::vector<char>> linked(n, std::vector<char>(n, 0));
     for (std::size_t s = 0; s < n; ++s)
-        for (std::size_t t = 0; t < n; ++t) {
-            linked[s][t] = beat[s][t] + beat[t][s] > 0;
-            wins[s][t] = beat[s][t] > 0;
-        }
+        for (std::size_t t = 0; t < n; ++t) linked[s][t] = beat[s][t] + beat[t][s] > 0;
     const auto connected = closure(linked);
     std::vector<std::vector<std::size_t>> groups;
     std::vector<int> group_of(n, -1);
@@ -161,6 +170,29 @@ PairedFit fit_paired_comparison(const PairedData& data, const PairedOptions& opt
             "group, each with its own reference at 0, and compare only "
             "within it.");
     }
+    return groups;
+}
+
+}  // namespace
+
+PairedFit fit_paired_comparison(const PairedData& data, const PairedOptions& options) {
+    const std::size_t n = data.stimuli.size();
+    PairedFit fit;
+    fit.model = options.link == BinomialLink::logit ? "Bradley-Terry (logit)"
+                                                    : "Thurstone Case V (probit)";
+    fit.abilities.resize(n);
+    for (std::size_t s = 0; s < n; ++s) fit.abilities[s].stimulus = data.stimuli[s];
+
+    const bool ordered = options.screen_order_rows || options.order_effect;
+    const Tally tally = tally_counts(data, ordered, fit);
+    const std::vector<PairCount>& rows = tally.rows;
+    const std::vector<std::vector<double>>& beat = tally.beat;
+    test_position(fit);
+    const std::vector<std::vector<std::size_t>> groups =
+        connected_groups(data, beat, fit);
+    std::vector<std::vector<char>> wins(n, std::vector<char>(n, 0));
+    for (std::size_t s = 0; s < n; ++s)
+        for (std::size_t t = 0; t < n; ++t) wins[s][t] = beat[s][t] > 0;
 
     // Within a group the maximum likelihood is finite only where every stimulus beat,
     // and lost to, the others through some chain of comparisons (the win graph strongly
