@@ -335,21 +335,31 @@ std::vector<PsychometricBin> checked_bins(const std::vector<PsychometricBin>& in
     return bins;
 }
 
-// Stage 2: the data that settle the answer without a fit (no trials, all or none
-// correct, below chance, one intensity), said in fit.notes; true when one did.
-bool settled_without_a_fit(PsychometricFit& fit, const PsychometricOptions& options) {
+// The tested range and the proportion correct of a fit with trials, and the tally its
+// notes quote ("K of N trials correct").
+struct Summary {
+    double x_min = 0, x_max = 0, proportion = 0;
+    std::string tally;
+};
+
+Summary summary_of(const PsychometricFit& fit) {
+    return {fit.bins.front().x, fit.bins.back().x,
+            static_cast<double>(fit.correct) / fit.trials,
+            std::to_string(fit.correct) + " of " + std::to_string(fit.trials) +
+                " trials correct"};
+}
+
+// Stage 2: the data that settle the answer without a fit (all or none correct, below
+// chance, one intensity), said in fit.notes; true when one did.
+bool settled_without_a_fit(PsychometricFit& fit, const Summary& summary,
+                           const PsychometricOptions& options) {
     auto both = [&](const Threshold& t) {
         fit.threshold = t;
         if (options.p_correct_level) fit.threshold_p = t;
     };
-    if (fit.trials == 0) {
-        fit.notes.push_back("No trials: there is no psychometric function to fit.");
-        return true;
-    }
-    const double x_min = fit.bins.front().x, x_max = fit.bins.back().x;
-    const double proportion = static_cast<double>(fit.correct) / fit.trials;
-    const std::string tally = std::to_string(fit.correct) + " of " +
-                              std::to_string(fit.trials) + " trials correct";
+    const double x_min = summary.x_min, x_max = summary.x_max;
+    const double proportion = summary.proportion;
+    const std::string& tally = summary.tally;
     if (fit.correct == fit.trials) {
         both(bounded(ThresholdStatus::below_range, x_min));
         fit.notes.push_back("Every response was correct (" + tally +
@@ -489,11 +499,15 @@ PsychometricFit fit_psychometric(const std::vector<PsychometricBin>& input,
         fit.trials += b.n_trials;
         fit.correct += b.n_correct;
     }
-    if (settled_without_a_fit(fit, options)) return fit;
-    const double x_min = fit.bins.front().x, x_max = fit.bins.back().x;
-    const double proportion = static_cast<double>(fit.correct) / fit.trials;
-    const std::string tally = std::to_string(fit.correct) + " of " +
-                              std::to_string(fit.trials) + " trials correct";
+    if (fit.trials == 0) {
+        fit.notes.push_back("No trials: there is no psychometric function to fit.");
+        return fit;
+    }
+    const Summary summary = summary_of(fit);
+    if (settled_without_a_fit(fit, summary, options)) return fit;
+    const double x_min = summary.x_min, x_max = summary.x_max;
+    const double proportion = summary.proportion;
+    const std::string& tally = summary.tally;
 
     const LikelihoodFit ml = maximum_likelihood(fit.bins, options, gauss);
     const Problem& p = ml.problem;

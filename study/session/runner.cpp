@@ -914,8 +914,9 @@ RunResult Session::run() {
             const int pressed_again = autopilot_->presses_again();
             const std::vector<std::string> keys = autopilot_->due(now, view);
             if (autopilot_->presses_again() > pressed_again)
-                log_ << "lucent run: autopilot: screen " << view.serial
-                     << " still shown 5 s after its keys; pressing them again\n";
+                log_ << "lucent run: autopilot: screen " << view.serial << " still shown "
+                     << Autopilot::kPatienceNs / 1'000'000'000
+                     << " s after its keys; pressing them again\n";
             // Take the focus back first: another window on the same X server may hold it.
             if (!keys.empty()) x_keyboard_->focus_window();
             for (const std::string& key : keys) x_keyboard_->tap(key);

@@ -52,37 +52,15 @@ std::string write_two_block_study(const std::filesystem::path& dir) {
 
 // What a participant's page met on its way (for the test's report).
 struct Encounters {
-    std::atomic<int> retried{0};     // network errors, 502, 503, 504: sent again
+    lucent::test::Retries retries;   // network errors, 502, 503, 504: sent again
     std::atomic<int> restarted{0};   // 409: started again with the token
     std::atomic<int> duplicates{0};  // an answer already stored (a retry's twin)
 };
 
-// The API over one keep-alive connection to the proxy, sending a request again on a
-// network error, 502, 503 or 504 with backoff (50 ms doubling to 1 s, Retry-After when
-// longer), for up to a minute, as lucent.js does.
+// The API over one keep-alive connection to the proxy, each request sent again on a
+// network error, 502, 503 or 504 exactly as lucent.js does (web_page.h's retrying).
 lucent::test::Transport retrying(httplib::Client& client, Encounters& seen) {
-    return [&client, &seen](const std::string& endpoint, const std::string& body) {
-        int delay_ms = 50;
-        const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-        for (;;) {
-            const auto r =
-                client.Post(("/api/" + endpoint).c_str(), body, "application/json");
-            const int status = r ? r->status : 0;
-            const bool transient =
-                status == 0 || status == 502 || status == 503 || status == 504;
-            if (!transient || std::chrono::steady_clock::now() > give_up)
-                return study::WebReply{status,
-                                       r ? r->body : json{{"error", "no reply"}}.dump()};
-            ++seen.retried;
-            int wait_ms = delay_ms;
-            if (r && r->has_header("Retry-After"))
-                wait_ms = std::max(
-                    wait_ms,
-                    1000 * std::atoi(r->get_header_value("Retry-After").c_str()));
-            std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
-            delay_ms = std::min(delay_ms * 2, 1000);
-        }
-    };
+    return lucent::test::retrying(lucent::test::over_http(client), &seen.retries);
 }
 
 // One scripted participant from the link to the completion screen: Enter on text
@@ -220,7 +198,7 @@ protected:
         std::cout << "[ instances] " << kParticipants << " participants, " << kConcurrent
                   << " at once, through nginx over " << kInstances << " instances in "
                   << seconds << " s; " << completed_before
-                  << " had completed at the failure; retried " << seen.retried
+                  << " had completed at the failure; retried " << seen.retries.sent_again
                   << " requests, restarted " << seen.restarted << " pages, "
                   << seen.duplicates << " answers arrived twice (stored once)\n";
         for (const std::string& f : failures) ADD_FAILURE() << f;
