@@ -10,7 +10,6 @@
 
 #include "analysis/analyze.h"
 #include "analysis/data/long_table.h"
-#include "analysis/data/matching_table.h"
 #include "analysis/matching/matching_report.h"
 #include "analysis/report/report.h"
 #include "analysis/scaling/mlds.h"
@@ -19,7 +18,6 @@
 #include "analysis/stats/one_way_analysis.h"
 #include "app/commands.h"
 #include "app/study_input.h"
-#include "study/study_store.h"
 
 namespace lucent::app {
 namespace {
@@ -40,10 +38,11 @@ struct AnalyzeArgs {
 };
 
 // The forced choices' scales (paired comparisons, MLDS), when the input has any.
-void add_scaling_section(const AnalyzeArgs& args, analysis::ReportOptions& options) {
+void add_scaling_section(const AnalyzeArgs& args, const AnalysisInput& input,
+                         analysis::ReportOptions& options) {
     using namespace lucent::analysis;
-    std::map<std::string, std::vector<std::string>> orders;
-    const ChoiceTable choices = read_choices(args.input, &orders);
+    const ChoiceTable& choices = input.choices;
+    const auto& orders = input.choice_orders;
     if (choices.rows.empty()) return;
     std::cerr << "lucent analyze: scaling " << choices.rows.size()
               << " forced choices (paired comparisons, MLDS)\n";
@@ -68,22 +67,15 @@ void add_scaling_section(const AnalyzeArgs& args, analysis::ReportOptions& optio
     ScalingSection section = scaling_section(paired, mlds, pictures);
     options.extra_blocks = std::move(section.blocks);
     options.extra_files = std::move(section.files);
-    for (const std::string& note : choices.notes) options.input_notes.push_back(note);
 }
 
 // Matching and thresholds (adjust and staircase blocks), when a study database has any;
 // appended after the scales.
-void add_matching_section(const AnalyzeArgs& args, analysis::ReportOptions& options) {
+void add_matching_section(const AnalyzeArgs& args, const AnalysisInput& input,
+                          analysis::ReportOptions& options) {
     using namespace lucent::analysis;
-    if (!study::is_server_uri(args.input) && !is_sqlite_file(args.input)) return;
-    MatchingTable table;
-    try {
-        const study::ReadableStudyFile source(args.input);
-        table = read_matching_table(source.path());
-    } catch (const study::StoreError& e) {
-        throw InputError(e.what());
-    }
-    if (table.matches.empty() && table.staircases.empty()) return;
+    const MatchingTable& table = input.matching;
+    if (!input.from_study || (table.matches.empty() && table.staircases.empty())) return;
     std::cerr << "lucent analyze: " << table.matches.size() << " matches, "
               << table.staircases.size() << " staircase trials\n";
     for (const std::string& p : table.excluded_participants)
@@ -153,17 +145,16 @@ int run_analyze(const AnalyzeArgs& args) {
         options.inputs = {args.input};  // a report file never replaces the input
         if (!(args.within_share > 0.0 && args.within_share <= 1.0))
             throw InputError("--within-share must lie in (0, 1]");
-        std::optional<Design> plan_design;
         options.scale = parse_scale(args.scale);
-        std::string plan_model;
-        // A choices CSV holds no ratings; a study database may hold both.
-        const LongTable table = is_choice_csv(args.input)
-                                    ? LongTable{}
-                                    : read_ratings(args.input, options.scale,
-                                                   &plan_design, &options.input_notes,
-                                                   &options.question_scales, &plan_model);
-        add_scaling_section(args, options);
-        add_matching_section(args, options);
+        // A choices CSV holds no ratings; a study database may hold every kind.
+        const AnalysisInput input = read_analysis_input(args.input, options.scale);
+        const LongTable& table = input.ratings;
+        const std::optional<Design>& plan_design = input.plan_design;
+        const std::string& plan_model = input.plan_model;
+        options.input_notes = input.notes;
+        options.question_scales = input.question_scales;
+        add_scaling_section(args, input, options);
+        add_matching_section(args, input, options);
         if (table.rows.empty() && options.extra_blocks.empty())
             throw InputError(args.input +
                              ": holds no ratings, no forced choices, no matches and no "

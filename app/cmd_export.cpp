@@ -1,5 +1,6 @@
 // lucent export: a study database as CSV (long, wide, the analysis long table, the
-// forced choices, the adjustments and matches, the staircase trials).
+// forced choices, the adjustments and matches, the staircase trials, and every answer
+// the analysis reads as one table of observations).
 #include <iostream>
 
 #include "app/commands.h"
@@ -33,9 +34,11 @@ void register_export(CLI::App& app, int& exit_code) {
            "catch trials left out); adjustments: one row per change of an adjust "
            "trial's knob (value, ms from onset, input); matches: one row per adjust "
            "trial (start, final value, count of adjustments, total ms); staircase: one "
-           "row per answered staircase trial (intensity, expected, choice, correct, RT)")
+           "row per answered staircase trial (intensity, expected, choice, correct, RT); "
+           "observations: every answer lucent analyze reads, of every kind, one row "
+           "each with a column per factor")
         ->check(CLI::IsMember({"long", "wide", "analysis", "choices", "choice-analysis",
-                               "adjustments", "matches", "staircase"}));
+                               "adjustments", "matches", "staircase", "observations"}));
     cmd->add_option("--out", *out,
                     "CSV file to write (never a database; written to a temporary file in "
                     "its folder, then renamed)")

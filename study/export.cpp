@@ -10,6 +10,7 @@
 #include "common/csv.h"
 #include "common/number_text.h"
 #include "common/output_file.h"
+#include "study/observations.h"
 #include "study/question_scales.h"
 #include "study/schema.h"
 #include "study/sqlite/database.h"
@@ -325,141 +326,35 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
     return rows;
 }
 
-LongTable analysis_long_table(const std::string& db_path,
-                              const LongTableOptions& options) {
-    Database db = open_read_only(db_path);
-    const auto params = stimulus_parameters(db);
-    std::map<std::string, std::pair<std::string, std::vector<std::string>>>
-        stimuli;  // technique, varies
-    {
-        Statement s = db.prepare("SELECT stimulus_key, technique, varies FROM stimuli");
-        while (s.step()) {
-            std::vector<std::string> varies;
-            std::istringstream words(s.text(2));
-            for (std::string w; words >> w;) varies.push_back(w);
-            stimuli[s.text(0)] = {s.text(1), varies};
-        }
-    }
-    LongTable table;
-    const std::optional<Protocol> protocol = stored_protocol(db);
-    if (protocol) {
-        table.primary_design = protocol->analysis.primary_design;
-        table.primary_model = protocol->analysis.primary_model;
-        table.sessions = protocol->analysis.sessions;
-    }
-    if (!options.sessions.empty()) table.sessions = options.sessions;
-    if (table.sessions != "completed" && table.sessions != "all")
-        throw StoreError("analysis sessions: expected \"completed\" or \"all\", got '" +
-                         table.sessions + "'");
-
-    const SessionSelection selected =
-        select_sessions(db, db_path, table.sessions, options.exclude_failed_catch);
-    const std::map<std::int64_t, std::string>& taken = selected.taken;
-    const std::set<std::string>& excluded = selected.excluded;
-    table.excluded_participants = selected.excluded_participants;
-    table.left_out = selected.left_out;
-    table.sessions_total = selected.total;
-    table.sessions_analysed = selected.analysed;
-    table.sessions_note = selected.note;
-
-    Statement s = db.prepare(
-        "SELECT p.code, st.stimulus_key, r.question, r.rating, se.id FROM responses r "
-        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
-        "JOIN participants p ON p.id = se.participant_id "
-        "JOIN stimuli st ON st.id = t.stimulus_id "
-        "WHERE t.practice = 0 AND t.catch = 0" +
-        rating_trials(db) + "ORDER BY p.code, se.id, t.position, r.id");
-    while (s.step()) {
-        const std::string participant = s.text(0);
-        if (!taken.count(s.integer(4)) || excluded.count(participant)) continue;
-        const std::string stimulus = s.text(1);
-        const auto& [technique, varies] = stimuli[stimulus];
-        const auto pit = params.find(stimulus);
-        std::vector<std::pair<std::string, std::string>> factors;
-        if (varies.empty()) {
-            if (pit != params.end())
-                for (const auto& [name, value] : pit->second)
-                    factors.emplace_back(name, value);
-        } else {
-            for (const std::string& f : varies) {
-                if (f == "technique")
-                    factors.emplace_back(f, technique);
-                else if (f.rfind("series:", 0) ==
-                         0)  // a comparison series: one level per stimulus
-                    factors.emplace_back(f.substr(7), stimulus);
-                else if (pit != params.end() && pit->second.count(f))
-                    factors.emplace_back(f, pit->second.at(f));
-            }
-        }
-        for (const auto& [factor, level] : factors)
-            table.rows.push_back({participant, stimulus, factor, level, s.text(2),
-                                  static_cast<int>(s.integer(3))});
-    }
-    return table;
-}
-
 ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
                             const ChoiceExportOptions& options) {
-    Database db = open_read_only(db_path);
+    const StudyObservations read = read_observations(
+        db_path, {.analysis = options.analysis, .sessions = options.sessions});
     ChoiceExport result;
     out << "participant,session,trial,block,task,question,practice,catch,expected,"
            "shown_1,shown_2,shown_3,shown_4,value_1,value_2,value_3,value_4,choice,"
            "rt_ms\n";
-    if (db.scalar_int("PRAGMA user_version") < 6) return result;  // ratings only then
-    const std::optional<Protocol> protocol = stored_protocol(db);
-    std::string sessions = options.sessions;
-    if (sessions.empty())
-        sessions = protocol ? protocol->analysis.sessions : std::string("completed");
-    if (sessions != "completed" && sessions != "all")
-        throw StoreError("analysis sessions: expected \"completed\" or \"all\", got '" +
-                         sessions + "'");
-    const SessionSelection selected = select_sessions(
-        db, db_path, options.analysis ? sessions : "all", options.analysis);
     if (options.analysis) {
-        result.excluded_participants = selected.excluded_participants;
-        result.notes.push_back(selected.note);
+        result.excluded_participants = read.selection.excluded_participants;
+        result.notes.push_back(read.selection.note);
     }
-    const auto params = stimulus_parameters(db);
-    // The series value of a stimulus in a block: its parameter named by the block's
-    // `series` (the stored protocol's), as written.
-    auto series_value = [&](const std::string& block, const std::string& stimulus) {
-        const Block* b = protocol ? protocol->find_block(block) : nullptr;
-        if (!b || b->series.empty()) return std::string();
-        const auto it = params.find(stimulus);
-        if (it == params.end() || !it->second.count(b->series)) return std::string();
-        return it->second.at(b->series);
-    };
-    Statement s = db.prepare(
-        "SELECT p.code, se.uuid, t.position, t.block, " + trial_kind(db) +
-        ", r.question, t.practice, "
-        "t.catch, t.expected_rating, t.shown, r.rating, r.rt_ms, se.id FROM responses r "
-        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
-        "JOIN participants p ON p.id = se.participant_id "
-        "WHERE " +
-        trial_kind(db) +
-        " IN ('pair', 'triad', 'quadruple') "
-        "ORDER BY p.code, se.id, t.position, r.id");
-    while (s.step()) {
-        const std::string participant = s.text(0);
-        const bool practice = s.integer(6) != 0;
-        if (options.analysis && (practice || !selected.taken.count(s.integer(12)) ||
-                                 selected.excluded.count(participant)))
-            continue;
-        if (!selected.taken.count(s.integer(12))) continue;  // withdrawn
-        const std::string block = s.text(3);
-        const std::vector<std::string> shown = shown_from_text(s.text(9));
-        out << common::csv_field(participant) << "," << common::csv_field(s.text(1))
-            << "," << s.integer(2) << "," << common::csv_field(block) << ","
-            << common::csv_field(s.text(4)) << "," << common::csv_field(s.text(5)) << ","
-            << (practice ? 1 : 0) << "," << s.integer(7) << ","
-            << (s.is_null(8) ? std::string() : std::to_string(s.integer(8)));
+    for (const common::Observation& row : read.table.rows) {
+        const std::optional<Task> task = parse_task(row.kind);
+        if (!task || !is_scaling_task(*task)) continue;
+        out << common::csv_field(row.participant) << "," << common::csv_field(row.session)
+            << "," << row.trial << "," << common::csv_field(row.block) << ","
+            << common::csv_field(row.kind) << "," << common::csv_field(row.question)
+            << "," << (row.practice ? 1 : 0) << "," << (row.is_catch ? 1 : 0) << ","
+            << (row.expected ? std::to_string(*row.expected) : std::string());
         for (size_t k = 0; k < 4; ++k)
-            out << "," << common::csv_field(k < shown.size() ? shown[k] : "");
-        for (size_t k = 0; k < 4; ++k)
+            out << "," << common::csv_field(k < row.shown.size() ? row.shown[k] : "");
+        for (size_t k = 0; k < 4; ++k) {
+            const auto v = row.measures.find("value_" + std::to_string(k + 1));
             out << ","
-                << common::csv_field(k < shown.size() ? series_value(block, shown[k])
-                                                      : "");
-        out << "," << s.integer(10) << "," << format_number(s.real(11)) << "\n";
+                << (v != row.measures.end() ? common::shortest_text(v->second) : "");
+        }
+        out << "," << static_cast<int>(row.response.value_or(0)) << ","
+            << format_number(row.rt_ms) << "\n";
         ++result.rows;
     }
     return result;
@@ -577,29 +472,23 @@ int export_staircase(const std::string& db_path, std::ostream& out) {
     return rows;
 }
 
-std::map<std::string, std::vector<std::string>> choice_block_orders(
-    const std::string& db_path) {
-    Database db = open_read_only(db_path);
-    std::map<std::string, std::vector<std::string>> out;
-    if (const std::optional<Protocol> protocol = stored_protocol(db))
-        for (const Block& b : protocol->blocks)
-            if (b.is_choice()) out[b.id] = b.stimuli;
-    return out;
-}
-
 ExportFileResult export_file(const std::string& db_path, const std::string& format,
                              const std::string& out_path, bool force) {
     ExportFileResult result;
     try {
         common::check_output_file(out_path, {db_path}, force);
         common::write_file_atomically(out_path, force, [&](std::ostream& out) {
-            if (format == "analysis") {
+            if (format == "analysis" || format == "observations") {
                 check_stored_ratings(db_path);  // no impossible rating enters an analysis
-                const LongTable table = analysis_long_table(db_path);
-                write_long_table_csv(table, out);
-                result.rows = static_cast<int>(table.rows.size());
-                result.excluded_participants = table.excluded_participants;
-                result.notes.push_back(table.sessions_note);
+                const StudyObservations read = read_observations(db_path);
+                if (format == "analysis") {
+                    result.rows = write_factor_ratings_csv(read.table, out);
+                } else {
+                    common::write_observation_csv(out, read.table);
+                    result.rows = static_cast<int>(read.table.rows.size());
+                }
+                result.excluded_participants = read.selection.excluded_participants;
+                result.notes.push_back(read.selection.note);
             } else if (format == "choices" || format == "choice-analysis") {
                 const bool analysis = format == "choice-analysis";
                 const ChoiceExport choices =
@@ -621,7 +510,7 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
                 throw StoreError(
                     "export: unknown format '" + format +
                     "' (valid: long, wide, analysis, choices, choice-analysis, "
-                    "adjustments, matches, staircase)");
+                    "adjustments, matches, staircase, observations)");
             }
         });
     } catch (const common::OutputError& e) {
@@ -630,12 +519,16 @@ ExportFileResult export_file(const std::string& db_path, const std::string& form
     return result;
 }
 
-void write_long_table_csv(const LongTable& table, std::ostream& out) {
+int write_factor_ratings_csv(const common::ObservationTable& table, std::ostream& out) {
     out << "participant,stimulus,factor,level,question,rating\n";
-    for (const LongRow& r : table.rows)
-        out << common::csv_field(r.participant) << "," << common::csv_field(r.stimulus)
-            << "," << common::csv_field(r.factor) << "," << common::csv_field(r.level)
-            << "," << common::csv_field(r.question) << "," << r.rating << "\n";
+    const std::vector<common::FactorRating> rows = common::factor_ratings(table);
+    for (const common::FactorRating& r : rows)
+        out << common::csv_field(r.observation->participant) << ","
+            << common::csv_field(r.observation->shown.front()) << ","
+            << common::csv_field(*r.factor) << "," << common::csv_field(*r.level) << ","
+            << common::csv_field(r.observation->question) << ","
+            << static_cast<int>(*r.observation->response) << "\n";
+    return static_cast<int>(rows.size());
 }
 
 }  // namespace lucent::study

@@ -1,6 +1,7 @@
 #pragma once
 // Data out of a study database: CSV exports (long: one row per rating; wide: one row per
-// participant), the analysis long table, and merging databases from several machines.
+// participant; observations: one row per answer of every kind, study/observations.h),
+// and merging databases from several machines.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/observation_table.h"
 #include "study/protocol.h"
 
 namespace lucent::study {
@@ -26,15 +28,18 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
 
 struct ExportFileResult {
     int rows = 0;
-    std::vector<std::string> excluded_participants;  // format "analysis" only
-    // long, wide: values older databases did not record; analysis: the sessions left out
-    // by reason (LongTable::sessions_note)
+    // analysis, choice-analysis, observations: failing too many catch trials
+    std::vector<std::string> excluded_participants;
+    // long, wide: values older databases did not record; analysis, choice-analysis,
+    // observations: the sessions left out by reason (SessionSelection::note)
     std::vector<std::string> notes;
 };
 
 // Writes format "long", "wide", "analysis", "choices", "choice-analysis" (the choices
-// as the scaling reads them: ChoiceExportOptions::analysis), "adjustments", "matches" or
-// "staircase" (export_adjustments, ...) of `db_path` to the CSV file
+// as the scaling reads them: ChoiceExportOptions::analysis), "adjustments", "matches",
+// "staircase" (export_adjustments, ...) or "observations" (every answer the analysis
+// reads, of every kind, one column per factor: common::write_observation_csv) of
+// `db_path` to the CSV file
 // `out_path`: never the database itself (by inode: symlinks, hard links and relative
 // paths included) nor any other database; an existing file only with `force`. Written to
 // a temporary file in the same folder and renamed into place. Throws StoreError (one
@@ -42,26 +47,7 @@ struct ExportFileResult {
 ExportFileResult export_file(const std::string& db_path, const std::string& format,
                              const std::string& out_path, bool force);
 
-// A row of the analysis input (issue 4): one per (rating, factor), practice and catch
-// trials excluded. Columns participant,stimulus,factor,level,question,rating.
-struct LongRow {
-    std::string participant;
-    std::string stimulus;
-    std::string factor;
-    std::string level;
-    std::string question;
-    int rating = 0;
-};
-
-struct LongTableOptions {
-    // Drop participants who failed more catch trials than the protocol allows.
-    bool exclude_failed_catch = true;
-    // "completed" or "all"; empty: the stored protocol's [analysis] sessions, and
-    // "completed" when there is none (or it cannot be read).
-    std::string sessions;
-};
-
-// The sessions a long table leaves out, by reason (each session counted once, in this
+// The sessions an analysis leaves out, by reason (each session counted once, in this
 // order: withdrawn, incomplete, failed catch trials).
 struct SessionsLeftOut {
     int withdrawn = 0;   // withdrawn_sessions tombstones (their ratings already deleted)
@@ -73,8 +59,8 @@ struct SessionsLeftOut {
 
 // The sessions an analysis reads (withdrawn never; "completed" or "all" by status),
 // the participants excluded for failed catch trials (when `exclude_failed_catch`, over
-// the stored protocol's max_failed_catch), and the note saying so (LongTable's
-// sessions_note). Every reader of a study database for the analysis takes these.
+// the stored protocol's max_failed_catch), and the note saying so. Every reader of a
+// study database for the analysis takes these.
 struct SessionSelection {
     std::map<std::int64_t, std::string> taken;  // session id -> participant code
     std::set<std::string> excluded;             // participant codes
@@ -102,30 +88,10 @@ SessionSelection select_sessions(Database& db, const std::string& db_path,
 // (before schema 5).
 std::string declined_consent_figure(Database& db);
 
-struct LongTable {
-    std::vector<LongRow> rows;
-    std::vector<std::string>
-        excluded_participants;  // with the reason, "P3 (2 catch failed)"
-    std::string
-        primary_design;         // the stored protocol's [analysis] plan; "" if unreadable
-    std::string primary_model;  // likewise ("anova", "clmm", "lmm")
-    std::string sessions = "completed";  // which sessions were taken
-    int sessions_total = 0;              // in the database, withdrawn ones included
-    int sessions_analysed = 0;
-    SessionsLeftOut left_out;
-    // One line: how many sessions were analysed and left out, by reason ("study.db: 2 of
-    // 5 sessions analysed (completed sessions only); left out: 2 incomplete (1 running,
-    // 1 paused), 1 failed catch trials, 0 withdrawn").
-    std::string sessions_note;
-};
-
-// Factors of a stimulus: the parameters it `varies` (or all its parameters when it
-// declares none); "technique" is a factor only when listed in `varies`. Only the
-// sessions the plan (or `options.sessions`) names are read: by default completed ones.
-// A session whose UUID is a withdrawal tombstone is never read.
-LongTable analysis_long_table(const std::string& db_path,
-                              const LongTableOptions& options = {});
-void write_long_table_csv(const LongTable& table, std::ostream& out);
+// `lucent export --format analysis`: the ratings the one-way tests and mixed models read,
+// one row per (rating, factor) (common::factor_ratings), as
+// participant,stimulus,factor,level,question,rating. Returns the data rows.
+int write_factor_ratings_csv(const common::ObservationTable& table, std::ostream& out);
 
 // Forced choices (issue 30): one row per answered pair, triad or quadruple trial, as
 // `lucent export --format choices` writes them and the scaling reads them
@@ -167,11 +133,6 @@ int export_matches(const std::string& db_path, std::ostream& out);
 // delta shown),expected (the comparison's place),choice,correct (1 when choice is
 // expected),rt_ms; skipped slots are not rows.
 int export_staircase(const std::string& db_path, std::ostream& out);
-
-// Each forced-choice block's stimuli in the stored protocol's order (its series); empty
-// when the protocol cannot be read.
-std::map<std::string, std::vector<std::string>> choice_block_orders(
-    const std::string& db_path);
 
 struct MergeReport {
     int sessions_added = 0;

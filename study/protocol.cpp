@@ -820,6 +820,10 @@ std::optional<Task> parse_task(std::string_view text) {
     return std::nullopt;
 }
 
+bool is_scaling_task(Task task) {
+    return task == Task::pair || task == Task::triad || task == Task::quadruple;
+}
+
 int pictures_per_trial(Task task) {
     switch (task) {
         case Task::rating:

@@ -63,6 +63,8 @@ struct CatchTrial {
 enum class Task { rating, pair, triad, quadruple, adjust, staircase };
 const char* task_name(Task task);
 std::optional<Task> parse_task(std::string_view text);
+// A forced choice the scaling reads (paired comparisons, MLDS): pair, triad, quadruple.
+bool is_scaling_task(Task task);
 // The pictures one trial of the task shows: 1, 2, 3 or 4 (adjust: the target and the
 // match; staircase: 2, see Block::pictures() for an odd-one-out staircase's 3).
 int pictures_per_trial(Task task);

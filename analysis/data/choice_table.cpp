@@ -211,6 +211,47 @@ ChoiceTable read_choice_csv(std::istream& in, const std::string& source) {
     return table;
 }
 
+ChoiceTable choices_of(const common::ObservationTable& observations,
+                       const std::string& source) {
+    ChoiceTable table;
+    for (std::size_t i = 0; i < observations.rows.size(); ++i) {
+        const common::Observation& o = observations.rows[i];
+        const std::optional<ChoiceTask> task = parse_choice_task(o.kind);
+        if (!task || o.practice) continue;
+        ChoiceRow row;
+        row.source_line = i + 1;
+        row.participant = o.participant;
+        row.session = o.session;
+        row.trial = o.trial;
+        row.block = o.block;
+        row.task = *task;
+        row.question = o.question;
+        row.is_catch = o.is_catch;
+        row.expected = o.expected;
+        const std::size_t n = static_cast<std::size_t>(shown_count(*task));
+        if (o.shown.size() < n)
+            throw InputError(source + ": session " + o.session + ", trial " +
+                             std::to_string(o.trial) + ": a " + choice_task_name(*task) +
+                             " shows " + std::to_string(n) + " stimuli; " +
+                             std::to_string(o.shown.size()) + " are stored");
+        for (std::size_t k = 0; k < n; ++k) {
+            row.shown[k] = o.shown[k];
+            if (const auto v = o.measures.find("value_" + std::to_string(k + 1));
+                v != o.measures.end())
+                row.value[k] = v->second;
+        }
+        if (!o.response || (*o.response != 1 && *o.response != 2))
+            throw InputError(source + ": session " + o.session + ", trial " +
+                             std::to_string(o.trial) + ": choice " +
+                             (o.response ? common::shortest_text(*o.response) : "empty") +
+                             ", expected 1 or 2");
+        row.choice = static_cast<int>(*o.response);
+        row.rt_ms = o.rt_ms;
+        table.rows.push_back(std::move(row));
+    }
+    return table;
+}
+
 ChoiceTable read_choice_csv(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path.string() + ": cannot open for reading");

@@ -1,7 +1,8 @@
 #pragma once
 // The table every scaling starts from: one row per forced choice of a paired-comparison
 // or difference-scaling (MLDS) trial. The CSV reader fills it from `lucent export
-// --format choices`; the study database reader (study/export.h) fills the same struct.
+// --format choices`; a study's observations (common/observation_table.h) give the same
+// rows.
 #include <array>
 #include <cstddef>
 #include <filesystem>
@@ -10,6 +11,8 @@
 #include <ostream>
 #include <string>
 #include <vector>
+
+#include "common/observation_table.h"
 
 namespace lucent::analysis {
 
@@ -46,9 +49,12 @@ struct ChoiceRow {
 
 struct ChoiceTable {
     std::vector<ChoiceRow> rows;  // practice trials never enter
-    // What the reader left out and why (sessions not completed, withdrawn, ...).
-    std::vector<std::string> notes;
 };
+
+// The forced choices (pair, triad, quadruple) of a study's observations, practice
+// trials left out; `source` names the study in errors (a choice other than 1 or 2).
+ChoiceTable choices_of(const common::ObservationTable& observations,
+                       const std::string& source);
 
 // Reads the `choices` CSV (header required, columns in any order, RFC 4180 quotes);
 // rows with practice = 1 are skipped. Throws InputError naming source:line and the field.

@@ -474,6 +474,21 @@ LongTable read_long_csv(const std::filesystem::path& path, const RatingScale& sc
     return read_long_csv(in, path.string(), scale);
 }
 
+LongTable ratings_of(const common::ObservationTable& observations,
+                     const std::string& source, const RatingScale& scale) {
+    LongTable table;
+    const std::vector<common::FactorRating> ratings =
+        common::factor_ratings(observations);
+    table.rows.reserve(ratings.size());
+    for (std::size_t i = 0; i < ratings.size(); ++i) {
+        const common::Observation& o = *ratings[i].observation;
+        table.rows.push_back({o.participant, o.shown.front(), *ratings[i].factor,
+                              *ratings[i].level, o.question, o.response, i + 1});
+    }
+    check_scale(table, scale, source);
+    return table;
+}
+
 void write_long_csv(std::ostream& out, const LongTable& table) {
     out << "participant,stimulus,factor,level,question,rating\n";
     for (const RatingRow& row : table.rows) {

@@ -1,7 +1,7 @@
 #pragma once
-// The long table every analysis starts from: one row per rating. The CSV reader fills it
-// from `participant,stimulus,factor,level,question,rating`; the study database reader
-// (study/, joined in app/) fills the same struct.
+// The long table the one-way tests and mixed models start from: one row per (rating,
+// factor). The CSV reader fills it from `participant,stimulus,factor,level,question,
+// rating`; a study's observations (common/observation_table.h) give the same rows.
 #include <cstddef>
 #include <filesystem>
 #include <istream>
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "analysis/data/label.h"
+#include "common/observation_table.h"
 
 namespace lucent::analysis {
 
@@ -51,6 +52,12 @@ void check_scale(const LongTable& table, const RatingScale& scale,
 LongTable read_long_csv(std::istream& in, const std::string& source,
                         const RatingScale& scale);
 LongTable read_long_csv(const std::filesystem::path& path, const RatingScale& scale);
+
+// The ratings of a study's observations, one row per (rating, factor) as
+// common::factor_ratings gives them; `source` names the study in errors. Ratings are
+// checked against the scale.
+LongTable ratings_of(const common::ObservationTable& observations,
+                     const std::string& source, const RatingScale& scale);
 
 // Writes the same format (used by the simulator); ratings are printed exactly.
 void write_long_csv(std::ostream& out, const LongTable& table);

@@ -2,19 +2,17 @@
 // The rows every matching and threshold analysis starts from (issue 31): one per
 // answered adjust trial (the value the participant confirmed) and one per answered
 // staircase trial (the delta shown and whether the choice was right), with the stored
-// protocol that says what each block's knob, match, range and procedures were.
-//
-// read_matching_table opens a study database read-only (as the other analysis readers,
-// study/export.h) and takes what the analysis takes of the other trial kinds: practice
-// trials never; withdrawn sessions never; only completed sessions unless the protocol's
-// [analysis] sessions (or `sessions`) says "all"; participants failing more catch
-// trials than the protocol allows left out. Part of lucent_matching (it reads the store
-// through study/).
+// protocol that says what each block's knob, match, range and procedures were. They come
+// out of a study's observations (common/observation_table.h, read by
+// study/observations.h), which have left practice, withdrawn and unselected sessions and
+// excluded participants out already. Part of lucent_matching (it replays the study's
+// adaptive procedures, study/adaptive).
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "common/observation_table.h"
 #include "study/protocol.h"
 
 namespace lucent::analysis {
@@ -60,10 +58,9 @@ struct MatchingTable {
     std::string sessions_note;
 };
 
-// Throws InputError (analysis/data/long_table.h), one line, when the file is not a
-// readable study database or `sessions` is not "", "completed" or "all". A database
-// before schema 7 (no adjust or staircase trials) gives empty rows.
-MatchingTable read_matching_table(const std::string& db_path,
-                                  const std::string& sessions = "");
+// The adjust trials with a confirmed value and the staircase trials with a delta and a
+// right answer, in the observations' order; `protocol` names each block's knob and match.
+MatchingTable matching_of(const common::ObservationTable& observations,
+                          std::optional<study::Protocol> protocol);
 
 }  // namespace lucent::analysis

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "study/export.h"
+#include "study/observations.h"
 #include "study/sqlite/database.h"
 #include "study/sqlite/sqlite_store.h"
 #include "tests/study/study_fixtures.h"
@@ -88,20 +89,22 @@ protected:
 TEST_F(AnalysisSessions, OnlyCompletedSessionsAreAnalysedAndTheRestCountedByReason) {
     fill(lucent::test::small_protocol());
     ASSERT_EQ(partial_rated_, 4);
-    const LongTable table = analysis_long_table(path_);
+    const StudyObservations read = read_observations(path_);
+    const SessionSelection& taken = read.selection;
     // P1 alone: 3 rated stimuli x 2 questions, one factor each.
-    ASSERT_EQ(table.rows.size(), 6u);
-    for (const LongRow& r : table.rows) EXPECT_EQ(r.participant, "P1");
-    EXPECT_EQ(table.sessions, "completed");
-    EXPECT_EQ(table.sessions_total, 7);  // 6 present (P6 withdrawn) + 1 tombstone only
-    EXPECT_EQ(table.sessions_analysed, 1);
-    EXPECT_EQ(table.left_out.incomplete, 3);
+    const auto rows = common::factor_ratings(read.table);
+    ASSERT_EQ(rows.size(), 6u);
+    for (const auto& r : rows) EXPECT_EQ(r.observation->participant, "P1");
+    EXPECT_EQ(read.sessions, "completed");
+    EXPECT_EQ(taken.total, 7);  // 6 present (P6 withdrawn) + 1 tombstone only
+    EXPECT_EQ(taken.analysed, 1);
+    EXPECT_EQ(taken.left_out.incomplete, 3);
     EXPECT_EQ(
-        table.left_out.incomplete_by_status,
+        taken.left_out.incomplete_by_status,
         (std::map<std::string, int>{{"aborted", 1}, {"paused", 1}, {"running", 1}}));
-    EXPECT_EQ(table.left_out.failed_catch, 1);
-    EXPECT_EQ(table.left_out.withdrawn, 2);
-    EXPECT_EQ(table.sessions_analysed + table.left_out.total(), table.sessions_total);
+    EXPECT_EQ(taken.left_out.failed_catch, 1);
+    EXPECT_EQ(taken.left_out.withdrawn, 2);
+    EXPECT_EQ(taken.analysed + taken.left_out.total(), taken.total);
 
     // export --format analysis says the same in its notes, and writes P1's rows only.
     const std::string csv = (dir_ / "ratings.csv").string();
@@ -124,32 +127,33 @@ TEST_F(AnalysisSessions, OnlyCompletedSessionsAreAnalysedAndTheRestCountedByReas
 
 TEST_F(AnalysisSessions, AllSessionsWhenAskedStillNeverTheWithdrawnOrFailedCatch) {
     fill(lucent::test::small_protocol());
-    const LongTable table = analysis_long_table(path_, {.sessions = "all"});
+    const StudyObservations read = read_observations(path_, {.sessions = "all"});
+    const auto rows = common::factor_ratings(read.table);
     // P1's 3 rated trials and the 4 answered by P3, P4, P5; x 2 questions.
-    EXPECT_EQ(table.rows.size(), static_cast<std::size_t>(2 * (3 + partial_rated_)));
+    EXPECT_EQ(rows.size(), static_cast<std::size_t>(2 * (3 + partial_rated_)));
     std::set<std::string> participants;
-    for (const LongRow& r : table.rows) participants.insert(r.participant);
+    for (const auto& r : rows) participants.insert(r.observation->participant);
     EXPECT_EQ(participants, (std::set<std::string>{"P1", "P3", "P4", "P5"}));
-    EXPECT_EQ(table.sessions_analysed, 4);
-    EXPECT_EQ(table.left_out.incomplete, 0);
-    EXPECT_EQ(table.left_out.failed_catch, 1);
-    EXPECT_EQ(table.left_out.withdrawn, 2);
-    EXPECT_THROW(analysis_long_table(path_, {.sessions = "some"}), StoreError);
+    EXPECT_EQ(read.selection.analysed, 4);
+    EXPECT_EQ(read.selection.left_out.incomplete, 0);
+    EXPECT_EQ(read.selection.left_out.failed_catch, 1);
+    EXPECT_EQ(read.selection.left_out.withdrawn, 2);
+    EXPECT_THROW(read_observations(path_, {.sessions = "some"}), StoreError);
 }
 
 TEST_F(AnalysisSessions, TheProtocolsAnalysisPlanCanTakeEverySession) {
     const std::string text =
         std::string(lucent::test::kSmallProtocol) + "\n[analysis]\nsessions = \"all\"\n";
     fill(parse_protocol(text, "all.toml"));
-    const LongTable table = analysis_long_table(path_);
-    EXPECT_EQ(table.sessions, "all");
-    EXPECT_EQ(table.sessions_analysed, 4);
+    const StudyObservations read = read_observations(path_);
+    EXPECT_EQ(read.sessions, "all");
+    EXPECT_EQ(read.selection.analysed, 4);
     EXPECT_NE(
-        table.sessions_note.find("sessions of every status, as the analysis plan says"),
+        read.selection.note.find("sessions of every status, as the analysis plan says"),
         std::string::npos)
-        << table.sessions_note;
+        << read.selection.note;
     // An explicit option wins over the plan.
-    EXPECT_EQ(analysis_long_table(path_, {.sessions = "completed"}).sessions_analysed, 1);
+    EXPECT_EQ(read_observations(path_, {.sessions = "completed"}).selection.analysed, 1);
 }
 
 TEST(AnalysisPlanSessions, AnUnknownValueIsRefusedNamingFileAndLine) {

@@ -10,6 +10,7 @@
 
 #include "common/csv.h"
 #include "study/export.h"
+#include "study/observations.h"
 #include "study/protocol.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/trial_plan.h"
@@ -399,8 +400,9 @@ TEST(ChoiceStore, KeepsTheChoicesInScreenOrderAndExportsOneRowEach) {
         export_file(path, "choice-analysis", (dir / "analysis.csv").string(), false).rows,
         34);
     // Ratings stay in the rating exports only.
-    const LongTable ratings = analysis_long_table(path);
-    EXPECT_EQ(ratings.rows.size(), 3u);  // 3 rated trials x 1 question x 1 factor
+    const StudyObservations read = read_observations(path);
+    // 3 rated trials x 1 question x 1 factor
+    EXPECT_EQ(common::factor_ratings(read.table).size(), 3u);
 }
 
 TEST(ChoiceStore, RefusesAChoiceOutsideItsTwoAnswersOrAnsweredWithRatings) {

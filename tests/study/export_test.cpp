@@ -10,6 +10,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "study/observations.h"
 #include "study/sqlite/sqlite_store.h"
 #include "tests/study/study_fixtures.h"
 #include "tests/support/test_paths.h"
@@ -123,22 +124,25 @@ TEST_F(ExportTest, WideHasOneRowPerParticipantWithEachRating) {
 }
 
 TEST_F(ExportTest, AnalysisLongTableExcludesPracticeCatchAndFailedParticipants) {
-    const LongTable table = analysis_long_table(path_);
-    ASSERT_EQ(table.excluded_participants.size(), 1u);
-    EXPECT_EQ(table.excluded_participants[0].rfind("P2", 0), 0u);
+    const StudyObservations read = read_observations(path_);
+    ASSERT_EQ(read.selection.excluded_participants.size(), 1u);
+    EXPECT_EQ(read.selection.excluded_participants[0].rfind("P2", 0), 0u);
     // P1: 3 rated stimuli x 2 questions x 1 factor (each varies thickness_exponent only).
-    ASSERT_EQ(table.rows.size(), 6u);
-    for (const LongRow& r : table.rows) {
-        EXPECT_EQ(r.participant, "P1");
-        EXPECT_EQ(r.factor, "thickness_exponent");
-        EXPECT_EQ(r.level,
-                  p_.find_stimulus(r.stimulus)->parameters.at("thickness_exponent"));
-        EXPECT_NE(r.stimulus, "p");
+    const auto rows = common::factor_ratings(read.table);
+    ASSERT_EQ(rows.size(), 6u);
+    for (const auto& r : rows) {
+        const std::string& stimulus = r.observation->shown.front();
+        EXPECT_EQ(r.observation->participant, "P1");
+        EXPECT_EQ(*r.factor, "thickness_exponent");
+        EXPECT_EQ(*r.level,
+                  p_.find_stimulus(stimulus)->parameters.at("thickness_exponent"));
+        EXPECT_NE(stimulus, "p");
     }
-    const LongTable all = analysis_long_table(path_, {.exclude_failed_catch = false});
-    EXPECT_EQ(all.rows.size(), 12u);
+    const StudyObservations all =
+        read_observations(path_, {.exclude_failed_catch = false});
+    EXPECT_EQ(common::factor_ratings(all.table).size(), 12u);
     std::ostringstream csv;
-    write_long_table_csv(table, csv);
+    EXPECT_EQ(write_factor_ratings_csv(read.table, csv), 6);
     EXPECT_EQ(csv.str().substr(0, csv.str().find('\n')),
               "participant,stimulus,factor,level,question,rating");
 }
@@ -161,15 +165,15 @@ TEST(ExportSeries, ComparisonSeriesLevelsAreTheStimuli) {
         Store store(path);
         lucent::test::run_full_session(store, p, "P1", 11);
     }
-    const LongTable table = analysis_long_table(path);
+    const StudyObservations read = read_observations(path);
     std::map<std::string, int> levels;
     int thickness = 0;
-    for (const LongRow& r : table.rows) {
-        if (r.factor == "pair") {
-            EXPECT_EQ(r.level, r.stimulus);
-            ++levels[r.level];
+    for (const auto& r : common::factor_ratings(read.table)) {
+        if (*r.factor == "pair") {
+            EXPECT_EQ(*r.level, r.observation->shown.front());
+            ++levels[*r.level];
         } else {
-            EXPECT_EQ(r.factor, "thickness_exponent");
+            EXPECT_EQ(*r.factor, "thickness_exponent");
             ++thickness;
         }
     }

@@ -12,6 +12,7 @@
 #include "analysis/scaling/mlds.h"
 #include "analysis/scaling/paired_comparison.h"
 #include "study/export.h"
+#include "study/observations.h"
 #include "study/simulated_observer.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/trial_plan.h"
@@ -61,7 +62,7 @@ TEST(ScalingRecovery, MldsAndThurstoneRecoverTheObserversScale) {
     EXPECT_TRUE(exported.excluded_participants.empty());  // obvious catches are obvious
     const analysis::ChoiceTable table = analysis::read_choice_csv(csv, db);
     const std::map<std::string, std::vector<std::string>> orders =
-        choice_block_orders(db);
+        read_observations(db).choice_orders;
 
     const std::vector<double> r = {1, 4, 7, 10, 14, 19, 25, 36, 64};
     auto psi = [&](double v) { return observer.scale(v, 1, 64); };

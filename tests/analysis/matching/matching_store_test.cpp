@@ -1,9 +1,9 @@
 // Matching and thresholds from a real study database (schema 7): sessions written
 // through the store's API (open_study_store, create_session, record_trial with final
 // values and adjustments, or the delta shown), a simulated matcher with a known bias and
-// a simulated detector with a known threshold answering them; read back by
-// read_matching_table and analysed end to end into the report. Expected values are what
-// the test recorded itself, never the store's.
+// a simulated detector with a known threshold answering them; read back as
+// the study's observations (study/observations.h) and analysed end to end into the
+// report. Expected values are what the test recorded itself, never the store's.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -18,6 +18,7 @@
 #include "app/cli_main.h"
 #include "app/commands.h"
 #include "study/adaptive/staircase_block.h"
+#include "study/observations.h"
 #include "study/study_store.h"
 #include "study/trial_plan.h"
 #include "tests/analysis/matching/matching_fixtures.h"
@@ -26,6 +27,19 @@ namespace lucent::analysis {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The matches and staircases of a study database, as lucent analyze reads them.
+MatchingTable read_matching(const std::string& db, const std::string& sessions = "") {
+    try {
+        study::StudyObservations read =
+            study::read_observations(db, {.sessions = sessions});
+        MatchingTable table = matching_of(read.table, std::move(read.protocol));
+        table.sessions_note = read.selection.note;
+        return table;
+    } catch (const study::StoreError& e) {
+        throw InputError(e.what());
+    }
+}
 
 struct Recorded {
     std::vector<MatchRow> matches;
@@ -126,7 +140,7 @@ TEST(MatchingStore, ReadsBackWhatTheStoreRecordedAndReportsIt) {
         run_session(*store, p, "P03", 13, {0.4, 0.1, false}, {1.0, 0.4, 0.0}, left_out,
                     5);
     }
-    const MatchingTable table = read_matching_table(db);
+    const MatchingTable table = read_matching(db);
     ASSERT_TRUE(table.protocol);
     EXPECT_NE(table.sessions_note.find("2 of 3 sessions analysed"), std::string::npos)
         << table.sessions_note;
@@ -156,10 +170,10 @@ TEST(MatchingStore, ReadsBackWhatTheStoreRecordedAndReportsIt) {
         EXPECT_EQ(a.correct, b.correct);
     }
     // "all" takes the running session too.
-    const MatchingTable all = read_matching_table(db, "all");
+    const MatchingTable all = read_matching(db, "all");
     EXPECT_EQ(all.matches.size() + all.staircases.size(),
               kept.matches.size() + kept.staircases.size() + 5);
-    EXPECT_THROW(read_matching_table(db, "some"), InputError);
+    EXPECT_THROW(read_matching(db, "some"), InputError);
 
     // The analysis: the matcher's bias 0.4 on "front" (thickness exponent 2).
     const auto conditions = analyse_matches(table.matches, &*table.protocol);
@@ -225,10 +239,10 @@ TEST(MatchingStore, ADatabaseWithoutSuchTrialsGivesNoRows) {
         auto store = study::open_study_store(db);
         store->ensure_study(testing::protocol());
     }
-    const MatchingTable table = read_matching_table(db);
+    const MatchingTable table = read_matching(db);
     EXPECT_TRUE(table.matches.empty());
     EXPECT_TRUE(table.staircases.empty());
-    EXPECT_THROW(read_matching_table((dir / "missing.db").string()), InputError);
+    EXPECT_THROW(read_matching((dir / "missing.db").string()), InputError);
 }
 
 }  // namespace
