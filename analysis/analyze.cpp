@@ -24,9 +24,8 @@ public:
         for (const FactorData& pair : pairs) {
             std::size_t ratings = 0;
             for (const Group& g : pair.data.groups) ratings += g.values.size();
-            for (const RatingModel model : {RatingModel::lmm, RatingModel::clmm})
-                if (model == RatingModel::lmm ? request.models.lmm : request.models.clmm)
-                    fits_.push_back({model, ratings});
+            for (const std::string& model : request.models.mixed)
+                fits_.push_back({model, ratings});
         }
     }
     // Before a pair's models: the time from here to the first one's end is its (the
@@ -34,7 +33,7 @@ public:
     void pair_starts() { mark_ = Clock::now(); }
     ModelFitHook hook(const FactorData& pair) {
         if (!on_fit_) return {};
-        return [this, &pair](RatingModel, const RatingModelFit* fit) {
+        return [this, &pair](const std::string&, const RatingModelFit* fit) {
             const Fit& f = fits_.at(next_);
             ModelFitProgress p;
             p.model = f.model;
@@ -73,7 +72,7 @@ public:
 
 private:
     struct Fit {
-        RatingModel model;
+        std::string model;
         std::size_t ratings;
     };
     struct Rate {
@@ -83,7 +82,7 @@ private:
     std::vector<Fit> fits_;
     std::size_t next_ = 0;
     Clock::time_point start_, mark_;
-    std::map<RatingModel, Rate> rates_;
+    std::map<std::string, Rate> rates_;
     Rate all_;
 };
 

@@ -15,7 +15,7 @@ namespace lucent::analysis {
 // The progress of one mixed-model fit (lucent analyze shows it on stderr): called before
 // each fit (`done` false) and after it.
 struct ModelFitProgress {
-    RatingModel model = RatingModel::clmm;
+    std::string model;         // its registered name
     int index = 0, total = 0;  // this fit (from 1) of every mixed-model fit of the run
     std::string question, factor;
     std::size_t ratings = 0;  // the pair's ratings, which a fit's time grows with

@@ -11,6 +11,7 @@
 #include "analysis/analyze.h"
 #include "analysis/data/long_table.h"
 #include "analysis/matching/matching_report.h"
+#include "analysis/models/rating_model.h"
 #include "analysis/report/report.h"
 #include "analysis/scaling/mlds.h"
 #include "analysis/scaling/paired_comparison.h"
@@ -121,10 +122,9 @@ std::string duration_text(double seconds) {
 // batch progress, on stderr only, so stdout keeps the report's file names.
 void show_fit_progress(const analysis::ModelFitProgress& p) {
     if (!p.done) {
-        std::cerr << "lucent analyze: " << analysis::rating_model_name(p.model) << " "
-                  << p.index << "/" << p.total << ": question " << p.question
-                  << ", factor " << p.factor << " (" << p.ratings << " ratings) ..."
-                  << std::flush;
+        std::cerr << "lucent analyze: " << p.model << " " << p.index << "/" << p.total
+                  << ": question " << p.question << ", factor " << p.factor << " ("
+                  << p.ratings << " ratings) ..." << std::flush;
         return;
     }
     std::cerr << " " << (p.fitted ? "" : "not fitted, ") << duration_text(p.seconds)
@@ -159,7 +159,7 @@ int run_analyze(const AnalyzeArgs& args) {
             throw InputError(args.input +
                              ": holds no ratings, no forced choices, no matches and no "
                              "staircase trials");
-        RatingModel primary_model = RatingModel::anova;
+        std::string primary_model = kOneWayTests;
         std::string primary_model_source;
         if (!args.primary_model.empty()) {
             primary_model = parse_rating_model(args.primary_model, "--primary-model");
@@ -250,12 +250,14 @@ void register_analyze(CLI::App& app, int& exit_code) {
                     "Folder of rendered stimuli (lucent render's output): each level's "
                     "picture is shown beside its descriptives, embedded in report.html");
     cmd->add_option("--model", args->models,
-                    "Analyses to run: a comma-separated subset of anova (the one-way "
-                    "tests), clmm (ordinal mixed model), lmm (linear mixed model)")
+                    "Analyses to run: a comma-separated subset of " +
+                        analysis::rating_model_help())
         ->capture_default_str();
     cmd->add_option("--primary-model", args->primary_model,
-                    "The analysis that leads the report: anova, clmm or lmm (default: "
-                    "the protocol's [analysis] primary_model; for a CSV, anova)");
+                    "The analysis that leads the report: one of " +
+                        analysis::rating_model_names() +
+                        " (default: the protocol's [analysis] primary_model; for a CSV, "
+                        "anova)");
     cmd->add_flag("--random-slopes", args->random_slopes,
                   "lmm: random slopes for the level within participant, where the design "
                   "identifies them (the report says when it does not)");

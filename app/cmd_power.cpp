@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "analysis/models/rating_model.h"
 #include "analysis/simulate/crossed_power.h"
 #include "analysis/simulate/power.h"
 #include "app/commands.h"
@@ -65,13 +66,13 @@ void print_result(const analysis::PowerResult& r, std::ostream& out) {
 }
 
 void print_crossed_header(const analysis::CrossedPowerSpec& s, std::ostream& out) {
-    out << "model " << analysis::rating_model_name(s.model) << " (rating ~ level + (1 | "
+    out << "model " << s.model << " (rating ~ level + (1 | "
         << "participant) + (1 | stimulus)), " << s.participants << " participants, "
         << s.level_means.size() << " levels, participant SD " << s.participant_sd
         << ", stimulus SD " << s.stimulus_sd << ", residual SD " << s.residual_sd
         << ", alpha " << s.alpha << ", " << s.simulations << " simulations (seed "
         << s.seed << ")"
-        << (s.likert || s.model == analysis::RatingModel::clmm
+        << (s.likert || analysis::find_rating_model(s.model)->rounds_to_scale
                 ? ", responses rounded to 1..7"
                 : "")
         << "\n";
@@ -135,7 +136,8 @@ int run_crossed_power(const PowerArgs& args) {
 int run_power(PowerArgs args) {
     using namespace lucent::analysis;
     try {
-        if (args.model != "anova") return run_crossed_power(args);
+        if (parse_rating_model(args.model, "--model") != kOneWayTests)
+            return run_crossed_power(args);
         args.spec.design = args.design == "between" ? Design::Between : Design::Within;
         check_power_spec(args.spec);
         if (args.target > 0.0) {
@@ -193,10 +195,13 @@ void register_power(CLI::App& app, int& exit_code) {
     cmd->add_option("--seed", args->spec.seed, "Random seed")->capture_default_str();
     cmd->add_flag("--likert", args->spec.likert,
                   "Round and clamp responses to the 1..7 scale (no closed form then)");
+    std::string simulated;
+    for (const analysis::RatingModelSpec* m : analysis::rating_models())
+        if (m->crossed_p) simulated += (simulated.empty() ? "" : " / ") + m->name;
     cmd->add_option("--model", args->model,
-                    "anova (the one-way tests, stimuli fixed), or lmm / clmm: the mixed "
-                    "model of a design with participants and stimuli both sampled")
-        ->check(CLI::IsMember({"anova", "lmm", "clmm"}))
+                    "anova (the one-way tests, stimuli fixed), or " + simulated +
+                        ": the mixed model of a design with participants and stimuli "
+                        "both sampled")
         ->capture_default_str();
     cmd->add_option("--stimuli", args->stimuli,
                     "Pictures per level (--model lmm|clmm); every participant rates all")

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "app/analysis_plan.h"
 #include "app/commands.h"
 #include "study/protocol.h"
 #include "study/session/live_stimuli.h"
@@ -67,6 +68,7 @@ int run_command(RunArgs& args) {
     try {
         o.protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                          : study::builtin_protocol(args.preset);
+        check_analysis_plan(o.protocol);  // a plan naming no analysis fails here, early
         if (args.seed >= 0) o.seed = static_cast<uint64_t>(args.seed);
         study::plan_trials(o.protocol, 0,
                            0);  // impossible randomisation fails here, early

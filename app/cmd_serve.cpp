@@ -22,6 +22,7 @@
 #include <sstream>
 #include <thread>
 
+#include "app/analysis_plan.h"
 #include "app/commands.h"
 #include "app/serve_http.h"
 #include "lucent/version.h"
@@ -178,6 +179,7 @@ int serve_command(const ServeArgs& args) {
     try {
         protocol = args.preset.empty() ? study::load_protocol_file(args.protocol_file)
                                        : study::builtin_protocol(args.preset);
+        check_analysis_plan(protocol);       // a plan naming no analysis fails here
         study::plan_trials(protocol, 0, 0);  // impossible randomisation fails here, early
         // The adjust series and staircase ladders are pictures of their own, each
         // checked against the manifest like the protocol's stimuli.

@@ -29,11 +29,15 @@ public:
 
     [[noreturn]] void fail(const toml::node* node, const std::string& key,
                            const std::string& reason) const {
-        const toml::source_region& where = node ? node->source() : table_.source();
+        throw ProtocolError(where(node, key) + ": " + reason);
+    }
+    // "p.toml:12:17: key 'analysis.primary_model'": where a key was written.
+    std::string where(const toml::node* node, const std::string& key) const {
+        const toml::source_region& at = node ? node->source() : table_.source();
         std::ostringstream out;
-        out << source_ << ":" << where.begin.line << ":" << where.begin.column
-            << ": key '" << full(key) << "': " << reason;
-        throw ProtocolError(out.str());
+        out << source_ << ":" << at.begin.line << ":" << at.begin.column << ": key '"
+            << full(key) << "'";
+        return out.str();
     }
     std::string full(const std::string& key) const {
         return path_.empty() ? key : path_ + "." + key;
@@ -762,11 +766,16 @@ void read_analysis_plan(Protocol& p, TableReader& root) {
             r.raw().get("primary_design"), "primary_design",
             "must be \"within\" or \"between\", got '" + p.analysis.primary_design + "'");
     p.analysis.primary_model = r.string("primary_model", "anova");
-    if (p.analysis.primary_model != "anova" && p.analysis.primary_model != "clmm" &&
-        p.analysis.primary_model != "lmm")
+    const std::string& model = p.analysis.primary_model;
+    if (model.empty() || !std::all_of(model.begin(), model.end(), [](char c) {
+            return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+        }))
         r.fail(r.raw().get("primary_model"), "primary_model",
-               "must be \"anova\", \"clmm\" or \"lmm\", got '" +
-                   p.analysis.primary_model + "'");
+               "must be the name of an analysis (lowercase letters, digits and '_', as "
+               "\"anova\", \"clmm\", \"lmm\"), got '" +
+                   model + "'");
+    if (const toml::node* node = r.raw().get("primary_model"))
+        p.analysis.primary_model_at = r.where(node, "primary_model");
     p.analysis.sessions = r.string("sessions", "completed");
     if (p.analysis.sessions != "completed" && p.analysis.sessions != "all")
         r.fail(r.raw().get("sessions"), "sessions",

@@ -180,9 +180,13 @@ struct AnalysisPlan {
     // repeated-measures tests lead the report; "between": independent groups lead.
     std::string primary_design = "within";
     // The analysis that leads the report: "anova" (the thesis's one-way tests, the
-    // default), "clmm" (the ordinal mixed model with participants and stimuli as random
-    // effects) or "lmm" (its linear cousin).
+    // default) or a registered rating model ("clmm", the ordinal mixed model with
+    // participants and stimuli as random effects; "lmm", its linear cousin). Study code
+    // cannot see the analysis's registry (analysis/models/): the protocol checks the
+    // name's spelling and where it was written, and lucent run, serve and analyze check
+    // that it is registered (app/analysis_plan.h).
     std::string primary_model = "anova";
+    std::string primary_model_at;  // "p.toml:12:17: key 'analysis.primary_model'"; ""
     // Which sessions enter the analysis (`lucent analyze`, `export --format analysis`):
     // "completed" (the default: a participant who gave up, or quit before the catch
     // trials, is left out as incomplete) or "all" (running, paused and aborted too).

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "analysis/data/long_table.h"
+#include "analysis/models/rating_model.h"
 #include "analysis/report/document.h"
 #include "analysis/report/format.h"
 #include "analysis/report/mixed_sections.h"
@@ -208,11 +209,8 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
     }
     std::string analyses_run;
     if (options.models.anova) analyses_run += "One-way ANOVA per (question, factor); ";
-    if (options.models.clmm)
-        analyses_run +=
-            "ordinal mixed model (clmm) per (question, factor) with "
-            "participants and stimuli as random effects; ";
-    if (options.models.lmm) analyses_run += "linear mixed model (lmm) likewise; ";
+    for (const RatingModelSpec* model : rating_models())
+        if (options.models.runs(model->name)) analyses_run += model->ran;
     doc.push_back({Block::kParagraph,
                    "Input: " + options.source + ". " + analyses_run +
                        "alpha = " + format_short(options.alpha) +
@@ -232,8 +230,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         std::vector<std::vector<std::string>> rows;
         if (models.anova)
             for (Design design : {primary, secondary}) {
-                const bool leads =
-                    models.primary == RatingModel::anova && design == primary;
+                const bool leads = models.primary == kOneWayTests && design == primary;
                 std::vector<std::string> row{
                     configuration(a),
                     std::string(design_name(design)) + (leads ? " (primary)" : "")};
@@ -241,13 +238,13 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
                     row.push_back(std::move(cell));
                 rows.push_back(std::move(row));
             }
-        for (RatingModel model : {RatingModel::clmm, RatingModel::lmm}) {
-            std::vector<std::string> cells = mixed_summary_cells(a, model, options.alpha);
+        for (const RatingModelSpec* model : rating_models()) {
+            std::vector<std::string> cells =
+                mixed_summary_cells(a, *model, options.alpha);
             if (cells.empty()) continue;
-            const bool leads = models.primary == model;
-            std::vector<std::string> row{
-                configuration(a),
-                std::string(rating_model_name(model)) + (leads ? " (primary)" : "")};
+            const bool leads = models.primary == model->name;
+            std::vector<std::string> row{configuration(a),
+                                         model->name + (leads ? " (primary)" : "")};
             for (std::string& cell : cells) row.push_back(std::move(cell));
             if (leads)
                 rows.insert(rows.begin(), std::move(row));
@@ -257,21 +254,17 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         summary.rows.insert(summary.rows.end(), rows.begin(), rows.end());
     }
     doc.push_back({Block::kHeading, "Summary", {}, {}, 2});
-    if (models.primary != RatingModel::anova)
-        doc.push_back(
-            {Block::kParagraph,
-             std::string("Primary analysis: the ") +
-                 (models.primary == RatingModel::clmm ? "ordinal mixed model (clmm)"
-                                                      : "linear mixed model (lmm)") +
-                 (models.primary_source.empty()
-                      ? std::string()
-                      : ", as " + models.primary_source + " states") +
-                 ", with participants and stimuli as random effects."});
+    if (const RatingModelSpec* leading = find_rating_model(models.primary))
+        doc.push_back({Block::kParagraph,
+                       "Primary analysis: the " + leading->title +
+                           (models.primary_source.empty()
+                                ? std::string()
+                                : ", as " + models.primary_source + " states") +
+                           ", with participants and stimuli as random effects."});
     doc.push_back(
         {Block::kParagraph,
-         std::string(models.primary == RatingModel::anova
-                         ? "Primary design: "
-                         : "Design of the one-way tests: ") +
+         std::string(models.primary == kOneWayTests ? "Primary design: "
+                                                    : "Design of the one-way tests: ") +
              design_name(primary) +
              (primary == Design::Within
                   ? " (repeated-measures tests on the means of the participants "
@@ -316,7 +309,7 @@ std::vector<Block> build_document(const std::vector<OneWayAnalysis>& analyses,
         }
         if (!thumbnails.images.empty()) doc.push_back(thumbnails);
         const std::vector<Block> mixed = mixed_model_blocks(a);
-        const bool mixed_leads = models.primary != RatingModel::anova;
+        const bool mixed_leads = models.primary != kOneWayTests;
         if (mixed_leads) doc.insert(doc.end(), mixed.begin(), mixed.end());
         const std::vector<Block> within = within_subject_blocks(a, options.alpha);
         if (models.anova && primary == Design::Within)

@@ -6,23 +6,15 @@
 #include <cmath>
 #include <string>
 
-#include "analysis/mixed/clmm.h"
-#include "analysis/mixed/lmm.h"
+#include "analysis/models/rating_model.h"
 #include "analysis/simulate/normal_source.h"
 #include "analysis/stats/repeated_measures.h"
 
 namespace lucent::analysis {
 namespace {
 
-// One simulated study in model form: responses, level of each, participant and stimulus
-// codes.
-struct SimulatedStudy {
-    std::vector<double> y;
-    mixed::FactorColumn level, participant, stimulus;
-};
-
-SimulatedStudy layout(const CrossedPowerSpec& spec) {
-    SimulatedStudy study;
+CrossedSample layout(const CrossedPowerSpec& spec) {
+    CrossedSample study;
     const int k = int(spec.level_means.size()), m = spec.stimuli_per_level,
               n = spec.participants;
     study.level = {"level", {}, {}};
@@ -43,14 +35,14 @@ SimulatedStudy layout(const CrossedPowerSpec& spec) {
     return study;
 }
 
-void draw(const CrossedPowerSpec& spec, NormalSource& normal, SimulatedStudy& study) {
+void draw(const CrossedPowerSpec& spec, NormalSource& normal, CrossedSample& study) {
     const int k = int(spec.level_means.size()), m = spec.stimuli_per_level,
               n = spec.participants;
     std::vector<double> participant(static_cast<std::size_t>(n));
     std::vector<double> stimulus(static_cast<std::size_t>(k * m));
     for (double& p : participant) p = spec.participant_sd * normal.next();
     for (double& s : stimulus) s = spec.stimulus_sd * normal.next();
-    const bool rounded = spec.likert || spec.model == RatingModel::clmm;
+    const bool rounded = spec.likert || find_rating_model(spec.model)->rounds_to_scale;
     for (std::size_t r = 0; r < study.y.size(); ++r) {
         const double latent = spec.level_means[std::size_t(study.level.codes[r])] +
                               participant[std::size_t(study.participant.codes[r])] +
@@ -60,7 +52,23 @@ void draw(const CrossedPowerSpec& spec, NormalSource& normal, SimulatedStudy& st
     }
 }
 
-mixed::FixedDesign level_design(const SimulatedStudy& study, bool intercept) {
+// Each participant's mean per level, for the repeated-measures ANOVA.
+Statistic by_participant_p(const CrossedPowerSpec& spec, const CrossedSample& study) {
+    const std::size_t k = spec.level_means.size(), n = std::size_t(spec.participants);
+    SubjectByLevel matrix;
+    matrix.participants = study.participant.levels;
+    matrix.levels = study.level.levels;
+    matrix.values.assign(n * k, 0.0);
+    for (std::size_t r = 0; r < study.y.size(); ++r)
+        matrix.values[std::size_t(study.participant.codes[r]) * k +
+                      std::size_t(study.level.codes[r])] +=
+            study.y[r] / spec.stimuli_per_level;
+    return repeated_measures_anova(matrix).p;
+}
+
+}  // namespace
+
+mixed::FixedDesign crossed_level_design(const CrossedSample& study, bool intercept) {
     mixed::FixedDesign design;
     const auto rows = Eigen::Index(study.y.size());
     const auto k = study.level.levels.size();
@@ -82,57 +90,16 @@ mixed::FixedDesign level_design(const SimulatedStudy& study, bool intercept) {
     return design;
 }
 
-Statistic lmm_p(const SimulatedStudy& study) {
-    mixed::LmmSpec spec;
-    spec.y =
-        Eigen::Map<const Eigen::VectorXd>(study.y.data(), Eigen::Index(study.y.size()));
-    spec.fixed = level_design(study, true);
-    spec.random = {mixed::random_intercept(study.participant),
-                   mixed::random_intercept(study.stimulus)};
-    const mixed::LmmFit fit = mixed::fit_lmm(spec);
-    return fit.anova.empty() ? std::nullopt : fit.anova.front().p;
-}
-
-Statistic clmm_p(const SimulatedStudy& study) {
-    mixed::ClmmSpec spec;
-    spec.response.name = "rating";
-    std::vector<int> used(8, 0);
-    for (double y : study.y) used[std::size_t(y)] = 1;
-    std::vector<int> code_of(8, -1);
-    for (int v = 1; v <= 7; ++v)
-        if (used[std::size_t(v)]) {
-            code_of[std::size_t(v)] = int(spec.response.levels.size());
-            spec.response.levels.push_back(std::to_string(v));
-        }
-    if (spec.response.levels.size() < 2) return std::nullopt;
-    for (double y : study.y) spec.response.codes.push_back(code_of[std::size_t(y)]);
-    spec.fixed = level_design(study, false);
-    spec.random_intercepts = {study.participant, study.stimulus};
-    const mixed::ClmmFit fit = mixed::fit_clmm(spec);
-    const auto test = mixed::clmm_likelihood_ratio_test(spec, fit, "level");
-    if (test.df <= 0 || !std::isfinite(test.p)) return std::nullopt;
-    return test.p;
-}
-
-// Each participant's mean per level, for the repeated-measures ANOVA.
-Statistic by_participant_p(const CrossedPowerSpec& spec, const SimulatedStudy& study) {
-    const std::size_t k = spec.level_means.size(), n = std::size_t(spec.participants);
-    SubjectByLevel matrix;
-    matrix.participants = study.participant.levels;
-    matrix.levels = study.level.levels;
-    matrix.values.assign(n * k, 0.0);
-    for (std::size_t r = 0; r < study.y.size(); ++r)
-        matrix.values[std::size_t(study.participant.codes[r]) * k +
-                      std::size_t(study.level.codes[r])] +=
-            study.y[r] / spec.stimuli_per_level;
-    return repeated_measures_anova(matrix).p;
-}
-
-}  // namespace
-
 void check_crossed_power_spec(const CrossedPowerSpec& spec) {
-    if (spec.model != RatingModel::lmm && spec.model != RatingModel::clmm)
-        throw InputError("--model must be lmm or clmm for a crossed design");
+    const RatingModelSpec* model = find_rating_model(spec.model);
+    if (!model || !model->crossed_p) {
+        std::string simulated;
+        for (const RatingModelSpec* m : rating_models())
+            if (m->crossed_p) simulated += (simulated.empty() ? "" : " or ") + m->name;
+        throw InputError(
+            "--model must be " + simulated + " for a crossed design" +
+            (model ? " ('" + spec.model + "' has no power simulation)" : ""));
+    }
     if (spec.participants < 2)
         throw InputError("--participants must be at least 2, got " +
                          std::to_string(spec.participants));
@@ -163,7 +130,8 @@ void check_crossed_power_spec(const CrossedPowerSpec& spec) {
 }
 
 std::optional<double> crossed_closed_form_power(const CrossedPowerSpec& spec) {
-    if (spec.model != RatingModel::lmm || spec.likert) return std::nullopt;
+    // The closed form is the linear model's F test of the stimulus means.
+    if (spec.model != "lmm" || spec.likert) return std::nullopt;
     const double k = double(spec.level_means.size()), m = spec.stimuli_per_level,
                  n = spec.participants;
     double grand = 0.0;
@@ -188,13 +156,14 @@ CrossedPowerResult estimate_crossed_power(const CrossedPowerSpec& spec,
     result.spec = spec;
     result.closed_form = crossed_closed_form_power(spec);
     NormalSource normal(spec.seed);
-    SimulatedStudy study = layout(spec);
+    CrossedSample study = layout(spec);
+    const RatingModelSpec& model = *find_rating_model(spec.model);
     long model_hits = 0, naive_hits = 0;
     for (int run = 0; run < spec.simulations; ++run) {
         draw(spec, normal, study);
         Statistic p;
         try {
-            p = spec.model == RatingModel::lmm ? lmm_p(study) : clmm_p(study);
+            p = model.crossed_p(study);
         } catch (const InputError&) {
             p.reset();
         }

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "analysis/mixed/rating_models.h"
@@ -26,7 +27,7 @@
 namespace lucent::analysis {
 
 struct CrossedPowerSpec {
-    RatingModel model = RatingModel::lmm;  // lmm or clmm
+    std::string model = "lmm";  // a registered model with a power simulation
     int participants = 30;
     int stimuli_per_level = 6;
     std::vector<double> level_means;
@@ -34,8 +35,17 @@ struct CrossedPowerSpec {
     double alpha = 0.05;
     int simulations = 200;
     std::uint64_t seed = 1;
-    bool likert = false;  // always for clmm
+    bool likert = false;  // always for a model that rounds to the scale (clmm)
 };
+
+// One simulated study in model form: responses, level of each, participant and stimulus
+// codes. A model's power simulation (RatingModelSpec::crossed_p) tests its level.
+struct CrossedSample {
+    std::vector<double> y;
+    mixed::FactorColumn level, participant, stimulus;
+};
+// The level's treatment-coded columns, after an intercept column when `intercept`.
+mixed::FixedDesign crossed_level_design(const CrossedSample& study, bool intercept);
 
 struct CrossedPowerResult {
     CrossedPowerSpec spec;

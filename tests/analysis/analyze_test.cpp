@@ -58,7 +58,7 @@ TEST(AnalyzeTable, MixedModelProgressCountsEveryFitBeforeAndAfter) {
         "p3,a,thickness,18,translucent,3\np3,b,thickness,25,translucent,4\n"
         "p1,a,thickness,18,realistic,4\np1,b,thickness,25,realistic,5\n");
     AnalysisRequest request;
-    request.models = parse_model_list("anova,lmm,clmm", RatingModel::anova);
+    request.models = parse_model_list("anova,lmm,clmm", "anova");
     std::vector<ModelFitProgress> seen;
     request.on_fit = [&](const ModelFitProgress& p) { seen.push_back(p); };
     analyze_table(t, request);
@@ -68,7 +68,7 @@ TEST(AnalyzeTable, MixedModelProgressCountsEveryFitBeforeAndAfter) {
         EXPECT_EQ(p.index, static_cast<int>(i / 2) + 1);
         EXPECT_EQ(p.total, 4);
         EXPECT_EQ(p.done, i % 2 == 1);
-        EXPECT_EQ(p.model, (i / 2) % 2 == 0 ? RatingModel::lmm : RatingModel::clmm);
+        EXPECT_EQ(p.model, (i / 2) % 2 == 0 ? "clmm" : "lmm");  // in registry order
         EXPECT_EQ(p.question, i < 4 ? "translucent" : "realistic");
         EXPECT_EQ(p.factor, "thickness");
         EXPECT_EQ(p.ratings, i < 4 ? 6u : 2u);
@@ -81,7 +81,7 @@ TEST(AnalyzeTable, MixedModelProgressCountsEveryFitBeforeAndAfter) {
     }
     EXPECT_EQ(seen.back().left, 0.0);
 
-    request.models = parse_model_list("anova", RatingModel::anova);
+    request.models = parse_model_list("anova", "anova");
     seen.clear();
     analyze_table(t, request);
     EXPECT_TRUE(seen.empty());

@@ -84,7 +84,7 @@ add_test(NAME app.readme_analyst_commands_run_as_written
 add_test(NAME app.analyze_bad_model_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>
                  "-DARGS=analyze;${LUCENT_APP_TEST_DIR}/data/wine_long.csv;--out;${CMAKE_CURRENT_BINARY_DIR}/bad_model;--model;anova,glmm"
-                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=^lucent analyze: --model: 'glmm' is not one of anova, lmm, clmm"
+                 -DEXPECT_CODE=2 "-DEXPECT_STDERR=^lucent analyze: --model: 'glmm' is not one of anova, clmm, lmm"
                  -P ${LUCENT_APP_TEST_DIR}/expect_exit.cmake)
 add_test(NAME app.analyze_primary_model_must_run_exits_2
          COMMAND ${CMAKE_COMMAND} -DCOMMAND=$<TARGET_FILE:lucent>

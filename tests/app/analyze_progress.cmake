@@ -54,6 +54,6 @@ endfunction()
 # The default (anova,clmm): one clmm fit per question.
 check_progress("anova,clmm" "clmm translucent;clmm realistic;clmm glossy")
 check_progress("anova,lmm,clmm"
-               "lmm translucent;clmm translucent;lmm realistic;clmm realistic;lmm glossy;clmm glossy")
+               "clmm translucent;lmm translucent;clmm realistic;lmm realistic;clmm glossy;lmm glossy")
 # No mixed model, no progress line.
 check_progress("anova" "")

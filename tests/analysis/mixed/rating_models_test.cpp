@@ -44,7 +44,7 @@ LongTable wine_table() {
 
 ModelChoice both() {
     ModelChoice choice;
-    choice.lmm = choice.clmm = true;
+    choice.mixed = {"clmm", "lmm"};
     return choice;
 }
 
@@ -81,8 +81,8 @@ void expect_all_finite(const RatingModelFit& fit) {
 // anova()
 TEST(RatingModels, WineAsARatingStudyEqualsR) {
     const PairModels models = fit(wine_table());
-    ASSERT_TRUE(models.clmm && models.clmm->fitted);
-    const RatingModelFit& clmm = *models.clmm;
+    ASSERT_TRUE(models.of("clmm") && models.of("clmm")->fitted);
+    const RatingModelFit& clmm = *models.of("clmm");
     EXPECT_EQ(clmm.formula, "rating ~ level + (1 | participant) + (1 | stimulus)");
     expect_close(clmm.log_likelihood, -87.3979638147415);
     expect_close(clmm.statistic, 9.42770228736111, 1e-5);
@@ -105,8 +105,8 @@ TEST(RatingModels, WineAsARatingStudyEqualsR) {
     EXPECT_NEAR(clmm.observed[0][1], 16.0 / 36, 1e-15);
     EXPECT_EQ(clmm.observed[0][4], 0.0);
 
-    ASSERT_TRUE(models.lmm && models.lmm->fitted);
-    const RatingModelFit& lmm = *models.lmm;
+    ASSERT_TRUE(models.of("lmm") && models.of("lmm")->fitted);
+    const RatingModelFit& lmm = *models.of("lmm");
     expect_close(lmm.statistic, 15.9397583938132);
     expect_close(lmm.den_df, 5.99999970439998);
     expect_close(lmm.p, 0.00718039403222973);
@@ -124,8 +124,8 @@ TEST(RatingModels, RandomSlopesWhereIdentifiedEqualR) {
     choice.random_slopes = true;
     const PairModels models =
         fit_pair_models(wine_table(), "bitterness", "temp", {"cold", "warm"}, choice);
-    ASSERT_TRUE(models.lmm && models.lmm->fitted);
-    const RatingModelFit& lmm = *models.lmm;
+    ASSERT_TRUE(models.of("lmm") && models.of("lmm")->fitted);
+    const RatingModelFit& lmm = *models.of("lmm");
     EXPECT_EQ(lmm.formula, "rating ~ level + (1 + level | participant) + (1 | stimulus)");
     expect_close(lmm.log_likelihood, -179.974252736021 / 2);
     expect_close(lmm.statistic, 14.4294475145931);
@@ -141,10 +141,11 @@ TEST(RatingModels, RandomSlopesWhereIdentifiedEqualR) {
         });
     const PairModels few =
         fit_pair_models(one, "bitterness", "temp", {"cold", "warm"}, choice);
-    ASSERT_TRUE(few.lmm);
-    EXPECT_TRUE(
-        has_note(*few.lmm, "not identified (2 participants for a 2 x 2 covariance"));
-    EXPECT_EQ(few.lmm->formula, "rating ~ level + (1 | participant) + (1 | stimulus)");
+    ASSERT_TRUE(few.of("lmm"));
+    EXPECT_TRUE(has_note(*few.of("lmm"),
+                         "not identified (2 participants for a 2 x 2 covariance"));
+    EXPECT_EQ(few.of("lmm")->formula,
+              "rating ~ level + (1 | participant) + (1 | stimulus)");
 }
 
 // One bottle per temperature: stimulus and level confounded; clmm(rating ~ temp +
@@ -156,13 +157,13 @@ TEST(RatingModels, OneStimulusPerLevelDropsTheStimulusTermAndSaysSo) {
             return true;
         });
     const PairModels models = fit(table);
-    ASSERT_TRUE(models.clmm && models.clmm->fitted);
-    EXPECT_EQ(models.clmm->formula, "rating ~ level + (1 | participant)");
-    EXPECT_TRUE(has_note(*models.clmm, "stimulus and level are confounded"));
-    expect_close(models.clmm->log_likelihood, -88.7388151628385);
-    expect_close(models.clmm->statistic, 28.4983639483682, 1e-5);
-    EXPECT_NEAR(models.clmm->effects[0].estimate, 2.66752203377235, 1e-5);
-    EXPECT_TRUE(has_note(*models.lmm, "stimulus and level are confounded"));
+    ASSERT_TRUE(models.of("clmm") && models.of("clmm")->fitted);
+    EXPECT_EQ(models.of("clmm")->formula, "rating ~ level + (1 | participant)");
+    EXPECT_TRUE(has_note(*models.of("clmm"), "stimulus and level are confounded"));
+    expect_close(models.of("clmm")->log_likelihood, -88.7388151628385);
+    expect_close(models.of("clmm")->statistic, 28.4983639483682, 1e-5);
+    EXPECT_NEAR(models.of("clmm")->effects[0].estimate, 2.66752203377235, 1e-5);
+    EXPECT_TRUE(has_note(*models.of("lmm"), "stimulus and level are confounded"));
 }
 
 // Judge 1 rates every wine 3: w4$rating[w4$judge == "1"] <- "3"; clmm as above.
@@ -173,13 +174,13 @@ TEST(RatingModels, AParticipantWhoGivesOneRatingToEverythingEqualsR) {
             return true;
         });
     const PairModels models = fit(table);
-    ASSERT_TRUE(models.clmm && models.clmm->fitted);
-    expect_close(models.clmm->log_likelihood, -85.2847251060079);
-    expect_close(models.clmm->statistic, 9.58349761998187, 1e-5);
+    ASSERT_TRUE(models.of("clmm") && models.of("clmm")->fitted);
+    expect_close(models.of("clmm")->log_likelihood, -85.2847251060079);
+    expect_close(models.of("clmm")->statistic, 9.58349761998187, 1e-5);
     // R's clmm stops at a gradient of 1e-6, which leaves the estimate 5e-6 from the
     // optimum here.
-    EXPECT_NEAR(models.clmm->effects[0].estimate, 2.48273607198091, 2.5e-5);
-    expect_all_finite(*models.clmm);
+    EXPECT_NEAR(models.of("clmm")->effects[0].estimate, 2.48273607198091, 2.5e-5);
+    expect_all_finite(*models.of("clmm"));
 }
 
 // Ratings of 4 recoded to 5, so nobody used 4: R's factor() drops the level; Lucent
@@ -191,14 +192,14 @@ TEST(RatingModels, ARatingCategoryNobodyUsedIsDroppedAndSaid) {
             return true;
         });
     const PairModels models = fit(table);
-    ASSERT_TRUE(models.clmm && models.clmm->fitted);
-    expect_close(models.clmm->log_likelihood, -75.3413952327874);
-    expect_close(models.clmm->statistic, 9.17420362748371, 1e-5);
-    EXPECT_NEAR(models.clmm->effects[0].estimate, 2.94760415691191, 1e-5);
-    ASSERT_EQ(models.clmm->categories.size(), 5u);
-    for (const auto& row : models.clmm->predicted) EXPECT_EQ(row[3], 0.0);
-    EXPECT_TRUE(has_note(*models.clmm, "4"));
-    expect_all_finite(*models.clmm);
+    ASSERT_TRUE(models.of("clmm") && models.of("clmm")->fitted);
+    expect_close(models.of("clmm")->log_likelihood, -75.3413952327874);
+    expect_close(models.of("clmm")->statistic, 9.17420362748371, 1e-5);
+    EXPECT_NEAR(models.of("clmm")->effects[0].estimate, 2.94760415691191, 1e-5);
+    ASSERT_EQ(models.of("clmm")->categories.size(), 5u);
+    for (const auto& row : models.of("clmm")->predicted) EXPECT_EQ(row[3], 0.0);
+    EXPECT_TRUE(has_note(*models.of("clmm"), "4"));
+    expect_all_finite(*models.of("clmm"));
 }
 
 // Every participant gives the same ratings and every stimulus gets the same ones (a
@@ -223,14 +224,14 @@ TEST(RatingModels, VariancesAtZeroAreABoundaryFitEqualToClm) {
                 table.rows.push_back(row);
             }
     const PairModels models = fit(table, {"A", "B"});
-    ASSERT_TRUE(models.clmm && models.clmm->fitted);
-    expect_close(models.clmm->log_likelihood, -47.3326237369776, 1e-5);
-    EXPECT_NEAR(models.clmm->effects[0].estimate, 2.92044288292418, 1e-4);
-    expect_close(models.clmm->statistic, 14.5178016124659, 1e-5);
-    EXPECT_TRUE(has_note(*models.clmm, "singular"));
-    EXPECT_TRUE(has_note(*models.lmm, "singular"));
-    expect_all_finite(*models.clmm);
-    expect_all_finite(*models.lmm);
+    ASSERT_TRUE(models.of("clmm") && models.of("clmm")->fitted);
+    expect_close(models.of("clmm")->log_likelihood, -47.3326237369776, 1e-5);
+    EXPECT_NEAR(models.of("clmm")->effects[0].estimate, 2.92044288292418, 1e-4);
+    expect_close(models.of("clmm")->statistic, 14.5178016124659, 1e-5);
+    EXPECT_TRUE(has_note(*models.of("clmm"), "singular"));
+    EXPECT_TRUE(has_note(*models.of("lmm"), "singular"));
+    expect_all_finite(*models.of("clmm"));
+    expect_all_finite(*models.of("lmm"));
 }
 
 // Warm wines rated 4-5 and cold ones 1-3: the effect runs to infinity. It is reported as
@@ -243,12 +244,12 @@ TEST(RatingModels, CompleteSeparationIsReportedNotNaN) {
             return true;
         });
     const PairModels models = fit(table);
-    ASSERT_TRUE(models.clmm);
-    ASSERT_EQ(models.clmm->effects.size(), 1u);
-    EXPECT_FALSE(models.clmm->effects[0].estimable);
-    EXPECT_TRUE(has_note(*models.clmm, "separation"));
-    expect_all_finite(*models.clmm);
-    expect_all_finite(*models.lmm);
+    ASSERT_TRUE(models.of("clmm"));
+    ASSERT_EQ(models.of("clmm")->effects.size(), 1u);
+    EXPECT_FALSE(models.of("clmm")->effects[0].estimable);
+    EXPECT_TRUE(has_note(*models.of("clmm"), "separation"));
+    expect_all_finite(*models.of("clmm"));
+    expect_all_finite(*models.of("lmm"));
 }
 
 // Judge 3 alone: no participant variance to estimate.
@@ -256,12 +257,12 @@ TEST(RatingModels, ASingleParticipantDropsTheParticipantTerm) {
     const LongTable table = wine_table([](std::string& judge, std::string&, std::string&,
                                           double&) { return judge == "J3"; });
     const PairModels models = fit(table);
-    ASSERT_TRUE(models.clmm && models.lmm);
-    EXPECT_EQ(models.clmm->formula, "rating ~ level + (1 | stimulus)");
-    EXPECT_TRUE(has_note(*models.clmm, "One participant"));
-    EXPECT_EQ(models.clmm->participants, 1);
-    expect_all_finite(*models.clmm);
-    expect_all_finite(*models.lmm);
+    ASSERT_TRUE(models.of("clmm") && models.of("lmm"));
+    EXPECT_EQ(models.of("clmm")->formula, "rating ~ level + (1 | stimulus)");
+    EXPECT_TRUE(has_note(*models.of("clmm"), "One participant"));
+    EXPECT_EQ(models.of("clmm")->participants, 1);
+    expect_all_finite(*models.of("clmm"));
+    expect_all_finite(*models.of("lmm"));
 }
 
 // One participant rating one stimulus per level (scripts/run-default's first study): a
@@ -281,35 +282,35 @@ TEST(RatingModels, OneRatingPerLevelFitsNothingAndSaysWhy) {
         table.rows.push_back(row);
     }
     const PairModels models = fit(table, {"1", "2", "3"});
-    ASSERT_TRUE(models.clmm && models.lmm);
-    EXPECT_FALSE(models.clmm->fitted);
-    EXPECT_FALSE(models.clmm->p.has_value());
-    EXPECT_TRUE(has_note(*models.clmm, "Needs at least 2 ratings in some level"));
-    EXPECT_FALSE(models.lmm->fitted);
+    ASSERT_TRUE(models.of("clmm") && models.of("lmm"));
+    EXPECT_FALSE(models.of("clmm")->fitted);
+    EXPECT_FALSE(models.of("clmm")->p.has_value());
+    EXPECT_TRUE(has_note(*models.of("clmm"), "Needs at least 2 ratings in some level"));
+    EXPECT_FALSE(models.of("lmm")->fitted);
 }
 
 TEST(RatingModels, OneLevelFitsNothingAndSaysWhy) {
     const PairModels models = fit(wine_table(), {"cold"});
-    ASSERT_TRUE(models.clmm);
-    EXPECT_FALSE(models.clmm->fitted);
-    EXPECT_TRUE(has_note(*models.clmm, "nothing to compare"));
+    ASSERT_TRUE(models.of("clmm"));
+    EXPECT_FALSE(models.of("clmm")->fitted);
+    EXPECT_TRUE(has_note(*models.of("clmm"), "nothing to compare"));
 }
 
 TEST(RatingModels, ModelListsParseAndNameBadEntries) {
-    const ModelChoice choice = parse_model_list("clmm,lmm", RatingModel::anova);
+    const ModelChoice choice = parse_model_list("lmm,clmm", "anova");
     EXPECT_FALSE(choice.anova);
-    EXPECT_TRUE(choice.lmm && choice.clmm);
-    EXPECT_EQ(choice.primary, RatingModel::clmm);  // anova does not run: the first listed
-    EXPECT_EQ(parse_model_list("anova,clmm", RatingModel::clmm).primary,
-              RatingModel::clmm);
+    // In registry order, whatever the list's.
+    EXPECT_EQ(choice.mixed, (std::vector<std::string>{"clmm", "lmm"}));
+    EXPECT_EQ(choice.primary, "lmm");  // anova does not run: the first listed
+    EXPECT_EQ(parse_model_list("anova,clmm", "clmm").primary, "clmm");
     try {
-        parse_model_list("anova,glmm", RatingModel::anova);
+        parse_model_list("anova,glmm", "anova");
         FAIL() << "accepted glmm";
     } catch (const InputError& error) {
         EXPECT_EQ(std::string(error.what()),
-                  "--model: 'glmm' is not one of anova, lmm, clmm");
+                  "--model: 'glmm' is not one of anova, clmm, lmm");
     }
-    EXPECT_THROW(parse_model_list("", RatingModel::anova), InputError);
+    EXPECT_THROW(parse_model_list("", "anova"), InputError);
 }
 
 }  // namespace
