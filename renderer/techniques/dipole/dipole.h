@@ -42,6 +42,8 @@ struct Params {
 
 const std::vector<Knob>& knobs();
 Params params(const Scene& scene);
+// The `material` knob's choices: every preset's name, then "custom".
+std::vector<std::string> material_choices();
 // The preset's values, or the custom sigma_a, sigma_s' and eta.
 Material material_of(const Params& p);
 // mm per mesh unit: model_size / (the mesh's bounding-box diagonal), 1 for a point mesh.

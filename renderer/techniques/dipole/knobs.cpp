@@ -2,101 +2,83 @@
 #include <cmath>
 
 #include "renderer/core/common_knobs.h"
+#include "renderer/core/knob_binding.h"
 #include "renderer/cpu/blinn_phong.h"
 #include "renderer/techniques/dipole/dipole.h"
 
 namespace lucent::dipole {
 
+std::vector<std::string> material_choices() {
+    std::vector<std::string> choices;
+    for (const auto& preset : material_presets()) choices.push_back(preset.name);
+    choices.push_back("custom");
+    return choices;
+}
+
+namespace {
+
+void bind(Params& p, KnobBinder& b) {
+    b.choice(p.material, "material",
+             "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta 1.3), or "
+             "custom: sigma_a, sigma_s_prime and eta",
+             material_choices());
+    b.knob(p.sigma_a, {"sigma_a", "custom material: absorption coefficient, mm^-1 (rgb)",
+                       KnobKind::rgb, 0.0, 100.0});
+    b.knob(
+        p.sigma_s_prime,
+        {"sigma_s_prime", "custom material: reduced scattering coefficient, mm^-1 (rgb)",
+         KnobKind::rgb, 0.0, 1000.0});
+    b.knob(p.eta, {"eta", "custom material: relative index of refraction",
+                   KnobKind::scalar, 1.0, 2.0});
+    b.knob(p.model_size,
+           {"model_size", "the mesh's bounding-box diagonal in mm (the paper's '10 mm')",
+            KnobKind::scalar, 0.1, 1000.0});
+    b.knob(p.samples,
+           {"samples", "N: texture-space importance samples shared by every pixel",
+            KnobKind::integer, 1.0, 65536.0});
+    b.choice(p.atlas_resolution, "atlas_resolution",
+             "side of the surfel atlas of irradiance (texels)",
+             {"256", "512", "1024", "2048"});
+    b.choice(p.hybrid, "hybrid",
+             "Sec. 4 hybrid: local part from the light view (L rings x C + 1), "
+             "global part by texture-space sampling",
+             {"off", "on"});
+    b.knob(p.rings, {"rings", "L: rings of the local pattern (hybrid)", KnobKind::integer,
+                     1.0, 32.0});
+    b.knob(p.ring_samples,
+           {"ring_samples", "C: samples per ring of the local pattern (hybrid)",
+            KnobKind::integer, 1.0, 32.0});
+    b.knob(p.importance_bound,
+           {"importance_bound",
+            "c: Rp is the largest r with 2 pi r Rd(r) = c, per channel (mm^-1; hybrid)",
+            KnobKind::scalar, 0.001, 10.0});
+    b.knob(p.hybrid_k,
+           {"hybrid_k", "K: steepness of the local weight around Rp (mm^-1; hybrid)",
+            KnobKind::scalar, 0.01, 100.0});
+    b.choice(p.light_map_resolution, "light_map_resolution",
+             "side of the light-view depth/flux maps (visibility, hybrid local part)",
+             {"256", "512", "1024"});
+    b.knob(p.sample_seed,
+           {"sample_seed", "stratification offset xi = frac(0.5 + seed * 0.618...)",
+            KnobKind::integer, 0.0, 1000000.0});
+    b.choice(p.tone_map, "tone_map", "none (linear radiance) or reinhard s/(1+s)",
+             {"none", "reinhard"});
+    b.knob(p.tone_key, {"tone_key", "a: Reinhard key, s = a L / L_avg", KnobKind::scalar,
+                        0.001, 100.0});
+    b.knob(p.specular, specular_knob());
+    b.knob(p.shininess, shininess_knob());
+    b.knob(p.ambient, ambient_knob());
+    b.knob(p.ao_rays, ao_rays_knob());
+}
+
+}  // namespace
+
 const std::vector<Knob>& knobs() {
-    static const std::vector<Knob> list = [] {
-        const Params d{};
-        std::vector<std::string> materials;
-        for (const auto& preset : material_presets()) materials.push_back(preset.name);
-        materials.push_back("custom");
-        Knob ambient = ambient_knob(), specular = specular_knob(),
-             shininess = shininess_knob(), rays = ao_rays_knob();
-        ambient.default_value = d.ambient;
-        specular.default_value = d.specular;
-        shininess.default_value = d.shininess;
-        rays.default_value = d.ao_rays;
-        return std::vector<Knob>{
-            choice_knob(
-                "material",
-                "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta 1.3), or "
-                "custom: sigma_a, sigma_s_prime and eta",
-                d.material, materials),
-            {"sigma_a", "custom material: absorption coefficient, mm^-1 (rgb)",
-             KnobKind::rgb, 0.0, 100.0, d.sigma_a},
-            {"sigma_s_prime",
-             "custom material: reduced scattering coefficient, mm^-1 (rgb)",
-             KnobKind::rgb, 0.0, 1000.0, d.sigma_s_prime},
-            {"eta", "custom material: relative index of refraction", KnobKind::scalar,
-             1.0, 2.0, d.eta},
-            {"model_size", "the mesh's bounding-box diagonal in mm (the paper's '10 mm')",
-             KnobKind::scalar, 0.1, 1000.0, d.model_size},
-            {"samples", "N: texture-space importance samples shared by every pixel",
-             KnobKind::integer, 1.0, 65536.0, d.samples},
-            choice_knob(
-                "atlas_resolution", "side of the surfel atlas of irradiance (texels)",
-                std::to_string(d.atlas_resolution), {"256", "512", "1024", "2048"}),
-            choice_knob(
-                "hybrid",
-                "Sec. 4 hybrid: local part from the light view (L rings x C + 1), "
-                "global part by texture-space sampling",
-                d.hybrid ? "on" : "off", {"off", "on"}),
-            {"rings", "L: rings of the local pattern (hybrid)", KnobKind::integer, 1.0,
-             32.0, d.rings},
-            {"ring_samples", "C: samples per ring of the local pattern (hybrid)",
-             KnobKind::integer, 1.0, 32.0, d.ring_samples},
-            {"importance_bound",
-             "c: Rp is the largest r with 2 pi r Rd(r) = c, per channel (mm^-1; hybrid)",
-             KnobKind::scalar, 0.001, 10.0, d.importance_bound},
-            {"hybrid_k", "K: steepness of the local weight around Rp (mm^-1; hybrid)",
-             KnobKind::scalar, 0.01, 100.0, d.hybrid_k},
-            choice_knob(
-                "light_map_resolution",
-                "side of the light-view depth/flux maps (visibility, hybrid local part)",
-                std::to_string(d.light_map_resolution), {"256", "512", "1024"}),
-            {"sample_seed", "stratification offset xi = frac(0.5 + seed * 0.618...)",
-             KnobKind::integer, 0.0, 1000000.0, d.sample_seed},
-            choice_knob("tone_map", "none (linear radiance) or reinhard s/(1+s)",
-                        d.tone_map, {"none", "reinhard"}),
-            {"tone_key", "a: Reinhard key, s = a L / L_avg", KnobKind::scalar, 0.001,
-             100.0, d.tone_key},
-            specular,
-            shininess,
-            ambient,
-            rays,
-        };
-    }();
+    static const std::vector<Knob> list = list_knobs<Params>(bind);
     return list;
 }
 
-Params params(const Scene& scene) {
-    const KnobValues& v = scene.values;
-    Params p;
-    p.material = v.choice("material");
-    p.sigma_a = v.vec3("sigma_a");
-    p.sigma_s_prime = v.vec3("sigma_s_prime");
-    p.eta = v.scalar("eta");
-    p.model_size = v.scalar("model_size");
-    p.samples = v.integer("samples");
-    p.atlas_resolution = std::stoi(v.choice("atlas_resolution"));
-    p.hybrid = v.choice("hybrid") == "on";
-    p.rings = v.integer("rings");
-    p.ring_samples = v.integer("ring_samples");
-    p.importance_bound = v.scalar("importance_bound");
-    p.hybrid_k = v.scalar("hybrid_k");
-    p.light_map_resolution = std::stoi(v.choice("light_map_resolution"));
-    p.sample_seed = v.integer("sample_seed");
-    p.tone_map = v.choice("tone_map");
-    p.tone_key = v.scalar("tone_key");
-    p.specular = v.scalar("specular");
-    p.shininess = v.scalar("shininess");
-    p.ambient = v.scalar("ambient");
-    p.ao_rays = v.integer("ao_rays");
-    return p;
-}
+Params params(const Scene& scene) { return read_knobs<Params>(scene.values, bind); }
 
 Material material_of(const Params& p) {
     if (const Material* preset = find_material_preset(p.material)) return *preset;

@@ -6,89 +6,73 @@
 
 #include "renderer/core/common_knobs.h"
 #include "renderer/core/density_volume.h"
+#include "renderer/core/knob_binding.h"
 #include "renderer/techniques/htsm/htsm.h"
 
 namespace lucent::htsm {
+namespace {
+
+Knob in_density_panel(Knob knob) {
+    knob.panel = "Density";
+    return knob;
+}
+
+void bind(Params& p, KnobBinder& b) {
+    b.choice(p.samples, "rays",
+             "n: rays per pixel in the hierarchical pattern (1 + 4 rings)",
+             {"1", "5", "9", "13"});
+    b.knob(p.steps, {"steps", "S: midpoint steps through the density per ray",
+                     KnobKind::integer, 1.0, 64.0});
+    b.choice(p.light_map_size, "light_map_size",
+             "W_L: side of the light-view images (texels)",
+             {"64", "128", "256", "512", "1024"});
+    b.choice(p.light_mips, "light_mips",
+             "on: each ring reads the mip level of its footprint (Sec. 4.3.1); "
+             "off: every ray reads level 0 (point samples, no prefiltering)",
+             {"off", "on"});
+    // make_scene builds the volume from these three (density_from_knobs); Params holds
+    // the resolution only as the place of htsm's default.
+    const std::vector<Knob> volume = density_volume_knobs("marble", p.density_resolution);
+    b.scene_input(volume[0]);
+    b.knob(p.density_resolution, volume[1]);
+    b.scene_input(volume[2]);
+    b.knob(p.density_scale,
+           in_density_panel(
+               {"density_scale",
+                "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
+                KnobKind::scalar, 0.0, 1000.0}));
+    b.choice(p.phase_table_size, "phase_table_size",
+             "N_f: entries of the phase-function table", {"16", "64", "256", "1024"});
+    b.knob(p.pattern_radius,
+           {"pattern_radius",
+            "r1: radius of the first ring, fraction of Phi (ring k: r1 2^(k-1))",
+            KnobKind::scalar, 0.0, 0.5});
+    b.knob(p.transport_colour, {"transport_colour", "Tc: transport colour (linear rgb)",
+                                KnobKind::rgb, 0.0, 4.0});
+    b.knob(p.transport_distance,
+           {"transport_distance", "Td: transport distance, fraction of Phi",
+            KnobKind::scalar, 1e-3, 10.0});
+    b.knob(p.phase_g,
+           {"phase_g", "g: Henyey-Greenstein asymmetry, normalised to f(1) = 1",
+            KnobKind::scalar, 0.0, 0.8});
+    b.knob(p.ior,
+           {"ior", "eta: index of refraction for Schlick's Fresnel on the lit side",
+            KnobKind::scalar, 1.0, 2.0});
+    b.knob(p.diffuse, {"diffuse", "wd: weight of the shadowed Lambert term Kd Id N.L",
+                       KnobKind::scalar, 0.0, 10.0});
+    b.knob(p.albedo, albedo_knob());
+    b.knob(p.specular, specular_knob());
+    b.knob(p.shininess, shininess_knob());
+}
+
+}  // namespace
 
 const std::vector<Knob>& knobs() {
-    static const std::vector<Knob> list = [] {
-        const Params d{};
-        Knob albedo = albedo_knob(), specular = specular_knob(),
-             shininess = shininess_knob();
-        albedo.default_value = d.albedo;
-        specular.default_value = d.specular;
-        shininess.default_value = d.shininess;
-        const std::vector<Knob> volume =
-            density_volume_knobs("marble", d.density_resolution);
-        const auto in_density_panel = [](Knob knob) {
-            knob.panel = "Density";
-            return knob;
-        };
-        return std::vector<Knob>{
-            choice_knob("rays",
-                        "n: rays per pixel in the hierarchical pattern (1 + 4 rings)",
-                        std::to_string(d.samples), {"1", "5", "9", "13"}),
-            {"steps", "S: midpoint steps through the density per ray", KnobKind::integer,
-             1.0, 64.0, d.steps},
-            choice_knob("light_map_size", "W_L: side of the light-view images (texels)",
-                        std::to_string(d.light_map_size),
-                        {"64", "128", "256", "512", "1024"}),
-            choice_knob(
-                "light_mips",
-                "on: each ring reads the mip level of its footprint (Sec. 4.3.1); "
-                "off: every ray reads level 0 (point samples, no prefiltering)",
-                "on", {"off", "on"}),
-            volume[0],
-            volume[1],
-            volume[2],
-            in_density_panel(
-                {"density_scale",
-                 "kappa: optical depth per Phi (bounding-sphere diameter) at rho = 1",
-                 KnobKind::scalar, 0.0, 1000.0, d.density_scale}),
-            choice_knob("phase_table_size", "N_f: entries of the phase-function table",
-                        std::to_string(d.phase_table_size), {"16", "64", "256", "1024"}),
-            {"pattern_radius",
-             "r1: radius of the first ring, fraction of Phi (ring k: r1 2^(k-1))",
-             KnobKind::scalar, 0.0, 0.5, d.pattern_radius},
-            {"transport_colour", "Tc: transport colour (linear rgb)", KnobKind::rgb, 0.0,
-             4.0, d.transport_colour},
-            {"transport_distance", "Td: transport distance, fraction of Phi",
-             KnobKind::scalar, 1e-3, 10.0, d.transport_distance},
-            {"phase_g", "g: Henyey-Greenstein asymmetry, normalised to f(1) = 1",
-             KnobKind::scalar, 0.0, 0.8, d.phase_g},
-            {"ior", "eta: index of refraction for Schlick's Fresnel on the lit side",
-             KnobKind::scalar, 1.0, 2.0, d.ior},
-            {"diffuse", "wd: weight of the shadowed Lambert term Kd Id N.L",
-             KnobKind::scalar, 0.0, 10.0, d.diffuse},
-            albedo,
-            specular,
-            shininess,
-        };
-    }();
+    static const std::vector<Knob> list = list_knobs<Params>(bind);
     return list;
 }
 
-Params params(const Scene& scene) {
-    const KnobValues& v = scene.values;
-    Params p;
-    p.samples = std::stoi(v.choice("rays"));
-    p.steps = v.integer("steps");
-    p.light_map_size = std::stoi(v.choice("light_map_size"));
-    p.light_mips = v.choice("light_mips") == "on";
-    p.density_resolution = std::stoi(v.choice("density_resolution"));
-    p.phase_table_size = std::stoi(v.choice("phase_table_size"));
-    p.pattern_radius = v.scalar("pattern_radius");
-    p.transport_colour = v.vec3("transport_colour");
-    p.transport_distance = v.scalar("transport_distance");
-    p.density_scale = v.scalar("density_scale");
-    p.phase_g = v.scalar("phase_g");
-    p.ior = v.scalar("ior");
-    p.albedo = v.vec3("albedo");
-    p.diffuse = v.scalar("diffuse");
-    p.specular = v.scalar("specular");
-    p.shininess = v.scalar("shininess");
-    return p;
-}
+Params params(const Scene& scene) { return read_knobs<Params>(scene.values, bind); }
 
 Geometry geometry(const Scene& scene, const Params& p) {
     Geometry g;

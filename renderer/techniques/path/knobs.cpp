@@ -4,77 +4,66 @@
 
 #include "common/number_text.h"
 #include "renderer/core/common_knobs.h"
+#include "renderer/core/knob_binding.h"
 #include "renderer/techniques/dipole/dipole.h"
 #include "renderer/techniques/dipole/scattering.h"
 #include "renderer/techniques/path/path.h"
 
 namespace lucent::path {
+namespace {
+
+void bind(Params& p, KnobBinder& b) {
+    // The dipole's table of measured materials (Jensen et al. 2001), so that both
+    // techniques read the same numbers for a name.
+    b.choice(p.material, "material",
+             "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta "
+             "1.3), or custom: sigma_a, sigma_s_prime and eta",
+             dipole::material_choices());
+    b.knob(p.sigma_a, {"sigma_a", "custom material: absorption coefficient, mm^-1 (rgb)",
+                       KnobKind::rgb, 0.0, 100.0});
+    b.knob(p.sigma_s_prime, {"sigma_s_prime",
+                             "custom material: reduced scattering coefficient sigma_s (1 "
+                             "- g), mm^-1 (rgb)",
+                             KnobKind::rgb, 0.0, 1000.0});
+    b.knob(p.eta,
+           {"eta", "custom material: relative index of refraction (1: index-matched)",
+            KnobKind::scalar, 1.0, 2.0});
+    b.knob(p.g, {"g", "Henyey-Greenstein asymmetry; sigma_s = sigma_s' / (1 - g)",
+                 KnobKind::scalar, -0.95, 0.95});
+    b.knob(p.model_size, {"model_size", "the mesh's bounding-box diagonal in mm",
+                          KnobKind::scalar, 0.1, 1000.0});
+    b.knob(p.light_radius,
+           {"light_radius",
+            "angular radius of the key light's disc, degrees (0: a directional light, "
+            "reachable only with eta = 1)",
+            KnobKind::scalar, 0.0, 45.0});
+    b.knob(p.paths,
+           {"paths", "paths per pixel and channel", KnobKind::integer, 1.0, 1048576.0});
+    b.knob(p.time_budget,
+           {"time_budget",
+            "seconds after which no further sample pass starts (0: none; a budget makes "
+            "the image depend on the machine)",
+            KnobKind::scalar, 0.0, 86400.0});
+    b.knob(p.seed, {"seed", "random seed: another seed, independent samples",
+                    KnobKind::integer, 0.0, 1000000.0});
+    // The medium's density: make_scene builds it (density_from_knobs), no member holds
+    // it.
+    std::vector<Knob> volume = density_volume_knobs("constant:value=1", 32);
+    volume[0].description =
+        "rho: scales the material's coefficients over the mesh's bounding box (a "
+        "generator, e.g. marble:frequency=3, or an .nrrd file); constant:value=1 is "
+        "the homogeneous material";
+    for (Knob& knob : volume) b.scene_input(std::move(knob));
+}
+
+}  // namespace
 
 const std::vector<Knob>& knobs() {
-    static const std::vector<Knob> list = [] {
-        const Params d{};
-        // The dipole's table of measured materials (Jensen et al. 2001), so that both
-        // techniques read the same numbers for a name.
-        std::vector<std::string> materials;
-        for (const auto& preset : dipole::material_presets())
-            materials.push_back(preset.name);
-        materials.push_back("custom");
-        std::vector<Knob> volume = density_volume_knobs("constant:value=1", 32);
-        volume[0].description =
-            "rho: scales the material's coefficients over the mesh's bounding box (a "
-            "generator, e.g. marble:frequency=3, or an .nrrd file); constant:value=1 is "
-            "the homogeneous material";
-        std::vector<Knob> list{
-            choice_knob("material",
-                        "Jensen et al. 2001 material (sigma_a, sigma_s' in mm^-1, eta "
-                        "1.3), or custom: sigma_a, sigma_s_prime and eta",
-                        d.material, materials),
-            {"sigma_a", "custom material: absorption coefficient, mm^-1 (rgb)",
-             KnobKind::rgb, 0.0, 100.0, d.sigma_a},
-            {"sigma_s_prime",
-             "custom material: reduced scattering coefficient sigma_s (1 - g), mm^-1 "
-             "(rgb)",
-             KnobKind::rgb, 0.0, 1000.0, d.sigma_s_prime},
-            {"eta", "custom material: relative index of refraction (1: index-matched)",
-             KnobKind::scalar, 1.0, 2.0, d.eta},
-            {"g", "Henyey-Greenstein asymmetry; sigma_s = sigma_s' / (1 - g)",
-             KnobKind::scalar, -0.95, 0.95, d.g},
-            {"model_size", "the mesh's bounding-box diagonal in mm", KnobKind::scalar,
-             0.1, 1000.0, d.model_size},
-            {"light_radius",
-             "angular radius of the key light's disc, degrees (0: a directional light, "
-             "reachable only with eta = 1)",
-             KnobKind::scalar, 0.0, 45.0, d.light_radius},
-            {"paths", "paths per pixel and channel", KnobKind::integer, 1.0, 1048576.0,
-             d.paths},
-            {"time_budget",
-             "seconds after which no further sample pass starts (0: none; a budget makes "
-             "the image depend on the machine)",
-             KnobKind::scalar, 0.0, 86400.0, d.time_budget},
-            {"seed", "random seed: another seed, independent samples", KnobKind::integer,
-             0.0, 1000000.0, d.seed},
-        };
-        list.insert(list.end(), volume.begin(), volume.end());
-        return list;
-    }();
+    static const std::vector<Knob> list = list_knobs<Params>(bind);
     return list;
 }
 
-Params params(const Scene& scene) {
-    const KnobValues& v = scene.values;
-    Params p;
-    p.material = v.choice("material");
-    p.sigma_a = v.vec3("sigma_a");
-    p.sigma_s_prime = v.vec3("sigma_s_prime");
-    p.eta = v.scalar("eta");
-    p.g = v.scalar("g");
-    p.model_size = v.scalar("model_size");
-    p.light_radius = v.scalar("light_radius");
-    p.paths = v.integer("paths");
-    p.time_budget = v.scalar("time_budget");
-    p.seed = v.integer("seed");
-    return p;
-}
+Params params(const Scene& scene) { return read_knobs<Params>(scene.values, bind); }
 
 namespace {
 

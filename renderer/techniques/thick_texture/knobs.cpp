@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 
+#include "renderer/core/knob_binding.h"
 #include "renderer/techniques/thick_texture/thick_texture.h"
 
 namespace lucent::thick_texture {
@@ -12,102 +13,84 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+Knob texture_knob() {
+    Knob texture{"texture",
+                 "binary texture: net:H,W (holes H, walls W texels), stripes:H,W, "
+                 "checker, random:P,SEED, weave:T,G, curtain:SEED or an image file "
+                 "(alpha < 0.5 = hole)",
+                 KnobKind::text, 0.0, 0.0};
+    // Its meaning (spec or file) is checked by Technique::check_scene, which names
+    // the texture; here only that there is one.
+    texture.check = [](std::string_view text) -> std::string {
+        return text.empty() ? "empty" : "";
+    };
+    texture.accepted =
+        "non-empty text such as net:5,1, weave:2,1, random:0.5,1, curtain:1 or "
+        "holes.png";
+    return texture;
+}
+
+void bind(Params& p, KnobBinder& b) {
+    b.knob(p.texture, texture_knob());
+    b.knob(p.thickness,
+           {"thickness", "h: height of the opaque texels, in level-0 texel widths",
+            KnobKind::scalar, 0.0, 64.0});
+    b.knob(p.texel_density,
+           {"texel_density", "level-0 texels per uv unit (the sheets: per 2 mesh units)",
+            KnobKind::scalar, 1.0, 8192.0});
+    b.knob(p.tilt, {"tilt",
+                    "sheet rotation about the vertical axis, degrees (the viewing angle "
+                    "of a flat sheet)",
+                    KnobKind::scalar, 0.0, 89.0});
+    b.knob(p.azimuth,
+           {"azimuth", "sheet rotation about its own normal before the tilt, degrees",
+            KnobKind::scalar, -180.0, 180.0});
+    b.choice(p.filter, "filter",
+             "texture filtering (Fig. 4.6): nearest texel and level, linear = "
+             "nearest texel blended across levels, bilinear, trilinear",
+             {"nearest", "linear", "bilinear", "trilinear"});
+    b.choice(p.fetch_path, "fetch_path",
+             "hardware: normalised averages, hardware filtering, 3 fetches; thesis: "
+             "Algorithm 3.1 on 8 texels, 32 fetches (Sec. 3.5)",
+             {"hardware", "thesis"});
+    b.choice(p.wide_hole_bins, "wide_hole_bins",
+             "K: 1 = the thesis's neighbour walls only; 4 or 8 = run-length bins per "
+             "direction (the future-work fix for holes wider than a texel)",
+             {"1", "4", "8"});
+    b.knob(p.layers, {"layers", "sheet layers by depth peeling (folds in front of folds)",
+                      KnobKind::integer, 1.0, 4.0});
+    b.knob(
+        p.top_colour,
+        {"top_colour", "c1: colour of the opaque texels' tops (textures without colours)",
+         KnobKind::rgb, 0.0, 1.0});
+    b.knob(p.wall_colour, {"wall_colour", "c2: colour of the hole walls (linear rgb)",
+                           KnobKind::rgb, 0.0, 1.0});
+    b.choice(p.colour_source, "colour_source",
+             "c1 from the texture's colours (weave, curtain, files) or top_colour",
+             {"texture", "knob"});
+    b.choice(p.backdrop, "backdrop",
+             "opaque plane behind the sheet, perpendicular to the view",
+             {"checker", "stripes", "plain"});
+    b.knob(p.backdrop_a,
+           {"backdrop_a", "first backdrop colour (linear rgb)", KnobKind::rgb, 0.0, 1.0});
+    b.knob(p.backdrop_b, {"backdrop_b", "second backdrop colour (linear rgb)",
+                          KnobKind::rgb, 0.0, 1.0});
+    b.knob(p.backdrop_period,
+           {"backdrop_period", "backdrop squares / stripes, mesh units", KnobKind::scalar,
+            0.001, 100.0});
+    b.knob(p.reference_rays,
+           {"reference_rays", "CPU reference: rays per pixel (n x n stratified)",
+            KnobKind::integer, 1.0, 4096.0});
+}
+
 }  // namespace
 
 const std::vector<Knob>& knobs() {
-    static const std::vector<Knob> list = [] {
-        const Params d{};
-        Knob texture{"texture",
-                     "binary texture: net:H,W (holes H, walls W texels), stripes:H,W, "
-                     "checker, random:P,SEED, weave:T,G, curtain:SEED or an image file "
-                     "(alpha < 0.5 = hole)",
-                     KnobKind::text,
-                     0.0,
-                     0.0,
-                     d.texture};
-        // Its meaning (spec or file) is checked by Technique::check_scene, which names
-        // the texture; here only that there is one.
-        texture.check = [](std::string_view text) -> std::string {
-            return text.empty() ? "empty" : "";
-        };
-        texture.accepted =
-            "non-empty text such as net:5,1, weave:2,1, random:0.5,1, curtain:1 or "
-            "holes.png";
-        return std::vector<Knob>{
-            texture,
-            {"thickness", "h: height of the opaque texels, in level-0 texel widths",
-             KnobKind::scalar, 0.0, 64.0, d.thickness},
-            {"texel_density", "level-0 texels per uv unit (the sheets: per 2 mesh units)",
-             KnobKind::scalar, 1.0, 8192.0, d.texel_density},
-            {"tilt",
-             "sheet rotation about the vertical axis, degrees (the viewing angle "
-             "of a flat sheet)",
-             KnobKind::scalar, 0.0, 89.0, d.tilt},
-            {"azimuth", "sheet rotation about its own normal before the tilt, degrees",
-             KnobKind::scalar, -180.0, 180.0, d.azimuth},
-            choice_knob("filter",
-                        "texture filtering (Fig. 4.6): nearest texel and level, linear = "
-                        "nearest texel blended across levels, bilinear, trilinear",
-                        d.filter, {"nearest", "linear", "bilinear", "trilinear"}),
-            choice_knob(
-                "fetch_path",
-                "hardware: normalised averages, hardware filtering, 3 fetches; thesis: "
-                "Algorithm 3.1 on 8 texels, 32 fetches (Sec. 3.5)",
-                d.fetch_path, {"hardware", "thesis"}),
-            choice_knob(
-                "wide_hole_bins",
-                "K: 1 = the thesis's neighbour walls only; 4 or 8 = run-length bins per "
-                "direction (the future-work fix for holes wider than a texel)",
-                std::to_string(d.wide_hole_bins), {"1", "4", "8"}),
-            {"layers", "sheet layers by depth peeling (folds in front of folds)",
-             KnobKind::integer, 1.0, 4.0, d.layers},
-            {"top_colour",
-             "c1: colour of the opaque texels' tops (textures without colours)",
-             KnobKind::rgb, 0.0, 1.0, d.top_colour},
-            {"wall_colour", "c2: colour of the hole walls (linear rgb)", KnobKind::rgb,
-             0.0, 1.0, d.wall_colour},
-            choice_knob(
-                "colour_source",
-                "c1 from the texture's colours (weave, curtain, files) or top_colour",
-                d.colour_source, {"texture", "knob"}),
-            choice_knob("backdrop",
-                        "opaque plane behind the sheet, perpendicular to the view",
-                        d.backdrop, {"checker", "stripes", "plain"}),
-            {"backdrop_a", "first backdrop colour (linear rgb)", KnobKind::rgb, 0.0, 1.0,
-             d.backdrop_a},
-            {"backdrop_b", "second backdrop colour (linear rgb)", KnobKind::rgb, 0.0, 1.0,
-             d.backdrop_b},
-            {"backdrop_period", "backdrop squares / stripes, mesh units",
-             KnobKind::scalar, 0.001, 100.0, d.backdrop_period},
-            {"reference_rays", "CPU reference: rays per pixel (n x n stratified)",
-             KnobKind::integer, 1.0, 4096.0, d.reference_rays},
-        };
-    }();
+    static const std::vector<Knob> list = list_knobs<Params>(bind);
     return list;
 }
 
-Params params(const Scene& scene) {
-    const KnobValues& v = scene.values;
-    Params p;
-    p.texture = v.choice("texture");
-    p.thickness = v.scalar("thickness");
-    p.texel_density = v.scalar("texel_density");
-    p.tilt = v.scalar("tilt");
-    p.azimuth = v.scalar("azimuth");
-    p.filter = v.choice("filter");
-    p.fetch_path = v.choice("fetch_path");
-    p.wide_hole_bins = std::stoi(v.choice("wide_hole_bins"));
-    p.layers = v.integer("layers");
-    p.top_colour = v.vec3("top_colour");
-    p.wall_colour = v.vec3("wall_colour");
-    p.colour_source = v.choice("colour_source");
-    p.backdrop = v.choice("backdrop");
-    p.backdrop_a = v.vec3("backdrop_a");
-    p.backdrop_b = v.vec3("backdrop_b");
-    p.backdrop_period = v.scalar("backdrop_period");
-    p.reference_rays = v.integer("reference_rays");
-    return p;
-}
+Params params(const Scene& scene) { return read_knobs<Params>(scene.values, bind); }
 
 const TexelGrid& scene_texture(const Params& p) {
     // Textures are small; keep every one asked for (the explorer switches back and

@@ -1,4 +1,5 @@
 #include "renderer/core/common_knobs.h"
+#include "renderer/core/knob_binding.h"
 #include "renderer/techniques/ward/ward.h"
 
 namespace lucent::ward {
@@ -9,54 +10,42 @@ const char* diffuse_knob_name(Variant variant) {
 
 namespace {
 
-std::vector<Knob> make_knobs(Variant variant) {
-    const Params d{};
-    Knob albedo = albedo_knob(), ambient = ambient_knob(), rays = ao_rays_knob();
-    albedo.default_value = d.albedo;
-    ambient.default_value = d.ambient;
-    rays.default_value = d.ao_rays;
-    Knob diffuse = variant == Variant::ward
-                       ? Knob{"diffuse_reflectance",
-                              "rho_d: Ward's diffuse reflectance (scalar)",
-                              KnobKind::scalar,
-                              0.0,
-                              10.0,
-                              d.diffuse}
-                       : Knob{"reversed_diffuse",
-                              "w: weight of the reversed diffuse term Id*chroma(Kd)*(1 - "
-                              "Y(Kd)*max(N.L,0)) (scalar)",
-                              KnobKind::scalar,
-                              0.0,
-                              10.0,
-                              d.diffuse};
-    return {albedo,
-            ambient,
-            diffuse,
-            {"specular_reflectance", "rho_s: Ward's specular reflectance (scalar)",
-             KnobKind::scalar, 0.0, 1.0, d.specular_reflectance},
-            {"roughness", "alpha: rms surface slope of Ward's lobe; 0 acts as 0.001",
-             KnobKind::scalar, 0.0, 1.0, d.roughness},
-            rays};
+void bind(Params& p, KnobBinder& b, Variant variant) {
+    b.knob(p.albedo, albedo_knob());
+    b.knob(p.ambient, ambient_knob());
+    // One member, named and meant by the variant (Eq. 14 or 15).
+    const char* diffuse_meaning =
+        variant == Variant::ward
+            ? "rho_d: Ward's diffuse reflectance (scalar)"
+            : "w: weight of the reversed diffuse term Id*chroma(Kd)*(1 - "
+              "Y(Kd)*max(N.L,0)) (scalar)";
+    b.knob(p.diffuse,
+           {diffuse_knob_name(variant), diffuse_meaning, KnobKind::scalar, 0.0, 10.0});
+    b.knob(p.specular_reflectance,
+           {"specular_reflectance", "rho_s: Ward's specular reflectance (scalar)",
+            KnobKind::scalar, 0.0, 1.0});
+    b.knob(p.roughness,
+           {"roughness", "alpha: rms surface slope of Ward's lobe; 0 acts as 0.001",
+            KnobKind::scalar, 0.0, 1.0});
+    b.knob(p.ao_rays, ao_rays_knob());
+}
+
+// bind() for one variant, as list_knobs and read_knobs call it.
+auto bind_variant(Variant variant) {
+    return [variant](Params& p, KnobBinder& b) { bind(p, b, variant); };
 }
 
 }  // namespace
 
 const std::vector<Knob>& knobs(Variant variant) {
-    static const std::vector<Knob> ward = make_knobs(Variant::ward);
-    static const std::vector<Knob> reversed = make_knobs(Variant::contrast_reversed);
+    static const std::vector<Knob> ward = list_knobs<Params>(bind_variant(Variant::ward));
+    static const std::vector<Knob> reversed =
+        list_knobs<Params>(bind_variant(Variant::contrast_reversed));
     return variant == Variant::ward ? ward : reversed;
 }
 
 Params params(const Scene& scene, Variant variant) {
-    const KnobValues& v = scene.values;
-    Params p;
-    p.albedo = v.vec3("albedo");
-    p.ambient = v.scalar("ambient");
-    p.diffuse = v.scalar(diffuse_knob_name(variant));
-    p.specular_reflectance = v.scalar("specular_reflectance");
-    p.roughness = v.scalar("roughness");
-    p.ao_rays = v.integer("ao_rays");
-    return p;
+    return read_knobs<Params>(scene.values, bind_variant(variant));
 }
 
 double albedo_luminance(glm::dvec3 albedo) {
