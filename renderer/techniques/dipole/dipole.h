@@ -38,6 +38,7 @@ struct Params {
     double shininess = 64.0;                     // n (shared knob)
     double ambient = 0.3;                        // ka (shared knob)
     int ao_rays = 320;
+    bool operator==(const Params&) const = default;
 };
 
 const std::vector<Knob>& knobs();

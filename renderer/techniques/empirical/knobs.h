@@ -27,6 +27,7 @@ struct Params {
     // "auto": on a closed mesh facing out the layers are the nearest front and back faces
     // (culling, no peel); otherwise, and always with "peel", the thesis's depth peeling.
     std::string layer_method = "auto";
+    bool operator==(const Params&) const = default;
 };
 
 // The technique's knobs (material + technique), defaults taken from Params{}.

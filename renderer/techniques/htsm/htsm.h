@@ -36,6 +36,7 @@ struct Params {
     double diffuse = 0.2;                // wd, [0, 10]
     double specular = 0.5;               // ks (the shared default)
     double shininess = 64.0;             // n (the shared default)
+    bool operator==(const Params&) const = default;
 };
 
 const std::vector<Knob>& knobs();

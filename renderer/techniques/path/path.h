@@ -31,6 +31,7 @@ struct Params {
     int paths = 16;             // per pixel and channel
     double time_budget = 0.0;   // seconds, 0: none (then deterministic)
     int seed = 0;
+    bool operator==(const Params&) const = default;
 };
 
 const std::vector<Knob>& knobs();

@@ -119,6 +119,7 @@ struct Params {
     glm::dvec3 backdrop_b{0.1, 0.15, 0.5};
     double backdrop_period = 0.2;  // mesh units on the backdrop plane
     int reference_rays = 256;      // per pixel, n x n stratified
+    bool operator==(const Params&) const = default;
 };
 const std::vector<Knob>& knobs();
 Params params(const Scene& scene);

@@ -26,6 +26,7 @@ struct Params {
     double specular_reflectance = 0.08;  // rho_s, [0, 1]
     double roughness = 0.1;              // alpha (rms slope), [0, 1]; 0 acts as 1e-3
     int ao_rays = 320;                   // AO bake rays per vertex, [1, 4096]
+    bool operator==(const Params&) const = default;
 };
 
 // The name of Params::diffuse's knob: "diffuse_reflectance" or "reversed_diffuse".
