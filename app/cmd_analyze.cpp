@@ -76,7 +76,7 @@ void add_matching_section(const AnalyzeArgs& args, const AnalysisInput& input,
                           analysis::ReportOptions& options) {
     using namespace lucent::analysis;
     const MatchingTable& table = input.matching;
-    if (!input.from_study || (table.matches.empty() && table.staircases.empty())) return;
+    if (table.matches.empty() && table.staircases.empty()) return;
     std::cerr << "lucent analyze: " << table.matches.size() << " matches, "
               << table.staircases.size() << " staircase trials\n";
     for (const std::string& p : table.excluded_participants)
@@ -85,8 +85,10 @@ void add_matching_section(const AnalyzeArgs& args, const AnalysisInput& input,
     const study::Protocol* protocol = table.protocol ? &*table.protocol : nullptr;
     if (!protocol)
         options.input_notes.push_back(
-            "The stored protocol could not be read: the matches have no target values "
-            "and the staircases are taken as pairs (guess rate 1/2), not replayed.");
+            std::string(input.from_study ? "The stored protocol could not be read"
+                                         : "A table of observations holds no protocol") +
+            ": the matches have no target values and the staircases are taken as pairs "
+            "(guess rate 1/2), not replayed.");
     ThresholdOptions threshold_options;
     threshold_options.family = args.psychometric == "weibull"
                                    ? PsychometricFamily::weibull

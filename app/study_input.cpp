@@ -4,11 +4,22 @@
 #include <fstream>
 #include <iostream>
 
+#include "analysis/data/observation_csv.h"
 #include "study/observations.h"
 #include "study/question_scales.h"
 #include "study/study_store.h"
 
 namespace lucent::app {
+namespace {
+
+std::string first_line(const std::string& path) {
+    std::ifstream in(path);
+    std::string header;
+    std::getline(in, header);
+    return header;
+}
+
+}  // namespace
 
 bool is_sqlite_file(const std::string& path) {
     char magic[16] = {};
@@ -20,18 +31,34 @@ bool is_sqlite_file(const std::string& path) {
 
 bool is_choice_csv(const std::string& path) {
     if (study::is_server_uri(path) || is_sqlite_file(path)) return false;
-    std::ifstream in(path);
-    std::string header;
-    std::getline(in, header);
+    const std::string header = first_line(path);
     return header.find("shown_1") != std::string::npos &&
            header.find("choice") != std::string::npos;
 }
+
+namespace {
+
+// Ratings, choices and matches: the one table's views.
+void read_views(const common::ObservationTable& table, const std::string& path,
+                const analysis::RatingScale& scale,
+                std::optional<study::Protocol> protocol, AnalysisInput& input) {
+    input.ratings = analysis::ratings_of(table, path, scale);
+    input.choices = analysis::choices_of(table, path);
+    input.matching = analysis::matching_of(table, std::move(protocol));
+}
+
+}  // namespace
 
 AnalysisInput read_analysis_input(const std::string& path,
                                   const analysis::RatingScale& scale) {
     AnalysisInput input;
     if (!study::is_server_uri(path) && !is_sqlite_file(path)) {
-        if (is_choice_csv(path))
+        if (analysis::is_observation_header(first_line(path))) {
+            // An exported study (or a table in its layout): no protocol travels with it.
+            read_views(analysis::read_observation_csv(std::filesystem::path(path)), path,
+                       scale, std::nullopt, input);
+            input.matching.sessions_note = path + ": a table of observations";
+        } else if (is_choice_csv(path))
             input.choices = analysis::read_choice_csv(std::filesystem::path(path));
         else
             input.ratings = analysis::read_long_csv(path, scale);
@@ -64,9 +91,7 @@ AnalysisInput read_analysis_input(const std::string& path,
     std::cerr << "lucent analyze: note: " << note << "\n";
     input.notes.push_back("Sessions: " + note + ".");
     input.choice_orders = read.choice_orders;
-    input.ratings = analysis::ratings_of(read.table, path, scale);
-    input.choices = analysis::choices_of(read.table, path);
-    input.matching = analysis::matching_of(read.table, std::move(read.protocol));
+    read_views(read.table, path, scale, std::move(read.protocol), input);
     input.matching.excluded_participants = read.selection.excluded_participants;
     input.matching.sessions_note = note;
     return input;

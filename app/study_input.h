@@ -1,7 +1,9 @@
 #pragma once
 // `lucent analyze` input, read once: a study database (a server's through one snapshot)
 // as its observations (study/observations.h), out of which come the ratings, the forced
-// choices and the matches; or a long CSV of ratings; or a choices CSV.
+// choices and the matches; or the same table as CSV (`lucent export --format
+// observations`: the same views, without the stored protocol); or a long CSV of
+// ratings; or a choices CSV.
 #include <map>
 #include <optional>
 #include <string>

@@ -46,4 +46,23 @@ std::vector<std::string> split_csv_line(std::string_view line) {
     return fields;
 }
 
+bool CsvRecordReader::next(std::vector<std::string>& fields) {
+    while (std::getline(in_, line_)) {
+        first_line_ = ++line_no_;
+        if (first_line_ == 1 && line_.rfind("\xEF\xBB\xBF", 0) == 0) line_.erase(0, 3);
+        if (line_.find_first_not_of(" \t\r") == std::string::npos) continue;
+        record_ = line_;
+        while (!decode_csv_record(record_, fields)) {
+            if (!std::getline(in_, line_))
+                throw CsvError(first_line_, std::to_string(first_line_) +
+                                                ": unterminated quoted field");
+            ++line_no_;
+            record_ += '\n';
+            record_ += line_;
+        }
+        return true;
+    }
+    return false;
+}
+
 }  // namespace lucent::common

@@ -1,6 +1,9 @@
 #pragma once
 // CSV fields as RFC 4180 writes and reads them: every table Lucent writes (manifests,
 // exports, analysis tables, bench results) and reads (manifests, long rating tables).
+#include <cstddef>
+#include <istream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -29,5 +32,29 @@ bool decode_csv_record(std::string_view record, std::vector<std::string>& fields
 // The fields of one line (as decode_csv_record, bare CRs dropped; a quote left open at
 // the end of the line closes there).
 std::vector<std::string> split_csv_line(std::string_view line);
+
+// A stream ended inside a quoted field; the message names the record's first line.
+class CsvError : public std::runtime_error {
+public:
+    CsvError(std::size_t line, const std::string& message)
+        : std::runtime_error(message), line(line) {}
+    std::size_t line;
+};
+
+// A CSV stream record by record, as every table reader takes it: a UTF-8 byte-order mark
+// skipped, blank lines (spaces, tabs, a CR) skipped, a quoted field may span lines.
+class CsvRecordReader {
+public:
+    explicit CsvRecordReader(std::istream& in) : in_(in) {}
+    // The next record's fields, false at the end. Throws CsvError ("unterminated quoted
+    // field") when the stream ends inside a quoted field.
+    bool next(std::vector<std::string>& fields);
+    std::size_t line() const { return first_line_; }  // the record's first line
+
+private:
+    std::istream& in_;
+    std::size_t line_no_ = 0, first_line_ = 0;
+    std::string line_, record_;
+};
 
 }  // namespace lucent::common

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "analysis/data/long_table.h"
+#include "analysis/data/table_records.h"
 #include "common/csv.h"
 #include "common/number_text.h"
 
@@ -124,45 +125,23 @@ ChoiceTable read_choice_csv(std::istream& in, const std::string& source) {
     ChoiceTable table;
     std::array<int, kColumns.size()> column{};
     column.fill(-1);
-    std::size_t header_fields = 0, line_no = 0;
-    std::string line;
+    TableRecords records(in, source);
+    const std::vector<std::string>& head = records.header();
+    for (std::size_t f = 0; f < head.size(); ++f)
+        for (std::size_t c = 0; c < kColumns.size(); ++c)
+            if (trimmed(head[f]) == kColumns[c]) column[c] = static_cast<int>(f);
+    for (const Column c : kRequired)
+        if (column[c] < 0)
+            throw InputError(source + ":" + std::to_string(records.header_line()) +
+                             ": header lacks column '" + kColumns[c] +
+                             "' (expected the columns of lucent export --format "
+                             "choices: participant,...,shown_1,...,choice,rt_ms)");
+    if (column[kShown1 + 1] < 0)
+        throw InputError(source + ":" + std::to_string(records.header_line()) +
+                         ": header lacks column 'shown_2'");
     std::vector<std::string> fields;
-    while (std::getline(in, line)) {
-        ++line_no;
-        const std::size_t first_line = line_no;
-        if (first_line == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
-        if (trimmed(line).empty() || trimmed(line) == "\r") continue;
-        std::string record = line;
-        while (!common::decode_csv_record(record, fields)) {
-            if (!std::getline(in, line))
-                throw InputError(source + ":" + std::to_string(first_line) +
-                                 ": unterminated quoted field");
-            ++line_no;
-            record += '\n';
-            record += line;
-        }
-        if (header_fields == 0) {
-            header_fields = fields.size();
-            for (std::size_t f = 0; f < fields.size(); ++f)
-                for (std::size_t c = 0; c < kColumns.size(); ++c)
-                    if (trimmed(fields[f]) == kColumns[c])
-                        column[c] = static_cast<int>(f);
-            for (const Column c : kRequired)
-                if (column[c] < 0)
-                    throw InputError(
-                        source + ":" + std::to_string(first_line) +
-                        ": header lacks column '" + kColumns[c] +
-                        "' (expected the columns of lucent export --format "
-                        "choices: participant,...,shown_1,...,choice,rt_ms)");
-            if (column[kShown1 + 1] < 0)
-                throw InputError(source + ":" + std::to_string(first_line) +
-                                 ": header lacks column 'shown_2'");
-            continue;
-        }
-        if (fields.size() != header_fields)
-            throw InputError(source + ":" + std::to_string(first_line) + ": expected " +
-                             std::to_string(header_fields) + " fields, found " +
-                             std::to_string(fields.size()));
+    while (records.next(fields)) {
+        const std::size_t first_line = records.line();
         const RowReader cell(source, first_line, column, fields);
         if (cell.flag(kPractice)) continue;
         ChoiceRow row;
@@ -206,8 +185,6 @@ ChoiceTable read_choice_csv(std::istream& in, const std::string& source) {
         row.rt_ms = cell.number(kRt).value_or(0.0);
         table.rows.push_back(std::move(row));
     }
-    if (in.bad()) throw InputError(source + ": read error");
-    if (header_fields == 0) throw InputError(source + ": empty file (no header)");
     return table;
 }
 
