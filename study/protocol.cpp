@@ -599,15 +599,23 @@ void read_block_task(const Protocol& p, TableReader& r, Block& b) {
     const std::optional<Task> parsed = parse_task(task);
     if (!parsed)
         r.fail(r.raw().get("task"), "task",
-               "must be \"rating\", \"pair\", \"triad\", \"quadruple\", \"adjust\" or "
-               "\"staircase\", got '" +
-                   task + "'");
+               "must be " + task_names_text() + ", got '" + task + "'");
     b.task = *parsed;
-    if (b.task == Task::rating) return;
-    read_block_question(p, r, b);
-    if (b.task == Task::adjust) return read_adjust_block(p, r, b);
-    if (b.task == Task::staircase) return read_staircase_block(p, r, b);
-    read_choice_block(p, r, b);
+    switch (b.task) {
+        case Task::rating:
+            return;
+        case Task::adjust:
+            read_block_question(p, r, b);
+            return read_adjust_block(p, r, b);
+        case Task::staircase:
+            read_block_question(p, r, b);
+            return read_staircase_block(p, r, b);
+        case Task::pair:
+        case Task::triad:
+        case Task::quadruple:
+            read_block_question(p, r, b);
+            return read_choice_block(p, r, b);
+    }
 }
 
 // The keys of a pair, triad or quadruple block (design notes: Block in protocol.h).
@@ -823,14 +831,33 @@ const char* task_name(Task task) {
 }
 
 std::optional<Task> parse_task(std::string_view text) {
-    for (Task t : {Task::rating, Task::pair, Task::triad, Task::quadruple, Task::adjust,
-                   Task::staircase})
+    for (Task t : kAllTasks)
         if (text == task_name(t)) return t;
     return std::nullopt;
 }
 
+std::string task_names_text() {
+    std::string text;
+    for (std::size_t i = 0; i < kAllTasks.size(); ++i)
+        text += std::string(i == 0                      ? ""
+                            : i + 1 == kAllTasks.size() ? " or "
+                                                        : ", ") +
+                "\"" + task_name(kAllTasks[i]) + "\"";
+    return text;
+}
+
 bool is_scaling_task(Task task) {
-    return task == Task::pair || task == Task::triad || task == Task::quadruple;
+    switch (task) {
+        case Task::pair:
+        case Task::triad:
+        case Task::quadruple:
+            return true;
+        case Task::rating:
+        case Task::adjust:
+        case Task::staircase:
+            return false;
+    }
+    return false;
 }
 
 int pictures_per_trial(Task task) {

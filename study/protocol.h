@@ -1,6 +1,7 @@
 #pragma once
 // A study protocol: what participants see and rate, in what order, and how trials are
 // randomised. Parsed from TOML (parse_protocol) or the built-in `thesis` preset. GL-free.
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -61,6 +62,14 @@ struct CatchTrial {
 // until it looks like a target picture; `staircase`, a forced choice between a standard
 // and the standard with a knob changed by a delta that an adaptive procedure chooses.
 enum class Task { rating, pair, triad, quadruple, adjust, staircase };
+// The closed family, listed once. Code that does something per kind switches over Task
+// with no default, and the build refuses a switch that misses a kind (-Werror=switch),
+// so a new kind is a compile error at every place that must handle it.
+inline constexpr std::array<Task, 6> kAllTasks = {Task::rating, Task::pair,
+                                                  Task::triad,  Task::quadruple,
+                                                  Task::adjust, Task::staircase};
+// "\"rating\", \"pair\", ... or \"staircase\"": every kind's name, for messages.
+std::string task_names_text();
 const char* task_name(Task task);
 std::optional<Task> parse_task(std::string_view text);
 // A forced choice the scaling reads (paired comparisons, MLDS): pair, triad, quadruple.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 
@@ -485,6 +486,28 @@ std::string sequence_level(const PlannedTrial& trial,
     return level;
 }
 
+namespace {
+
+// A block of another kind than rating: its trials as its kind plans them (ratings are
+// planned with the protocol's randomisation, in plan_trials).
+std::vector<PlannedTrial> planned_block_trials(const Block& block, std::mt19937_64& rng) {
+    switch (block.task) {
+        case Task::adjust:
+            return adjust_block_trials(block, rng);
+        case Task::staircase:
+            return staircase_block_trials(block, rng);
+        case Task::pair:
+        case Task::triad:
+        case Task::quadruple:
+            return choice_block_trials(block, rng);
+        case Task::rating:
+            break;
+    }
+    throw std::logic_error("rating blocks are planned by plan_trials");
+}
+
+}  // namespace
+
 TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_number) {
     TrialPlan plan;
     for (const std::string& id : protocol.practice) {
@@ -532,10 +555,7 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
             // Its own stream per block, so the design of one block does not depend on
             // the order of the others.
             std::mt19937_64 design_rng(seed + 0x632be59bd9b4e019ULL * (b + 1));
-            trials = block.task == Task::adjust ? adjust_block_trials(block, design_rng)
-                     : block.task == Task::staircase
-                         ? staircase_block_trials(block, design_rng)
-                         : choice_block_trials(block, design_rng);
+            trials = planned_block_trials(block, design_rng);
             // A slot's level names its place in the block: unique, so the constraints
             // never hold a staircase's rounds back.
             for (size_t i = 0; i < trials.size(); ++i)

@@ -175,10 +175,21 @@ AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
                 "trial is " +
                     std::string(task == Task::rating ? "a rating" : "a forced choice"));
     }
-    AnswerEvent ev =
-        task == Task::rating   ? rating_event_of(e, type, questions, max_points)
-        : task == Task::adjust ? adjust_event_of(e, type)
-                               : choice_event_of(e, type, task, alternatives);
+    AnswerEvent ev;
+    switch (task) {
+        case Task::rating:
+            ev = rating_event_of(e, type, questions, max_points);
+            break;
+        case Task::adjust:
+            ev = adjust_event_of(e, type);
+            break;
+        case Task::pair:
+        case Task::triad:
+        case Task::quadruple:
+        case Task::staircase:
+            ev = choice_event_of(e, type, task, alternatives);
+            break;
+    }
     ev.t_ns = t_ns;
     return ev;
 }

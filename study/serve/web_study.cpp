@@ -1002,10 +1002,22 @@ json WebStudy::state(const Page& page) const {
         questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
     out["questions"] = questions;
     if (const TrialRow* t = flow.trial()) {
-        out["trial"] = t->task == Task::rating      ? rating_trial(*t)
-                       : t->task == Task::adjust    ? adjust_trial(*t)
-                       : t->task == Task::staircase ? staircase_trial(*t, flow)
-                                                    : choice_trial(*t, t->shown);
+        switch (t->task) {
+            case Task::rating:
+                out["trial"] = rating_trial(*t);
+                break;
+            case Task::adjust:
+                out["trial"] = adjust_trial(*t);
+                break;
+            case Task::staircase:
+                out["trial"] = staircase_trial(*t, flow);
+                break;
+            case Task::pair:
+            case Task::triad:
+            case Task::quadruple:
+                out["trial"] = choice_trial(*t, t->shown);
+                break;
+        }
     } else {
         const std::string& text = flow.text();
         out["text"] = text.empty() ? std::string("Press Enter.") : text;
