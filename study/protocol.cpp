@@ -846,6 +846,20 @@ std::string task_names_text() {
     return text;
 }
 
+bool is_choice_task(Task task) {
+    switch (task) {
+        case Task::pair:
+        case Task::triad:
+        case Task::quadruple:
+        case Task::staircase:
+            return true;
+        case Task::rating:
+        case Task::adjust:
+            return false;
+    }
+    return false;
+}
+
 bool is_scaling_task(Task task) {
     switch (task) {
         case Task::pair:

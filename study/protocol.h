@@ -74,6 +74,8 @@ const char* task_name(Task task);
 std::optional<Task> parse_task(std::string_view text);
 // A forced choice the scaling reads (paired comparisons, MLDS): pair, triad, quadruple.
 bool is_scaling_task(Task task);
+// A trial answered by choosing among its pictures: the scaling's kinds and staircase.
+bool is_choice_task(Task task);
 // The pictures one trial of the task shows: 1, 2, 3 or 4 (adjust: the target and the
 // match; staircase: 2, see Block::pictures() for an odd-one-out staircase's 3).
 int pictures_per_trial(Task task);
@@ -168,7 +170,7 @@ struct Block {
     // Picture count of one trial: pictures_per_trial, 3 for an odd-one-out staircase.
     int pictures() const;
     // Forced choices, answered 1..answers(): pair, triad, quadruple and staircase.
-    bool is_choice() const { return task != Task::rating && task != Task::adjust; }
+    bool is_choice() const { return is_choice_task(task); }
     // The number of answers of a trial: 2 (a choice), 3 (an odd-one-out staircase), 1
     // (an adjustment's confirmation), 0 (a rating: its [[questions]]).
     int answers() const;

@@ -868,8 +868,8 @@ WebReply WebStudy::answer(Page& page, const json& body) {
     const double onset_ms = *number_field(body, "onset_ms", 0, kMaxPageMs, true);
     const TrialRow& trial = *flow.trial();
     const Block* block = protocol_.find_block(trial.block);
-    const bool sequential = trial.task != Task::rating && trial.task != Task::adjust &&
-                            block && block->presentation == Presentation::sequential;
+    const bool sequential = is_choice_task(trial.task) && block &&
+                            block->presentation == Presentation::sequential;
     const std::optional<SequenceOnsets> sequence = sequence_onsets_of(body, sequential);
     const std::vector<AnswerEvent> replay =
         events_of(body, protocol_.questions, trial.task, block ? block->answers() : 2);

@@ -127,8 +127,7 @@ const Block* SessionFlow::block() const {
 }
 
 bool SessionFlow::choice_trial() const {
-    return current_ < trials_.size() && trials_[current_].task != Task::rating &&
-           trials_[current_].task != Task::adjust;
+    return current_ < trials_.size() && is_choice_task(trials_[current_].task);
 }
 
 adaptive::StaircaseBlock& SessionFlow::staircase_block(const Block& block) {
