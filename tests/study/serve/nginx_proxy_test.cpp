@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include <chrono>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -13,6 +14,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "tests/study/serve/web_page.h"
 
 namespace lucent::test {
 namespace {
@@ -67,12 +70,23 @@ protected:
         c->set_read_timeout(5);
         return c;
     }
-    // Who answered each of `n` GET /who through the proxy ("error N" for a failure).
+    // Who answered each of `n` GET /who through the proxy ("error N" for a failure). Each
+    // request is retried as the page retries (web_page.h: no reply, 502, 503, 504): on a
+    // loaded machine an upstream may be slow enough for nginx to give up on it once,
+    // which the page waits out; what is asserted is who finally answers.
     static std::map<std::string, int> who(const NginxProxy& proxy, int n) {
         auto c = client(proxy);
         std::map<std::string, int> seen;
         for (int i = 0; i < n; ++i) {
-            const auto r = c->Get("/who");
+            auto r = c->Get("/who");
+            for (std::size_t attempt = 0;
+                 attempt < lucent::test::kRetryDelaysMs.size() &&
+                 (!r || lucent::test::transient_status(r->status));
+                 ++attempt) {
+                std::this_thread::sleep_for(
+                    std::chrono::milliseconds(lucent::test::kRetryDelaysMs[attempt]));
+                r = c->Get("/who");
+            }
             if (!r)
                 ++seen["no reply: " + httplib::to_string(r.error())];
             else if (r->status != 200)
