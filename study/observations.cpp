@@ -110,19 +110,26 @@ StudyObservations read_observations(const std::string& db_path,
         row.participant = s.text(0);
         row.practice = s.integer(6) != 0;
         if (!out.selection.taken.count(s.integer(13))) continue;  // withdrawn, or status
-        if (options.analysis && (row.practice || !out.selection.keeps(s.integer(13))))
-            continue;
         row.session = s.text(1);
         row.trial = static_cast<int>(s.integer(2));
-        row.block = s.text(3);
         row.kind = s.text(4);
+        // A kind written by a build that had it is never read as another, even where
+        // the analysis would leave the row out.
+        const std::optional<Task> task = parse_task(row.kind);
+        if (!task)
+            throw StoreError(db_path + ": trial " + std::to_string(row.trial) +
+                             " of session " + row.session + " has kind '" + row.kind +
+                             "', which this build does not know (" + task_names_text() +
+                             ")");
+        if (options.analysis && (row.practice || !out.selection.keeps(s.integer(13))))
+            continue;
+        row.block = s.text(3);
         row.question = s.text(5);
         row.is_catch = s.integer(7) != 0;
         if (!s.is_null(8)) row.expected = static_cast<int>(s.integer(8));
         if (!s.is_null(11)) row.response = s.real(11);
         row.rt_ms = s.real(12);
-        const std::optional<Task> task = parse_task(row.kind);
-        if (task && is_scaling_task(*task)) {
+        if ((*task)->is_scaling()) {
             row.shown = shown_from_text(s.text(9));
             const Block* b = out.protocol ? out.protocol->find_block(row.block) : nullptr;
             for (std::size_t k = 0; b && !b->series.empty() && k < row.shown.size();
@@ -144,14 +151,13 @@ StudyObservations read_observations(const std::string& db_path,
             if (!s.is_null(10)) row.shown = {s.text(10)};
             if (!row.shown.empty()) row.factors = factors_of(row.shown.front(), stimuli);
         }
-        if (row.kind == "adjust") {
-            row.response = s.is_null(15) ? std::nullopt : std::optional(s.real(15));
-            if (!s.is_null(14)) row.measures["start_value"] = s.real(14);
-            row.measures["adjustments"] = static_cast<double>(s.integer(16));
-        } else if (row.kind == "staircase") {
-            row.procedure = s.text(17);
-            if (!s.is_null(18)) row.measures["intensity"] = s.real(18);
-        }
+        StoredTrialMeasures stored;
+        if (!s.is_null(14)) stored.start_value = s.real(14);
+        if (!s.is_null(15)) stored.final_value = s.real(15);
+        stored.adjustments = s.is_null(16) ? 0 : s.integer(16);
+        stored.staircase = s.text(17);
+        if (!s.is_null(18)) stored.intensity = s.real(18);
+        (*task)->observe(stored, row);
         out.table.rows.push_back(std::move(row));
     }
     return out;

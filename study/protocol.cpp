@@ -17,109 +17,12 @@
 #include "renderer/techniques/registry.h"
 #include "study/embedded_study_files.h"
 #include "study/sha256.h"
+#include "study/trials/block_keys.h"
+#include "study/trials/table_reader.h"
+#include "study/trials/trial_kind.h"
 
 namespace lucent::study {
 namespace {
-
-// Reads one TOML table, remembering which keys were used so unknown ones are reported.
-class TableReader {
-public:
-    TableReader(const toml::table& table, std::string path, const std::string& source)
-        : table_(table), path_(std::move(path)), source_(source) {}
-
-    [[noreturn]] void fail(const toml::node* node, const std::string& key,
-                           const std::string& reason) const {
-        throw ProtocolError(where(node, key) + ": " + reason);
-    }
-    // "p.toml:12:17: key 'analysis.primary_model'": where a key was written.
-    std::string where(const toml::node* node, const std::string& key) const {
-        const toml::source_region& at = node ? node->source() : table_.source();
-        std::ostringstream out;
-        out << source_ << ":" << at.begin.line << ":" << at.begin.column << ": key '"
-            << full(key) << "'";
-        return out.str();
-    }
-    std::string full(const std::string& key) const {
-        return path_.empty() ? key : path_ + "." + key;
-    }
-    const toml::node* get(const std::string& key) {
-        used_.insert(key);
-        return table_.get(key);
-    }
-    std::string string(const std::string& key, std::string fallback,
-                       bool required = false) {
-        const toml::node* node = get(key);
-        if (!node) {
-            if (required) fail(nullptr, key, "is required");
-            return fallback;
-        }
-        if (!node->is_string()) fail(node, key, "must be a string");
-        return std::string(*node->value<std::string>());
-    }
-    double number(const std::string& key, double fallback, double lo, double hi) {
-        const toml::node* node = get(key);
-        if (!node) return fallback;
-        std::optional<double> value = node->value<double>();
-        if (!value || !(node->is_integer() || node->is_floating_point()))
-            fail(node, key, "must be a number");
-        if (!std::isfinite(*value) || *value < lo || *value > hi) {
-            std::ostringstream range;
-            range << "must lie in [" << lo << ", " << hi << "], got " << *value;
-            fail(node, key, range.str());
-        }
-        return *value;
-    }
-    int integer(const std::string& key, int fallback, int lo, int hi) {
-        const toml::node* node = get(key);
-        if (node && !node->is_integer()) fail(node, key, "must be an integer");
-        return static_cast<int>(number(key, fallback, lo, hi));
-    }
-    bool boolean(const std::string& key, bool fallback) {
-        const toml::node* node = get(key);
-        if (!node) return fallback;
-        if (!node->is_boolean()) fail(node, key, "must be true or false");
-        return *node->value<bool>();
-    }
-    std::vector<std::string> strings(const std::string& key) {
-        std::vector<std::string> out;
-        const toml::node* node = get(key);
-        if (!node) return out;
-        const toml::array* array = node->as_array();
-        if (!array) fail(node, key, "must be an array of strings");
-        for (const toml::node& item : *array) {
-            if (!item.is_string()) fail(&item, key, "must be an array of strings");
-            out.emplace_back(*item.value<std::string>());
-        }
-        return out;
-    }
-    const toml::array* array(const std::string& key) {
-        const toml::node* node = get(key);
-        if (!node) return nullptr;
-        if (!node->is_array()) fail(node, key, "must be an array");
-        return node->as_array();
-    }
-    const toml::table* table(const std::string& key) {
-        const toml::node* node = get(key);
-        if (!node) return nullptr;
-        if (!node->is_table()) fail(node, key, "must be a table");
-        return node->as_table();
-    }
-    // Call after reading: any key not asked for is a typo or an unsupported option.
-    void reject_unknown() const {
-        for (const auto& [key, node] : table_) {
-            if (!used_.count(std::string(key.str())))
-                fail(&node, std::string(key.str()), "unknown key");
-        }
-    }
-    const toml::table& raw() const { return table_; }
-    const std::string& path() const { return path_; }
-
-private:
-    const toml::table& table_;
-    std::string path_;
-    const std::string& source_;
-    std::set<std::string> used_;
-};
 
 // A parameter's text as the database and the factor levels hold it: as written, numbers
 // in the shortest form that reads back to the same double ("25" for 25.0), arrays as
@@ -298,302 +201,7 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir,
     }
 }
 
-void check_stimulus_ref(const Protocol& p, TableReader& r, const std::string& key,
-                        const std::string& id) {
-    if (!p.find_stimulus(id))
-        r.fail(r.raw().get(key), key, "no stimulus with id '" + id + "'");
-}
-
-// What every block but a rating block has: its own question, answered by one
-// response; its stimuli distinct and free of whitespace (trials.shown holds them
-// space-separated).
-void read_block_question(const Protocol& p, TableReader& r, Block& b) {
-    const int n = static_cast<int>(b.stimuli.size());
-    for (const std::string& id : b.stimuli)
-        if (id.find_first_of(" \t\r\n") != std::string::npos)
-            r.fail(r.raw().get("stimuli"), "stimuli",
-                   "stimulus id '" + id +
-                       "' holds whitespace: a choice trial stores its "
-                       "stimuli space-separated");
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < i; ++j)
-            if (b.stimuli[i] == b.stimuli[j])
-                r.fail(r.raw().get("stimuli"), "stimuli",
-                       "stimulus '" + b.stimuli[i] + "' is listed twice in block '" +
-                           b.id + "'");
-    b.question = r.string("question", "", true);
-    b.question_id = r.string("question_id", b.id);
-    for (const Question& q : p.questions)
-        if (q.id == b.question_id)
-            r.fail(r.raw().get("question_id"), "question_id",
-                   "'" + b.question_id + "' is already a [[questions]] id");
-    for (const Block& other : p.blocks)
-        if (other.task != Task::rating && other.question_id == b.question_id)
-            r.fail(
-                r.raw().get("question_id"), "question_id",
-                "'" + b.question_id + "' is already block '" + other.id + "'s question");
-}
-
-// How a pair's (or a staircase's) pictures are shown and what its answers are called.
-void read_presentation(TableReader& r, Block& b, int pictures) {
-    const std::string presentation = r.string("presentation", "side_by_side");
-    if (presentation == "sequential")
-        b.presentation = Presentation::sequential;
-    else if (presentation != "side_by_side")
-        r.fail(r.raw().get("presentation"), "presentation",
-               "must be \"side_by_side\" or \"sequential\", got '" + presentation + "'");
-    b.labels = r.strings("labels");
-    // A sequence's pictures have no left and right: they come first, second (third).
-    const bool sequence = b.presentation == Presentation::sequential;
-    if (b.labels.empty()) {
-        if (b.task == Task::triad || b.task == Task::quadruple)
-            b.labels = {"first pair", "second pair"};
-        else if (pictures == 3)
-            b.labels = sequence ? std::vector<std::string>{"first", "second", "third"}
-                                : std::vector<std::string>{"left", "middle", "right"};
-        else
-            b.labels = sequence ? std::vector<std::string>{"first", "second"}
-                                : std::vector<std::string>{"left", "right"};
-    }
-    const size_t answers = b.task == Task::staircase ? static_cast<size_t>(pictures) : 2;
-    if (b.labels.size() != answers)
-        r.fail(r.raw().get("labels"), "labels",
-               answers == 2 ? "needs exactly two answers"
-                            : "needs exactly " + std::to_string(answers) + " answers");
-    b.duration_ms = r.integer("duration_ms", 1000, 50, 60000);
-    b.blank_ms = r.integer("blank_ms", 500, 0, 60000);
-}
-
-// The scalar knob `b.knob` of a live stimulus's technique; fails at `key` otherwise.
-Knob block_knob(const Protocol& p, TableReader& r, const Block& b,
-                const std::string& stimulus, const std::string& key) {
-    const StimulusSpec* s = p.find_stimulus(stimulus);
-    if (!s || !s->live())
-        r.fail(r.raw().get(key), key,
-               "'" + stimulus + "' must be a live stimulus (a technique): its knob '" +
-                   b.knob + "' is rendered at the participant's value");
-    const std::vector<Knob> knobs = knobs_for(find_technique(s->technique));
-    const Knob* knob = find_knob(knobs, b.knob);
-    if (!knob)
-        r.fail(r.raw().get("knob"), "knob",
-               "'" + b.knob + "' is not a knob of technique '" + s->technique + "'");
-    if (knob->kind != KnobKind::scalar)
-        r.fail(r.raw().get("knob"), "knob",
-               "'" + b.knob + "' is not a number (only a scalar knob can be turned)");
-    return *knob;
-}
-
-// A live stimulus's value of a scalar knob: its parameter, else the knob's default.
-double knob_value_of(const Protocol& p, const std::string& stimulus, const Knob& knob) {
-    if (const std::optional<double> v = p.numeric_parameter(stimulus, knob.name))
-        return *v;
-    return std::get<double>(knob.default_value);
-}
-
-// The keys of an adjust block (design notes: Block in protocol.h).
-void read_adjust_block(const Protocol& p, TableReader& r, Block& b) {
-    b.match = r.string("match", "", true);
-    check_stimulus_ref(p, r, "match", b.match);
-    b.knob = r.string("knob", "", true);
-    const Knob knob = block_knob(p, r, b, b.match, "match");
-    b.range_min = knob.min;
-    b.range_max = knob.max;
-    if (const toml::node* range = r.get("range")) {
-        const toml::array* a = range->as_array();
-        const bool numbers =
-            a && a->size() == 2 && std::all_of(a->begin(), a->end(), [](auto& n) {
-                return n.is_integer() || n.is_floating_point();
-            });
-        if (!numbers) r.fail(range, "range", "must be [min, max], two numbers");
-        b.range_min = *(*a)[0].value<double>();
-        b.range_max = *(*a)[1].value<double>();
-        if (!(b.range_min < b.range_max) || b.range_min < knob.min ||
-            b.range_max > knob.max)
-            r.fail(range, "range",
-                   "must be [min, max] with min < max inside the knob's range [" +
-                       common::shortest_text(knob.min) + ", " +
-                       common::shortest_text(knob.max) + "]");
-    }
-    b.scale = r.string("scale", "linear");
-    if (b.scale != "linear" && b.scale != "log")
-        r.fail(r.raw().get("scale"), "scale",
-               "must be \"linear\" or \"log\", got '" + b.scale + "'");
-    if (b.scale == "log" && !(b.range_min > 0))
-        r.fail(r.raw().get("scale"), "scale",
-               "a log scale needs a range above 0, got min " +
-                   common::shortest_text(b.range_min));
-    // Default steps: 1/20 and 1/200 of the range on the scale (a log step is in log10
-    // units, a factor 10^step).
-    const double width = b.scale == "log" ? std::log10(b.range_max / b.range_min)
-                                          : b.range_max - b.range_min;
-    b.step = r.number("step", width / 20, 0, width);
-    if (!(b.step > 0)) r.fail(r.raw().get("step"), "step", "must be above 0");
-    b.fine_step = r.number("fine_step", b.step / 10, 0, b.step);
-    if (!(b.fine_step > 0))
-        r.fail(r.raw().get("fine_step"), "fine_step", "must be above 0");
-    b.series_steps = r.integer(
-        "series_steps",
-        static_cast<int>(std::min(10000.0, std::round(width / b.fine_step))) + 1, 2,
-        10001);
-    b.start = "random";
-    if (const toml::node* start = r.get("start")) {
-        if (start->is_string()) {
-            b.start = *start->value<std::string>();
-            if (b.start != "random" && b.start != "min" && b.start != "max")
-                r.fail(start, "start",
-                       "must be \"random\", \"min\", \"max\" or a number, got '" +
-                           b.start + "'");
-        } else {
-            const double v = r.number("start", 0, b.range_min, b.range_max);
-            b.start = common::shortest_text(v);
-        }
-    }
-    for (const std::string& target : b.stimuli)
-        if (target == b.match)
-            r.fail(r.raw().get("match"), "match",
-                   "'" + b.match + "' is also a target of block '" + b.id + "'");
-}
-
-// The keys of one [[blocks.staircases]] entry.
-Block::Procedure read_procedure(TableReader& r, const Block& b, double max_delta) {
-    Block::Procedure s;
-    s.id = r.string("id", "", true);
-    if (s.id.find_first_of(" \t\r\n/") != std::string::npos)
-        r.fail(r.raw().get("id"), "id", "must not hold whitespace or '/'");
-    s.method = r.string("method", "updown");
-    if (s.method != "updown" && s.method != "quest")
-        r.fail(r.raw().get("method"), "method",
-               "must be \"updown\" or \"quest\", got '" + s.method + "'");
-    s.min_delta = r.number("min_delta", 0, 0, max_delta);
-    s.max_delta = r.number("max_delta", max_delta, 0, max_delta);
-    if (!(s.max_delta > s.min_delta))
-        r.fail(r.raw().get("max_delta"), "max_delta",
-               "must be above min_delta (" + common::shortest_text(s.min_delta) + ")");
-    s.start = r.number("start", 0, s.min_delta, s.max_delta);
-    if (!r.raw().get("start")) r.fail(nullptr, "start", "is required");
-    s.max_trials = r.integer("max_trials", 50, 1, 1000);
-    if (s.method == "updown") {
-        s.n_up = r.integer("n_up", 1, 1, 10);
-        s.n_down = r.integer("n_down", 3, 1, 10);
-        s.step_type = r.string("step_type", "lin");
-        if (s.step_type != "lin" && s.step_type != "log" && s.step_type != "db")
-            r.fail(r.raw().get("step_type"), "step_type",
-                   "must be \"lin\", \"log\" or \"db\", got '" + s.step_type + "'");
-        if (s.step_type != "lin" && !(s.start > 0))
-            r.fail(r.raw().get("start"), "start",
-                   "must be above 0 with " + s.step_type + " steps");
-        if (const toml::array* steps = r.array("step_sizes")) {
-            for (const toml::node& n : *steps) {
-                const std::optional<double> v = n.value<double>();
-                if (!v || !(n.is_integer() || n.is_floating_point()) ||
-                    !std::isfinite(*v) || !(*v > 0))
-                    r.fail(&n, "step_sizes", "must be numbers above 0");
-                s.step_sizes.push_back(*v);
-            }
-        }
-        if (s.step_sizes.empty())
-            r.fail(r.raw().get("step_sizes"), "step_sizes",
-                   "is required: the step after 0, 1, 2... reversals");
-        s.n_trials = r.integer("n_trials", 0, 0, 1000);
-        s.n_reversals = r.integer("n_reversals", 0, 0, 1000);
-        // PsychoPy runs to n_trials AND n_reversals (at least the step sizes' count).
-        const int reversals =
-            std::max<int>(s.n_reversals, static_cast<int>(s.step_sizes.size()));
-        if (s.max_trials < std::max(s.n_trials, reversals))
-            r.fail(r.raw().get("max_trials"), "max_trials",
-                   "must be at least n_trials and n_reversals (" +
-                       std::to_string(std::max(s.n_trials, reversals)) +
-                       "): the plan holds max_trials slots");
-    } else {
-        s.start_sd = r.number("start_sd", 0, 0, 1e300);
-        if (!(s.start_sd > 0))
-            r.fail(r.raw().get("start_sd"), "start_sd", "is required and above 0");
-        const double guess = b.staircase_trial == "oddity" ? 1.0 / 3 : 0.5;
-        s.p_threshold = r.number("p_threshold", guess == 0.5 ? 0.82 : 0.75, 0, 1);
-        if (!(s.p_threshold > guess) || !(s.p_threshold < 1))
-            r.fail(r.raw().get("p_threshold"), "p_threshold",
-                   "must lie between the guess rate (" + common::shortest_text(guess) +
-                       ") and 1");
-        s.beta = r.number("beta", 3.5, 1e-6, 1e6);
-        s.delta = r.number("delta", 0.01, 0, 0.5);
-        // Default grid: 500 grains over twice the deltas' range, so it covers every
-        // delta the block allows wherever the prior is centred.
-        s.quest_range = r.number("range", 0, 0, 1e300);
-        const double grid =
-            s.quest_range > 0 ? s.quest_range : 2 * (s.max_delta - s.min_delta);
-        s.grain = r.number("grain", grid / 500, 1e-12, grid);
-        if (!(s.grain > 0)) r.fail(r.raw().get("grain"), "grain", "must be above 0");
-        s.n_trials = r.integer("n_trials", s.max_trials, 1, 1000);
-        if (s.max_trials < s.n_trials)
-            r.fail(r.raw().get("max_trials"), "max_trials",
-                   "must be at least n_trials (" + std::to_string(s.n_trials) + ")");
-    }
-    r.reject_unknown();
-    return s;
-}
-
-// The keys of a staircase block (design notes: Block in protocol.h).
-void read_staircase_block(const Protocol& p, TableReader& r, Block& b) {
-    b.knob = r.string("knob", "", true);
-    b.direction = r.string("direction", "up");
-    if (b.direction != "up" && b.direction != "down")
-        r.fail(r.raw().get("direction"), "direction",
-               "must be \"up\" or \"down\", got '" + b.direction + "'");
-    // The room each standard leaves in the knob's range bounds the delta.
-    double room = std::numeric_limits<double>::infinity();
-    for (const std::string& standard : b.stimuli) {
-        const Knob knob = block_knob(p, r, b, standard, "stimuli");
-        const double value = knob_value_of(p, standard, knob);
-        room = std::min(room, b.direction == "up" ? knob.max - value : value - knob.min);
-    }
-    if (!(room > 0))
-        r.fail(r.raw().get("stimuli"), "stimuli",
-               "a standard's '" + b.knob + "' is at the end of the knob's range: no " +
-                   b.direction + "ward delta is possible");
-    b.staircase_trial = r.string("trial", "pair");
-    if (b.staircase_trial != "pair" && b.staircase_trial != "oddity")
-        r.fail(r.raw().get("trial"), "trial",
-               "must be \"pair\" or \"oddity\", got '" + b.staircase_trial + "'");
-    read_presentation(r, b, b.pictures());
-    // The flow's sequence has two parts (a pair's pictures), not three.
-    if (b.staircase_trial == "oddity" && b.presentation == Presentation::sequential)
-        r.fail(r.raw().get("presentation"), "presentation",
-               "an odd-one-out staircase is shown side by side (\"sequential\" shows two "
-               "pictures, not three)");
-    const toml::array* procedures = r.array("staircases");
-    if (!procedures || procedures->empty())
-        r.fail(procedures, "staircases",
-               "at least one [[blocks.staircases]] entry is required");
-    for (const toml::node& node : *procedures) {
-        if (!node.is_table()) r.fail(&node, "staircases", "must be tables");
-        TableReader pr(*node.as_table(), r.full("staircases"), p.source);
-        Block::Procedure s = read_procedure(pr, b, room);
-        for (const Block::Procedure& other : b.procedures)
-            if (other.id == s.id)
-                pr.fail(pr.raw().get("id"), "id",
-                        "duplicate staircase id '" + s.id + "'");
-        b.procedures.push_back(std::move(s));
-    }
-    double low = b.procedures.front().min_delta, high = b.procedures.front().max_delta;
-    double smallest_linear_step = std::numeric_limits<double>::infinity();
-    for (const Block::Procedure& s : b.procedures) {
-        low = std::min(low, s.min_delta);
-        high = std::max(high, s.max_delta);
-        if (s.method == "updown" && s.step_type == "lin")
-            for (double step : s.step_sizes)
-                smallest_linear_step = std::min(smallest_linear_step, step);
-    }
-    const double span = high - low;
-    b.ladder_step = r.number(
-        "ladder_step",
-        std::isfinite(smallest_linear_step) ? smallest_linear_step : span / 32, 0, span);
-    if (!(b.ladder_step > 0))
-        r.fail(r.raw().get("ladder_step"), "ladder_step", "must be above 0");
-}
-
-void read_choice_block(const Protocol& p, TableReader& r, Block& b);
-
-// The keys of a block by its task (design notes: Block in protocol.h).
+// The keys of a block by its task: the kind reads its own (trials/<kind>/).
 void read_block_task(const Protocol& p, TableReader& r, Block& b) {
     const std::string task = r.string("task", "rating");
     const std::optional<Task> parsed = parse_task(task);
@@ -601,83 +209,7 @@ void read_block_task(const Protocol& p, TableReader& r, Block& b) {
         r.fail(r.raw().get("task"), "task",
                "must be " + task_names_text() + ", got '" + task + "'");
     b.task = *parsed;
-    switch (b.task) {
-        case Task::rating:
-            return;
-        case Task::adjust:
-            read_block_question(p, r, b);
-            return read_adjust_block(p, r, b);
-        case Task::staircase:
-            read_block_question(p, r, b);
-            return read_staircase_block(p, r, b);
-        case Task::pair:
-        case Task::triad:
-        case Task::quadruple:
-            read_block_question(p, r, b);
-            return read_choice_block(p, r, b);
-    }
-}
-
-// The keys of a pair, triad or quadruple block (design notes: Block in protocol.h).
-void read_choice_block(const Protocol& p, TableReader& r, Block& b) {
-    const std::string task = task_name(b.task);
-    const int n = static_cast<int>(b.stimuli.size());
-    const int shown = pictures_per_trial(b.task);
-    if (n < shown)
-        r.fail(r.raw().get("stimuli"), "stimuli",
-               "a " + task + " block needs at least " + std::to_string(shown) +
-                   " stimuli, got " + std::to_string(n));
-    b.design = r.string("design", "all");
-    if (b.design != "all" && !(b.task == Task::pair && b.design == "cyclic"))
-        r.fail(r.raw().get("design"), "design",
-               b.task == Task::pair
-                   ? "must be \"all\" or \"cyclic\", got '" + b.design + "'"
-                   : "must be \"all\" for a " + task + " block, got '" + b.design + "'");
-    b.neighbours = r.integer("neighbours", 0, 0, 100000);
-    if (b.design == "cyclic") {
-        // (i, i+d) and (i, i+n-d) are the same pairs: d up to n/2 gives every pair once.
-        if (b.neighbours < 1 || b.neighbours > n / 2)
-            r.fail(r.raw().get("neighbours"), "neighbours",
-                   "a cyclic design needs 1 <= neighbours <= " + std::to_string(n / 2) +
-                       " for " + std::to_string(n) + " stimuli");
-    } else if (r.raw().get("neighbours")) {
-        r.fail(r.raw().get("neighbours"), "neighbours", "only a cyclic design has them");
-    }
-    read_presentation(r, b, shown);
-    b.identical_catch = r.integer("identical_catch", 0, 0, 1000);
-    if (b.identical_catch > 0 && b.task != Task::pair)
-        r.fail(r.raw().get("identical_catch"), "identical_catch",
-               "only pair blocks have identical-pair catch trials");
-    b.obvious_catch = r.strings("obvious_catch");
-    if (!b.obvious_catch.empty()) {
-        if (b.obvious_catch.size() != 2 || b.obvious_catch[0] == b.obvious_catch[1])
-            r.fail(r.raw().get("obvious_catch"), "obvious_catch",
-                   "must name two different stimuli: [low, high]");
-        for (const std::string& id : b.obvious_catch)
-            check_stimulus_ref(p, r, "obvious_catch", id);
-    }
-    b.obvious_catch_repeats =
-        r.integer("obvious_catch_repeats", b.obvious_catch.empty() ? 0 : 1, 0, 1000);
-    if (b.obvious_catch.empty() && b.obvious_catch_repeats > 0)
-        r.fail(r.raw().get("obvious_catch_repeats"), "obvious_catch_repeats",
-               "needs obvious_catch");
-    b.series = r.string("series", "");
-    if (!b.series.empty()) {
-        std::optional<double> previous;
-        for (const std::string& id : b.stimuli) {
-            const std::optional<double> v = p.numeric_parameter(id, b.series);
-            if (!v)
-                r.fail(
-                    r.raw().get("series"), "series",
-                    "stimulus '" + id + "' has no numeric parameter '" + b.series + "'");
-            if (b.task != Task::pair && previous && !(*v > *previous))
-                r.fail(r.raw().get("stimuli"), "stimuli",
-                       "an MLDS series must be listed in increasing '" + b.series +
-                           "': '" + id + "' does not follow its predecessor");
-            previous = v;
-        }
-    }
-    b.practice = r.integer("practice", 0, 0, 100);
+    b.task->read_block(p, r, b);
 }
 
 void read_trials(Protocol& p, TableReader& root) {
@@ -812,103 +344,34 @@ void read_online(Protocol& p, TableReader& root) {
 
 }  // namespace
 
-const char* task_name(Task task) {
-    switch (task) {
-        case Task::rating:
-            return "rating";
-        case Task::pair:
-            return "pair";
-        case Task::triad:
-            return "triad";
-        case Task::quadruple:
-            return "quadruple";
-        case Task::adjust:
-            return "adjust";
-        case Task::staircase:
-            return "staircase";
-    }
-    return "rating";
-}
+const char* task_name(Task task) { return task->name(); }
 
 std::optional<Task> parse_task(std::string_view text) {
-    for (Task t : kAllTasks)
+    for (Task t : all_tasks())
         if (text == task_name(t)) return t;
     return std::nullopt;
 }
 
 std::string task_names_text() {
+    const std::vector<Task> tasks = all_tasks();
     std::string text;
-    for (std::size_t i = 0; i < kAllTasks.size(); ++i)
-        text += std::string(i == 0                      ? ""
-                            : i + 1 == kAllTasks.size() ? " or "
-                                                        : ", ") +
-                "\"" + task_name(kAllTasks[i]) + "\"";
+    for (std::size_t i = 0; i < tasks.size(); ++i)
+        text += std::string(i == 0                  ? ""
+                            : i + 1 == tasks.size() ? " or "
+                                                    : ", ") +
+                "\"" + task_name(tasks[i]) + "\"";
     return text;
 }
 
-bool is_choice_task(Task task) {
-    switch (task) {
-        case Task::pair:
-        case Task::triad:
-        case Task::quadruple:
-        case Task::staircase:
-            return true;
-        case Task::rating:
-        case Task::adjust:
-            return false;
-    }
-    return false;
-}
+bool is_choice_task(Task task) { return task->is_choice(); }
 
-bool is_scaling_task(Task task) {
-    switch (task) {
-        case Task::pair:
-        case Task::triad:
-        case Task::quadruple:
-            return true;
-        case Task::rating:
-        case Task::adjust:
-        case Task::staircase:
-            return false;
-    }
-    return false;
-}
+bool is_scaling_task(Task task) { return task->is_scaling(); }
 
-int pictures_per_trial(Task task) {
-    switch (task) {
-        case Task::rating:
-            return 1;
-        case Task::pair:
-            return 2;
-        case Task::triad:
-            return 3;
-        case Task::quadruple:
-            return 4;
-        case Task::adjust:
-        case Task::staircase:
-            return 2;
-    }
-    return 1;
-}
+int pictures_per_trial(Task task) { return task->pictures_per_trial(); }
 
-int Block::pictures() const {
-    return task == Task::staircase && staircase_trial == "oddity"
-               ? 3
-               : pictures_per_trial(task);
-}
+int Block::pictures() const { return task->pictures(*this); }
 
-int Block::answers() const {
-    switch (task) {
-        case Task::rating:
-            return 0;
-        case Task::adjust:
-            return 1;
-        case Task::staircase:
-            return pictures();
-        default:
-            return 2;
-    }
-}
+int Block::answers() const { return task->answers(*this); }
 
 std::optional<double> Protocol::numeric_parameter(std::string_view stimulus,
                                                   const std::string& parameter) const {

@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "study/trials/trial_kind.h"
+
 namespace lucent::study {
 
 // Bad protocol text. what() is one line: "FILE:LINE:COL: key 'a.b': reason".
@@ -61,13 +63,8 @@ struct CatchTrial {
 // thresholds (issue 31): `adjust`, a live match object whose knob the participant turns
 // until it looks like a target picture; `staircase`, a forced choice between a standard
 // and the standard with a knob changed by a delta that an adaptive procedure chooses.
-enum class Task { rating, pair, triad, quadruple, adjust, staircase };
-// The closed family, listed once. Code that does something per kind switches over Task
-// with no default, and the build refuses a switch that misses a kind (-Werror=switch),
-// so a new kind is a compile error at every place that must handle it.
-inline constexpr std::array<Task, 6> kAllTasks = {Task::rating, Task::pair,
-                                                  Task::triad,  Task::quadruple,
-                                                  Task::adjust, Task::staircase};
+// Each is one folder and one line of trials/registry.cpp (trial_kind.h: the Task
+// handle and what a kind answers for itself).
 // "\"rating\", \"pair\", ... or \"staircase\"": every kind's name, for messages.
 std::string task_names_text();
 const char* task_name(Task task);

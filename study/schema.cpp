@@ -249,6 +249,18 @@ CREATE TABLE series_pictures (
     PRIMARY KEY (study_id, set_hash, picture));
 ALTER TABLE session_segments ADD COLUMN series_set TEXT;
 )sql",
+    // 10: trial kinds are a registry (study/trials/), so trials.kind may hold any
+    // registered kind's name: its CHECK of the six built-in names goes, and the store's
+    // rules (a kind this build does not know is refused on reading) guard it instead.
+    // SQLite cannot drop a CHECK with ALTER TABLE; it documents this edit of the
+    // table's SQL for removing one (lang_altertable.html, "Making Other Kinds Of Table
+    // Schema Changes"): no row changes, and migrate() bumps schema_version so every
+    // connection reads the new SQL. PostgreSQL drops the constraint by name.
+    R"sql(
+PRAGMA writable_schema = ON;
+UPDATE sqlite_schema SET sql = replace(sql, ', kind TEXT CHECK (kind IN (''rating'', ''pair'', ''triad'', ''quadruple'', ''adjust'', ''staircase''))', ', kind TEXT') WHERE type = 'table' AND name = 'trials';
+PRAGMA writable_schema = OFF;
+)sql",
 };
 static_assert(std::size(kMigrations) == kSchemaVersion);
 

@@ -10,7 +10,12 @@
 namespace lucent::study {
 
 inline constexpr int32_t kApplicationId = 0x4C55434E;  // "LUCN"
-inline constexpr int kSchemaVersion = 9;
+inline constexpr int kSchemaVersion = 10;
+// Schema 10 drops trials.kind's CHECK of the six built-in names: a kind is a registry
+// entry (study/trials/). The step edits the table's SQL in SQLite's sqlite_schema, so
+// each backend runs it its own way (migrate() in sqlite/database_file.cpp,
+// postgres_migrations).
+inline constexpr int kKindsFromRegistryVersion = 10;
 
 // Migration steps 1..kSchemaVersion; step i brings a store from version i-1 to i.
 const std::vector<std::string>& schema_migrations();

@@ -109,23 +109,18 @@ int simulated_choice(const ObserverModel& observer, const ChoiceStimuli& trial,
     std::vector<double> psi;
     for (double v : trial.values) psi.push_back(observer.scale(v, trial.lo, trial.hi));
     const double e = observer.sigma > 0 ? noise(rng) : 0.0;
-    switch (trial.task) {
-        case Task::pair: {
-            // Each picture its own noise: the difference has variance 2 sigma^2.
-            const double e2 = observer.sigma > 0 ? noise(rng) : 0.0;
-            const double sign = trial.more_is_lower ? -1.0 : 1.0;
-            return sign * psi[0] + e >= sign * psi[1] + e2 ? 1 : 2;
-        }
-        case Task::triad:
-            return std::abs(psi[1] - psi[0]) - std::abs(psi[2] - psi[1]) + e >= 0 ? 1 : 2;
-        case Task::quadruple:
-            return std::abs(psi[1] - psi[0]) - std::abs(psi[3] - psi[2]) + e >= 0 ? 1 : 2;
-        case Task::rating:
-        case Task::adjust:
-        case Task::staircase:
-            break;
+    if (trial.task == Task::pair) {
+        // Each picture its own noise: the difference has variance 2 sigma^2.
+        const double e2 = observer.sigma > 0 ? noise(rng) : 0.0;
+        const double sign = trial.more_is_lower ? -1.0 : 1.0;
+        return sign * psi[0] + e >= sign * psi[1] + e2 ? 1 : 2;
     }
-    return 1;
+    if (trial.task == Task::triad)
+        return std::abs(psi[1] - psi[0]) - std::abs(psi[2] - psi[1]) + e >= 0 ? 1 : 2;
+    if (trial.task == Task::quadruple)
+        return std::abs(psi[1] - psi[0]) - std::abs(psi[3] - psi[2]) + e >= 0 ? 1 : 2;
+    throw std::logic_error(std::string("simulated_choice: '") + task_name(trial.task) +
+                           "' is not a forced choice the scaling reads");
 }
 
 DetectionObserver DetectionObserver::parse(const std::string& text) {

@@ -20,48 +20,18 @@ void refuse_skipped_trial(const std::string& store, int64_t trial_id) {
                      " was skipped (its staircase had finished); refusing to record it");
 }
 
-namespace {
-
-// What an outcome carries beside its responses, by the trial's kind (schema 7).
-void check_kind_outcome(const std::string& where, const TrialAnswerFacts& facts,
-                        const TrialOutcome& outcome) {
-    const std::string kind = task_name(facts.kind);
+void refuse_outcome_columns(const std::string& where, Task kind,
+                            const TrialOutcome& outcome, OutcomeColumns carries) {
+    const std::string name = task_name(kind);
     const std::string a_kind =
-        std::string(facts.kind == Task::adjust ? "an " : "a ") + kind + " trial";
-    if (facts.kind == Task::adjust) {
-        if (!outcome.final_value)
-            throw StoreError(where + " is an adjust trial without a final value");
-        if (!std::isfinite(*outcome.final_value))
-            throw StoreError(where + " has a final value that is not finite");
-        for (size_t k = 0; k < outcome.adjustments.size(); ++k) {
-            const Adjustment& a = outcome.adjustments[k];
-            const std::string step = where + ": adjustment " + std::to_string(k + 1);
-            if (!std::isfinite(a.value))
-                throw StoreError(step + " has a value that is not finite");
-            if (a.input != "key" && a.input != "fine_key" && a.input != "wheel" &&
-                a.input != "drag")
-                throw StoreError(step + " has input '" + a.input +
-                                 "' (expected key, fine_key, wheel or drag)");
-            if (k > 0 && a.t_ns < outcome.adjustments[k - 1].t_ns)
-                throw StoreError(step + " is earlier than adjustment " +
-                                 std::to_string(k) + " (t_ns " + std::to_string(a.t_ns) +
-                                 " < " + std::to_string(outcome.adjustments[k - 1].t_ns) +
-                                 ")");
-        }
-    } else {
+        std::string(name.find_first_of("aeiou") == 0 ? "an " : "a ") + name + " trial";
+    if (!carries.final_value_and_adjustments) {
         if (outcome.final_value)
             throw StoreError(where + " is " + a_kind + " but carries a final value");
         if (!outcome.adjustments.empty())
             throw StoreError(where + " is " + a_kind + " but carries adjustments");
     }
-    if (facts.kind == Task::staircase) {
-        if (!outcome.intensity)
-            throw StoreError(where + " is a staircase trial without an intensity");
-        if (!std::isfinite(*outcome.intensity))
-            throw StoreError(where + " has an intensity that is not finite");
-        if (outcome.finishes_staircase && facts.staircase.empty())
-            throw StoreError(where + " finishes a staircase but was planned without one");
-    } else {
+    if (!carries.intensity) {
         if (outcome.intensity)
             throw StoreError(where + " is " + a_kind + " but carries an intensity");
         if (outcome.finishes_staircase)
@@ -69,7 +39,10 @@ void check_kind_outcome(const std::string& where, const TrialAnswerFacts& facts,
     }
 }
 
-}  // namespace
+void TrialKind::check_outcome(const std::string& where, const TrialAnswerFacts& facts,
+                              const TrialOutcome& outcome) const {
+    refuse_outcome_columns(where, facts.kind, outcome, {});
+}
 
 void check_trial_answer(const std::string& store, int64_t session_id, int64_t trial_id,
                         const TrialAnswerFacts& facts, const QuestionPoints& points,
@@ -88,7 +61,7 @@ void check_trial_answer(const std::string& store, int64_t session_id, int64_t tr
     if (outcome.responses.size() != points.size())
         throw StoreError(where + " has " + std::to_string(outcome.responses.size()) +
                          " ratings for " + std::to_string(points.size()) + " questions");
-    check_kind_outcome(where, facts, outcome);
+    facts.kind->check_outcome(where, facts, outcome);
 }
 
 void check_status_change(const std::string& store, const std::string& session_uuid,
@@ -228,14 +201,20 @@ std::optional<int> expected_rating_column(const PlannedTrial& trial) {
 
 Task task_column(const std::optional<std::string>& text) {
     if (!text) return Task::rating;
-    return parse_task(*text).value_or(Task::rating);
+    if (const std::optional<Task> task = parse_task(*text)) return *task;
+    // Written by a build with a kind this one lacks: never read as another kind.
+    throw StoreError("a trial's kind is '" + *text +
+                     "', which this build does not know (" + task_names_text() + ")");
 }
 
 std::string kind_column(const PlannedTrial& trial) { return task_name(trial.task); }
 
 std::optional<std::string> legacy_task_column(const PlannedTrial& trial) {
-    if (trial.task == Task::adjust || trial.task == Task::staircase) return std::nullopt;
-    return std::string(task_name(trial.task));
+    // Schema 6's CHECK on trials.task knows these four; every other kind leaves it NULL
+    // (trials.kind is the kind).
+    for (Task known : {Task::rating, Task::pair, Task::triad, Task::quadruple})
+        if (trial.task == known) return std::string(task_name(trial.task));
+    return std::nullopt;
 }
 
 std::optional<std::string> staircase_column(const PlannedTrial& trial) {

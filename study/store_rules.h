@@ -44,6 +44,15 @@ struct TrialAnswerFacts {
 void check_trial_answer(const std::string& store, int64_t session_id, int64_t trial_id,
                         const TrialAnswerFacts& facts, const QuestionPoints& points,
                         const TrialOutcome& outcome);
+// The outcome's columns only some kinds carry (schema 7), for TrialKind::check_outcome:
+// those a kind does not carry are refused (StoreError: "<where> is a rating trial but
+// carries a final value").
+struct OutcomeColumns {
+    bool final_value_and_adjustments = false;  // adjust
+    bool intensity = false;                    // staircase (and finishes_staircase)
+};
+void refuse_outcome_columns(const std::string& where, Task kind,
+                            const TrialOutcome& outcome, OutcomeColumns carries);
 // The refusal of a second answer to `trial_id`, for a store that finds the first one
 // only later (a server holding ratings for a journaled trial).
 [[noreturn]] void refuse_second_answer(const std::string& store, int64_t trial_id);
@@ -84,12 +93,13 @@ std::optional<std::string> shown_column(const PlannedTrial& trial);
 std::optional<int> expected_rating_column(const PlannedTrial& trial);
 // trials.task as read back (NULL: a rating, planned before schema 6). From schema 7
 // on readers read trials.kind, which the migration fills: read
-// coalesce(t.kind, t.task) and give it here.
+// coalesce(t.kind, t.task) and give it here. A kind this build does not know (a
+// build with another registry wrote it) throws StoreError naming it.
 Task task_column(const std::optional<std::string>& text);
 // The kind columns of a planned trial as both backends write them (schema 7):
 // trials.kind, its task's name; trials.task the same for the tasks its CHECK knows
-// (rating, pair, triad, quadruple; older readers see those as before), NULL for adjust
-// and staircase trials.
+// (rating, pair, triad, quadruple; older readers see those as before), NULL for every
+// other kind (adjust, staircase, a registered one).
 std::string kind_column(const PlannedTrial& trial);
 std::optional<std::string> legacy_task_column(const PlannedTrial& trial);
 // trials.staircase: a staircase slot's procedure; NULL for every other trial.

@@ -276,237 +276,16 @@ std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,
     return constrained_block_shuffles({levels}, c, rng, max_attempts).front();
 }
 
-namespace {
-
-PlannedTrial choice_trial(const Block& block, std::vector<std::string> shown) {
-    PlannedTrial t;
-    t.block = block.id;
-    t.task = block.task;
-    t.stimulus = shown.front();
-    t.shown = std::move(shown);
-    return t;
-}
-
-// `count` orientations (false: the design's order), half of them flipped; an odd one
-// out is flipped or not at random.
-std::vector<char> balanced_flips(size_t count, std::mt19937_64& rng) {
-    std::vector<char> flips(count);
-    for (size_t i = 0; i < count; ++i) flips[i] = i % 2 == 1;
-    if (count % 2 == 1) flips.back() = rng() % 2 == 1;
-    portable_shuffle(flips, rng);
-    return flips;
-}
-
-}  // namespace
-
-std::vector<PlannedTrial> choice_block_trials(const Block& block, std::mt19937_64& rng) {
-    const std::vector<std::string>& s = block.stimuli;
-    const int n = static_cast<int>(s.size());
-    // The design's groups, as indices into the series in increasing order.
-    std::vector<std::vector<int>> groups;
-    if (block.task == Task::pair && block.design == "cyclic") {
-        for (int d = 1; d <= block.neighbours; ++d)
-            for (int i = 0; i < n; ++i) {
-                // With n even, d = n/2 pairs each stimulus with its opposite once, not
-                // twice.
-                if (2 * d == n && i >= d) continue;
-                const int j = (i + d) % n;
-                groups.push_back({std::min(i, j), std::max(i, j)});
-            }
-    } else {
-        const int k = pictures_per_trial(block.task);
-        std::vector<int> g(k);
-        // Every increasing k-subset, in lexicographic order.
-        std::function<void(int, int)> choose = [&](int from, int depth) {
-            if (depth == k) {
-                groups.push_back(g);
-                return;
-            }
-            for (int i = from; i <= n - (k - depth); ++i) {
-                g[depth] = i;
-                choose(i + 1, depth + 1);
-            }
-        };
-        choose(0, 0);
-    }
-    // Screen order: a pair's order, a triad forwards or backwards, a quadruple's pairs
-    // which first; the two orientations of each group equally often over the repeats
-    // (and over the groups when the repeats are odd).
-    std::vector<PlannedTrial> trials;
-    auto oriented = [&](const std::vector<int>& g, bool flip) {
-        std::vector<std::string> shown;
-        if (block.task == Task::quadruple) {
-            const std::vector<int> order =
-                flip ? std::vector<int>{g[2], g[3], g[0], g[1]} : g;
-            for (int i : order) shown.push_back(s[i]);
-        } else {
-            for (int i : g) shown.push_back(s[i]);
-            if (flip) std::reverse(shown.begin(), shown.end());
-        }
-        return shown;
-    };
-    for (int r = 0; r + 1 < block.repeats; r += 2)
-        for (const std::vector<int>& g : groups) {
-            trials.push_back(choice_trial(block, oriented(g, false)));
-            trials.push_back(choice_trial(block, oriented(g, true)));
-        }
-    if (block.repeats % 2 == 1) {
-        const std::vector<char> flips = balanced_flips(groups.size(), rng);
-        for (size_t i = 0; i < groups.size(); ++i)
-            trials.push_back(choice_trial(block, oriented(groups[i], flips[i])));
-    }
-    // Identical pairs: no right answer (they measure a preference for a side); the
-    // stimuli taken in turn from a random start.
-    const size_t start = n > 0 ? uniform_below(rng, static_cast<uint64_t>(n)) : 0;
-    for (int i = 0; i < block.identical_catch; ++i) {
-        const std::string& id = s[(start + i) % n];
-        PlannedTrial t = choice_trial(block, {id, id});
-        t.is_catch = true;
-        t.catch_id = "identical";
-        trials.push_back(t);
-    }
-    if (!block.obvious_catch.empty()) {
-        const std::string& low = block.obvious_catch[0];
-        const std::string& high = block.obvious_catch[1];
-        const std::vector<char> flips = balanced_flips(block.obvious_catch_repeats, rng);
-        for (char flip : flips) {
-            std::vector<std::string> shown;
-            int expected = 0;
-            switch (block.task) {
-                case Task::pair:
-                    shown = {low, high};
-                    expected = 2;
-                    break;
-                case Task::triad:  // (low, low) against (low, high)
-                    shown = {low, low, high};
-                    expected = 2;
-                    break;
-                default:
-                    shown = {low, low, low, high};
-                    expected = 2;
-                    break;
-            }
-            if (flip) {
-                if (block.task == Task::quadruple)
-                    shown = {shown[2], shown[3], shown[0], shown[1]};
-                else
-                    std::reverse(shown.begin(), shown.end());
-                expected = 1;
-            }
-            PlannedTrial t = choice_trial(block, shown);
-            t.is_catch = true;
-            t.catch_id = "obvious";
-            t.expected = expected;
-            trials.push_back(t);
-        }
-    }
-    return trials;
-}
-
-std::vector<PlannedTrial> adjust_block_trials(const Block& block, std::mt19937_64& rng) {
-    std::vector<PlannedTrial> trials;
-    for (int r = 0; r < block.repeats; ++r)
-        for (const std::string& target : block.stimuli) {
-            PlannedTrial t;
-            t.block = block.id;
-            t.task = Task::adjust;
-            t.stimulus = target;
-            t.shown = {target, block.match};
-            t.start_value = adjust_start_value(block, rng);
-            trials.push_back(std::move(t));
-        }
-    return trials;
-}
-
-double adjust_start_value(const Block& block, std::mt19937_64& rng) {
-    if (block.start == "min") return block.range_min;
-    if (block.start == "max") return block.range_max;
-    if (block.start != "random") return std::stod(block.start);
-    // Uniform over the range on the scale, at one of the points of the browser's series
-    // (web_series.h), so the lab and the browser start from the same value.
-    const std::vector<double> points = adjust_series_values(block);
-    const double u = uniform_unit(rng);
-    return points[std::min(points.size() - 1,
-                           static_cast<size_t>(u * static_cast<double>(points.size())))];
-}
-
-std::vector<PlannedTrial> staircase_block_trials(const Block& block,
-                                                 std::mt19937_64& rng) {
-    struct Slots {
-        std::string standard, label;
-        std::vector<int> places;  // the comparison's place per slot, in order
-    };
-    const int k = block.pictures();
-    std::vector<Slots> procedures;
-    for (const std::string& standard : block.stimuli)
-        for (const Block::Procedure& p : block.procedures) {
-            Slots s{standard, standard + "/" + p.id, {}};
-            // Every place equally often; the remainder's places distinct, at random.
-            for (int i = 0; i < p.max_trials - p.max_trials % k; ++i)
-                s.places.push_back(1 + i % k);
-            std::vector<int> rest(k);
-            for (int i = 0; i < k; ++i) rest[i] = i + 1;
-            portable_shuffle(rest, rng);
-            for (int i = 0; i < p.max_trials % k; ++i) s.places.push_back(rest[i]);
-            portable_shuffle(s.places, rng);
-            procedures.push_back(std::move(s));
-        }
-    std::vector<PlannedTrial> trials;
-    std::vector<size_t> used(procedures.size(), 0);
-    for (;;) {
-        std::vector<size_t> round;
-        for (size_t i = 0; i < procedures.size(); ++i)
-            if (used[i] < procedures[i].places.size()) round.push_back(i);
-        if (round.empty()) break;
-        portable_shuffle(round, rng);
-        for (size_t i : round) {
-            PlannedTrial t;
-            t.block = block.id;
-            t.task = Task::staircase;
-            t.stimulus = procedures[i].standard;
-            t.shown.assign(k, procedures[i].standard);
-            t.staircase = procedures[i].label;
-            t.expected = procedures[i].places[used[i]++];
-            trials.push_back(std::move(t));
-        }
-    }
-    return trials;
-}
-
 std::string sequence_level(const PlannedTrial& trial,
                            const std::map<std::string, std::string>& level_of_stimulus) {
-    if (trial.task == Task::staircase)
-        return "staircase " + trial.block + " " + std::to_string(trial.position);
-    if (trial.task == Task::adjust || trial.shown.empty())
-        return level_of_stimulus.at(trial.stimulus);
-    std::vector<std::string> ids = trial.shown;
-    std::sort(ids.begin(), ids.end());
-    std::string level = "choice";
-    for (const std::string& id : ids) level += " " + id;
-    return level;
+    return trial.task->sequence_level(trial, level_of_stimulus);
 }
 
-namespace {
-
-// A block of another kind than rating: its trials as its kind plans them (ratings are
-// planned with the protocol's randomisation, in plan_trials).
-std::vector<PlannedTrial> planned_block_trials(const Block& block, std::mt19937_64& rng) {
-    switch (block.task) {
-        case Task::adjust:
-            return adjust_block_trials(block, rng);
-        case Task::staircase:
-            return staircase_block_trials(block, rng);
-        case Task::pair:
-        case Task::triad:
-        case Task::quadruple:
-            return choice_block_trials(block, rng);
-        case Task::rating:
-            break;
-    }
-    throw std::logic_error("rating blocks are planned by plan_trials");
+std::string TrialKind::sequence_level(
+    const PlannedTrial& trial,
+    const std::map<std::string, std::string>& level_of_stimulus) const {
+    return level_of_stimulus.at(trial.stimulus);
 }
-
-}  // namespace
 
 TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_number) {
     TrialPlan plan;
@@ -517,13 +296,14 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
         t.practice = true;
         plan.trials.push_back(t);
     }
-    // Practice of the forced choices: the first trials of each choice block's design
-    // in a random order of its own (a stream apart from the main order's, so adding
-    // practice does not change the main trials).
+    // Practice of a block's own task (the forced choices'): the first trials of its
+    // design in a random order of its own (a stream apart from the main order's, so
+    // adding practice does not change the main trials).
     std::mt19937_64 practice_rng(seed ^ 0x9e3779b97f4a7c15ULL);
     for (const Block& block : protocol.blocks) {
-        if (!block.is_choice() || block.practice == 0) continue;
-        std::vector<PlannedTrial> pool = choice_block_trials(block, practice_rng);
+        if (block.practice == 0) continue;
+        std::vector<PlannedTrial> pool =
+            block.task->plan_block(protocol, block, practice_rng);
         pool.erase(std::remove_if(pool.begin(), pool.end(),
                                   [](const PlannedTrial& t) { return t.is_catch; }),
                    pool.end());
@@ -551,36 +331,14 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
         const Block& block = protocol.blocks[b];
         plan.block_order.push_back(block.id);
         std::vector<PlannedTrial>& trials = block_trials.emplace_back();
-        if (block.task != Task::rating) {
-            // Its own stream per block, so the design of one block does not depend on
-            // the order of the others.
-            std::mt19937_64 design_rng(seed + 0x632be59bd9b4e019ULL * (b + 1));
-            trials = planned_block_trials(block, design_rng);
-            // A slot's level names its place in the block: unique, so the constraints
-            // never hold a staircase's rounds back.
-            for (size_t i = 0; i < trials.size(); ++i)
-                trials[i].position = static_cast<int>(i);
-            continue;
-        }
-        for (int r = 0; r < block.repeats; ++r)
-            for (const std::string& id : block.stimuli) {
-                PlannedTrial t;
-                t.block = block.id;
-                t.stimulus = id;
-                trials.push_back(t);
-            }
-        for (const CatchTrial& c : protocol.catch_trials) {
-            if (c.block != block.id) continue;
-            PlannedTrial t;
-            t.block = block.id;
-            t.stimulus = c.stimulus;
-            t.is_catch = true;
-            t.catch_id = c.id;
-            t.prompt = c.prompt;
-            t.expected = c.expected;
-            t.tolerance = c.tolerance;
-            trials.push_back(t);
-        }
+        // Its own stream per block, so the design of one block does not depend on the
+        // order of the others.
+        std::mt19937_64 design_rng(seed + 0x632be59bd9b4e019ULL * (b + 1));
+        trials = block.task->plan_block(protocol, block, design_rng);
+        // A slot's level names its place in the block: unique, so the constraints never
+        // hold a staircase's rounds back.
+        for (size_t i = 0; i < trials.size(); ++i)
+            trials[i].position = static_cast<int>(i);
     }
     if (rz.shuffle) {
         const SequenceConstraints constraints{rz.max_repeat, rz.min_distance};
@@ -606,8 +364,7 @@ TrialPlan plan_trials(const Protocol& protocol, uint64_t seed, int participant_n
         for (size_t b = 0; b < block_trials.size(); ++b) {
             // A staircase block keeps its rounds (its slots' levels are unique, so any
             // order of them meets the constraints).
-            if (protocol.find_block(plan.block_order[b])->task == Task::staircase)
-                continue;
+            if (!protocol.find_block(plan.block_order[b])->task->shuffled()) continue;
             std::vector<PlannedTrial> shuffled;
             for (int i : orders[b]) shuffled.push_back(block_trials[b][i]);
             block_trials[b] = std::move(shuffled);

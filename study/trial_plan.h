@@ -107,29 +107,6 @@ std::vector<int> constrained_shuffle(const std::vector<std::string>& levels,
                                      const SequenceConstraints& c, uint64_t seed,
                                      int max_attempts = kMaxShuffleAttempts);
 
-// The trials of a forced-choice block in design order, before shuffling: every pair or
-// group of block.design, `repeats` times, its screen order counterbalanced (a pair's two
-// orders, a triad forwards and backwards, a quadruple's pairs either first, each equally
-// often over the block, odd counts split at random), then the catch trials.
-std::vector<PlannedTrial> choice_block_trials(const Block& block, std::mt19937_64& rng);
-
-// An adjust block's trials in design order, before shuffling: each target `repeats`
-// times, each with its start value (adjust_start_value).
-std::vector<PlannedTrial> adjust_block_trials(const Block& block, std::mt19937_64& rng);
-// Where an adjust trial's match starts: block.start's number, range_min ("min"),
-// range_max ("max"), or ("random") uniform over the range on the block's scale (its
-// logarithm for "log"), at a point of the browser's series (adjust_series_values: one of
-// Block::series_steps evenly spaced points), so both start from the same values.
-double adjust_start_value(const Block& block, std::mt19937_64& rng);
-
-// A staircase block's slots in their final order (not shuffled again): for each
-// standard and [[blocks.staircases]] entry a procedure "<standard>/<id>" with max_trials
-// slots, laid out in rounds, each round a random order of the procedures with slots
-// left; each procedure's comparison place balanced over its slots (every place equally
-// often, a remainder at random).
-std::vector<PlannedTrial> staircase_block_trials(const Block& block,
-                                                 std::mt19937_64& rng);
-
 // A trial's level for the sequence constraints: a rating's (and an adjustment's
 // target's) level of the protocol's factor; a forced choice's unordered set of stimuli
 // (the same pair is one level); a staircase slot's own level (its order is its

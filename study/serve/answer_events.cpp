@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 
 #include "study/serve/request_fields.h"
@@ -176,20 +177,15 @@ AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
                     std::string(task == Task::rating ? "a rating" : "a forced choice"));
     }
     AnswerEvent ev;
-    switch (task) {
-        case Task::rating:
-            ev = rating_event_of(e, type, questions, max_points);
-            break;
-        case Task::adjust:
-            ev = adjust_event_of(e, type);
-            break;
-        case Task::pair:
-        case Task::triad:
-        case Task::quadruple:
-        case Task::staircase:
-            ev = choice_event_of(e, type, task, alternatives);
-            break;
-    }
+    if (task->rated_on_questions())
+        ev = rating_event_of(e, type, questions, max_points);
+    else if (task == Task::adjust)
+        ev = adjust_event_of(e, type);
+    else if (task->is_choice())
+        ev = choice_event_of(e, type, task, alternatives);
+    else
+        throw std::logic_error(std::string("trial kind '") + task_name(task) +
+                               "' has no answer events");
     ev.t_ns = t_ns;
     return ev;
 }

@@ -1002,22 +1002,17 @@ json WebStudy::state(const Page& page) const {
         questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
     out["questions"] = questions;
     if (const TrialRow* t = flow.trial()) {
-        switch (t->task) {
-            case Task::rating:
-                out["trial"] = rating_trial(*t);
-                break;
-            case Task::adjust:
-                out["trial"] = adjust_trial(*t);
-                break;
-            case Task::staircase:
-                out["trial"] = staircase_trial(*t, flow);
-                break;
-            case Task::pair:
-            case Task::triad:
-            case Task::quadruple:
-                out["trial"] = choice_trial(*t, t->shown);
-                break;
-        }
+        if (t->task == Task::rating)
+            out["trial"] = rating_trial(*t);
+        else if (t->task == Task::adjust)
+            out["trial"] = adjust_trial(*t);
+        else if (t->task == Task::staircase)
+            out["trial"] = staircase_trial(*t, flow);
+        else if (t->task->is_scaling())
+            out["trial"] = choice_trial(*t, t->shown);
+        else
+            throw std::logic_error(std::string("trial kind '") + task_name(t->task) +
+                                   "' has no page");
     } else {
         const std::string& text = flow.text();
         out["text"] = text.empty() ? std::string("Press Enter.") : text;

@@ -110,7 +110,23 @@ void migrate(Database& db, int target) {
     Transaction tx(db);
     if (current == 0)
         db.exec("PRAGMA application_id = " + std::to_string(kApplicationId));
-    for (int v = current + 1; v <= target; ++v) db.exec(schema_migrations()[v - 1]);
+    for (int v = current + 1; v <= target; ++v) {
+        db.exec(schema_migrations()[v - 1]);
+        if (v == kKindsFromRegistryVersion) {
+            // The step edited sqlite_schema: a new schema cookie makes every connection
+            // (this one too) read the table's SQL again.
+            db.exec("PRAGMA schema_version = " +
+                    std::to_string(db.scalar_int("PRAGMA schema_version") + 1));
+            Statement trials =
+                db.prepare("SELECT sql FROM sqlite_schema WHERE name = 'trials'");
+            if (trials.step() &&
+                trials.text(0).find("CHECK (kind IN") != std::string::npos)
+                throw StoreError(
+                    db.path() +
+                    ": schema 10 could not drop trials.kind's CHECK (the "
+                    "table's SQL is not as schema 7 wrote it); left unchanged");
+        }
+    }
     db.exec("PRAGMA user_version = " + std::to_string(target));
     tx.commit();
 }

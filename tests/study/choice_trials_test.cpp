@@ -1,6 +1,8 @@
 // Forced-choice trials (issue 30): the protocol's pair, triad and quadruple blocks, the
 // designs they generate, and how a SQLite store keeps, exports and merges the choices.
 // Expected counts are combinatorics (C(n, k)), written out, never the planner's output.
+#include "study/trials/choice/choice_trials.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -13,6 +13,7 @@
 #include "study/protocol.h"
 #include "study/session/session_flow.h"
 #include "study/trial_plan.h"
+#include "study/trials/adjust/adjust_trials.h"
 #include "study/web_series.h"
 
 namespace lucent::study {

@@ -524,16 +524,10 @@ TEST_F(MatchingStation, AnOfflineStationsAdjustAndFinishingStaircaseReachTheServ
 // trial's kind from its task (NULL: a rating), as on a file (store_test.cpp).
 TEST_F(MatchingStation, AServerOfSchema6MigratesFillingEachTrialsKindFromItsTask) {
     const std::string uri = lucent::test::new_postgres_database("matching_schema_6");
+    lucent::test::migrate_server_to(uri, 6);
     {
         pqxx::connection c(uri);
         pqxx::work tx(c);
-        tx.exec(
-            "CREATE TABLE lucent_schema (application_id BIGINT NOT NULL, version INTEGER "
-            "NOT NULL)");
-        const std::vector<std::string> steps = postgres_migrations();
-        for (int v = 1; v <= 6; ++v) tx.exec(steps[v - 1]);
-        tx.exec_params("INSERT INTO lucent_schema VALUES ($1, 6)",
-                       static_cast<int64_t>(kApplicationId));
         tx.exec(R"sql(
 INSERT INTO studies (id, name, protocol_text, protocol_hash, created_utc)
     VALUES (1, 's', 'x', 'h', 'now');

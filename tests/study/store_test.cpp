@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "study/export.h"
+#include "study/observations.h"
 #include "study/sqlite/sqlite_store.h"
 #include "tests/study/study_fixtures.h"
 #include "tests/support/test_paths.h"
@@ -227,6 +228,68 @@ TEST(Store, MigratesASchema8DatabaseKeepingItsPageDeclinesBesideTheNewCodes) {
     EXPECT_EQ(declined_consent_figure(db),
               "1 participant code declined consent, and 401 consent declines counted "
               "per page before schema 9 (page loads, not people)");
+}
+
+// Schema 10 on a file an older build left at schema 9: trials.kind's CHECK of the six
+// built-in names is gone (a kind is a registry entry), no row moved, and a kind this
+// build does not know is refused when read, never taken for another.
+TEST(Store, MigratesASchema9DatabaseDroppingTheKindCheckAndRefusesAnUnknownKind) {
+    const auto dir = lucent::test::scratch_dir("store_migrate_9");
+    const std::string path = (dir / "old.db").string();
+    const Protocol p = lucent::test::choice_protocol();
+    int64_t trials = 0, responses = 0, session = 0;
+    auto trials_sql = [](Database& db) {
+        Statement s = db.prepare("SELECT sql FROM sqlite_schema WHERE name = 'trials'");
+        return s.step() ? s.text(0) : std::string();
+    };
+    {
+        Store store(path);
+        session = lucent::test::run_full_session(store, p, "P1", 3);
+        Database& db = store.db();
+        trials = db.scalar_int("SELECT count(*) FROM trials");
+        responses = db.scalar_int("SELECT count(*) FROM responses");
+        lucent::test::downgrade_schema(db, 9);
+        ASSERT_NE(trials_sql(db).find("CHECK (kind IN"), std::string::npos);
+        EXPECT_THROW(db.exec("UPDATE trials SET kind = 'probe' WHERE id = 1"),
+                     StoreError);
+    }
+    Store store(path);
+    Database& db = store.db();
+    EXPECT_EQ(db.scalar_int("PRAGMA user_version"), kSchemaVersion);
+    EXPECT_EQ(trials_sql(db).find("CHECK (kind IN"), std::string::npos) << trials_sql(db);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM trials"), trials);
+    EXPECT_EQ(db.scalar_int("SELECT count(*) FROM responses"), responses);
+    {
+        Statement check = db.prepare("PRAGMA integrity_check");
+        ASSERT_TRUE(check.step());
+        EXPECT_EQ(check.text(0), "ok");
+    }
+    // The other CHECKs stay (skipped's, task's).
+    EXPECT_THROW(db.exec("UPDATE trials SET skipped = 2 WHERE id = 1"), StoreError);
+    const int64_t answered = db.scalar_int(
+        "SELECT min(t.id) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE "
+        "t.session_id = " +
+        std::to_string(session) + " AND t.kind = 'pair'");
+    db.exec("UPDATE trials SET kind = 'probe' WHERE id = " + std::to_string(answered));
+    try {
+        store.trials(session);
+        ADD_FAILURE() << "a trial of an unknown kind was read";
+    } catch (const StoreError& e) {
+        EXPECT_NE(std::string(e.what()).find("kind is 'probe', which this build does not "
+                                             "know"),
+                  std::string::npos)
+            << e.what();
+    }
+    try {
+        read_observations(path, {});
+        ADD_FAILURE() << "an observation of an unknown kind was read";
+    } catch (const StoreError& e) {
+        EXPECT_NE(
+            std::string(e.what()).find("has kind 'probe', which this build does not "
+                                       "know"),
+            std::string::npos)
+            << e.what();
+    }
 }
 
 // Schema 7 (issue 31) on a file an older build left at schema 6: trials.kind filled from

@@ -5,7 +5,13 @@
 
 #include <atomic>
 #include <cctype>
+#include <cstdint>
 #include <memory>
+#include <pqxx/pqxx>
+#include <vector>
+
+#include "study/postgres/postgres_store.h"
+#include "study/schema.h"
 
 namespace lucent::test {
 namespace {
@@ -30,6 +36,19 @@ std::string new_postgres_database(const std::string& hint) {
     for (char c : hint.substr(0, 40))
         name += std::isalnum(static_cast<unsigned char>(c)) ? char(std::tolower(c)) : '_';
     return g_server->create_database(name);
+}
+
+void migrate_server_to(const std::string& uri, int version) {
+    pqxx::connection c(uri);
+    pqxx::work tx(c);
+    tx.exec(
+        "CREATE TABLE lucent_schema (application_id BIGINT NOT NULL, version INTEGER NOT "
+        "NULL)");
+    const std::vector<std::string> steps = study::postgres_migrations();
+    for (int v = 1; v <= version; ++v) tx.exec(steps[v - 1]);
+    tx.exec_params("INSERT INTO lucent_schema VALUES ($1, $2)",
+                   static_cast<int64_t>(study::kApplicationId), version);
+    tx.commit();
 }
 
 }  // namespace lucent::test

@@ -12,5 +12,8 @@ namespace lucent::test {
 study::LocalPostgres& postgres_server();
 // A new, empty database on it, named after `hint` (made unique); returns its URI.
 std::string new_postgres_database(const std::string& hint);
+// The server at `uri` brought to schema `version` only, as an older release left it:
+// the first `version` migrations and lucent_schema saying so.
+void migrate_server_to(const std::string& uri, int version);
 
 }  // namespace lucent::test

@@ -1027,17 +1027,34 @@ TEST_F(Server, SnapshotHoldsEveryRowTheServerHolds) {
 // Schema 9 on a server an older build left at schema 8: `lucent store init` adds
 // declined_codes and keeps what schema 8 counted (per page) and the pages it kept
 // declined; the report names both for what they are.
+// Schema 10 on a server an older build left at schema 9: trials.kind's CHECK of the
+// six built-in names is dropped (a kind is a registry entry), and only that one.
+TEST_F(Server, ASchema9ServerMigratesDroppingOnlyTheKindCheck) {
+    auto checks = [&] {
+        pqxx::connection c(uri_);
+        pqxx::work tx(c);
+        std::set<std::string> names;
+        for (const auto& row : tx.exec(
+                 "SELECT conname FROM pg_constraint WHERE contype = 'c' AND conrelid = "
+                 "'trials'::regclass"))
+            names.insert(row[0].as<std::string>());
+        return names;
+    };
+    lucent::test::migrate_server_to(uri_, 9);
+    std::set<std::string> before = checks();
+    ASSERT_TRUE(before.count("trials_kind_check")) << before.size();
+    EXPECT_EQ(init_study_store(uri_), std::make_pair(9, kSchemaVersion));
+    std::set<std::string> after = checks();
+    before.erase("trials_kind_check");
+    EXPECT_EQ(after, before);
+    EXPECT_FALSE(after.empty());  // task's, skipped's... stay
+}
+
 TEST_F(Server, ASchema8ServerMigratesKeepingItsPageDeclinesBesideTheNewCodes) {
+    lucent::test::migrate_server_to(uri_, 8);
     {
         pqxx::connection c(uri_);
         pqxx::work tx(c);
-        tx.exec(
-            "CREATE TABLE lucent_schema (application_id BIGINT NOT NULL, version INTEGER "
-            "NOT NULL)");
-        const std::vector<std::string> steps = postgres_migrations();
-        for (int v = 1; v <= 8; ++v) tx.exec(steps[v - 1]);
-        tx.exec_params("INSERT INTO lucent_schema VALUES ($1, 8)",
-                       static_cast<int64_t>(kApplicationId));
         tx.exec(R"sql(
 INSERT INTO studies (id, name, protocol_text, protocol_hash, created_utc)
     VALUES (1, 's', 'x', 'h', 'now');

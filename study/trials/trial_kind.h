@@ -1,0 +1,122 @@
+#pragma once
+// What one block's trials ask, as one family listed once (trials/registry.cpp), in the
+// way techniques are one folder and one registry line: a kind's folder holds how its
+// block is read from a protocol and how its trials are planned; the rest of the study
+// asks the kind instead of naming it. A test may register a kind of its own
+// (TrialKindRegistration). README.md in this folder says what is still dispatched by
+// name, and why.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <random>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lucent::common {
+struct Observation;
+}
+
+namespace lucent::study {
+
+struct Block;
+struct PlannedTrial;
+struct Protocol;
+class TableReader;
+class TrialKind;
+struct TrialAnswerFacts;
+struct TrialOutcome;
+
+// A trial's own stored columns beside its responses (schema 7), as an observation reads
+// them.
+struct StoredTrialMeasures {
+    std::optional<double> start_value, final_value, intensity;
+    std::int64_t adjustments = 0;  // rows in `adjustments`
+    std::string staircase;         // trials.staircase ("" when NULL)
+};
+
+// A handle on one registered kind: a small value, cheap to copy and compare, that names
+// one entry of the registry (the idea of pbrt's TaggedPointer: a closed family listed
+// once). The built-in kinds have constants, in the registry's order; a kind registered
+// later gets the next index.
+class Task {
+public:
+    static const Task rating, pair, triad, quadruple, adjust, staircase;
+    constexpr Task() = default;  // rating
+    constexpr explicit Task(std::uint8_t index) : index_(index) {}
+    const TrialKind& kind() const;
+    const TrialKind* operator->() const { return &kind(); }
+    constexpr std::uint8_t index() const { return index_; }
+    friend constexpr bool operator==(Task a, Task b) { return a.index_ == b.index_; }
+    friend constexpr bool operator<(Task a, Task b) { return a.index_ < b.index_; }
+
+private:
+    std::uint8_t index_ = 0;
+};
+inline constexpr Task Task::rating{0};
+inline constexpr Task Task::pair{1};
+inline constexpr Task Task::triad{2};
+inline constexpr Task Task::quadruple{3};
+inline constexpr Task Task::adjust{4};
+inline constexpr Task Task::staircase{5};
+
+class TrialKind {
+public:
+    virtual ~TrialKind() = default;
+    // The name a protocol's `task` and the database's trials.kind hold.
+    virtual const char* name() const = 0;
+    // Answered by choosing among its pictures (responses.rating holds 1..answers()).
+    virtual bool is_choice() const = 0;
+    // A forced choice the scaling reads (paired comparisons, MLDS).
+    virtual bool is_scaling() const = 0;
+    // Rated on the protocol's [[questions]] (the kind that catch trials and practice
+    // stimuli belong to); every other kind asks its block's own question.
+    virtual bool rated_on_questions() const { return false; }
+    // The pictures of one trial: the kind's usual count, and a block's (a block's keys
+    // may change it, as an odd-one-out staircase's 3).
+    virtual int pictures_per_trial() const = 0;
+    virtual int pictures(const Block&) const { return pictures_per_trial(); }
+    // The answers of one trial: 0 (the [[questions]]), 1 (a confirmation), 2 or more.
+    virtual int answers(const Block& block) const = 0;
+
+    // The block's own keys, read after its id, stimuli and repeats; the reader refuses
+    // any key nobody asked for once the block is read.
+    virtual void read_block(const Protocol& protocol, TableReader& keys,
+                            Block& block) const = 0;
+    // The block's trials in its design's order, drawn from the block's own stream.
+    virtual std::vector<PlannedTrial> plan_block(const Protocol& protocol,
+                                                 const Block& block,
+                                                 std::mt19937_64& rng) const = 0;
+    // False: the protocol's shuffle keeps the planned order (a staircase's rounds).
+    virtual bool shuffled() const { return true; }
+    // A trial's level for the shuffle's constraints (max_repeat, min_distance): by
+    // default the level of its stimulus under the randomisation's factor.
+    virtual std::string sequence_level(
+        const PlannedTrial& trial,
+        const std::map<std::string, std::string>& level_of_stimulus) const;
+
+    // What an answer of this kind carries beside its responses (a final value and
+    // adjustments, an intensity), checked before any store writes it; throws
+    // StoreError naming `where`. By default it carries none of them
+    // (refuse_outcome_columns in store_rules.h).
+    virtual void check_outcome(const std::string& where, const TrialAnswerFacts& facts,
+                               const TrialOutcome& outcome) const;
+    // The observation's part that only this kind's trials have, from their stored
+    // columns (an adjustment's final value as its response; a staircase's procedure).
+    virtual void observe(const StoredTrialMeasures&, common::Observation&) const {}
+};
+
+// Every registered kind, built-ins first in the order of the Task constants.
+std::vector<Task> all_tasks();
+// Registers a kind (a test's own): its Task is the next index. Kept for the program's
+// life; a second kind of the same name is refused (std::logic_error).
+class TrialKindRegistration {
+public:
+    explicit TrialKindRegistration(const TrialKind& kind);
+    Task task() const { return task_; }
+
+private:
+    Task task_;
+};
+
+}  // namespace lucent::study
