@@ -160,32 +160,40 @@ AnswerEvent event_of(const json& e, const std::vector<Question>& questions,
     if (!e.is_object()) throw RequestError(400, "each event must be an object");
     const int64_t t_ns = ms_to_ns(*number_field(e, "t_ms", 0, kMaxPageMs, true));
     const std::string type = text_field(e, "type", 16, true);
-    if (task != Task::adjust) {
+    const TrialScreen screen = task->screen();
+    if (screen != TrialScreen::adjust) {
         // An adjustment's input on any other trial: refused, never ignored.
+        const std::string this_trial =
+            screen == TrialScreen::scales
+                ? std::string(task == Task::rating
+                                  ? "a rating"
+                                  : std::string("a rating (") + task_name(task) + ")")
+                : std::string("a forced choice (") + task_name(task) + ")";
         if (type == "wheel" || type == "drag")
-            throw RequestError(
-                400,
-                "field 'type': a '" + type + "' event adjusts a match; this trial is " +
-                    (task == Task::rating
-                         ? std::string("a rating")
-                         : std::string("a forced choice (") + task_name(task) + ")"));
+            throw RequestError(400, "field 'type': a '" + type +
+                                        "' event adjusts a match; this trial is " +
+                                        this_trial);
         if (const json* shift = field(e, "shift"); shift && *shift != json(false))
             throw RequestError(
                 400,
                 "field 'shift' is only for an adjustment's arrows; this "
                 "trial is " +
-                    std::string(task == Task::rating ? "a rating" : "a forced choice"));
+                    std::string(screen == TrialScreen::scales ? "a rating"
+                                                              : "a forced choice"));
     }
     AnswerEvent ev;
-    if (task->rated_on_questions())
-        ev = rating_event_of(e, type, questions, max_points);
-    else if (task == Task::adjust)
-        ev = adjust_event_of(e, type);
-    else if (task->is_choice())
-        ev = choice_event_of(e, type, task, alternatives);
-    else
-        throw std::logic_error(std::string("trial kind '") + task_name(task) +
-                               "' has no answer events");
+    switch (screen) {
+        case TrialScreen::scales:
+            ev = rating_event_of(e, type, questions, max_points);
+            break;
+        case TrialScreen::adjust:
+            ev = adjust_event_of(e, type);
+            break;
+        case TrialScreen::choice:
+        case TrialScreen::staircase:
+            ev = choice_event_of(e, type, task, alternatives);
+            break;
+    }
     ev.t_ns = t_ns;
     return ev;
 }

@@ -872,7 +872,8 @@ WebReply WebStudy::answer(Page& page, const json& body) {
                             block->presentation == Presentation::sequential;
     const std::optional<SequenceOnsets> sequence = sequence_onsets_of(body, sequential);
     const std::vector<AnswerEvent> replay =
-        events_of(body, protocol_.questions, trial.task, block ? block->answers() : 2);
+        events_of(body, trial.task->questions(protocol_, block), trial.task,
+                  block ? block->answers() : 2);
 
     SessionFlow next =
         replayed(flow, onset_ms, sequence, replay, protocol_.inter_trial_ms);
@@ -885,7 +886,11 @@ WebReply WebStudy::answer(Page& page, const json& body) {
 // ---- [SECTION] the state a page shows -------------------------------------------------
 json WebStudy::rating_trial(const TrialRow& t) const {
     const WebImage& image = options_.images.at(t.stimulus);
+    json questions = json::array();
+    for (const Question& q : t.task->questions(protocol_, protocol_.find_block(t.block)))
+        questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
     return {{"id", t.uuid},
+            {"questions", questions},
             {"task", task_name(t.task)},
             {"image", picture_names_.url(t.uuid, 0, t.stimulus)},
             {"width", image.width},
@@ -1002,17 +1007,23 @@ json WebStudy::state(const Page& page) const {
         questions.push_back({{"id", q.id}, {"text", q.text}, {"labels", q.labels}});
     out["questions"] = questions;
     if (const TrialRow* t = flow.trial()) {
-        if (t->task == Task::rating)
-            out["trial"] = rating_trial(*t);
-        else if (t->task == Task::adjust)
-            out["trial"] = adjust_trial(*t);
-        else if (t->task == Task::staircase)
-            out["trial"] = staircase_trial(*t, flow);
-        else if (t->task->is_scaling())
-            out["trial"] = choice_trial(*t, t->shown);
-        else
-            throw std::logic_error(std::string("trial kind '") + task_name(t->task) +
-                                   "' has no page");
+        const TrialScreen screen = t->task->screen();
+        switch (screen) {
+            case TrialScreen::scales:
+                out["trial"] = rating_trial(*t);
+                break;
+            case TrialScreen::adjust:
+                out["trial"] = adjust_trial(*t);
+                break;
+            case TrialScreen::staircase:
+                out["trial"] = staircase_trial(*t, flow);
+                break;
+            case TrialScreen::choice:
+                out["trial"] = choice_trial(*t, t->shown);
+                break;
+        }
+        // The page draws the screen; `task` names the kind (its class on the page).
+        out["trial"]["screen"] = screen_name(screen);
     } else {
         const std::string& text = flow.text();
         out["text"] = text.empty() ? std::string("Press Enter.") : text;

@@ -335,8 +335,9 @@ void Session::draw_rating_panel(const ScreenLayout& layout) {
     else
         ImGui::TextUnformatted(t.practice ? "Practice" : "");
     const float button = ImGui::GetFrameHeight() * 1.4f;
-    for (size_t q = 0; q < p_.questions.size(); ++q) {
-        const Question& question = p_.questions[q];
+    const std::vector<Question> questions = flow_->questions();
+    for (size_t q = 0; q < questions.size(); ++q) {
+        const Question& question = questions[q];
         ImGui::PushID(static_cast<int>(q));
         const bool focused = input && input->focus() == static_cast<int>(q);
         ImGui::SetCursorPosX(layout.panel.width * 0.5f -
@@ -444,8 +445,8 @@ std::optional<ChoiceLayout> Session::choice_layout(ChoiceShow show, int w, int h
 bool Session::waits_for_a_larger_window(int w, int h) {
     if (flow_->screen() != Screen::Blank || flow_->paused()) return false;
     const Block* b = flow_->block();
-    if (!b || (!b->is_choice() && b->task != Task::adjust)) return false;
-    const bool fits = b->task == Task::adjust
+    if (!b || b->task->screen() == TrialScreen::scales) return false;
+    const bool fits = b->task->screen() == TrialScreen::adjust
                           ? adjust_layout(w, h).value_or(AdjustLayout{}).fits
                           : choice_layout(choice_show(*b, std::nullopt), w, h)
                                 .value_or(ChoiceLayout{})
@@ -538,9 +539,9 @@ std::string Session::check_live_blocks() const {
                "' is turned during the session), not taken from a picture file";
     };
     for (const Block& b : p_.blocks) {
-        if (b.task == Task::adjust) {
+        if (b.task->screen() == TrialScreen::adjust) {
             if (std::string why = not_live(b, b.match); !why.empty()) return why;
-        } else if (b.task == Task::staircase) {
+        } else if (b.task->screen() == TrialScreen::staircase) {
             if (b.pictures() == 3 && b.presentation == Presentation::sequential)
                 return "block '" + b.id +
                        "': an odd-one-out staircase in sequence is not presented by "
@@ -570,14 +571,15 @@ LiveKnobRenderer& Session::knob_renderer(const std::string& stimulus,
 void Session::prepare_live() {
     const TrialRow* t = flow_->trial();
     const Block* b = flow_->block();
-    if (!t || !b || (b->task != Task::adjust && b->task != Task::staircase)) {
+    const TrialScreen screen = b ? b->task->screen() : TrialScreen::scales;
+    if (!t || (screen != TrialScreen::adjust && screen != TrialScreen::staircase)) {
         live_shown_.reset();
         live_texture_ = nullptr;
         return;
     }
     double value = 0;
     std::string stimulus;
-    if (b->task == Task::adjust) {
+    if (screen == TrialScreen::adjust) {
         const AdjustInput* input = flow_->adjustment();
         value = input ? input->value()
                       : std::clamp(t->start_value.value_or(b->range_min), b->range_min,
@@ -600,8 +602,8 @@ void Session::prepare_live() {
 // place, else the stimulus shown there.
 const StimulusTexture& Session::shown_texture(size_t place) const {
     const TrialRow& t = *flow_->trial();
-    if (t.task == Task::staircase && static_cast<int>(place) + 1 == t.expected &&
-        live_texture_)
+    if (t.task->screen() == TrialScreen::staircase &&
+        static_cast<int>(place) + 1 == t.expected && live_texture_)
         return *live_texture_;
     return textures_.at(t.shown[place]);
 }
@@ -755,23 +757,23 @@ void Session::draw(int w, int h) {
             ImGui::End();
             break;
         case Screen::Trial: {
-            if (flow_->block() && flow_->block()->task == Task::adjust) {
+            const TrialScreen screen = flow_->trial()->task->screen();
+            if (screen == TrialScreen::adjust) {
                 draw_adjust(w, h);
                 break;
             }
-            if (flow_->block() && flow_->block()->task == Task::staircase &&
-                flow_->block()->pictures() == 3) {
+            if (screen == TrialScreen::staircase && flow_->block()->pictures() == 3) {
                 draw_oddity(w, h);
                 break;
             }
-            if (flow_->block() && flow_->block()->is_choice()) {
+            if (screen == TrialScreen::choice || screen == TrialScreen::staircase) {
                 draw_choice(w, h);
                 break;
             }
             const StimulusTexture& texture = textures_.at(flow_->trial()->stimulus);
             const ScreenLayout layout = compute_layout(
                 w, h, texture.width, texture.height,
-                static_cast<int>(p_.questions.size()),
+                static_cast<int>(flow_->questions().size()),
                 static_cast<int>(ImGui::GetFrameHeightWithSpacing() * 1.25f));
             ImGui::GetBackgroundDrawList()->AddImage(
                 ui::imgui_texture(texture.texture),

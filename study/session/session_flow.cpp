@@ -126,6 +126,12 @@ const Block* SessionFlow::block() const {
     return t ? protocol_.find_block(t->block) : nullptr;
 }
 
+std::vector<Question> SessionFlow::questions() const {
+    const TrialRow* t = trial();
+    if (!t || t->task->screen() != TrialScreen::scales) return {};
+    return t->task->questions(protocol_, block());
+}
+
 bool SessionFlow::choice_trial() const {
     return current_ < trials_.size() && is_choice_task(trials_[current_].task);
 }
@@ -143,7 +149,7 @@ adaptive::StaircaseBlock& SessionFlow::staircase_block(const Block& block) {
         // A slot on screen already has its delta: its procedure waits for the answer
         // again (the same proposal: the procedures are deterministic).
         if (delta_ && current_ < trials_.size() && trials_[current_].block == block.id &&
-            trials_[current_].task == Task::staircase)
+            trials_[current_].task->screen() == TrialScreen::staircase)
             it->second.propose(trials_[current_].staircase);
     }
     return it->second;
@@ -154,7 +160,7 @@ void SessionFlow::advance_to_open_trial() {
     for (; current_ < trials_.size(); ++current_) {
         TrialRow& t = trials_[current_];
         if (t.answered || t.skipped) continue;
-        if (t.task != Task::staircase) return;
+        if (t.task->screen() != TrialScreen::staircase) return;
         adaptive::StaircaseBlock& b = staircase_block(*protocol_.find_block(t.block));
         // A procedure that finished has its open slots skipped in the store, in the
         // transaction of its last answer; one that reached its cap has no slots left.
@@ -168,7 +174,7 @@ void SessionFlow::advance_to_open_trial() {
 }
 
 std::optional<adaptive::Proposal> SessionFlow::staircase_delta() const {
-    if (!trial() || trials_[current_].task != Task::staircase || !delta_)
+    if (!trial() || trials_[current_].task->screen() != TrialScreen::staircase || !delta_)
         return std::nullopt;
     const KnobSeries* ladder =
         series_ ? series_->find(trials_[current_].block, trials_[current_].stimulus)
@@ -234,26 +240,28 @@ ScreenView SessionFlow::view() const {
         case Screen::Trial:
             v.is_catch = trials_[current_].is_catch;
             v.expected = trials_[current_].expected;
-            if (trials_[current_].task == Task::adjust) {
-                v.kind = adjust_ ? ScreenView::Kind::Adjust : ScreenView::Kind::Blank;
-                if (adjust_) v.adjust = adjust_view();
-                break;
+            switch (trials_[current_].task->screen()) {
+                case TrialScreen::adjust:
+                    v.kind = adjust_ ? ScreenView::Kind::Adjust : ScreenView::Kind::Blank;
+                    if (adjust_) v.adjust = adjust_view();
+                    break;
+                case TrialScreen::staircase:
+                    v.kind =
+                        input_ ? ScreenView::Kind::Staircase : ScreenView::Kind::Blank;
+                    v.staircase.delta = delta_ ? staircase_delta()->intensity : 0.0;
+                    v.staircase.answers = block()->answers();
+                    v.staircase.comparison_place = trials_[current_].expected;
+                    break;
+                case TrialScreen::choice:
+                    v.kind = input_ ? ScreenView::Kind::Choice : ScreenView::Kind::Blank;
+                    v.choice = choice_stimuli(protocol_, trials_[current_].block,
+                                              trials_[current_].shown);
+                    break;
+                case TrialScreen::scales:
+                    v.kind = input_ ? ScreenView::Kind::Rating : ScreenView::Kind::Blank;
+                    for (const Question& q : questions()) v.points.push_back(q.points());
+                    break;
             }
-            if (trials_[current_].task == Task::staircase) {
-                v.kind = input_ ? ScreenView::Kind::Staircase : ScreenView::Kind::Blank;
-                v.staircase.delta = delta_ ? staircase_delta()->intensity : 0.0;
-                v.staircase.answers = block()->answers();
-                v.staircase.comparison_place = trials_[current_].expected;
-                break;
-            }
-            if (choice_trial()) {
-                v.kind = input_ ? ScreenView::Kind::Choice : ScreenView::Kind::Blank;
-                v.choice = choice_stimuli(protocol_, trials_[current_].block,
-                                          trials_[current_].shown);
-                break;
-            }
-            v.kind = input_ ? ScreenView::Kind::Rating : ScreenView::Kind::Blank;
-            for (const Question& q : protocol_.questions) v.points.push_back(q.points());
             break;
         case Screen::Blank:
         case Screen::Done:
@@ -336,21 +344,27 @@ void SessionFlow::presented(int serial, int64_t t_ns) {
             }
             if (phase_ != ChoicePhase::Answer) return;  // a sequence: not answerable yet
             const TrialRow& t = trials_[current_];
-            if (t.task == Task::adjust) {
-                const KnobSeries* series =
-                    series_ ? series_->find(t.block, block()->match) : nullptr;
-                if (series)
-                    adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns,
-                                    series->steps);
-                else
-                    adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns);
-            } else if (choice_trial()) {
-                input_.emplace(RatingInput::forced_choice(t_ns, block()->answers()));
-            } else {
-                std::vector<int> points;
-                for (const Question& q : protocol_.questions)
-                    points.push_back(q.points());
-                input_.emplace(std::move(points), t_ns);
+            switch (t.task->screen()) {
+                case TrialScreen::adjust: {
+                    const KnobSeries* series =
+                        series_ ? series_->find(t.block, block()->match) : nullptr;
+                    if (series)
+                        adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns,
+                                        series->steps);
+                    else
+                        adjust_.emplace(*block(), t.start_value.value_or(0.0), t_ns);
+                    break;
+                }
+                case TrialScreen::choice:
+                case TrialScreen::staircase:
+                    input_.emplace(RatingInput::forced_choice(t_ns, block()->answers()));
+                    break;
+                case TrialScreen::scales: {
+                    std::vector<int> points;
+                    for (const Question& q : questions()) points.push_back(q.points());
+                    input_.emplace(std::move(points), t_ns);
+                    break;
+                }
             }
             ++serial_;  // the answer screen is a new view (same presentation)
         }
@@ -516,20 +530,20 @@ void SessionFlow::finish_trial() {
     TrialRow& t = trials_[current_];
     const Block* b = protocol_.find_block(t.block);
     TrialOutcome outcome;
-    if (t.task == Task::adjust) {
+    if (t.task->screen() == TrialScreen::adjust) {
         outcome = adjust_->outcome(b->question_id);
     } else {
         std::vector<std::string> ids;
-        if (choice_trial())
-            ids.push_back(b->question_id);
+        if (t.task->screen() == TrialScreen::scales)
+            for (const Question& q : questions()) ids.push_back(q.id);
         else
-            for (const Question& q : protocol_.questions) ids.push_back(q.id);
+            ids.push_back(b->question_id);
         outcome.onset_ns = *trial_onset_ns_;
         outcome.confirm_ns = input_->confirm_ns();
         outcome.responses = input_->responses(ids);
     }
     outcome.onset_ns = *trial_onset_ns_;
-    if (t.task == Task::staircase) {
+    if (t.task->screen() == TrialScreen::staircase) {
         const int choice = outcome.responses.front().rating;
         outcome.intensity = staircase_delta()->intensity;
         outcome.finishes_staircase = staircase_block(*b).answer(

@@ -139,6 +139,9 @@ public:
     double knob_value(const std::string& stimulus, const std::string& knob) const;
     // The block of the trial on screen (nullptr between trials).
     const Block* block() const;
+    // The scales of the trial on screen, when its kind answers on the scales screen (a
+    // rating's [[questions]]; a kind's own question); none otherwise.
+    std::vector<Question> questions() const;
     // On a forced choice's Trial screen, what it shows now; nullopt otherwise.
     std::optional<ChoicePhase> choice_phase() const;
     const std::string& text()

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "study/protocol.h"
 #include "study/trials/adjust/adjust_trials.h"
 #include "study/trials/choice/choice_trials.h"
 #include "study/trials/rating/rating_trials.h"
@@ -50,6 +51,24 @@ Registry& registry() {
 }
 
 }  // namespace
+
+const char* screen_name(TrialScreen screen) {
+    switch (screen) {
+        case TrialScreen::scales:
+            return "scales";
+        case TrialScreen::choice:
+            return "choice";
+        case TrialScreen::adjust:
+            return "adjust";
+        case TrialScreen::staircase:
+            return "staircase";
+    }
+    return "scales";
+}
+
+std::vector<Question> TrialKind::questions(const Protocol&, const Block*) const {
+    return {};
+}
 
 const TrialKind& Task::kind() const {
     const TrialKind* kind = registry().kinds[index_].load(std::memory_order_acquire);

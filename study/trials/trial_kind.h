@@ -22,6 +22,7 @@ namespace lucent::study {
 struct Block;
 struct PlannedTrial;
 struct Protocol;
+struct Question;
 class TableReader;
 class TrialKind;
 struct TrialAnswerFacts;
@@ -60,6 +61,18 @@ inline constexpr Task Task::quadruple{3};
 inline constexpr Task Task::adjust{4};
 inline constexpr Task Task::staircase{5};
 
+// How a trial is answered on screen. The lab (session/) and the page (serve/) each draw
+// every screen once; a kind picks the one its trials use, so a kind that asks a question
+// of its own on a scale, or a choice among its pictures, needs no screen of its own.
+enum class TrialScreen {
+    scales,     // one picture and rating scales (TrialKind::questions): a digit each
+    choice,     // its pictures, side by side or in sequence; one of answers() chosen
+    adjust,     // a target beside a live match whose knob the participant turns
+    staircase,  // a choice whose comparison is rendered at the procedure's delta
+};
+// "scales", "choice", "adjust" or "staircase": the page's name for the screen.
+const char* screen_name(TrialScreen screen);
+
 class TrialKind {
 public:
     virtual ~TrialKind() = default;
@@ -78,6 +91,13 @@ public:
     virtual int pictures(const Block&) const { return pictures_per_trial(); }
     // The answers of one trial: 0 (the [[questions]]), 1 (a confirmation), 2 or more.
     virtual int answers(const Block& block) const = 0;
+    // The screen its trials are answered on.
+    virtual TrialScreen screen() const = 0;
+    // The scales of a `scales` trial, each answered 1..points (`block`: null for a
+    // practice rating): a rating's are the protocol's [[questions]]; a kind asking its
+    // block's own question gives that, its labels the points. None for other screens.
+    virtual std::vector<Question> questions(const Protocol& protocol,
+                                            const Block* block) const;
 
     // The block's own keys, read after its id, stimuli and repeats; the reader refuses
     // any key nobody asked for once the block is read.

@@ -151,8 +151,9 @@
       return message(s.text, 'declined');
     }
     if (s.screen === 'trial') {
-      if (s.trial.task === 'adjust') return beginAdjust(s);
-      return s.trial.task && s.trial.task !== 'rating' ? beginChoice(s) : beginTrial(s);
+      // The server names the screen the trial's kind is answered on.
+      if (s.trial.screen === 'adjust') return beginAdjust(s);
+      return s.trial.screen === 'scales' ? beginTrial(s) : beginChoice(s);
     }
     only('text-screen');
     el('text').textContent = s.text;
@@ -188,10 +189,13 @@
   // ---- the rating screen ------------------------------------------------------------
   const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
+  // A trial's own scales: the study's questions, or its kind's question.
+  const scalesOf = (s) => s.trial.questions || s.questions;
+
   function buildQuestions(s) {
     const box = el('questions');
     box.textContent = '';
-    s.questions.forEach((q, qi) => {
+    scalesOf(s).forEach((q, qi) => {
       const div = document.createElement('div');
       div.className = 'question';
       const text = document.createElement('div');
@@ -279,8 +283,8 @@
     const onset = await firstFrame();
     if (state !== s) return;
     trial = {
-      onset, events: [], focus: 0, ratings: s.questions.map(() => null),
-      points: s.questions.map((q) => q.labels.length),
+      onset, events: [], focus: 0, ratings: scalesOf(s).map(() => null),
+      points: scalesOf(s).map((q) => q.labels.length),
     };
     render();
     document.body.dataset.trial = t.id;
@@ -712,9 +716,9 @@
     if (['ArrowLeft', 'ArrowRight', 'ArrowUp', 'ArrowDown', 'Enter', ' '].includes(k))
       ev.preventDefault();
     if (state.screen === 'trial') {
-      if (state.trial && state.trial.task === 'adjust')
+      if (state.trial && state.trial.screen === 'adjust')
         return adjustInput({ type: 'key', key: k, shift: ev.shiftKey }, t);
-      if (state.trial && state.trial.task && state.trial.task !== 'rating')
+      if (state.trial && state.trial.screen !== 'scales')
         return choiceInput({ type: 'key', key: k }, t);
       return input({ type: 'key', key: k }, t);
     }

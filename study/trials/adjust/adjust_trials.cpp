@@ -90,6 +90,7 @@ public:
     bool is_scaling() const override { return false; }
     int pictures_per_trial() const override { return 2; }  // the target and the match
     int answers(const Block&) const override { return 1; }
+    TrialScreen screen() const override { return TrialScreen::adjust; }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_adjust_block(p, keys, b);
     }

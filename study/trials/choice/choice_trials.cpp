@@ -210,6 +210,7 @@ public:
     bool is_scaling() const override { return true; }
     int pictures_per_trial() const override { return pictures_; }
     int answers(const Block&) const override { return 2; }
+    TrialScreen screen() const override { return TrialScreen::choice; }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_choice_block(p, keys, b);
     }

@@ -13,6 +13,11 @@ public:
     bool rated_on_questions() const override { return true; }
     int pictures_per_trial() const override { return 1; }
     int answers(const Block&) const override { return 0; }
+    TrialScreen screen() const override { return TrialScreen::scales; }
+    std::vector<Question> questions(const Protocol& protocol,
+                                    const Block*) const override {
+        return protocol.questions;
+    }
     // A rating block has no keys of its own: its questions are the protocol's.
     void read_block(const Protocol&, TableReader&, Block&) const override {}
     // Each stimulus `repeats` times, then the block's catch trials.

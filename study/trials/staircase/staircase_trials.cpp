@@ -167,6 +167,7 @@ public:
         return b.staircase_trial == "oddity" ? 3 : 2;
     }
     int answers(const Block& b) const override { return pictures(b); }
+    TrialScreen screen() const override { return TrialScreen::staircase; }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_staircase_block(p, keys, b);
     }

@@ -294,13 +294,14 @@ TEST_P(ServeMatching, TheMatchMovesOverItsSeriesAsInTheLabAndEveryChangeIsStored
     EXPECT_EQ(trial["question"], protocol_.blocks[0].question);
     EXPECT_EQ(trial["practice"], false);
     EXPECT_EQ(trial["blank_ms"], 100);
+    EXPECT_EQ(trial["screen"], "adjust");
     // Nothing more: never the target's value (its picture is named by its id).
     std::set<std::string> keys;
     for (const auto& [key, value] : trial.items()) keys.insert(key);
-    EXPECT_EQ(keys,
-              (std::set<std::string>{"id", "task", "target", "match", "series", "low",
-                                     "high", "coarse", "fine", "start_index", "question",
-                                     "practice", "prompt", "blank_ms", "max_events"}));
+    EXPECT_EQ(keys, (std::set<std::string>{"id", "task", "screen", "target", "match",
+                                           "series", "low", "high", "coarse", "fine",
+                                           "start_index", "question", "practice",
+                                           "prompt", "blank_ms", "max_events"}));
 
     // Hostile events: each a 400 naming what is wrong, nothing stored.
     auto with = [&](const json& event) {

@@ -143,13 +143,19 @@ struct Page {
         const json& trial = state["trial"];
         const double onset = now + trial["blank_ms"].get<double>() + 20;
         json events = json::array();
-        const int n = static_cast<int>(state["questions"].size());
+        // The trial's own scales (a kind's question), else the study's questions.
+        const json& scales =
+            trial.contains("questions") ? trial["questions"] : state["questions"];
+        const int n = static_cast<int>(scales.size());
         const bool is_catch = !trial["prompt"].get<std::string>().empty();
-        for (int q = 0; q < n; ++q)
-            events.push_back({{"t_ms", onset + 100.0 * (q + 1)},
-                              {"type", "point"},
-                              {"question", q},
-                              {"value", page_rating(k, q, is_catch, catch_rating)}});
+        for (int q = 0; q < n; ++q) {
+            const int points = static_cast<int>(scales[q]["labels"].size());
+            events.push_back(
+                {{"t_ms", onset + 100.0 * (q + 1)},
+                 {"type", "point"},
+                 {"question", q},
+                 {"value", std::min(points, page_rating(k, q, is_catch, catch_rating))}});
+        }
         events.push_back({{"t_ms", onset + 100.0 * (n + 1)}, {"type", "next"}});
         return {{"trial", trial["id"]},
                 {"view", state["view"]},
@@ -199,7 +205,7 @@ struct Page {
     }
     bool on_choice() const {
         return state.contains("trial") &&
-               state["trial"].value("task", "rating") != "rating";
+               state["trial"].value("screen", "scales") != "scales";
     }
     void answer(int k) {
         if (on_choice()) {

@@ -13,19 +13,23 @@
 
 #include "study/observations.h"
 #include "study/protocol.h"
+#include "study/serve/web_study.h"
+#include "study/session/session_flow.h"
 #include "study/sqlite/sqlite_store.h"
 #include "study/trial_plan.h"
 #include "study/trials/block_keys.h"
 #include "study/trials/table_reader.h"
 #include "study/trials/trial_kind.h"
+#include "tests/study/serve/web_page.h"
 #include "tests/study/study_fixtures.h"
 #include "tests/support/test_paths.h"
 
 namespace lucent::study {
 namespace {
 
-// "probe": one picture, a yes/no question about it; its key `flashes` (1..5) is how
-// often each stimulus is probed per repeat.
+// "probe": one picture, a yes/no question about it on the scales screen (its own
+// question, its labels the two points); its key `flashes` (1..5) is how often each
+// stimulus is probed per repeat.
 class ProbeKind : public TrialKind {
 public:
     const char* name() const override { return "probe"; }
@@ -33,9 +37,14 @@ public:
     bool is_scaling() const override { return false; }
     int pictures_per_trial() const override { return 1; }
     int answers(const Block&) const override { return 2; }
+    TrialScreen screen() const override { return TrialScreen::scales; }
+    std::vector<Question> questions(const Protocol&, const Block* b) const override {
+        return {Question{b->question_id, b->question, b->labels}};
+    }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_block_question(p, keys, b);
         b.neighbours = keys.integer("flashes", 1, 1, 5);  // an integer field it may use
+        b.labels = {"yes", "no"};
     }
     std::vector<PlannedTrial> plan_block(const Protocol&, const Block& b,
                                          std::mt19937_64&) const override {
@@ -217,6 +226,106 @@ TEST(TrialKinds, AStoreKeepsTheKindsAnswersAndTheObservationsReadThemBack) {
         ++answers[row.shown.at(0)];
     }
     EXPECT_EQ(answers, (std::map<std::string, int>{{"a", 6}, {"b", 6}}));
+}
+
+// The probe's answers as stored: (stimulus, rating) per trial, in trial order.
+std::vector<std::pair<std::string, int>> stored_answers(const std::string& path) {
+    Database db(path, SQLITE_OPEN_READONLY);
+    Statement s = db.prepare(
+        "SELECT st.stimulus_key, r.rating, r.question FROM responses r JOIN trials t ON "
+        "t.id = r.trial_id JOIN stimuli st ON st.id = t.stimulus_id ORDER BY t.position");
+    std::vector<std::pair<std::string, int>> out;
+    while (s.step()) {
+        EXPECT_EQ(s.text(2), "probes");
+        out.emplace_back(s.text(0), static_cast<int>(s.integer(1)));
+    }
+    return out;
+}
+
+// The lab's flow (the runner draws what it says): each probe trial is the scales screen
+// with the kind's own question and two points; digits answer it, one response each.
+TEST(TrialKinds, TheLabFlowAsksTheKindsQuestionOnTheScalesScreen) {
+    const Protocol p =
+        parse_protocol(kProbeProtocol, "probe.toml", "", KnobCheck::lenient);
+    const auto dir = lucent::test::scratch_dir("registered_kind_lab");
+    const std::string path = (dir / "lab.db").string();
+    Store store(path);
+    const int64_t study = store.ensure_study(p);
+    int number = 0;
+    const int64_t pid = store.ensure_participant(study, "P1", &number);
+    const SessionRow session =
+        store.create_session(study, pid, plan_trials(p, 5, number), 5, {});
+    store.set_consent(session.id);
+    int64_t now = 1'000'000'000;
+    SessionFlow flow(p, store, session.id, store.trials(session.id), true, now);
+    std::vector<std::pair<std::string, int>> pressed;
+    for (int guard = 0; guard < 5000 && !flow.finished(); ++guard) {
+        now += 16'000'000;
+        flow.tick(now);
+        flow.presented(flow.serial(), now);
+        if (flow.rating()) {
+            const std::vector<Question> scales = flow.questions();
+            ASSERT_EQ(scales.size(), 1u);
+            EXPECT_EQ(scales[0].id, "probes");
+            EXPECT_EQ(scales[0].text, "Did it flicker?");
+            EXPECT_EQ(scales[0].points(), 2);
+            EXPECT_EQ(flow.view().points, std::vector<int>{2});
+            const int digit = 1 + static_cast<int>(pressed.size()) % 2;
+            pressed.emplace_back(flow.trial()->stimulus, digit);
+            flow.key({Key::Digit, 3, now += 50'000'000});  // off the scale: ignored
+            flow.key({Key::Digit, digit, now += 50'000'000});
+            flow.key({Key::Enter, 0, now += 50'000'000});
+        } else if (flow.screen() != Screen::Trial && flow.screen() != Screen::Blank) {
+            flow.key({Key::Enter, 0, now += 300'000'000});
+        }
+    }
+    ASSERT_TRUE(flow.finished());
+    EXPECT_EQ(pressed.size(), 12u);
+    EXPECT_EQ(stored_answers(path), pressed);
+}
+
+// The page's side (WebStudy, as lucent serve answers lucent.js): the trial names the
+// scales screen and carries the kind's question; the page's clicks are stored.
+TEST(TrialKinds, ThePageGetsTheScalesScreenWithTheKindsQuestion) {
+    const Protocol p = parse_protocol(
+        std::string(kProbeProtocol) +
+            "\n[screens]\nconsent = \"Do you agree?\"\n[online]\ncompletion_code = "
+            "\"DONE\"\n",
+        "probe.toml", "", KnobCheck::lenient);
+    const auto dir = lucent::test::scratch_dir("registered_kind_page");
+    const std::string path = (dir / "page.db").string();
+    std::unique_ptr<StudyStore> store = open_study_store(path, StoreOptions{});
+    WebStudyOptions o;
+    o.secret = "test secret";
+    o.environment.machine_id = "server";
+    o.environment.software_version = "test";
+    o.environment.build_hash = "test";
+    for (const StimulusSpec& s : p.stimuli) o.images[s.id] = {64, 48};
+    WebStudy web(p, *store, o);
+    lucent::test::Page page{lucent::test::direct(web)};
+    page.open({{"participant", "P1"}});
+    int trials = 0;
+    for (int guard = 0; guard < 100 && page.state["screen"] != "done"; ++guard) {
+        if (page.state["screen"] != "trial") {
+            page.enter();
+            continue;
+        }
+        const nlohmann::json& trial = page.state["trial"];
+        EXPECT_EQ(trial["screen"], "scales");
+        EXPECT_EQ(trial["task"], "probe");
+        ASSERT_EQ(trial["questions"].size(), 1u);
+        EXPECT_EQ(trial["questions"][0]["id"], "probes");
+        EXPECT_EQ(trial["questions"][0]["labels"], nlohmann::json::array({"yes", "no"}));
+        page.answer(trials++);
+    }
+    ASSERT_EQ(page.state["screen"], "done");
+    EXPECT_EQ(trials, 12);
+    const std::vector<std::pair<std::string, int>> stored = stored_answers(path);
+    ASSERT_EQ(stored.size(), 12u);
+    for (size_t k = 0; k < stored.size(); ++k)  // the page's rating, on the 2 points
+        EXPECT_EQ(stored[k].second,
+                  std::min(2, lucent::test::page_rating(static_cast<int>(k), 0, false)))
+            << k;
 }
 
 TEST(TrialKinds, ASecondKindOfTheSameNameIsRefused) {
