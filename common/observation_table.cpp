@@ -10,8 +10,9 @@ namespace lucent::common {
 namespace {
 
 constexpr const char* kFixedColumns[] = {
-    "participant", "session",  "trial", "block",    "kind",  "question", "practice",
-    "catch",       "expected", "shown", "response", "rt_ms", "procedure"};
+    "participant", "session",  "trial",    "block",    "kind",
+    "analysed_as", "question", "practice", "catch",    "expected",
+    "shown",       "response", "rt_ms",    "procedure"};
 
 }  // namespace
 
@@ -27,7 +28,7 @@ std::vector<std::string> ObservationTable::factor_columns() const {
 std::vector<FactorRating> factor_ratings(const ObservationTable& table) {
     std::vector<FactorRating> out;
     for (const Observation& row : table.rows) {
-        if (row.kind != "rating" || row.practice || row.is_catch || !row.response)
+        if (row.analysed_as != "ratings" || row.practice || row.is_catch || !row.response)
             continue;
         for (const auto& [factor, level] : row.factors)
             out.push_back({&row, &factor, &level});
@@ -64,8 +65,8 @@ void write_observation_csv(std::ostream& out, const ObservationTable& table) {
         for (const std::string& id : row.shown) shown += (shown.empty() ? "" : " ") + id;
         out << csv_field(row.participant) << "," << csv_field(row.session) << ","
             << row.trial << "," << csv_field(row.block) << "," << csv_field(row.kind)
-            << "," << csv_field(row.question) << "," << (row.practice ? 1 : 0) << ","
-            << (row.is_catch ? 1 : 0) << ","
+            << "," << csv_field(row.analysed_as) << "," << csv_field(row.question) << ","
+            << (row.practice ? 1 : 0) << "," << (row.is_catch ? 1 : 0) << ","
             << (row.expected ? std::to_string(*row.expected) : std::string()) << ","
             << csv_field(shown) << ","
             << (row.response ? shortest_text(*row.response) : std::string()) << ","

@@ -20,7 +20,11 @@ struct Observation {
     std::string session;      // the session's UUID
     int trial = 0;            // the trial's position in the session
     std::string block;
-    std::string kind;      // the trial kind: rating, pair, triad, quadruple, adjust, ...
+    std::string kind;  // the trial kind: rating, pair, triad, quadruple, adjust, ...
+    // What the analysis reads it as (its kind says: TrialKind::analysed_as): "ratings"
+    // (the factor ratings' tests and models), "choices" (the scaling), "matches",
+    // "thresholds", or "" (none: exported, not analysed).
+    std::string analysed_as;
     std::string question;  // the question answered; "" where the kind asks none
     bool practice = false;
     bool is_catch = false;

@@ -123,6 +123,7 @@ StudyObservations read_observations(const std::string& db_path,
                              ")");
         if (options.analysis && (row.practice || !out.selection.keeps(s.integer(13))))
             continue;
+        row.analysed_as = (*task)->analysed_as();
         row.block = s.text(3);
         row.question = s.text(5);
         row.is_catch = s.integer(7) != 0;

@@ -193,8 +193,10 @@ ChoiceTable choices_of(const common::ObservationTable& observations,
     ChoiceTable table;
     for (std::size_t i = 0; i < observations.rows.size(); ++i) {
         const common::Observation& o = observations.rows[i];
+        if (o.analysed_as != "choices" || o.practice) continue;
+        // The scaling's design is the kind's (pair, triad or quadruple).
         const std::optional<ChoiceTask> task = parse_choice_task(o.kind);
-        if (!task || o.practice) continue;
+        if (!task) continue;
         ChoiceRow row;
         row.source_line = i + 1;
         row.participant = o.participant;

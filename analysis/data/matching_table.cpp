@@ -27,7 +27,7 @@ MatchingTable matching_of(const common::ObservationTable& observations,
             const auto it = o.measures.find(name);
             return it != o.measures.end() ? std::optional(it->second) : std::nullopt;
         };
-        if (o.kind == "adjust" && o.response) {
+        if (o.analysed_as == "matches" && o.response) {
             MatchRow row = answered_at<MatchRow>(o);
             row.target = o.shown.front();
             if (table.protocol)
@@ -39,7 +39,7 @@ MatchingTable matching_of(const common::ObservationTable& observations,
             row.final_value = *o.response;
             row.adjustments = static_cast<int>(measure("adjustments").value_or(0));
             table.matches.push_back(std::move(row));
-        } else if (o.kind == "staircase" && measure("intensity") && o.expected) {
+        } else if (o.analysed_as == "thresholds" && measure("intensity") && o.expected) {
             StaircaseRow row = answered_at<StaircaseRow>(o);
             row.standard = o.shown.front();
             row.staircase = o.procedure;

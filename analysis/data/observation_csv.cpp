@@ -21,12 +21,20 @@ const std::set<std::string> kMeasures = {"start_value", "adjustments", "intensit
                                          "value_1",     "value_2",     "value_3",
                                          "value_4"};
 const std::set<std::string> kFixed = {
-    "participant", "session",  "trial", "block",    "kind",  "question", "practice",
-    "catch",       "expected", "shown", "response", "rt_ms", "procedure"};
+    "participant", "session",  "trial",    "block",    "kind",
+    "analysed_as", "question", "practice", "catch",    "expected",
+    "shown",       "response", "rt_ms",    "procedure"};
+const std::set<std::string> kAnalyses = {"ratings", "choices", "matches", "thresholds",
+                                         ""};
 
-bool known_kind(const std::string& kind) {
-    return kind == "rating" || kind == "adjust" || kind == "staircase" ||
-           parse_choice_task(kind).has_value();
+// What a built-in kind is analysed as, for a file without the analysed_as column (the
+// analysis cannot ask the study's registry of kinds); nullopt for any other kind.
+std::optional<std::string> built_in_analysis(const std::string& kind) {
+    if (kind == "rating") return "ratings";
+    if (kind == "adjust") return "matches";
+    if (kind == "staircase") return "thresholds";
+    if (parse_choice_task(kind)) return "choices";
+    return std::nullopt;
 }
 
 // One data row's cells by column name; every message names "source:line: column N
@@ -127,10 +135,26 @@ common::ObservationTable read_observation_csv(std::istream& in,
         row.participant = cell.text("participant");
         if (row.participant.empty()) cell.fail("participant", "participant is empty");
         row.kind = cell.text("kind");
-        if (!known_kind(row.kind))
+        if (row.kind.empty()) cell.fail("kind", "kind is empty");
+        if (column.count("analysed_as")) {
+            row.analysed_as = cell.text("analysed_as");
+            if (!kAnalyses.count(row.analysed_as))
+                cell.fail("analysed_as",
+                          "'" + row.analysed_as +
+                              "' is not one of ratings, choices, matches, thresholds or "
+                              "empty");
+            if (row.analysed_as == "choices" && !parse_choice_task(row.kind))
+                cell.fail("analysed_as", "a " + row.kind +
+                                             " trial is not a pair, triad or quadruple: "
+                                             "the scaling reads no other choice");
+        } else if (const auto analysis = built_in_analysis(row.kind)) {
+            row.analysed_as = *analysis;
+        } else {
             cell.fail("kind", "'" + row.kind +
                                   "' is not one of rating, pair, triad, quadruple, "
-                                  "adjust, staircase");
+                                  "adjust, staircase (another kind needs the analysed_as "
+                                  "column)");
+        }
         row.session = cell.text("session");
         row.trial = static_cast<int>(cell.integer("trial").value_or(0));
         row.block = cell.text("block");
@@ -148,7 +172,7 @@ common::ObservationTable read_observation_csv(std::istream& in,
         const auto scaling = parse_choice_task(row.kind);
         const std::size_t pictures =
             scaling ? static_cast<std::size_t>(shown_count(*scaling)) : 1;
-        if (row.shown.size() != pictures)
+        if (!row.analysed_as.empty() && row.shown.size() != pictures)
             cell.fail("shown", "a " + row.kind + " shows " + std::to_string(pictures) +
                                    (pictures == 1 ? " stimulus" : " stimuli") + ", " +
                                    std::to_string(row.shown.size()) + " are named");

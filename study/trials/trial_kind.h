@@ -121,6 +121,9 @@ public:
     // (refuse_outcome_columns in store_rules.h).
     virtual void check_outcome(const std::string& where, const TrialAnswerFacts& facts,
                                const TrialOutcome& outcome) const;
+    // What the analysis reads its observations as (Observation::analysed_as):
+    // "ratings", "choices", "matches", "thresholds", or "" (exported, not analysed).
+    virtual const char* analysed_as() const = 0;
     // The observation's part that only this kind's trials have, from their stored
     // columns (an adjustment's final value as its response; a staircase's procedure).
     virtual void observe(const StoredTrialMeasures&, common::Observation&) const {}

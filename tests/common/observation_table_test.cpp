@@ -16,6 +16,7 @@ Observation rating(const std::string& participant, double value,
     Observation o;
     o.participant = participant;
     o.kind = "rating";
+    o.analysed_as = "ratings";
     o.question = "q";
     o.shown = {"s"};
     o.response = value;
@@ -41,13 +42,21 @@ TEST(ObservationTable, FactorRatingsAreAnsweredRatingsOfNoPracticeOrCatchTrial) 
     unanswered.response.reset();
     Observation choice = rating("choice", 1, {{"a", "1"}});
     choice.kind = "pair";
-    for (const Observation& o : {practice, catch_trial, unanswered, choice})
+    choice.analysed_as = "choices";
+    // A kind of another name that its kind says is analysed as ratings is one.
+    Observation other_kind = rating("kept", 5, {{"a", "3"}});
+    other_kind.kind = "probe";
+    Observation not_analysed = rating("not analysed", 5, {{"a", "3"}});
+    not_analysed.analysed_as = "";
+    for (const Observation& o :
+         {practice, catch_trial, unanswered, choice, other_kind, not_analysed})
         table.rows.push_back(o);
     const std::vector<FactorRating> rows = factor_ratings(table);
-    ASSERT_EQ(rows.size(), 2u);
+    ASSERT_EQ(rows.size(), 3u);
     for (const FactorRating& r : rows) EXPECT_EQ(r.observation->participant, "kept");
     EXPECT_EQ(*rows[0].factor, "a");
     EXPECT_EQ(*rows[1].level, "2");
+    EXPECT_EQ(rows[2].observation->kind, "probe");
 }
 
 TEST(ObservationTable, TheWideCsvHasAColumnPerMeasureAndFactorAndNoClash) {
@@ -65,18 +74,19 @@ TEST(ObservationTable, TheWideCsvHasAColumnPerMeasureAndFactorAndNoClash) {
     while (std::getline(in, line)) rows.push_back(split_csv_line(line));
     ASSERT_EQ(rows.size(), 3u);
     const std::vector<std::string> header = {
-        "participant", "session",   "trial",        "block", "kind",     "question",
-        "practice",    "catch",     "expected",     "shown", "response", "rt_ms",
-        "procedure",   "intensity", "factor:trial", "light"};
+        "participant", "session",   "trial",     "block",        "kind",  "analysed_as",
+        "question",    "practice",  "catch",     "expected",     "shown", "response",
+        "rt_ms",       "procedure", "intensity", "factor:trial", "light"};
     EXPECT_EQ(rows[0], header);
     EXPECT_EQ(rows[1][0], "P, 1");  // quoted, read back whole
     EXPECT_EQ(rows[1][2], "3");
-    EXPECT_EQ(rows[1][10], "0.1");  // the shortest exact text
-    EXPECT_EQ(rows[1][13], "0.25");
-    EXPECT_EQ(rows[1][14], "t1");
-    EXPECT_EQ(rows[2][13], "");  // no intensity
-    EXPECT_EQ(rows[2][14], "");
-    EXPECT_EQ(rows[2][15], "front");
+    EXPECT_EQ(rows[1][5], "ratings");
+    EXPECT_EQ(rows[1][11], "0.1");  // the shortest exact text
+    EXPECT_EQ(rows[1][14], "0.25");
+    EXPECT_EQ(rows[1][15], "t1");
+    EXPECT_EQ(rows[2][14], "");  // no intensity
+    EXPECT_EQ(rows[2][15], "");
+    EXPECT_EQ(rows[2][16], "front");
 }
 
 }  // namespace

@@ -91,6 +91,7 @@ public:
     int pictures_per_trial() const override { return 2; }  // the target and the match
     int answers(const Block&) const override { return 1; }
     TrialScreen screen() const override { return TrialScreen::adjust; }
+    const char* analysed_as() const override { return "matches"; }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_adjust_block(p, keys, b);
     }

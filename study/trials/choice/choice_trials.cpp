@@ -211,6 +211,7 @@ public:
     int pictures_per_trial() const override { return pictures_; }
     int answers(const Block&) const override { return 2; }
     TrialScreen screen() const override { return TrialScreen::choice; }
+    const char* analysed_as() const override { return "choices"; }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_choice_block(p, keys, b);
     }

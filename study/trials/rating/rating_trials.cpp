@@ -14,6 +14,7 @@ public:
     int pictures_per_trial() const override { return 1; }
     int answers(const Block&) const override { return 0; }
     TrialScreen screen() const override { return TrialScreen::scales; }
+    const char* analysed_as() const override { return "ratings"; }
     std::vector<Question> questions(const Protocol& protocol,
                                     const Block*) const override {
         return protocol.questions;

@@ -168,6 +168,7 @@ public:
     }
     int answers(const Block& b) const override { return pictures(b); }
     TrialScreen screen() const override { return TrialScreen::staircase; }
+    const char* analysed_as() const override { return "thresholds"; }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_staircase_block(p, keys, b);
     }

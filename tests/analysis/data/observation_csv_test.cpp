@@ -30,6 +30,7 @@ TEST(ObservationCsv, WhatIsWrittenReadsBackTheSame) {
     rating.trial = 4;
     rating.block = "b";
     rating.kind = "rating";
+    rating.analysed_as = "ratings";
     rating.question = "translucent";
     rating.shown = {"a"};
     rating.response = 0.1;
@@ -38,6 +39,7 @@ TEST(ObservationCsv, WhatIsWrittenReadsBackTheSame) {
     common::Observation pair;
     pair.participant = "P2";
     pair.kind = "pair";
+    pair.analysed_as = "choices";
     pair.is_catch = true;
     pair.expected = 2;
     pair.shown = {"a", "b"};
@@ -46,18 +48,23 @@ TEST(ObservationCsv, WhatIsWrittenReadsBackTheSame) {
     common::Observation staircase;
     staircase.participant = "P3";
     staircase.kind = "staircase";
+    staircase.analysed_as = "thresholds";
     staircase.shown = {"std"};
     staircase.expected = 1;
     staircase.response = 1;
     staircase.procedure = "std/a";
     staircase.measures = {{"intensity", 0.0625}};
-    table.rows = {rating, pair, staircase};
+    // A kind the analysis does not know by name, read as its column says.
+    common::Observation probe = rating;
+    probe.kind = "probe";
+    probe.analysed_as = "ratings";
+    table.rows = {rating, pair, staircase, probe};
     std::ostringstream out;
     common::write_observation_csv(out, table);
     std::istringstream in(out.str());
     const common::ObservationTable back = read_observation_csv(in, "obs.csv");
-    ASSERT_EQ(back.rows.size(), 3u);
-    for (std::size_t i = 0; i < 3; ++i) {
+    ASSERT_EQ(back.rows.size(), 4u);
+    for (std::size_t i = 0; i < 4; ++i) {
         const common::Observation& a = table.rows[i];
         const common::Observation& b = back.rows[i];
         EXPECT_EQ(a.participant, b.participant);
@@ -65,6 +72,7 @@ TEST(ObservationCsv, WhatIsWrittenReadsBackTheSame) {
         EXPECT_EQ(a.trial, b.trial);
         EXPECT_EQ(a.block, b.block);
         EXPECT_EQ(a.kind, b.kind);
+        EXPECT_EQ(a.analysed_as, b.analysed_as);
         EXPECT_EQ(a.question, b.question);
         EXPECT_EQ(a.is_catch, b.is_catch);
         EXPECT_EQ(a.expected, b.expected);
@@ -87,7 +95,23 @@ TEST(ObservationCsv, BadInputNamesTheLineColumnAndField) {
               std::string::npos);
     EXPECT_EQ(error_of(header + "P1,rating,a,3\nP1,ratng,a,3\n"),
               "obs.csv:3: column 2 (kind): 'ratng' is not one of rating, pair, triad, "
-              "quadruple, adjust, staircase");
+              "quadruple, adjust, staircase (another kind needs the analysed_as column)");
+    // Without the column, each built-in kind is read as what it is analysed as.
+    {
+        std::istringstream in(header + "P1,rating,a,3\nP1,pair,a b,1\n");
+        const common::ObservationTable t = read_observation_csv(in, "obs.csv");
+        EXPECT_EQ(t.rows[0].analysed_as, "ratings");
+        EXPECT_EQ(t.rows[1].analysed_as, "choices");
+    }
+    const std::string with_analysis = "participant,kind,analysed_as,shown,response\n";
+    EXPECT_EQ(error_of(with_analysis + "P1,probe,rating,a,1\n"),
+              "obs.csv:2: column 3 (analysed_as): 'rating' is not one of ratings, "
+              "choices, matches, thresholds or empty");
+    EXPECT_EQ(error_of(with_analysis + "P1,probe,choices,a,1\n"),
+              "obs.csv:2: column 3 (analysed_as): a probe trial is not a pair, triad or "
+              "quadruple: the scaling reads no other choice");
+    EXPECT_EQ(error_of(with_analysis + "P1,,ratings,a,1\n"),
+              "obs.csv:2: column 2 (kind): kind is empty");
     EXPECT_EQ(error_of(header + "P1,pair,a,1\n"),
               "obs.csv:2: column 3 (shown): a pair shows 2 stimuli, 1 are named");
     EXPECT_EQ(error_of(header + "P1,rating,a,seven\n"),

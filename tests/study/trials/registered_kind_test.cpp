@@ -5,12 +5,18 @@
 // reads them back. Its own binary, so the other suites never see the extra kind.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "app/cli_main.h"
+#include "app/commands.h"
+#include "common/csv.h"
 #include "study/observations.h"
 #include "study/protocol.h"
 #include "study/serve/web_study.h"
@@ -38,6 +44,7 @@ public:
     int pictures_per_trial() const override { return 1; }
     int answers(const Block&) const override { return 2; }
     TrialScreen screen() const override { return TrialScreen::scales; }
+    const char* analysed_as() const override { return "ratings"; }
     std::vector<Question> questions(const Protocol&, const Block* b) const override {
         return {Question{b->question_id, b->question, b->labels}};
     }
@@ -74,10 +81,12 @@ name = "probes"
 [[stimuli]]
 id = "a"
 image = "a.png"
+params = { contrast = 1 }
 
 [[stimuli]]
 id = "b"
 image = "b.png"
+params = { contrast = 2 }
 
 [[blocks]]
 id = "probes"
@@ -150,7 +159,7 @@ TEST(TrialKinds, TheProtocolReadsTheKindsOwnKeysAndRefusesItsBadOnes) {
 
     const std::string range =
         error_of(replaced(kProbeProtocol, "flashes = 3", "flashes = 9"));
-    EXPECT_NE(range.find("probe.toml:19:"), std::string::npos) << range;
+    EXPECT_NE(range.find("probe.toml:21:"), std::string::npos) << range;
     EXPECT_NE(range.find("key 'blocks.flashes': must lie in [1, 5], got 9"),
               std::string::npos)
         << range;
@@ -326,6 +335,76 @@ TEST(TrialKinds, ThePageGetsTheScalesScreenWithTheKindsQuestion) {
         EXPECT_EQ(stored[k].second,
                   std::min(2, lucent::test::page_rating(static_cast<int>(k), 0, false)))
             << k;
+}
+
+int run_lucent(std::vector<std::string> args) {
+    args.insert(args.begin(), "lucent");
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    return app::run_cli(static_cast<int>(argv.size()), argv.data(),
+                        {app::register_analyze, app::register_export});
+}
+
+// Exported as every kind is (one row per answer, with the stimulus's factors), and
+// analysed as its kind says (its answers are ratings of its question): the report's
+// descriptives per level equal the stored answers' means, computed here in SQL.
+TEST(TrialKinds, TheKindsAnswersAreExportedAndAnalysedAsItsKindSays) {
+    const Protocol p =
+        parse_protocol(kProbeProtocol, "probe.toml", "", KnobCheck::lenient);
+    const auto dir = lucent::test::scratch_dir("registered_kind_analysis");
+    const std::string path = (dir / "probe.db").string();
+    {
+        Store store(path);
+        for (int k = 1; k <= 3; ++k)
+            lucent::test::run_full_session(store, p, "P" + std::to_string(k), 10 + k);
+    }
+    const std::string csv = (dir / "observations.csv").string();
+    ASSERT_EQ(run_lucent({"export", path, "--format", "observations", "--out", csv}), 0);
+    std::ifstream exported(csv);
+    std::string line;
+    std::getline(exported, line);
+    const std::vector<std::string> header = common::split_csv_line(line);
+    const auto column = [&](const std::string& name) {
+        return static_cast<size_t>(std::find(header.begin(), header.end(), name) -
+                                   header.begin());
+    };
+    ASSERT_LT(column("contrast"), header.size()) << line;
+    int rows = 0;
+    while (std::getline(exported, line)) {
+        const std::vector<std::string> f = common::split_csv_line(line);
+        EXPECT_EQ(f[column("kind")], "probe");
+        EXPECT_EQ(f[column("analysed_as")], "ratings");
+        EXPECT_EQ(f[column("contrast")], f[column("shown")] == "a" ? "1" : "2");
+        ++rows;
+    }
+    EXPECT_EQ(rows, 36);
+
+    const std::string out = (dir / "report").string();
+    ASSERT_EQ(run_lucent({"analyze", path, "--out", out, "--model", "anova"}), 0);
+    std::map<std::string, double> expected;  // contrast level -> mean answer
+    {
+        Database db(path, SQLITE_OPEN_READONLY);
+        Statement s = db.prepare(
+            "SELECT sp.value, avg(r.rating) FROM responses r JOIN trials t ON t.id = "
+            "r.trial_id JOIN stimulus_parameters sp ON sp.stimulus_id = t.stimulus_id "
+            "WHERE sp.name = 'contrast' AND t.practice = 0 GROUP BY sp.value");
+        while (s.step()) expected[s.text(0)] = s.real(1);
+    }
+    ASSERT_EQ(expected.size(), 2u);
+    std::ifstream descriptives(std::filesystem::path(out) / "descriptives.csv");
+    std::getline(descriptives, line);
+    const std::vector<std::string> desc_header = common::split_csv_line(line);
+    std::map<std::string, double> reported;
+    while (std::getline(descriptives, line)) {
+        const std::vector<std::string> f = common::split_csv_line(line);
+        std::map<std::string, std::string> cell;
+        for (size_t i = 0; i < f.size() && i < desc_header.size(); ++i)
+            cell[desc_header[i]] = f[i];
+        if (cell["question"] == "probes" && cell["factor"] == "contrast")
+            reported[cell["level"]] = std::stod(cell["mean"]);
+    }
+    ASSERT_EQ(reported.size(), 2u) << "no descriptives of the probe's answers";
+    for (const auto& [level, mean] : expected) EXPECT_NEAR(reported[level], mean, 1e-12);
 }
 
 TEST(TrialKinds, ASecondKindOfTheSameNameIsRefused) {
