@@ -405,68 +405,71 @@ int export_adjustments(const std::string& db_path, std::ostream& out) {
     return rows;
 }
 
+namespace {
+
+// Every answer of every session not withdrawn, practice included: what the per-kind
+// exports below write, each from the rows its kinds are analysed as.
+StudyObservations exported_observations(const std::string& db_path) {
+    return read_observations(db_path, {.analysis = false});
+}
+
+std::string optional_text(const std::map<std::string, double>& measures,
+                          const std::string& name) {
+    const auto it = measures.find(name);
+    return it == measures.end() ? std::string() : common::shortest_text(it->second);
+}
+
+std::string optional_text(const std::optional<double>& v) {
+    return v ? common::shortest_text(*v) : std::string();
+}
+
+}  // namespace
+
 int export_matches(const std::string& db_path, std::ostream& out) {
-    Database db = open_read_only(db_path);
+    const StudyObservations read = exported_observations(db_path);
     out << "participant,session,trial,block,practice,target,match_knob,start_value,"
            "final_value,adjustments,total_ms\n";
-    if (db.scalar_int("PRAGMA user_version") < 7) return 0;
-    const auto taken = readable_sessions(db, db_path);
-    const std::optional<Protocol> protocol = stored_protocol(db);
     auto knob_of = [&](const std::string& block) {
-        const Block* b = protocol ? protocol->find_block(block) : nullptr;
+        const Block* b = read.protocol ? read.protocol->find_block(block) : nullptr;
         return b ? b->knob : std::string();
     };
-    Statement s = db.prepare(
-        "SELECT p.code, se.uuid, t.position, t.block, t.practice, st.stimulus_key, "
-        "t.start_value, t.final_value, (SELECT count(*) FROM adjustments a WHERE "
-        "a.trial_id = t.id), r.rt_ms, se.id FROM responses r "
-        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
-        "JOIN participants p ON p.id = se.participant_id "
-        "JOIN stimuli st ON st.id = t.stimulus_id "
-        "WHERE " +
-        trial_kind(db) + " = 'adjust' ORDER BY p.code, se.id, t.position, r.id");
     int rows = 0;
-    while (s.step()) {
-        if (!taken.count(s.integer(10))) continue;  // withdrawn
-        const std::string block = s.text(3);
-        out << common::csv_field(s.text(0)) << "," << common::csv_field(s.text(1)) << ","
-            << s.integer(2) << "," << common::csv_field(block) << ","
-            << (s.integer(4) != 0 ? 1 : 0) << "," << common::csv_field(s.text(5)) << ","
-            << common::csv_field(knob_of(block)) << "," << optional_number(s, 6) << ","
-            << optional_number(s, 7) << "," << s.integer(8) << ","
-            << common::shortest_text(s.real(9)) << "\n";
+    for (const common::Observation& row : read.table.rows) {
+        if (row.analysed_as != "matches") continue;
+        out << common::csv_field(row.participant) << "," << common::csv_field(row.session)
+            << "," << row.trial << "," << common::csv_field(row.block) << ","
+            << (row.practice ? 1 : 0) << ","
+            << common::csv_field(row.shown.empty() ? "" : row.shown.front()) << ","
+            << common::csv_field(knob_of(row.block)) << ","
+            << optional_text(row.measures, "start_value") << ","
+            << optional_text(row.response) << ","
+            << optional_text(row.measures, "adjustments") << ","
+            << common::shortest_text(row.rt_ms) << "\n";
         ++rows;
     }
     return rows;
 }
 
 int export_staircase(const std::string& db_path, std::ostream& out) {
-    Database db = open_read_only(db_path);
+    const StudyObservations read = exported_observations(db_path);
     out << "participant,session,trial,block,standard,staircase,intensity,expected,"
            "choice,correct,rt_ms\n";
-    if (db.scalar_int("PRAGMA user_version") < 7) return 0;
-    const auto taken = readable_sessions(db, db_path);
-    Statement s = db.prepare(
-        "SELECT p.code, se.uuid, t.position, t.block, st.stimulus_key, "
-        "coalesce(t.staircase, ''), t.intensity, t.expected_rating, r.rating, r.rt_ms, "
-        "se.id FROM responses r "
-        "JOIN trials t ON t.id = r.trial_id JOIN sessions se ON se.id = r.session_id "
-        "JOIN participants p ON p.id = se.participant_id "
-        "JOIN stimuli st ON st.id = t.stimulus_id "
-        "WHERE " +
-        trial_kind(db) + " = 'staircase' ORDER BY p.code, se.id, t.position, r.id");
     int rows = 0;
-    while (s.step()) {
-        if (!taken.count(s.integer(10))) continue;  // withdrawn
-        const bool has_expected = !s.is_null(7);
-        out << common::csv_field(s.text(0)) << "," << common::csv_field(s.text(1)) << ","
-            << s.integer(2) << "," << common::csv_field(s.text(3)) << ","
-            << common::csv_field(s.text(4)) << "," << common::csv_field(s.text(5)) << ","
-            << optional_number(s, 6) << ","
-            << (has_expected ? std::to_string(s.integer(7)) : std::string()) << ","
-            << s.integer(8) << ","
-            << (has_expected ? (s.integer(8) == s.integer(7) ? "1" : "0") : "") << ","
-            << common::shortest_text(s.real(9)) << "\n";
+    for (const common::Observation& row : read.table.rows) {
+        if (row.analysed_as != "thresholds") continue;
+        const std::string choice =
+            row.response ? std::to_string(static_cast<long long>(*row.response)) : "";
+        out << common::csv_field(row.participant) << "," << common::csv_field(row.session)
+            << "," << row.trial << "," << common::csv_field(row.block) << ","
+            << common::csv_field(row.shown.empty() ? "" : row.shown.front()) << ","
+            << common::csv_field(row.procedure) << ","
+            << optional_text(row.measures, "intensity") << ","
+            << (row.expected ? std::to_string(*row.expected) : std::string()) << ","
+            << choice << ","
+            << (row.expected && row.response
+                    ? (static_cast<long long>(*row.response) == *row.expected ? "1" : "0")
+                    : "")
+            << "," << common::shortest_text(row.rt_ms) << "\n";
         ++rows;
     }
     return rows;

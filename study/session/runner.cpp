@@ -335,7 +335,7 @@ void Session::draw_rating_panel(const ScreenLayout& layout) {
     else
         ImGui::TextUnformatted(t.practice ? "Practice" : "");
     const float button = ImGui::GetFrameHeight() * 1.4f;
-    const std::vector<Question> questions = flow_->questions();
+    const std::vector<Question>& questions = flow_->questions();
     for (size_t q = 0; q < questions.size(); ++q) {
         const Question& question = questions[q];
         ImGui::PushID(static_cast<int>(q));

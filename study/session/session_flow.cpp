@@ -126,10 +126,15 @@ const Block* SessionFlow::block() const {
     return t ? protocol_.find_block(t->block) : nullptr;
 }
 
-std::vector<Question> SessionFlow::questions() const {
+const std::vector<Question>& SessionFlow::questions() const {
+    static const std::vector<Question> none;
     const TrialRow* t = trial();
-    if (!t || t->task->screen() != TrialScreen::scales) return {};
-    return t->task->questions(protocol_, block());
+    if (!t || t->task->screen() != TrialScreen::scales) return none;
+    if (questions_of_ != current_) {
+        questions_ = t->task->questions(protocol_, block());
+        questions_of_ = current_;
+    }
+    return questions_;
 }
 
 bool SessionFlow::choice_trial() const {

@@ -141,7 +141,8 @@ public:
     const Block* block() const;
     // The scales of the trial on screen, when its kind answers on the scales screen (a
     // rating's [[questions]]; a kind's own question); none otherwise.
-    std::vector<Question> questions() const;
+    // Computed once per trial: the lab draws them every frame.
+    const std::vector<Question>& questions() const;
     // On a forced choice's Trial screen, what it shows now; nullopt otherwise.
     std::optional<ChoicePhase> choice_phase() const;
     const std::string& text()
@@ -171,7 +172,9 @@ private:
     int64_t session_id_;
     bool consented_ = false;  // on record when the flow was made, or recorded by it
     std::vector<TrialRow> trials_;
-    size_t current_ = 0;  // the first unanswered trial
+    size_t current_ = 0;                       // the first unanswered trial
+    mutable std::vector<Question> questions_;  // of trial questions_of_
+    mutable size_t questions_of_ = SIZE_MAX;
     Screen screen_ = Screen::Consent;
     bool paused_ = false;
     bool finished_ = false;
