@@ -326,6 +326,21 @@ int export_csv(const std::string& db_path, ExportFormat format, std::ostream& ou
     return rows;
 }
 
+namespace {
+
+// A measure or value as the shortest exact text, or empty when it was not recorded.
+std::string optional_text(const std::map<std::string, double>& measures,
+                          const std::string& name) {
+    const auto it = measures.find(name);
+    return it == measures.end() ? std::string() : common::shortest_text(it->second);
+}
+
+std::string optional_text(const std::optional<double>& v) {
+    return v ? common::shortest_text(*v) : std::string();
+}
+
+}  // namespace
+
 ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
                             const ChoiceExportOptions& options) {
     const StudyObservations read = read_observations(
@@ -348,11 +363,8 @@ ChoiceExport export_choices(const std::string& db_path, std::ostream& out,
             << (row.expected ? std::to_string(*row.expected) : std::string());
         for (size_t k = 0; k < 4; ++k)
             out << "," << common::csv_field(k < row.shown.size() ? row.shown[k] : "");
-        for (size_t k = 0; k < 4; ++k) {
-            const auto v = row.measures.find("value_" + std::to_string(k + 1));
-            out << ","
-                << (v != row.measures.end() ? common::shortest_text(v->second) : "");
-        }
+        for (size_t k = 0; k < 4; ++k)
+            out << "," << optional_text(row.measures, "value_" + std::to_string(k + 1));
         out << "," << static_cast<int>(row.response.value_or(0)) << ","
             << format_number(row.rt_ms) << "\n";
         ++result.rows;
@@ -411,16 +423,6 @@ namespace {
 // exports below write, each from the rows its kinds are analysed as.
 StudyObservations exported_observations(const std::string& db_path) {
     return read_observations(db_path, {.analysis = false});
-}
-
-std::string optional_text(const std::map<std::string, double>& measures,
-                          const std::string& name) {
-    const auto it = measures.find(name);
-    return it == measures.end() ? std::string() : common::shortest_text(it->second);
-}
-
-std::string optional_text(const std::optional<double>& v) {
-    return v ? common::shortest_text(*v) : std::string();
 }
 
 }  // namespace
