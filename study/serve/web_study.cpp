@@ -918,6 +918,7 @@ json WebStudy::choice_trial(const TrialRow& t,
         {"id", t.uuid},
         {"task", task_name(t.task)},
         {"shown", shown},
+        {"groups", block.task->answer_groups(block)},  // what each answer names
         {"question", block.question},
         {"labels", block.labels},
         {"presentation",

@@ -1,7 +1,6 @@
 #pragma once
 // Where the stimulus and the rating panel go on screen, and where a forced choice's
 // pictures, question, answers and click targets go (GL-free, unit-tested).
-#include <array>
 #include <vector>
 
 #include "study/protocol.h"
@@ -29,22 +28,27 @@ ScreenLayout compute_layout(int screen_width, int screen_height, int image_width
 
 // ---- forced choices (issue 30) -------------------------------------------------------
 // What a choice trial's screen shows now. Side by side: `all` (every picture with the
-// two answers under them). In sequence: the first part (a pair's first picture, an MLDS
-// trial's first pair), nothing (the blank), the second part, then the two answers.
+// answers under them). In sequence (two answers): the first part (the first answer's
+// pictures: a pair's first picture, an MLDS trial's first pair), nothing (the blank),
+// the second part, then the two answers.
 enum class ChoiceShow { all, first_part, second_part, nothing, answers };
 
 struct PictureSize {
     int width = 0, height = 0;
 };
 
+// Which pictures each answer names (TrialKind::answer_groups): a pair's {0}, {1}; a
+// triad's {0, 1}, {1, 2}; a quadruple's {0, 1}, {2, 3}; an odd one out's {0}, {1}, {2}.
+using AnswerGroups = std::vector<std::vector<int>>;
+
 struct ChoiceLayoutInput {
     int screen_width = 0, screen_height = 0;
-    Task task = Task::pair;  // pair, triad or quadruple
+    AnswerGroups groups = {{0}, {1}};
     ChoiceShow show = ChoiceShow::all;
     std::vector<PictureSize> pictures;  // every picture of the trial, in screen order
     int row_height = 32;  // one line of text (the question, an answer's label)
     int gap = 24;         // between two pictures
-    int group_gap = 96;   // between a quadruple's two pairs
+    int group_gap = 96;   // between two answers' groups of several pictures each
 };
 
 struct ChoiceLayout {
@@ -56,19 +60,22 @@ struct ChoiceLayout {
     std::vector<Rect> picture;
     std::vector<int> index;
     Rect question;  // one row above the pictures (or the answer boxes), screen wide
-    // The two answers' names, under what they name: a pair's pictures; an MLDS trial's
-    // pairs (under a bracket spanning each pair); the answer boxes in sequence.
-    std::array<Rect, 2> label;
-    // MLDS side by side: each pair's bracket, its ticks going up at x and x + width from
-    // y + height to y; a triad's two meet at the middle picture's centre. Empty (width
-    // 0) otherwise.
-    std::array<Rect, 2> bracket;
-    // In sequence, the Answer phase's two boxes (the labels sit in them).
-    std::array<Rect, 2> box;
-    // Where a click picks an answer: a pair's pictures; a triad's left and right half
-    // (split at the middle picture's centre); a quadruple's two groups (pictures,
-    // bracket and label); the two boxes in sequence. Empty in the sequence's parts.
-    std::array<Rect, 2> alternative;
+    // One per answer, in answer order; none in a sequence's parts and its blank (the
+    // answers are not shown yet). The answers' names, under what they name: a picture of
+    // its own; a group of pictures (under a bracket spanning it); the answer boxes in
+    // sequence.
+    std::vector<Rect> label;
+    // Side by side, each group's bracket, its ticks going up at x and x + width from
+    // y + height to y: from edge to edge of its pictures, or, where the groups share a
+    // picture (a triad), from centre to centre, so two meet at the shared picture's
+    // centre. Empty (width 0) for an answer of one picture.
+    std::vector<Rect> bracket;
+    // In sequence, the Answer phase's boxes (the labels sit in them).
+    std::vector<Rect> box;
+    // Where a click picks an answer: its pictures with their bracket and label, split
+    // at a shared picture's centre (a triad's left and right half); the boxes in
+    // sequence.
+    std::vector<Rect> alternative;
 };
 
 // The row of pictures is centred on the screen; the question row sits `row_height / 2`
@@ -88,20 +95,8 @@ AdjustLayout compute_adjust_layout(int screen_width, int screen_height,
                                    PictureSize target, PictureSize match, int row_height,
                                    int gap = 24);
 
-// An odd-one-out staircase trial side by side: three pictures in a row as a triad's
-// (no brackets), each picture's answer name under it, a click on a picture or its name
-// picks it (answers 1..3 left to right). Too large for the screen: fits = false.
-struct OddityLayout {
-    bool fits = true;
-    std::vector<Rect> picture, label, alternative;
-    Rect question;
-};
-OddityLayout compute_oddity_layout(int screen_width, int screen_height,
-                                   const std::vector<PictureSize>& pictures,
-                                   int row_height, int gap = 24);
-
-// Which picture indices a sequence's part shows: a pair's {0} or {1}; a triad's {0, 1}
-// or {1, 2}; a quadruple's {0, 1} or {2, 3}. `all`: every one; otherwise none.
-std::vector<int> choice_part(Task task, ChoiceShow show);
+// Which picture indices a sequence's part shows: the first or the second answer's
+// group. `all`: every picture of the groups; otherwise none.
+std::vector<int> choice_part(const AnswerGroups& groups, ChoiceShow show);
 
 }  // namespace lucent::study

@@ -122,7 +122,6 @@ private:
     const StimulusTexture& shown_texture(size_t place) const;
     std::optional<AdjustLayout> adjust_layout(int w, int h) const;
     void draw_adjust(int w, int h);
-    void draw_oddity(int w, int h);
     std::optional<ChoiceLayout> choice_layout(ChoiceShow show, int w, int h) const;
     bool waits_for_a_larger_window(int w, int h);
     void present(int w, int h);
@@ -400,12 +399,6 @@ ChoiceShow choice_show(const Block& block, std::optional<ChoicePhase> phase) {
     return ChoiceShow::answers;
 }
 
-// The two answers' names on screen (a sequence's pair defaults to "first" and "second":
-// protocol.cpp).
-std::array<std::string, 2> answer_names(const Block& block) {
-    return {block.labels.at(0), block.labels.at(1)};
-}
-
 ImU32 colour(float r, float g, float b) {
     return ImGui::ColorConvertFloat4ToU32(ImVec4(r, g, b, 1));
 }
@@ -427,10 +420,7 @@ std::optional<ChoiceLayout> Session::choice_layout(ChoiceShow show, int w, int h
     ChoiceLayoutInput in;
     in.screen_width = w;
     in.screen_height = h;
-    // A staircase pair is laid out as a pair, an odd one out as a triad.
-    in.task = b->task != Task::staircase ? b->task
-              : b->pictures() == 3       ? Task::triad
-                                         : Task::pair;
+    in.groups = b->task->answer_groups(*b);
     in.show = show;
     for (const std::string& id : t->shown) {
         const StimulusTexture& texture = textures_.at(id);
@@ -490,34 +480,36 @@ void Session::draw_choice(int w, int h) {
     }
     // The answers: from the first frame of the Answer phase (the flow's input follows
     // that frame), none in a sequence's parts and its blank.
-    if (l->alternative[0].width == 0) return;
+    if (l->alternative.empty()) return;
     const RatingInput* input = flow_->rating();
     const std::optional<int> chosen = input ? input->rating(0) : std::nullopt;
-    const std::array<std::string, 2> names = answer_names(b);
-    for (int k = 0; k < 2; ++k) {
+    const int answers = static_cast<int>(std::min(l->label.size(), b.labels.size()));
+    for (int k = 0; k < answers; ++k) {
         const bool on = chosen == k + 1;
         const ImU32 col = on ? chosen_colour : dim;
-        if (const Rect& box = l->box[k]; box.width > 0) {
+        if (k < static_cast<int>(l->box.size())) {  // in sequence, the Answer phase
+            const Rect& box = l->box[k];
             list->AddRectFilled(
                 ImVec2(float(box.x), float(box.y)),
                 ImVec2(float(box.x + box.width), float(box.y + box.height)),
                 on ? chosen_colour : colour(0.25f, 0.25f, 0.3f), 6.f);
-            centred_text(list, box, on ? colour(0, 0, 0) : text, names[k]);
+            centred_text(list, box, on ? colour(0, 0, 0) : text, b.labels[k]);
             continue;
         }
-        if (const Rect& br = l->bracket[k]; br.width > 0) {
+        if (k < static_cast<int>(l->bracket.size()) && l->bracket[k].width > 0) {
+            const Rect& br = l->bracket[k];
             const float x0 = br.x + 0.5f, x1 = br.x + br.width - 0.5f, y0 = float(br.y),
                         y1 = br.y + br.height - 0.5f;
             const ImVec2 points[4] = {{x0, y0}, {x0, y1}, {x1, y1}, {x1, y0}};
             list->AddPolyline(points, 4, col, ImDrawFlags_None, on ? 3.f : 1.5f);
         }
-        centred_text(list, l->label[k], on ? chosen_colour : text, names[k]);
+        centred_text(list, l->label[k], on ? chosen_colour : text, b.labels[k]);
     }
     // A click on an alternative picks it and confirms it (the flow's click_choice).
     if (input && ImGui::IsMouseClicked(ImGuiMouseButton_Left) &&
         !ImGui::GetIO().WantCaptureMouse) {
         const ImVec2 m = ImGui::GetIO().MousePos;
-        for (int k = 0; k < 2; ++k)
+        for (int k = 0; k < answers; ++k)
             if (l->alternative[k].contains(int(m.x), int(m.y))) {
                 const int64_t t_ns = steady_now_ns();
                 ui_actions_.push_back(
@@ -662,49 +654,6 @@ void Session::draw_adjust(int w, int h) {
 
 // An odd one out side by side: three pictures, the comparison at its place, each
 // picture's name under it; 1..3 (or the arrows) and Enter, or a click, answer.
-void Session::draw_oddity(int w, int h) {
-    const TrialRow& t = *flow_->trial();
-    const Block& b = *flow_->block();
-    std::vector<PictureSize> sizes;
-    for (size_t k = 0; k < t.shown.size(); ++k) {
-        const StimulusTexture& texture = shown_texture(k);
-        sizes.push_back({texture.width, texture.height});
-    }
-    const OddityLayout l = compute_oddity_layout(
-        w, h, sizes, static_cast<int>(ImGui::GetFrameHeightWithSpacing() * 1.25f));
-    if (!l.fits) return;
-    ImDrawList* list = ImGui::GetBackgroundDrawList();
-    for (size_t k = 0; k < l.picture.size(); ++k) {
-        const Rect& r = l.picture[k];
-        list->AddImage(ui::imgui_texture(shown_texture(k).texture),
-                       ImVec2(float(r.x), float(r.y)),
-                       ImVec2(float(r.x + r.width), float(r.y + r.height)));
-    }
-    const ImU32 text = colour(1, 1, 1), chosen_colour = colour(0.9f, 0.6f, 0.1f);
-    centred_text(list, l.question, text, b.question);
-    if (t.practice) {
-        Rect above = l.question;
-        above.y -= above.height;
-        centred_text(list, above, colour(0.75f, 0.75f, 0.75f), "Practice");
-    }
-    const RatingInput* input = flow_->rating();
-    const std::optional<int> chosen = input ? input->rating(0) : std::nullopt;
-    for (size_t k = 0; k < l.label.size() && k < b.labels.size(); ++k)
-        centred_text(list, l.label[k], chosen == int(k) + 1 ? chosen_colour : text,
-                     b.labels[k]);
-    if (input && ImGui::IsMouseClicked(ImGuiMouseButton_Left) &&
-        !ImGui::GetIO().WantCaptureMouse) {
-        const ImVec2 m = ImGui::GetIO().MousePos;
-        for (size_t k = 0; k < l.alternative.size(); ++k)
-            if (l.alternative[k].contains(int(m.x), int(m.y))) {
-                const int64_t t_ns = steady_now_ns();
-                const int answer = static_cast<int>(k) + 1;
-                ui_actions_.push_back(
-                    [this, answer, t_ns] { flow_->click_choice(answer, t_ns); });
-            }
-    }
-}
-
 void Session::draw(int w, int h) {
     auto button_key = [this](const char* label, Key key) {
         if (ImGui::Button(label)) {
@@ -760,10 +709,6 @@ void Session::draw(int w, int h) {
             const TrialScreen screen = flow_->trial()->task->screen();
             if (screen == TrialScreen::adjust) {
                 draw_adjust(w, h);
-                break;
-            }
-            if (screen == TrialScreen::staircase && flow_->block()->pictures() == 3) {
-                draw_oddity(w, h);
                 break;
             }
             if (screen == TrialScreen::choice || screen == TrialScreen::staircase) {

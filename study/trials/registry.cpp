@@ -70,6 +70,12 @@ std::vector<Question> TrialKind::questions(const Protocol&, const Block*) const 
     return {};
 }
 
+std::vector<std::vector<int>> TrialKind::answer_groups(const Block& block) const {
+    std::vector<std::vector<int>> groups;
+    for (int k = 0; k < pictures(block); ++k) groups.push_back({k});
+    return groups;
+}
+
 const TrialKind& Task::kind() const {
     const TrialKind* kind = registry().kinds[index_].load(std::memory_order_acquire);
     if (!kind)

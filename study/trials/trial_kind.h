@@ -93,6 +93,14 @@ public:
     virtual int answers(const Block& block) const = 0;
     // The screen its trials are answered on.
     virtual TrialScreen screen() const = 0;
+    // What each answer of a `choice` or `staircase` screen names, in answer order: the
+    // indices of its pictures (into the trial's shown pictures, left to right). By
+    // default each picture is its own answer; a triad's two pairs share their middle
+    // picture ({0, 1}, {1, 2}), a quadruple's pairs are {0, 1} and {2, 3}. In sequence
+    // the first answer's pictures are shown, then the second's. Both screens lay these
+    // out the same way (session/layout.h, serve/web/lucent.js), so a new kind chooses
+    // among its pictures with no screen code.
+    virtual std::vector<std::vector<int>> answer_groups(const Block& block) const;
     // The scales of a `scales` trial, each answered 1..points (`block`: null for a
     // practice rating): a rating's are the protocol's [[questions]]; a kind asking its
     // block's own question gives that, its labels the points. None for other screens.

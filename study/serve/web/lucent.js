@@ -343,13 +343,20 @@
   }
 
   // ---- a forced choice --------------------------------------------------------------
-  // Which pictures (indices into `shown`) each alternative is: a pair's two pictures, a
-  // staircase's two or three, a triad's pairs (a, b) and (b, c), a quadruple's pairs
-  // (a, b) and (c, d).
-  function partsOf(t) {
-    if (t.task === 'pair' || t.task === 'staircase') return t.shown.map((p, i) => [i]);
-    if (t.task === 'triad') return [[0, 1], [1, 2]];
-    return [[0, 1], [2, 3]];
+  // Which pictures (indices into `shown`) each alternative is, as the trial's kind says
+  // (TrialKind::answer_groups): a pair's two pictures, a staircase's two or three, a
+  // triad's pairs (a, b) and (b, c), a quadruple's pairs (a, b) and (c, d).
+  function partsOf(t) { return t.groups; }
+  // Groups that share a picture (a triad's): one row with each group's answer
+  // bracketing it below, the two meeting at the shared picture.
+  function sharesPictures(parts) {
+    const seen = new Set();
+    for (const group of parts)
+      for (const i of group) {
+        if (seen.has(i)) return true;
+        seen.add(i);
+      }
+    return false;
   }
   function answerButton(label, alternative) {
     const b = document.createElement('button');
@@ -359,15 +366,15 @@
     b.dataset.alternative = String(alternative);
     return b;
   }
-  // Side by side: a pair or a quadruple as two groups (a wider gap between a
-  // quadruple's), each with its answer below it; a triad as one row with each pair's
-  // answer bracketing it below. `part` (0, 1) lays out one part of a sequence instead,
-  // and 'answer' its two answers alone.
+  // Side by side: each answer's pictures as a group with its answer below it (a wider
+  // gap between groups of several pictures, a quadruple's pairs); groups sharing a
+  // picture (a triad's) as one row with each group's answer bracketing it below. `part`
+  // (0, 1) lays out one part of a sequence instead, and 'answer' its answers alone.
   function layoutChoice(t, imgs, part) {
     const box = el('alternatives');
     box.textContent = '';
-    box.className = 'task-' + t.task;
     const parts = partsOf(t);
+    box.className = parts.every((group) => group.length > 1) ? 'groups-apart' : '';
     if (part === 'answer') {
       box.classList.add('answers');
       t.labels.forEach((label, i) => box.appendChild(answerButton(label, i + 1)));
@@ -381,17 +388,20 @@
       box.appendChild(group);
       return;
     }
-    if (t.task === 'triad') {
+    if (sharesPictures(parts)) {
       const grid = document.createElement('div');
-      grid.className = 'triad';
-      imgs.forEach((img, i) => {
-        img.dataset.alternative = i === 0 ? '1' : i === 2 ? '2' : '';
+      grid.className = 'shared';
+      grid.style.gridTemplateColumns = 'repeat(' + imgs.length + ', auto)';
+      imgs.forEach((img, i) => {  // a click on a picture only one answer names picks it
+        const naming = parts.flatMap((group, k) => (group.includes(i) ? [k + 1] : []));
+        img.dataset.alternative = naming.length === 1 ? String(naming[0]) : '';
         grid.appendChild(img);
       });
-      parts.forEach((pair, i) => {
+      parts.forEach((group, i) => {
         const bracket = answerButton(t.labels[i], i + 1);
         bracket.classList.add('bracket');
-        bracket.style.gridColumn = pair[0] + 1 + ' / ' + (pair[1] + 2);
+        bracket.style.gridColumn =
+          Math.min(...group) + 1 + ' / ' + (Math.max(...group) + 2);
         bracket.style.gridRow = String(i + 2);
         grid.appendChild(bracket);
       });
@@ -517,7 +527,7 @@
     const parts = partsOf(t);
     el('alternatives').querySelectorAll('[data-alternative]').forEach((node) =>
       node.classList.toggle('chosen', Number(node.dataset.alternative) === choice.pick));
-    if (t.task === 'triad')  // the chosen pair's pictures
+    if (sharesPictures(parts))  // the chosen group's pictures
       el('alternatives').querySelectorAll('img').forEach((img) =>
         img.classList.toggle('chosen', choice.pick !== null &&
                              parts[choice.pick - 1].includes(Number(img.dataset.index))));

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "common/portable_random.h"
 #include "study/trials/block_keys.h"
@@ -204,13 +206,20 @@ namespace {
 
 class ChoiceKind : public TrialKind {
 public:
-    ChoiceKind(const char* name, int pictures) : name_(name), pictures_(pictures) {}
+    ChoiceKind(const char* name, std::vector<std::vector<int>> groups)
+        : name_(name), groups_(std::move(groups)) {
+        for (const std::vector<int>& group : groups_)
+            for (int k : group) pictures_ = std::max(pictures_, k + 1);
+    }
     const char* name() const override { return name_; }
     bool is_choice() const override { return true; }
     bool is_scaling() const override { return true; }
     int pictures_per_trial() const override { return pictures_; }
-    int answers(const Block&) const override { return 2; }
+    int answers(const Block&) const override { return static_cast<int>(groups_.size()); }
     TrialScreen screen() const override { return TrialScreen::choice; }
+    std::vector<std::vector<int>> answer_groups(const Block&) const override {
+        return groups_;
+    }
     const char* analysed_as() const override { return "choices"; }
     void read_block(const Protocol& p, TableReader& keys, Block& b) const override {
         read_choice_block(p, keys, b);
@@ -234,23 +243,24 @@ public:
 
 private:
     const char* name_;
-    int pictures_;
+    std::vector<std::vector<int>> groups_;
+    int pictures_ = 0;
 };
 
 }  // namespace
 
 const TrialKind& pair_trial_kind() {
-    static const ChoiceKind kind("pair", 2);
+    static const ChoiceKind kind("pair", {{0}, {1}});
     return kind;
 }
 
 const TrialKind& triad_trial_kind() {
-    static const ChoiceKind kind("triad", 3);
+    static const ChoiceKind kind("triad", {{0, 1}, {1, 2}});
     return kind;
 }
 
 const TrialKind& quadruple_trial_kind() {
-    static const ChoiceKind kind("quadruple", 4);
+    static const ChoiceKind kind("quadruple", {{0, 1}, {2, 3}});
     return kind;
 }
 

@@ -1083,6 +1083,12 @@ TEST_P(Serve, PairsTriadsAndQuadruplesAreAnsweredOnlineAsInTheLabEachChoiceStore
         }
         EXPECT_EQ(shown["question"], block.question) << where;
         EXPECT_EQ(shown["labels"], json(block.labels)) << where;
+        // What each answer names, the page laying it out from these alone.
+        EXPECT_EQ(shown["groups"],
+                  json::parse(t.task == Task::pair    ? "[[0], [1]]"
+                              : t.task == Task::triad ? "[[0, 1], [1, 2]]"
+                                                      : "[[0, 1], [2, 3]]"))
+            << where;
         EXPECT_EQ(shown["prompt"], "") << where;
         if (t.task == Task::quadruple) {
             EXPECT_EQ(shown["presentation"], "sequential");

@@ -34,9 +34,11 @@ ChoiceLayoutInput choice_input(int w, int h, Task task, ChoiceShow show, int siz
     ChoiceLayoutInput in;
     in.screen_width = w;
     in.screen_height = h;
-    in.task = task;
+    Block block;
+    block.task = task;
+    in.groups = task->answer_groups(block);  // what the lab's runner asks the kind
     in.show = show;
-    in.pictures.assign(pictures_per_trial(task), PictureSize{size, size});
+    in.pictures.assign(task->pictures(block), PictureSize{size, size});
     in.row_height = 32;
     in.gap = 24;
     in.group_gap = 96;
@@ -111,7 +113,8 @@ TEST(ChoiceLayout, ASequenceShowsEachPartCentredThenTwoAnswerBoxes) {
     EXPECT_EQ(first.index, (std::vector<int>{0}));
     EXPECT_EQ(second.picture, first.picture);
     EXPECT_EQ(second.index, (std::vector<int>{1}));
-    EXPECT_EQ(first.alternative[0].width, 0);  // nothing to answer yet
+    EXPECT_TRUE(first.alternative.empty());  // nothing to answer yet
+    EXPECT_TRUE(first.label.empty());
     const ChoiceLayout gap = at(Task::pair, ChoiceShow::nothing, 384);
     EXPECT_TRUE(gap.fits);
     EXPECT_TRUE(gap.picture.empty());
@@ -217,9 +220,15 @@ TEST(AdjustLayout, TargetLeftMatchRightAtTrueSizeQuestionAboveHintBelow) {
     EXPECT_FALSE(compute_adjust_layout(1280, 300, {256, 256}, {256, 256}, 32).fits);
 }
 
-TEST(OddityLayout, ThreePicturesEachWithItsNameUnderItAndItsOwnClickTarget) {
-    const OddityLayout l =
-        compute_oddity_layout(1280, 1024, {{256, 256}, {256, 256}, {256, 256}}, 32);
+TEST(ChoiceLayout, AnOddOneOutsThreePicturesEachHaveTheirNameUnderThemAndTheirClicks) {
+    Block oddity;
+    oddity.task = Task::staircase;
+    oddity.staircase_trial = "oddity";
+    ChoiceLayoutInput in = choice_input(1280, 1024, Task::pair, ChoiceShow::all, 256);
+    in.groups = Task::staircase->answer_groups(oddity);
+    ASSERT_EQ(in.groups, (AnswerGroups{{0}, {1}, {2}}));
+    in.pictures.assign(3, PictureSize{256, 256});
+    const ChoiceLayout l = compute_choice_layout(in);
     ASSERT_TRUE(l.fits);
     ASSERT_EQ(l.picture.size(), 3u);
     ASSERT_EQ(l.label.size(), 3u);
@@ -227,6 +236,7 @@ TEST(OddityLayout, ThreePicturesEachWithItsNameUnderItAndItsOwnClickTarget) {
     for (int k = 0; k < 3; ++k) {
         EXPECT_EQ(l.label[k].x, l.picture[k].x);
         EXPECT_EQ(l.label[k].y, l.picture[k].y + 256 + 16);
+        EXPECT_EQ(l.bracket[k].width, 0);
         EXPECT_TRUE(l.alternative[k].contains(l.picture[k].x + 1, l.picture[k].y + 1));
         EXPECT_TRUE(l.alternative[k].contains(l.label[k].x + 1, l.label[k].y + 1));
         for (int j = 0; j < 3; ++j)
@@ -235,8 +245,37 @@ TEST(OddityLayout, ThreePicturesEachWithItsNameUnderItAndItsOwnClickTarget) {
                                                        l.picture[k].y + 128));
     }
     EXPECT_EQ(l.question.y, l.picture[0].y - 16 - 32);
-    EXPECT_FALSE(
-        compute_oddity_layout(700, 1024, {{256, 256}, {256, 256}, {256, 256}}, 32).fits);
+    in.screen_width = 700;
+    EXPECT_FALSE(compute_choice_layout(in).fits);
+}
+
+// A kind of its own chooses between two groups of three pictures: laid out from its
+// groups alone, as a quadruple's pairs are (edge-to-edge brackets, a wide gap between).
+TEST(ChoiceLayout, AnyKindsGroupsAreLaidOutWithNoScreenCodeOfItsOwn) {
+    ChoiceLayoutInput in = choice_input(1280, 1024, Task::pair, ChoiceShow::all, 100);
+    in.groups = {{0, 1, 2}, {3, 4, 5}};
+    in.pictures.assign(6, PictureSize{100, 100});
+    const ChoiceLayout l = compute_choice_layout(in);
+    ASSERT_TRUE(l.fits);
+    // 6 x 100 + 4 x 24 + 96 = 792: x from 244; y (1024 - 100) / 2 = 462.
+    ASSERT_EQ(l.picture.size(), 6u);
+    EXPECT_EQ(l.picture[0], (Rect{244, 462, 100, 100}));
+    EXPECT_EQ(l.picture[2], (Rect{492, 462, 100, 100}));
+    EXPECT_EQ(l.picture[3], (Rect{688, 462, 100, 100}));
+    EXPECT_EQ(l.picture[5], (Rect{936, 462, 100, 100}));
+    EXPECT_EQ(l.bracket, (std::vector<Rect>{{244, 578, 348, 16}, {688, 578, 348, 16}}));
+    EXPECT_EQ(l.label, (std::vector<Rect>{{244, 594, 348, 32}, {688, 594, 348, 32}}));
+    EXPECT_EQ(l.alternative,
+              (std::vector<Rect>{{244, 462, 348, 164}, {688, 462, 348, 164}}));
+    // In sequence each part is one group, centred: 3 x 100 + 2 x 24 = 348 from 466.
+    in.show = ChoiceShow::second_part;
+    const ChoiceLayout second = compute_choice_layout(in);
+    EXPECT_EQ(second.index, (std::vector<int>{3, 4, 5}));
+    EXPECT_EQ(second.picture.front().x, 466);
+    // Groups naming a picture the trial does not have do not fit (never drawn).
+    in.show = ChoiceShow::all;
+    in.groups = {{0}, {6}};
+    EXPECT_FALSE(compute_choice_layout(in).fits);
 }
 
 }  // namespace
