@@ -22,15 +22,6 @@
 namespace lucent::study {
 namespace {
 
-std::string error_of(const std::string& text) {
-    try {
-        parse_protocol(text, "bad.toml");
-    } catch (const ProtocolError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 // The choice protocol with `from` replaced by `to` (once).
 std::string edited(const std::string& from, const std::string& to) {
     std::string text = lucent::test::kChoiceProtocol;
@@ -80,8 +71,9 @@ TEST(ChoiceProtocol, AStudyOfChoicesOnlyNeedsNoQuestions) {
     EXPECT_NO_THROW(parse_protocol(text, "choices_only.toml"));
     // With the rating block back, the questions are required again.
     std::string with_ratings = text + "\n[[blocks]]\nid = \"r\"\nstimuli = [\"s1\"]\n";
-    EXPECT_NE(error_of(with_ratings).find("[[questions]] entry is required"),
-              std::string::npos);
+    EXPECT_NE(
+        test::protocol_error_of(with_ratings).find("[[questions]] entry is required"),
+        std::string::npos);
 }
 
 TEST(ChoiceProtocol, RefusesEachBadKeyInOneLineNamingIt) {
@@ -111,7 +103,7 @@ TEST(ChoiceProtocol, RefusesEachBadKeyInOneLineNamingIt) {
          "must be \"all\" for a triad block"},
     };
     for (const auto& [text, expected] : cases) {
-        const std::string error = error_of(text);
+        const std::string error = test::protocol_error_of(text);
         EXPECT_NE(error.find(expected), std::string::npos) << error;
         EXPECT_EQ(error.find('\n'), std::string::npos) << error;
         EXPECT_EQ(error.rfind("bad.toml:", 0), 0u) << error;

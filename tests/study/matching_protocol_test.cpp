@@ -15,6 +15,7 @@
 #include "study/trial_plan.h"
 #include "study/trials/adjust/adjust_trials.h"
 #include "study/web_series.h"
+#include "tests/study/study_fixtures.h"
 
 namespace lucent::study {
 namespace {
@@ -84,15 +85,6 @@ std::string edited(const std::string& from, const std::string& to) {
     const size_t at = text.find(from);
     EXPECT_NE(at, std::string::npos) << from;
     return text.replace(at, from.size(), to);
-}
-
-std::string error_of(const std::string& text) {
-    try {
-        parse_protocol(text, "bad.toml");
-    } catch (const ProtocolError& e) {
-        return e.what();
-    }
-    return "";
 }
 
 TEST(MatchingProtocol, ReadsAnAdjustBlockWithItsDefaults) {
@@ -219,7 +211,7 @@ TEST(MatchingProtocol, RefusesEachBadKeyInOneLineNamingIt) {
          "key 'blocks.series_steps': must lie in [2, 10001]"},
     };
     for (const auto& [text, expected] : cases) {
-        const std::string error = error_of(text);
+        const std::string error = test::protocol_error_of(text);
         EXPECT_NE(error.find(expected), std::string::npos) << error;
         EXPECT_EQ(error.find('\n'), std::string::npos) << error;
         EXPECT_EQ(error.rfind("bad.toml:", 0), 0u) << error;

@@ -137,19 +137,10 @@ TEST(BuiltinProtocol, UnknownNameListsValidOnes) {
     }
 }
 
-std::string error_of(const std::string& text) {
-    try {
-        parse_protocol(text, "bad.toml");
-    } catch (const ProtocolError& e) {
-        return e.what();
-    }
-    return "";
-}
-
 TEST(ProtocolErrors, UnknownKeyNamesFileLineAndKey) {
     std::string text = lucent::test::kSmallProtocol;
     text.replace(text.find("break_every = 2"), 15, "break_every = 2\ncolour = 3");
-    const std::string e = error_of(text);
+    const std::string e = test::protocol_error_of(text);
     // kSmallProtocol starts with a newline: [study] is line 2, colour line 5.
     EXPECT_NE(e.find("bad.toml:5:"), std::string::npos) << e;
     EXPECT_NE(e.find("study.colour"), std::string::npos) << e;
@@ -176,7 +167,7 @@ TEST(ProtocolErrors, EachKindIsOneLineNamingTheKey) {
         const size_t at = text.find(c.from);
         ASSERT_NE(at, std::string::npos) << c.from;
         text.replace(at, c.from.size(), c.to);
-        const std::string e = error_of(text);
+        const std::string e = test::protocol_error_of(text);
         EXPECT_NE(e.find(c.expect), std::string::npos) << "got: " << e;
         EXPECT_EQ(e.find('\n'), std::string::npos) << e;
         EXPECT_EQ(e.rfind("bad.toml:", 0), 0u) << e;
@@ -204,7 +195,7 @@ TEST(ProtocolParameters, AreHeldToTheTechniquesKnobsAtTheirLine) {
     for (const Case& c : cases) {
         std::string text = lucent::test::kSmallProtocol;
         text.replace(text.find("roughness = 0.2"), 15, c.to);
-        const std::string e = error_of(text);
+        const std::string e = test::protocol_error_of(text);
         for (const std::string& part : c.expect)
             EXPECT_NE(e.find(part), std::string::npos) << c.to << " got: " << e;
         EXPECT_EQ(e.find('\n'), std::string::npos) << e;
@@ -240,8 +231,9 @@ TEST(Protocol, AnalysisPlanNamesThePrimaryDesign) {
     text += "\n[analysis]\nprimary_design = \"between\"\n";
     EXPECT_EQ(parse_protocol(text, "p.toml").analysis.primary_design, "between");
     EXPECT_EQ(builtin_protocol("thesis").analysis.primary_design, "within");
-    const std::string e = error_of(std::string(lucent::test::kSmallProtocol) +
-                                   "\n[analysis]\nprimary_design = \"mixed\"\n");
+    const std::string e =
+        test::protocol_error_of(std::string(lucent::test::kSmallProtocol) +
+                                "\n[analysis]\nprimary_design = \"mixed\"\n");
     EXPECT_NE(e.find("analysis.primary_design"), std::string::npos) << e;
     EXPECT_NE(e.find("'mixed'"), std::string::npos) << e;
     EXPECT_EQ(e.rfind("bad.toml:", 0), 0u) << e;
@@ -261,7 +253,7 @@ TEST(Protocol, AnalysisPlanNamesThePrimaryModel) {
                             "\n[analysis]\nprimary_model = \"G LMM\"\n";
     const std::string line = std::to_string(
         1 + std::count(bad.begin(), bad.begin() + bad.find("primary_model ="), '\n'));
-    const std::string e = error_of(bad);
+    const std::string e = test::protocol_error_of(bad);
     EXPECT_NE(e.find("analysis.primary_model"), std::string::npos) << e;
     EXPECT_NE(e.find("'G LMM'"), std::string::npos) << e;
     EXPECT_EQ(e.rfind("bad.toml:" + line + ":", 0), 0u) << e;

@@ -12,6 +12,18 @@
 
 namespace lucent::test {
 
+// The one-line error parse_protocol gives `text` read as `source`; "" when it reads.
+inline std::string protocol_error_of(const std::string& text,
+                                     const std::string& source = "bad.toml",
+                                     study::KnobCheck check = study::KnobCheck::strict) {
+    try {
+        study::parse_protocol(text, source, "", check);
+    } catch (const study::ProtocolError& e) {
+        return e.what();
+    }
+    return "";
+}
+
 // A hand-written provenance for every stimulus of protocol `p`: `albedo` is the one
 // value the tests vary.
 inline std::vector<study::StimulusProvenance> provenance_for(const study::Protocol& p,

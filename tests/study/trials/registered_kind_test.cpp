@@ -98,12 +98,7 @@ flashes = 3
 )toml";
 
 std::string error_of(const std::string& text) {
-    try {
-        parse_protocol(text, "probe.toml", "", KnobCheck::lenient);
-    } catch (const ProtocolError& e) {
-        return e.what();
-    }
-    return "";
+    return test::protocol_error_of(text, "probe.toml", KnobCheck::lenient);
 }
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
