@@ -149,8 +149,12 @@ ChoiceLayout compute_choice_layout(const ChoiceLayoutInput& in) {
     const int margin = row / 2;
     const bool sequence = in.show != ChoiceShow::all;
     const std::vector<int> all = choice_part(in.groups, ChoiceShow::all);
-    if (in.groups.empty() || all.empty() || all.front() < 0 ||
-        all.back() >= static_cast<int>(in.pictures.size()))
+    // Every picture named by an answer, every answer naming one: place_answers reads a
+    // group's pictures by their index in the row.
+    const bool empty_group = std::any_of(in.groups.begin(), in.groups.end(),
+                                         [](const auto& group) { return group.empty(); });
+    if (in.groups.empty() || empty_group || all.size() != in.pictures.size() ||
+        all.front() != 0 || all.back() != static_cast<int>(in.pictures.size()) - 1)
         return ChoiceLayout{.fits = false};  // answers naming no picture shown
     // The row of pictures: every picture side by side; in sequence the tallest of them
     // (every part and the answer boxes centred on the same line, so the question stays

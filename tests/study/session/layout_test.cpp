@@ -276,6 +276,11 @@ TEST(ChoiceLayout, AnyKindsGroupsAreLaidOutWithNoScreenCodeOfItsOwn) {
     in.show = ChoiceShow::all;
     in.groups = {{0}, {6}};
     EXPECT_FALSE(compute_choice_layout(in).fits);
+    // Nor do groups leaving a picture unnamed, or an answer naming none.
+    in.groups = {{0, 1, 2}, {4, 5}};
+    EXPECT_FALSE(compute_choice_layout(in).fits);
+    in.groups = {{0, 1, 2, 3, 4, 5}, {}};
+    EXPECT_FALSE(compute_choice_layout(in).fits);
 }
 
 }  // namespace
