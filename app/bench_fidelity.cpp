@@ -45,7 +45,8 @@ struct Case {
     std::vector<KnobAssignment> settings;
 };
 
-// The thesis's key light (stimuli/presets/thesis.toml) and its back-lit counterpart.
+// The thesis's key light (renderer/core/presets/thesis.toml) and its back-lit
+// counterpart.
 const std::vector<KnobAssignment> kFrontLight = {
     {"light_direction", "0.4,0.6,1"}, {"light_ambient", "0.6"}, {"light_diffuse", "1"}};
 const std::vector<KnobAssignment> kBackLight = {

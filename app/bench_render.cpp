@@ -62,7 +62,7 @@ int run_render_bench(const RenderBenchOptions& options) {
                      "in 1..64\n";
         return kExitUsage;
     }
-    auto set = stimuli::load_preset("thesis", stimuli::default_catalog());
+    auto set = load_set_preset("thesis", default_set_catalog());
     set.width = width;
     set.height = height;
 
@@ -82,7 +82,7 @@ int run_render_bench(const RenderBenchOptions& options) {
             "lucent bench render: '%s' set, %zu stimuli at %dx%d, %d job(s), formats:",
             set.name.c_str(), set.stimuli.size(), width, height, options.jobs);
         for (const auto format : set.formats)
-            std::printf(" %s", std::string(stimuli::extension(format)).c_str());
+            std::printf(" %s", std::string(image_extension(format)).c_str());
         std::printf(
             "\nstage seconds are summed over workers: %d render (AO, GL) and %d encode "
             "(encode, stats+hash) workers run at once; busy = stages / wall;\nCPU s: "

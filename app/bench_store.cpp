@@ -307,7 +307,7 @@ struct ServeSetup {
     std::map<std::string, ServedPicture> pictures;
     ServeSetup() {
         options.secret = "bench";
-        for (const study::StimulusSpec& s : protocol.stimuli) {
+        for (const Stimulus& s : protocol.stimuli) {
             options.images[s.id] = {protocol.stimulus_width, protocol.stimulus_height};
             pictures[s.id] = {"", options.images[s.id]};
         }

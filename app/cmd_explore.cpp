@@ -5,9 +5,9 @@
 #include "app/commands.h"
 #include "renderer/core/image.h"
 #include "renderer/core/mesh.h"
+#include "renderer/core/stimulus_set.h"
 #include "stimuli/explorer/explorer.h"
 #include "stimuli/explorer/frame_stats.h"
-#include "stimuli/stimulus_set.h"
 
 namespace lucent::app {
 namespace {
@@ -62,7 +62,7 @@ int run_explore(const ExploreOptions& options) {
     } catch (const KnobError& e) {
         std::cerr << "lucent explore: " << e.what() << "\n";
         return kExitUsage;
-    } catch (const stimuli::StimulusSetError& e) {
+    } catch (const StimulusSetError& e) {
         std::cerr << "lucent explore: " << e.what() << "\n";
         return kExitUsage;
     } catch (const std::invalid_argument& e) {

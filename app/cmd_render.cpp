@@ -180,16 +180,15 @@ std::string study_preset_list() {
 
 // The pictures of a study for the browser; a protocol or series problem is one line
 // (exit 2, nothing written).
-stimuli::StimulusSet study_picture_set(const std::string& file,
-                                       const std::string& preset) {
+StimulusSet study_picture_set(const std::string& file, const std::string& preset) {
     try {
         return study::browser_picture_set(preset.empty()
                                               ? study::load_protocol_file(file)
                                               : study::builtin_protocol(preset));
     } catch (const study::ProtocolError& e) {
-        throw stimuli::StimulusSetError(e.what());
+        throw StimulusSetError(e.what());
     } catch (const study::StimulusError& e) {
-        throw stimuli::StimulusSetError(e.what());
+        throw StimulusSetError(e.what());
     }
 }
 
@@ -203,27 +202,27 @@ bool is_builtin_study(const std::string& name) {
 // report), and when NAME is also a built-in study, every other picture that study shows:
 // its adjust series and staircase ladders (study/web_series.h). A picture of both must
 // be the same render, or the study would check its folder against another picture.
-stimuli::StimulusSet preset_picture_set(const std::string& name) {
-    stimuli::StimulusSet set = stimuli::load_preset(name, stimuli::default_catalog());
+StimulusSet preset_picture_set(const std::string& name) {
+    StimulusSet set = load_set_preset(name, default_set_catalog());
     if (!is_builtin_study(name)) return set;
-    const stimuli::StimulusSet shown = study_picture_set("", name);
+    const StimulusSet shown = study_picture_set("", name);
     const std::string where = "--preset " + name + ": ";
     if (shown.width != set.width || shown.height != set.height)
-        throw stimuli::StimulusSetError(
+        throw StimulusSetError(
             where +
             "the stimulus set's resolution differs from the study's stimulus_size");
-    std::map<std::string, const stimuli::Stimulus*> by_id;
-    for (const stimuli::Stimulus& s : set.stimuli) by_id[s.id] = &s;
-    for (const stimuli::Stimulus& picture : shown.stimuli) {
+    std::map<std::string, const Stimulus*> by_id;
+    for (const Stimulus& s : set.stimuli) by_id[s.id] = &s;
+    for (const Stimulus& picture : shown.stimuli) {
         const auto it = by_id.find(picture.id);
         if (it == by_id.end()) {
             set.stimuli.push_back(picture);
             continue;
         }
-        const stimuli::Stimulus& own = *it->second;
-        if (own.technique != picture.technique || own.mesh_spec != picture.mesh_spec ||
-            own.parameters.all() != picture.parameters.all())
-            throw stimuli::StimulusSetError(
+        const Stimulus& own = *it->second;
+        if (own.technique != picture.technique || own.mesh != picture.mesh ||
+            own.values.all() != picture.values.all())
+            throw StimulusSetError(
                 where + "stimulus '" + picture.id +
                 "' of the stimulus set differs from the built-in study's");
     }
@@ -251,7 +250,7 @@ void register_render(CLI::App& app, int& exit_code) {
     cmd->add_option("config", options->config,
                     "stimulus-set config (TOML): render every stimulus into --out DIR");
     std::string presets;
-    for (const std::string& name : stimuli::preset_names())
+    for (const std::string& name : set_preset_names())
         presets += (presets.empty() ? "" : ", ") + name;
     cmd->add_option(
         "--preset", options->preset,
@@ -328,9 +327,8 @@ void register_render(CLI::App& app, int& exit_code) {
                         options->preset.empty() ? options->study_preset : options->preset;
                     // --study-preset names a built-in study.
                     if (options->preset.empty() && !is_builtin_study(name))
-                        throw stimuli::StimulusSetError(
-                            "unknown preset '" + name +
-                            "' (valid: " + study_preset_list() + ")");
+                        throw StimulusSetError("unknown preset '" + name +
+                                               "' (valid: " + study_preset_list() + ")");
                     return preset_picture_set(name);
                 },
                 options->out, options->jobs, options->force);

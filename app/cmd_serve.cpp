@@ -67,7 +67,7 @@ std::string read_file(const std::filesystem::path& path) {
 std::map<std::string, ServedPicture> load_pictures(
     const study::Protocol& protocol, const study::PrerenderedStimuli& stimuli) {
     std::map<std::string, ServedPicture> out;
-    for (const study::StimulusSpec& s : protocol.stimuli) {
+    for (const Stimulus& s : protocol.stimuli) {
         const study::CpuImage image = study::load_image_rgba8(stimuli.path_for(s));
         out[s.id] = {study::encode_png_rgba8(image), {image.width, image.height}};
     }

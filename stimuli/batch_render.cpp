@@ -41,21 +41,21 @@ double seconds_since(Clock::time_point start) {
 }
 
 std::filesystem::path file_of(const Stimulus& s, ImageFormat format) {
-    return s.id + "." + std::string(extension(format));
+    return s.id + "." + std::string(image_extension(format));
 }
 
 // The parameter columns in knob order (scene knobs first), values as text.
 std::vector<ManifestField> parameter_fields(const Stimulus& stimulus) {
     std::vector<ManifestField> fields;
     for (const Knob& knob : knobs_for(find_technique(stimulus.technique))) {
-        const auto& value = stimulus.parameters.get(knob.name);
+        const auto& value = stimulus.values.get(knob.name);
         const bool numeric =
             std::holds_alternative<double>(value) || std::holds_alternative<int>(value);
         fields.push_back({knob.name, format_knob_value(value), numeric});
         // An input's content hash follows its spec, as mesh_hash follows mesh.
         if (knob.input_hash)
             fields.push_back(
-                {input_hash_column(knob), knob.input_hash(stimulus.parameters), false});
+                {input_hash_column(knob), knob.input_hash(stimulus.values), false});
     }
     return fields;
 }
@@ -84,7 +84,7 @@ ManifestRow identity_fields(const StimulusSet& set, const Stimulus& s, const Mes
                        {"files", files, false},
                        {"technique", s.technique, false},
                        {"series", s.series, false},
-                       {"mesh", s.mesh_spec, false},
+                       {"mesh", s.mesh, false},
                        {"mesh_faces", std::to_string(mesh.face_count()), true},
                        {"mesh_hash", mesh.content_hash, false},
                        {"width", std::to_string(set.width), true},
@@ -210,12 +210,12 @@ std::string input_hash(const StimulusSet& set, const Stimulus& stimulus,
     hasher.field(version_string()).field(build_hash());
     hasher.field(stimulus.technique).field(mesh_hash);
     hasher.field(std::to_string(set.width)).field(std::to_string(set.height));
-    for (const auto format : set.formats) hasher.field(extension(format));
-    for (const auto& [name, value] : stimulus.parameters.all())
+    for (const auto format : set.formats) hasher.field(image_extension(format));
+    for (const auto& [name, value] : stimulus.values.all())
         hasher.field(name).field(format_knob_value(value));
     // An input file can change under the same spec: its content decides.
     for (const auto& [column, hash] :
-         input_hashes(knobs_for(find_technique(stimulus.technique)), stimulus.parameters))
+         input_hashes(knobs_for(find_technique(stimulus.technique)), stimulus.values))
         hasher.field(column).field(hash);
     return hasher.hex();
 }
@@ -228,8 +228,8 @@ using MeshesBySpec = std::map<std::string, std::shared_ptr<const Mesh>>;
 MeshesBySpec load_meshes(const StimulusSet& set) {
     MeshesBySpec meshes;
     for (const auto& s : set.stimuli)
-        if (!meshes.count(s.mesh_spec))
-            meshes[s.mesh_spec] = std::make_shared<const Mesh>(load_mesh(s.mesh_spec));
+        if (!meshes.count(s.mesh))
+            meshes[s.mesh] = std::make_shared<const Mesh>(load_mesh(s.mesh));
     return meshes;
 }
 
@@ -267,7 +267,7 @@ RenderPlan plan_renders(
     plan.inputs.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
         const auto& s = set.stimuli[i];
-        const Mesh& mesh = *meshes.at(s.mesh_spec);
+        const Mesh& mesh = *meshes.at(s.mesh);
         plan.inputs[i] = input_hash(set, s, mesh.content_hash);
         const auto it = previous.find(s.id);
         const auto* old = it == previous.end() ? nullptr : &it->second;
@@ -301,8 +301,8 @@ Prebaked prebake(const StimulusSet& set, const MeshesBySpec& meshes,
     for (const std::size_t i : pending) {
         const Stimulus& s = set.stimuli[i];
         const Technique& technique = find_technique(s.technique);
-        const Scene scene = make_scene(meshes.at(s.mesh_spec), technique, s.parameters,
-                                       set.width, set.height);
+        const Scene scene =
+            make_scene(meshes.at(s.mesh), technique, s.values, set.width, set.height);
         for (const Pass& pass : make_frame_plan(scene, technique).passes)
             if (is_bake(pass)) bakes.emplace(pass.data.content_hash, pass);
     }
@@ -413,7 +413,7 @@ bool RenderWorkers::finish_stimulus(const RenderedStimulus& item, BatchTimings& 
     timings.encode_seconds += seconds_since(start);
 
     start = Clock::now();
-    ManifestRow row = identity_fields(set_, s, *meshes_.at(s.mesh_spec));
+    ManifestRow row = identity_fields(set_, s, *meshes_.at(s.mesh));
     const auto stats = compute_image_statistics(
         FloatImageView{image.width, image.height, 4, image.rgba}, kHistogramBins);
     const auto measured = measured_fields(stats, item.rendered.non_finite_pixels);
@@ -462,8 +462,8 @@ void RenderWorkers::render_worker(int index) {
             // The single-image path of `lucent render --mesh`.
             const auto start = Clock::now();
             const double ao_before = timings.ao_seconds;
-            const Scene scene = make_scene(meshes_.at(s.mesh_spec), technique,
-                                           s.parameters, set_.width, set_.height);
+            const Scene scene = make_scene(meshes_.at(s.mesh), technique, s.values,
+                                           set_.width, set_.height);
             RenderedStimulus item{i, render_image_counted(executor, scene)};
             timings.gl_seconds += seconds_since(start) - (timings.ao_seconds - ao_before);
 
@@ -604,9 +604,9 @@ int run_render_set_command(const std::string& config_path, const std::string& pr
                            const std::string& out_dir, int jobs, bool force) {
     return run_render_set_command(
         [&] {
-            const auto catalog = default_catalog();
+            const auto catalog = default_set_catalog();
             return preset.empty() ? load_stimulus_set(config_path, catalog)
-                                  : load_preset(preset, catalog);
+                                  : load_set_preset(preset, catalog);
         },
         out_dir, jobs, force);
 }

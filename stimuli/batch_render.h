@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "renderer/core/image.h"
+#include "renderer/core/stimulus_set.h"
 #include "stimuli/manifest.h"
-#include "stimuli/stimulus_set.h"
 
 namespace lucent::stimuli {
 

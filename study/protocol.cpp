@@ -14,6 +14,7 @@
 
 #include "common/number_text.h"
 #include "renderer/core/knob_toml.h"
+#include "renderer/core/stimulus_set.h"
 #include "renderer/techniques/registry.h"
 #include "study/embedded_study_files.h"
 #include "study/sha256.h"
@@ -24,29 +25,15 @@
 namespace lucent::study {
 namespace {
 
-// A parameter's text as the database and the factor levels hold it: as written, numbers
-// in the shortest form that reads back to the same double ("25" for 25.0), arrays as
-// "a,b,c". A pre-rendered image's parameters are only this: labels, not knobs.
+// A parameter's text as the database and the factor levels hold it (the renderer's one
+// parameter_text). A pre-rendered image's parameters are only this: labels, not knobs.
 std::string label_text(const toml::node& node, TableReader& reader,
                        const std::string& key) {
-    auto number = [&](const toml::node& item) {
-        const double v = *item.value<double>();
-        if (!std::isfinite(v)) reader.fail(&item, key, "must be finite");
-        return common::shortest_text(v);
-    };
-    if (node.is_integer() || node.is_floating_point()) return number(node);
-    if (node.is_string()) return std::string(*node.value<std::string>());
-    if (node.is_boolean()) return *node.value<bool>() ? "true" : "false";
-    if (const toml::array* array = node.as_array()) {
-        std::string out;
-        for (const toml::node& item : *array) {
-            if (!(item.is_integer() || item.is_floating_point()))
-                reader.fail(&item, key, "array values must be numbers (r,g,b)");
-            out += (out.empty() ? "" : ",") + number(item);
-        }
-        return out;
+    try {
+        return parameter_text(node);
+    } catch (const ParameterTextError& e) {
+        reader.fail(e.node, key, e.what());
     }
-    reader.fail(&node, key, "must be a number, string, boolean or array of numbers");
 }
 
 // A live stimulus's parameter: a knob of its technique, checked by the renderer's one
@@ -54,7 +41,7 @@ std::string label_text(const toml::node& node, TableReader& reader,
 // grey "0.6" stays one number, as the database and the factor levels always had it) with
 // each number in the shortest text that parse_knob_value() reads back to the same double
 // as that reader. See KnobCheck for what a refusal does.
-std::string knob_text(const std::vector<Knob>& knobs, const StimulusSpec& stimulus,
+std::string knob_text(const std::vector<Knob>& knobs, const Stimulus& stimulus,
                       const toml::node& node, TableReader& reader, const std::string& key,
                       KnobCheck check) {
     const Knob* knob = find_knob(knobs, key);
@@ -108,6 +95,7 @@ void read_study(Protocol& p, TableReader& root) {
     p.break_every = r.integer("break_every", 0, 0, 100000);
     p.inter_trial_ms = r.integer("inter_trial_ms", 500, 0, 60000);
     p.max_failed_catch = r.integer("max_failed_catch", 0, 0, 100000);
+    p.stimulus_set = r.string("stimulus_set", "");
     r.reject_unknown();
 }
 
@@ -149,17 +137,82 @@ void read_questions(Protocol& p, TableReader& root) {
     }
 }
 
+// The stimulus set a protocol names ([study] stimulus_set), as stored with it
+// ([embedded_stimulus_set]) or else read from the preset or file; the protocol's text
+// gains the embedded copy. The set's own errors keep their file:line.
+std::vector<Stimulus> read_named_set(Protocol& p, TableReader& root,
+                                     const std::string& base_dir) {
+    const toml::node* named_at = root.raw().at_path("study.stimulus_set").node();
+    std::string text, source = p.stimulus_set;
+    std::string directory = ".";
+    if (const toml::table* stored = root.table("embedded_stimulus_set")) {
+        TableReader r(*stored, "embedded_stimulus_set", p.source);
+        const std::string named = r.string("source", "", true);
+        if (named != p.stimulus_set)
+            r.fail(stored->get("source"), "source",
+                   "is '" + named + "', not the [study] stimulus_set '" + p.stimulus_set +
+                       "'");
+        text = r.string("text", "", true);
+        directory = r.string("directory", ".");
+        r.reject_unknown();
+    } else if (p.stimulus_set.rfind("preset:", 0) == 0) {
+        const std::string name = p.stimulus_set.substr(7);
+        const std::optional<std::string_view> preset = set_preset_text(name);
+        if (!preset) {
+            std::string valid;
+            for (const std::string& known : set_preset_names())
+                valid += (valid.empty() ? "" : ", ") + known;
+            root.fail(named_at, "study.stimulus_set",
+                      "unknown preset '" + name + "' (valid: " + valid + ")");
+        }
+        text = std::string(*preset);
+    } else {
+        std::filesystem::path file(p.stimulus_set);
+        if (file.is_relative() && !base_dir.empty()) file = base_dir / file;
+        std::ifstream in(file, std::ios::binary);
+        std::ostringstream bytes;
+        if (!in || !(bytes << in.rdbuf()))
+            root.fail(named_at, "study.stimulus_set",
+                      "cannot read the stimulus set '" + file.string() + "'");
+        text = bytes.str();
+        source = file.string();
+        directory = std::filesystem::absolute(file).parent_path().string();
+    }
+    std::vector<Stimulus> stimuli;
+    try {
+        stimuli =
+            parse_stimulus_set(text, source, directory, default_set_catalog()).stimuli;
+    } catch (const StimulusSetError& e) {
+        throw ProtocolError(p.source + ": study.stimulus_set: " + e.what());
+    }
+    if (!root.raw().get("embedded_stimulus_set")) {
+        const toml::table embedded{
+            {"source", p.stimulus_set}, {"text", text}, {"directory", directory}};
+        std::ostringstream out;
+        out << "\n# The stimulus set as it was read (lucent adds it), so that the stored "
+               "protocol\n# needs no other file.\n[embedded_stimulus_set]\n"
+            << embedded << "\n";
+        p.text += out.str();
+    }
+    return stimuli;
+}
+
 void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir,
                   KnobCheck check) {
+    if (!p.stimulus_set.empty()) p.stimuli = read_named_set(p, root, base_dir);
     const toml::array* stimuli = root.array("stimuli");
-    if (!stimuli || stimuli->empty())
-        root.fail(stimuli, "stimuli", "at least one [[stimuli]] entry is required");
+    if (!stimuli || stimuli->empty()) {
+        if (!p.stimuli.empty()) return;
+        root.fail(stimuli, "stimuli",
+                  "at least one [[stimuli]] entry is required (or [study] stimulus_set)");
+    }
     for (const toml::node& node : *stimuli) {
         TableReader r(as_table(node, root, "stimuli"), "stimuli", p.source);
-        StimulusSpec s;
+        Stimulus s;
         s.id = r.string("id", "", true);
         s.technique = r.string("technique", "");
         s.mesh = r.string("mesh", "");
+        s.mesh_name = s.mesh;
         s.image = r.string("image", "");
         if (s.technique.empty() == s.image.empty())
             r.fail(nullptr, "technique",
@@ -184,16 +237,33 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir,
                                          : label_text(value, pr, name);
             }
         }
+        // The experimenter's own factors: named levels no renderer reads.
+        if (const toml::table* factors = r.table("factors")) {
+            TableReader fr(*factors, "stimuli.factors", p.source);
+            const std::vector<Knob> knobs =
+                s.live() ? knobs_for(find_technique(s.technique)) : std::vector<Knob>{};
+            for (const auto& [key, value] : *factors) {
+                const std::string name(key.str());
+                if (s.parameters.count(name) || find_knob(knobs, name))
+                    fr.fail(&value, name,
+                            "'" + name + "' is a parameter of stimulus '" + s.id +
+                                "': set it in params, not as a factor");
+                if (name == "technique" || name.find(':') != std::string::npos)
+                    fr.fail(&value, name, "'" + name + "' is not a factor name");
+                s.factors[name] = label_text(value, fr, name);
+            }
+        }
         s.varies = r.strings("varies");
-        // A factor is a parameter, "technique", or "series:NAME": a comparison series
-        // whose levels are the stimuli themselves (e.g. one empirical picture against
-        // three physically based ones).
+        // A factor is a parameter, an own factor, "technique", or "series:NAME": a
+        // comparison series whose levels are the stimuli themselves (e.g. one empirical
+        // picture against three physically based ones).
         for (const std::string& factor : s.varies)
             if (factor != "technique" && !s.parameters.count(factor) &&
+                !s.factors.count(factor) &&
                 !(factor.rfind("series:", 0) == 0 && factor.size() > 7))
                 r.fail(r.raw().get("varies"), "varies",
-                       "'" + factor + "' is not a parameter of stimulus '" + s.id +
-                           "' (nor technique or series:NAME)");
+                       "'" + factor + "' is not a parameter or factor of stimulus '" +
+                           s.id + "' (nor technique or series:NAME)");
         if (p.find_stimulus(s.id))
             r.fail(r.raw().get("id"), "id", "duplicate stimulus id '" + s.id + "'");
         r.reject_unknown();
@@ -287,7 +357,7 @@ void read_randomisation(Protocol& p, TableReader& root) {
     if (rz.factor != "stimulus" && rz.factor != "technique") {
         bool known = std::any_of(
             p.stimuli.begin(), p.stimuli.end(),
-            [&](const StimulusSpec& s) { return s.parameters.count(rz.factor) > 0; });
+            [&](const Stimulus& s) { return s.columns().count(rz.factor) > 0; });
         if (!known)
             r.fail(r.raw().get("factor"), "factor",
                    "'" + rz.factor +
@@ -375,7 +445,7 @@ int Block::answers() const { return task->answers(*this); }
 
 std::optional<double> Protocol::numeric_parameter(std::string_view stimulus,
                                                   const std::string& parameter) const {
-    const StimulusSpec* s = find_stimulus(stimulus);
+    const Stimulus* s = find_stimulus(stimulus);
     if (!s) return std::nullopt;
     const auto it = s->parameters.find(parameter);
     if (it == s->parameters.end()) return std::nullopt;
@@ -394,13 +464,13 @@ bool Protocol::has_rating_trials() const {
                        [](const Block& b) { return b.task == Task::rating; });
 }
 
-const StimulusSpec* Protocol::find_stimulus(std::string_view id) const {
-    for (const StimulusSpec& s : stimuli)
+const Stimulus* Protocol::find_stimulus(std::string_view id) const {
+    for (const Stimulus& s : stimuli)
         if (s.id == id) return &s;
     return nullptr;
 }
 
-std::string Protocol::picture_key(const StimulusSpec& stimulus) {
+std::string Protocol::picture_key(const Stimulus& stimulus) {
     if (!stimulus.live()) {
         std::ifstream in(stimulus.image, std::ios::binary);
         std::ostringstream bytes;
@@ -416,17 +486,16 @@ std::string Protocol::picture_key(const StimulusSpec& stimulus) {
 std::map<std::string, std::string> Protocol::levels_of(std::string_view factor) const {
     std::map<std::string, std::string> levels;
     if (factor != "stimulus") {
-        for (const StimulusSpec& s : stimuli) levels[s.id] = level_of(s, factor);
+        for (const Stimulus& s : stimuli) levels[s.id] = level_of(s, factor);
         return levels;
     }
     std::map<std::string, std::string> first_id_of_picture;
-    for (const StimulusSpec& s : stimuli)
+    for (const Stimulus& s : stimuli)
         levels[s.id] = first_id_of_picture.emplace(picture_key(s), s.id).first->second;
     return levels;
 }
 
-std::string Protocol::level_of(const StimulusSpec& stimulus,
-                               std::string_view factor) const {
+std::string Protocol::level_of(const Stimulus& stimulus, std::string_view factor) const {
     if (factor == "stimulus") {
         const auto levels = levels_of(factor);
         const auto it = levels.find(stimulus.id);
@@ -435,8 +504,9 @@ std::string Protocol::level_of(const StimulusSpec& stimulus,
     if (factor == "technique")
         return stimulus.technique.empty() ? "image" : stimulus.technique;
     if (factor.rfind("series:", 0) == 0) return stimulus.id;
-    auto it = stimulus.parameters.find(std::string(factor));
-    return it == stimulus.parameters.end() ? std::string() : it->second;
+    const std::map<std::string, std::string> columns = stimulus.columns();
+    auto it = columns.find(std::string(factor));
+    return it == columns.end() ? std::string() : it->second;
 }
 
 Protocol parse_protocol(std::string_view text, const std::string& source,

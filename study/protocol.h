@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "renderer/core/stimulus.h"
 #include "study/trials/trial_kind.h"
 
 namespace lucent::study {
@@ -18,25 +19,6 @@ namespace lucent::study {
 class ProtocolError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
-};
-
-// One stimulus: either rendered live (technique + parameters) or a pre-rendered image.
-struct StimulusSpec {
-    std::string id;         // unique within the protocol, e.g. "emp1"
-    std::string technique;  // a registered technique (renderer/techniques/registry.cpp);
-                            // "" for images
-    std::string mesh;       // built-in mesh name or path (live stimuli)
-    std::string image;      // image path (pre-rendered stimuli), relative to the protocol
-    // Technique parameters by knob name, ordered by name; they become analysis factors.
-    // Values as written ("25", "1.2", "0.8,0.6,0.5", a grey "0.6"), each number in the
-    // shortest text that reads back to the same double; a live stimulus's are checked
-    // against its technique's knobs when the protocol is read.
-    std::map<std::string, std::string> parameters;
-    // Which parameters this stimulus was designed to vary (its factor series); empty
-    // means every parameter is a factor. "technique" may be listed too, and
-    // "series:NAME": a factor NAME whose levels are the stimuli listing it.
-    std::vector<std::string> varies;
-    bool live() const { return image.empty(); }
 };
 
 struct Question {
@@ -218,8 +200,13 @@ struct Screens {
 struct Protocol {
     std::string name;
     std::string title;
-    std::string source;                     // file name or "preset:thesis", for messages
-    std::string text;                       // the TOML text itself (stored with its hash)
+    std::string source;  // file name or "preset:thesis", for messages
+    // The TOML text itself (stored with its hash). A protocol that takes its stimuli from
+    // a set ([study] stimulus_set) holds the set's text too, in a [embedded_stimulus_set]
+    // table appended when it is first read, so the stored protocol needs no other file
+    // and its hash changes with the set.
+    std::string text;
+    std::string stimulus_set;  // "preset:NAME" or a set file; "" when the entries are own
     float background[3] = {0.f, 0.f, 0.f};  // linear 0..1, behind every stimulus
     int stimulus_width = 512;               // live stimuli are rendered at this size
     int stimulus_height = 512;
@@ -227,7 +214,7 @@ struct Protocol {
     int inter_trial_ms = 500;  // blank screen between trials
     int max_failed_catch = 0;  // participants failing more catch trials are excluded
     Screens screens;
-    std::vector<StimulusSpec> stimuli;
+    std::vector<Stimulus> stimuli;
     std::vector<Question> questions;
     std::vector<std::string> practice;  // stimulus ids of the practice trials, in order
     std::vector<Block> blocks;
@@ -236,7 +223,7 @@ struct Protocol {
     AnalysisPlan analysis;
     OnlineSettings online;
 
-    const StimulusSpec* find_stimulus(std::string_view id) const;
+    const Stimulus* find_stimulus(std::string_view id) const;
     const Block* find_block(std::string_view id) const;
     // A stimulus's parameter as a finite number (e.g. its place on a block's series);
     // nullopt when it has no such parameter or it is not a number.
@@ -249,14 +236,14 @@ struct Protocol {
     // when the stimulus has no such parameter. The level of "stimulus" is the picture:
     // the id of the first stimulus with the same picture_key, so ids that show the same
     // picture (the thesis's rows 1, 4 and 7) share a level.
-    std::string level_of(const StimulusSpec& stimulus, std::string_view factor) const;
+    std::string level_of(const Stimulus& stimulus, std::string_view factor) const;
     // level_of for every stimulus at once (stimulus id -> level), hashing each image
     // once.
     std::map<std::string, std::string> levels_of(std::string_view factor) const;
     // What the participant sees, independent of the id: a live stimulus's technique,
     // mesh and parameters (as written; a default spelled out counts as different), or a
     // pre-rendered image's content hash (its path when the file cannot be read).
-    static std::string picture_key(const StimulusSpec& stimulus);
+    static std::string picture_key(const Stimulus& stimulus);
 };
 
 // How a live stimulus's parameters are held to its technique's knobs.

@@ -22,7 +22,7 @@ double stimulus_knob_value(const Protocol& protocol, std::string_view stimulus,
                            const std::string& knob) {
     if (const std::optional<double> v = protocol.numeric_parameter(stimulus, knob))
         return *v;
-    const StimulusSpec* s = protocol.find_stimulus(stimulus);
+    const Stimulus* s = protocol.find_stimulus(stimulus);
     const std::vector<Knob> knobs = knobs_for(find_technique(s->technique));
     return std::get<double>(find_knob(knobs, knob)->default_value);
 }
@@ -128,21 +128,21 @@ WebSeries web_series(const Protocol& protocol) {
     // r = 30 - 5 is the standard r = 25 itself.
     std::map<std::string, std::string> id_of_picture;
     std::set<std::string> ids;
-    for (const StimulusSpec& s : protocol.stimuli) {
+    for (const Stimulus& s : protocol.stimuli) {
         ids.insert(s.id);
         if (s.live()) id_of_picture.emplace(Protocol::picture_key(s), s.id);
     }
     const auto add = [&](const Block& block, const std::string& stimulus,
                          std::vector<double> steps, double base, double sign) {
         KnobSeries series{block.id, stimulus, block.knob, std::move(steps), {}};
-        const StimulusSpec& spec = *protocol.find_stimulus(stimulus);
+        const Stimulus& spec = *protocol.find_stimulus(stimulus);
         for (double step : series.steps) {
             if (block.task == Task::staircase && step == 0) {
                 series.pictures.push_back(stimulus);
                 continue;
             }
             const double value = base + sign * step;
-            StimulusSpec picture = spec;
+            Stimulus picture = spec;
             picture.parameters[block.knob] = common::shortest_text(value);
             auto [known, is_new] =
                 id_of_picture.emplace(Protocol::picture_key(picture), "");

@@ -33,7 +33,7 @@ struct WebSeries {
     std::vector<KnobSeries> series;
     // The pictures that are no protocol stimulus: live stimuli of their own (the base
     // stimulus with the knob set), each once.
-    std::vector<StimulusSpec> added;
+    std::vector<Stimulus> added;
     // The series of an adjust block (stimulus: its match) or a staircase block's
     // standard; nullptr when there is none.
     const KnobSeries* find(std::string_view block, std::string_view stimulus) const;

@@ -17,8 +17,7 @@ std::string text(double v) { return format_short(v); }
 
 // The target's value of the knob, or why it has none.
 std::optional<double> target_value(const study::Protocol& protocol,
-                                   const study::StimulusSpec& target,
-                                   const study::StimulusSpec* match,
+                                   const Stimulus& target, const Stimulus* match,
                                    const std::string& knob, std::string& why) {
     if (!target.live()) {
         why = "no physical value: the target is a picture";
@@ -39,7 +38,7 @@ std::optional<double> target_value(const study::Protocol& protocol,
 
 std::optional<double> knob_value(const study::Protocol& protocol,
                                  const std::string& stimulus, const std::string& knob) {
-    const study::StimulusSpec* s = protocol.find_stimulus(stimulus);
+    const Stimulus* s = protocol.find_stimulus(stimulus);
     if (!s || !s->live()) return std::nullopt;
     if (const auto v = protocol.numeric_parameter(stimulus, knob)) return v;
     // Not stated: the technique's default, which the renderer used.
@@ -89,8 +88,7 @@ std::optional<double> constancy_index(double mean_match, double target, double l
     return index;
 }
 
-std::vector<std::string> differing_factors(const study::StimulusSpec& a,
-                                           const study::StimulusSpec& b,
+std::vector<std::string> differing_factors(const Stimulus& a, const Stimulus& b,
                                            const std::string& knob) {
     std::vector<std::string> out;
     if (a.mesh != b.mesh) out.push_back("mesh");
@@ -224,10 +222,8 @@ std::vector<ConditionMatch> analyse_matches(const std::vector<MatchRow>& rows,
             }
         }
         // The target's value and the constancy index.
-        const study::StimulusSpec* target =
-            protocol ? protocol->find_stimulus(c.target) : nullptr;
-        const study::StimulusSpec* match =
-            protocol ? protocol->find_stimulus(c.match) : nullptr;
+        const Stimulus* target = protocol ? protocol->find_stimulus(c.target) : nullptr;
+        const Stimulus* match = protocol ? protocol->find_stimulus(c.match) : nullptr;
         std::string why = "no physical value: the stored protocol is not readable";
         if (target && protocol)
             c.target_value = target_value(*protocol, *target, match, c.knob, why);

@@ -98,8 +98,7 @@ std::optional<double> knob_value(const study::Protocol& protocol,
 // parameter whose text differs (or that one of them lacks); across techniques only the
 // scene's knobs (light, camera, background: renderer/core/common_knobs.h), since each
 // technique's own knobs describe the material being matched.
-std::vector<std::string> differing_factors(const study::StimulusSpec& a,
-                                           const study::StimulusSpec& b,
+std::vector<std::string> differing_factors(const Stimulus& a, const Stimulus& b,
                                            const std::string& knob);
 
 }  // namespace lucent::analysis

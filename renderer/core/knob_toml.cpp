@@ -1,5 +1,7 @@
 #include "renderer/core/knob_toml.h"
 
+#include <cmath>
+
 #include "common/number_text.h"
 
 namespace lucent {
@@ -67,6 +69,28 @@ KnobValue read_knob_value(const Knob& knob, const toml::node& node) {
             message.erase(0, knob.name.size() + 2);
         throw KnobError(message);
     }
+}
+
+std::string parameter_text(const toml::node& node) {
+    auto number = [](const toml::node& item) {
+        const double v = *item.value<double>();
+        if (!std::isfinite(v)) throw ParameterTextError(item, "must be finite");
+        return common::shortest_text(v);
+    };
+    if (node.is_integer() || node.is_floating_point()) return number(node);
+    if (node.is_string()) return std::string(*node.value<std::string>());
+    if (node.is_boolean()) return *node.value<bool>() ? "true" : "false";
+    if (const toml::array* array = node.as_array()) {
+        std::string out;
+        for (const toml::node& item : *array) {
+            if (!(item.is_integer() || item.is_floating_point()))
+                throw ParameterTextError(item, "array values must be numbers (r,g,b)");
+            out += (out.empty() ? "" : ",") + number(item);
+        }
+        return out;
+    }
+    throw ParameterTextError(node,
+                             "must be a number, string, boolean or array of numbers");
 }
 
 }  // namespace lucent

@@ -5,8 +5,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "renderer/core/common_knobs.h"
+#include "renderer/core/stimulus_set.h"
 #include "renderer/techniques/registry.h"
-#include "stimuli/stimulus_set.h"
 
 namespace lucent::explorer {
 
@@ -134,16 +134,13 @@ KnobGroup knob_group(const Knob& knob) {
 namespace lucent::explorer {
 
 ExplorerSession session_from_config(const std::string& config_path) {
-    const stimuli::StimulusSet set =
-        stimuli::load_stimulus_set(config_path, stimuli::default_catalog());
-    const stimuli::Stimulus& first =
-        set.stimuli.front();  // the loader rejects empty sets
+    const StimulusSet set = load_stimulus_set(config_path, default_set_catalog());
+    const Stimulus& first = set.stimuli.front();  // the loader rejects empty sets
     ExplorerSession session;
-    session.mesh = first.mesh_spec;
+    session.mesh = first.mesh;
     for (ParameterSet& parameters : session.sets) {
         parameters.set_technique(first.technique);
-        for (const auto& [name, value] : first.parameters.all())
-            parameters.set(name, value);
+        for (const auto& [name, value] : first.values.all()) parameters.set(name, value);
     }
     session.stimulus_config = config_path;
     session.stimulus_id = first.id + "_explored";

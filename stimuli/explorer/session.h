@@ -106,7 +106,7 @@ namespace lucent::explorer {
 
 // A session starting from the first stimulus of a stimulus-set config (its mesh,
 // technique and parameters in both sets), with "Add to stimulus set" aimed at that file.
-// Throws stimuli::StimulusSetError naming the file, line and key.
+// Throws StimulusSetError naming the file, line and key.
 ExplorerSession session_from_config(const std::string& config_path);
 
 }  // namespace lucent::explorer

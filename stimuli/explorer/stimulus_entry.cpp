@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "common/output_file.h"
+#include "renderer/core/stimulus_set.h"
 #include "renderer/techniques/registry.h"
-#include "stimuli/stimulus_set.h"
 
 namespace lucent::explorer {
 namespace {
@@ -110,7 +110,7 @@ std::string stimulus_table_text(const StimulusEntry& entry, const std::string& i
 
 std::string append_stimulus(const std::filesystem::path& config,
                             const StimulusEntry& entry) {
-    const stimuli::SetCatalog catalog = stimuli::default_catalog();
+    const SetCatalog catalog = default_set_catalog();
     std::error_code error;
     const bool exists = std::filesystem::exists(config, error);
     std::string original, text;
@@ -119,7 +119,7 @@ std::string append_stimulus(const std::filesystem::path& config,
     if (exists) {
         original = read_text(config);
         // The file must be a valid set before we touch it.
-        for (const auto& stimulus : stimuli::load_stimulus_set(config, catalog).stimuli)
+        for (const auto& stimulus : load_stimulus_set(config, catalog).stimuli)
             ids.insert(stimulus.id);
         const toml::table root = toml::parse(original, config.string());
         mesh_key = find_mesh_key(root, config.parent_path(), entry.mesh);
@@ -133,7 +133,7 @@ std::string append_stimulus(const std::filesystem::path& config,
                 for (const auto& node : *stimuli)
                     if (const auto* table = node.as_table();
                         table && !table->contains("mesh"))
-                        throw stimuli::StimulusSetError(
+                        throw StimulusSetError(
                             config.string() + ":" +
                             std::to_string(table->source().begin.line) +
                             ": mesh: adding mesh '" + entry.mesh +
@@ -144,9 +144,9 @@ std::string append_stimulus(const std::filesystem::path& config,
             mesh_key = new_mesh_key(root, entry.mesh);
             const std::size_t at = after_meshes_header(text);
             if (at == std::string::npos)
-                throw stimuli::StimulusSetError(
-                    config.string() + ": meshes: no [meshes] table to add mesh '" +
-                    entry.mesh + "' to");
+                throw StimulusSetError(config.string() +
+                                       ": meshes: no [meshes] table to add mesh '" +
+                                       entry.mesh + "' to");
             text.insert(at, mesh_key + " = " + quoted(entry.mesh) +
                                 "  # added by lucent explore\n");
         }
@@ -166,7 +166,7 @@ std::string append_stimulus(const std::filesystem::path& config,
 
     write_text(config, text);
     try {
-        stimuli::load_stimulus_set(config, catalog);
+        load_stimulus_set(config, catalog);
     } catch (...) {
         // Roll back: the file is exactly as before (or gone, when we created it).
         if (exists)

@@ -1,7 +1,7 @@
 #pragma once
 // "Add to stimulus set": appends the explorer's current parameters as one [[stimuli]]
-// entry to a stimulus-set config (stimuli/stimulus_set.h), keeping the file's text and
-// comments. The text is appended (plus one line under [meshes] when the mesh is new),
+// entry to a stimulus-set config (renderer/core/stimulus_set.h), keeping the file's text
+// and comments. The text is appended (plus one line under [meshes] when the mesh is new),
 // then the whole file is parsed again with the stimulus-set loader; on any error the
 // original file is restored. GL-free.
 #include <filesystem>
@@ -21,7 +21,7 @@ struct StimulusEntry {
 };
 
 // Appends `entry` to `config` (created when missing); returns the id written. Throws
-// stimuli::StimulusSetError (the existing file or the result does not parse; the file is
+// StimulusSetError (the existing file or the result does not parse; the file is
 // left as it was) or std::runtime_error (I/O).
 std::string append_stimulus(const std::filesystem::path& config,
                             const StimulusEntry& entry);

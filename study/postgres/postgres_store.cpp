@@ -146,7 +146,7 @@ int64_t PostgresStore::ensure_study(const Protocol& protocol) {
                   "created_utc) VALUES ($1, $2, $3, $4) RETURNING id",
                   protocol.name, protocol.text, hash, utc_now_iso8601())[0]
                 .as<int64_t>();
-        for (const StimulusSpec& s : protocol.stimuli) {
+        for (const Stimulus& s : protocol.stimuli) {
             std::string varies;
             for (const std::string& v : s.varies)
                 varies += (varies.empty() ? "" : " ") + v;
@@ -156,7 +156,7 @@ int64_t PostgresStore::ensure_study(const Protocol& protocol) {
                       "image, varies) VALUES ($1, $2, $3, $4, $5, $6) RETURNING id",
                       study_id, s.id, s.technique, s.mesh, s.image, varies)[0]
                     .as<int64_t>();
-            for (const auto& [name, value] : s.parameters)
+            for (const auto& [name, value] : s.columns())
                 tx.exec_params(
                     "INSERT INTO stimulus_parameters (stimulus_id, name, value) "
                     "VALUES ($1, $2, $3)",

@@ -314,7 +314,7 @@ WebStudy::WebStudy(const Protocol& protocol, StorePool& pool, WebStudyOptions op
 }
 
 void WebStudy::init() {
-    for (const StimulusSpec& s : protocol_.stimuli)
+    for (const Stimulus& s : protocol_.stimuli)
         if (!options_.images.count(s.id))
             throw std::invalid_argument("lucent serve: no picture for stimulus '" + s.id +
                                         "'");

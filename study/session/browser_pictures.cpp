@@ -6,16 +6,15 @@
 
 namespace lucent::study {
 
-stimuli::StimulusSet browser_picture_set(const Protocol& protocol,
-                                         const stimuli::SetCatalog& catalog) {
+StimulusSet browser_picture_set(const Protocol& protocol, const SetCatalog& catalog) {
     const WebSeries series = web_series(protocol);
     const Protocol shown = with_series_pictures(protocol, series);
-    stimuli::StimulusSet set;
+    StimulusSet set;
     set.name = protocol.name;
     set.source = "study:" + protocol.source;
     set.width = protocol.stimulus_width;
     set.height = protocol.stimulus_height;
-    for (const StimulusSpec& spec : shown.stimuli) {
+    for (const Stimulus& spec : shown.stimuli) {
         if (!spec.live()) continue;  // the protocol's own image file is shown as it is
         const std::string where = protocol.source + ": stimulus '" + spec.id + "': ";
         const auto knobs = catalog.knobs_of(spec.technique);
@@ -24,14 +23,15 @@ stimuli::StimulusSet browser_picture_set(const Protocol& protocol,
         std::vector<KnobAssignment> assignments;
         for (const auto& [name, value] : spec.parameters)
             assignments.push_back({name, value});
-        stimuli::Stimulus s;
+        Stimulus s;
         s.id = spec.id;
         s.technique = spec.technique;
         // The same mesh default as the lab's resolution (stimulus_provenance.cpp).
-        s.mesh_spec = spec.mesh.empty() ? RenderRequest{}.mesh : spec.mesh;
-        s.mesh_name = s.mesh_spec;
+        s.mesh = spec.mesh.empty() ? RenderRequest{}.mesh : spec.mesh;
+        s.mesh_name = s.mesh;
+        s.parameters = spec.parameters;
         try {
-            s.parameters = resolve_knob_values(*knobs, assignments);
+            s.values = resolve_knob_values(*knobs, assignments);
         } catch (const std::exception& e) {
             throw StimulusError(where + e.what());
         }

@@ -21,8 +21,7 @@ const std::vector<ResolvedProtocolStimulus>& LiveOrPrerenderedStimuli::resolved(
 void LiveOrPrerenderedStimuli::check(const Protocol& protocol) const {
     resolved(protocol);
     Protocol images_only = protocol;  // image stimuli: their files must exist
-    std::erase_if(images_only.stimuli,
-                  [](const StimulusSpec& s) { return s.image.empty(); });
+    std::erase_if(images_only.stimuli, [](const Stimulus& s) { return s.image.empty(); });
     images_.check(images_only);
 }
 
@@ -35,14 +34,14 @@ std::vector<StimulusProvenance> LiveOrPrerenderedStimuli::provenance(
 }
 
 std::shared_ptr<const Scene> LiveOrPrerenderedStimuli::live_scene(
-    const StimulusSpec& spec) const {
+    const Stimulus& spec) const {
     if (!images_.path_for(spec).empty()) return nullptr;
     for (const ResolvedProtocolStimulus& r : resolved_)
         if (r.provenance.stimulus == spec.id) return r.scene;
     return nullptr;
 }
 
-StimulusTexture LiveOrPrerenderedStimuli::render(const StimulusSpec& spec, int width,
+StimulusTexture LiveOrPrerenderedStimuli::render(const Stimulus& spec, int width,
                                                  int height) {
     if (!images_.path_for(spec).empty()) return images_.render(spec, width, height);
     const auto resolved_scene = std::find_if(

@@ -20,7 +20,7 @@ public:
     // Pre-rendered file if there is one, else renders the scene resolved for the
     // stimulus (resolve_protocol_stimuli: the scene whose values the database records)
     // at width x height into a texture (GL context current), sRGB-encoded as PNG output.
-    StimulusTexture render(const StimulusSpec& spec, int width, int height) override;
+    StimulusTexture render(const Stimulus& spec, int width, int height) override;
     // Without GL: resolves every stimulus once (technique, parameters, mesh, the
     // technique's own scene checks) and keeps the result for provenance() and render().
     void check(const Protocol& protocol) const override;
@@ -30,7 +30,7 @@ public:
     // The resolved scene of a live stimulus rendered live (null for an image stimulus
     // and one shown from an --images file): what a LiveKnobRenderer (live_knob.h) turns
     // a knob of. check() the protocol first.
-    std::shared_ptr<const Scene> live_scene(const StimulusSpec& spec) const;
+    std::shared_ptr<const Scene> live_scene(const Stimulus& spec) const;
 
     // Called with each scene just before it is rendered (tests: the scene the renderer
     // received).

@@ -524,7 +524,7 @@ void Session::draw_choice(int w, int h) {
 std::string Session::check_live_blocks() const {
     const auto* live = dynamic_cast<const LiveOrPrerenderedStimuli*>(&stimuli_);
     auto not_live = [&](const Block& b, const std::string& id) -> std::string {
-        const StimulusSpec* spec = p_.find_stimulus(id);
+        const Stimulus* spec = p_.find_stimulus(id);
         if (live && spec && live->live_scene(*spec)) return "";
         return "block '" + b.id + "': stimulus '" + id +
                "' must be rendered live (its knob '" + b.knob +

@@ -293,8 +293,8 @@ AdjustView SessionFlow::adjust_view() const {
     // technique: the built-in matching study's dipole targets) the simulation takes the
     // match stimulus's protocol value as what the target looks like, a known reference
     // the analysis's bias is checked against.
-    const StimulusSpec* target = protocol_.find_stimulus(trials_[current_].stimulus);
-    const StimulusSpec* match = protocol_.find_stimulus(b.match);
+    const Stimulus* target = protocol_.find_stimulus(trials_[current_].stimulus);
+    const Stimulus* match = protocol_.find_stimulus(b.match);
     if (target && match && target->live() && target->technique == match->technique)
         a.target = knob_value(target->id, b.knob);
     else if (match)

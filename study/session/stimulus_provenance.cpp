@@ -102,15 +102,14 @@ void check_against_manifest(StimulusProvenance& resolved, const std::vector<Knob
 }  // namespace
 
 std::vector<ResolvedProtocolStimulus> resolve_protocol_stimuli(
-    const Protocol& protocol, const std::string& images_dir,
-    const stimuli::SetCatalog& catalog) {
+    const Protocol& protocol, const std::string& images_dir, const SetCatalog& catalog) {
     const PrerenderedStimuli images(images_dir);
     const ManifestRows manifest =
         images_dir.empty() ? ManifestRows{} : stimuli::read_manifest_csv(images_dir);
     // By spec: each mesh loaded once and shared by every scene that shows it.
     std::map<std::string, std::shared_ptr<const Mesh>> meshes;
     std::vector<ResolvedProtocolStimulus> out;
-    for (const StimulusSpec& spec : protocol.stimuli) {
+    for (const Stimulus& spec : protocol.stimuli) {
         StimulusProvenance p;
         p.stimulus = spec.id;
         p.software_version = version_string();
@@ -175,7 +174,7 @@ std::vector<ResolvedProtocolStimulus> resolve_protocol_stimuli(
 
 std::vector<StimulusProvenance> resolve_stimuli(const Protocol& protocol,
                                                 const std::string& images_dir,
-                                                const stimuli::SetCatalog& catalog) {
+                                                const SetCatalog& catalog) {
     std::vector<StimulusProvenance> rows;
     for (ResolvedProtocolStimulus& resolved :
          resolve_protocol_stimuli(protocol, images_dir, catalog))

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "renderer/core/scene.h"
-#include "stimuli/stimulus_set.h"
+#include "renderer/core/stimulus_set.h"
 #include "study/protocol.h"
 #include "study/sqlite/sqlite_store.h"
 
@@ -34,10 +34,10 @@ struct ResolvedProtocolStimulus {
 // and checked by its technique (Technique::check_scene). Each mesh is loaded once.
 std::vector<ResolvedProtocolStimulus> resolve_protocol_stimuli(
     const Protocol& protocol, const std::string& images_dir,
-    const stimuli::SetCatalog& catalog = stimuli::default_catalog());
+    const SetCatalog& catalog = default_set_catalog());
 // resolve_protocol_stimuli()'s database rows.
 std::vector<StimulusProvenance> resolve_stimuli(
     const Protocol& protocol, const std::string& images_dir,
-    const stimuli::SetCatalog& catalog = stimuli::default_catalog());
+    const SetCatalog& catalog = default_set_catalog());
 
 }  // namespace lucent::study

@@ -138,7 +138,7 @@ StimulusTexture upload_texture(const CpuImage& image, const std::string& what) {
     return t;
 }
 
-std::string PrerenderedStimuli::path_for(const StimulusSpec& spec) const {
+std::string PrerenderedStimuli::path_for(const Stimulus& spec) const {
     if (!spec.image.empty()) return spec.image;
     if (images_dir_.empty()) return "";
     for (const char* ext : {".png", ".tif", ".exr"}) {
@@ -178,7 +178,7 @@ std::string how_to_render(const Protocol& protocol, const std::string& dir) {
 }  // namespace
 
 void PrerenderedStimuli::check(const Protocol& protocol) const {
-    for (const StimulusSpec& s : protocol.stimuli) {
+    for (const Stimulus& s : protocol.stimuli) {
         const std::string path = path_for(s);
         if (path.empty())
             throw StimulusError(
@@ -199,7 +199,7 @@ std::vector<StimulusProvenance> PrerenderedStimuli::provenance(
     return resolve_stimuli(protocol, images_dir_);
 }
 
-StimulusTexture PrerenderedStimuli::render(const StimulusSpec& spec, int, int) {
+StimulusTexture PrerenderedStimuli::render(const Stimulus& spec, int, int) {
     const std::string path = path_for(spec);
     if (path.empty()) throw StimulusError("stimulus '" + spec.id + "': no image");
     return upload_texture(load_image_rgba8(path), path);

@@ -48,7 +48,7 @@ public:
     virtual ~StimulusRenderer() = default;
     // Renders (or loads) the stimulus at the protocol's size into a texture; a GL
     // context is current. Throws StimulusError naming the stimulus on failure.
-    virtual StimulusTexture render(const StimulusSpec& spec, int width, int height) = 0;
+    virtual StimulusTexture render(const Stimulus& spec, int width, int height) = 0;
     // Checks, before any window opens, that every stimulus can be provided.
     virtual void check(const Protocol& protocol) const = 0;
     // What each stimulus will be, for the database: resolved values, mesh hash, and for
@@ -67,10 +67,10 @@ class PrerenderedStimuli : public StimulusRenderer {
 public:
     explicit PrerenderedStimuli(std::string images_dir)
         : images_dir_(std::move(images_dir)) {}
-    StimulusTexture render(const StimulusSpec& spec, int width, int height) override;
+    StimulusTexture render(const Stimulus& spec, int width, int height) override;
     void check(const Protocol& protocol) const override;
     std::vector<StimulusProvenance> provenance(const Protocol& protocol) const override;
-    std::string path_for(const StimulusSpec& spec) const;  // "" when none exists
+    std::string path_for(const Stimulus& spec) const;  // "" when none exists
     const std::string& images_dir() const { return images_dir_; }
 
 private:

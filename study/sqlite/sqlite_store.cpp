@@ -115,7 +115,7 @@ int64_t Store::ensure_study(const Protocol& protocol) {
         "VALUES (?, ?, ?, ?, ?, ?)");
     Statement param = db_.prepare(
         "INSERT INTO stimulus_parameters (stimulus_id, name, value) VALUES (?, ?, ?)");
-    for (const StimulusSpec& s : protocol.stimuli) {
+    for (const Stimulus& s : protocol.stimuli) {
         std::string varies;
         for (const std::string& v : s.varies) varies += (varies.empty() ? "" : " ") + v;
         stim.reset();
@@ -127,7 +127,7 @@ int64_t Store::ensure_study(const Protocol& protocol) {
             .bind(6, varies)
             .run();
         const int64_t stimulus_id = db_.last_insert_id();
-        for (const auto& [name, value] : s.parameters) {
+        for (const auto& [name, value] : s.columns()) {
             param.reset();
             param.bind(1, stimulus_id).bind(2, name).bind(3, value).run();
         }

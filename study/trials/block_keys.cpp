@@ -74,7 +74,7 @@ void read_presentation(TableReader& r, Block& b, int pictures, bool answers_are_
 
 Knob block_knob(const Protocol& p, TableReader& r, const Block& b,
                 const std::string& stimulus, const std::string& key) {
-    const StimulusSpec* s = p.find_stimulus(stimulus);
+    const Stimulus* s = p.find_stimulus(stimulus);
     if (!s || !s->live())
         r.fail(r.raw().get(key), key,
                "'" + stimulus + "' must be a live stimulus (a technique): its knob '" +

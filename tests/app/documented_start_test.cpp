@@ -169,7 +169,7 @@ std::string picture_url(const fs::path& key_file, const study::Protocol& protoco
     const study::Protocol shown =
         study::with_series_pictures(protocol, study::web_series(protocol));
     std::vector<std::string> ids;
-    for (const study::StimulusSpec& s : shown.stimuli) ids.push_back(s.id);
+    for (const Stimulus& s : shown.stimuli) ids.push_back(s.id);
     return study::PictureNames(read_file(key_file), ids).url("documented start", 0, id);
 }
 
@@ -195,7 +195,7 @@ void documented_start(const std::string& name) {
     Child r = start(render, dir, "render", false);
     ASSERT_EQ(wait_exit(r), 0) << read_file(r.stderr_path);
     const fs::path pictures = dir / render.back();
-    for (const study::StimulusSpec& s : protocol.stimuli)
+    for (const Stimulus& s : protocol.stimuli)
         EXPECT_TRUE(fs::exists(pictures / (s.id + ".png"))) << s.id;
     for (const std::string& id : protocol.practice) {
         const std::string manifest = read_file(pictures / "manifest.csv");

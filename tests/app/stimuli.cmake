@@ -12,7 +12,7 @@ add_test(NAME app.render_preset_thesis
 # The committed example file is the same set.
 add_test(NAME app.render_config_example
          COMMAND ${CMAKE_COMMAND} -DLUCENT=$<TARGET_FILE:lucent> -DMODE=config
-                 -DCONFIG=${CMAKE_SOURCE_DIR}/stimuli/presets/thesis.toml
+                 -DCONFIG=${CMAKE_SOURCE_DIR}/renderer/core/presets/thesis.toml
                  -DOUT=${LUCENT_STIMULI_CLI_DIR}/example -DEXPECT_IMAGES=20
                  -P ${LUCENT_RENDER_SET_CHECK})
 set_tests_properties(app.render_preset_thesis app.render_config_example PROPERTIES

@@ -33,7 +33,7 @@ StimulusSet eight_stimuli(const std::string& scale = "1") {
         scale +
         "\n"
         "[stimuli.vary]\nroughness = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8]\n";
-    return parse_stimulus_set(config, "eight.toml", ".", default_catalog());
+    return parse_stimulus_set(config, "eight.toml", ".", default_set_catalog());
 }
 
 BatchOptions options_for(const std::filesystem::path& dir, int jobs = 1) {

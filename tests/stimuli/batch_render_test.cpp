@@ -41,7 +41,7 @@ std::string small_config(const std::string& reversed_weight = "0.6") {
 
 StimulusSet small_set(const std::string& reversed_weight = "0.6") {
     return parse_stimulus_set(small_config(reversed_weight), "small.toml", ".",
-                              default_catalog());
+                              default_set_catalog());
 }
 
 BatchResult render(const StimulusSet& set, const std::filesystem::path& dir,

@@ -8,32 +8,32 @@
 #include <sstream>
 
 #include "renderer/core/density_volume.h"
+#include "renderer/core/stimulus_set.h"
 #include "stimuli/batch_render.h"
 #include "stimuli/manifest.h"
-#include "stimuli/stimulus_set.h"
 #include "tests/support/test_paths.h"
 
 namespace lucent::stimuli {
 namespace {
 
 TEST(HeterogeneousPreset, EmbeddedTextIsTheCommittedFile) {
-    std::ifstream in(test::source_dir() / "stimuli/presets/heterogeneous.toml",
+    std::ifstream in(test::source_dir() / "renderer/core/presets/heterogeneous.toml",
                      std::ios::binary);
     std::ostringstream file;
     file << in.rdbuf();
-    ASSERT_TRUE(preset_text("heterogeneous").has_value());
-    EXPECT_EQ(std::string(*preset_text("heterogeneous")), file.str());
+    ASSERT_TRUE(set_preset_text("heterogeneous").has_value());
+    EXPECT_EQ(std::string(*set_preset_text("heterogeneous")), file.str());
 }
 
 TEST(HeterogeneousPreset, ThreeStructuresAtTwoTransportDistances) {
-    const auto set = load_preset("heterogeneous", default_catalog());
+    const auto set = load_set_preset("heterogeneous", default_set_catalog());
     ASSERT_EQ(set.stimuli.size(), 6u);
     std::set<std::string> hashes;
     for (const Stimulus& s : set.stimuli) {
         EXPECT_EQ(s.technique, "htsm") << s.id;
-        const double td = s.parameters.scalar("transport_distance");
+        const double td = s.values.scalar("transport_distance");
         EXPECT_EQ(s.series, td == 0.25 ? "td_0.25" : "td_0.5") << s.id;
-        const auto volume = density_from_knobs(s.parameters);
+        const auto volume = density_from_knobs(s.values);
         ASSERT_NE(volume, nullptr);
         // The homogeneous control is the planner's constant-density case; the others
         // are structured.
@@ -57,7 +57,7 @@ TEST(HeterogeneousPreset, ManifestCarriesTheDensityHashAndAChangedFileRerenders)
         "\"sphere:1k\"\n[[stimuli]]\nid = \"h\"\ntechnique = "
         "\"htsm\"\ndensity = \"" +
         volume_path + "\"\n";
-    const auto set = parse_stimulus_set(config, "d.toml", dir, default_catalog());
+    const auto set = parse_stimulus_set(config, "d.toml", dir, default_set_catalog());
     BatchOptions options;
     options.out_dir = out;
     options.progress = false;

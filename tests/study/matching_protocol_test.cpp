@@ -418,7 +418,7 @@ TEST(MatchingProtocol, TheBrowserShowsEachSeriesFromItsPicturesAndRefusesAStartO
     EXPECT_EQ(nearest_step(ladder->steps, 7.0), 1000u);
     // Each picture is a live stimulus of its own: the base with the knob set.
     const Protocol shown = with_series_pictures(p, series);
-    const StimulusSpec* picture = shown.find_stimulus("target2@thickness_exponent=3.25");
+    const Stimulus* picture = shown.find_stimulus("target2@thickness_exponent=3.25");
     ASSERT_NE(picture, nullptr);
     EXPECT_EQ(picture->technique, "empirical");
     EXPECT_EQ(shown.numeric_parameter(picture->id, "thickness_exponent"), 3.25);
@@ -471,8 +471,8 @@ TEST(BuiltinMatchingStudies, MatchingAndJndPlanWhatTheirCommentsSay) {
     EXPECT_EQ(matches, (std::set<std::string>{"match_front", "match_back"}));
     // The cross block's target and match differ in exactly the light's direction.
     const Block& cross = *matching.find_block("cross");
-    const StimulusSpec& match = *matching.find_stimulus(cross.match);
-    const StimulusSpec& target = *matching.find_stimulus(cross.stimuli[0]);
+    const Stimulus& match = *matching.find_stimulus(cross.match);
+    const Stimulus& target = *matching.find_stimulus(cross.stimuli[0]);
     EXPECT_NE(match.parameters.at("light_direction"),
               target.parameters.at("light_direction"));
     EXPECT_EQ(matching.find_stimulus(matching.find_block("back")->match)

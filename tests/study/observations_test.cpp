@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -73,7 +74,7 @@ void expect_every_answer_observed(const Protocol& p, const std::string& name) {
                             p.find_stimulus(t.shown[k])->parameters.at(block.series)));
             } else {
                 ASSERT_EQ(row.shown, std::vector<std::string>{t.stimulus});
-                const StimulusSpec& stimulus = *p.find_stimulus(t.stimulus);
+                const Stimulus& stimulus = *p.find_stimulus(t.stimulus);
                 std::vector<std::string> factors;
                 for (const auto& [factor, level] : row.factors) {
                     factors.push_back(factor);
@@ -111,6 +112,43 @@ TEST(Observations, EveryRatingAndForcedChoiceIsOneObservation) {
 
 TEST(Observations, EveryAdjustAndStaircaseAnswerIsOneObservation) {
     expect_every_answer_observed(lucent::test::matching_protocol(), "matching");
+}
+
+// Issue 51 item 1: the experimenter's own factors (a stimulus's `factors`, named levels
+// no renderer reads) are columns of the observation table like its parameters.
+TEST(Observations, AnOwnFactorIsAColumnBesideTheParameters) {
+    std::string text = lucent::test::kSmallProtocol;
+    for (const auto& [id, lighting] :
+         {std::pair{"a", "front"}, std::pair{"b", "front"}, std::pair{"c", "back"}}) {
+        const std::string entry = std::string("id = \"") + id + "\"";
+        const std::string varies = "varies = [\"thickness_exponent\"]";
+        const std::size_t at = text.find(varies, text.find(entry));
+        text.replace(at, varies.size(),
+                     std::string("factors = { lighting = \"") + lighting +
+                         "\" }\nvaries = [\"thickness_exponent\", \"lighting\"]");
+    }
+    const Protocol p = parse_protocol(text, "own_factors.toml");
+    EXPECT_EQ(p.find_stimulus("c")->factors.at("lighting"), "back");
+    EXPECT_EQ(p.levels_of("lighting").at("c"), "back");
+
+    const auto dir = lucent::test::scratch_dir("observations_own_factor_levels");
+    const std::string path = (dir / "study.db").string();
+    {
+        Store store(path);
+        lucent::test::run_full_session(store, p, "P1", 9);
+    }
+    std::map<std::string, std::set<std::string>> lighting_of;
+    for (const common::Observation& o : read_observations(path).table.rows) {
+        std::vector<std::string> names;
+        for (const auto& [factor, level] : o.factors) {
+            names.push_back(factor);
+            if (factor == "lighting") lighting_of[o.shown.at(0)].insert(level);
+        }
+        EXPECT_EQ(names, (std::vector<std::string>{"thickness_exponent", "lighting"}));
+    }
+    const std::map<std::string, std::set<std::string>> expected = {
+        {"a", {"front"}}, {"b", {"front"}}, {"c", {"back"}}};
+    EXPECT_EQ(lighting_of, expected);
 }
 
 TEST(Observations, TheAnalysisViewLeavesPracticeOut) {

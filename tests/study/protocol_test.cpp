@@ -33,7 +33,7 @@ TEST(ThesisPreset, HasTheNineStimuliOfTable43) {
                                 {25, 1.2, 0.2}, {25, 1.2, 0.0}, {25, 1.2, 0.5}};
     const char* varies[3] = {"thickness_exponent", "backlight", "diffuse_weight"};
     for (int i = 0; i < 9; ++i) {
-        const StimulusSpec* s = p.find_stimulus("empirical_row_" + std::to_string(i + 1));
+        const Stimulus* s = p.find_stimulus("empirical_row_" + std::to_string(i + 1));
         ASSERT_NE(s, nullptr) << i;
         EXPECT_EQ(s->technique, "empirical");
         EXPECT_DOUBLE_EQ(std::stod(s->parameters.at("thickness_exponent")), table[i][0]);
@@ -50,14 +50,14 @@ TEST(ThesisPreset, HasTheNineStimuliOfTable43) {
 TEST(ThesisPreset, PhysicallyBasedSeriesIsTheBestEmpiricalImageAndThreeDipoles) {
     const Protocol p = builtin_protocol("thesis");
     std::vector<std::string> series;
-    for (const StimulusSpec& s : p.stimuli)
+    for (const Stimulus& s : p.stimuli)
         if (std::find(s.varies.begin(), s.varies.end(), "series:physically_based") !=
             s.varies.end())
             series.push_back(s.id);
     EXPECT_EQ(series, (std::vector<std::string>{"empirical_row_1", "dipole_skin1",
                                                 "dipole_marble", "dipole_skimmilk"}));
     for (const char* material : {"skin1", "marble", "skimmilk"}) {
-        const StimulusSpec* s = p.find_stimulus(std::string("dipole_") + material);
+        const Stimulus* s = p.find_stimulus(std::string("dipole_") + material);
         ASSERT_NE(s, nullptr) << material;
         EXPECT_EQ(s->technique, "dipole");
         EXPECT_EQ(s->parameters.at("material"), material);
@@ -69,12 +69,12 @@ TEST(ThesisPreset, PhysicallyBasedSeriesIsTheBestEmpiricalImageAndThreeDipoles) 
 TEST(ThesisPreset, ContrastReversedStimuliHaveWardCounterparts) {
     const Protocol p = builtin_protocol("thesis");
     int pairs = 0;
-    for (const StimulusSpec& s : p.stimuli) {
+    for (const Stimulus& s : p.stimuli) {
         if (s.technique != "contrast_reversed" || s.id.rfind("practice", 0) == 0)
             continue;
         for (const char* key : {"reversed_diffuse", "specular_reflectance", "roughness"})
             EXPECT_TRUE(s.parameters.count(key)) << s.id << " lacks " << key;
-        const StimulusSpec* ward = p.find_stimulus("ward_" + s.id.substr(18));
+        const Stimulus* ward = p.find_stimulus("ward_" + s.id.substr(18));
         ASSERT_NE(ward, nullptr) << s.id;
         EXPECT_EQ(ward->technique, "ward");
         // The same material: ward's diffuse_reflectance is contrast_reversed's weight.
@@ -112,7 +112,7 @@ TEST(FabricsPreset, TwelveThickTextureStimuliWithThreeFactors) {
     EXPECT_EQ(p.stimuli.size(), 14u);  // 12 rated + 2 practice
     std::set<std::string> tilts, thicknesses, textures;
     int rated = 0;
-    for (const StimulusSpec& s : p.stimuli) {
+    for (const Stimulus& s : p.stimuli) {
         EXPECT_EQ(s.technique, "thick_texture");
         if (s.varies.empty()) continue;  // practice
         ++rated;

@@ -29,7 +29,7 @@ inline std::string protocol_error_of(const std::string& text,
 inline std::vector<study::StimulusProvenance> provenance_for(const study::Protocol& p,
                                                              const std::string& albedo) {
     std::vector<study::StimulusProvenance> out;
-    for (const study::StimulusSpec& s : p.stimuli) {
+    for (const Stimulus& s : p.stimuli) {
         study::StimulusProvenance v;
         v.stimulus = s.id;
         v.source = "live";

@@ -34,7 +34,7 @@ int closest_repeat(const std::vector<std::string>& s) {
 }
 
 // Independent picture identity: what is drawn, whatever the stimulus id.
-bool same_picture(const StimulusSpec& a, const StimulusSpec& b) {
+bool same_picture(const Stimulus& a, const Stimulus& b) {
     return a.technique == b.technique && a.mesh == b.mesh &&
            a.parameters == b.parameters && a.image == b.image;
 }
@@ -280,7 +280,7 @@ TEST(ConstrainedShuffle, UnmeetableConstraintsWithFeasibleCountsEndInAClearError
 
 // The thesis protocol's trials per block (stimulus specs, catch flags) in plan order.
 struct BlockTrials {
-    std::vector<const StimulusSpec*> stimuli;
+    std::vector<const Stimulus*> stimuli;
     std::vector<bool> is_catch;
 };
 
@@ -291,7 +291,7 @@ TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
     // Expected position of each block's catch trial over all its valid orders, by brute
     // force over every permutation of the block.
     std::map<std::string, std::vector<double>> catch_position_probability;
-    std::map<std::string, std::vector<const StimulusSpec*>> pictures_of_block;
+    std::map<std::string, std::vector<const Stimulus*>> pictures_of_block;
     for (const Block& block : p.blocks) {
         BlockTrials trials;
         for (const std::string& id : block.stimuli) {
@@ -315,8 +315,8 @@ TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
         pictures_of_block[block.id] = trials.stimuli;
     }
     // Blocks share no picture, so the blocks' orders are independent of each other.
-    for (const StimulusSpec* a : pictures_of_block["empirical"])
-        for (const StimulusSpec* b : pictures_of_block["contrast_reversal"])
+    for (const Stimulus* a : pictures_of_block["empirical"])
+        for (const Stimulus* b : pictures_of_block["contrast_reversal"])
             ASSERT_FALSE(same_picture(*a, *b)) << a->id << " " << b->id;
 
     constexpr int kPlans = 20000;
@@ -330,7 +330,7 @@ TEST(PlanTrials, ThesisPlansKeepPicturesApartAndPlaceCatchTrialsUniformly) {
         std::map<std::string, int> block_position;
         for (size_t i = 0; i < plan.trials.size(); ++i) {
             const PlannedTrial& t = plan.trials[i];
-            const StimulusSpec& here = *p.find_stimulus(t.stimulus);
+            const Stimulus& here = *p.find_stimulus(t.stimulus);
             if (i > 0) {
                 const PlannedTrial& before = plan.trials[i - 1];
                 const bool same = same_picture(*p.find_stimulus(before.stimulus), here);

@@ -9,8 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "renderer/core/stimulus_set.h"
 #include "renderer/techniques/registry.h"
-#include "stimuli/stimulus_set.h"
 #include "tests/support/test_paths.h"
 
 namespace lucent::explorer {
@@ -53,7 +53,7 @@ StimulusEntry entry_for(const std::string& technique, const std::string& mesh) {
     return entry;
 }
 
-const stimuli::Stimulus& find(const stimuli::StimulusSet& set, const std::string& id) {
+const Stimulus& find(const StimulusSet& set, const std::string& id) {
     for (const auto& s : set.stimuli)
         if (s.id == id) return s;
     throw std::runtime_error("no stimulus " + id);
@@ -69,11 +69,11 @@ TEST(AppendStimulus, KeepsTheFileAndReadsBackTheExactValues) {
     const std::string text = read(config);
     EXPECT_EQ(text.substr(0, std::string(kConfig).size()),
               kConfig);  // nothing above changed
-    const auto set = stimuli::load_stimulus_set(config, stimuli::default_catalog());
+    const auto set = load_stimulus_set(config, default_set_catalog());
     ASSERT_EQ(set.stimuli.size(), 2u);
     const auto& added = find(set, "explored");
     EXPECT_EQ(added.mesh_name, "knot");  // the existing entry for the same spec
-    EXPECT_EQ(added.parameters.all(), entry.values.all());
+    EXPECT_EQ(added.values.all(), entry.values.all());
     // A second append of the same id gets a fresh one.
     EXPECT_EQ(append_stimulus(config, entry), "explored_2");
 }
@@ -85,13 +85,13 @@ TEST(AppendStimulus, AddsANewMeshUnderTheMeshesTable) {
     write(config, text);
     const StimulusEntry entry = entry_for("ward", "sphere:2k");
     append_stimulus(config, entry);
-    const auto set = stimuli::load_stimulus_set(config, stimuli::default_catalog());
+    const auto set = load_stimulus_set(config, default_set_catalog());
     const auto& added = find(set, "explored");
-    EXPECT_EQ(added.mesh_spec, "sphere:2k");
+    EXPECT_EQ(added.mesh, "sphere:2k");
     EXPECT_EQ(added.technique, "ward");
-    EXPECT_EQ(added.parameters.all(), entry.values.all());
+    EXPECT_EQ(added.values.all(), entry.values.all());
     EXPECT_NE(read(config).find("# the usual knot"), std::string::npos);
-    EXPECT_EQ(find(set, "first").mesh_spec, "torus_knot:4k");
+    EXPECT_EQ(find(set, "first").mesh, "torus_knot:4k");
 }
 
 TEST(AppendStimulus, RefusesANewMeshThatWouldMakeOtherEntriesAmbiguous) {
@@ -101,7 +101,7 @@ TEST(AppendStimulus, RefusesANewMeshThatWouldMakeOtherEntriesAmbiguous) {
     try {
         append_stimulus(config, entry_for("ward", "sphere:2k"));
         FAIL() << "expected an error";
-    } catch (const stimuli::StimulusSetError& e) {
+    } catch (const StimulusSetError& e) {
         EXPECT_NE(std::string(e.what()).find("set.toml:9: mesh:"), std::string::npos)
             << e.what();
     }
@@ -114,11 +114,11 @@ TEST(AppendStimulus, CreatesAMissingFile) {
     entry.width = 80;
     entry.height = 60;
     append_stimulus(config, entry);
-    const auto set = stimuli::load_stimulus_set(config, stimuli::default_catalog());
+    const auto set = load_stimulus_set(config, default_set_catalog());
     EXPECT_EQ(set.width, 80);
     EXPECT_EQ(set.height, 60);
     ASSERT_EQ(set.stimuli.size(), 1u);
-    EXPECT_EQ(set.stimuli[0].parameters.all(), entry.values.all());
+    EXPECT_EQ(set.stimuli[0].values.all(), entry.values.all());
 }
 
 TEST(AppendStimulus, RollsBackWhenTheResultDoesNotLoad) {
@@ -126,7 +126,7 @@ TEST(AppendStimulus, RollsBackWhenTheResultDoesNotLoad) {
     write(config, kConfig);
     StimulusEntry entry = entry_for("empirical", "torus_knot:4k");
     entry.id = "not a valid id!";  // the loader rejects it after the append
-    EXPECT_THROW(append_stimulus(config, entry), stimuli::StimulusSetError);
+    EXPECT_THROW(append_stimulus(config, entry), StimulusSetError);
     EXPECT_EQ(read(config), kConfig);
 }
 
@@ -135,7 +135,7 @@ TEST(AppendStimulus, RefusesAnInvalidConfigWithoutTouchingIt) {
     const std::string broken = std::string(kConfig) + "unknown_key = 1\n";
     write(config, broken);
     EXPECT_THROW(append_stimulus(config, entry_for("empirical", "torus_knot:4k")),
-                 stimuli::StimulusSetError);
+                 StimulusSetError);
     EXPECT_EQ(read(config), broken);
 }
 

@@ -24,7 +24,7 @@ TEST(ThesisSetReport, EveryPairOfLevelsPassesTheThresholdAndTheReportDrawsInABro
     BatchOptions options;
     options.out_dir = dir;
     options.progress = false;
-    render_stimulus_set(load_preset("thesis", default_catalog()), options);
+    render_stimulus_set(load_set_preset("thesis", default_set_catalog()), options);
 
     const SetReport report = measure_stimulus_set(dir);
     EXPECT_TRUE(report.warnings.empty()) << ::testing::PrintToString(report.warnings);
@@ -89,7 +89,7 @@ TEST(ScalingSetReport, NeighbouringLevelsDifferByAtLeastOneDeltaE00) {
     BatchOptions options;
     options.out_dir = dir;
     options.progress = false;
-    render_stimulus_set(load_preset("scaling", default_catalog()), options);
+    render_stimulus_set(load_set_preset("scaling", default_set_catalog()), options);
 
     const SetReport report = measure_stimulus_set(dir);
     EXPECT_TRUE(report.warnings.empty()) << ::testing::PrintToString(report.warnings);

@@ -563,7 +563,7 @@ TEST_P(Backend, AResumeAddsASegmentAndLaterSessionsMustShowTheSameValues) {
     // Values are recorded once per stimulus (albedo, fov_y and its own parameters), not
     // again by the second segment.
     int64_t values = 0;
-    for (const StimulusSpec& spec : p.stimuli)
+    for (const Stimulus& spec : p.stimuli)
         values += 2 + static_cast<int64_t>(spec.parameters.size());
     EXPECT_EQ(store->query_int("SELECT count(*) FROM stimulus_values"), values);
     try {

@@ -532,7 +532,7 @@ TEST(ServeBrowserMatching,
     // The names the server gives its pictures, decoded with its key (beside the db).
     const Protocol parsed = parse_protocol(kMatchingProtocol, protocol.string());
     std::vector<std::string> ids;
-    for (const StimulusSpec& s : with_series_pictures(parsed, web_series(parsed)).stimuli)
+    for (const Stimulus& s : with_series_pictures(parsed, web_series(parsed)).stimuli)
         ids.push_back(s.id);
     const lucent::study::PictureNames names(file_text(db + "-serve-key"), ids);
     lucent::test::DevToolsBrowser browser(1280, 900);

@@ -168,7 +168,7 @@ TEST_P(ServeHttp, HostileRequestsGetA4xxWithOneLineAndNothingIsServedOrStored) {
         std::ifstream key_in(key, std::ios::binary);
         const std::string secret(std::istreambuf_iterator<char>(key_in), {});
         std::vector<std::string> ids;
-        for (const StimulusSpec& s : load_protocol_file(protocol_).stimuli)
+        for (const Stimulus& s : load_protocol_file(protocol_).stimuli)
             ids.push_back(s.id);
         const PictureNames names(secret, ids);
         const std::optional<NamedPicture> named = names.picture(picture_url);

@@ -44,7 +44,7 @@ TEST_P(ServeTurn, RequestsForAHeldCodeStarveNoOtherParticipant) {
     options.environment.machine_id = "server";
     options.environment.software_version = "test";
     options.environment.build_hash = "test";
-    for (const StimulusSpec& s : protocol.stimuli) {
+    for (const Stimulus& s : protocol.stimuli) {
         StimulusProvenance p;
         p.stimulus = s.id;
         p.source = "images";

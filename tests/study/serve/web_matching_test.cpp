@@ -172,7 +172,7 @@ protected:
         o.environment.machine_id = "server-machine";
         o.environment.software_version = "test";
         o.environment.build_hash = "test";
-        for (const StimulusSpec& s : protocol.stimuli) o.images[s.id] = {64, 48};
+        for (const Stimulus& s : protocol.stimuli) o.images[s.id] = {64, 48};
         o.series = web_series(protocol);
         for (const KnobSeries& s : o.series.series)
             for (const std::string& id : s.pictures) o.images[id] = {64, 48};

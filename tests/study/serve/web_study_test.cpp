@@ -97,7 +97,7 @@ protected:
         o.environment.software_version = "test";
         o.environment.build_hash = "test";
         // What each segment shows: one segment_stimuli row per stimulus.
-        for (const StimulusSpec& s : protocol_.stimuli) {
+        for (const Stimulus& s : protocol_.stimuli) {
             StimulusProvenance p;
             p.stimulus = s.id;
             p.source = "images";
@@ -111,7 +111,7 @@ protected:
             p.content_hash = "content-" + s.id;
             o.environment.stimuli.push_back(p);
         }
-        for (const StimulusSpec& s : protocol_.stimuli) o.images[s.id] = {64, 48};
+        for (const Stimulus& s : protocol_.stimuli) o.images[s.id] = {64, 48};
         o.idle_timeout = std::chrono::minutes(30);
         o.clock = [this] { return now_; };
         o.participant_wait = std::chrono::milliseconds(300);

@@ -775,7 +775,7 @@ TEST_F(SessionE2E, ThesisPresetCompletesWithPrerenderedImages) {
     // live renderer is wired separately): every planned (trial, question) gets a rating.
     const Protocol thesis = builtin_protocol("thesis");
     std::vector<std::string> ids;
-    for (const StimulusSpec& st : thesis.stimuli) ids.push_back(st.id);
+    for (const Stimulus& st : thesis.stimuli) ids.push_back(st.id);
     write_images(dir_, ids, 64);
     write_manifest_for(dir_, thesis);
     const std::string db = (dir_ / "thesis.db").string();

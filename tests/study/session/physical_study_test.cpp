@@ -6,8 +6,8 @@
 
 #include <algorithm>
 
+#include "renderer/core/stimulus_set.h"
 #include "renderer/techniques/registry.h"
-#include "stimuli/stimulus_set.h"
 #include "study/protocol.h"
 #include "study/session/stimulus_provenance.h"
 #include "tests/support/test_paths.h"
@@ -18,7 +18,7 @@ namespace {
 TEST(PhysicalStudy, ItsStimuliAreThePhysicalSetsValueForValue) {
     const Protocol protocol = load_protocol_file(
         (test::source_dir() / "docs" / "physical_study.toml").string());
-    const auto set = stimuli::load_preset("physical", stimuli::default_catalog());
+    const auto set = load_set_preset("physical", default_set_catalog());
     const std::vector<ResolvedProtocolStimulus> resolved =
         resolve_protocol_stimuli(protocol, "");
     ASSERT_EQ(resolved.size(), set.stimuli.size());
@@ -26,12 +26,12 @@ TEST(PhysicalStudy, ItsStimuliAreThePhysicalSetsValueForValue) {
         ASSERT_TRUE(r.scene);
         const auto match = std::find_if(
             set.stimuli.begin(), set.stimuli.end(),
-            [&](const stimuli::Stimulus& s) { return s.id == r.provenance.stimulus; });
+            [&](const Stimulus& s) { return s.id == r.provenance.stimulus; });
         ASSERT_NE(match, set.stimuli.end()) << r.provenance.stimulus;
         EXPECT_EQ(r.scene->technique, match->technique);
-        EXPECT_EQ(r.scene->mesh->name, match->mesh_spec) << r.provenance.stimulus;
+        EXPECT_EQ(r.scene->mesh->name, match->mesh) << r.provenance.stimulus;
         for (const Knob& knob : knobs_for(find_technique(match->technique)))
-            EXPECT_EQ(r.scene->values.get(knob.name), match->parameters.get(knob.name))
+            EXPECT_EQ(r.scene->values.get(knob.name), match->values.get(knob.name))
                 << r.provenance.stimulus << " " << knob.name;
     }
     // One factor: the empirical baseline against the three path-traced materials.

@@ -69,8 +69,8 @@ void store_session(const std::string& path, const Protocol& p,
 }
 
 // The registry with one default changed, as a later build might.
-stimuli::SetCatalog catalog_with_albedo_default(glm::dvec3 albedo) {
-    stimuli::SetCatalog catalog = stimuli::default_catalog();
+SetCatalog catalog_with_albedo_default(glm::dvec3 albedo) {
+    SetCatalog catalog = default_set_catalog();
     auto registry = catalog.knobs_of;
     catalog.knobs_of = [registry, albedo](std::string_view name) {
         auto knobs = registry(name);
@@ -194,11 +194,11 @@ class ImagesAgainstManifest : public ::testing::Test {
 protected:
     void SetUp() override {
         dir_ = lucent::test::scratch_dir("provenance_images");
-        const auto set = stimuli::parse_stimulus_set(
+        const auto set = parse_stimulus_set(
             "name = \"tiny\"\nresolution = [24, 24]\nformats = [\"png\"]\n"
             "[meshes]\nball = \"sphere:1k\"\n[defaults]\nao_rays = 8\n"
             "[[stimuli]]\nid = \"w\"\ntechnique = \"ward\"\nroughness = 0.2\n",
-            "tiny.toml", ".", stimuli::default_catalog());
+            "tiny.toml", ".", default_set_catalog());
         stimuli::BatchOptions options;
         options.out_dir = dir_;
         options.progress = false;
@@ -276,36 +276,40 @@ TEST_F(ImagesAgainstManifest, AFileWithoutAManifestRowIsRefused) {
 }
 
 // Every built-in study runs from the folder its own `lucent render --preset NAME` writes
-// (issue 26 item 9): the set holds every stimulus the protocol shows, practice included,
-// with the same technique, mesh and resolved values, and nothing else.
+// (issue 26 item 9). It takes its stimuli from that set (issue 51), and a session
+// resolves each from the text the protocol keeps (the parameters as written) to exactly
+// the values the set renders: same technique, mesh and every knob, practice included,
+// and nothing else.
 TEST(BuiltinPresets, EachStudyShowsExactlyItsStimulusSetsPicturesValueForValue) {
     for (const std::string& name : builtin_protocol_names()) {
         SCOPED_TRACE(name);
-        const auto set = stimuli::load_preset(name, stimuli::default_catalog());
+        const auto set = load_set_preset(name, default_set_catalog());
         const Protocol study = builtin_protocol(name);
+        EXPECT_EQ(study.stimulus_set, "preset:" + name);
         std::map<std::string, StimulusProvenance> by_id;
         for (StimulusProvenance& p : resolve_stimuli(study, "")) by_id[p.stimulus] = p;
-        for (const stimuli::Stimulus& s : set.stimuli) {
+        for (const Stimulus& s : set.stimuli) {
             SCOPED_TRACE(s.id);
-            ASSERT_TRUE(by_id.count(s.id)) << "not in study/presets/" << name << ".toml";
+            ASSERT_TRUE(by_id.count(s.id))
+                << "not shown by study/presets/" << name << ".toml";
             const StimulusProvenance& p = by_id.at(s.id);
             EXPECT_EQ(p.technique, s.technique);
-            EXPECT_EQ(p.mesh, s.mesh_spec);
-            EXPECT_EQ(p.mesh_hash, load_mesh(s.mesh_spec).content_hash);
+            EXPECT_EQ(p.mesh, s.mesh);
+            EXPECT_EQ(p.mesh_hash, load_mesh(s.mesh).content_hash);
             std::map<std::string, std::string> set_values;
-            for (const auto& [key, value] : s.parameters.all())
+            for (const auto& [key, value] : s.values.all())
                 set_values[key] = format_knob_value(value);
             EXPECT_EQ(values_of(p), set_values);
             by_id.erase(s.id);
         }
         for (const auto& [id, p] : by_id)
-            ADD_FAILURE() << id << " is shown by the study but not in stimuli/presets/"
+            ADD_FAILURE() << id
+                          << " is shown by the study but not in renderer/core/presets/"
                           << name << ".toml";
         for (const std::string& id : study.practice)
-            EXPECT_NE(
-                std::find_if(set.stimuli.begin(), set.stimuli.end(),
-                             [&](const stimuli::Stimulus& s) { return s.id == id; }),
-                set.stimuli.end())
+            EXPECT_NE(std::find_if(set.stimuli.begin(), set.stimuli.end(),
+                                   [&](const Stimulus& s) { return s.id == id; }),
+                      set.stimuli.end())
                 << "practice stimulus " << id;
     }
 }
@@ -428,7 +432,7 @@ TEST_F(ResolvedOnce, TheDatabaseRecordsTheValuesOfTheSceneTheRendererReceived) {
             store.create_session(id, participant, plan_trials(study, 1, number), 1, env);
         }
         // Small pictures: the values, not the pixels, are under test here.
-        for (const StimulusSpec& spec : study.stimuli) {
+        for (const Stimulus& spec : study.stimuli) {
             rendering = spec.id;
             (void)stimuli.render(spec, 24, 16);
         }
@@ -451,7 +455,7 @@ TEST_F(ResolvedOnce, TheDatabaseRecordsTheValuesOfTheSceneTheRendererReceived) {
             EXPECT_EQ(row.values, received);
             // And the scene is the one `lucent render` builds from the protocol's
             // parameters at that size: the same values, camera and light to the bit.
-            const StimulusSpec& spec = *study.find_stimulus(id);
+            const Stimulus& spec = *study.find_stimulus(id);
             RenderRequest request;
             if (!spec.mesh.empty()) request.mesh = spec.mesh;
             request.technique = spec.technique;

@@ -304,7 +304,7 @@ TEST(TrialKinds, ThePageGetsTheScalesScreenWithTheKindsQuestion) {
     o.environment.machine_id = "server";
     o.environment.software_version = "test";
     o.environment.build_hash = "test";
-    for (const StimulusSpec& s : p.stimuli) o.images[s.id] = {64, 48};
+    for (const Stimulus& s : p.stimuli) o.images[s.id] = {64, 48};
     WebStudy web(p, *store, o);
     lucent::test::Page page{lucent::test::direct(web)};
     page.open({{"participant", "P1"}});

@@ -1,11 +1,11 @@
 // The default SetCatalog: the technique registry and the built-in meshes.
 #include "renderer/core/mesh.h"
+#include "renderer/core/stimulus_set.h"
 #include "renderer/techniques/registry.h"
-#include "stimuli/stimulus_set.h"
 
-namespace lucent::stimuli {
+namespace lucent {
 
-SetCatalog default_catalog() {
+SetCatalog default_set_catalog() {
     SetCatalog catalog;
     for (const Technique* technique : all_techniques())
         catalog.technique_names.emplace_back(technique->name());
@@ -18,4 +18,4 @@ SetCatalog default_catalog() {
     return catalog;
 }
 
-}  // namespace lucent::stimuli
+}  // namespace lucent

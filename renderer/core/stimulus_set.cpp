@@ -6,7 +6,7 @@
 // [SECTION] public entry points
 // Parameter precedence (later wins): technique defaults, [defaults], [camera], the
 // stimulus's light, its material, its own keys, its [stimuli.vary] values.
-#include "stimuli/stimulus_set.h"
+#include "renderer/core/stimulus_set.h"
 
 #include <toml++/toml.h>
 
@@ -19,7 +19,7 @@
 
 #include "renderer/core/knob_toml.h"
 
-namespace lucent::stimuli {
+namespace lucent {
 namespace {
 
 constexpr int kMaxSide = 8192;
@@ -262,9 +262,11 @@ private:
     void read_stimulus(const toml::table& table, const std::string& prefix,
                        StimulusSet& set) {
         const EntryIdentity entry = read_identity(table, prefix);
-        const KnobValues base =
+        Stimulus base =
             base_values(table, prefix, entry, read_own_parameters(table, prefix, entry));
         const Axes axes = read_vary(table, prefix, entry);
+        read_motion(table, prefix, entry, axes, base);
+        read_factors(table, prefix, entry, base);
         const std::string expand = read_expand(table, prefix);
         const std::size_t count = expansion_count(table, prefix, axes, expand);
         // The factor series: named, or the id pattern of an entry with several stimuli.
@@ -276,23 +278,22 @@ private:
                     *node, prefix + "series",
                     "'" + series + "' is not a valid name (letters, digits, _ - . only)");
         }
+        const std::vector<std::string> varies = read_varies(table, prefix, base, axes);
         const int line = int(table.source().begin.line);
         for (std::size_t index = 0; index < count; ++index) {
-            Stimulus stimulus{entry.id,
-                              entry.technique,
-                              entry.mesh_name,
-                              meshes_.at(entry.mesh_name),
-                              base,
-                              line};
+            Stimulus stimulus = base;
             std::size_t rest = index;
             for (auto axis = axes.rbegin(); axis != axes.rend(); ++axis) {
                 const std::size_t n = axis->second.size();
                 const std::size_t pick = expand == "zip" ? index : rest % n;
                 rest /= n;
-                stimulus.parameters.set(axis->first, axis->second[pick]);
+                stimulus.values.set(axis->first, axis->second[pick].value);
+                stimulus.parameters[axis->first] = axis->second[pick].text;
             }
-            stimulus.id = expanded_id(entry.id, stimulus.parameters, index, count);
+            stimulus.id = expanded_id(entry.id, stimulus.values, index, count);
             stimulus.series = series;
+            stimulus.varies = varies;
+            stimulus.source_line = line;
             check_id(stimulus.id, *entry.id_node, prefix + "id");
             set.stimuli.push_back(std::move(stimulus));
         }
@@ -345,7 +346,8 @@ private:
             const std::string name(key.str());
             if (name == "id" || name == "technique" || name == "mesh" ||
                 name == "light" || name == "material" || name == "vary" ||
-                name == "expand" || name == "series")
+                name == "expand" || name == "series" || name == "varies" ||
+                name == "motion" || name == "factors")
                 continue;
             const Knob* knob = find_knob(entry.knobs, name);
             if (!knob)
@@ -358,17 +360,24 @@ private:
         return own;
     }
 
-    // Base values in precedence order; keys a technique lacks are skipped here.
-    KnobValues base_values(const toml::table& table, const std::string& prefix,
-                           const EntryIdentity& entry, const Assignments& own) {
+    // The entry's stimulus before its vary lists: identity, and its values in precedence
+    // order; keys a technique lacks are skipped here.
+    Stimulus base_values(const toml::table& table, const std::string& prefix,
+                         const EntryIdentity& entry, const Assignments& own) {
         const auto* light = lookup(table, "light", lights_, prefix);
         const auto* material = lookup(table, "material", materials_, prefix);
-        KnobValues base;
-        for (const auto& knob : entry.knobs) base.set(knob.name, knob.default_value);
+        Stimulus base;
+        base.technique = entry.technique;
+        base.mesh_name = entry.mesh_name;
+        base.mesh = meshes_.at(entry.mesh_name);
+        for (const auto& knob : entry.knobs)
+            base.values.set(knob.name, knob.default_value);
         auto apply = [&](const Assignments& assignments) {
             for (const auto& a : assignments)
-                if (const Knob* knob = find_knob(entry.knobs, a.key))
-                    base.set(a.key, knob_value(*knob, *a.node, a.key, errors_));
+                if (const Knob* knob = find_knob(entry.knobs, a.key)) {
+                    base.values.set(a.key, knob_value(*knob, *a.node, a.key, errors_));
+                    base.parameters[a.key] = text_of(*a.node, a.key);
+                }
         };
         apply(defaults_);
         apply(camera_);
@@ -378,8 +387,21 @@ private:
         return base;
     }
 
+    // A value's text as the stimulus keeps it (Stimulus::parameters).
+    std::string text_of(const toml::node& node, const std::string& key) const {
+        try {
+            return parameter_text(node);
+        } catch (const ParameterTextError& e) {
+            errors_.fail(*e.node, key, e.what());
+        }
+    }
+
     // Expansion: [stimuli.vary] lists, each a knob with its values.
-    using Axes = std::vector<std::pair<std::string, std::vector<KnobValue>>>;
+    struct AxisValue {
+        KnobValue value;
+        std::string text;  // as written (Stimulus::parameters)
+    };
+    using Axes = std::vector<std::pair<std::string, std::vector<AxisValue>>>;
     Axes read_vary(const toml::table& table, const std::string& prefix,
                    const EntryIdentity& entry) {
         Axes axes;
@@ -408,12 +430,130 @@ private:
             if (!list || list->empty())
                 errors_.fail(value, full,
                              "wrong type: expected a non-empty list of values");
-            std::vector<KnobValue> values;
+            std::vector<AxisValue> values;
             for (const auto& element : *list)
-                values.push_back(knob_value(*knob, element, full, errors_));
+                values.push_back(
+                    {knob_value(*knob, element, full, errors_), text_of(element, full)});
             axes.emplace_back(name, std::move(values));
         }
         return axes;
+    }
+
+    // The entry's `varies`: each a parameter it sets, "technique" or "series:NAME" (as a
+    // protocol's own entries say it).
+    std::vector<std::string> read_varies(const toml::table& table,
+                                         const std::string& prefix, const Stimulus& base,
+                                         const Axes& axes) {
+        std::vector<std::string> varies;
+        const auto* node = table.get("varies");
+        if (!node) return varies;
+        const auto* list = node->as_array();
+        if (!list) errors_.fail(*node, prefix + "varies", "expected a list of names");
+        for (const auto& element : *list) {
+            const std::string factor = as_string(element, prefix + "varies", errors_);
+            const bool on_axis =
+                std::any_of(axes.begin(), axes.end(),
+                            [&](const auto& axis) { return axis.first == factor; });
+            if (factor != "technique" && !base.parameters.count(factor) &&
+                !base.factors.count(factor) && !on_axis &&
+                !(factor.rfind("series:", 0) == 0 && factor.size() > 7))
+                errors_.fail(element, prefix + "varies",
+                             "'" + factor +
+                                 "' is not a parameter or factor the entry sets (nor "
+                                 "technique or series:NAME)");
+            varies.push_back(factor);
+        }
+        return varies;
+    }
+
+    // `factors`: the experimenter's own named levels (Stimulus::factors); a name that is
+    // a knob of the technique is refused, as it would be two columns of one name.
+    void read_factors(const toml::table& table, const std::string& prefix,
+                      const EntryIdentity& entry, Stimulus& base) {
+        const auto* node = table.get("factors");
+        if (!node) return;
+        const std::string at = prefix + "factors";
+        for (auto&& [key, value] : as_table(*node, at, errors_)) {
+            const std::string name(key.str()), full = at + "." + name;
+            if (find_knob(entry.knobs, name))
+                errors_.fail(key.source(), full,
+                             "'" + name + "' is a parameter of technique '" +
+                                 entry.technique + "': set it as one, not as a factor");
+            if (name == "technique" || name.find(':') != std::string::npos ||
+                !is_safe_name(name))
+                errors_.fail(key.source(), full,
+                             "'" + name +
+                                 "' is not a factor name (letters, digits, _ - . only; "
+                                 "not technique)");
+            base.factors[name] = text_of(value, full);
+        }
+    }
+
+    // [stimuli.motion]: each a scalar knob of the technique as a function of time
+    // (Stimulus::motion), not also in the vary lists; the still's value is `from`.
+    void read_motion(const toml::table& table, const std::string& prefix,
+                     const EntryIdentity& entry, const Axes& axes, Stimulus& base) {
+        const auto* node = table.get("motion");
+        if (!node) return;
+        const std::string at = prefix + "motion";
+        if (!catalog_.draws_motion)
+            errors_.fail(*node, at,
+                         "lucent does not draw moving stimuli yet; leave out "
+                         "[stimuli.motion] to render the still at t = 0");
+        for (auto&& [key, value] : as_table(*node, at, errors_)) {
+            const std::string name(key.str()), full = at + "." + name;
+            const Knob* knob = find_knob(entry.knobs, name);
+            if (!knob)
+                errors_.fail(key.source(), full,
+                             "unknown key (not a parameter of technique '" +
+                                 entry.technique + "')");
+            if (knob->kind != KnobKind::scalar)
+                errors_.fail(key.source(), full, "only a number parameter can move");
+            if (std::any_of(axes.begin(), axes.end(),
+                            [&](const auto& axis) { return axis.first == name; }))
+                errors_.fail(key.source(), full,
+                             "'" + name + "' is in [stimuli.vary] too: a parameter " +
+                                 "either varies across stimuli or moves");
+            const toml::table& spec = as_table(value, full, errors_);
+            check_keys(spec, {"from", "to", "period_s", "shape"}, full + ".", errors_);
+            auto endpoint = [&](const char* end) -> const toml::node& {
+                const toml::node* n = spec.get(end);
+                if (!n) errors_.fail(spec.source(), full + "." + end, "missing");
+                return *n;
+            };
+            // A scalar knob's value is a double (read_knob_value), checked against its
+            // range.
+            auto number = [&](const toml::node& n, const std::string& key) {
+                const KnobValue v = knob_value(*knob, n, key, errors_);
+                if (const double* d = std::get_if<double>(&v)) return *d;
+                errors_.fail(n, key, "expected a number");
+            };
+            KnobMotion motion;
+            motion.knob = name;
+            const toml::node& from = endpoint("from");
+            motion.from = number(from, full + ".from");
+            motion.to = number(endpoint("to"), full + ".to");
+            const toml::node& period = endpoint("period_s");
+            const std::optional<double> seconds = period.value<double>();
+            if (!period.is_number() || !seconds || !std::isfinite(*seconds) ||
+                *seconds <= 0 || *seconds > 1e6)
+                errors_.fail(period, full + ".period_s",
+                             "out of range: a number of seconds in (0, 1e6]");
+            motion.period_s = *seconds;
+            if (const auto* shape = spec.get("shape")) {
+                const std::string text = as_string(*shape, full + ".shape", errors_);
+                if (text == "loop")
+                    motion.shape = KnobMotion::Shape::loop;
+                else if (text != "back_and_forth")
+                    errors_.fail(*shape, full + ".shape",
+                                 "'" + text +
+                                     "' is out of range (valid: back_and_forth, "
+                                     "loop)");
+            }
+            base.values.set(name, motion.from);
+            base.parameters[name] = text_of(from, full + ".from");
+            base.motion.push_back(std::move(motion));
+        }
     }
 
     // "grid" (every combination of the vary lists) or "zip" (the i-th of each).
@@ -504,7 +644,7 @@ private:
 
 }  // namespace
 
-std::string_view extension(ImageFormat format) {
+std::string_view image_extension(ImageFormat format) {
     switch (format) {
         case ImageFormat::png:
             return "png";
@@ -537,4 +677,4 @@ StimulusSet load_stimulus_set(const std::filesystem::path& file,
     return parse_stimulus_set(text.str(), file.string(), file.parent_path(), catalog);
 }
 
-}  // namespace lucent::stimuli
+}  // namespace lucent

@@ -2,7 +2,9 @@
 // Stimulus sets: a TOML file naming meshes, camera, lights, material presets and a list
 // of stimuli (id, technique, parameters; lists of values expand into several stimuli),
 // with the resolution and image formats of the whole set. The format is documented in
-// stimuli/README.md; stimuli/presets/thesis.toml is the built-in example.
+// stimuli/README.md; renderer/core/presets/thesis.toml is the built-in example. It sits
+// in the renderer's core, below stimuli/ and study/, because both read it: `lucent
+// render` renders a set and a protocol may take its stimuli from one.
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -12,8 +14,9 @@
 #include <vector>
 
 #include "renderer/core/knobs.h"
+#include "renderer/core/stimulus.h"
 
-namespace lucent::stimuli {
+namespace lucent {
 
 // A bad config; what() is one line "FILE:LINE:COLUMN: KEY: reason".
 class StimulusSetError : public std::runtime_error {
@@ -22,20 +25,7 @@ public:
 };
 
 enum class ImageFormat { png, exr, tif };
-std::string_view extension(ImageFormat format);  // "png", "exr", "tif"
-
-struct Stimulus {
-    std::string id;         // unique in the set; also the image file's stem
-    std::string technique;  // a registered technique name
-    std::string mesh_name;  // the key in [meshes]
-    std::string mesh_spec;  // built-in spec ("torus_knot:60k") or absolute file path
-    KnobValues parameters;  // every knob of the technique, defaults filled in
-    int source_line = 0;    // line of the [[stimuli]] entry it expanded from
-    // The factor series it belongs to (the entry's `series`; by default the id pattern
-    // of an entry that expands into several stimuli); empty for none. The report
-    // compares the levels of each series.
-    std::string series;
-};
+std::string_view image_extension(ImageFormat format);  // "png", "exr", "tif"
 
 struct StimulusSet {
     std::string name;
@@ -53,8 +43,13 @@ struct SetCatalog {
     std::function<std::optional<std::vector<Knob>>(std::string_view)> knobs_of;
     std::vector<std::string> technique_names;  // for error messages, in order
     std::vector<std::string> builtin_meshes;   // "sphere", "torus_knot", ...
+    // Whether the program shows moving stimuli ([stimuli.motion]). No renderer or runner
+    // draws them yet, so every program refuses them rather than show a still in their
+    // place; the record and its parse are tested with this set.
+    bool draws_motion = false;
 };
-SetCatalog default_catalog();
+// The technique registry and the built-in meshes (renderer/techniques/set_catalog.cpp).
+SetCatalog default_set_catalog();
 
 // Parses `toml_text`; `source_name` is used in messages and `base_dir` resolves relative
 // mesh paths. Throws StimulusSetError; reads no file other than checking mesh paths
@@ -67,8 +62,8 @@ StimulusSet load_stimulus_set(const std::filesystem::path& file,
                               const SetCatalog& catalog);
 
 // Built-in sets embedded in the binary ("thesis"); text is the TOML file as committed.
-std::vector<std::string> preset_names();
-std::optional<std::string_view> preset_text(std::string_view name);
-StimulusSet load_preset(std::string_view name, const SetCatalog& catalog);
+std::vector<std::string> set_preset_names();
+std::optional<std::string_view> set_preset_text(std::string_view name);
+StimulusSet load_set_preset(std::string_view name, const SetCatalog& catalog);
 
-}  // namespace lucent::stimuli
+}  // namespace lucent
