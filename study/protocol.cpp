@@ -226,10 +226,10 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir,
         if (!s.image.empty() && !base_dir.empty() &&
             std::filesystem::path(s.image).is_relative())
             s.image = (std::filesystem::path(base_dir) / s.image).string();
+        const std::vector<Knob> knobs =
+            s.live() ? knobs_for(find_technique(s.technique)) : std::vector<Knob>{};
         if (const toml::table* params = r.table("params")) {
             TableReader pr(*params, "stimuli.params", p.source);
-            const std::vector<Knob> knobs =
-                s.live() ? knobs_for(find_technique(s.technique)) : std::vector<Knob>{};
             for (const auto& [key, value] : *params) {
                 const std::string name(key.str());
                 s.parameters[name] = s.live()
@@ -240,8 +240,6 @@ void read_stimuli(Protocol& p, TableReader& root, const std::string& base_dir,
         // The experimenter's own factors: named levels no renderer reads.
         if (const toml::table* factors = r.table("factors")) {
             TableReader fr(*factors, "stimuli.factors", p.source);
-            const std::vector<Knob> knobs =
-                s.live() ? knobs_for(find_technique(s.technique)) : std::vector<Knob>{};
             for (const auto& [key, value] : *factors) {
                 const std::string name(key.str());
                 if (s.parameters.count(name) || find_knob(knobs, name))

@@ -146,6 +146,30 @@ TEST(ProtocolFromSetErrors, EachIsOneLineNamingTheKeyOrTheSetsOwnLine) {
     }
 }
 
+// A protocol entry's own factor may not take a knob's name, set or not: it would be two
+// columns of one name, or a knob no renderer would see.
+TEST(ProtocolOwnFactors, AKnobsNameIsRefusedInOneLine) {
+    for (const auto& [factor, expect] :
+         {std::pair{"backlight", "'backlight' is a parameter of stimulus 'a'"},
+          std::pair{"albedo", "'albedo' is a parameter of stimulus 'a'"},
+          std::pair{"technique", "'technique' is not a factor name"}}) {
+        std::string text = test::kSmallProtocol;
+        const std::string varies = "varies = [\"thickness_exponent\"]";
+        text.replace(text.find(varies), varies.size(),
+                     std::string("factors = { ") + factor + " = \"x\" }");
+        const std::string e = test::protocol_error_of(text);
+        EXPECT_NE(e.find(std::string("stimuli.factors.") + factor), std::string::npos)
+            << e;
+        EXPECT_NE(e.find(expect), std::string::npos) << e;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    }
+    std::string text = test::kSmallProtocol;
+    const std::string varies = "varies = [\"thickness_exponent\"]";
+    text.replace(text.find(varies), varies.size(),
+                 "factors = { lighting = \"front\" }\nvaries = [\"lighting\"]");
+    EXPECT_EQ(test::protocol_error_of(text), "");
+}
+
 TEST(ProtocolFromSetErrors, AnEmbeddedSetOfAnotherNameIsRefused) {
     const Protocol p = builtin_protocol("jnd");
     std::string text = p.text;
