@@ -338,6 +338,17 @@ private:
         return entry;
     }
 
+    // The knob `key` names in the entry's technique; refused at the key otherwise.
+    const Knob& technique_knob(const EntryIdentity& entry, const toml::key& key,
+                               const std::string& full) const {
+        const Knob* knob = find_knob(entry.knobs, key.str());
+        if (!knob)
+            errors_.fail(
+                key.source(), full,
+                "unknown key (not a parameter of technique '" + entry.technique + "')");
+        return *knob;
+    }
+
     // Own parameters (every other key must be a knob of this technique).
     Assignments read_own_parameters(const toml::table& table, const std::string& prefix,
                                     const EntryIdentity& entry) {
@@ -349,11 +360,7 @@ private:
                 name == "expand" || name == "series" || name == "varies" ||
                 name == "motion" || name == "factors")
                 continue;
-            const Knob* knob = find_knob(entry.knobs, name);
-            if (!knob)
-                errors_.fail(key.source(), prefix + name,
-                             "unknown key (not a parameter of technique '" +
-                                 entry.technique + "')");
+            const Knob* knob = &technique_knob(entry, key, prefix + name);
             knob_value(*knob, value, prefix + name, errors_);
             own.push_back({name, &value});
         }
@@ -421,11 +428,7 @@ private:
             const toml::key& key = *key_ptr;
             const toml::node& value = *value_ptr;
             const std::string name(key.str()), full = prefix + "vary." + name;
-            const Knob* knob = find_knob(entry.knobs, name);
-            if (!knob)
-                errors_.fail(key.source(), full,
-                             "unknown key (not a parameter of technique '" +
-                                 entry.technique + "')");
+            const Knob* knob = &technique_knob(entry, key, full);
             const auto* list = value.as_array();
             if (!list || list->empty())
                 errors_.fail(value, full,
@@ -502,11 +505,7 @@ private:
                          "[stimuli.motion] to render the still at t = 0");
         for (auto&& [key, value] : as_table(*node, at, errors_)) {
             const std::string name(key.str()), full = at + "." + name;
-            const Knob* knob = find_knob(entry.knobs, name);
-            if (!knob)
-                errors_.fail(key.source(), full,
-                             "unknown key (not a parameter of technique '" +
-                                 entry.technique + "')");
+            const Knob* knob = &technique_knob(entry, key, full);
             if (knob->kind != KnobKind::scalar)
                 errors_.fail(key.source(), full, "only a number parameter can move");
             if (std::any_of(axes.begin(), axes.end(),
